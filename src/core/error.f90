@@ -1,0 +1,64 @@
+!> Error values threaded through every fallible call (errors are values, not stops).
+!>
+!> A fallible routine takes `type(error_t), allocatable, intent(out) :: error`; it allocates
+!> the error on failure and returns. Callers propagate with `if (allocated(error)) return`.
+!> Only the main program stops, with a non-zero exit code.
+module core_error
+    implicit none
+    private
+    public :: error_t, make_error, make_input_error
+
+    !> A user-facing error: what went wrong and where (file, line, keyword when known).
+    type :: error_t
+        !> Complete message, ready to print.
+        character(len=:), allocatable :: message
+        !> File the error refers to ('' when none).
+        character(len=:), allocatable :: file
+        !> Line in that file (0 when none).
+        integer :: line = 0
+        !> Keyword the error refers to ('' when none).
+        character(len=:), allocatable :: keyword
+    end type error_t
+
+contains
+
+    !> Build a plain error with a message.
+    subroutine make_error(error, message)
+        !> The error to allocate.
+        type(error_t), allocatable, intent(out) :: error
+        !> What went wrong and what to do about it.
+        character(len=*), intent(in) :: message
+        allocate (error)
+        error%message = message
+        error%file = ''
+        error%keyword = ''
+    end subroutine make_error
+
+    !> Build an input error that names file, line and keyword:
+    !> `file:line: keyword 'kw': message`.
+    subroutine make_input_error(error, file, line, keyword, message)
+        !> The error to allocate.
+        type(error_t), allocatable, intent(out) :: error
+        !> Input file name.
+        character(len=*), intent(in) :: file
+        !> Line number in the file (0 if the error concerns the whole file).
+        integer, intent(in) :: line
+        !> Keyword concerned ('' if none).
+        character(len=*), intent(in) :: keyword
+        !> What is wrong and what is expected.
+        character(len=*), intent(in) :: message
+        character(len=32) :: buf
+        allocate (error)
+        error%file = file
+        error%line = line
+        error%keyword = keyword
+        if (line > 0) then
+            write (buf, '(i0)') line
+            error%message = file//':'//trim(buf)//': '
+        else
+            error%message = file//': '
+        end if
+        if (len(keyword) > 0) error%message = error%message//"keyword '"//keyword//"': "
+        error%message = error%message//message
+    end subroutine make_input_error
+end module core_error

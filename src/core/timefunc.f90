@@ -1,0 +1,63 @@
+!> Time functions f(t) that multiply loads: constant, ramp, step, piecewise-linear table,
+!> harmonic. One concrete type with a kind tag keeps arrays of functions simple; evaluation
+!> is not in a hot loop (once per load per step).
+module core_timefunc
+    use core_kinds, only: wp
+    implicit none
+    private
+    public :: time_function_t, tf_constant, tf_ramp, tf_step, tf_table, tf_harmonic
+
+    !> Kinds of time function.
+    integer, parameter :: tf_constant = 1, tf_ramp = 2, tf_step = 3, tf_table = 4, tf_harmonic = 5
+
+    !> f(t). constant: f = c; ramp: f = min(t/t1, 1); step: f = 0 for t < t0, 1 after;
+    !> table: linear interpolation in (t_i, f_i), constant beyond the ends;
+    !> harmonic: f = sin(2 pi freq t + phase).
+    type :: time_function_t
+        !> One of tf_constant, tf_ramp, tf_step, tf_table, tf_harmonic.
+        integer :: kind = tf_constant
+        !> Parameters: constant (c), ramp (t1), step (t0), harmonic (freq [Hz], phase [rad]).
+        real(wp) :: p(2) = [1.0_wp, 0.0_wp]
+        !> Table abscissae [s] (strictly increasing) and values, for tf_table.
+        real(wp), allocatable :: t(:), f(:)
+    contains
+        !> Value at time t.
+        procedure :: value => time_function_value
+    end type time_function_t
+
+contains
+
+    !> Value of the time function at time t [s].
+    pure real(wp) function time_function_value(self, t) result(f)
+        !> The function.
+        class(time_function_t), intent(in) :: self
+        !> Time [s].
+        real(wp), intent(in) :: t
+        real(wp), parameter :: two_pi = 6.283185307179586476925286766559_wp
+        integer :: i, n
+        select case (self%kind)
+        case (tf_constant)
+            f = self%p(1)
+        case (tf_ramp)
+            f = min(max(t, 0.0_wp)/self%p(1), 1.0_wp)
+        case (tf_step)
+            f = merge(1.0_wp, 0.0_wp, t >= self%p(1))
+        case (tf_table)
+            n = size(self%t)
+            if (t <= self%t(1)) then
+                f = self%f(1)
+            else if (t >= self%t(n)) then
+                f = self%f(n)
+            else
+                do i = 2, n
+                    if (t <= self%t(i)) exit
+                end do
+                f = self%f(i - 1) + (self%f(i) - self%f(i - 1))*(t - self%t(i - 1))/(self%t(i) - self%t(i - 1))
+            end if
+        case (tf_harmonic)
+            f = sin(two_pi*self%p(1)*t + self%p(2))
+        case default
+            f = 0.0_wp
+        end select
+    end function time_function_value
+end module core_timefunc

@@ -1,0 +1,4 @@
+!> Placeholder driver.
+program multicor
+    implicit none
+end program multicor

@@ -1,0 +1,5 @@
+!> Placeholder: to be written.
+module fem_modal
+    implicit none
+    private
+end module fem_modal
