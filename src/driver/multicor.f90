@@ -1,4 +1,104 @@
-!> Placeholder driver.
+!> MULTICOR command-line driver: parses the command line and runs a deck.
+!>
+!>     multicor [--output DIR] [--quiet] deck.dat
+!>     multicor --check deck.dat
+!>     multicor --help | --version | --schema-markdown
 program multicor
+    use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
+    use core_error, only: error_t
+    use core_version, only: multicor_version
+    use io_deck_schema, only: multicor_schema, schema_markdown
+    use driver_run, only: run_options_t, run_deck
     implicit none
+
+    type(run_options_t) :: opts
+    type(error_t), allocatable :: error
+    character(len=:), allocatable :: arg, text
+    integer :: i, n
+    logical :: take_output
+
+    n = command_argument_count()
+    take_output = .false.
+    do i = 1, n
+        call get_arg(i, arg)
+        if (take_output) then
+            opts%output_dir = arg
+            take_output = .false.
+            cycle
+        end if
+        select case (arg)
+        case ('-h', '--help')
+            call print_help()
+            stop
+        case ('-V', '--version')
+            write (output_unit, '(a)') 'multicor '//multicor_version
+            stop
+        case ('--schema-markdown')
+            call schema_markdown(multicor_schema(), text)
+            write (output_unit, '(a)', advance='no') text
+            stop
+        case ('--check')
+            opts%check_only = .true.
+        case ('-q', '--quiet')
+            opts%quiet = .true.
+        case ('-o', '--output')
+            take_output = .true.
+        case default
+            if (arg(1:1) == '-') call usage_error("unknown option '"//arg//"'")
+            if (allocated(opts%deck_path)) call usage_error("more than one deck given ('"// &
+                                                          opts%deck_path//"' and '"//arg//"')")
+            opts%deck_path = arg
+        end select
+    end do
+    if (take_output) call usage_error('--output needs a folder name')
+    if (.not. allocated(opts%deck_path)) call usage_error('no deck given')
+
+    call run_deck(opts, report, error)
+    if (allocated(error)) then
+        write (error_unit, '(a)') 'multicor: error: '//error%message
+        stop 1, quiet=.true.
+    end if
+
+contains
+
+    !> Print one line of progress or summary.
+    subroutine report(line)
+        character(len=*), intent(in) :: line
+        write (output_unit, '(a)') line
+        flush (output_unit)
+    end subroutine report
+
+    subroutine get_arg(i, value)
+        integer, intent(in) :: i
+        character(len=:), allocatable, intent(out) :: value
+        integer :: length
+        call get_command_argument(i, length=length)
+        allocate (character(len=length) :: value)
+        call get_command_argument(i, value)
+    end subroutine get_arg
+
+    subroutine usage_error(message)
+        character(len=*), intent(in) :: message
+        write (error_unit, '(a)') 'multicor: error: '//message
+        write (error_unit, '(a)') "usage: multicor [--check] [--output DIR] [--quiet] deck.dat; " &
+            //"'multicor --help' for more"
+        stop 2, quiet=.true.
+    end subroutine usage_error
+
+    subroutine print_help()
+        write (output_unit, '(a)') 'MULTICOR '//multicor_version// &
+            ' - discrete elements (Contact Dynamics) coupled with beam finite elements', &
+            '', &
+            'usage: multicor [options] deck.dat', &
+            '', &
+            '  -o, --output DIR     results folder (default: results/<deck name>)', &
+            '  -q, --quiet          no progress lines', &
+            '      --check          validate the deck only (nothing is written)', &
+            '      --schema-markdown  print the reference of every deck keyword (doc/input.md)', &
+            '  -V, --version        print the version', &
+            '  -h, --help           print this help', &
+            '', &
+            'Results: DIR/<deck name>.h5 (HDF5, layout in doc/output.md).', &
+            'Exit codes: 0 success, 1 error in the deck or the run, 2 bad command line.'
+    end subroutine print_help
 end program multicor

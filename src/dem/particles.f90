@@ -1,5 +1,5 @@
 !> Placeholder: to be written.
-module driver_run_fem
+module dem_particles
     implicit none
     private
-end module driver_run_fem
+end module dem_particles

@@ -1,0 +1,211 @@
+!> Runs one deck: read and validate, build the model, run the analysis, write the results.
+!>
+!> Everything that can fail because of the input is checked before the results folder is
+!> touched; the HDF5 file is written as '<name>.h5.partial' and renamed only on success, so
+!> earlier results stay intact when a run fails.
+module driver_run
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_error
+    use io_deck_schema, only: multicor_schema
+    use io_deck, only: deck_t, read_deck
+    use io_paths, only: stem, mkdir_p
+    use io_progress, only: progress_t
+    use fem_beam_config, only: beam_config_t
+    use fem_beam_model, only: beam_model_t, build_beam_model
+    use fem_static, only: solve_static
+    use fem_modal, only: solve_modal
+    use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
+    use driver_config, only: run_config_t, build_config
+    use driver_results, only: results_writer_t
+    implicit none
+    private
+    public :: run_options_t, run_deck, report_iface
+
+    !> Command-line options of one run.
+    type :: run_options_t
+        !> Path of the deck.
+        character(len=:), allocatable :: deck_path
+        !> Results folder ('' = results/<deck name>).
+        character(len=:), allocatable :: output_dir
+        !> Validate only.
+        logical :: check_only = .false.
+        !> No progress lines.
+        logical :: quiet = .false.
+    end type run_options_t
+
+    abstract interface
+        !> Receives one line of progress or summary text.
+        subroutine report_iface(line)
+            character(len=*), intent(in) :: line
+        end subroutine report_iface
+    end interface
+
+contains
+
+    !> Read, check and run a deck; write results unless only checking.
+    subroutine run_deck(opts, report, error)
+        !> What to run and where to write.
+        type(run_options_t), intent(in) :: opts
+        !> Where progress and summary lines go.
+        procedure(report_iface) :: report
+        !> Set on any input or run error.
+        type(error_t), allocatable, intent(out) :: error
+        type(deck_t) :: deck
+        type(run_config_t) :: run
+        type(beam_config_t) :: beam
+        type(beam_model_t) :: model
+        class(time_integrator_t), allocatable :: integ
+        type(results_writer_t) :: out
+        character(len=:), allocatable :: dir, path
+
+        call read_deck(opts%deck_path, multicor_schema(), deck, error)
+        if (allocated(error)) return
+        call build_config(deck, run, beam, error)
+        if (allocated(error)) return
+        call build_beam_model(beam, model, error)
+        if (allocated(error)) return
+        if (run%analysis == 'dynamic') then
+            call make_integrator(run, model, integ, error)
+            if (allocated(error)) return
+        end if
+        if (opts%check_only) then
+            call report(opts%deck_path//': deck is valid ('//run%analysis//' analysis)')
+            return
+        end if
+
+        dir = 'results/'//stem(opts%deck_path)
+        if (allocated(opts%output_dir)) dir = opts%output_dir
+        call mkdir_p(dir, error)
+        if (allocated(error)) return
+        path = dir//'/'//stem(opts%deck_path)//'.h5'
+        call out%open(path, opts%deck_path, deck%text, run%title, run%analysis, error)
+        if (allocated(error)) return
+        call out%write_mesh(beam%node_id, beam%x, beam%y, beam%conn, error)
+        if (.not. allocated(error)) then
+            select case (run%analysis)
+            case ('static')
+                call run_static(model, out, report, error)
+            case ('modal')
+                call run_modal(run, model, out, report, error)
+            case ('dynamic')
+                call run_dynamic(run, model, integ, out, opts%quiet, report, error)
+            end select
+        end if
+        if (allocated(error)) then
+            call out%abort()
+            return
+        end if
+        call out%close(error)
+        if (allocated(error)) return
+        call report('results written to '//path)
+    end subroutine run_deck
+
+    !> Build the time integrator the deck asks for (refuses an unstable explicit step).
+    subroutine make_integrator(run, model, integ, error)
+        type(run_config_t), intent(in) :: run
+        type(beam_model_t), intent(in) :: model
+        class(time_integrator_t), allocatable, intent(out) :: integ
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: u0(:), v0(:)
+        select case (run%scheme)
+        case ('central_difference')
+            allocate (central_difference_t :: integ)
+        case default
+            allocate (newmark_t :: integ)
+            select type (integ)
+            type is (newmark_t)
+                integ%beta = run%beta
+                integ%gamma = run%gamma
+            end select
+        end select
+        call model%restrict(run%u0, u0)
+        call model%restrict(run%v0, v0)
+        call integ%init(model, run%h, 0.0_wp, u0, v0, error)
+    end subroutine make_integrator
+
+    subroutine run_static(model, out, report, error)
+        type(beam_model_t), intent(in) :: model
+        type(results_writer_t), intent(inout) :: out
+        procedure(report_iface) :: report
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: u(:), d(:, :), r(:, :)
+        character(len=120) :: buf
+        call solve_static(model, 0.0_wp, u, error)
+        if (allocated(error)) return
+        allocate (d(3, model%n_nodes), r(3, model%n_nodes))
+        call model%expand(u, d)
+        call model%reactions(u, 0.0_wp, r)
+        call out%write_static(d, r, error)
+        if (allocated(error)) return
+        write (buf, '(a,es12.5,a)') 'static solution: max |displacement| = ', &
+            maxval(abs(d(1:2, :))), ' m'
+        call report(trim(buf))
+    end subroutine run_static
+
+    subroutine run_modal(run, model, out, report, error)
+        type(run_config_t), intent(in) :: run
+        type(beam_model_t), intent(in) :: model
+        type(results_writer_t), intent(inout) :: out
+        procedure(report_iface) :: report
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: omega(:), shapes(:, :), full(:, :, :)
+        real(wp), parameter :: two_pi = 6.283185307179586476925286766559_wp
+        character(len=120) :: buf
+        integer :: k
+        call solve_modal(model, run%n_modes, omega, shapes, error)
+        if (allocated(error)) return
+        allocate (full(3, model%n_nodes, run%n_modes))
+        do k = 1, run%n_modes
+            call model%expand(shapes(:, k), full(:, :, k))
+            write (buf, '(a,i3,a,es14.7,a,es14.7,a)') 'mode ', k, ': omega = ', omega(k), &
+                ' rad/s, f = ', omega(k)/two_pi, ' Hz'
+            call report(trim(buf))
+        end do
+        call out%write_modal(omega, full, error)
+    end subroutine run_modal
+
+    subroutine run_dynamic(run, model, integ, out, quiet, report, error)
+        type(run_config_t), intent(in) :: run
+        type(beam_model_t), intent(in) :: model
+        class(time_integrator_t), intent(inout) :: integ
+        type(results_writer_t), intent(inout) :: out
+        logical, intent(in) :: quiet
+        procedure(report_iface) :: report
+        type(error_t), allocatable, intent(out) :: error
+        type(progress_t) :: progress
+        real(wp), allocatable :: d(:, :), v(:, :), a(:, :)
+        integer :: n_steps, k
+        character(len=160) :: buf
+
+        n_steps = nint(run%t_end/run%h)
+        allocate (d(3, model%n_nodes), v(3, model%n_nodes), a(3, model%n_nodes))
+        call progress%start(n_steps, run%t_end, run%progress_seconds)
+        call store(error)
+        if (allocated(error)) return
+        do k = 1, n_steps
+            call integ%step(model, error)
+            if (allocated(error)) return
+            if (mod(k, run%output_interval) == 0 .or. k == n_steps) then
+                call store(error)
+                if (allocated(error)) return
+            end if
+            if (.not. quiet .and. progress%due()) call report(progress%line(k, integ%t))
+        end do
+        write (buf, '(a,i0,a,es12.5,a,es10.3)') 'dynamic run: ', n_steps, ' steps to t = ', &
+            integ%t, ' s; energy balance residual ', integ%energy_balance()
+        call report(trim(buf))
+        call report(progress%summary_line(n_steps))
+        call out%write_summary(n_steps, progress%elapsed(), error)
+    contains
+        subroutine store(error)
+            type(error_t), allocatable, intent(out) :: error
+            call model%expand(integ%u, d)
+            call model%expand(integ%v, v)
+            call model%expand(integ%a, a)
+            call out%append_state(integ%t, d, v, a, error)
+            if (allocated(error)) return
+            call out%append_energy(integ%t, integ%kinetic, integ%strain, integ%external_work, &
+                                   integ%damping_dissipation, error)
+        end subroutine store
+    end subroutine run_dynamic
+end module driver_run

@@ -1,0 +1,96 @@
+!> File-system helpers: file name parts, directory creation, file existence and removal.
+module io_paths
+    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+    use core_error, only: error_t, make_error
+    implicit none
+    private
+    public :: basename, stem, mkdir_p, file_exists, remove_file, rename_file
+
+    interface
+        function c_mkdir(path, mode) bind(C, name='mkdir') result(rc)
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int), value :: mode
+            integer(c_int) :: rc
+        end function c_mkdir
+        function c_rename(old, new) bind(C, name='rename') result(rc)
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: old(*), new(*)
+            integer(c_int) :: rc
+        end function c_rename
+    end interface
+
+contains
+
+    !> Last component of a path ('input/cantilever.dat' -> 'cantilever.dat').
+    pure function basename(path) result(name)
+        !> A file path.
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: name
+        integer :: i
+        i = index(path, '/', back=.true.)
+        name = path(i + 1:)
+    end function basename
+
+    !> File name without folder and without its last extension ('input/a.dat' -> 'a').
+    pure function stem(path) result(name)
+        !> A file path.
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: name
+        integer :: i
+        name = basename(path)
+        i = index(name, '.', back=.true.)
+        if (i > 1) name = name(:i - 1)
+    end function stem
+
+    !> True if a file (or folder) exists.
+    logical function file_exists(path)
+        !> A path.
+        character(len=*), intent(in) :: path
+        inquire (file=path, exist=file_exists)
+    end function file_exists
+
+    !> Create a folder and its parents (like mkdir -p).
+    subroutine mkdir_p(path, error)
+        !> Folder to create.
+        character(len=*), intent(in) :: path
+        !> Set if a folder could not be created.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: i
+        integer(c_int) :: rc
+        do i = 2, len_trim(path) + 1
+            if (i <= len_trim(path)) then
+                if (path(i:i) /= '/') cycle
+            end if
+            if (file_exists(path(:i - 1))) cycle
+            rc = c_mkdir(path(:i - 1)//c_null_char, int(o'755', c_int))
+            if (rc /= 0 .and. .not. file_exists(path(:i - 1))) then
+                call make_error(error, "cannot create folder '"//path(:i - 1)//"'")
+                return
+            end if
+        end do
+    end subroutine mkdir_p
+
+    !> Delete a file if it exists.
+    subroutine remove_file(path)
+        !> File to delete.
+        character(len=*), intent(in) :: path
+        integer :: unit, ios
+        if (.not. file_exists(path)) return
+        open (newunit=unit, file=path, status='old', iostat=ios)
+        if (ios == 0) close (unit, status='delete', iostat=ios)
+    end subroutine remove_file
+
+    !> Rename a file, replacing the target if it exists.
+    subroutine rename_file(old, new, error)
+        !> Current name.
+        character(len=*), intent(in) :: old
+        !> New name.
+        character(len=*), intent(in) :: new
+        !> Set if the rename failed.
+        type(error_t), allocatable, intent(out) :: error
+        if (c_rename(old//c_null_char, new//c_null_char) /= 0) then
+            call make_error(error, "cannot rename '"//old//"' to '"//new//"'")
+        end if
+    end subroutine rename_file
+end module io_paths

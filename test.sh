@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Run every MULTICOR test suite: Fortran unit tests (pFUnit or its fallback), malformed-deck
+# errors, regression runs of the executable, and the Python post-processing tests.
+# Installs what is missing and builds a Debug build with run-time checks in build-debug/.
+# Exit code is non-zero on any failure.
+set -uo pipefail
+source "$(cd "$(dirname "$0")" && pwd)/scripts/bootstrap.sh"
+cd "$MULTICOR_ROOT"
+
+ensure_system_deps
+ensure_venv
+configure_and_build build-debug Debug
+
+status=0
+say "Python tests (postproc)"
+.venv/bin/python -m pytest -q postproc/tests || status=1
+say "CTest suites"
+ctest --test-dir build-debug --output-on-failure -j "$(nproc)" || status=1
+exit $status
