@@ -1,5 +1,417 @@
-!> Placeholder: to be written.
+!> Results file of a run (HDF5, layout in doc/output.md).
+!>
+!> The file is written as '<final_path>.partial' and renamed to `final_path` by `close` only
+!> when the run succeeded: an earlier result stays intact until then, and `abort` deletes the
+!> partial file. Arrays per node are (3, n_nodes) in Fortran = (n_nodes, 3) in h5py, with the
+!> DOFs u (x), w (y), theta (rotation about z); time series add a last Fortran dimension
+!> (the first in h5py) per stored output.
 module driver_results
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_error
+    use core_version, only: multicor_version, multicor_name
+    use io_hdf5_file, only: h5_file_t
+    use io_paths, only: rename_file, remove_file
     implicit none
     private
+    public :: results_writer_t
+
+    !> 2 pi, for frequencies in Hz.
+    real(wp), parameter :: two_pi = 6.283185307179586476925286766559_wp
+
+    !> Writes the results of one run into one HDF5 file.
+    type :: results_writer_t
+        !> The HDF5 file ('.partial' while writing).
+        type(h5_file_t) :: file
+        !> Name the file gets on success.
+        character(len=:), allocatable :: final_path
+        !> Name of the file while writing.
+        character(len=:), allocatable :: partial_path
+        !> Number of nodes (0 until the mesh or a first state is written).
+        integer :: n_nodes = 0
+        !> Whether the /fem state series exist.
+        logical :: have_state = .false.
+        !> Whether the /energy series exist.
+        logical :: have_energy = .false.
+        !> Total energy of the first energy record [J] (reference of the balance).
+        real(wp) :: energy0 = 0.0_wp
+    contains
+        procedure :: open => writer_open
+        procedure :: write_mesh => writer_write_mesh
+        procedure :: append_state => writer_append_state
+        procedure :: append_energy => writer_append_energy
+        procedure :: write_static => writer_write_static
+        procedure :: write_modal => writer_write_modal
+        procedure :: write_summary => writer_write_summary
+        procedure :: close => writer_close
+        procedure :: abort => writer_abort
+        procedure :: is_open => writer_is_open
+    end type results_writer_t
+
+contains
+
+    !> Create '<final_path>.partial' and write the root attributes (code, deck, title, date).
+    subroutine writer_open(self, final_path, deck_file, deck_text, title, analysis, error)
+        !> The writer; must not be open.
+        class(results_writer_t), intent(inout) :: self
+        !> Name of the results file on success (its folder must exist).
+        character(len=*), intent(in) :: final_path
+        !> Deck file name (as given on the command line).
+        character(len=*), intent(in) :: deck_file
+        !> The whole deck text.
+        character(len=*), intent(in) :: deck_text
+        !> Title of the run.
+        character(len=*), intent(in) :: title
+        !> Analysis type ('static', 'modal', 'dynamic').
+        character(len=*), intent(in) :: analysis
+        !> Set when the file cannot be created or written.
+        type(error_t), allocatable, intent(out) :: error
+        if (self%is_open()) then
+            call make_error(error, "results: cannot open '"//final_path//"': '" &
+                //self%final_path//"' is still open")
+            return
+        end if
+        self%final_path = final_path
+        self%partial_path = final_path//'.partial'
+        self%n_nodes = 0
+        self%have_state = .false.
+        self%have_energy = .false.
+        self%energy0 = 0.0_wp
+        call self%file%create(self%partial_path, error)
+        if (allocated(error)) return
+        call root_attributes(error)
+        if (allocated(error)) call self%abort()
+    contains
+        subroutine root_attributes(error)
+            type(error_t), allocatable, intent(out) :: error
+            call self%file%write_attribute('/', 'code_name', multicor_name, error)
+            if (allocated(error)) return
+            call self%file%write_attribute('/', 'code_version', multicor_version, error)
+            if (allocated(error)) return
+            call self%file%write_attribute('/', 'deck_file', deck_file, error)
+            if (allocated(error)) return
+            call self%file%write_attribute('/', 'deck_text', deck_text, error)
+            if (allocated(error)) return
+            call self%file%write_attribute('/', 'title', title, error)
+            if (allocated(error)) return
+            call self%file%write_attribute('/', 'analysis', analysis, error)
+            if (allocated(error)) return
+            call self%file%write_attribute('/', 'created', iso_date_time(), error)
+        end subroutine root_attributes
+    end subroutine writer_open
+
+    !> Write the FE mesh: /fem/mesh/{node_id, coordinates, connectivity}.
+    subroutine writer_write_mesh(self, node_id, x, y, conn, error)
+        !> An open writer.
+        class(results_writer_t), intent(inout) :: self
+        !> Deck ids of the nodes (n_nodes).
+        integer, intent(in) :: node_id(:)
+        !> Node x coordinates [m] (n_nodes).
+        real(wp), intent(in) :: x(:)
+        !> Node y coordinates [m] (n_nodes).
+        real(wp), intent(in) :: y(:)
+        !> Element connectivity (2, n_elements), node indices 1..n_nodes.
+        integer, intent(in) :: conn(:, :)
+        !> Set on a size mismatch or a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: coordinates(:, :)
+        call require_open(self, 'write_mesh', error)
+        if (allocated(error)) return
+        if (size(x) /= size(node_id) .or. size(y) /= size(node_id) .or. size(conn, 1) /= 2) then
+            call make_error(error, 'results: write_mesh: node_id, x, y must have the same size ' &
+                //'and conn must be (2, n_elements)')
+            return
+        end if
+        call check_nodes(self, size(node_id), 'write_mesh', error)
+        if (allocated(error)) return
+        allocate (coordinates(2, size(x)))
+        coordinates(1, :) = x
+        coordinates(2, :) = y
+        call self%file%create_group('/fem/mesh', error)
+        if (allocated(error)) return
+        call self%file%write_dataset('/fem/mesh/node_id', node_id, error)
+        if (allocated(error)) return
+        call self%file%write_dataset('/fem/mesh/coordinates', coordinates, error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/fem/mesh/coordinates', 'units', 'm', error)
+        if (allocated(error)) return
+        call self%file%write_dataset('/fem/mesh/connectivity', conn, error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/fem/mesh/connectivity', 'description', &
+            'node indices (1-based positions in node_id) of the 2 ends of each element', error)
+    end subroutine writer_write_mesh
+
+    !> Append one output state: /fem/{time, displacement, velocity, acceleration}.
+    subroutine writer_append_state(self, t, d, v, a, error)
+        !> An open writer.
+        class(results_writer_t), intent(inout) :: self
+        !> Time [s].
+        real(wp), intent(in) :: t
+        !> Nodal displacements (3, n_nodes) [m, m, rad].
+        real(wp), intent(in) :: d(:, :)
+        !> Nodal velocities (3, n_nodes) [m/s, m/s, rad/s].
+        real(wp), intent(in) :: v(:, :)
+        !> Nodal accelerations (3, n_nodes) [m/s^2, m/s^2, rad/s^2].
+        real(wp), intent(in) :: a(:, :)
+        !> Set on a shape mismatch or a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call require_open(self, 'append_state', error)
+        if (allocated(error)) return
+        if (size(d, 1) /= 3 .or. any(shape(v) /= shape(d)) .or. any(shape(a) /= shape(d))) then
+            call make_error(error, 'results: append_state: d, v, a must all be (3, n_nodes)')
+            return
+        end if
+        call check_nodes(self, size(d, 2), 'append_state', error)
+        if (allocated(error)) return
+        if (.not. self%have_state) then
+            call new_series(self, '/fem/time', [integer ::], 's', error)
+            if (allocated(error)) return
+            call new_series(self, '/fem/displacement', shape(d), 'm, m, rad', error)
+            if (allocated(error)) return
+            call new_series(self, '/fem/velocity', shape(d), 'm/s, m/s, rad/s', error)
+            if (allocated(error)) return
+            call new_series(self, '/fem/acceleration', shape(d), 'm/s^2, m/s^2, rad/s^2', error)
+            if (allocated(error)) return
+            self%have_state = .true.
+        end if
+        call self%file%append('/fem/time', t, error)
+        if (allocated(error)) return
+        call self%file%append('/fem/displacement', d, error)
+        if (allocated(error)) return
+        call self%file%append('/fem/velocity', v, error)
+        if (allocated(error)) return
+        call self%file%append('/fem/acceleration', a, error)
+    end subroutine writer_append_state
+
+    !> Append one energy record: /energy/{time, kinetic, strain, external_work, damping,
+    !> balance}, balance = kinetic + strain + damping - external_work - (same at the first
+    !> record), i.e. zero for an exact energy-conserving integration.
+    subroutine writer_append_energy(self, t, kinetic, strain, external_work, damping, error)
+        !> An open writer.
+        class(results_writer_t), intent(inout) :: self
+        !> Time [s].
+        real(wp), intent(in) :: t
+        !> Kinetic energy [J].
+        real(wp), intent(in) :: kinetic
+        !> Strain energy [J].
+        real(wp), intent(in) :: strain
+        !> Work of the external loads since t = 0 [J].
+        real(wp), intent(in) :: external_work
+        !> Energy dissipated by damping since t = 0 [J].
+        real(wp), intent(in) :: damping
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        real(wp) :: total
+        call require_open(self, 'append_energy', error)
+        if (allocated(error)) return
+        total = kinetic + strain + damping - external_work
+        if (.not. self%have_energy) then
+            call new_series(self, '/energy/time', [integer ::], 's', error)
+            if (allocated(error)) return
+            call new_series(self, '/energy/kinetic', [integer ::], 'J', error)
+            if (allocated(error)) return
+            call new_series(self, '/energy/strain', [integer ::], 'J', error)
+            if (allocated(error)) return
+            call new_series(self, '/energy/external_work', [integer ::], 'J', error)
+            if (allocated(error)) return
+            call new_series(self, '/energy/damping', [integer ::], 'J', error)
+            if (allocated(error)) return
+            call new_series(self, '/energy/balance', [integer ::], 'J', error)
+            if (allocated(error)) return
+            self%energy0 = total
+            self%have_energy = .true.
+        end if
+        call self%file%append('/energy/time', t, error)
+        if (allocated(error)) return
+        call self%file%append('/energy/kinetic', kinetic, error)
+        if (allocated(error)) return
+        call self%file%append('/energy/strain', strain, error)
+        if (allocated(error)) return
+        call self%file%append('/energy/external_work', external_work, error)
+        if (allocated(error)) return
+        call self%file%append('/energy/damping', damping, error)
+        if (allocated(error)) return
+        call self%file%append('/energy/balance', total - self%energy0, error)
+    end subroutine writer_append_energy
+
+    !> Write a static solution: /static/{displacement, reactions}.
+    subroutine writer_write_static(self, d, reactions, error)
+        !> An open writer.
+        class(results_writer_t), intent(inout) :: self
+        !> Nodal displacements (3, n_nodes) [m, m, rad].
+        real(wp), intent(in) :: d(:, :)
+        !> Support reactions (3, n_nodes) [N, N, N.m] (zero at free DOFs).
+        real(wp), intent(in) :: reactions(:, :)
+        !> Set on a shape mismatch or a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call require_open(self, 'write_static', error)
+        if (allocated(error)) return
+        if (size(d, 1) /= 3 .or. any(shape(reactions) /= shape(d))) then
+            call make_error(error, 'results: write_static: d and reactions must be (3, n_nodes)')
+            return
+        end if
+        call check_nodes(self, size(d, 2), 'write_static', error)
+        if (allocated(error)) return
+        call self%file%write_dataset('/static/displacement', d, error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/static/displacement', 'units', 'm, m, rad', error)
+        if (allocated(error)) return
+        call self%file%write_dataset('/static/reactions', reactions, error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/static/reactions', 'units', 'N, N, N.m', error)
+    end subroutine writer_write_static
+
+    !> Write modal results: /modal/{omega, frequency, shapes}.
+    subroutine writer_write_modal(self, omega, shapes, error)
+        !> An open writer.
+        class(results_writer_t), intent(inout) :: self
+        !> Angular eigenfrequencies [rad/s] (n_modes).
+        real(wp), intent(in) :: omega(:)
+        !> Mode shapes (3, n_nodes, n_modes), normalised as the modal solver returns them.
+        real(wp), intent(in) :: shapes(:, :, :)
+        !> Set on a shape mismatch or a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call require_open(self, 'write_modal', error)
+        if (allocated(error)) return
+        if (size(shapes, 1) /= 3 .or. size(shapes, 3) /= size(omega)) then
+            call make_error(error, 'results: write_modal: shapes must be (3, n_nodes, n_modes) ' &
+                //'with n_modes = size(omega)')
+            return
+        end if
+        call check_nodes(self, size(shapes, 2), 'write_modal', error)
+        if (allocated(error)) return
+        call self%file%write_dataset('/modal/omega', omega, error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/modal/omega', 'units', 'rad/s', error)
+        if (allocated(error)) return
+        call self%file%write_dataset('/modal/frequency', omega/two_pi, error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/modal/frequency', 'units', 'Hz', error)
+        if (allocated(error)) return
+        call self%file%write_dataset('/modal/shapes', shapes, error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/modal/shapes', 'units', 'm, m, rad (arbitrary scale)', &
+            error)
+    end subroutine writer_write_modal
+
+    !> Write run statistics as attributes of /summary.
+    subroutine writer_write_summary(self, steps, wall_seconds, error)
+        !> An open writer.
+        class(results_writer_t), intent(inout) :: self
+        !> Number of time steps done.
+        integer, intent(in) :: steps
+        !> Wall time of the analysis [s].
+        real(wp), intent(in) :: wall_seconds
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call require_open(self, 'write_summary', error)
+        if (allocated(error)) return
+        call self%file%create_group('/summary', error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/summary', 'steps', steps, error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/summary', 'wall_seconds', wall_seconds, error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/summary', 'finished', iso_date_time(), error)
+    end subroutine writer_write_summary
+
+    !> Close the file and rename '<final_path>.partial' to `final_path` (replacing an earlier
+    !> file). If the rename fails, the results stay in the partial file (the error says so) and
+    !> the earlier file is left as it was.
+    subroutine writer_close(self, error)
+        !> An open writer; closed on return.
+        class(results_writer_t), intent(inout) :: self
+        !> Set when the file cannot be closed or renamed.
+        type(error_t), allocatable, intent(out) :: error
+        call require_open(self, 'close', error)
+        if (allocated(error)) return
+        call self%file%close(error)
+        if (allocated(error)) then
+            ! An HDF5 file that failed to close is not trustworthy.
+            call remove_file(self%partial_path)
+            error%message = 'results: '//error%message
+            return
+        end if
+        call rename_file(self%partial_path, self%final_path, error)
+        if (allocated(error)) error%message = 'results: '//error%message//' (the results are ' &
+            //"kept in '"//self%partial_path//"')"
+    end subroutine writer_close
+
+    !> Close and delete the partial file after a failed run (an earlier result is untouched).
+    !> Does nothing when the writer is not open.
+    subroutine writer_abort(self)
+        !> The writer; closed on return.
+        class(results_writer_t), intent(inout) :: self
+        type(error_t), allocatable :: ignored
+        if (.not. self%file%is_open()) return
+        call self%file%close(ignored)
+        call remove_file(self%partial_path)
+    end subroutine writer_abort
+
+    !> Whether a results file is being written.
+    pure logical function writer_is_open(self)
+        !> The writer.
+        class(results_writer_t), intent(in) :: self
+        writer_is_open = self%file%is_open()
+    end function writer_is_open
+
+    !> Create an empty series and give it a 'units' attribute.
+    subroutine new_series(self, path, record_shape, units, error)
+        !> An open writer.
+        type(results_writer_t), intent(inout) :: self
+        !> Series path.
+        character(len=*), intent(in) :: path
+        !> Shape of one record (Fortran order).
+        integer, intent(in) :: record_shape(:)
+        !> Units of the values.
+        character(len=*), intent(in) :: units
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call self%file%create_series(path, record_shape, error)
+        if (allocated(error)) return
+        call self%file%write_attribute(path, 'units', units, error)
+    end subroutine new_series
+
+    !> Error unless the writer is open.
+    subroutine require_open(self, what, error)
+        !> The writer.
+        type(results_writer_t), intent(in) :: self
+        !> Name of the operation.
+        character(len=*), intent(in) :: what
+        !> Set when the writer is not open.
+        type(error_t), allocatable, intent(out) :: error
+        if (.not. self%is_open()) then
+            call make_error(error, 'results: '//what//': no results file is open')
+        end if
+    end subroutine require_open
+
+    !> Record the number of nodes, or check it against the one recorded.
+    subroutine check_nodes(self, n, what, error)
+        !> The writer.
+        type(results_writer_t), intent(inout) :: self
+        !> Number of nodes of the data being written.
+        integer, intent(in) :: n
+        !> Name of the operation.
+        character(len=*), intent(in) :: what
+        !> Set when `n` differs from the number of nodes written before.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=64) :: buf
+        if (self%n_nodes == 0) then
+            self%n_nodes = n
+        else if (n /= self%n_nodes) then
+            write (buf, '(i0,a,i0)') n, ' nodes instead of ', self%n_nodes
+            call make_error(error, 'results: '//what//': '//trim(buf))
+        end if
+    end subroutine check_nodes
+
+    !> Local date and time as ISO 8601, e.g. '2025-01-31T14:05:09+01:00'.
+    function iso_date_time() result(text)
+        !> The date-time.
+        character(len=:), allocatable :: text
+        character(len=8) :: date
+        character(len=10) :: time
+        character(len=5) :: zone
+        call date_and_time(date, time, zone)
+        text = date(1:4)//'-'//date(5:6)//'-'//date(7:8)//'T'//time(1:2)//':'//time(3:4)//':' &
+            //time(5:6)//zone(1:3)//':'//zone(4:5)
+    end function iso_date_time
 end module driver_results

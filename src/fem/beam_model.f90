@@ -1,5 +1,614 @@
-!> Placeholder: to be written.
+!> Assembled planar frame model: equation numbering, band stiffness and mass, Rayleigh
+!> damping, loads, and the vector operations the solvers and time integrators need.
+!>
+!> Free DOFs are numbered node by node (u, w, theta), which keeps the bandwidth at most
+!> 3*(largest node-number difference in an element) + 2. All vectors of size `n_free`
+!> are in that numbering; `expand` and `restrict` convert to and from (3, n_nodes) arrays.
 module fem_beam_model
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_error
+    use core_linalg, only: band_spd_t
+    use core_timefunc, only: time_function_t
+    use fem_beam_config, only: beam_config_t, beam_load_t, beam_section_t
+    use fem_beam_element, only: element_stiffness, element_mass_consistent, &
+                                element_mass_lumped, to_global
     implicit none
     private
+    public :: beam_model_t, build_beam_model
+
+    !> Names of the DOFs of a node, for messages.
+    character(len=5), parameter :: dof_names(3) = ['u    ', 'w    ', 'theta']
+
+    !> A planar Euler-Bernoulli frame ready for static, modal and transient analysis.
+    type :: beam_model_t
+        !> Number of nodes.
+        integer :: n_nodes = 0
+        !> Number of elements.
+        integer :: n_elements = 0
+        !> Number of free DOFs (equations).
+        integer :: n_free = 0
+        !> Equation number of each DOF (3, n_nodes), 0 if fixed.
+        integer, allocatable :: eq(:, :)
+        !> Node ids of the deck (for messages), size n_nodes.
+        integer, allocatable :: node_id(:)
+        !> Node coordinates [m].
+        real(wp), allocatable :: x(:), y(:)
+        !> Connectivity (2, n_elements).
+        integer, allocatable :: conn(:, :)
+        !> Element length [m], direction cosines of the axis.
+        real(wp), allocatable :: length(:), cosine(:), sine(:)
+        !> Element rigidities E*A [N], E*I [N.m^2] and mass per length rho*A [kg/m].
+        real(wp), allocatable :: ea(:), ei(:), rho_a(:)
+        !> Lumped (HRZ, diagonal: `m%kd` = 0) instead of consistent mass.
+        logical :: lumped_mass = .false.
+        !> Stiffness matrix on the free DOFs (band).
+        type(band_spd_t) :: k
+        !> Mass matrix on the free DOFs (band; diagonal when lumped).
+        type(band_spd_t) :: m
+        !> Rayleigh damping C = a0 M + a1 K: a0 [1/s], a1 [s].
+        real(wp) :: rayleigh_a0 = 0.0_wp
+        !> See `rayleigh_a0`.
+        real(wp) :: rayleigh_a1 = 0.0_wp
+        !> Nodal loads (value times function).
+        type(beam_load_t), allocatable :: loads(:)
+        !> Time functions referenced by the loads.
+        type(time_function_t), allocatable :: functions(:)
+    contains
+        !> f(n_free) = external nodal forces at time t.
+        procedure :: external_force
+        !> ku = K u.
+        procedure :: stiffness_times
+        !> mv = M v.
+        procedure :: mass_times
+        !> cv = C v (Rayleigh).
+        procedure :: damping_times
+        !> True when C /= 0.
+        procedure :: is_damped
+        !> 1/2 u.K u.
+        procedure :: strain_energy
+        !> 1/2 v.M v.
+        procedure :: kinetic_energy
+        !> Free-DOF vector to (3, n_nodes), zeros on fixed DOFs.
+        procedure :: expand
+        !> (3, n_nodes) to free-DOF vector.
+        procedure :: restrict
+        !> Reactions (3, n_nodes) on fixed DOFs.
+        procedure :: reactions
+        !> 'node 3 (id 12), DOF w' for an equation number.
+        procedure :: equation_label
+        !> Error when a connected part of the frame can move as a rigid body.
+        procedure :: check_supports
+    end type beam_model_t
+
+contains
+
+    !> Build the model from its description: checks, equation numbering, assembly of K and M.
+    !> A model without enough supports is accepted here (explicit dynamics and modal analysis
+    !> do not need it); the singular stiffness is reported when K is factored.
+    subroutine build_beam_model(config, model, error)
+        !> The frame description.
+        type(beam_config_t), intent(in) :: config
+        !> The model built.
+        type(beam_model_t), intent(out) :: model
+        !> Set when the description is invalid.
+        type(error_t), allocatable, intent(out) :: error
+        call check_mesh(config, error)
+        if (allocated(error)) return
+        call check_elements(config, error)
+        if (allocated(error)) return
+        call check_sections(config, error)
+        if (allocated(error)) return
+        call check_loads(config, error)
+        if (allocated(error)) return
+        call copy_geometry(config, model)
+        call number_equations(config, model, error)
+        if (allocated(error)) return
+        model%lumped_mass = config%lumped_mass
+        model%rayleigh_a0 = config%rayleigh_a0
+        model%rayleigh_a1 = config%rayleigh_a1
+        allocate (model%loads(0), model%functions(0))
+        if (allocated(config%loads)) model%loads = config%loads
+        if (allocated(config%functions)) model%functions = config%functions
+        call assemble(model, error)
+    end subroutine build_beam_model
+
+    !> Node label for messages: 'node 3 (id 12)'.
+    function node_label(config, i) result(label)
+        type(beam_config_t), intent(in) :: config
+        integer, intent(in) :: i
+        character(len=:), allocatable :: label
+        character(len=40) :: buf
+        write (buf, '(a,i0)') 'node ', i
+        if (allocated(config%node_id)) then
+            if (size(config%node_id) >= i) write (buf, '(a,i0,a,i0,a)') 'node ', i, &
+                ' (id ', config%node_id(i), ')'
+        end if
+        label = trim(buf)
+    end function node_label
+
+    !> Sizes and presence of the arrays.
+    subroutine check_mesh(config, error)
+        type(beam_config_t), intent(in) :: config
+        type(error_t), allocatable, intent(out) :: error
+        integer :: n
+        if (.not. (allocated(config%x) .and. allocated(config%y))) then
+            call make_error(error, 'beam model: no nodes given (at least 2 are needed)')
+            return
+        end if
+        n = size(config%x)
+        if (n < 2 .or. size(config%y) /= n) then
+            call make_error(error, 'beam model: at least 2 nodes with x and y are needed')
+        else if (.not. allocated(config%conn)) then
+            call make_error(error, 'beam model: no elements given (at least 1 is needed)')
+        else if (size(config%conn, 1) /= 2 .or. size(config%conn, 2) < 1) then
+            call make_error(error, 'beam model: at least 1 element with 2 nodes is needed')
+        else if (.not. allocated(config%elem_section)) then
+            call make_error(error, 'beam model: elements have no section')
+        else if (size(config%elem_section) /= size(config%conn, 2)) then
+            call make_error(error, 'beam model: one section index per element is needed')
+        else if (.not. allocated(config%sections)) then
+            call make_error(error, 'beam model: no section defined')
+        end if
+        if (allocated(error) .or. .not. allocated(config%fixed)) return
+        if (any(shape(config%fixed) /= [3, n])) &
+            call make_error(error, 'beam model: supports array must be (3, n_nodes)')
+    end subroutine check_mesh
+
+    !> Node indices, lengths and section indices of the elements.
+    subroutine check_elements(config, error)
+        type(beam_config_t), intent(in) :: config
+        type(error_t), allocatable, intent(out) :: error
+        integer :: e, n1, n2, n
+        real(wp) :: span, length
+        character(len=200) :: buf
+        n = size(config%x)
+        span = hypot(maxval(config%x) - minval(config%x), maxval(config%y) - minval(config%y))
+        do e = 1, size(config%conn, 2)
+            n1 = config%conn(1, e)
+            n2 = config%conn(2, e)
+            if (min(n1, n2) < 1 .or. max(n1, n2) > n) then
+                write (buf, '(a,i0,a,i0,a)') 'beam model: element ', e, &
+                    ' refers to a node outside 1..', n, ''
+                call make_error(error, trim(buf))
+                return
+            end if
+            length = hypot(config%x(n2) - config%x(n1), config%y(n2) - config%y(n1))
+            ! Zero up to rounding of the coordinates (relative to the size of the model).
+            if (length <= 1.0e-12_wp*span) then
+                write (buf, '(a,i0,a)') 'beam model: element ', e, ' has zero length ('// &
+                    node_label(config, n1)//' and '//node_label(config, n2)// &
+                    ' are at the same place); remove it or move a node'
+                call make_error(error, trim(buf))
+                return
+            end if
+            if (config%elem_section(e) < 1 .or. config%elem_section(e) > size(config%sections)) then
+                write (buf, '(a,i0,a,i0,a,i0,a)') 'beam model: element ', e, ' uses section ', &
+                    config%elem_section(e), ' but sections are numbered 1..', &
+                    size(config%sections), ''
+                call make_error(error, trim(buf))
+                return
+            end if
+        end do
+    end subroutine check_elements
+
+    !> Material and section properties must be positive.
+    subroutine check_sections(config, error)
+        type(beam_config_t), intent(in) :: config
+        type(error_t), allocatable, intent(out) :: error
+        integer :: i
+        character(len=200) :: buf
+        type(beam_section_t) :: s
+        do i = 1, size(config%sections)
+            s = config%sections(i)
+            if (.not. (s%young > 0 .and. s%density > 0 .and. s%area > 0 .and. s%inertia > 0)) then
+                write (buf, '(a,i0,a)') 'beam model: section ', i, ' needs young, density, '// &
+                    'area and inertia > 0'
+                call make_error(error, trim(buf))
+                return
+            end if
+        end do
+        if (config%rayleigh_a0 < 0 .or. config%rayleigh_a1 < 0) &
+            call make_error(error, 'beam model: Rayleigh damping coefficients must be >= 0')
+    end subroutine check_sections
+
+    !> Loads refer to existing nodes, DOFs and functions, and not to a fixed DOF.
+    subroutine check_loads(config, error)
+        type(beam_config_t), intent(in) :: config
+        type(error_t), allocatable, intent(out) :: error
+        integer :: i, nf
+        character(len=200) :: buf
+        type(beam_load_t) :: ld
+        if (.not. allocated(config%loads)) return
+        nf = 0
+        if (allocated(config%functions)) nf = size(config%functions)
+        do i = 1, size(config%loads)
+            ld = config%loads(i)
+            if (ld%node < 1 .or. ld%node > size(config%x)) then
+                write (buf, '(a,i0,a,i0,a)') 'beam model: load ', i, ' is on node ', ld%node, &
+                    ', which does not exist'
+            else if (ld%dof < 1 .or. ld%dof > 3) then
+                write (buf, '(a,i0,a)') 'beam model: load ', i, ' has a DOF not in 1..3'
+            else if (ld%func < 0 .or. ld%func > nf) then
+                write (buf, '(a,i0,a,i0,a)') 'beam model: load ', i, ' uses time function ', &
+                    ld%func, ', which is not defined'
+            else if (is_fixed(config, ld%node, ld%dof)) then
+                write (buf, '(a,i0,a)') 'beam model: load ', i, ' acts on fixed DOF '// &
+                    trim(dof_names(ld%dof))//' of '//node_label(config, ld%node)// &
+                    '; a load on a support does nothing: remove it or free the DOF'
+            else
+                cycle
+            end if
+            call make_error(error, trim(buf))
+            return
+        end do
+    end subroutine check_loads
+
+    !> True when DOF dof of node i is fixed.
+    pure logical function is_fixed(config, i, dof)
+        type(beam_config_t), intent(in) :: config
+        integer, intent(in) :: i, dof
+        is_fixed = .false.
+        if (allocated(config%fixed)) is_fixed = config%fixed(dof, i)
+    end function is_fixed
+
+    !> Nodes, connectivity, element geometry and rigidities.
+    subroutine copy_geometry(config, model)
+        type(beam_config_t), intent(in) :: config
+        type(beam_model_t), intent(inout) :: model
+        integer :: e, n1, n2, i
+        real(wp) :: dx, dy
+        model%n_nodes = size(config%x)
+        model%n_elements = size(config%conn, 2)
+        model%x = config%x
+        model%y = config%y
+        model%conn = config%conn
+        if (allocated(config%node_id)) then
+            model%node_id = config%node_id
+        else
+            model%node_id = [(i, i=1, model%n_nodes)]
+        end if
+        allocate (model%length(model%n_elements), model%cosine(model%n_elements))
+        allocate (model%sine(model%n_elements), model%ea(model%n_elements))
+        allocate (model%ei(model%n_elements), model%rho_a(model%n_elements))
+        do e = 1, model%n_elements
+            n1 = config%conn(1, e)
+            n2 = config%conn(2, e)
+            dx = config%x(n2) - config%x(n1)
+            dy = config%y(n2) - config%y(n1)
+            model%length(e) = hypot(dx, dy)
+            model%cosine(e) = dx/model%length(e)
+            model%sine(e) = dy/model%length(e)
+            associate (s => config%sections(config%elem_section(e)))
+                model%ea(e) = s%young*s%area
+                model%ei(e) = s%young*s%inertia
+                model%rho_a(e) = s%density*s%area
+            end associate
+        end do
+    end subroutine copy_geometry
+
+    !> Equation numbers node by node; fails when every DOF is fixed.
+    subroutine number_equations(config, model, error)
+        type(beam_config_t), intent(in) :: config
+        type(beam_model_t), intent(inout) :: model
+        type(error_t), allocatable, intent(out) :: error
+        integer :: i, d
+        allocate (model%eq(3, model%n_nodes), source=0)
+        model%n_free = 0
+        do i = 1, model%n_nodes
+            do d = 1, 3
+                if (is_fixed(config, i, d)) cycle
+                model%n_free = model%n_free + 1
+                model%eq(d, i) = model%n_free
+            end do
+        end do
+        if (model%n_free == 0) &
+            call make_error(error, 'beam model: every DOF is fixed, there is nothing to solve')
+    end subroutine number_equations
+
+    !> Equation numbers of the six DOFs of element e (0 = fixed).
+    pure function element_dofs(model, e) result(dofs)
+        type(beam_model_t), intent(in) :: model
+        integer, intent(in) :: e
+        integer :: dofs(6)
+        dofs(1:3) = model%eq(:, model%conn(1, e))
+        dofs(4:6) = model%eq(:, model%conn(2, e))
+    end function element_dofs
+
+    !> Assemble the band K and M on the free DOFs.
+    subroutine assemble(model, error)
+        type(beam_model_t), intent(inout) :: model
+        type(error_t), allocatable, intent(out) :: error
+        integer :: e, a, b, kd
+        integer :: dofs(6)
+        real(wp) :: kg(6, 6), mg(6, 6), ml(6)
+        kd = 0
+        do e = 1, model%n_elements
+            dofs = element_dofs(model, e)
+            if (count(dofs > 0) > 1) kd = max(kd, maxval(dofs) - minval(dofs, dofs > 0))
+        end do
+        call model%k%init(model%n_free, kd)
+        call model%m%init(model%n_free, merge(0, kd, model%lumped_mass))
+        do e = 1, model%n_elements
+            dofs = element_dofs(model, e)
+            associate (c => model%cosine(e), s => model%sine(e), l => model%length(e))
+                kg = to_global(element_stiffness(model%ea(e), model%ei(e), l), c, s)
+                mg = to_global(element_mass_consistent(model%rho_a(e), l), c, s)
+                ml = element_mass_lumped(model%rho_a(e), l)
+            end associate
+            do b = 1, 6
+                if (dofs(b) == 0) cycle
+                do a = 1, 6
+                    if (dofs(a) == 0) cycle
+                    call model%k%add(dofs(a), dofs(b), kg(a, b))
+                    if (.not. model%lumped_mass) call model%m%add(dofs(a), dofs(b), mg(a, b))
+                end do
+                if (model%lumped_mass) call model%m%add(dofs(b), dofs(b), ml(b))
+            end do
+        end do
+        if (model%k%out_of_band .or. model%m%out_of_band) &
+            call make_error(error, 'beam model: internal error, bandwidth too small')
+    end subroutine assemble
+
+    !> External nodal forces at time t on the free DOFs: sum of value*function(t).
+    subroutine external_force(self, t, f)
+        !> The model.
+        class(beam_model_t), intent(in) :: self
+        !> Time [s].
+        real(wp), intent(in) :: t
+        !> Forces (n_free) [N, N.m].
+        real(wp), intent(out) :: f(:)
+        integer :: i, ieq
+        real(wp) :: scale
+        f = 0.0_wp
+        do i = 1, size(self%loads)
+            ieq = self%eq(self%loads(i)%dof, self%loads(i)%node)
+            if (ieq == 0) cycle
+            scale = 1.0_wp
+            if (self%loads(i)%func > 0) scale = self%functions(self%loads(i)%func)%value(t)
+            f(ieq) = f(ieq) + self%loads(i)%value*scale
+        end do
+    end subroutine external_force
+
+    !> ku = K u.
+    subroutine stiffness_times(self, u, ku)
+        !> The model.
+        class(beam_model_t), intent(in) :: self
+        !> Displacements (n_free).
+        real(wp), contiguous, intent(in) :: u(:)
+        !> Elastic forces K u (n_free).
+        real(wp), contiguous, intent(out) :: ku(:)
+        call self%k%matvec(u, ku)
+    end subroutine stiffness_times
+
+    !> mv = M v.
+    subroutine mass_times(self, v, mv)
+        !> The model.
+        class(beam_model_t), intent(in) :: self
+        !> Velocities or accelerations (n_free).
+        real(wp), contiguous, intent(in) :: v(:)
+        !> M v (n_free).
+        real(wp), contiguous, intent(out) :: mv(:)
+        call self%m%matvec(v, mv)
+    end subroutine mass_times
+
+    !> cv = C v = a0 M v + a1 K v.
+    subroutine damping_times(self, v, cv)
+        !> The model.
+        class(beam_model_t), intent(in) :: self
+        !> Velocities (n_free).
+        real(wp), contiguous, intent(in) :: v(:)
+        !> Damping forces C v (n_free).
+        real(wp), contiguous, intent(out) :: cv(:)
+        call self%k%matvec(v, cv, alpha=self%rayleigh_a1)
+        call self%m%matvec(v, cv, alpha=self%rayleigh_a0, beta=1.0_wp)
+    end subroutine damping_times
+
+    !> True when the Rayleigh damping is not zero.
+    pure logical function is_damped(self)
+        !> The model.
+        class(beam_model_t), intent(in) :: self
+        is_damped = self%rayleigh_a0 /= 0 .or. self%rayleigh_a1 /= 0
+    end function is_damped
+
+    !> Strain energy 1/2 u.K u [J].
+    real(wp) function strain_energy(self, u)
+        !> The model.
+        class(beam_model_t), intent(in) :: self
+        !> Displacements (n_free).
+        real(wp), contiguous, intent(in) :: u(:)
+        real(wp) :: ku(size(u))
+        call self%k%matvec(u, ku)
+        strain_energy = 0.5_wp*dot_product(u, ku)
+    end function strain_energy
+
+    !> Kinetic energy 1/2 v.M v [J].
+    real(wp) function kinetic_energy(self, v)
+        !> The model.
+        class(beam_model_t), intent(in) :: self
+        !> Velocities (n_free).
+        real(wp), contiguous, intent(in) :: v(:)
+        real(wp) :: mv(size(v))
+        call self%m%matvec(v, mv)
+        kinetic_energy = 0.5_wp*dot_product(v, mv)
+    end function kinetic_energy
+
+    !> Free-DOF vector to nodal array d(3, n_nodes), zeros on fixed DOFs.
+    pure subroutine expand(self, u_free, d)
+        !> The model.
+        class(beam_model_t), intent(in) :: self
+        !> Vector on the free DOFs (n_free).
+        real(wp), intent(in) :: u_free(:)
+        !> Nodal values (3, n_nodes).
+        real(wp), intent(out) :: d(:, :)
+        integer :: i, k
+        do i = 1, self%n_nodes
+            do k = 1, 3
+                d(k, i) = 0.0_wp
+                if (self%eq(k, i) > 0) d(k, i) = u_free(self%eq(k, i))
+            end do
+        end do
+    end subroutine expand
+
+    !> Nodal array d(3, n_nodes) to a free-DOF vector (values on fixed DOFs are dropped);
+    !> an absent d (e.g. an unallocated array) gives zeros.
+    pure subroutine restrict(self, d, u_free)
+        !> The model.
+        class(beam_model_t), intent(in) :: self
+        !> Nodal values (3, n_nodes).
+        real(wp), intent(in), optional :: d(:, :)
+        !> Vector on the free DOFs (n_free).
+        real(wp), allocatable, intent(out) :: u_free(:)
+        integer :: i, k
+        allocate (u_free(self%n_free), source=0.0_wp)
+        if (.not. present(d)) return
+        do i = 1, self%n_nodes
+            do k = 1, 3
+                if (self%eq(k, i) > 0) u_free(self%eq(k, i)) = d(k, i)
+            end do
+        end do
+    end subroutine restrict
+
+    !> Support reactions r(3, n_nodes) = (K_full u - F)(t) on fixed DOFs, 0 on free DOFs
+    !> (element-by-element product, no full matrix).
+    subroutine reactions(self, u, t, r)
+        !> The model.
+        class(beam_model_t), intent(in) :: self
+        !> Displacements on the free DOFs (n_free).
+        real(wp), intent(in) :: u(:)
+        !> Time [s] of the loads.
+        real(wp), intent(in) :: t
+        !> Reactions (3, n_nodes) [N, N.m].
+        real(wp), intent(out) :: r(:, :)
+        real(wp) :: d(3, self%n_nodes), kg(6, 6), fe(6), scale
+        integer :: e, n1, n2, i
+        call self%expand(u, d)
+        r = 0.0_wp
+        do e = 1, self%n_elements
+            n1 = self%conn(1, e)
+            n2 = self%conn(2, e)
+            kg = to_global(element_stiffness(self%ea(e), self%ei(e), self%length(e)), &
+                           self%cosine(e), self%sine(e))
+            fe = matmul(kg, [d(:, n1), d(:, n2)])
+            r(:, n1) = r(:, n1) + fe(1:3)
+            r(:, n2) = r(:, n2) + fe(4:6)
+        end do
+        ! Loads on supports are refused at build time; kept here so r = K u - F holds anyway.
+        do i = 1, size(self%loads)
+            associate (ld => self%loads(i))
+                scale = 1.0_wp
+                if (ld%func > 0) scale = self%functions(ld%func)%value(t)
+                r(ld%dof, ld%node) = r(ld%dof, ld%node) - ld%value*scale
+            end associate
+        end do
+        where (self%eq > 0) r = 0.0_wp
+    end subroutine reactions
+
+    !> Label of equation ieq for messages: 'node 3 (id 12), DOF w'.
+    function equation_label(self, ieq) result(label)
+        !> The model.
+        class(beam_model_t), intent(in) :: self
+        !> Equation number (1..n_free).
+        integer, intent(in) :: ieq
+        character(len=:), allocatable :: label
+        character(len=80) :: buf
+        integer :: loc(2)
+        label = 'an unknown DOF'
+        if (.not. any(self%eq == ieq) .or. ieq < 1) return
+        loc = findloc(self%eq, ieq)
+        write (buf, '(a,i0,a,i0,a)') 'node ', loc(2), ' (id ', self%node_id(loc(2)), '), DOF '
+        label = trim(buf)//' '//trim(dof_names(loc(1)))
+    end function equation_label
+
+    !> Error when some connected part of the frame is not held against rigid-body motion
+    !> (x and y translation, rotation): exact test on the geometry of the supports, free of
+    !> the rounding that blurs small pivots of a singular K. Each part needs fixed DOFs whose
+    !> rigid-body rows (see `rigid_row`) have rank 3.
+    subroutine check_supports(self, error)
+        !> The model.
+        class(beam_model_t), intent(in) :: self
+        !> Set when a part can move freely.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: comp(self%n_nodes), i, c, d
+        real(wp) :: centre(2, self%n_nodes), gram(3, 3, self%n_nodes), row(3)
+        character(len=160) :: buf
+        call component_roots(self, comp)
+        centre = 0.0_wp
+        do i = 1, self%n_nodes
+            centre(:, comp(i)) = centre(:, comp(i)) + [self%x(i), self%y(i)]
+        end do
+        do c = 1, self%n_nodes
+            if (comp(c) == c) centre(:, c) = centre(:, c)/count(comp == c)
+        end do
+        gram = 0.0_wp
+        do i = 1, self%n_nodes
+            c = comp(i)
+            do d = 1, 3
+                if (self%eq(d, i) /= 0) cycle
+                row = rigid_row(d, self%x(i) - centre(1, c), self%y(i) - centre(2, c))
+                gram(:, :, c) = gram(:, :, c) + spread(row, 2, 3)*spread(row, 1, 3)
+            end do
+        end do
+        do c = 1, self%n_nodes
+            if (comp(c) /= c .or. full_rank(gram(:, :, c))) cycle
+            write (buf, '(a,i0,a,i0,a)') 'node ', c, ' (id ', self%node_id(c), ')'
+            call make_error(error, 'stiffness matrix is singular: the part of the frame '// &
+                            'that contains '//trim(buf)//' can move as a rigid body (its '// &
+                            'supports do not hold x, y and rotation); fix more DOFs (supports)')
+            return
+        end do
+    end subroutine check_supports
+
+    !> Smallest node index of the connected part of each node (union-find over elements).
+    pure subroutine component_roots(self, comp)
+        type(beam_model_t), intent(in) :: self
+        integer, intent(out) :: comp(:)
+        integer :: parent(self%n_nodes), e, a, b, i
+        parent = [(i, i=1, self%n_nodes)]
+        do e = 1, self%n_elements
+            a = root(self%conn(1, e))
+            b = root(self%conn(2, e))
+            parent(max(a, b)) = min(a, b)
+        end do
+        do i = 1, self%n_nodes
+            comp(i) = root(i)
+        end do
+    contains
+        pure integer function root(i0) result(r)
+            integer, intent(in) :: i0
+            r = i0
+            do while (parent(r) /= r)
+                r = parent(r)
+            end do
+        end function root
+    end subroutine component_roots
+
+    !> Value of DOF d at a node at (dx, dy) from the centre in the three rigid-body motions
+    !> (x translation, y translation, unit rotation about the centre).
+    pure function rigid_row(d, dx, dy) result(row)
+        integer, intent(in) :: d
+        real(wp), intent(in) :: dx, dy
+        real(wp) :: row(3)
+        select case (d)
+        case (1)
+            row = [1.0_wp, 0.0_wp, -dy]
+        case (2)
+            row = [0.0_wp, 1.0_wp, dx]
+        case default
+            row = [0.0_wp, 0.0_wp, 1.0_wp]
+        end select
+    end function rigid_row
+
+    !> Rank 3 test of a 3x3 Gram matrix: det(G)/prod(diag G) is 1 for orthogonal rows, 0 for
+    !> rank < 3, and does not depend on the scale of each column; 1e-12 separates exact
+    !> zero (rounding ~ 1e-16) from nearly aligned supports (e.g. a roller 1e-6 L from a pin).
+    pure logical function full_rank(g)
+        real(wp), intent(in) :: g(3, 3)
+        real(wp) :: det
+        full_rank = .false.
+        if (any([g(1, 1), g(2, 2), g(3, 3)] <= 0)) return
+        det = g(1, 1)*(g(2, 2)*g(3, 3) - g(2, 3)*g(3, 2)) &
+              - g(1, 2)*(g(2, 1)*g(3, 3) - g(2, 3)*g(3, 1)) &
+              + g(1, 3)*(g(2, 1)*g(3, 2) - g(2, 2)*g(3, 1))
+        full_rank = det > 1.0e-12_wp*g(1, 1)*g(2, 2)*g(3, 3)
+    end function full_rank
 end module fem_beam_model

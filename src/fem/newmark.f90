@@ -1,5 +1,390 @@
-!> Placeholder: to be written.
+!> Time integrators of M a + C v + K u = F(t) for the frame model (THEORY.md section 3).
+!>
+!> `time_integrator_t` holds the state (t, u, v, a) and the energy accounts, and defers
+!> `init` and `step` to the schemes:
+!> - `newmark_t`: implicit Newmark (beta, gamma) in acceleration form, default average
+!>   acceleration (1/4, 1/2); the effective matrix M + gamma h C + beta h^2 K is factored
+!>   once in `init` (band Cholesky).
+!> - `central_difference_t`: explicit (beta = 0, gamma = 1/2) with lumped mass; refuses a
+!>   step above the critical one.
+!>
+!> Energy accounts, updated every step (trapezoidal rule, exact for average acceleration):
+!> W += 1/2 (F_n + F_{n+1}).(u_{n+1} - u_n), D += (u_{n+1} - u_n).C (v_n + v_{n+1})/2,
+!> and `energy_balance()` = kinetic + strain + D - W - (initial kinetic + strain).
 module fem_newmark
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_error
+    use core_linalg, only: band_spd_t, largest_generalized_eigenvalue
+    use fem_beam_model, only: beam_model_t
     implicit none
     private
+    public :: time_integrator_t, newmark_t, central_difference_t, critical_time_step
+
+    !> State and energy accounts common to all time integrators.
+    type, abstract :: time_integrator_t
+        !> Current time [s].
+        real(wp) :: t = 0.0_wp
+        !> Time step [s].
+        real(wp) :: h = 0.0_wp
+        !> Initial time [s].
+        real(wp) :: t0 = 0.0_wp
+        !> Number of steps done since `init`.
+        integer :: step_count = 0
+        !> Displacements, velocities, accelerations on the free DOFs (n_free).
+        real(wp), allocatable :: u(:), v(:), a(:)
+        !> Kinetic energy 1/2 v.M v [J].
+        real(wp) :: kinetic = 0.0_wp
+        !> Strain energy 1/2 u.K u [J].
+        real(wp) :: strain = 0.0_wp
+        !> Work of the external forces since `init` [J].
+        real(wp) :: external_work = 0.0_wp
+        !> Energy dissipated by the Rayleigh damping since `init` [J].
+        real(wp) :: damping_dissipation = 0.0_wp
+        !> Kinetic + strain energy at `init` [J].
+        real(wp) :: initial_energy = 0.0_wp
+        !> Work arrays (n_free): previous u, v, F; F at the new time; scratch.
+        real(wp), allocatable :: u_old(:), v_old(:), f_old(:), f_new(:), work(:), work2(:)
+    contains
+        !> Set the step, the initial state and the initial acceleration; prepare the scheme.
+        procedure(integrator_init), deferred :: init
+        !> Advance one step.
+        procedure(integrator_step), deferred :: step
+        !> kinetic + strain + dissipation - external work - initial energy [J].
+        procedure :: energy_balance
+        !> Common part of `init` for the schemes (state, work arrays, energies).
+        procedure, non_overridable :: start_state
+        !> a = F(t) - K u - C v with the current state.
+        procedure, non_overridable :: initial_residual
+        !> Energy accounts, time and step count after a step.
+        procedure, non_overridable :: finish_step
+    end type time_integrator_t
+
+    abstract interface
+        !> Prepare the integrator: time step h from time t0 with displacements u0 and
+        !> velocities v0 (n_free); computes a0 from M a0 = F(t0) - K u0 - C v0.
+        subroutine integrator_init(self, model, h, t0, u0, v0, error)
+            import :: time_integrator_t, beam_model_t, wp, error_t
+            !> The integrator.
+            class(time_integrator_t), intent(inout) :: self
+            !> The model.
+            type(beam_model_t), intent(in) :: model
+            !> Time step [s].
+            real(wp), intent(in) :: h
+            !> Initial time [s].
+            real(wp), intent(in) :: t0
+            !> Initial displacements and velocities (n_free).
+            real(wp), intent(in) :: u0(:), v0(:)
+            !> Set on invalid parameters or a failed factorisation.
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine integrator_init
+
+        !> Advance one time step.
+        subroutine integrator_step(self, model, error)
+            import :: time_integrator_t, beam_model_t, error_t
+            !> The integrator.
+            class(time_integrator_t), intent(inout) :: self
+            !> The model (the same as at `init`).
+            type(beam_model_t), intent(in) :: model
+            !> Set on failure of the linear solve.
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine integrator_step
+    end interface
+
+    !> Implicit Newmark scheme; unconditionally stable for gamma >= 1/2 and
+    !> beta >= (gamma + 1/2)^2/4. Set beta and gamma before `init`.
+    type, extends(time_integrator_t) :: newmark_t
+        !> Newmark beta.
+        real(wp) :: beta = 0.25_wp
+        !> Newmark gamma.
+        real(wp) :: gamma = 0.5_wp
+        !> Factored effective matrix M + gamma h C + beta h^2 K.
+        type(band_spd_t) :: s
+    contains
+        !> See `time_integrator_t%init`.
+        procedure :: init => newmark_init
+        !> See `time_integrator_t%step`.
+        procedure :: step => newmark_step
+    end type newmark_t
+
+    !> Explicit central-difference scheme (Newmark beta = 0, gamma = 1/2), lumped mass.
+    !> Mass-proportional damping is treated implicitly (diagonal), stiffness-proportional
+    !> damping explicitly with the half-step velocity, which lowers the critical step to
+    !> 2/omega_max (sqrt(1 + xi^2) - xi), xi = a1 omega_max/2.
+    type, extends(time_integrator_t) :: central_difference_t
+        !> Critical time step used by the check in `init` [s].
+        real(wp) :: h_crit = 0.0_wp
+        !> 1/(m_ii (1 + a0 h/2)) (n_free).
+        real(wp), allocatable :: inv_mass(:)
+    contains
+        !> See `time_integrator_t%init`.
+        procedure :: init => central_difference_init
+        !> See `time_integrator_t%step`.
+        procedure :: step => central_difference_step
+    end type central_difference_t
+
+contains
+
+    !> kinetic + strain + damping_dissipation - external_work - initial energy [J]; zero up
+    !> to rounding for average acceleration.
+    pure real(wp) function energy_balance(self)
+        !> The integrator.
+        class(time_integrator_t), intent(in) :: self
+        energy_balance = self%kinetic + self%strain + self%damping_dissipation &
+                         - self%external_work - self%initial_energy
+    end function energy_balance
+
+    !> Common part of `init`: checks, state, work arrays, energies; leaves
+    !> F(t0) - K u0 - C v0 in `a` (to be multiplied by M^-1 by the scheme).
+    subroutine start_state(self, model, h, t0, u0, v0, error)
+        !> The integrator.
+        class(time_integrator_t), intent(inout) :: self
+        !> The model.
+        type(beam_model_t), intent(in) :: model
+        !> Time step and initial time [s].
+        real(wp), intent(in) :: h, t0
+        !> Initial displacements and velocities (n_free).
+        real(wp), intent(in) :: u0(:), v0(:)
+        !> Set when h <= 0 or the sizes are wrong.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: n
+        n = model%n_free
+        if (.not. (h > 0)) then
+            call make_error(error, 'time integration: the time step must be > 0')
+            return
+        end if
+        if (size(u0) /= n .or. size(v0) /= n) then
+            call make_error(error, 'time integration: initial displacements and velocities '// &
+                            'must have one value per free DOF')
+            return
+        end if
+        self%h = h
+        self%t0 = t0
+        self%t = t0
+        self%step_count = 0
+        self%u = u0
+        self%v = v0
+        ! (Re)allocate the state and work arrays once; `step` never allocates.
+        self%a = u0
+        self%u_old = u0
+        self%v_old = v0
+        self%f_old = u0
+        self%f_new = u0
+        self%work = u0
+        self%work2 = u0
+        call model%external_force(t0, self%f_old)
+        self%kinetic = model%kinetic_energy(self%v)
+        self%strain = model%strain_energy(self%u)
+        self%initial_energy = self%kinetic + self%strain
+        self%external_work = 0.0_wp
+        self%damping_dissipation = 0.0_wp
+        call self%initial_residual(model)
+    end subroutine start_state
+
+    !> a = F(t) - K u - C v with the current state (F(t) in f_old).
+    subroutine initial_residual(self, model)
+        !> The integrator.
+        class(time_integrator_t), intent(inout) :: self
+        !> The model.
+        type(beam_model_t), intent(in) :: model
+        call model%stiffness_times(self%u, self%work)
+        self%a = self%f_old - self%work
+        if (model%is_damped()) then
+            call model%damping_times(self%v, self%work)
+            self%a = self%a - self%work
+        end if
+    end subroutine initial_residual
+
+    !> Energy accounts and time after u, v, a were advanced from (u_old, v_old, f_old)
+    !> with loads f_new.
+    subroutine finish_step(self, model)
+        !> The integrator.
+        class(time_integrator_t), intent(inout) :: self
+        !> The model.
+        type(beam_model_t), intent(in) :: model
+        ! work = u_{n+1} - u_n
+        self%work = self%u - self%u_old
+        self%external_work = self%external_work + &
+                             0.5_wp*dot_product(self%f_old + self%f_new, self%work)
+        if (model%is_damped()) then
+            self%v_old = self%v_old + self%v
+            call model%damping_times(self%v_old, self%work2)
+            self%damping_dissipation = self%damping_dissipation + &
+                                       0.5_wp*dot_product(self%work, self%work2)
+        end if
+        call model%mass_times(self%v, self%work)
+        self%kinetic = 0.5_wp*dot_product(self%v, self%work)
+        call model%stiffness_times(self%u, self%work)
+        self%strain = 0.5_wp*dot_product(self%u, self%work)
+        self%f_old = self%f_new
+        self%step_count = self%step_count + 1
+        self%t = self%t0 + self%step_count*self%h
+    end subroutine finish_step
+
+    !> Newmark: check (beta, gamma), factor M + gamma h C + beta h^2 K, compute a0.
+    subroutine newmark_init(self, model, h, t0, u0, v0, error)
+        !> The integrator (beta and gamma set beforehand).
+        class(newmark_t), intent(inout) :: self
+        !> The model.
+        type(beam_model_t), intent(in) :: model
+        !> Time step [s].
+        real(wp), intent(in) :: h
+        !> Initial time [s].
+        real(wp), intent(in) :: t0
+        !> Initial displacements and velocities (n_free).
+        real(wp), intent(in) :: u0(:), v0(:)
+        !> Set on invalid parameters or a failed factorisation.
+        type(error_t), allocatable, intent(out) :: error
+        type(band_spd_t) :: mf
+        if (self%gamma < 0.5_wp .or. self%beta < 0.0_wp) then
+            call make_error(error, 'Newmark scheme: gamma >= 1/2 and beta >= 0 are required '// &
+                            '(gamma < 1/2 amplifies the solution); average acceleration is '// &
+                            'beta = 1/4, gamma = 1/2')
+            return
+        end if
+        call self%start_state(model, h, t0, u0, v0, error)
+        if (allocated(error)) return
+        mf = model%m
+        call mf%factor(error)
+        if (allocated(error)) return
+        call mf%solve(self%a, error)
+        if (allocated(error)) return
+        call self%s%init(model%n_free, model%k%kd)
+        call self%s%add_scaled(model%m, 1.0_wp + self%gamma*h*model%rayleigh_a0)
+        call self%s%add_scaled(model%k, self%gamma*h*model%rayleigh_a1 + self%beta*h**2)
+        call self%s%factor(error)
+        if (allocated(error)) error%message = 'Newmark effective matrix M + gamma h C + '// &
+            'beta h^2 K: '//error%message
+    end subroutine newmark_init
+
+    !> Newmark step: predictor, solve for a_{n+1}, corrector, energies.
+    subroutine newmark_step(self, model, error)
+        !> The integrator.
+        class(newmark_t), intent(inout) :: self
+        !> The model.
+        type(beam_model_t), intent(in) :: model
+        !> Set on failure of the solve.
+        type(error_t), allocatable, intent(out) :: error
+        real(wp) :: h
+        h = self%h
+        self%u_old = self%u
+        self%v_old = self%v
+        call model%external_force(self%t0 + (self%step_count + 1)*h, self%f_new)
+        ! Predictors (u~, v~) in u and v.
+        self%u = self%u + h*self%v + h**2*(0.5_wp - self%beta)*self%a
+        self%v = self%v + h*(1.0_wp - self%gamma)*self%a
+        ! (M + gamma h C + beta h^2 K) a_{n+1} = F_{n+1} - K u~ - C v~
+        call model%stiffness_times(self%u, self%work)
+        self%a = self%f_new - self%work
+        if (model%is_damped()) then
+            call model%damping_times(self%v, self%work)
+            self%a = self%a - self%work
+        end if
+        call self%s%solve(self%a, error)
+        if (allocated(error)) return
+        self%u = self%u + self%beta*h**2*self%a
+        self%v = self%v + self%gamma*h*self%a
+        call self%finish_step(model)
+    end subroutine newmark_step
+
+    !> Critical time step 2/omega_max of the undamped central-difference scheme [s], with
+    !> omega_max^2 the largest eigenvalue of K phi = omega^2 M phi.
+    real(wp) function critical_time_step(model, error) result(h_crit)
+        !> The model.
+        type(beam_model_t), intent(in) :: model
+        !> Set on eigensolver failure (h_crit is then 0).
+        type(error_t), allocatable, intent(out), optional :: error
+        type(error_t), allocatable :: err
+        real(wp) :: lambda_max
+        h_crit = 0.0_wp
+        call largest_generalized_eigenvalue(model%k, model%m, lambda_max, err)
+        if (allocated(err)) then
+            if (present(error)) call move_alloc(err, error)
+            return
+        end if
+        h_crit = huge(1.0_wp)
+        if (lambda_max > 0) h_crit = 2.0_wp/sqrt(lambda_max)
+    end function critical_time_step
+
+    !> Central difference: lumped mass required; refuses h above the critical step.
+    subroutine central_difference_init(self, model, h, t0, u0, v0, error)
+        !> The integrator.
+        class(central_difference_t), intent(inout) :: self
+        !> The model (lumped mass).
+        type(beam_model_t), intent(in) :: model
+        !> Time step [s].
+        real(wp), intent(in) :: h
+        !> Initial time [s].
+        real(wp), intent(in) :: t0
+        !> Initial displacements and velocities (n_free).
+        real(wp), intent(in) :: u0(:), v0(:)
+        !> Set when the mass is not lumped, h is too large, or on eigensolver failure.
+        type(error_t), allocatable, intent(out) :: error
+        if (.not. model%lumped_mass .or. model%m%kd /= 0) then
+            call make_error(error, 'the central-difference scheme needs a lumped mass matrix: '// &
+                            'ask for lumped mass or use the Newmark scheme')
+            return
+        end if
+        call check_critical_step(self, model, h, error)
+        if (allocated(error)) return
+        call self%start_state(model, h, t0, u0, v0, error)
+        if (allocated(error)) return
+        self%inv_mass = self%a
+        call model%m%diagonal(self%inv_mass)
+        self%a = self%a/self%inv_mass
+        self%inv_mass = 1.0_wp/(self%inv_mass*(1.0_wp + 0.5_wp*h*model%rayleigh_a0))
+    end subroutine central_difference_init
+
+    !> Store the critical step (reduced by stiffness damping) and refuse h above it.
+    subroutine check_critical_step(self, model, h, error)
+        class(central_difference_t), intent(inout) :: self
+        type(beam_model_t), intent(in) :: model
+        real(wp), intent(in) :: h
+        type(error_t), allocatable, intent(out) :: error
+        real(wp) :: xi
+        character(len=240) :: buf
+        character(len=:), allocatable :: what
+        self%h_crit = critical_time_step(model, error)
+        if (allocated(error)) return
+        what = '(2/omega_max)'
+        if (model%rayleigh_a1 > 0) then
+            xi = model%rayleigh_a1/self%h_crit
+            self%h_crit = self%h_crit*(sqrt(1.0_wp + xi**2) - xi)
+            what = '(2/omega_max, reduced by the stiffness-proportional damping)'
+        end if
+        if (h > self%h_crit) then
+            write (buf, '(a,es9.3,a,es9.3,a)') 'time step ', h, &
+                ' s exceeds the critical time step ', self%h_crit, &
+                ' s of the central-difference scheme '//what//'; reduce [time] step'
+            call make_error(error, trim(buf))
+        end if
+    end subroutine check_critical_step
+
+    !> Central-difference step: u_{n+1} = u + h v + h^2/2 a, then a_{n+1} from the lumped
+    !> mass, v_{n+1} = v + h/2 (a_n + a_{n+1}).
+    subroutine central_difference_step(self, model, error)
+        !> The integrator.
+        class(central_difference_t), intent(inout) :: self
+        !> The model.
+        type(beam_model_t), intent(in) :: model
+        !> Never set (kept for the common interface).
+        type(error_t), allocatable, intent(out) :: error
+        real(wp) :: h
+        h = self%h
+        self%u_old = self%u
+        self%v_old = self%v
+        call model%external_force(self%t0 + (self%step_count + 1)*h, self%f_new)
+        self%u = self%u + h*self%v + 0.5_wp*h**2*self%a
+        ! Half-step velocity v_{n+1/2} = v + h/2 a.
+        self%v = self%v + 0.5_wp*h*self%a
+        call model%stiffness_times(self%u, self%work)
+        self%a = self%f_new - self%work
+        if (model%is_damped()) then
+            ! C v_{n+1/2}; the mass part a0 M is also taken at n+1 through inv_mass.
+            call model%damping_times(self%v, self%work)
+            self%a = self%a - self%work
+        end if
+        self%a = self%a*self%inv_mass
+        self%v = self%v + 0.5_wp*h*self%a
+        call self%finish_step(model)
+    end subroutine central_difference_step
 end module fem_newmark

@@ -1,5 +1,209 @@
-!> Placeholder: to be written.
+!> Progress lines for long runs: step n/N, simulated time, % done, wall time and ETA.
+!>
+!> Nothing is printed here: the driver asks `due()` and prints `line(step, t)`. Wall time comes
+!> from `system_clock`; the text itself is built by pure helpers that take the elapsed time as
+!> an argument (`format_progress_line`, `format_summary_line`, `format_hms`), so the
+!> formatting and the ETA are testable without a clock.
 module io_progress
+    use core_kinds, only: wp, i8
     implicit none
     private
+    public :: progress_t, format_progress_line, format_summary_line, format_hms, eta_seconds
+
+    !> Progress of a time-stepping run.
+    type :: progress_t
+        !> Number of steps of the run.
+        integer :: total_steps = 0
+        !> End time of the run [s].
+        real(wp) :: t_end = 0.0_wp
+        !> Minimum wall time between two progress lines [s].
+        real(wp) :: interval = 0.0_wp
+        !> Clock count at `start`.
+        integer(i8) :: start_count = 0
+        !> Clock count when `due` last returned true.
+        integer(i8) :: last_count = 0
+        !> Clock counts per second.
+        integer(i8) :: rate = 1
+    contains
+        procedure :: start => progress_start
+        procedure :: due => progress_due
+        procedure :: elapsed => progress_elapsed
+        procedure :: line => progress_line
+        procedure :: summary_line => progress_summary_line
+    end type progress_t
+
+contains
+
+    !> Start timing a run.
+    subroutine progress_start(self, total_steps, t_end, interval_seconds)
+        !> The progress object.
+        class(progress_t), intent(out) :: self
+        !> Number of steps of the run.
+        integer, intent(in) :: total_steps
+        !> End time of the run [s].
+        real(wp), intent(in) :: t_end
+        !> Minimum wall time between two progress lines [s] (0: every call to `due`).
+        real(wp), intent(in) :: interval_seconds
+        self%total_steps = total_steps
+        self%t_end = t_end
+        self%interval = interval_seconds
+        call system_clock(self%start_count, self%rate)
+        if (self%rate <= 0) self%rate = 1
+        self%last_count = self%start_count
+    end subroutine progress_start
+
+    !> True when at least `interval_seconds` of wall time have passed since `start` or since
+    !> the last time `due` returned true (the interval then restarts).
+    impure logical function progress_due(self)
+        !> The progress object (its interval restarts when the result is true).
+        class(progress_t), intent(inout) :: self
+        integer(i8) :: now
+        call system_clock(now)
+        progress_due = real(now - self%last_count, wp)/real(self%rate, wp) >= self%interval
+        if (progress_due) self%last_count = now
+    end function progress_due
+
+    !> Wall time since `start` [s].
+    impure real(wp) function progress_elapsed(self)
+        !> The progress object.
+        class(progress_t), intent(in) :: self
+        integer(i8) :: now
+        call system_clock(now)
+        progress_elapsed = real(now - self%start_count, wp)/real(self%rate, wp)
+    end function progress_elapsed
+
+    !> Progress line for the current step, e.g.
+    !> `step 1200/5000 (24.0%)  t = 1.2000E-03 s  wall 00:00:12  ETA 00:00:38`.
+    impure function progress_line(self, step, t) result(text)
+        !> The progress object.
+        class(progress_t), intent(in) :: self
+        !> Steps done.
+        integer, intent(in) :: step
+        !> Simulated time reached [s].
+        real(wp), intent(in) :: t
+        !> The line (no trailing newline).
+        character(len=:), allocatable :: text
+        text = format_progress_line(step, self%total_steps, t, self%t_end, self%elapsed())
+    end function progress_line
+
+    !> Closing line of a run, e.g. `done: 5000 steps, t = 5.0000E-03 s, wall 00:01:40
+    !> (20.000 ms/step)`.
+    impure function progress_summary_line(self, steps, t) result(text)
+        !> The progress object.
+        class(progress_t), intent(in) :: self
+        !> Steps done.
+        integer, intent(in) :: steps
+        !> Simulated time reached [s] (not shown when absent).
+        real(wp), intent(in), optional :: t
+        !> The line.
+        character(len=:), allocatable :: text
+        text = format_summary_line(steps, self%elapsed(), t)
+    end function progress_summary_line
+
+    !> Estimated remaining wall time [s] after `step` of `total_steps` steps took `elapsed`
+    !> seconds, assuming a constant cost per step; negative when unknown (no step done yet).
+    pure real(wp) function eta_seconds(step, total_steps, elapsed)
+        !> Steps done.
+        integer, intent(in) :: step
+        !> Number of steps of the run.
+        integer, intent(in) :: total_steps
+        !> Wall time spent so far [s].
+        real(wp), intent(in) :: elapsed
+        if (step <= 0) then
+            eta_seconds = -1.0_wp
+        else
+            eta_seconds = elapsed*real(max(total_steps - step, 0), wp)/real(step, wp)
+        end if
+    end function eta_seconds
+
+    !> Progress line built from explicit values (see `progress_t%line`).
+    pure function format_progress_line(step, total_steps, t, t_end, elapsed) result(text)
+        !> Steps done.
+        integer, intent(in) :: step
+        !> Number of steps of the run.
+        integer, intent(in) :: total_steps
+        !> Simulated time reached [s].
+        real(wp), intent(in) :: t
+        !> End time of the run [s] (not shown when <= 0).
+        real(wp), intent(in) :: t_end
+        !> Wall time spent so far [s].
+        real(wp), intent(in) :: elapsed
+        !> The line.
+        character(len=:), allocatable :: text
+        character(len=64) :: buf
+        real(wp) :: percent
+        write (buf, '(i0,a,i0)') step, '/', total_steps
+        text = 'step '//trim(buf)
+        if (total_steps > 0) then
+            percent = 100.0_wp*real(step, wp)/real(total_steps, wp)
+            text = text//' ('//fixed(percent, '(f0.1)')//'%)'
+        end if
+        write (buf, '(es11.4)') t
+        text = text//'  t = '//trim(adjustl(buf))
+        if (t_end > 0.0_wp) then
+            write (buf, '(es11.4)') t_end
+            text = text//' / '//trim(adjustl(buf))
+        end if
+        text = text//' s  wall '//format_hms(elapsed)//'  ETA ' &
+            //format_hms(eta_seconds(step, total_steps, elapsed))
+    end function format_progress_line
+
+    !> Summary line built from explicit values (see `progress_t%summary_line`).
+    pure function format_summary_line(steps, elapsed, t) result(text)
+        !> Steps done.
+        integer, intent(in) :: steps
+        !> Wall time of the run [s].
+        real(wp), intent(in) :: elapsed
+        !> Simulated time reached [s] (not shown when absent).
+        real(wp), intent(in), optional :: t
+        !> The line.
+        character(len=:), allocatable :: text
+        character(len=64) :: buf
+        write (buf, '(i0)') steps
+        text = 'done: '//trim(buf)//' steps'
+        if (present(t)) then
+            write (buf, '(es11.4)') t
+            text = text//', t = '//trim(adjustl(buf))//' s'
+        end if
+        text = text//', wall '//format_hms(elapsed)
+        if (steps > 0) then
+            text = text//' ('//fixed(1000.0_wp*elapsed/real(steps, wp), '(f0.3)')//' ms/step)'
+        end if
+    end function format_summary_line
+
+    !> Wall time as hh:mm:ss (rounded to the nearest second; hours grow past 99 as needed);
+    !> '--:--:--' for a negative (unknown) time.
+    pure function format_hms(seconds) result(text)
+        !> Time [s].
+        real(wp), intent(in) :: seconds
+        !> The text.
+        character(len=:), allocatable :: text
+        character(len=32) :: buf
+        integer(i8) :: s
+        if (seconds < 0.0_wp .or. seconds /= seconds) then
+            text = '--:--:--'
+            return
+        end if
+        s = nint(min(seconds, 3.6e12_wp), i8)
+        write (buf, '(i0.2,a,i2.2,a,i2.2)') s/3600, ':', mod(s/60, 60_i8), ':', mod(s, 60_i8)
+        text = trim(buf)
+    end function format_hms
+
+    !> A real in the fixed-point format `fmt` (e.g. '(f0.1)'), with a leading zero ('0.5').
+    pure function fixed(x, fmt) result(text)
+        !> Value.
+        real(wp), intent(in) :: x
+        !> Edit descriptor in parentheses.
+        character(len=*), intent(in) :: fmt
+        !> The text.
+        character(len=:), allocatable :: text
+        character(len=64) :: buf
+        write (buf, fmt) x
+        text = trim(adjustl(buf))
+        if (text(1:1) == '.') then
+            text = '0'//text
+        else if (len(text) >= 2) then
+            if (text(1:2) == '-.') text = '-0'//text(2:)
+        end if
+    end function fixed
 end module io_progress

@@ -1,0 +1,212 @@
+"""Load a MULTICOR results file (HDF5, layout in doc/output.md) into plain numpy arrays.
+
+Every array is in h5py (C) order: nodal fields are ``(n_nodes, 3)`` with the columns
+``u`` (x displacement), ``w`` (y displacement), ``theta`` (rotation about z); time series add
+a first axis, one entry per stored output.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from typing import Optional
+
+import h5py
+import numpy as np
+
+#: Column of each DOF in nodal arrays.
+U, W, THETA = 0, 1, 2
+
+
+class ResultsError(Exception):
+    """A results file is missing, unreadable or does not follow the documented layout."""
+
+
+@dataclass
+class Mesh:
+    """FE mesh: deck node ids, coordinates [m] and element connectivity (0-based indices)."""
+
+    node_id: np.ndarray        # (n_nodes,) int
+    x: np.ndarray              # (n_nodes,) [m]
+    y: np.ndarray              # (n_nodes,) [m]
+    connectivity: np.ndarray   # (n_elements, 2) int, 0-based node indices
+
+    @property
+    def n_nodes(self) -> int:
+        return int(self.node_id.size)
+
+    def index_of(self, node_id: int) -> int:
+        """Position of the node with deck id ``node_id``."""
+        hits = np.flatnonzero(self.node_id == node_id)
+        if hits.size == 0:
+            raise ResultsError(f"no node with id {node_id} (ids: {_id_range(self.node_id)})")
+        return int(hits[0])
+
+    def is_straight_along_x(self, rtol: float = 1e-9) -> bool:
+        """True when every node lies on one horizontal line (a straight beam along x)."""
+        size = max(np.ptp(self.x), np.ptp(self.y), 1e-300)
+        return bool(np.ptp(self.y) <= rtol * size)
+
+    def end_nodes(self) -> np.ndarray:
+        """Indices of the nodes that belong to exactly one element (free or supported ends)."""
+        counts = np.bincount(self.connectivity.ravel(), minlength=self.n_nodes)
+        return np.flatnonzero(counts == 1)
+
+
+@dataclass
+class Dynamic:
+    """Stored outputs of a dynamic run."""
+
+    time: np.ndarray           # (n_out,) [s]
+    displacement: np.ndarray   # (n_out, n_nodes, 3) [m, m, rad]
+    velocity: np.ndarray       # (n_out, n_nodes, 3) [m/s, m/s, rad/s]
+    acceleration: np.ndarray   # (n_out, n_nodes, 3) [m/s^2, m/s^2, rad/s^2]
+
+    def nearest_index(self, t: float) -> int:
+        """Index of the stored output whose time is nearest to ``t`` (first one on a tie)."""
+        if self.time.size == 0:
+            raise ResultsError("the results hold no stored output")
+        return int(np.argmin(np.abs(self.time - t)))
+
+
+@dataclass
+class Energy:
+    """Energy audit of a dynamic run [J]; balance = K + S + D - W - (same at the start)."""
+
+    time: np.ndarray
+    kinetic: np.ndarray
+    strain: np.ndarray
+    external_work: np.ndarray
+    damping: np.ndarray
+    balance: np.ndarray
+
+
+@dataclass
+class Static:
+    """Static solution."""
+
+    displacement: np.ndarray   # (n_nodes, 3) [m, m, rad]
+    reactions: np.ndarray      # (n_nodes, 3) [N, N, N.m]
+
+
+@dataclass
+class Modal:
+    """Eigenmodes, lowest first."""
+
+    omega: np.ndarray          # (n_modes,) [rad/s]
+    frequency: np.ndarray      # (n_modes,) [Hz]
+    shapes: np.ndarray         # (n_modes, n_nodes, 3), arbitrary scale
+
+
+@dataclass
+class Results:
+    """Everything in one results file; parts the run did not write are ``None``."""
+
+    path: str
+    attrs: dict                # root attributes as str (code_name, title, analysis, ...)
+    mesh: Mesh
+    dynamic: Optional[Dynamic] = None
+    energy: Optional[Energy] = None
+    static: Optional[Static] = None
+    modal: Optional[Modal] = None
+    summary: dict = field(default_factory=dict)
+
+    @property
+    def title(self) -> str:
+        return self.attrs.get("title", "") or os.path.basename(self.path)
+
+
+def load_results(path) -> Results:
+    """Read a results file. Raises ResultsError with a clear message when it is missing,
+    not an HDF5 file, or lacks a dataset of the documented layout."""
+    path = os.fspath(path)
+    if not os.path.exists(path):
+        hint = ""
+        if os.path.exists(path + ".partial"):
+            hint = f" ('{path}.partial' exists: the run did not finish)"
+        raise ResultsError(f"results file '{path}' does not exist{hint}")
+    try:
+        f = h5py.File(path, "r")
+    except OSError as exc:
+        raise ResultsError(f"'{path}' is not a readable HDF5 file ({exc})") from None
+    with f:
+        reader = _Reader(f, path)
+        mesh = Mesh(node_id=reader.array("fem/mesh/node_id", ndim=1).astype(int),
+                    x=reader.array("fem/mesh/coordinates", ndim=2, shape=(None, 2))[:, 0],
+                    y=reader.array("fem/mesh/coordinates", ndim=2, shape=(None, 2))[:, 1],
+                    connectivity=reader.array("fem/mesh/connectivity", ndim=2,
+                                              shape=(None, 2)).astype(int) - 1)
+        n = mesh.n_nodes
+        if mesh.x.size != n:
+            raise ResultsError(f"{path}: /fem/mesh/coordinates has {mesh.x.size} nodes, "
+                               f"/fem/mesh/node_id {n}")
+        if mesh.connectivity.size and (mesh.connectivity.min() < 0
+                                       or mesh.connectivity.max() >= n):
+            raise ResultsError(f"{path}: /fem/mesh/connectivity refers to nodes outside 1..{n}")
+        res = Results(path=path, attrs=_decode_attrs(f.attrs), mesh=mesh)
+        if "fem/time" in f:
+            time = reader.array("fem/time", ndim=1)
+            shape = (time.size, n, 3)
+            res.dynamic = Dynamic(time=time,
+                                  displacement=reader.array("fem/displacement", shape=shape),
+                                  velocity=reader.array("fem/velocity", shape=shape),
+                                  acceleration=reader.array("fem/acceleration", shape=shape))
+        if "energy" in f:
+            time = reader.array("energy/time", ndim=1)
+            parts = {name: reader.array(f"energy/{name}", shape=time.shape)
+                     for name in ("kinetic", "strain", "external_work", "damping", "balance")}
+            res.energy = Energy(time=time, **parts)
+        if "static" in f:
+            res.static = Static(displacement=reader.array("static/displacement", shape=(n, 3)),
+                                reactions=reader.array("static/reactions", shape=(n, 3)))
+        if "modal" in f:
+            omega = reader.array("modal/omega", ndim=1)
+            res.modal = Modal(omega=omega,
+                              frequency=reader.array("modal/frequency", shape=omega.shape),
+                              shapes=reader.array("modal/shapes", shape=(omega.size, n, 3)))
+        if "summary" in f:
+            res.summary = _decode_attrs(f["summary"].attrs)
+    return res
+
+
+class _Reader:
+    """Reads datasets with shape checks and messages that name the file and the dataset."""
+
+    def __init__(self, f, path):
+        self.f = f
+        self.path = path
+
+    def array(self, name, ndim=None, shape=None):
+        if name not in self.f or not isinstance(self.f[name], h5py.Dataset):
+            raise ResultsError(f"{self.path}: missing dataset '/{name}' (not a MULTICOR "
+                               "results file, or one from another version)")
+        data = np.asarray(self.f[name][()], dtype=float if self.f[name].dtype.kind == "f"
+                          else None)
+        if shape is not None:
+            ndim = len(shape)
+        if ndim is not None and data.ndim != ndim:
+            raise ResultsError(f"{self.path}: dataset '/{name}' has {data.ndim} dimensions, "
+                               f"expected {ndim}")
+        if shape is not None and any(want is not None and got != want
+                                     for got, want in zip(data.shape, shape)):
+            want = tuple("n" if s is None else s for s in shape)
+            raise ResultsError(f"{self.path}: dataset '/{name}' has shape {data.shape}, "
+                               f"expected {want}")
+        return data
+
+
+def _decode_attrs(attrs) -> dict:
+    out = {}
+    for key, value in attrs.items():
+        if isinstance(value, (bytes, np.bytes_)):
+            value = value.decode("utf-8", errors="replace")
+        elif isinstance(value, np.generic):
+            value = value.item()
+        out[key] = value
+    return out
+
+
+def _id_range(ids) -> str:
+    ids = np.asarray(ids)
+    if ids.size == 0:
+        return "none"
+    return f"{ids.min()}..{ids.max()}"

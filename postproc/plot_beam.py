@@ -1,0 +1,48 @@
+#!/usr/bin/env python3
+"""Plot a MULTICOR beam results file to PNG files and print their paths.
+
+    plot_beam.py results.h5 [--time T] [--node ID] [--out DIR] [--scale S]
+
+Writes, depending on what the run stored: <name>_deflection.png (deflection along a straight
+beam, or the deformed shape of a frame, at the stored time nearest to T; default the last),
+<name>_history_node<ID>.png (w(t) and u(t) of node ID; default the tip), <name>_energy.png,
+<name>_static.png and <name>_modes.png. Exit code 1 with a message on a missing or invalid
+file.
+"""
+import argparse
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+from multicor_post.beam import write_all  # noqa: E402
+from multicor_post.results import ResultsError, load_results  # noqa: E402
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="plot_beam.py", description=__doc__.split("\n")[0])
+    parser.add_argument("results", help="results file (.h5) written by multicor")
+    parser.add_argument("--time", type=float, default=None,
+                        help="time [s] of the deflection plot (nearest stored output; "
+                             "default: the last one)")
+    parser.add_argument("--node", type=int, default=None,
+                        help="deck id of the node whose history is plotted (default: the tip)")
+    parser.add_argument("--out", default=None,
+                        help="folder for the PNG files (default: the results file's folder)")
+    parser.add_argument("--scale", type=float, default=None,
+                        help="displacement scale factor of deformed-shape plots (default: auto)")
+    args = parser.parse_args(argv)
+    out = args.out if args.out is not None else (os.path.dirname(args.results) or ".")
+    try:
+        res = load_results(args.results)
+        paths = write_all(res, out, time=args.time, node_id=args.node, scale=args.scale)
+    except ResultsError as exc:
+        print(f"plot_beam.py: error: {exc}", file=sys.stderr)
+        return 1
+    for path in paths:
+        print(path)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,125 @@
+"""Plots: element interpolation against the analytic cantilever, tip detection, PNG output."""
+import math
+
+import numpy as np
+import pytest
+from synthetic import L, cantilever_layout, cantilever_theta, cantilever_w, rotate
+
+import plot_beam
+from multicor_post import load_results
+from multicor_post.beam import auto_scale, default_node, element_fields, plot_deflection
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def mesh_of(path):
+    return load_results(path).mesh
+
+
+def test_hermite_interpolation_reproduces_the_cubic_cantilever(cantilever_file):
+    res = load_results(cantilever_file(parts=("static",)))
+    curves = element_fields(res.mesh, res.static.displacement, points=7)
+    w_max = abs(cantilever_w(L))
+    for x, y, ux, uy in curves:
+        # The deflection is cubic: Hermite elements hold it exactly, up to round-off
+        # (~1e-16 relative per operation, a few dozen operations).
+        assert np.max(np.abs(uy - cantilever_w(x))) < 1e-13 * w_max
+        assert np.max(np.abs(ux)) < 1e-13 * w_max
+        np.testing.assert_array_equal(y, 0.0)
+
+
+def test_hermite_interpolation_in_an_inclined_member(cantilever_file):
+    angle = math.radians(30.0)
+    res = load_results(cantilever_file(angle=angle, parts=("static",)))
+    w_max = abs(cantilever_w(L))
+    for x, y, ux, uy in element_fields(res.mesh, res.static.displacement, points=5):
+        s = np.hypot(x, y)
+        u_ref, w_ref = rotate(angle, np.zeros_like(s), cantilever_w(s))
+        # Same cubic in the member's frame; rotation adds a few roundings.
+        assert np.max(np.abs(ux - u_ref)) < 1e-13 * w_max
+        assert np.max(np.abs(uy - w_ref)) < 1e-13 * w_max
+
+
+def test_rotation_is_the_slope_of_the_deflection():
+    # Guards the sign convention of the synthetic data the other tests rely on.
+    x, h = 1.3, 1e-6
+    slope = (cantilever_w(x + h) - cantilever_w(x - h)) / (2 * h)
+    # Central difference of a cubic: error h^2 * w'''/6 ~ 1e-14, far below 1e-9.
+    assert slope == pytest.approx(cantilever_theta(x), rel=1e-9)
+
+
+def test_default_node_is_the_free_end(cantilever_file):
+    res = load_results(cantilever_file())
+    assert default_node(res) == 90
+
+
+def test_auto_scale_is_round_and_makes_the_largest_displacement_visible():
+    ids, xy, conn, d = cantilever_layout()
+    from multicor_post.results import Mesh
+    mesh = Mesh(node_id=ids, x=xy[:, 0], y=xy[:, 1], connectivity=conn - 1)
+    scale = auto_scale(mesh, d)
+    mantissa = scale / 10 ** math.floor(math.log10(scale))
+    assert mantissa == pytest.approx(1.0) or mantissa == pytest.approx(2.0) \
+        or mantissa == pytest.approx(5.0)
+    # Target 10 % of the size; rounding down to 1-2-5 keeps it within a factor 2.5.
+    shown = scale * np.max(np.abs(d[:, 1])) / L
+    assert 0.04 <= shown <= 0.1 + 1e-12
+
+
+def test_deflection_title_states_the_nearest_stored_time(cantilever_file):
+    res = load_results(cantilever_file())
+    fig, k = plot_deflection(res, time=4.4e-3)
+    assert k == 4
+    title = fig.axes[0].get_title()
+    assert "t = 4 ms" in title and "nearest" in title
+
+
+def check_pngs(paths):
+    assert paths
+    for path in paths:
+        with open(path, "rb") as f:
+            head = f.read(8)
+        assert head == PNG_SIGNATURE
+        assert path.stat().st_size > 5000
+
+
+def test_cli_writes_every_plot_of_a_straight_cantilever(cantilever_file, tmp_path, capsys):
+    path = cantilever_file()
+    out = tmp_path / "png"
+    assert plot_beam.main([str(path), "--time", "0.005", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out.split()
+    names = sorted(p.name for p in out.iterdir())
+    assert names == ["cantilever_deflection.png", "cantilever_energy.png",
+                     "cantilever_history_node90.png", "cantilever_modes.png",
+                     "cantilever_static.png"]
+    assert sorted(printed) == sorted(str(out / n) for n in names)
+    check_pngs(list(out.iterdir()))
+
+
+def test_cli_plots_the_deformed_shape_of_an_l_frame(tmp_path, capsys):
+    from synthetic import write_results
+    # Column up the y axis (nodes 1-5), then a beam along x (nodes 5-9).
+    ids = np.arange(1, 10, dtype=np.int32)
+    xy = np.array([[0, 0], [0, .5], [0, 1], [0, 1.5], [0, 2],
+                   [.5, 2], [1, 2], [1.5, 2], [2, 2]], dtype=float)
+    conn = np.column_stack([np.arange(1, 9), np.arange(2, 10)]).astype(np.int32)
+    d = np.zeros((9, 3))
+    d[:, 0] = 1e-3 * xy[:, 1]
+    d[:, 1] = -2e-3 * xy[:, 0]
+    path = write_results(tmp_path / "lframe.h5", ids, xy, conn, d, parts=("dynamic",))
+    out = tmp_path / "png"
+    assert plot_beam.main([str(path), "--node", "5", "--out", str(out), "--scale", "100"]) == 0
+    names = sorted(p.name for p in out.iterdir())
+    assert names == ["lframe_deflection.png", "lframe_history_node5.png"]
+    check_pngs(list(out.iterdir()))
+
+
+def test_cli_reports_a_missing_file_and_exits_1(tmp_path, capsys):
+    assert plot_beam.main([str(tmp_path / "none.h5")]) == 1
+    assert "does not exist" in capsys.readouterr().err
+
+
+def test_cli_reports_a_missing_dataset_and_exits_1(cantilever_file, capsys):
+    path = cantilever_file(drop=("energy/balance",))
+    assert plot_beam.main([str(path)]) == 1
+    assert "missing dataset '/energy/balance'" in capsys.readouterr().err
