@@ -1,5 +1,806 @@
-!> Placeholder: to be written.
+!> From a validated deck to plain configuration types: `run_config_t` (what to compute and
+!> how) and `fem_beam_config::beam_config_t` (the frame). The deck reader has checked each
+!> line on its own; here come the checks across lines: references to node, section and
+!> function ids, duplicate ids, zero-length or duplicate elements, loads and initial
+!> conditions on fixed DOFs, table times, an empty model. Each error names the deck file,
+!> the line and the keyword concerned.
+!>
+!> Nodes come from `node` records and `line` generators. A `line` creates nodes
+!> first_node..first_node+elements equally spaced from (x1, y1) to (x2, y2) and the elements
+!> between them; a node id that already exists is reused when its coordinates coincide
+!> (|dx|, |dy| <= 1e-9 line length), otherwise it is an error. Node ids are mapped to
+!> indices 1..n in increasing id order (`beam%node_id(i)` is the deck id of node i).
 module driver_config
+    use core_kinds, only: wp, i8
+    use core_error, only: error_t, make_input_error
+    use core_strings, only: to_str
+    use core_timefunc, only: tf_constant, tf_ramp, tf_step, tf_table, tf_harmonic
+    use fem_beam_config, only: beam_config_t, dof_u, dof_w, dof_theta
+    use io_deck, only: deck_t, deck_entry_t
     implicit none
     private
+    public :: run_config_t, build_config
+
+    !> What to compute and how (everything but the model itself).
+    type :: run_config_t
+        !> Title of the run.
+        character(len=:), allocatable :: title
+        !> 'static', 'modal' or 'dynamic'.
+        character(len=:), allocatable :: analysis
+        !> 'average_acceleration', 'newmark' or 'central_difference'.
+        character(len=:), allocatable :: scheme
+        !> Newmark beta in effect (0.25 average acceleration, 0 central difference).
+        real(wp) :: beta = 0.25_wp
+        !> Newmark gamma in effect (0.5 for average acceleration and central difference).
+        real(wp) :: gamma = 0.5_wp
+        !> Time step [s] (dynamic; 0 otherwise).
+        real(wp) :: h = 0.0_wp
+        !> End time [s] (dynamic; 0 otherwise).
+        real(wp) :: t_end = 0.0_wp
+        !> Number of modes to compute (modal).
+        integer :: n_modes = 3
+        !> Time steps between stored states.
+        integer :: output_interval = 1
+        !> Wall-clock seconds between progress lines (0 = none).
+        real(wp) :: progress_seconds = 5.0_wp
+        !> Initial displacements (3, n_nodes) [m, rad]; zero unless given in [initial].
+        real(wp), allocatable :: u0(:, :)
+        !> Initial velocities (3, n_nodes) [m/s, rad/s]; zero unless given in [initial].
+        real(wp), allocatable :: v0(:, :)
+    end type run_config_t
+
+    !> Relative tolerance for coincident nodes and zero lengths (times a length).
+    real(wp), parameter :: coincidence = 1.0e-9_wp
+
+    !> A node before numbering: deck id, position, where it was defined.
+    type :: node_candidate_t
+        !> Deck id.
+        integer :: id = 0
+        !> Position [m].
+        real(wp) :: x = 0.0_wp, y = 0.0_wp
+        !> Coincidence tolerance [m] (0 for an explicit node).
+        real(wp) :: tol = 0.0_wp
+        !> Deck line.
+        integer :: line = 0
+        !> Created by a `line` generator (else a `node` record).
+        logical :: generated = .false.
+    end type node_candidate_t
+
+    !> An element before numbering: deck ids of its nodes and section, where it was defined.
+    type :: element_candidate_t
+        !> Element id (explicit elements) or 0 (generated).
+        integer :: id = 0
+        !> Deck ids of the end nodes.
+        integer :: node(2) = 0
+        !> Deck id of the section.
+        integer :: section = 0
+        !> Deck line.
+        integer :: line = 0
+        !> Created by a `line` generator (else an `element` record).
+        logical :: generated = .false.
+    end type element_candidate_t
+
+contains
+
+    !> Fill the run and beam configurations from a validated deck, with cross checks.
+    subroutine build_config(deck, run, beam, error)
+        !> Deck read by io_deck::read_deck with the MULTICOR schema.
+        type(deck_t), intent(in) :: deck
+        !> Run configuration.
+        type(run_config_t), intent(out) :: run
+        !> Beam model configuration.
+        type(beam_config_t), intent(out) :: beam
+        !> Error naming file, line and keyword, if any.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: section_ids(:), function_ids(:), fix_line(:, :)
+        call build_sections(deck, beam, section_ids, error)
+        if (allocated(error)) return
+        call build_mesh(deck, section_ids, beam, error)
+        if (allocated(error)) return
+        call build_functions(deck, beam, function_ids, error)
+        if (allocated(error)) return
+        call build_supports(deck, beam, fix_line, error)
+        if (allocated(error)) return
+        call build_loads(deck, function_ids, fix_line, beam, error)
+        if (allocated(error)) return
+        beam%lumped_mass = deck%get_word('beam', 'mass') == 'lumped'
+        beam%rayleigh_a0 = deck%get_real('beam', 'rayleigh', 1)
+        beam%rayleigh_a1 = deck%get_real('beam', 'rayleigh', 2)
+        call build_run(deck, beam, run, error)
+        if (allocated(error)) return
+        call build_initial(deck, beam, fix_line, run, error)
+    end subroutine build_config
+
+    !> Sections, with unique ids.
+    subroutine build_sections(deck, beam, ids, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Beam configuration (sections filled).
+        type(beam_config_t), intent(inout) :: beam
+        !> Deck id of each section.
+        integer, allocatable, intent(out) :: ids(:)
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        type(deck_entry_t), allocatable :: list(:)
+        type(deck_entry_t) :: e
+        integer :: i, n, j
+        allocate (list, source=deck%records('beam', 'section'))
+        n = size(list)
+        allocate (beam%sections(n), ids(n))
+        do i = 1, n
+            e = list(i)
+            ids(i) = e%int(1)
+            j = find_id(ids(:i - 1), ids(i))
+            if (j > 0) then
+                call make_input_error(error, deck%file, e%line, 'section', &
+                    'duplicate section id '// &
+                    to_str(ids(i))//': already defined on line '//to_str(list(j)%line))
+                return
+            end if
+            beam%sections(i)%young = e%real(2)
+            beam%sections(i)%density = e%real(3)
+            beam%sections(i)%area = e%real(4)
+            beam%sections(i)%inertia = e%real(5)
+        end do
+    end subroutine build_sections
+
+    !> Nodes and elements from `node`, `line` and `element` records (in file order).
+    subroutine build_mesh(deck, section_ids, beam, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Deck ids of the sections.
+        integer, intent(in) :: section_ids(:)
+        !> Beam configuration (x, y, node_id, conn, elem_section filled).
+        type(beam_config_t), intent(inout) :: beam
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        type(node_candidate_t), allocatable :: nodes(:)
+        type(element_candidate_t), allocatable :: elements(:)
+        integer, allocatable :: def_line(:)
+        logical, allocatable :: def_generated(:)
+        integer :: n_nodes, n_elements
+        call collect_candidates(deck, nodes, n_nodes, elements, n_elements, error)
+        if (allocated(error)) return
+        call merge_nodes(deck, nodes(:n_nodes), beam, def_line, def_generated, error)
+        if (allocated(error)) return
+        if (n_elements == 0) then
+            call make_input_error(error, deck%file, 0, '', 'the model has no element: '// &
+                'add [beam] line or element records')
+            return
+        end if
+        call resolve_elements(deck, elements(:n_elements), section_ids, def_line, &
+            def_generated, beam, error)
+    end subroutine build_mesh
+
+    !> Walk the [beam] entries in file order; list node and element candidates.
+    subroutine collect_candidates(deck, nodes, n_nodes, elements, n_elements, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Node candidates (first n_nodes used).
+        type(node_candidate_t), allocatable, intent(out) :: nodes(:)
+        !> Number of node candidates.
+        integer, intent(out) :: n_nodes
+        !> Element candidates (first n_elements used).
+        type(element_candidate_t), allocatable, intent(out) :: elements(:)
+        !> Number of element candidates.
+        integer, intent(out) :: n_elements
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: i, j, ne, first, stat
+        integer(i8) :: total_nodes, total_elements
+        real(wp) :: x1, y1, x2, y2, length, size_model
+        ! Sizes first, so that arrays are allocated once.
+        total_nodes = 0
+        total_elements = 0
+        do i = 1, size(deck%entries)
+            associate (e => deck%entries(i))
+                if (e%section /= 'beam') cycle
+                select case (e%keyword)
+                case ('node')
+                    total_nodes = total_nodes + 1
+                case ('element')
+                    total_elements = total_elements + 1
+                case ('line')
+                    if (e%int(1) > huge(0) - e%int(6)) then
+                        call make_input_error(error, deck%file, e%line, 'line', 'node ids '// &
+                            e%word(1)//' + '//e%word(6)//' exceed the largest integer')
+                        return
+                    end if
+                    total_nodes = total_nodes + e%int(6) + 1
+                    total_elements = total_elements + e%int(6)
+                end select
+            end associate
+        end do
+        stat = 1
+        if (max(total_nodes, total_elements) < huge(0)) then
+            allocate (nodes(total_nodes), elements(total_elements), stat=stat)
+        end if
+        if (stat /= 0) then
+            call make_input_error(error, deck%file, 0, '', 'the model is too large: '// &
+                'cannot hold its nodes and elements in memory')
+            return
+        end if
+        size_model = model_size(deck)
+        n_nodes = 0
+        n_elements = 0
+        do i = 1, size(deck%entries)
+            associate (e => deck%entries(i))
+                if (e%section /= 'beam') cycle
+                select case (e%keyword)
+                case ('node')
+                    n_nodes = n_nodes + 1
+                    nodes(n_nodes) = node_candidate_t(e%int(1), e%real(2), e%real(3), 0.0_wp, &
+                        e%line, .false.)
+                case ('element')
+                    n_elements = n_elements + 1
+                    elements(n_elements) = element_candidate_t(e%int(1), [e%int(2), e%int(3)], &
+                        e%int(4), e%line, .false.)
+                case ('line')
+                    first = e%int(1)
+                    x1 = e%real(2)
+                    y1 = e%real(3)
+                    x2 = e%real(4)
+                    y2 = e%real(5)
+                    ne = e%int(6)
+                    length = hypot(x2 - x1, y2 - y1)
+                    if (length <= coincidence*size_model) then
+                        call make_input_error(error, deck%file, e%line, 'line', &
+                            'zero-length line: (x1, y1) and (x2, y2) coincide')
+                        return
+                    end if
+                    do j = 0, ne
+                        n_nodes = n_nodes + 1
+                        nodes(n_nodes) = node_candidate_t(first + j, &
+                            x1 + (x2 - x1)*real(j, wp)/real(ne, wp), &
+                            y1 + (y2 - y1)*real(j, wp)/real(ne, wp), &
+                            coincidence*length, e%line, .true.)
+                    end do
+                    do j = 1, ne
+                        n_elements = n_elements + 1
+                        elements(n_elements) = element_candidate_t(0, [first + j - 1, first + j], &
+                            e%int(7), e%line, .true.)
+                    end do
+                end select
+            end associate
+        end do
+    end subroutine collect_candidates
+
+    !> Size of the model: diagonal of the bounding box of all nodes and line ends [m].
+    function model_size(deck) result(size_model)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        real(wp) :: size_model
+        real(wp) :: lo(2), hi(2)
+        integer :: i
+        lo = huge(1.0_wp)
+        hi = -huge(1.0_wp)
+        do i = 1, size(deck%entries)
+            associate (e => deck%entries(i))
+                if (e%section /= 'beam') cycle
+                if (e%keyword == 'node' .or. e%keyword == 'line') then
+                    lo = min(lo, [e%real(2), e%real(3)])
+                    hi = max(hi, [e%real(2), e%real(3)])
+                end if
+                if (e%keyword == 'line') then
+                    lo = min(lo, [e%real(4), e%real(5)])
+                    hi = max(hi, [e%real(4), e%real(5)])
+                end if
+            end associate
+        end do
+        size_model = 0.0_wp
+        if (all(hi >= lo)) size_model = hypot(hi(1) - lo(1), hi(2) - lo(2))
+    end function model_size
+
+    !> Merge candidates with the same id (generated nodes reuse coincident existing ones),
+    !> number the nodes in increasing id order, fill x, y and node_id.
+    subroutine merge_nodes(deck, nodes, beam, def_line, def_generated, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Node candidates in file order.
+        type(node_candidate_t), intent(in) :: nodes(:)
+        !> Beam configuration (x, y, node_id filled).
+        type(beam_config_t), intent(inout) :: beam
+        !> Deck line defining each node.
+        integer, allocatable, intent(out) :: def_line(:)
+        !> Whether each node was defined by a generator.
+        logical, allocatable, intent(out) :: def_generated(:)
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: order(size(nodes))
+        integer :: i, n, ref
+        order = sort_index([(int(nodes(i)%id, i8), i=1, size(nodes))])
+        allocate (beam%x(size(nodes)), beam%y(size(nodes)), beam%node_id(size(nodes)))
+        allocate (def_line(size(nodes)), def_generated(size(nodes)))
+        n = 0
+        ref = 0
+        do i = 1, size(nodes)
+            associate (c => nodes(order(i)))
+                if (n > 0) then
+                    if (c%id == beam%node_id(n)) then
+                        call check_same_node(nodes(ref), c)
+                        if (allocated(error)) return
+                        cycle
+                    end if
+                end if
+                n = n + 1
+                ref = order(i)
+                beam%node_id(n) = c%id
+                beam%x(n) = c%x
+                beam%y(n) = c%y
+                def_line(n) = c%line
+                def_generated(n) = c%generated
+            end associate
+        end do
+        beam%x = beam%x(:n)
+        beam%y = beam%y(:n)
+        beam%node_id = beam%node_id(:n)
+        def_line = def_line(:n)
+        def_generated = def_generated(:n)
+
+    contains
+
+        !> A second definition of a node id: an error unless a generator meets a coincident
+        !> existing node.
+        subroutine check_same_node(first, again)
+            type(node_candidate_t), intent(in) :: first, again
+            character(len=:), allocatable :: keyword
+            keyword = merge('line', 'node', again%generated)
+            if (.not. again%generated) then
+                call make_input_error(error, deck%file, again%line, keyword, &
+                    'duplicate node id '// &
+                    to_str(again%id)//': already defined on line '// &
+                    to_str(first%line))
+            else if (abs(again%x - first%x) > again%tol .or. &
+                     abs(again%y - first%y) > again%tol) then
+                call make_input_error(error, deck%file, again%line, keyword, 'node '// &
+                    to_str(again%id)//' would be at ('//to_str(again%x)//', '// &
+                    to_str(again%y)//') but already exists at ('//to_str(first%x)// &
+                    ', '//to_str(first%y)//') (line '//to_str(first%line)// &
+                    '); a line reuses an existing node only where they coincide')
+            end if
+        end subroutine check_same_node
+    end subroutine merge_nodes
+
+    !> Node indices and section indices of elements; checks unknown ids, duplicate element
+    !> ids, zero-length and duplicate elements, nodes connected to no element.
+    subroutine resolve_elements(deck, elements, section_ids, def_line, def_generated, beam, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Element candidates in file order.
+        type(element_candidate_t), intent(in) :: elements(:)
+        !> Deck ids of the sections.
+        integer, intent(in) :: section_ids(:)
+        !> Deck line defining each node.
+        integer, intent(in) :: def_line(:)
+        !> Whether each node was defined by a generator.
+        logical, intent(in) :: def_generated(:)
+        !> Beam configuration (conn, elem_section filled).
+        type(beam_config_t), intent(inout) :: beam
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: order(:)
+        integer(i8), allocatable :: keys(:)
+        logical, allocatable :: connected(:)
+        integer :: i, k, ne, a, b
+        real(wp) :: size_model, length
+        ne = size(elements)
+        allocate (beam%conn(2, ne), beam%elem_section(ne), keys(ne))
+        size_model = 0.0_wp
+        if (size(beam%x) > 0) size_model = hypot(maxval(beam%x) - minval(beam%x), &
+            maxval(beam%y) - minval(beam%y))
+        do i = 1, ne
+            associate (c => elements(i), kw => merge('line   ', 'element', elements(i)%generated))
+                do k = 1, 2
+                    beam%conn(k, i) = find_node(beam%node_id, c%node(k))
+                    if (beam%conn(k, i) == 0) then
+                        call make_input_error(error, deck%file, c%line, trim(kw), 'node '// &
+                            to_str(c%node(k))//' is not defined (no node or '// &
+                            'line record creates it)')
+                        return
+                    end if
+                end do
+                beam%elem_section(i) = find_id(section_ids, c%section)
+                if (beam%elem_section(i) == 0) then
+                    call make_input_error(error, deck%file, c%line, trim(kw), 'section '// &
+                        to_str(c%section)//' is not defined (no [beam] section '// &
+                        'record with this id)')
+                    return
+                end if
+                a = beam%conn(1, i)
+                b = beam%conn(2, i)
+                length = hypot(beam%x(b) - beam%x(a), beam%y(b) - beam%y(a))
+                if (length <= coincidence*size_model) then
+                    call make_input_error(error, deck%file, c%line, trim(kw), &
+                        'zero-length element: '// &
+                        'nodes '//to_str(c%node(1))//' and '//to_str(c%node(2))// &
+                        ' are at the same place')
+                    return
+                end if
+                keys(i) = int(min(a, b), i8)*int(size(beam%x) + 1, i8) + int(max(a, b), i8)
+            end associate
+        end do
+        ! Duplicate element ids (explicit elements) and duplicate node pairs.
+        order = sort_index([(merge(0_i8, int(elements(i)%id, i8), elements(i)%generated), &
+            i=1, ne)])
+        do i = 2, ne
+            associate (c => elements(order(i)), prev => elements(order(i - 1)))
+                if (.not. c%generated .and. .not. prev%generated .and. c%id == prev%id) then
+                    call make_input_error(error, deck%file, c%line, 'element', &
+                        'duplicate element id '// &
+                        to_str(c%id)//': already defined on line '//to_str(prev%line))
+                    return
+                end if
+            end associate
+        end do
+        order = sort_index(keys)
+        do i = 2, ne
+            if (keys(order(i)) == keys(order(i - 1))) then
+                associate (c => elements(order(i)), prev => elements(order(i - 1)))
+                    call make_input_error(error, deck%file, c%line, &
+                        trim(merge('line   ', 'element', c%generated)), &
+                        'element between nodes '//to_str(c%node(1))//' and '// &
+                        to_str(c%node(2))//' duplicates one defined on line '// &
+                        to_str(prev%line))
+                    return
+                end associate
+            end if
+        end do
+        allocate (connected(size(beam%x)))
+        connected = .false.
+        connected(beam%conn(1, :)) = .true.
+        connected(beam%conn(2, :)) = .true.
+        do i = 1, size(connected)
+            if (.not. connected(i)) then
+                call make_input_error(error, deck%file, def_line(i), &
+                    trim(merge('line', 'node', def_generated(i))), 'node '// &
+                    to_str(beam%node_id(i))//' is connected to no element')
+                return
+            end if
+        end do
+    end subroutine resolve_elements
+
+    !> Time functions, with unique ids and increasing table times.
+    subroutine build_functions(deck, beam, ids, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Beam configuration (functions filled).
+        type(beam_config_t), intent(inout) :: beam
+        !> Deck id of each function.
+        integer, allocatable, intent(out) :: ids(:)
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        type(deck_entry_t), allocatable :: list(:)
+        type(deck_entry_t) :: e
+        real(wp), allocatable :: tail(:)
+        integer :: i, j, n
+        allocate (list, source=deck%records('functions', 'function'))
+        n = size(list)
+        allocate (beam%functions(n), ids(n))
+        do i = 1, n
+            e = list(i)
+            ids(i) = e%int(1)
+            j = find_id(ids(:i - 1), ids(i))
+            if (j > 0) then
+                call make_input_error(error, deck%file, e%line, 'function', &
+                    'duplicate function id '// &
+                    to_str(ids(i))//': already defined on line '//to_str(list(j)%line))
+                return
+            end if
+            tail = e%reals_from(3)
+            associate (f => beam%functions(i))
+                select case (e%word(2))
+                case ('constant')
+                    f%kind = tf_constant
+                case ('ramp')
+                    f%kind = tf_ramp
+                case ('step')
+                    f%kind = tf_step
+                case ('harmonic')
+                    f%kind = tf_harmonic
+                case ('table')
+                    f%kind = tf_table
+                end select
+                if (f%kind == tf_table) then
+                    f%t = tail(1::2)
+                    f%f = tail(2::2)
+                    do j = 2, size(f%t)
+                        if (f%t(j) <= f%t(j - 1)) then
+                            call make_input_error(error, deck%file, e%line, 'function', &
+                                'table times must increase strictly: t = '// &
+                                e%word(2*j + 1)//' follows t = '//e%word(2*j - 1))
+                            return
+                        end if
+                    end do
+                else
+                    f%p = 0.0_wp
+                    f%p(:size(tail)) = tail
+                end if
+            end associate
+        end do
+    end subroutine build_functions
+
+    !> Fixed DOFs; `fix_line(dof, node)` is the line fixing it (0 = free).
+    subroutine build_supports(deck, beam, fix_line, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Beam configuration (fixed filled).
+        type(beam_config_t), intent(inout) :: beam
+        !> Line of the `fix` record fixing each DOF (0 if free).
+        integer, allocatable, intent(out) :: fix_line(:, :)
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        type(deck_entry_t), allocatable :: list(:)
+        type(deck_entry_t) :: e
+        integer :: i, k, node, dof
+        allocate (beam%fixed(3, size(beam%x)), fix_line(3, size(beam%x)))
+        beam%fixed = .false.
+        fix_line = 0
+        allocate (list, source=deck%records('beam', 'fix'))
+        do i = 1, size(list)
+            e = list(i)
+            node = find_node(beam%node_id, e%int(1))
+            if (node == 0) then
+                call unknown_node(deck, e, 'fix', error)
+                return
+            end if
+            do k = 2, e%n_values()
+                if (e%word(k) == 'all') then
+                    where (fix_line(:, node) == 0) fix_line(:, node) = e%line
+                else
+                    dof = dof_index(e%word(k))
+                    if (fix_line(dof, node) == 0) fix_line(dof, node) = e%line
+                end if
+            end do
+        end do
+        beam%fixed = fix_line > 0
+    end subroutine build_supports
+
+    !> Nodal loads: known node and function, free DOF.
+    subroutine build_loads(deck, function_ids, fix_line, beam, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Deck id of each function.
+        integer, intent(in) :: function_ids(:)
+        !> Line fixing each DOF (0 if free).
+        integer, intent(in) :: fix_line(:, :)
+        !> Beam configuration (loads filled).
+        type(beam_config_t), intent(inout) :: beam
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        type(deck_entry_t), allocatable :: list(:)
+        type(deck_entry_t) :: e
+        integer :: i
+        allocate (list, source=deck%records('beam', 'load'))
+        allocate (beam%loads(size(list)))
+        do i = 1, size(list)
+            e = list(i)
+            associate (load => beam%loads(i))
+                load%node = find_node(beam%node_id, e%int(1))
+                if (load%node == 0) then
+                    call unknown_node(deck, e, 'load', error)
+                    return
+                end if
+                load%dof = dof_index(e%word(2))
+                if (fix_line(load%dof, load%node) > 0) then
+                    call on_fixed_dof(deck, e, 'load', fix_line(load%dof, load%node), error)
+                    return
+                end if
+                load%value = e%real(3)
+                load%func = 0
+                if (e%n_values() >= 4) then
+                    load%func = find_id(function_ids, e%int(4))
+                    if (load%func == 0) then
+                        call make_input_error(error, deck%file, e%line, 'load', 'function '// &
+                            e%word(4)//' is not defined (no [functions] '// &
+                            'function record with this id)')
+                        return
+                    end if
+                end if
+            end associate
+        end do
+    end subroutine build_loads
+
+    !> Run settings: analysis, time integration, modes, output.
+    subroutine build_run(deck, beam, run, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Beam configuration (for the number of free DOFs).
+        type(beam_config_t), intent(in) :: beam
+        !> Run configuration.
+        type(run_config_t), intent(inout) :: run
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: n_free
+        run%title = deck%get_text('run', 'title')
+        run%analysis = deck%get_word('run', 'analysis')
+        run%scheme = deck%get_word('time', 'scheme')
+        select case (run%scheme)
+        case ('newmark')
+            run%beta = deck%get_real('time', 'beta')
+            run%gamma = deck%get_real('time', 'gamma')
+        case ('central_difference')
+            run%beta = 0.0_wp
+            run%gamma = 0.5_wp
+        case default
+            run%beta = 0.25_wp
+            run%gamma = 0.5_wp
+        end select
+        run%h = deck%get_real('time', 'step')
+        run%t_end = deck%get_real('time', 'end')
+        if (run%analysis == 'dynamic' .and. run%h > run%t_end) then
+            call make_input_error(error, deck%file, deck%line('time', 'step'), 'step', &
+                'time step '// &
+                deck%get_word('time', 'step')//' is larger than the end time '// &
+                deck%get_word('time', 'end'))
+            return
+        end if
+        run%n_modes = deck%get_int('modal', 'modes')
+        n_free = count(.not. beam%fixed)
+        if (run%analysis == 'modal' .and. run%n_modes > n_free) then
+            call make_input_error(error, deck%file, deck%line('modal', 'modes'), 'modes', &
+                to_str(run%n_modes)//' modes asked but the model has only '// &
+                to_str(n_free)//' free DOFs')
+            return
+        end if
+        run%output_interval = deck%get_int('output', 'interval')
+        run%progress_seconds = deck%get_real('output', 'progress')
+    end subroutine build_run
+
+    !> Initial displacements and velocities on free DOFs.
+    subroutine build_initial(deck, beam, fix_line, run, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Beam configuration.
+        type(beam_config_t), intent(in) :: beam
+        !> Line fixing each DOF (0 if free).
+        integer, intent(in) :: fix_line(:, :)
+        !> Run configuration (u0, v0 filled).
+        type(run_config_t), intent(inout) :: run
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        allocate (run%u0(3, size(beam%x)), run%v0(3, size(beam%x)))
+        run%u0 = 0.0_wp
+        run%v0 = 0.0_wp
+        call fill(deck%records('initial', 'displacement'), run%u0)
+        if (allocated(error)) return
+        call fill(deck%records('initial', 'velocity'), run%v0)
+
+    contains
+
+        !> Values of one kind of initial condition from its records.
+        subroutine fill(list, values)
+            type(deck_entry_t), intent(in) :: list(:)
+            real(wp), intent(inout) :: values(:, :)
+            integer :: i, node, dof
+            do i = 1, size(list)
+                node = find_node(beam%node_id, list(i)%int(1))
+                if (node == 0) then
+                    call unknown_node(deck, list(i), list(i)%keyword, error)
+                    return
+                end if
+                dof = dof_index(list(i)%word(2))
+                if (fix_line(dof, node) > 0) then
+                    call on_fixed_dof(deck, list(i), list(i)%keyword, fix_line(dof, node), error)
+                    return
+                end if
+                values(dof, node) = list(i)%real(3)
+            end do
+        end subroutine fill
+    end subroutine build_initial
+
+    ! ---------------------------------------------------------------------------------------
+    ! Helpers
+    ! ---------------------------------------------------------------------------------------
+
+    !> Error: a record refers to a node id that no node or line defines.
+    subroutine unknown_node(deck, e, keyword, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> The record.
+        type(deck_entry_t), intent(in) :: e
+        !> Its keyword.
+        character(len=*), intent(in) :: keyword
+        !> The error.
+        type(error_t), allocatable, intent(out) :: error
+        call make_input_error(error, deck%file, e%line, keyword, 'node '//e%word(1)// &
+            ' is not defined (no node or line record creates it)')
+    end subroutine unknown_node
+
+    !> Error: a load or initial condition on a fixed DOF.
+    subroutine on_fixed_dof(deck, e, keyword, fixed_on, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> The record (node, dof, value).
+        type(deck_entry_t), intent(in) :: e
+        !> Its keyword.
+        character(len=*), intent(in) :: keyword
+        !> Line of the fix record.
+        integer, intent(in) :: fixed_on
+        !> The error.
+        type(error_t), allocatable, intent(out) :: error
+        call make_input_error(error, deck%file, e%line, keyword, 'DOF '//e%word(2)//' of node '// &
+            e%word(1)//' is fixed (fix on line '//to_str(fixed_on)// &
+            '); a '//keyword//' applies only to a free DOF')
+    end subroutine on_fixed_dof
+
+    !> DOF index of a DOF word (u, w, theta).
+    pure integer function dof_index(word)
+        !> 'u', 'w' or 'theta'.
+        character(len=*), intent(in) :: word
+        select case (word)
+        case ('u')
+            dof_index = dof_u
+        case ('w')
+            dof_index = dof_w
+        case default
+            dof_index = dof_theta
+        end select
+    end function dof_index
+
+    !> Position of `id` in a short unsorted list (0 if absent).
+    pure integer function find_id(ids, id) result(k)
+        !> Ids.
+        integer, intent(in) :: ids(:)
+        !> Id wanted.
+        integer, intent(in) :: id
+        do k = 1, size(ids)
+            if (ids(k) == id) return
+        end do
+        k = 0
+    end function find_id
+
+    !> Node index of a deck node id (binary search in the increasing ids; 0 if absent).
+    pure integer function find_node(node_id, id) result(k)
+        !> Deck ids of the nodes, increasing.
+        integer, intent(in) :: node_id(:)
+        !> Id wanted.
+        integer, intent(in) :: id
+        integer :: lo, hi
+        lo = 1
+        hi = size(node_id)
+        do while (lo <= hi)
+            k = (lo + hi)/2
+            if (node_id(k) == id) return
+            if (node_id(k) < id) then
+                lo = k + 1
+            else
+                hi = k - 1
+            end if
+        end do
+        k = 0
+    end function find_node
+
+    !> Permutation sorting `keys` in increasing order; stable (merge sort).
+    pure function sort_index(keys) result(order)
+        !> Keys.
+        integer(i8), intent(in) :: keys(:)
+        integer, allocatable :: order(:)
+        integer, allocatable :: buffer(:)
+        integer :: n, width, lo, mid, hi, i, j, k
+        n = size(keys)
+        order = [(i, i=1, n)]
+        allocate (buffer(n))
+        width = 1
+        do while (width < n)
+            do lo = 1, n, 2*width
+                mid = min(lo + width, n + 1)
+                hi = min(lo + 2*width, n + 1)
+                i = lo
+                j = mid
+                do k = lo, hi - 1
+                    ! min() keeps the indices valid: Fortran does not short-circuit .or.
+                    if (i < mid .and. (j >= hi .or. &
+                        keys(order(min(i, n))) <= keys(order(min(j, n))))) then
+                        buffer(k) = order(i)
+                        i = i + 1
+                    else
+                        buffer(k) = order(j)
+                        j = j + 1
+                    end if
+                end do
+            end do
+            order = buffer
+            width = 2*width
+        end do
+    end function sort_index
 end module driver_config

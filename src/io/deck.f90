@@ -1,5 +1,774 @@
-!> Placeholder: to be written.
+!> Reader of plain-text input decks, validated against a declarative schema (io_deck_schema).
+!>
+!> Syntax: `[section]` headers, then `keyword = value value ...` lines; `#` starts a comment
+!> that runs to the end of the line; blank lines and tabs are fine. Every line is checked
+!> against the schema as it is read (known section and keyword, number of values, types,
+!> ranges, allowed words, duplicates of scalar keywords); then required keywords and
+!> conditional ones (`required_when`, `allowed_when`) are checked. The first problem found
+!> stops the reading with an error `file:line: keyword 'kw': message`.
+!>
+!> Access after a successful read:
+!> - `deck%has(section, keyword)`, `deck%count(...)`, `deck%line(...)` (first line, 0 if absent);
+!> - scalars with schema defaults: `deck%get_real(section, keyword, field)`, `get_int`,
+!>   `get_word`, `get_text` (field defaults to 1); a keyword absent from the deck and without
+!>   default gives 0 or '' (check `has` first);
+!> - records: `e = deck%record(section, keyword, i)` (i-th occurrence in file order) or
+!>   `list = deck%records(section, keyword)` (all of them), then `e%line`, `e%n_values()`,
+!>   `e%int(k)`, `e%real(k)`, `e%word(k)`, `e%reals_from(k)`.
 module io_deck
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_input_error
+    use core_strings, only: string_t, strip, split_words, join_words, &
+        closest_match, parse_real, parse_int, to_str
+    use io_deck_schema, only: schema_t, keyword_spec_t, field_spec_t, condition_t, field_text
     implicit none
     private
+    public :: deck_t, deck_entry_t, read_deck, read_deck_text
+
+    !> One validated `keyword = values` line.
+    type :: deck_entry_t
+        !> Section it appeared in.
+        character(len=:), allocatable :: section
+        !> Keyword.
+        character(len=:), allocatable :: keyword
+        !> Line number in the deck (0 for a value taken from the schema default).
+        integer :: line = 0
+        !> Values as written (for a text keyword: one token, the whole text).
+        type(string_t), allocatable :: tokens(:)
+    contains
+        !> Number of values.
+        procedure :: n_values => entry_n_values
+        !> k-th value as an integer (0 if absent).
+        procedure :: int => entry_int
+        !> k-th value as a real (0 if absent).
+        procedure :: real => entry_real
+        !> k-th value as written ('' if absent).
+        procedure :: word => entry_word
+        !> Values k, k+1, ... as reals (the variable-length tail of a record).
+        procedure :: reals_from => entry_reals_from
+    end type deck_entry_t
+
+    !> A validated deck.
+    type :: deck_t
+        !> Deck file name as given to read_deck.
+        character(len=:), allocatable :: file
+        !> Full text of the deck (to store with the results).
+        character(len=:), allocatable :: text
+        !> Validated entries, in file order.
+        type(deck_entry_t), allocatable :: entries(:)
+        !> Schema the deck was validated against (defaults come from it).
+        type(schema_t) :: schema
+    contains
+        !> Whether a keyword appears in the deck.
+        procedure :: has => deck_has
+        !> Number of occurrences of a keyword.
+        procedure :: count => deck_count
+        !> Line of the first occurrence of a keyword (0 if absent).
+        procedure :: line => deck_line
+        !> i-th occurrence of a keyword (an empty entry with line 0 if there is none).
+        procedure :: record => deck_record
+        !> All occurrences of a keyword, in file order (one pass: use it to loop over records).
+        procedure :: records => deck_records
+        !> A real value, from the deck or the schema default.
+        procedure :: get_real => deck_get_real
+        !> An integer value, from the deck or the schema default.
+        procedure :: get_int => deck_get_int
+        !> A word value, from the deck or the schema default.
+        procedure :: get_word => deck_get_word
+        !> A text value, from the deck or the schema default.
+        procedure :: get_text => deck_get_text
+    end type deck_t
+
+contains
+
+    !> Read a deck file and validate it against the schema.
+    subroutine read_deck(path, schema, deck, error)
+        !> Deck file.
+        character(len=*), intent(in) :: path
+        !> Schema to validate against.
+        type(schema_t), intent(in) :: schema
+        !> The deck.
+        type(deck_t), intent(out) :: deck
+        !> Error naming file, line and keyword, if any.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: text
+        character(len=512) :: msg
+        integer :: unit, ios, n
+        logical :: is_file
+        inquire (file=path, exist=is_file)
+        if (.not. is_file) then
+            call make_input_error(error, path, 0, '', 'cannot open the deck: no such file')
+            return
+        end if
+        open (newunit=unit, file=path, access='stream', form='unformatted', status='old', &
+            action='read', iostat=ios, iomsg=msg)
+        if (ios /= 0) then
+            call make_input_error(error, path, 0, '', 'cannot open the deck: '//trim(msg))
+            return
+        end if
+        inquire (unit=unit, size=n)
+        allocate (character(len=max(n, 0)) :: text)
+        ios = 0
+        if (n > 0) read (unit, iostat=ios, iomsg=msg) text
+        close (unit)
+        if (ios /= 0 .or. n < 0) then
+            if (n < 0) msg = 'size unknown'
+            call make_input_error(error, path, 0, '', 'cannot read the deck: '//trim(msg))
+            return
+        end if
+        call read_deck_text(path, text, schema, deck, error)
+    end subroutine read_deck
+
+    !> Validate deck text (lines separated by LF, CR LF accepted) against the schema;
+    !> `file` is the name used in error messages.
+    subroutine read_deck_text(file, text, schema, deck, error)
+        !> Name of the deck in messages.
+        character(len=*), intent(in) :: file
+        !> Deck text.
+        character(len=*), intent(in) :: text
+        !> Schema to validate against.
+        type(schema_t), intent(in) :: schema
+        !> The deck.
+        type(deck_t), intent(out) :: deck
+        !> Error naming file, line and keyword, if any.
+        type(error_t), allocatable, intent(out) :: error
+        type(deck_entry_t), allocatable :: entries(:), grown(:)
+        integer, allocatable :: first_line(:), section_line(:)
+        character(len=:), allocatable :: current
+        integer :: n, line_no, start, lf
+        deck%file = file
+        deck%text = text
+        deck%schema = schema
+        allocate (entries(16))
+        allocate (first_line(size(schema%keywords)), section_line(size(schema%sections)))
+        first_line = 0
+        section_line = 0
+        n = 0
+        current = ''
+        start = 1
+        line_no = 0
+        do while (start <= len(text))
+            lf = index(text(start:), new_line('a'))
+            if (lf == 0) then
+                lf = len(text) + 1
+            else
+                lf = start + lf - 1
+            end if
+            line_no = line_no + 1
+            call parse_line(text(start:lf - 1))
+            if (allocated(error)) return
+            start = lf + 1
+        end do
+        deck%entries = entries(:n)
+        if (n == 0) then
+            call make_input_error(error, file, 0, '', 'the deck is empty (no keyword found); '// &
+                'it needs at least '//required_list(schema))
+            return
+        end if
+        call check_required(deck, first_line, section_line, error)
+
+    contains
+
+        !> Validate one line and store its entry.
+        subroutine parse_line(raw)
+            character(len=*), intent(in) :: raw
+            character(len=:), allocatable :: s, key, value
+            type(string_t), allocatable :: tokens(:)
+            integer :: hash, eq, k
+            hash = index(raw, '#')
+            if (hash > 0) then
+                s = strip(raw(:hash - 1))
+            else
+                s = strip(raw)
+            end if
+            if (len(s) == 0) return
+            if (s(1:1) == '[') then
+                call parse_header(s)
+                return
+            end if
+            eq = index(s, '=')
+            if (eq == 0) then
+                call split_words(s, tokens)
+                call make_input_error(error, file, line_no, tokens(1)%s, &
+                    "expected 'keyword = value', found no '='")
+                return
+            end if
+            key = strip(s(:eq - 1))
+            value = strip(s(eq + 1:))
+            if (len(key) == 0) then
+                call make_input_error(error, file, line_no, '', "missing keyword name before '='")
+                return
+            end if
+            if (scan(key, ' '//achar(9)) > 0) then
+                call make_input_error(error, file, line_no, key, 'a keyword name is a single word')
+                return
+            end if
+            if (len(current) == 0) then
+                call make_input_error(error, file, line_no, key, &
+                    'appears before any [section] header'//home_of(schema, key))
+                return
+            end if
+            k = schema%find_keyword(current, key)
+            if (k == 0) then
+                call make_input_error(error, file, line_no, key, &
+                    unknown_keyword(schema, current, key))
+                return
+            end if
+            if (.not. schema%keywords(k)%repeatable .and. first_line(k) > 0) then
+                call make_input_error(error, file, line_no, key, 'given twice in section ['// &
+                    current//'] (first on line '//to_str(first_line(k))// &
+                    ', again on line '//to_str(line_no)//'); it may appear only once')
+                return
+            end if
+            if (schema%keywords(k)%fields(1)%value_type == field_text) then
+                allocate (tokens(1))
+                tokens(1)%s = value
+            else
+                call split_words(value, tokens)
+            end if
+            call check_values(schema%keywords(k), tokens, file, line_no, error)
+            if (allocated(error)) return
+            if (first_line(k) == 0) first_line(k) = line_no
+            if (n == size(entries)) then
+                allocate (grown(2*n))
+                grown(:n) = entries
+                call move_alloc(grown, entries)
+            end if
+            n = n + 1
+            entries(n)%section = current
+            entries(n)%keyword = key
+            entries(n)%line = line_no
+            call move_alloc(tokens, entries(n)%tokens)
+        end subroutine parse_line
+
+        !> Validate a `[section]` header and make it current.
+        subroutine parse_header(s)
+            character(len=*), intent(in) :: s
+            character(len=:), allocatable :: name
+            type(string_t), allocatable :: names(:)
+            integer :: k, best, d
+            if (s(len(s):len(s)) /= ']') then
+                call make_input_error(error, file, line_no, '', "malformed section header '"// &
+                    s//"': expected '[name]'")
+                return
+            end if
+            name = strip(s(2:len(s) - 1))
+            k = schema%find_section(name)
+            if (k == 0) then
+                allocate (names(size(schema%sections)))
+                do k = 1, size(names)
+                    names(k)%s = schema%sections(k)%name
+                end do
+                call closest_match(name, names, best, d)
+                if (best > 0 .and. d <= tolerance(name)) then
+                    call make_input_error(error, file, line_no, '', 'unknown section ['//name// &
+                        ']; did you mean ['//names(best)%s//']? (sections: '// &
+                        join_words(names, ', ')//')')
+                else
+                    call make_input_error(error, file, line_no, '', 'unknown section ['//name// &
+                        '] (sections: '//join_words(names, ', ')//')')
+                end if
+                return
+            end if
+            current = name
+            if (section_line(k) == 0) section_line(k) = line_no
+        end subroutine parse_header
+    end subroutine read_deck_text
+
+    !> Largest Levenshtein distance at which a name is suggested for a misspelt one.
+    pure integer function tolerance(name)
+        !> The misspelt name.
+        character(len=*), intent(in) :: name
+        tolerance = max(2, len(name)/2)
+    end function tolerance
+
+    !> Message for a keyword unknown in `section`: closest name in the section, or in another
+    !> section when that fits better, and the list of the section's keywords.
+    function unknown_keyword(schema, section, key) result(message)
+        !> The schema.
+        type(schema_t), intent(in) :: schema
+        !> Current section.
+        character(len=*), intent(in) :: section
+        !> The unknown keyword.
+        character(len=*), intent(in) :: key
+        character(len=:), allocatable :: message
+        type(string_t), allocatable :: local(:), everywhere(:)
+        integer :: k, best_local, d_local, best_all, d_all
+        allocate (local(0), everywhere(size(schema%keywords)))
+        do k = 1, size(schema%keywords)
+            everywhere(k)%s = schema%keywords(k)%name
+            if (schema%keywords(k)%section == section) local = [local, everywhere(k)]
+        end do
+        call closest_match(key, local, best_local, d_local)
+        call closest_match(key, everywhere, best_all, d_all)
+        message = 'unknown keyword in section ['//section//']'
+        if (best_all > 0 .and. d_all < d_local .and. d_all <= tolerance(key)) then
+            ! A better match in another section.
+            if (everywhere(best_all)%s == key) then
+                message = message//"; keyword '"//key//"' belongs to section ["// &
+                    schema%keywords(best_all)%section//']: move it there'
+            else
+                message = message//"; did you mean '"//everywhere(best_all)%s//"'? keyword '"// &
+                    everywhere(best_all)%s//"' belongs to section ["// &
+                    schema%keywords(best_all)%section//']'
+            end if
+        else if (best_local > 0 .and. d_local <= tolerance(key)) then
+            message = message//"; did you mean '"//local(best_local)%s//"'?"
+        end if
+        message = message//' (keywords of ['//section//']: '//join_words(local, ', ')//')'
+    end function unknown_keyword
+
+    !> " (it belongs to section [x])" for a keyword known in some section, '' otherwise.
+    function home_of(schema, key) result(text)
+        !> The schema.
+        type(schema_t), intent(in) :: schema
+        !> Keyword.
+        character(len=*), intent(in) :: key
+        character(len=:), allocatable :: text
+        integer :: k
+        text = ''
+        do k = 1, size(schema%keywords)
+            if (schema%keywords(k)%name == key) then
+                text = '; it belongs to section ['//schema%keywords(k)%section//']'
+                return
+            end if
+        end do
+    end function home_of
+
+    !> "[run] analysis, ..." : the unconditionally required keywords.
+    function required_list(schema) result(text)
+        !> The schema.
+        type(schema_t), intent(in) :: schema
+        character(len=:), allocatable :: text
+        integer :: k
+        text = ''
+        do k = 1, size(schema%keywords)
+            if (schema%keywords(k)%required) then
+                if (len(text) > 0) text = text//', '
+                text = text//'['//schema%keywords(k)%section//'] '//schema%keywords(k)%name
+            end if
+        end do
+    end function required_list
+
+    !> Check the values of one line: count (fixed fields and tail), types, ranges, words.
+    subroutine check_values(spec, tokens, file, line, error)
+        !> Keyword spec.
+        type(keyword_spec_t), intent(in) :: spec
+        !> Values as written.
+        type(string_t), intent(in) :: tokens(:)
+        !> Deck name.
+        character(len=*), intent(in) :: file
+        !> Line number.
+        integer, intent(in) :: line
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: message, selector
+        type(field_spec_t) :: field
+        integer :: nf, ntok, i, kt, g
+        logical :: ok
+        if (spec%fields(1)%value_type == field_text) return
+        nf = size(spec%fields)
+        ntok = size(tokens)
+        do i = 1, min(ntok, nf)
+            call spec%fields(i)%check(tokens(i)%s, ok, message)
+            if (.not. ok) then
+                call make_input_error(error, file, line, spec%name, 'value '//to_str(i)//' ('// &
+                    spec%fields(i)%name//'): '//message)
+                return
+            end if
+        end do
+        selector = ''
+        if (spec%selector > 0 .and. spec%selector <= ntok) selector = tokens(spec%selector)%s
+        if (ntok < nf) then
+            call count_error('too few')
+            return
+        end if
+        kt = spec%tail_index(selector)
+        if (kt == 0) then
+            if (ntok > nf) call count_error('too many')
+            return
+        end if
+        associate (t => spec%tails(kt))
+            g = size(t%fields)
+            if (ntok - nf < t%min_values) then
+                call count_error('too few')
+                return
+            end if
+            if (t%max_values >= 0 .and. ntok - nf > t%max_values) then
+                call count_error('too many')
+                return
+            end if
+            if (t%cyclic .and. modulo(ntok - nf, g) /= 0) then
+                call make_input_error(error, file, line, spec%name, "incomplete group: '"// &
+                    spec%usage(selector)//"' takes values after '"// &
+                    spec%fields(nf)%name//"' in groups of "//to_str(g)// &
+                    ', got '//to_str(ntok - nf))
+                return
+            end if
+            do i = 1, ntok - nf
+                field = t%field(i)
+                call field%check(tokens(nf + i)%s, ok, message)
+                if (.not. ok) then
+                    call make_input_error(error, file, line, spec%name, 'value '//to_str(nf + i)// &
+                        ' ('//field%name//'): '//message)
+                    return
+                end if
+            end do
+        end associate
+
+    contains
+
+        !> Error for a wrong number of values, with the expected usage.
+        subroutine count_error(what)
+            character(len=*), intent(in) :: what
+            call make_input_error(error, file, line, spec%name, what//' values (got '// &
+                to_str(ntok)//"): expected '"//spec%usage(selector)//"'")
+        end subroutine count_error
+    end subroutine check_values
+
+    !> Check required and conditional keywords once the whole deck is read.
+    subroutine check_required(deck, first_line, section_line, error)
+        !> The deck (entries filled).
+        type(deck_t), intent(in) :: deck
+        !> First line of each schema keyword (0 if absent).
+        integer, intent(in) :: first_line(:)
+        !> First header line of each schema section (0 if absent).
+        integer, intent(in) :: section_line(:)
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: k
+        character(len=:), allocatable :: actual
+        do k = 1, size(deck%schema%keywords)
+            associate (kw => deck%schema%keywords(k))
+                if (kw%required .and. first_line(k) == 0) then
+                    call make_input_error(error, deck%file, &
+                        section_line(deck%schema%find_section(kw%section)), kw%name, &
+                        'missing: this keyword is required in section ['// &
+                        kw%section//'] ('//kw%name//' = '//value_hint(kw)//')')
+                    return
+                end if
+            end associate
+        end do
+        do k = 1, size(deck%schema%keywords)
+            associate (kw => deck%schema%keywords(k), c => deck%schema%keywords(k)%required_when)
+                if (c%active .and. first_line(k) == 0) then
+                    if (deck%get_word(c%section, c%keyword) == c%word) then
+                        call make_input_error(error, deck%file, deck%line(c%section, c%keyword), &
+                            kw%name, 'missing: ['//kw%section//'] '//kw%name// &
+                            ' is required when '//c%text())
+                        return
+                    end if
+                end if
+            end associate
+        end do
+        do k = 1, size(deck%schema%keywords)
+            associate (kw => deck%schema%keywords(k), c => deck%schema%keywords(k)%allowed_when)
+                if (c%active .and. first_line(k) > 0) then
+                    actual = deck%get_word(c%section, c%keyword)
+                    if (actual /= c%word) then
+                        call make_input_error(error, deck%file, first_line(k), kw%name, &
+                            'only allowed when '//c%text()//'; here '//c%keyword// &
+                            ' = '//actual//condition_origin(deck, c)// &
+                            ': remove '//kw%name//' or set '//c%keyword//' = '//c%word)
+                        return
+                    end if
+                end if
+            end associate
+        end do
+    end subroutine check_required
+
+    !> What to write after `keyword =`: field names, or the allowed words as `a|b|c`.
+    function value_hint(kw) result(text)
+        !> The keyword.
+        type(keyword_spec_t), intent(in) :: kw
+        character(len=:), allocatable :: text
+        integer :: i
+        text = ''
+        do i = 1, size(kw%fields)
+            if (i > 1) text = text//' '
+            if (size(kw%fields(i)%allowed) > 0) then
+                text = text//join_words(kw%fields(i)%allowed, '|')
+            else
+                text = text//kw%fields(i)%name
+            end if
+        end do
+    end function value_hint
+
+    !> " (line N)" or " (default)": where the value tested by a condition comes from.
+    function condition_origin(deck, c) result(text)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> The condition.
+        type(condition_t), intent(in) :: c
+        character(len=:), allocatable :: text
+        integer :: line
+        line = deck%line(c%section, c%keyword)
+        if (line > 0) then
+            text = ' (line '//to_str(line)//')'
+        else
+            text = ' (default)'
+        end if
+    end function condition_origin
+
+    ! ---------------------------------------------------------------------------------------
+    ! Access
+    ! ---------------------------------------------------------------------------------------
+
+    !> Index in `entries` of the i-th occurrence of a keyword (0 if none).
+    pure integer function find_entry(self, section, keyword, i) result(idx)
+        !> The deck.
+        class(deck_t), intent(in) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        !> Keyword.
+        character(len=*), intent(in) :: keyword
+        !> Occurrence wanted (1 = first).
+        integer, intent(in) :: i
+        integer :: seen
+        seen = 0
+        do idx = 1, size(self%entries)
+            if (self%entries(idx)%keyword == keyword .and. &
+                self%entries(idx)%section == section) then
+                seen = seen + 1
+                if (seen == i) return
+            end if
+        end do
+        idx = 0
+    end function find_entry
+
+    !> Whether a keyword appears in the deck.
+    pure logical function deck_has(self, section, keyword)
+        !> The deck.
+        class(deck_t), intent(in) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        !> Keyword.
+        character(len=*), intent(in) :: keyword
+        deck_has = find_entry(self, section, keyword, 1) > 0
+    end function deck_has
+
+    !> Number of occurrences of a keyword in the deck.
+    pure integer function deck_count(self, section, keyword) result(n)
+        !> The deck.
+        class(deck_t), intent(in) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        !> Keyword.
+        character(len=*), intent(in) :: keyword
+        integer :: idx
+        n = 0
+        do idx = 1, size(self%entries)
+            if (self%entries(idx)%keyword == keyword .and. &
+                self%entries(idx)%section == section) n = n + 1
+        end do
+    end function deck_count
+
+    !> Line of the first occurrence of a keyword (0 if absent).
+    pure integer function deck_line(self, section, keyword) result(line)
+        !> The deck.
+        class(deck_t), intent(in) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        !> Keyword.
+        character(len=*), intent(in) :: keyword
+        integer :: idx
+        idx = find_entry(self, section, keyword, 1)
+        line = 0
+        if (idx > 0) line = self%entries(idx)%line
+    end function deck_line
+
+    !> The i-th occurrence of a keyword, in file order; an entry with no values and line 0
+    !> if there is no such occurrence.
+    function deck_record(self, section, keyword, i) result(entry)
+        !> The deck.
+        class(deck_t), intent(in) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        !> Keyword.
+        character(len=*), intent(in) :: keyword
+        !> Occurrence (1 = first).
+        integer, intent(in) :: i
+        type(deck_entry_t) :: entry
+        integer :: idx
+        idx = find_entry(self, section, keyword, i)
+        if (idx > 0) then
+            entry = self%entries(idx)
+        else
+            entry%section = section
+            entry%keyword = keyword
+            allocate (entry%tokens(0))
+        end if
+    end function deck_record
+
+    !> All occurrences of a keyword, in file order (size 0 if none).
+    function deck_records(self, section, keyword) result(list)
+        !> The deck.
+        class(deck_t), intent(in) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        !> Keyword.
+        character(len=*), intent(in) :: keyword
+        type(deck_entry_t), allocatable :: list(:)
+        integer :: idx, n
+        allocate (list(self%count(section, keyword)))
+        n = 0
+        do idx = 1, size(self%entries)
+            if (self%entries(idx)%keyword == keyword .and. &
+                self%entries(idx)%section == section) then
+                n = n + 1
+                list(n) = self%entries(idx)
+            end if
+        end do
+    end function deck_records
+
+    !> First occurrence of a keyword, or its schema default (line 0), or an empty entry.
+    function value_entry(self, section, keyword) result(entry)
+        !> The deck.
+        class(deck_t), intent(in) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        !> Keyword.
+        character(len=*), intent(in) :: keyword
+        type(deck_entry_t) :: entry
+        integer :: k
+        entry = self%record(section, keyword, 1)
+        if (entry%line > 0) return
+        k = self%schema%find_keyword(section, keyword)
+        if (k == 0) return
+        associate (kw => self%schema%keywords(k))
+            if (.not. kw%has_default) return
+            if (kw%fields(1)%value_type == field_text) then
+                deallocate (entry%tokens)
+                allocate (entry%tokens(1))
+                entry%tokens(1)%s = kw%default
+            else
+                call split_words(kw%default, entry%tokens)
+            end if
+        end associate
+    end function value_entry
+
+    !> A real value (field `field`, default 1) from the deck or the schema default.
+    function deck_get_real(self, section, keyword, field) result(value)
+        !> The deck.
+        class(deck_t), intent(in) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        !> Keyword.
+        character(len=*), intent(in) :: keyword
+        !> Field index (default 1).
+        integer, intent(in), optional :: field
+        real(wp) :: value
+        type(deck_entry_t) :: entry
+        entry = value_entry(self, section, keyword)
+        value = entry%real(field_or_1(field))
+    end function deck_get_real
+
+    !> An integer value (field `field`, default 1) from the deck or the schema default.
+    function deck_get_int(self, section, keyword, field) result(value)
+        !> The deck.
+        class(deck_t), intent(in) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        !> Keyword.
+        character(len=*), intent(in) :: keyword
+        !> Field index (default 1).
+        integer, intent(in), optional :: field
+        integer :: value
+        type(deck_entry_t) :: entry
+        entry = value_entry(self, section, keyword)
+        value = entry%int(field_or_1(field))
+    end function deck_get_int
+
+    !> A word value (field `field`, default 1) from the deck or the schema default.
+    function deck_get_word(self, section, keyword, field) result(value)
+        !> The deck.
+        class(deck_t), intent(in) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        !> Keyword.
+        character(len=*), intent(in) :: keyword
+        !> Field index (default 1).
+        integer, intent(in), optional :: field
+        character(len=:), allocatable :: value
+        type(deck_entry_t) :: entry
+        entry = value_entry(self, section, keyword)
+        value = entry%word(field_or_1(field))
+    end function deck_get_word
+
+    !> A text value from the deck or the schema default.
+    function deck_get_text(self, section, keyword) result(value)
+        !> The deck.
+        class(deck_t), intent(in) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        !> Keyword.
+        character(len=*), intent(in) :: keyword
+        character(len=:), allocatable :: value
+        type(deck_entry_t) :: entry
+        entry = value_entry(self, section, keyword)
+        value = entry%word(1)
+    end function deck_get_text
+
+    !> The optional field index, 1 when absent.
+    pure integer function field_or_1(field)
+        !> Field index.
+        integer, intent(in), optional :: field
+        field_or_1 = 1
+        if (present(field)) field_or_1 = field
+    end function field_or_1
+
+    !> Number of values of an entry.
+    pure integer function entry_n_values(self) result(n)
+        !> The entry.
+        class(deck_entry_t), intent(in) :: self
+        n = 0
+        if (allocated(self%tokens)) n = size(self%tokens)
+    end function entry_n_values
+
+    !> k-th value as an integer (0 if absent; values were validated when read).
+    integer function entry_int(self, k) result(value)
+        !> The entry.
+        class(deck_entry_t), intent(in) :: self
+        !> Value index.
+        integer, intent(in) :: k
+        logical :: ok
+        value = 0
+        if (k >= 1 .and. k <= self%n_values()) call parse_int(self%tokens(k)%s, value, ok)
+    end function entry_int
+
+    !> k-th value as a real (0 if absent; values were validated when read).
+    real(wp) function entry_real(self, k) result(value)
+        !> The entry.
+        class(deck_entry_t), intent(in) :: self
+        !> Value index.
+        integer, intent(in) :: k
+        logical :: ok
+        value = 0.0_wp
+        if (k >= 1 .and. k <= self%n_values()) call parse_real(self%tokens(k)%s, value, ok)
+    end function entry_real
+
+    !> k-th value as written ('' if absent).
+    function entry_word(self, k) result(value)
+        !> The entry.
+        class(deck_entry_t), intent(in) :: self
+        !> Value index.
+        integer, intent(in) :: k
+        character(len=:), allocatable :: value
+        value = ''
+        if (k >= 1 .and. k <= self%n_values()) value = self%tokens(k)%s
+    end function entry_word
+
+    !> Values k, k+1, ..., n_values() as reals (size 0 if k > n_values()).
+    function entry_reals_from(self, k) result(values)
+        !> The entry.
+        class(deck_entry_t), intent(in) :: self
+        !> First value index.
+        integer, intent(in) :: k
+        real(wp), allocatable :: values(:)
+        integer :: i
+        allocate (values(max(self%n_values() - k + 1, 0)))
+        do i = 1, size(values)
+            values(i) = self%real(k + i - 1)
+        end do
+    end function entry_reals_from
 end module io_deck

@@ -1,5 +1,880 @@
-!> Placeholder: to be written.
+!> The input deck schema: every section and keyword of a MULTICOR deck declared as data,
+!> with its fields (type, unit, range, allowed words), whether it is required or repeatable,
+!> its default and a one-line description.
+!>
+!> The reader (io_deck) validates a deck against a `schema_t`, and the reference
+!> documentation (doc/input.md) is generated from it by `schema_markdown`. A new section is
+!> added by a new `add_<section>` routine called from `multicor_schema` that declares its
+!> keywords with `add_section` / `add_keyword` and the field builders below: data only.
+!>
+!> A keyword has fixed fields, then optionally a variable-length tail: a list of values
+!> whose count lies in [min_values, max_values], possibly made of repeated groups (pairs of a
+!> table). The tail may depend on a word field (the selector): `function = 1 table 0 0 1 1`
+!> takes the tail declared for `table`.
 module io_deck_schema
+    use core_kinds, only: wp
+    use core_strings, only: string_t, split_words, join_words, to_str, parse_real, parse_int
     implicit none
     private
+    public :: field_spec_t, tail_spec_t, condition_t, keyword_spec_t, section_spec_t, schema_t
+    public :: field_int, field_real, field_word, field_text
+    public :: int_field, real_field, positive, word_field, text_field, tail, when
+    public :: multicor_schema, schema_markdown, type_name
+
+    !> Field type: integer.
+    integer, parameter :: field_int = 1
+    !> Field type: real number.
+    integer, parameter :: field_real = 2
+    !> Field type: one word (from a list of allowed words when one is given).
+    integer, parameter :: field_word = 3
+    !> Field type: free text, the rest of the line (comment stripped); only as the single field.
+    integer, parameter :: field_text = 4
+
+    !> One value of a keyword: name, type, unit, range, allowed words.
+    type :: field_spec_t
+        !> Name shown in documentation and messages.
+        character(len=:), allocatable :: name
+        !> field_int, field_real, field_word or field_text.
+        integer :: value_type = field_real
+        !> SI unit ('' when dimensionless or not a number).
+        character(len=:), allocatable :: unit
+        !> Whether a lower bound applies.
+        logical :: has_lower = .false.
+        !> Lower bound excluded (x > lower) instead of included (x >= lower).
+        logical :: lower_strict = .false.
+        !> Lower bound.
+        real(wp) :: lower = 0.0_wp
+        !> Whether an upper bound applies.
+        logical :: has_upper = .false.
+        !> Upper bound excluded (x < upper) instead of included (x <= upper).
+        logical :: upper_strict = .false.
+        !> Upper bound.
+        real(wp) :: upper = 0.0_wp
+        !> Allowed words (field_word only; size 0 = any word).
+        type(string_t), allocatable :: allowed(:)
+    contains
+        !> Check one token against the field; explain the problem when it is not valid.
+        procedure :: check => field_check
+        !> Text of the allowed range or words ('' when anything goes).
+        procedure :: constraint => field_constraint
+    end type field_spec_t
+
+    !> Variable-length tail of a record: values after the fixed fields.
+    type :: tail_spec_t
+        !> Selector word this tail belongs to ('' when the keyword has a single tail).
+        character(len=:), allocatable :: when
+        !> Fields of the tail, in order; with `cyclic`, the group repeats.
+        type(field_spec_t), allocatable :: fields(:)
+        !> Least number of values.
+        integer :: min_values = 0
+        !> Largest number of values (-1 = no limit).
+        integer :: max_values = -1
+        !> The fields repeat as a group (the count must be a multiple of the group size).
+        logical :: cyclic = .false.
+    contains
+        !> Field spec of the i-th tail value.
+        procedure :: field => tail_field
+        !> Usage text, e.g. `t f ... (groups of 2, at least 2 groups)`.
+        procedure :: usage => tail_usage
+    end type tail_spec_t
+
+    !> Condition "[section] keyword = word" on another keyword's first (word) field.
+    type :: condition_t
+        !> Whether the condition is in use.
+        logical :: active = .false.
+        !> Section of the keyword tested.
+        character(len=:), allocatable :: section
+        !> Keyword tested.
+        character(len=:), allocatable :: keyword
+        !> Value of its first field that makes the condition true.
+        character(len=:), allocatable :: word
+    contains
+        !> Text `[section] keyword = word`.
+        procedure :: text => condition_text
+    end type condition_t
+
+    !> One keyword of the deck.
+    type :: keyword_spec_t
+        !> Section it belongs to.
+        character(len=:), allocatable :: section
+        !> Keyword name.
+        character(len=:), allocatable :: name
+        !> Fixed fields, in order.
+        type(field_spec_t), allocatable :: fields(:)
+        !> Index of the word field that selects the tail (0 = single or no tail).
+        integer :: selector = 0
+        !> Tails (at most one when selector = 0).
+        type(tail_spec_t), allocatable :: tails(:)
+        !> Must appear in every deck.
+        logical :: required = .false.
+        !> Must appear when this condition holds.
+        type(condition_t) :: required_when
+        !> May only appear when this condition holds.
+        type(condition_t) :: allowed_when
+        !> May appear several times (a record); scalar keywords appear at most once.
+        logical :: repeatable = .false.
+        !> Whether a default applies when the keyword is absent.
+        logical :: has_default = .false.
+        !> Default values as they would be written in the deck.
+        character(len=:), allocatable :: default
+        !> One-line description.
+        character(len=:), allocatable :: description
+    contains
+        !> Tail for a given selector word (0 if none).
+        procedure :: tail_index => keyword_tail_index
+        !> Usage text, e.g. `id young density area inertia`.
+        procedure :: usage => keyword_usage
+    end type keyword_spec_t
+
+    !> One `[section]` of the deck.
+    type :: section_spec_t
+        !> Section name.
+        character(len=:), allocatable :: name
+        !> One-line description.
+        character(len=:), allocatable :: description
+    end type section_spec_t
+
+    !> The whole schema: sections and keywords in documentation order.
+    type :: schema_t
+        !> Sections.
+        type(section_spec_t), allocatable :: sections(:)
+        !> Keywords.
+        type(keyword_spec_t), allocatable :: keywords(:)
+    contains
+        !> Declare a section.
+        procedure :: add_section => schema_add_section
+        !> Declare a keyword.
+        procedure :: add_keyword => schema_add_keyword
+        !> Index of a section (0 if unknown).
+        procedure :: find_section => schema_find_section
+        !> Index of a keyword in a section (0 if unknown).
+        procedure :: find_keyword => schema_find_keyword
+    end type schema_t
+
+contains
+
+    ! ---------------------------------------------------------------------------------------
+    ! The MULTICOR schema (data). Sections appear in the documentation in this order.
+    ! ---------------------------------------------------------------------------------------
+
+    !> The complete MULTICOR deck schema.
+    function multicor_schema() result(s)
+        !> The schema.
+        type(schema_t) :: s
+        allocate (s%sections(0), s%keywords(0))
+        call add_run(s)
+        call add_beam(s)
+        call add_functions(s)
+        call add_time(s)
+        call add_modal(s)
+        call add_initial(s)
+        call add_output(s)
+    end function multicor_schema
+
+    !> [run]: title and kind of analysis.
+    subroutine add_run(s)
+        !> Schema to extend.
+        type(schema_t), intent(inout) :: s
+        call s%add_section('run', 'What to compute.')
+        call s%add_keyword('run', 'title', [text_field('title')], &
+            'Free text stored with the results.', default='')
+        call s%add_keyword('run', 'analysis', [word_field('analysis', 'static modal dynamic')], &
+            'Kind of analysis: static equilibrium, natural modes, or time integration.', &
+            required=.true.)
+    end subroutine add_run
+
+    !> [beam]: planar Euler-Bernoulli frame (sections, nodes, elements, supports, loads).
+    subroutine add_beam(s)
+        !> Schema to extend.
+        type(schema_t), intent(inout) :: s
+        call s%add_section('beam', &
+            'Planar Euler-Bernoulli frame: geometry, material, supports, loads.')
+        call s%add_keyword('beam', 'mass', [word_field('mass', 'consistent lumped')], &
+            'Mass matrix: consistent, or lumped (HRZ, diagonal).', default='consistent')
+        call s%add_keyword('beam', 'section', [int_field('id', lower=1), &
+            positive('young', 'Pa'), positive('density', 'kg/m^3'), positive('area', 'm^2'), &
+            positive('inertia', 'm^4')], &
+            'Cross-section and material: Young modulus, density, area, second moment of area.', &
+            repeatable=.true.)
+        call s%add_keyword('beam', 'node', &
+            [int_field('id', lower=1), real_field('x', 'm'), real_field('y', 'm')], &
+            'A node at (x, y).', repeatable=.true.)
+        call s%add_keyword('beam', 'line', [int_field('first_node', lower=1), &
+            real_field('x1', 'm'), real_field('y1', 'm'), real_field('x2', 'm'), &
+            real_field('y2', 'm'), int_field('elements', lower=1), int_field('section', lower=1)], &
+            'Generator: nodes first_node..first_node+elements equally spaced from (x1, y1) to '// &
+            '(x2, y2) and the elements between them; existing coincident nodes are reused.', &
+            repeatable=.true.)
+        call s%add_keyword('beam', 'element', [int_field('id', lower=1), &
+            int_field('node1', lower=1), int_field('node2', lower=1), &
+            int_field('section', lower=1)], &
+            'An element from node1 to node2 with the given section.', repeatable=.true.)
+        call s%add_keyword('beam', 'fix', [int_field('node', lower=1)], &
+            'Clamp DOFs of a node to zero: u (x), w (y), theta (rotation), or all.', &
+            tails=[tail([word_field('dof', 'u w theta all')], 1, 3, cyclic=.true.)], &
+            repeatable=.true.)
+        call s%add_keyword('beam', 'load', [int_field('node', lower=1), &
+            word_field('dof', 'u w theta'), real_field('value', 'N or N.m')], &
+            'Nodal force (u, w) or moment (theta) times a time function (none: constant 1).', &
+            tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
+        call s%add_keyword('beam', 'rayleigh', &
+            [real_field('a0', '1/s', lower=0.0_wp), real_field('a1', 's', lower=0.0_wp)], &
+            'Rayleigh damping C = a0 M + a1 K.', default='0 0')
+    end subroutine add_beam
+
+    !> [functions]: time functions multiplying loads.
+    subroutine add_functions(s)
+        !> Schema to extend.
+        type(schema_t), intent(inout) :: s
+        type(tail_spec_t), allocatable :: tails(:)
+        call s%add_section('functions', 'Time functions f(t) that multiply loads.')
+        tails = [tail([real_field('c', '')], 1, 1, selected_by='constant'), &
+            tail([positive('t1', 's')], 1, 1, selected_by='ramp'), &
+            tail([real_field('t0', 's', lower=0.0_wp)], 1, 1, selected_by='step'), &
+            tail([real_field('t', 's'), real_field('f', '')], 4, -1, cyclic=.true., &
+            selected_by='table'), &
+            tail([positive('freq', 'Hz'), real_field('phase', 'rad')], 1, 2, &
+            selected_by='harmonic')]
+        call s%add_keyword('functions', 'function', &
+            [int_field('id', lower=1), word_field('kind', 'constant ramp step table harmonic')], &
+            'constant: f = c; ramp: f = min(t/t1, 1); step: f = 0 before t0, 1 after; '// &
+            'table: linear in (t, f) pairs, t increasing, constant outside; '// &
+            'harmonic: f = sin(2 pi freq t + phase).', &
+            selector=2, tails=tails, repeatable=.true.)
+    end subroutine add_functions
+
+    !> [time]: time integration.
+    subroutine add_time(s)
+        !> Schema to extend.
+        type(schema_t), intent(inout) :: s
+        call s%add_section('time', 'Time integration (dynamic analysis).')
+        call s%add_keyword('time', 'step', [positive('step', 's')], &
+            'Time step h.', required_when=when('run', 'analysis', 'dynamic'))
+        call s%add_keyword('time', 'end', [positive('end', 's')], &
+            'End time (the run starts at t = 0).', required_when=when('run', 'analysis', 'dynamic'))
+        call s%add_keyword('time', 'scheme', &
+            [word_field('scheme', 'average_acceleration newmark central_difference')], &
+            'Newmark family: average_acceleration (beta 1/4, gamma 1/2), newmark (beta and '// &
+            'gamma below), central_difference (beta 0, gamma 1/2, explicit).', &
+            default='average_acceleration')
+        call s%add_keyword('time', 'beta', [real_field('beta', '', lower=0.0_wp, upper=0.5_wp)], &
+            'Newmark beta.', default='0.25', allowed_when=when('time', 'scheme', 'newmark'))
+        call s%add_keyword('time', 'gamma', [real_field('gamma', '', lower=0.5_wp, upper=1.0_wp)], &
+            'Newmark gamma (> 1/2 adds numerical damping).', default='0.5', &
+            allowed_when=when('time', 'scheme', 'newmark'))
+    end subroutine add_time
+
+    !> [modal]: natural modes.
+    subroutine add_modal(s)
+        !> Schema to extend.
+        type(schema_t), intent(inout) :: s
+        call s%add_section('modal', 'Natural modes (modal analysis).')
+        call s%add_keyword('modal', 'modes', [int_field('modes', lower=1)], &
+            'Number of lowest modes to compute.', default='3')
+    end subroutine add_modal
+
+    !> [initial]: initial conditions.
+    subroutine add_initial(s)
+        !> Schema to extend.
+        type(schema_t), intent(inout) :: s
+        call s%add_section('initial', &
+            'Initial conditions on free DOFs (dynamic analysis); the others start at zero.')
+        call s%add_keyword('initial', 'velocity', [int_field('node', lower=1), &
+            word_field('dof', 'u w theta'), real_field('value', 'm/s or rad/s')], &
+            'Initial velocity of one DOF of a node.', repeatable=.true.)
+        call s%add_keyword('initial', 'displacement', [int_field('node', lower=1), &
+            word_field('dof', 'u w theta'), real_field('value', 'm or rad')], &
+            'Initial displacement of one DOF of a node.', repeatable=.true.)
+    end subroutine add_initial
+
+    !> [output]: what is stored and shown.
+    subroutine add_output(s)
+        !> Schema to extend.
+        type(schema_t), intent(inout) :: s
+        call s%add_section('output', 'Results and progress reports.')
+        call s%add_keyword('output', 'interval', [int_field('interval', lower=1)], &
+            'Time steps between stored states.', default='1')
+        call s%add_keyword('output', 'progress', [real_field('progress', 's', lower=0.0_wp)], &
+            'Wall-clock seconds between progress lines (0 = none).', default='5')
+    end subroutine add_output
+
+    ! ---------------------------------------------------------------------------------------
+    ! Builders
+    ! ---------------------------------------------------------------------------------------
+
+    !> An integer field, optionally bounded (bounds included).
+    pure function int_field(name, lower, upper) result(f)
+        !> Field name.
+        character(len=*), intent(in) :: name
+        !> Least allowed value.
+        integer, intent(in), optional :: lower
+        !> Largest allowed value.
+        integer, intent(in), optional :: upper
+        type(field_spec_t) :: f
+        f%name = name
+        f%value_type = field_int
+        f%unit = ''
+        allocate (f%allowed(0))
+        if (present(lower)) then
+            f%has_lower = .true.
+            f%lower = real(lower, wp)
+        end if
+        if (present(upper)) then
+            f%has_upper = .true.
+            f%upper = real(upper, wp)
+        end if
+    end function int_field
+
+    !> A real field with a unit, optionally bounded (bounds included unless `*_strict`).
+    pure function real_field(name, unit, lower, upper, lower_strict, upper_strict) result(f)
+        !> Field name.
+        character(len=*), intent(in) :: name
+        !> SI unit ('' if dimensionless).
+        character(len=*), intent(in) :: unit
+        !> Lower bound.
+        real(wp), intent(in), optional :: lower
+        !> Upper bound.
+        real(wp), intent(in), optional :: upper
+        !> Exclude the lower bound (x > lower).
+        logical, intent(in), optional :: lower_strict
+        !> Exclude the upper bound (x < upper).
+        logical, intent(in), optional :: upper_strict
+        type(field_spec_t) :: f
+        f%name = name
+        f%value_type = field_real
+        f%unit = unit
+        allocate (f%allowed(0))
+        if (present(lower)) then
+            f%has_lower = .true.
+            f%lower = lower
+        end if
+        if (present(upper)) then
+            f%has_upper = .true.
+            f%upper = upper
+        end if
+        if (present(lower_strict)) f%lower_strict = lower_strict
+        if (present(upper_strict)) f%upper_strict = upper_strict
+    end function real_field
+
+    !> A real field with a unit that must be > 0.
+    pure function positive(name, unit) result(f)
+        !> Field name.
+        character(len=*), intent(in) :: name
+        !> SI unit.
+        character(len=*), intent(in) :: unit
+        type(field_spec_t) :: f
+        f = real_field(name, unit, lower=0.0_wp, lower_strict=.true.)
+    end function positive
+
+    !> A word field; `allowed` lists the valid words separated by blanks ('' = any word).
+    pure function word_field(name, allowed) result(f)
+        !> Field name.
+        character(len=*), intent(in) :: name
+        !> Allowed words, blank-separated.
+        character(len=*), intent(in) :: allowed
+        type(field_spec_t) :: f
+        f%name = name
+        f%value_type = field_word
+        f%unit = ''
+        call split_words(allowed, f%allowed)
+    end function word_field
+
+    !> A free-text field: the rest of the line.
+    pure function text_field(name) result(f)
+        !> Field name.
+        character(len=*), intent(in) :: name
+        type(field_spec_t) :: f
+        f%name = name
+        f%value_type = field_text
+        f%unit = ''
+        allocate (f%allowed(0))
+    end function text_field
+
+    !> A record tail: `fields` (repeated as a group if `cyclic`), between `min_values` and
+    !> `max_values` values (-1 = no limit); `selected_by` is the selector word, if any.
+    pure function tail(fields, min_values, max_values, cyclic, selected_by) result(t)
+        !> Fields of the tail.
+        type(field_spec_t), intent(in) :: fields(:)
+        !> Least number of values.
+        integer, intent(in) :: min_values
+        !> Largest number of values (-1 = no limit).
+        integer, intent(in) :: max_values
+        !> The fields repeat as a group.
+        logical, intent(in), optional :: cyclic
+        !> Selector word.
+        character(len=*), intent(in), optional :: selected_by
+        type(tail_spec_t) :: t
+        allocate (t%fields, source=fields)
+        t%min_values = min_values
+        t%max_values = max_values
+        if (present(cyclic)) t%cyclic = cyclic
+        t%when = ''
+        if (present(selected_by)) t%when = selected_by
+    end function tail
+
+    !> Condition "[section] keyword = word".
+    pure function when(section, keyword, word) result(c)
+        !> Section of the keyword tested.
+        character(len=*), intent(in) :: section
+        !> Keyword tested.
+        character(len=*), intent(in) :: keyword
+        !> Value of its first field.
+        character(len=*), intent(in) :: word
+        type(condition_t) :: c
+        c%active = .true.
+        c%section = section
+        c%keyword = keyword
+        c%word = word
+    end function when
+
+    !> Declare a section.
+    subroutine schema_add_section(self, name, description)
+        !> The schema.
+        class(schema_t), intent(inout) :: self
+        !> Section name.
+        character(len=*), intent(in) :: name
+        !> One-line description.
+        character(len=*), intent(in) :: description
+        type(section_spec_t) :: sec
+        if (.not. allocated(self%sections)) allocate (self%sections(0))
+        sec%name = name
+        sec%description = description
+        self%sections = [self%sections, sec]
+    end subroutine schema_add_section
+
+    !> Declare a keyword of an already declared section.
+    subroutine schema_add_keyword(self, section, name, fields, description, required, repeatable, &
+        default, selector, tails, required_when, allowed_when)
+        !> The schema.
+        class(schema_t), intent(inout) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        !> Keyword name.
+        character(len=*), intent(in) :: name
+        !> Fixed fields.
+        type(field_spec_t), intent(in) :: fields(:)
+        !> One-line description.
+        character(len=*), intent(in) :: description
+        !> Must appear in every deck.
+        logical, intent(in), optional :: required
+        !> May appear several times.
+        logical, intent(in), optional :: repeatable
+        !> Default values as written in a deck.
+        character(len=*), intent(in), optional :: default
+        !> Index of the word field selecting the tail.
+        integer, intent(in), optional :: selector
+        !> Tails.
+        type(tail_spec_t), intent(in), optional :: tails(:)
+        !> Required when this condition holds.
+        type(condition_t), intent(in), optional :: required_when
+        !> Allowed only when this condition holds.
+        type(condition_t), intent(in), optional :: allowed_when
+        type(keyword_spec_t) :: kw
+        if (.not. allocated(self%keywords)) allocate (self%keywords(0))
+        kw%section = section
+        kw%name = name
+        kw%fields = fields
+        kw%description = description
+        if (present(required)) kw%required = required
+        if (present(repeatable)) kw%repeatable = repeatable
+        kw%default = ''
+        if (present(default)) then
+            kw%has_default = .true.
+            kw%default = default
+        end if
+        if (present(selector)) kw%selector = selector
+        if (present(tails)) then
+            kw%tails = tails
+        else
+            allocate (kw%tails(0))
+        end if
+        if (present(required_when)) kw%required_when = required_when
+        if (present(allowed_when)) kw%allowed_when = allowed_when
+        self%keywords = [self%keywords, kw]
+    end subroutine schema_add_keyword
+
+    !> Index of a section in the schema (0 if unknown).
+    pure integer function schema_find_section(self, name) result(k)
+        !> The schema.
+        class(schema_t), intent(in) :: self
+        !> Section name.
+        character(len=*), intent(in) :: name
+        do k = 1, size(self%sections)
+            if (self%sections(k)%name == name) return
+        end do
+        k = 0
+    end function schema_find_section
+
+    !> Index of a keyword of a section in the schema (0 if unknown).
+    pure integer function schema_find_keyword(self, section, name) result(k)
+        !> The schema.
+        class(schema_t), intent(in) :: self
+        !> Section name.
+        character(len=*), intent(in) :: section
+        !> Keyword name.
+        character(len=*), intent(in) :: name
+        do k = 1, size(self%keywords)
+            if (self%keywords(k)%section == section .and. self%keywords(k)%name == name) return
+        end do
+        k = 0
+    end function schema_find_keyword
+
+    ! ---------------------------------------------------------------------------------------
+    ! Field, tail and keyword helpers
+    ! ---------------------------------------------------------------------------------------
+
+    !> Name of a field type as used in messages and documentation.
+    pure function type_name(value_type) result(name)
+        !> field_int, field_real, field_word or field_text.
+        integer, intent(in) :: value_type
+        character(len=:), allocatable :: name
+        select case (value_type)
+        case (field_int)
+            name = 'integer'
+        case (field_real)
+            name = 'real'
+        case (field_word)
+            name = 'word'
+        case default
+            name = 'text'
+        end select
+    end function type_name
+
+    !> Check a token against a field: type, range, allowed words. On failure, `message`
+    !> says what is expected and what was found (e.g. "expected a real number, got 'abc'").
+    subroutine field_check(self, token, ok, message)
+        !> The field.
+        class(field_spec_t), intent(in) :: self
+        !> The token as written.
+        character(len=*), intent(in) :: token
+        !> Whether the token is valid.
+        logical, intent(out) :: ok
+        !> Explanation when not valid ('' otherwise).
+        character(len=:), allocatable, intent(out) :: message
+        real(wp) :: x
+        integer :: i
+        message = ''
+        select case (self%value_type)
+        case (field_int)
+            call parse_int(token, i, ok)
+            if (.not. ok) then
+                message = "expected an integer, got '"//token//"'"
+                return
+            end if
+            x = real(i, wp)
+        case (field_real)
+            call parse_real(token, x, ok)
+            if (.not. ok) then
+                message = "expected a real number, got '"//token//"'"
+                return
+            end if
+        case (field_word)
+            ok = size(self%allowed) == 0
+            do i = 1, size(self%allowed)
+                if (self%allowed(i)%s == token) ok = .true.
+            end do
+            if (.not. ok) message = "'"//token//"' is not allowed: expected one of "// &
+                join_words(self%allowed, ', ')
+            return
+        case default
+            ok = .true.
+            return
+        end select
+        ok = .true.
+        if (self%has_lower) then
+            if (self%lower_strict) then
+                ok = x > self%lower
+            else
+                ok = x >= self%lower
+            end if
+        end if
+        if (ok .and. self%has_upper) then
+            if (self%upper_strict) then
+                ok = x < self%upper
+            else
+                ok = x <= self%upper
+            end if
+        end if
+        if (.not. ok) message = 'out of range: must be '//self%constraint()//", got '"//token//"'"
+    end subroutine field_check
+
+    !> Allowed range (`> 0`, `>= 0 and <= 0.5`) or words (`u, w, theta`); '' if unconstrained.
+    function field_constraint(self) result(text)
+        !> The field.
+        class(field_spec_t), intent(in) :: self
+        character(len=:), allocatable :: text
+        text = ''
+        if (self%value_type == field_word) then
+            text = join_words(self%allowed, ', ')
+            return
+        end if
+        if (self%has_lower) then
+            if (self%lower_strict) then
+                text = '> '//bound_text(self, self%lower)
+            else
+                text = '>= '//bound_text(self, self%lower)
+            end if
+        end if
+        if (self%has_upper) then
+            if (len(text) > 0) text = text//' and '
+            if (self%upper_strict) then
+                text = text//'< '//bound_text(self, self%upper)
+            else
+                text = text//'<= '//bound_text(self, self%upper)
+            end if
+        end if
+    end function field_constraint
+
+    !> A bound as text: integer for integer fields.
+    function bound_text(field, x) result(text)
+        !> The field.
+        type(field_spec_t), intent(in) :: field
+        !> The bound.
+        real(wp), intent(in) :: x
+        character(len=:), allocatable :: text
+        if (field%value_type == field_int) then
+            text = to_str(nint(x))
+        else
+            text = to_str(x)
+        end if
+    end function bound_text
+
+    !> Field spec of the i-th value of a tail (i >= 1).
+    function tail_field(self, i) result(f)
+        !> The tail.
+        class(tail_spec_t), intent(in) :: self
+        !> Position in the tail.
+        integer, intent(in) :: i
+        type(field_spec_t) :: f
+        if (self%cyclic) then
+            f = self%fields(modulo(i - 1, size(self%fields)) + 1)
+        else
+            f = self%fields(min(i, size(self%fields)))
+        end if
+    end function tail_field
+
+    !> Usage of a tail: names, `[optional]` ones, or `group ...` with the count.
+    function tail_usage(self) result(text)
+        !> The tail.
+        class(tail_spec_t), intent(in) :: self
+        character(len=:), allocatable :: text
+        integer :: i, g
+        text = ''
+        g = size(self%fields)
+        if (self%cyclic) then
+            do i = 1, g
+                if (i > 1) text = text//' '
+                text = text//self%fields(i)%name
+            end do
+            if (g == 1) then
+                text = text//' ... ('//count_text(self%min_values, self%max_values, 'value')//')'
+            else
+                text = text//' ... ('// &
+                    count_text(self%min_values/g, group_max(self%max_values, g), 'group')// &
+                    ' of '//to_str(g)//')'
+            end if
+        else
+            do i = 1, g
+                if (i > 1) text = text//' '
+                if (i > self%min_values) then
+                    text = text//'['//self%fields(i)%name//']'
+                else
+                    text = text//self%fields(i)%name
+                end if
+            end do
+        end if
+    end function tail_usage
+
+    !> "1 to 3 values", "at least 2 groups", "exactly 1 value".
+    function count_text(lo, hi, noun) result(text)
+        !> Least count.
+        integer, intent(in) :: lo
+        !> Largest count (< 0: no limit).
+        integer, intent(in) :: hi
+        !> What is counted (singular).
+        character(len=*), intent(in) :: noun
+        character(len=:), allocatable :: text
+        if (hi < 0) then
+            text = 'at least '//to_str(lo)//' '//noun//'s'
+        else if (hi == lo .and. lo == 1) then
+            text = 'exactly 1 '//noun
+        else if (hi == lo) then
+            text = 'exactly '//to_str(lo)//' '//noun//'s'
+        else
+            text = to_str(lo)//' to '//to_str(hi)//' '//noun//'s'
+        end if
+    end function count_text
+
+    !> Largest number of groups of size g in max_values values (-1 if no limit).
+    pure integer function group_max(max_values, g) result(n)
+        !> Largest number of values (-1 if no limit).
+        integer, intent(in) :: max_values
+        !> Group size.
+        integer, intent(in) :: g
+        n = -1
+        if (max_values >= 0) n = max_values/g
+    end function group_max
+
+    !> Index of the tail applying when the selector field holds `word` (0 if none).
+    pure integer function keyword_tail_index(self, word) result(k)
+        !> The keyword.
+        class(keyword_spec_t), intent(in) :: self
+        !> Selector word ('' when the keyword has no selector).
+        character(len=*), intent(in) :: word
+        if (self%selector == 0) then
+            k = min(size(self%tails), 1)
+            return
+        end if
+        do k = 1, size(self%tails)
+            if (self%tails(k)%when == word) return
+        end do
+        k = 0
+    end function keyword_tail_index
+
+    !> Usage of a keyword: its field names and the tail for the selector word `word`
+    !> (e.g. `node dof value [function]`).
+    function keyword_usage(self, word) result(text)
+        !> The keyword.
+        class(keyword_spec_t), intent(in) :: self
+        !> Selector word ('' if none).
+        character(len=*), intent(in) :: word
+        character(len=:), allocatable :: text
+        integer :: i, k
+        text = ''
+        do i = 1, size(self%fields)
+            if (i > 1) text = text//' '
+            text = text//self%fields(i)%name
+        end do
+        k = self%tail_index(word)
+        if (k > 0) text = text//' '//self%tails(k)%usage()
+    end function keyword_usage
+
+    !> Text of a condition: `[run] analysis = dynamic`.
+    function condition_text(self) result(text)
+        !> The condition.
+        class(condition_t), intent(in) :: self
+        character(len=:), allocatable :: text
+        text = '['//self%section//'] '//self%keyword//' = '//self%word
+    end function condition_text
+
+    ! ---------------------------------------------------------------------------------------
+    ! Reference documentation
+    ! ---------------------------------------------------------------------------------------
+
+    !> Markdown reference of the deck: one table per section (keyword, values, unit, default,
+    !> allowed, description), lines separated by LF, ending with LF. `multicor
+    !> --schema-markdown` prints exactly this; doc/input.md holds it between the markers.
+    subroutine schema_markdown(s, text)
+        !> The schema.
+        type(schema_t), intent(in) :: s
+        !> The Markdown text.
+        character(len=:), allocatable, intent(out) :: text
+        character(len=*), parameter :: lf = new_line('a')
+        integer :: i, k
+        text = ''
+        do i = 1, size(s%sections)
+            if (i > 1) text = text//lf
+            text = text//'### ['//s%sections(i)%name//']'//lf//lf//s%sections(i)%description//lf//lf
+            text = text//'| keyword | values | unit | default | allowed | description |'//lf
+            text = text//'|---|---|---|---|---|---|'//lf
+            do k = 1, size(s%keywords)
+                if (s%keywords(k)%section == s%sections(i)%name) then
+                    call keyword_rows(s%keywords(k), text)
+                end if
+            end do
+        end do
+    end subroutine schema_markdown
+
+    !> Append the table rows of one keyword: one row per field and tail field.
+    subroutine keyword_rows(kw, text)
+        !> The keyword.
+        type(keyword_spec_t), intent(in) :: kw
+        !> Text to append to.
+        character(len=:), allocatable, intent(inout) :: text
+        character(len=:), allocatable :: first, default, description, values
+        integer :: i, j
+        logical :: started
+        first = '`'//kw%name//'`'
+        if (kw%repeatable) first = first//' (repeatable)'
+        if (kw%required) then
+            default = 'required'
+        else if (kw%required_when%active) then
+            default = 'required if '//kw%required_when%text()
+        else if (kw%has_default) then
+            default = '`'//kw%default//'`'
+            if (len(kw%default) == 0) default = '(empty)'
+        else
+            default = '-'
+        end if
+        description = kw%description
+        if (kw%allowed_when%active) description = description//' Only allowed if '// &
+            kw%allowed_when%text()//'.'
+        started = .false.
+        do i = 1, size(kw%fields)
+            values = '`'//kw%fields(i)%name//'` ('//type_name(kw%fields(i)%value_type)//')'
+            call add_row(kw%fields(i), values)
+        end do
+        do j = 1, size(kw%tails)
+            do i = 1, size(kw%tails(j)%fields)
+                values = ''
+                if (len(kw%tails(j)%when) > 0) values = 'if `'//kw%fields(kw%selector)%name// &
+                    '` = '//kw%tails(j)%when//': '
+                values = values//'`'//kw%tails(j)%fields(i)%name//'` ('// &
+                    type_name(kw%tails(j)%fields(i)%value_type)//tail_note(kw%tails(j), i)//')'
+                call add_row(kw%tails(j)%fields(i), values)
+            end do
+        end do
+
+    contains
+
+        !> One table row; keyword, default and description on the first row only.
+        subroutine add_row(field, values)
+            type(field_spec_t), intent(in) :: field
+            character(len=*), intent(in) :: values
+            character(len=*), parameter :: lf = new_line('a')
+            if (.not. started) then
+                text = text//'|'//cell(first)//cell(values)//cell(field%unit)//cell(default)// &
+                    cell(field%constraint())//cell(description)//lf
+                started = .true.
+            else
+                text = text//'|'//cell('')//cell(values)//cell(field%unit)//cell('')// &
+                    cell(field%constraint())//cell('')//lf
+            end if
+        end subroutine add_row
+
+        !> A table cell followed by its closing bar: ` x |`, or ` |` when empty.
+        function cell(content) result(c)
+            character(len=*), intent(in) :: content
+            character(len=:), allocatable :: c
+            if (len(content) == 0) then
+                c = ' |'
+            else
+                c = ' '//content//' |'
+            end if
+        end function cell
+    end subroutine keyword_rows
+
+    !> Note on a tail field: optional, or repeated with its count (", 1 to 3 values").
+    function tail_note(t, i) result(note)
+        !> The tail.
+        type(tail_spec_t), intent(in) :: t
+        !> Field index in the tail.
+        integer, intent(in) :: i
+        character(len=:), allocatable :: note
+        integer :: g
+        g = size(t%fields)
+        note = ''
+        if (t%cyclic) then
+            if (i == 1) then
+                if (g == 1) then
+                    note = ', repeated: '//count_text(t%min_values, t%max_values, 'value')
+                else
+                    note = ', repeated with the next: '// &
+                        count_text(t%min_values/g, group_max(t%max_values, g), 'group')
+                end if
+            end if
+        else if (i > t%min_values) then
+            note = ', optional'
+        end if
+    end function tail_note
 end module io_deck_schema

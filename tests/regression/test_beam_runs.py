@@ -1,0 +1,132 @@
+#!/usr/bin/env python3
+"""Regression runs of the multicor executable on beam decks, checked against closed forms.
+
+Each check reads the results back from the HDF5 file written by the run. The decks live in
+tests/regression/decks/ (their headers state the reference) and input/.
+Usage (ctest does this): test_beam_runs.py --exe multicor --work DIR --source REPO
+"""
+import argparse
+import math
+import pathlib
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+FAILED = []
+
+
+def check(name, ok, detail):
+    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
+    if not ok:
+        FAILED.append(name)
+
+
+def run(exe, deck, work):
+    out = work / deck.stem
+    proc = subprocess.run([str(exe), str(deck), "--output", str(out), "--quiet"],
+                          capture_output=True, text=True)
+    if proc.returncode != 0:
+        print(proc.stdout, proc.stderr)
+        raise SystemExit(f"multicor failed on {deck} (exit {proc.returncode})")
+    return h5py.File(out / f"{deck.stem}.h5", "r")
+
+
+def static_cantilever(exe, decks, work):
+    E, A, I, L, P, N = 7.0e10, 3.0e-4, 2.5e-9, 0.8, 25.0, 1000.0
+    with run(exe, decks / "cantilever_static.dat", work) as f:
+        d = f["static/displacement"][...]          # (n_nodes, 3): u, w, theta
+        r = f["static/reactions"][...]
+        assert f.attrs["code_name"] == "MULTICOR"
+        assert "cantilever" in f.attrs["deck_text"].lower()
+    tip = d[-1]
+    # Hermite elements are nodally exact: round-off only (banded Cholesky), rel. 1e-8.
+    w_ref, t_ref, u_ref = -P * L**3 / (3 * E * I), -P * L**2 / (2 * E * I), N * L / (E * A)
+    check("static tip deflection", abs(tip[1] / w_ref - 1) < 1e-8, f"{tip[1]:.10e} vs {w_ref:.10e}")
+    check("static tip rotation", abs(tip[2] / t_ref - 1) < 1e-8, f"{tip[2]:.10e} vs {t_ref:.10e}")
+    check("static axial extension", abs(tip[0] / u_ref - 1) < 1e-8, f"{tip[0]:.10e} vs {u_ref:.10e}")
+    # Support reactions balance the loads: Fy = +P, M = +P L at the clamp (rel. round-off).
+    check("clamp reaction force", abs(r[0, 1] / P - 1) < 1e-8, f"{r[0, 1]:.10e} vs {P}")
+    check("clamp reaction moment", abs(r[0, 2] / (P * L) - 1) < 1e-8, f"{r[0, 2]:.10e} vs {P * L}")
+
+
+def static_lframe(exe, decks, work):
+    E, A, I, H, L, P = 2.1e11, 4.0e-4, 3.0e-8, 1.5, 1.0, 500.0
+    with run(exe, decks / "lframe_static.dat", work) as f:
+        d = f["static/displacement"][...]
+        ids = f["fem/mesh/node_id"][...]
+    tip = d[list(ids).index(23)]
+    w_ref = -(P * L**3 / (3 * E * I) + P * L * H * L / (E * I) + P * H / (E * A))
+    u_ref = P * L * H**2 / (2 * E * I)
+    # Exact for Hermite frames up to round-off: rel. 1e-8.
+    check("L-frame vertical tip deflection", abs(tip[1] / w_ref - 1) < 1e-8, f"{tip[1]:.10e} vs {w_ref:.10e}")
+    check("L-frame horizontal tip displacement", abs(tip[0] / u_ref - 1) < 1e-8, f"{tip[0]:.10e} vs {u_ref:.10e}")
+
+
+def modal_cantilever(exe, decks, work):
+    E, rho, A, I, L = 1.1e11, 8900.0, 1.2e-4, 1.0e-9, 0.6
+    with run(exe, decks / "cantilever_modal.dat", work) as f:
+        omega = f["modal/omega"][...]
+        freq = f["modal/frequency"][...]
+        shapes = f["modal/shapes"][...]
+    bl = np.array([1.875104069, 4.694091133, 7.854757438])
+    ref = bl**2 * math.sqrt(E * I / (rho * A * L**4))
+    err = np.abs(omega[:3] / ref - 1)
+    # 24 consistent-mass Hermite elements: discretisation error ~1e-6 for these modes; 0.5 %
+    # is the issue's requirement, 1e-4 shows the convergence is as expected.
+    check("modal frequencies", bool(np.all(err < 1e-4)), f"relative errors {err}")
+    check("modal Hz = rad/s / 2pi", bool(np.allclose(freq, omega / (2 * math.pi), rtol=1e-14)), "")
+    check("modal shapes stored", shapes.shape == (4, 25, 3), f"shape {shapes.shape}")
+
+
+def dynamic_cantilever(exe, src, work):
+    E, rho, A, I, L, P = 2.1e11, 7800.0, 2.0e-4, 1.0 / 6.0e8, 1.0, 10.0
+    with run(exe, src / "input" / "cantilever.dat", work) as f:
+        t = f["fem/time"][...]
+        w = f["fem/displacement"][:, -1, 1]
+        bal = f["energy/balance"][...]
+        kin = f["energy/kinetic"][...]
+    w_s = -P * L**3 / (3 * E * I)
+    T1 = 2 * math.pi / (1.875104069**2 * math.sqrt(E * I / (rho * A * L**4)))
+    # Step load: each mode oscillates about its static share, so the time mean over whole
+    # first-mode periods is the static deflection; higher modes (3 % of the tip static
+    # deflection, periods T1/6 and shorter) average out to well under 1 %.
+    n_per = int(t[-1] // T1)
+    sel = t <= n_per * T1
+    trapezoid = getattr(np, "trapezoid", None) or np.trapz
+    mean = trapezoid(w[sel], t[sel]) / t[sel][-1]
+    check("dynamic mean tip deflection = static", abs(mean / w_s - 1) < 1e-2, f"{mean:.6e} vs {w_s:.6e}")
+    # Period from upward crossings of the static level (linear interpolation).
+    s = w - w_s
+    up = np.where((s[:-1] < 0) & (s[1:] >= 0))[0]
+    tc = t[up] - s[up] * (t[up + 1] - t[up]) / (s[up + 1] - s[up])
+    period = np.mean(np.diff(tc))
+    # 600 steps per period: average acceleration period error (pi^2/12)(h/T)^2 ~ 2e-6, plus
+    # higher-mode ripple on the crossings: 1 %.
+    check("dynamic period = first cantilever period", abs(period / T1 - 1) < 1e-2, f"{period:.6f} s vs {T1:.6f} s")
+    # Average acceleration conserves energy exactly for a linear undamped system: balance
+    # residual at round-off relative to the energy in play.
+    scale = max(np.max(np.abs(kin)), 1e-30)
+    check("dynamic energy balance", np.max(np.abs(bal)) / scale < 1e-9, f"max |balance|/max kinetic = {np.max(np.abs(bal)) / scale:.2e}")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--exe", required=True)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("--source", required=True)
+    args = ap.parse_args()
+    exe, work, src = pathlib.Path(args.exe), pathlib.Path(args.work), pathlib.Path(args.source)
+    work.mkdir(parents=True, exist_ok=True)
+    decks = src / "tests" / "regression" / "decks"
+    static_cantilever(exe, decks, work)
+    static_lframe(exe, decks, work)
+    modal_cantilever(exe, decks, work)
+    dynamic_cantilever(exe, src, work)
+    print(f"{len(FAILED)} failed checks")
+    return 1 if FAILED else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
