@@ -625,6 +625,13 @@ contains
             run%beta = 0.25_wp
             run%gamma = 0.5_wp
         end select
+        if (run%analysis == 'dynamic' .and. run%scheme == 'central_difference' .and. &
+            .not. beam%lumped_mass) then
+            call make_input_error(error, deck%file, deck%line('time', 'scheme'), 'scheme', &
+                'the central-difference scheme needs a lumped mass matrix: set [beam] '// &
+                'mass = lumped, or use scheme = average_acceleration')
+            return
+        end if
         run%h = deck%get_real('time', 'step')
         run%t_end = deck%get_real('time', 'end')
         if (run%analysis == 'dynamic' .and. run%h > run%t_end) then

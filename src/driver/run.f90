@@ -5,7 +5,7 @@
 !> earlier results stay intact when a run fails.
 module driver_run
     use core_kinds, only: wp
-    use core_error, only: error_t, make_error
+    use core_error, only: error_t, make_input_error
     use io_deck_schema, only: multicor_schema
     use io_deck, only: deck_t, read_deck
     use io_paths, only: stem, mkdir_p
@@ -56,17 +56,27 @@ contains
         type(beam_model_t) :: model
         class(time_integrator_t), allocatable :: integ
         type(results_writer_t) :: out
-        character(len=:), allocatable :: dir, path
+        character(len=:), allocatable :: dir, path, message
 
         call read_deck(opts%deck_path, multicor_schema(), deck, error)
         if (allocated(error)) return
         call build_config(deck, run, beam, error)
         if (allocated(error)) return
         call build_beam_model(beam, model, error)
-        if (allocated(error)) return
+        ! A static solve needs supports that stop every rigid-body motion.
+        if (.not. allocated(error) .and. run%analysis == 'static') call model%check_supports(error)
+        if (allocated(error)) then
+            error%message = deck%file//': '//error%message
+            return
+        end if
         if (run%analysis == 'dynamic') then
             call make_integrator(run, model, integ, error)
-            if (allocated(error)) return
+            if (allocated(error)) then
+                ! The integrator only refuses a time step (stability limit).
+                message = error%message
+                call make_input_error(error, deck%file, deck%line('time', 'step'), 'step', message)
+                return
+            end if
         end if
         if (opts%check_only) then
             call report(opts%deck_path//': deck is valid ('//run%analysis//' analysis)')
@@ -93,6 +103,7 @@ contains
         end if
         if (allocated(error)) then
             call out%abort()
+            error%message = deck%file//': '//error%message
             return
         end if
         call out%close(error)
@@ -177,7 +188,8 @@ contains
         integer :: n_steps, k
         character(len=160) :: buf
 
-        n_steps = nint(run%t_end/run%h)
+        ! Whole steps up to the end time (the last one may end slightly after it).
+        n_steps = ceiling(run%t_end/run%h*(1.0_wp - 1.0e-12_wp))
         allocate (d(3, model%n_nodes), v(3, model%n_nodes), a(3, model%n_nodes))
         call progress%start(n_steps, run%t_end, run%progress_seconds)
         call store(error)
