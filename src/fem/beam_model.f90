@@ -4,20 +4,38 @@
 !> Free DOFs are numbered node by node (u, w, theta), which keeps the bandwidth at most
 !> 3*(largest node-number difference in an element) + 2. All vectors of size `n_free`
 !> are in that numbering; `expand` and `restrict` convert to and from (3, n_nodes) arrays.
+!>
+!> Arlequin weighting (THEORY.md section 4): given a weight alpha(s) (s = `abscissa`, the
+!> distance from node 1 along the elements), mass and stiffness are integrated as
+!> int alpha(s) (...) ds by Gauss quadrature (6 points on each piece of an element between
+!> the weight's breakpoints: exact for a piecewise cubic alpha times the degree-6 Hermite
+!> mass products) and nodal loads are multiplied by alpha at their node.
 module fem_beam_model
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
     use core_linalg, only: band_spd_t
     use core_timefunc, only: time_function_t
+    use core_weight, only: weight_function_t
     use fem_beam_config, only: beam_config_t, beam_load_t, beam_section_t
     use fem_beam_element, only: element_stiffness, element_mass_consistent, &
-                                element_mass_lumped, to_global
+                                element_mass_lumped, to_global, hermite_shape
     implicit none
     private
     public :: beam_model_t, build_beam_model
 
     !> Names of the DOFs of a node, for messages.
     character(len=5), parameter :: dof_names(3) = ['u    ', 'w    ', 'theta']
+
+    !> 6-point Gauss-Legendre rule on [0, 1] (exact to degree 11): abscissas and weights.
+    real(wp), parameter :: gauss_t(6) = 0.5_wp + 0.5_wp*[ &
+                           -0.9324695142031520278123016_wp, -0.6612093864662645136613996_wp, &
+                           -0.2386191860831969086305017_wp, 0.2386191860831969086305017_wp, &
+                           0.6612093864662645136613996_wp, 0.9324695142031520278123016_wp]
+    !> See `gauss_t`.
+    real(wp), parameter :: gauss_w(6) = 0.5_wp*[ &
+                           0.1713244923791703450402961_wp, 0.3607615730481386075698025_wp, &
+                           0.4679139345726910473898703_wp, 0.4679139345726910473898703_wp, &
+                           0.3607615730481386075698025_wp, 0.1713244923791703450402961_wp]
 
     !> A planar Euler-Bernoulli frame ready for static, modal and transient analysis.
     type :: beam_model_t
@@ -53,6 +71,16 @@ module fem_beam_model
         type(beam_load_t), allocatable :: loads(:)
         !> Time functions referenced by the loads.
         type(time_function_t), allocatable :: functions(:)
+        !> Curvilinear abscissa of each node [m]: distance from node 1 along the elements
+        !> (from the lowest node of each connected part); size n_nodes.
+        real(wp), allocatable :: abscissa(:)
+        !> True when mass, stiffness and loads were weighted by an Arlequin weight.
+        logical :: weighted = .false.
+        !> Weight alpha at each node (1 when not weighted); loads are already multiplied by it.
+        real(wp), allocatable :: node_weight(:)
+        !> Weighted element stiffness matrices in global axes (6, 6, n_elements), kept for
+        !> `reactions` (allocated only when weighted).
+        real(wp), allocatable :: k_element(:, :, :)
     contains
         !> f(n_free) = external nodal forces at time t.
         procedure :: external_force
@@ -78,6 +106,8 @@ module fem_beam_model
         procedure :: equation_label
         !> Error when a connected part of the frame can move as a rigid body.
         procedure :: check_supports
+        !> Curvilinear abscissa at reduced coordinate xi of an element.
+        procedure :: abscissa_at
     end type beam_model_t
 
 contains
@@ -85,13 +115,18 @@ contains
     !> Build the model from its description: checks, equation numbering, assembly of K and M.
     !> A model without enough supports is accepted here (explicit dynamics and modal analysis
     !> do not need it); the singular stiffness is reported when K is factored.
-    subroutine build_beam_model(config, model, error)
+    !> With a weight, K and M are integrated with alpha(s) and loads scaled by alpha at their
+    !> node (Arlequin partition); elements where alpha = 0 get no mass nor stiffness.
+    subroutine build_beam_model(config, model, error, weight)
         !> The frame description.
         type(beam_config_t), intent(in) :: config
         !> The model built.
         type(beam_model_t), intent(out) :: model
         !> Set when the description is invalid.
         type(error_t), allocatable, intent(out) :: error
+        !> Arlequin weight alpha(s), s = `model%abscissa`; none = alpha = 1 everywhere.
+        class(weight_function_t), intent(in), optional :: weight
+        integer :: i
         call check_mesh(config, error)
         if (allocated(error)) return
         call check_elements(config, error)
@@ -109,7 +144,22 @@ contains
         allocate (model%loads(0), model%functions(0))
         if (allocated(config%loads)) model%loads = config%loads
         if (allocated(config%functions)) model%functions = config%functions
-        call assemble(model, error)
+        call compute_abscissa(model)
+        allocate (model%node_weight(model%n_nodes), source=1.0_wp)
+        if (present(weight)) then
+            model%weighted = .true.
+            do i = 1, model%n_nodes
+                model%node_weight(i) = weight%value(model%abscissa(i))
+            end do
+            do i = 1, size(model%loads)
+                associate (ld => model%loads(i))
+                    ld%value = ld%value*model%node_weight(ld%node)
+                end associate
+            end do
+            call assemble(model, error, weight)
+        else
+            call assemble(model, error)
+        end if
     end subroutine build_beam_model
 
     !> Node label for messages: 'node 3 (id 12)'.
@@ -314,10 +364,11 @@ contains
         dofs(4:6) = model%eq(:, model%conn(2, e))
     end function element_dofs
 
-    !> Assemble the band K and M on the free DOFs.
-    subroutine assemble(model, error)
+    !> Assemble the band K and M on the free DOFs (weighted when a weight is given).
+    subroutine assemble(model, error, weight)
         type(beam_model_t), intent(inout) :: model
         type(error_t), allocatable, intent(out) :: error
+        class(weight_function_t), intent(in), optional :: weight
         integer :: e, a, b, kd
         integer :: dofs(6)
         real(wp) :: kg(6, 6), mg(6, 6), ml(6)
@@ -328,13 +379,19 @@ contains
         end do
         call model%k%init(model%n_free, kd)
         call model%m%init(model%n_free, merge(0, kd, model%lumped_mass))
+        if (present(weight)) allocate (model%k_element(6, 6, model%n_elements))
         do e = 1, model%n_elements
             dofs = element_dofs(model, e)
-            associate (c => model%cosine(e), s => model%sine(e), l => model%length(e))
-                kg = to_global(element_stiffness(model%ea(e), model%ei(e), l), c, s)
-                mg = to_global(element_mass_consistent(model%rho_a(e), l), c, s)
-                ml = element_mass_lumped(model%rho_a(e), l)
-            end associate
+            if (present(weight)) then
+                call weighted_element(model, e, weight, kg, mg, ml)
+                model%k_element(:, :, e) = kg
+            else
+                associate (c => model%cosine(e), s => model%sine(e), l => model%length(e))
+                    kg = to_global(element_stiffness(model%ea(e), model%ei(e), l), c, s)
+                    mg = to_global(element_mass_consistent(model%rho_a(e), l), c, s)
+                    ml = element_mass_lumped(model%rho_a(e), l)
+                end associate
+            end if
             do b = 1, 6
                 if (dofs(b) == 0) cycle
                 do a = 1, 6
@@ -348,6 +405,152 @@ contains
         if (model%k%out_of_band .or. model%m%out_of_band) &
             call make_error(error, 'beam model: internal error, bandwidth too small')
     end subroutine assemble
+
+    !> Weighted element matrices in global axes: kg = int alpha B^T D B ds, mg = int alpha
+    !> rho A N^T N ds (Gauss, 6 points per piece between breakpoints of alpha), and the
+    !> lumped diagonal ml: translations int alpha rho A N_i ds (linear N_i, the same in x and
+    !> y so that it does not depend on the axes), rotations the consistent diagonal scaled as
+    !> in HRZ (by the transverse mass over the sum of the transverse diagonal); with alpha = 1
+    !> these are the unweighted matrices.
+    subroutine weighted_element(model, e, weight, kg, mg, ml)
+        type(beam_model_t), intent(in) :: model
+        integer, intent(in) :: e
+        class(weight_function_t), intent(in) :: weight
+        real(wp), intent(out) :: kg(6, 6), mg(6, 6), ml(6)
+        real(wp), allocatable :: cuts(:)
+        real(wp) :: kl(6, 6), m(6, 6), xi, dxi, dw, l, na(2), nh(4), bh(4), total, scale
+        integer :: p, g
+        integer, parameter :: ax(2) = [1, 4], tr(4) = [2, 3, 5, 6]
+        l = model%length(e)
+        cuts = element_cuts(model, e, weight)
+        kl = 0.0_wp
+        m = 0.0_wp
+        do p = 1, size(cuts) - 1
+            dxi = cuts(p + 1) - cuts(p)
+            do g = 1, 6
+                xi = cuts(p) + dxi*gauss_t(g)
+                ! alpha ds at this Gauss point.
+                dw = weight%value(model%abscissa_at(e, xi))*gauss_w(g)*dxi*l
+                na = [1.0_wp - xi, xi]
+                nh = hermite_shape(xi, l)
+                ! Curvatures d2N/dx2 of the Hermite functions.
+                bh = [(12*xi - 6)/l**2, (6*xi - 4)/l, (6 - 12*xi)/l**2, (6*xi - 2)/l]
+                kl(ax, ax) = kl(ax, ax) + dw*model%ea(e)/l**2* &
+                             reshape([1.0_wp, -1.0_wp, -1.0_wp, 1.0_wp], [2, 2])
+                kl(tr, tr) = kl(tr, tr) + dw*model%ei(e)*outer(bh, bh)
+                m(ax, ax) = m(ax, ax) + dw*model%rho_a(e)*outer(na, na)
+                m(tr, tr) = m(tr, tr) + dw*model%rho_a(e)*outer(nh, nh)
+            end do
+        end do
+        kg = to_global(kl, model%cosine(e), model%sine(e))
+        mg = to_global(m, model%cosine(e), model%sine(e))
+        ! Lumped: the row sums of the axial mass (= int alpha rho A N_i ds) on both
+        ! translations, the HRZ-scaled consistent rotational diagonal.
+        ml(1) = m(1, 1) + m(1, 4)
+        ml(4) = m(4, 1) + m(4, 4)
+        ml(2) = ml(1)
+        ml(5) = ml(4)
+        total = ml(1) + ml(4)
+        scale = 0.0_wp
+        if (m(2, 2) + m(5, 5) > 0) scale = total/(m(2, 2) + m(5, 5))
+        ml(3) = m(3, 3)*scale
+        ml(6) = m(6, 6)*scale
+    end subroutine weighted_element
+
+    !> Outer product a b^T.
+    pure function outer(a, b) result(c)
+        real(wp), intent(in) :: a(:), b(:)
+        real(wp) :: c(size(a), size(b))
+        c = spread(a, 2, size(b))*spread(b, 1, size(a))
+    end function outer
+
+    !> Reduced coordinates 0 = c_1 < ... < c_n = 1 of an element cut at the breakpoints of
+    !> the weight that fall strictly inside it.
+    function element_cuts(model, e, weight) result(cuts)
+        type(beam_model_t), intent(in) :: model
+        integer, intent(in) :: e
+        class(weight_function_t), intent(in) :: weight
+        real(wp), allocatable :: cuts(:)
+        real(wp), allocatable :: bp(:)
+        real(wp) :: s1, s2, xi, tmp
+        integer :: i, j
+        ! Cuts closer than this to an end or to each other are dropped: pieces of relative
+        ! length 1e-12 carry nothing at double precision.
+        real(wp), parameter :: eps = 1.0e-12_wp
+        s1 = model%abscissa(model%conn(1, e))
+        s2 = model%abscissa(model%conn(2, e))
+        bp = weight%breakpoints()
+        cuts = [0.0_wp]
+        if (s2 /= s1) then
+            do i = 1, size(bp)
+                xi = (bp(i) - s1)/(s2 - s1)
+                if (xi > eps .and. xi < 1 - eps) cuts = [cuts, xi]
+            end do
+        end if
+        ! Sort (breakpoints are increasing in s, but s may decrease along the element).
+        do i = 2, size(cuts)
+            tmp = cuts(i)
+            j = i - 1
+            do while (j >= 1)
+                if (cuts(j) <= tmp) exit
+                cuts(j + 1) = cuts(j)
+                j = j - 1
+            end do
+            cuts(j + 1) = tmp
+        end do
+        ! Drop coincident breakpoints, then close with 1.
+        j = 1
+        do i = 2, size(cuts)
+            if (cuts(i) - cuts(j) <= eps) cycle
+            j = j + 1
+            cuts(j) = cuts(i)
+        end do
+        cuts = [cuts(1:j), 1.0_wp]
+    end function element_cuts
+
+    !> Curvilinear abscissa of every node: shortest distance along the elements from the
+    !> lowest-numbered node of its connected part (node 1 for a connected frame); for a
+    !> single chain of elements this is the arc length from node 1.
+    subroutine compute_abscissa(model)
+        type(beam_model_t), intent(inout) :: model
+        integer :: comp(model%n_nodes), e, n1, n2, i
+        logical :: changed
+        call component_roots(model, comp)
+        allocate (model%abscissa(model%n_nodes), source=huge(1.0_wp))
+        do i = 1, model%n_nodes
+            if (comp(i) == i) model%abscissa(i) = 0.0_wp
+        end do
+        ! Bellman-Ford relaxation over the elements (one sweep for elements in chain order).
+        changed = .true.
+        do while (changed)
+            changed = .false.
+            do e = 1, model%n_elements
+                n1 = model%conn(1, e)
+                n2 = model%conn(2, e)
+                if (model%abscissa(n1) + model%length(e) < model%abscissa(n2)) then
+                    model%abscissa(n2) = model%abscissa(n1) + model%length(e)
+                    changed = .true.
+                else if (model%abscissa(n2) + model%length(e) < model%abscissa(n1)) then
+                    model%abscissa(n1) = model%abscissa(n2) + model%length(e)
+                    changed = .true.
+                end if
+            end do
+        end do
+    end subroutine compute_abscissa
+
+    !> Curvilinear abscissa [m] at reduced coordinate xi in [0, 1] of element e (linear
+    !> between the abscissas of its nodes).
+    pure real(wp) function abscissa_at(self, e, xi) result(s)
+        !> The model.
+        class(beam_model_t), intent(in) :: self
+        !> Element.
+        integer, intent(in) :: e
+        !> Reduced coordinate x/L from the element's first node.
+        real(wp), intent(in) :: xi
+        associate (s1 => self%abscissa(self%conn(1, e)), s2 => self%abscissa(self%conn(2, e)))
+            s = s1 + xi*(s2 - s1)
+        end associate
+    end function abscissa_at
 
     !> External nodal forces at time t on the free DOFs: sum of value*function(t).
     subroutine external_force(self, t, f)
@@ -486,8 +689,12 @@ contains
         do e = 1, self%n_elements
             n1 = self%conn(1, e)
             n2 = self%conn(2, e)
-            kg = to_global(element_stiffness(self%ea(e), self%ei(e), self%length(e)), &
-                           self%cosine(e), self%sine(e))
+            if (allocated(self%k_element)) then
+                kg = self%k_element(:, :, e)
+            else
+                kg = to_global(element_stiffness(self%ea(e), self%ei(e), self%length(e)), &
+                               self%cosine(e), self%sine(e))
+            end if
             fe = matmul(kg, [d(:, n1), d(:, n2)])
             r(:, n1) = r(:, n1) + fe(1:3)
             r(:, n2) = r(:, n2) + fe(4:6)

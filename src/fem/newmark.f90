@@ -10,7 +10,15 @@
 !>
 !> Energy accounts, updated every step (trapezoidal rule, exact for average acceleration):
 !> W += 1/2 (F_n + F_{n+1}).(u_{n+1} - u_n), D += (u_{n+1} - u_n).C (v_n + v_{n+1})/2,
-!> and `energy_balance()` = kinetic + strain + D - W - (initial kinetic + strain).
+!> and `energy_balance()` = kinetic + strain + D - W - W_c - (initial kinetic + strain),
+!> W_c being the work of the coupling forces (same rule, zero without coupling).
+!>
+!> Coupled steps (Arlequin, THEORY.md section 4) split `newmark_t%step` in two:
+!> `predict` advances to t_{n+1} without coupling force (the free state: u, v, a), then
+!> `correct(f_c)` adds the response to an extra force f_c (= -C^T lambda) and finishes the
+!> step. The scheme being linear, a = a_free + S^-1 f_c, u = u_free + beta h^2 S^-1 f_c,
+!> v = v_free + gamma h S^-1 f_c with S = M + gamma h C + beta h^2 K (`solve_effective`);
+!> `predict` + `correct(0)` is bit-identical to `step`.
 module fem_newmark
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
@@ -42,6 +50,8 @@ module fem_newmark
         real(wp) :: damping_dissipation = 0.0_wp
         !> Kinetic + strain energy at `init` [J].
         real(wp) :: initial_energy = 0.0_wp
+        !> Work of the coupling forces since `init` [J] (see `newmark_t%correct`).
+        real(wp) :: coupling_work = 0.0_wp
         !> Work arrays (n_free): previous u, v, F; F at the new time; scratch.
         real(wp), allocatable :: u_old(:), v_old(:), f_old(:), f_new(:), work(:), work2(:)
     contains
@@ -99,11 +109,23 @@ module fem_newmark
         real(wp) :: gamma = 0.5_wp
         !> Factored effective matrix M + gamma h C + beta h^2 K.
         type(band_spd_t) :: s
+        !> True between `predict` and `correct`.
+        logical :: predicted = .false.
+        !> Coupling force of the previous step (n_free), for the coupling work.
+        real(wp), allocatable :: fc_old(:)
     contains
         !> See `time_integrator_t%init`.
         procedure :: init => newmark_init
         !> See `time_integrator_t%step`.
         procedure :: step => newmark_step
+        !> Free prediction of the step (no coupling force): u, v, a at t_{n+1}.
+        procedure :: predict => newmark_predict
+        !> Add the response to a coupling force and finish the step.
+        procedure :: correct => newmark_correct
+        procedure, private :: solve_effective_vec, solve_effective_mat
+        !> x = S^-1 b with S = M + gamma h C + beta h^2 K (one or several right-hand sides).
+        generic :: solve_effective => solve_effective_vec, solve_effective_mat
+        procedure, private :: free_solve
     end type newmark_t
 
     !> Explicit central-difference scheme (Newmark beta = 0, gamma = 1/2), lumped mass.
@@ -130,7 +152,7 @@ contains
         !> The integrator.
         class(time_integrator_t), intent(in) :: self
         energy_balance = self%kinetic + self%strain + self%damping_dissipation &
-                         - self%external_work - self%initial_energy
+                         - self%external_work - self%coupling_work - self%initial_energy
     end function energy_balance
 
     !> Common part of `init`: checks, state, work arrays, energies; leaves
@@ -177,6 +199,7 @@ contains
         self%initial_energy = self%kinetic + self%strain
         self%external_work = 0.0_wp
         self%damping_dissipation = 0.0_wp
+        self%coupling_work = 0.0_wp
         call self%initial_residual(model)
     end subroutine start_state
 
@@ -243,6 +266,8 @@ contains
         end if
         call self%start_state(model, h, t0, u0, v0, error)
         if (allocated(error)) return
+        self%predicted = .false.
+        self%fc_old = 0*u0
         mf = model%m
         call mf%factor(error)
         if (allocated(error)) return
@@ -262,7 +287,23 @@ contains
         class(newmark_t), intent(inout) :: self
         !> The model.
         type(beam_model_t), intent(in) :: model
-        !> Set on failure of the solve.
+        !> Set on failure of the solve, or when a prediction awaits its correction.
+        type(error_t), allocatable, intent(out) :: error
+        if (self%predicted) then
+            call make_error(error, 'Newmark step: a prediction awaits its correction (call '// &
+                            'correct, not step, after predict)')
+            return
+        end if
+        call self%free_solve(model, error)
+        if (allocated(error)) return
+        call self%finish_step(model)
+    end subroutine newmark_step
+
+    !> Predictor, solve for a_{n+1} and corrector without coupling force; time, step count
+    !> and energies are not advanced.
+    subroutine free_solve(self, model, error)
+        class(newmark_t), intent(inout) :: self
+        type(beam_model_t), intent(in) :: model
         type(error_t), allocatable, intent(out) :: error
         real(wp) :: h
         h = self%h
@@ -283,8 +324,98 @@ contains
         if (allocated(error)) return
         self%u = self%u + self%beta*h**2*self%a
         self%v = self%v + self%gamma*h*self%a
+    end subroutine free_solve
+
+    !> First half of a coupled step: the state (u, v, a) becomes the free prediction at
+    !> t_{n+1} (the end-of-step values without coupling force); t, step count and energies
+    !> stay at t_n until `correct`.
+    subroutine newmark_predict(self, model, error)
+        !> The integrator (initialised).
+        class(newmark_t), intent(inout) :: self
+        !> The model (the same as at `init`).
+        type(beam_model_t), intent(in) :: model
+        !> Set when the previous prediction was not corrected, or on failure of the solve.
+        type(error_t), allocatable, intent(out) :: error
+        if (self%predicted) then
+            call make_error(error, 'Newmark predict: the previous prediction was not '// &
+                            'corrected (call correct once after each predict)')
+            return
+        end if
+        call self%free_solve(model, error)
+        if (allocated(error)) return
+        self%predicted = .true.
+    end subroutine newmark_predict
+
+    !> Second half of a coupled step: with da = S^-1 f_c, a += da, u += beta h^2 da,
+    !> v += gamma h da; then energies (coupling work W_c += 1/2 (f_c,n + f_c,n+1).du) and time.
+    subroutine newmark_correct(self, model, f_coupling, error)
+        !> The integrator, after `predict`.
+        class(newmark_t), intent(inout) :: self
+        !> The model (the same as at `init`).
+        type(beam_model_t), intent(in) :: model
+        !> Coupling force at t_{n+1} on the free DOFs (n_free) [N, N.m], e.g. -C^T lambda.
+        real(wp), contiguous, intent(in) :: f_coupling(:)
+        !> Set without a prediction, on a wrong size or failure of the solve.
+        type(error_t), allocatable, intent(out) :: error
+        if (.not. self%predicted) then
+            call make_error(error, 'Newmark correct: no prediction to correct (call predict '// &
+                            'first)')
+            return
+        end if
+        if (size(f_coupling) /= size(self%u)) then
+            call make_error(error, 'Newmark correct: the coupling force must have one value '// &
+                            'per free DOF')
+            return
+        end if
+        self%work = f_coupling
+        call self%s%solve(self%work, error)
+        if (allocated(error)) return
+        self%a = self%a + self%work
+        self%u = self%u + self%beta*self%h**2*self%work
+        self%v = self%v + self%gamma*self%h*self%work
+        self%coupling_work = self%coupling_work + &
+                             0.5_wp*dot_product(self%fc_old + f_coupling, self%u - self%u_old)
+        self%fc_old = f_coupling
+        self%predicted = .false.
         call self%finish_step(model)
-    end subroutine newmark_step
+    end subroutine newmark_correct
+
+    !> x = S^-1 b, S = M + gamma h C + beta h^2 K (factored at `init`). The FE velocity
+    !> responds to a force f at t_{n+1} by gamma h S^-1 f, the displacement by beta h^2 S^-1 f.
+    subroutine solve_effective_vec(self, b, x, error)
+        !> The integrator (initialised).
+        class(newmark_t), intent(in) :: self
+        !> Right-hand side (n_free).
+        real(wp), intent(in) :: b(:)
+        !> Solution (n_free).
+        real(wp), contiguous, intent(out) :: x(:)
+        !> Set when the integrator is not initialised or sizes disagree.
+        type(error_t), allocatable, intent(out) :: error
+        if (size(x) /= size(b)) then
+            call make_error(error, 'Newmark solve_effective: b and x differ in size')
+            return
+        end if
+        x = b
+        call self%s%solve(x, error)
+    end subroutine solve_effective_vec
+
+    !> X = S^-1 B for several right-hand sides (columns).
+    subroutine solve_effective_mat(self, b, x, error)
+        !> The integrator (initialised).
+        class(newmark_t), intent(in) :: self
+        !> Right-hand sides (n_free, k).
+        real(wp), intent(in) :: b(:, :)
+        !> Solutions (n_free, k).
+        real(wp), contiguous, intent(out) :: x(:, :)
+        !> Set when the integrator is not initialised or sizes disagree.
+        type(error_t), allocatable, intent(out) :: error
+        if (any(shape(x) /= shape(b))) then
+            call make_error(error, 'Newmark solve_effective: b and x differ in shape')
+            return
+        end if
+        x = b
+        call self%s%solve(x, error)
+    end subroutine solve_effective_mat
 
     !> Critical time step 2/omega_max of the undamped central-difference scheme [s], with
     !> omega_max^2 the largest eigenvalue of K phi = omega^2 M phi.

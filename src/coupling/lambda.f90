@@ -1,0 +1,156 @@
+!> Lagrange multipliers of the Arlequin coupling at velocity level (THEORY.md section 4).
+!>
+!> Conventions: on the particle side the multiplier lambda acts as a force +lambda on the
+!> coupled DOF ((1 - alpha) m qdd = (1 - alpha) F + lambda), on the FE side as -C^T lambda
+!> (alpha M udd = alpha F - C^T lambda). In a step of length h, the particle velocities
+!> respond by h W lambda (W = ((1 - alpha) m)^-1 for independent particles, or the mobility
+!> of rigid clusters), the FE velocities by -gamma h S^-1 C^T lambda (Newmark, S = M +
+!> gamma h C + beta h^2 K). With the free velocity residual g = v_d,free - C v_c,free (plus
+!> a drift term (q - C u)/h if wanted), the constraint v_d - C v_c = 0 at t_{n+1} reads
+!>   A lambda = -g,   A = h [ W + gamma C S^-1 C^T ],
+!> symmetric positive definite when every coupled DOF has a positive weighted mass on both
+!> sides and C has full row rank. A is factored once (dense Cholesky) and reused while the
+!> coupled set, h and the weights do not change.
+module coupling_lambda
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_error
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use core_linalg, only: dense_spd_t
+    use fem_newmark, only: newmark_t
+    use coupling_operator, only: coupling_operator_t
+    implicit none
+    private
+    public :: coupling_system_t, fe_coupling_force
+
+    !> The factored multiplier matrix A of one coupled set.
+    type :: coupling_system_t
+        !> Number of multipliers (rows of C).
+        integer :: n = 0
+        !> Time step the matrix was built for [s].
+        real(wp) :: h = 0.0_wp
+        !> A = h (W + gamma C S^-1 C^T) and its Cholesky factor.
+        type(dense_spd_t) :: a
+    contains
+        !> Build and factor A.
+        procedure :: assemble
+        !> lambda = -A^-1 g.
+        procedure :: solve
+    end type coupling_system_t
+
+contains
+
+    !> Build A = h (W + gamma C S^-1 C^T) and factor it. W is diag(inverse_mass), plus
+    !> `mobility` if given (at least one of the two is needed).
+    subroutine assemble(self, op, integ, error, inverse_mass, mobility)
+        !> The multiplier system.
+        class(coupling_system_t), intent(inout) :: self
+        !> The coupling operator.
+        type(coupling_operator_t), intent(in) :: op
+        !> The FE time integrator, initialised (its factored S, h and gamma are used).
+        type(newmark_t), intent(in) :: integ
+        !> Set on inconsistent sizes, a negative inverse mass or a singular A.
+        type(error_t), allocatable, intent(out) :: error
+        !> Particle side, independent DOFs: 1/((1 - alpha) m) per row (translations) or
+        !> 1/((1 - alpha) I) (rotations) [1/kg, 1/(kg m^2)], size n_rows.
+        real(wp), intent(in), optional :: inverse_mass(:)
+        !> Particle side, coupled DOFs: velocity response of the coupled DOFs to unit
+        !> multipliers (G M^-1 G^T of a rigid cluster), symmetric (n_rows, n_rows).
+        real(wp), intent(in), optional :: mobility(:, :)
+        real(wp), allocatable :: ct(:, :), x(:, :)
+        integer :: n, j
+        character(len=200) :: buf
+        n = op%n_rows
+        if (.not. (present(inverse_mass) .or. present(mobility))) then
+            call make_error(error, 'coupling multipliers: the particle side is missing (give '// &
+                            'inverse_mass or mobility)')
+            return
+        end if
+        if (present(inverse_mass)) then
+            if (size(inverse_mass) /= n) then
+                call make_error(error, 'coupling multipliers: inverse_mass needs one value per '// &
+                                'row of C')
+                return
+            end if
+            if (any(.not. (inverse_mass >= 0 .and. ieee_is_finite(inverse_mass)))) then
+                write (buf, '(a,i0,a)') 'coupling multipliers: inverse mass of row ', &
+                    findloc(inverse_mass >= 0 .and. ieee_is_finite(inverse_mass), .false., &
+                            dim=1), ' is negative or not finite (alpha = 1 at a coupled '// &
+                    'point leaves it no particle-side mass)'
+                call make_error(error, trim(buf))
+                return
+            end if
+        end if
+        if (present(mobility)) then
+            if (any(shape(mobility) /= [n, n])) then
+                call make_error(error, 'coupling multipliers: mobility must be (n_rows, n_rows)')
+                return
+            end if
+            if (.not. all(ieee_is_finite(mobility))) then
+                call make_error(error, 'coupling multipliers: mobility is not finite')
+                return
+            end if
+        end if
+        if (size(integ%u) /= op%n_free) then
+            call make_error(error, 'coupling multipliers: C and the FE integrator have '// &
+                            'different numbers of free DOFs')
+            return
+        end if
+        self%n = n
+        self%h = integ%h
+        call self%a%init(n)
+        ! gamma C S^-1 C^T, column by column of C^T.
+        ct = transpose(op%to_dense())
+        allocate (x(op%n_free, n))
+        call integ%solve_effective(ct, x, error)
+        if (allocated(error)) return
+        do j = 1, n
+            call op%apply(x(:, j), self%a%a(:, j))
+        end do
+        self%a%a = integ%gamma*self%a%a
+        if (present(mobility)) self%a%a = self%a%a + mobility
+        if (present(inverse_mass)) then
+            do j = 1, n
+                self%a%a(j, j) = self%a%a(j, j) + inverse_mass(j)
+            end do
+        end if
+        ! Symmetric up to the rounding of the solves; keep it exactly symmetric.
+        self%a%a = self%h*0.5_wp*(self%a%a + transpose(self%a%a))
+        call self%a%factor(error)
+        if (allocated(error)) error%message = 'coupling multipliers: A = h (W + gamma C '// &
+            'S^-1 C^T) is singular: a coupled DOF without weighted mass on the particle side '// &
+            '(alpha = 1), or more multipliers than the FE can resolve (too many coupled points '// &
+            'per element: couple fewer or use the mediator space); '//error%message
+    end subroutine assemble
+
+    !> lambda = -A^-1 g: the multipliers that cancel the free velocity residual
+    !> g = v_d,free - C v_c,free (see the module description).
+    subroutine solve(self, g, lambda, error)
+        !> The multiplier system, assembled.
+        class(coupling_system_t), intent(in) :: self
+        !> Free velocity residual (n) [m/s, rad/s].
+        real(wp), intent(in) :: g(:)
+        !> Multipliers (n) [N, N.m].
+        real(wp), contiguous, intent(out) :: lambda(:)
+        !> Set when A is not assembled or sizes disagree.
+        type(error_t), allocatable, intent(out) :: error
+        if (size(g) /= self%n .or. size(lambda) /= self%n) then
+            call make_error(error, 'coupling multipliers: g and lambda need one value per '// &
+                            'multiplier')
+            return
+        end if
+        lambda = -g
+        call self%a%solve(lambda, error)
+    end subroutine solve
+
+    !> FE coupling force f = -C^T lambda (n_free), to pass to `newmark_t%correct`.
+    pure subroutine fe_coupling_force(op, lambda, f)
+        !> The coupling operator.
+        type(coupling_operator_t), intent(in) :: op
+        !> Multipliers (n_rows).
+        real(wp), intent(in) :: lambda(:)
+        !> Force on the free DOFs (n_free).
+        real(wp), intent(out) :: f(:)
+        call op%apply_transpose(lambda, f)
+        f = -f
+    end subroutine fe_coupling_force
+end module coupling_lambda

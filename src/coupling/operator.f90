@@ -1,0 +1,267 @@
+!> Coupling operator C of the Arlequin method (THEORY.md section 4): the beam's displacement
+!> field interpolated at the coupled points (particle centres).
+!>
+!> Each point (x_p, y_p) is projected on the beam axis: element e, reduced coordinate xi in
+!> [0, 1] and signed offset d from the axis (positive on the left of the element's direction,
+!> i.e. along n = (-sin, cos)). In the element's local axes (t along the element, n across):
+!>   u_t = (1 - xi) u1 + xi u2 - d theta(xi),  u_n = w(xi) (Hermite),  phi = theta(xi),
+!> rotated to global x, y; the rotation row (phi) is optional. Every row involves the six
+!> DOFs of one element: C is stored as 6 (column, value) pairs per row, in the model's
+!> free-DOF numbering (column 0 = a fixed DOF, value 0, skipped). Rows are ordered point by
+!> point: (x, y) or (x, y, phi) for point 1, then point 2, ...
+module coupling_operator
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_error
+    use core_weight, only: weight_function_t
+    use fem_beam_model, only: beam_model_t
+    use fem_beam_element, only: element_interpolation, rotation_matrix
+    implicit none
+    private
+    public :: coupling_operator_t, build_coupling_operator, row_x, row_y, row_phi
+
+    !> Component of a point's rows: x displacement.
+    integer, parameter :: row_x = 1
+    !> Component of a point's rows: y displacement.
+    integer, parameter :: row_y = 2
+    !> Component of a point's rows: rotation (only with rotation rows).
+    integer, parameter :: row_phi = 3
+
+    !> Sparse C (n_rows, n_free) and where each coupled point sits on the beam.
+    type :: coupling_operator_t
+        !> Number of coupled points.
+        integer :: n_points = 0
+        !> Rows per point: 2 (x, y) or 3 (x, y, phi).
+        integer :: rows_per_point = 2
+        !> Number of rows n_points*rows_per_point.
+        integer :: n_rows = 0
+        !> Number of columns (free DOFs of the model).
+        integer :: n_free = 0
+        !> Element holding each point (n_points).
+        integer, allocatable :: element(:)
+        !> Reduced coordinate on that element, in [0, 1] (n_points).
+        real(wp), allocatable :: xi(:)
+        !> Signed distance from the beam axis [m] (n_points).
+        real(wp), allocatable :: offset(:)
+        !> Curvilinear abscissa of the projection [m] (n_points), for the weight alpha.
+        real(wp), allocatable :: abscissa(:)
+        !> Free-DOF column of each non-zero (6, n_rows); 0 for a fixed DOF.
+        integer, allocatable :: col(:, :)
+        !> Value of each non-zero (6, n_rows); 0 where col = 0.
+        real(wp), allocatable :: val(:, :)
+    contains
+        !> y = C u.
+        procedure :: apply
+        !> f = C^T lambda.
+        procedure :: apply_transpose
+        !> Row index of a component (row_x, row_y, row_phi) of a point.
+        procedure :: row_of
+        !> C as a dense (n_rows, n_free) matrix (tests, small systems).
+        procedure :: to_dense
+        !> Weight alpha at each coupled point; error if one is outside the overlap.
+        procedure :: point_weights
+    end type coupling_operator_t
+
+contains
+
+    !> Project the points on the beam and build C.
+    subroutine build_coupling_operator(model, x, y, op, error, with_rotation, max_offset)
+        !> The beam model.
+        type(beam_model_t), intent(in) :: model
+        !> Coordinates of the coupled points [m] (n_points each).
+        real(wp), intent(in) :: x(:), y(:)
+        !> The operator built.
+        type(coupling_operator_t), intent(out) :: op
+        !> Set when a point is not over the beam or too far from its axis.
+        type(error_t), allocatable, intent(out) :: error
+        !> Add a rotation row phi = theta(xi) per point (default: no).
+        logical, intent(in), optional :: with_rotation
+        !> Largest accepted |offset| [m] (default: any).
+        real(wp), intent(in), optional :: max_offset
+        integer :: p, e, k, r
+        real(wp) :: xi, off
+        real(wp) :: rows(3, 6)
+        character(len=240) :: buf
+        if (size(x) /= size(y)) then
+            call make_error(error, 'coupling operator: x and y of the coupled points differ '// &
+                            'in size')
+            return
+        end if
+        op%n_points = size(x)
+        op%rows_per_point = 2
+        if (present(with_rotation)) then
+            if (with_rotation) op%rows_per_point = 3
+        end if
+        op%n_rows = op%n_points*op%rows_per_point
+        op%n_free = model%n_free
+        allocate (op%element(op%n_points), op%xi(op%n_points), op%offset(op%n_points))
+        allocate (op%abscissa(op%n_points), op%col(6, op%n_rows), op%val(6, op%n_rows))
+        do p = 1, op%n_points
+            call project(model, x(p), y(p), e, xi, off)
+            if (e == 0) then
+                write (buf, '(a,i0,a,es12.5,a,es12.5,a)') 'coupling operator: coupled point ', &
+                    p, ' at (', x(p), ', ', y(p), ') m is not over the beam (its projection '// &
+                    'on the axis falls outside every element); move it or extend the beam'
+                call make_error(error, trim(buf))
+                return
+            end if
+            if (present(max_offset)) then
+                if (abs(off) > max_offset) then
+                    write (buf, '(a,i0,a,es12.5,a,es12.5,a,es10.3,a,es10.3,a)') &
+                        'coupling operator: coupled point ', p, ' at (', x(p), ', ', y(p), &
+                        ') m is ', abs(off), ' m from the beam axis, more than the ', &
+                        max_offset, ' m allowed'
+                    call make_error(error, trim(buf))
+                    return
+                end if
+            end if
+            op%element(p) = e
+            op%xi(p) = xi
+            op%offset(p) = off
+            op%abscissa(p) = model%abscissa_at(e, xi)
+            rows = point_rows(model, e, xi, off)
+            do k = 1, op%rows_per_point
+                r = (p - 1)*op%rows_per_point + k
+                op%col(1:3, r) = model%eq(:, model%conn(1, e))
+                op%col(4:6, r) = model%eq(:, model%conn(2, e))
+                op%val(:, r) = merge(rows(k, :), 0.0_wp, op%col(:, r) > 0)
+            end do
+        end do
+    end subroutine build_coupling_operator
+
+    !> Element over which (px, py) projects, reduced coordinate and signed offset; among
+    !> several candidates (a point near a joint or over two branches) the one nearest to its
+    !> axis, the first in element order on ties. e = 0 when there is none.
+    pure subroutine project(model, px, py, e_best, xi_best, off_best)
+        type(beam_model_t), intent(in) :: model
+        real(wp), intent(in) :: px, py
+        integer, intent(out) :: e_best
+        real(wp), intent(out) :: xi_best, off_best
+        ! A projection within 1e-10 L outside an element (rounding of a point placed on an
+        ! end node) still belongs to it, clamped to the end.
+        real(wp), parameter :: tol = 1.0e-10_wp
+        integer :: e, n1
+        real(wp) :: dx, dy, xi, off
+        e_best = 0
+        xi_best = 0.0_wp
+        off_best = huge(1.0_wp)
+        do e = 1, model%n_elements
+            n1 = model%conn(1, e)
+            dx = px - model%x(n1)
+            dy = py - model%y(n1)
+            xi = (dx*model%cosine(e) + dy*model%sine(e))/model%length(e)
+            off = -dx*model%sine(e) + dy*model%cosine(e)
+            if (xi < -tol .or. xi > 1 + tol) cycle
+            if (abs(off) >= abs(off_best)) cycle
+            e_best = e
+            xi_best = min(max(xi, 0.0_wp), 1.0_wp)
+            off_best = off
+        end do
+        if (e_best == 0) off_best = 0.0_wp
+    end subroutine project
+
+    !> Rows (x, y, phi) acting on the six global DOFs of element e for a point at xi with
+    !> offset off: local rows (u_t - off theta, w, theta) rotated by R^T and applied to T.
+    pure function point_rows(model, e, xi, off) result(rows)
+        type(beam_model_t), intent(in) :: model
+        integer, intent(in) :: e
+        real(wp), intent(in) :: xi, off
+        real(wp) :: rows(3, 6)
+        real(wp) :: n(3, 6), t(6, 6), rt(6), rn(6)
+        associate (c => model%cosine(e), s => model%sine(e))
+            n = element_interpolation(xi, model%length(e))
+            t = rotation_matrix(c, s)
+            rt = matmul(n(1, :) - off*n(3, :), t)
+            rn = matmul(n(2, :), t)
+            rows(1, :) = c*rt - s*rn
+            rows(2, :) = s*rt + c*rn
+            rows(3, :) = matmul(n(3, :), t)
+        end associate
+    end function point_rows
+
+    !> y = C u.
+    pure subroutine apply(self, u, cu)
+        !> The operator.
+        class(coupling_operator_t), intent(in) :: self
+        !> Field on the free DOFs (n_free).
+        real(wp), intent(in) :: u(:)
+        !> Values at the coupled points (n_rows).
+        real(wp), intent(out) :: cu(:)
+        integer :: r, k
+        do r = 1, self%n_rows
+            cu(r) = 0.0_wp
+            do k = 1, 6
+                if (self%col(k, r) > 0) cu(r) = cu(r) + self%val(k, r)*u(self%col(k, r))
+            end do
+        end do
+    end subroutine apply
+
+    !> f = C^T lambda.
+    pure subroutine apply_transpose(self, lambda, f)
+        !> The operator.
+        class(coupling_operator_t), intent(in) :: self
+        !> One value per row (n_rows).
+        real(wp), intent(in) :: lambda(:)
+        !> Result on the free DOFs (n_free).
+        real(wp), intent(out) :: f(:)
+        integer :: r, k
+        f = 0.0_wp
+        do r = 1, self%n_rows
+            do k = 1, 6
+                if (self%col(k, r) > 0) f(self%col(k, r)) = f(self%col(k, r)) + &
+                                                            self%val(k, r)*lambda(r)
+            end do
+        end do
+    end subroutine apply_transpose
+
+    !> Row of component comp (row_x, row_y or row_phi) of point p.
+    pure integer function row_of(self, p, comp)
+        !> The operator.
+        class(coupling_operator_t), intent(in) :: self
+        !> Point (1..n_points).
+        integer, intent(in) :: p
+        !> Component.
+        integer, intent(in) :: comp
+        row_of = (p - 1)*self%rows_per_point + comp
+    end function row_of
+
+    !> Dense copy of C (n_rows, n_free).
+    pure function to_dense(self) result(c)
+        !> The operator.
+        class(coupling_operator_t), intent(in) :: self
+        real(wp) :: c(self%n_rows, self%n_free)
+        integer :: r, k
+        c = 0.0_wp
+        do r = 1, self%n_rows
+            do k = 1, 6
+                if (self%col(k, r) > 0) c(r, self%col(k, r)) = c(r, self%col(k, r)) + &
+                                                               self%val(k, r)
+            end do
+        end do
+    end function to_dense
+
+    !> Weight alpha at each coupled point (from its abscissa). A point where alpha is 0 or 1
+    !> (outside the overlap) has no mass on one side and would make the multiplier matrix
+    !> singular: that is an error naming the point.
+    subroutine point_weights(self, weight, alpha, error)
+        !> The operator.
+        class(coupling_operator_t), intent(in) :: self
+        !> The Arlequin weight.
+        class(weight_function_t), intent(in) :: weight
+        !> alpha at each point (n_points), in (0, 1).
+        real(wp), allocatable, intent(out) :: alpha(:)
+        !> Set when a point lies where alpha = 0 or 1.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: p
+        character(len=240) :: buf
+        allocate (alpha(self%n_points))
+        do p = 1, self%n_points
+            alpha(p) = weight%value(self%abscissa(p))
+            if (alpha(p) > 0 .and. alpha(p) < 1) cycle
+            write (buf, '(a,i0,a,es12.5,a,f5.3,a)') 'coupling: coupled point ', p, &
+                ' (abscissa ', self%abscissa(p), ' m) has weight alpha = ', alpha(p), &
+                ', outside the overlap: only points inside the overlap can be coupled'
+            call make_error(error, trim(buf))
+            return
+        end do
+    end subroutine point_weights
+end module coupling_operator

@@ -1,0 +1,5 @@
+# Sources of the multicor_coupling library (Arlequin DEM-FEM coupling).
+set(MULTICOR_COUPLING_SOURCES
+    ${CMAKE_CURRENT_LIST_DIR}/weights.f90
+    ${CMAKE_CURRENT_LIST_DIR}/operator.f90
+    ${CMAKE_CURRENT_LIST_DIR}/lambda.f90)
