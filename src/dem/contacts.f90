@@ -1,0 +1,456 @@
+!> Contact pairs between disks, and between a wall and a disk, stored as structure of arrays.
+!>
+!> Contact k joins body i1(k) to disk i2(k); i1 < 0 means wall -i1. The normal n goes from
+!> body i1 to disk i2 (from the wall into the disk), t = (-n_y, n_x). Local velocity of i2
+!> relative to i1 at the contact point: u_n = n.(v2 - v1),
+!> u_t = t.(v2 - v1) + c1 w1 + c2 w2 with lever arms c = -radius. Reaction r = (r_n, r_t)
+!> (impulse per unit thickness) acts on i2, -r on i1. W = H^T M^-1 H is the local 2x2
+!> Delassus block (W_nn, W_nt, W_tt).
+!>
+!> Order: by owner disk (i1 for disk pairs, i2 for wall contacts), then walls before disks,
+!> then by the other index; the detection emits contacts in this order so that consecutive
+!> contacts touch neighbouring memory, and the previous list is matched by merging as the
+!> contacts are appended (warm start).
+module dem_contacts
+    use core_kinds, only: wp, i8
+    use dem_materials, only: materials_t
+    implicit none
+    private
+    public :: contact_set_t, contact_law_t
+    public :: status_open, status_stick, status_slip, status_cohesive, status_broken
+    public :: contacts_begin_detection, contacts_append
+    public :: contacts_set_frames, contacts_set_laws, contacts_finish, contacts_impulses
+    public :: contacts_local_velocity, contacts_count_status, contacts_bytes
+
+    !> Status: no reaction (separated or not active this step).
+    integer, parameter :: status_open = 0
+    !> Status: reaction strictly inside the Coulomb cone.
+    integer, parameter :: status_stick = 1
+    !> Status: reaction on the boundary of the cone (sliding).
+    integer, parameter :: status_slip = 2
+    !> Status: cohesive bond, intact.
+    integer, parameter :: status_cohesive = 3
+    !> Status: cohesive bond broken for good (now a plain frictional contact).
+    integer, parameter :: status_broken = 4
+
+    !> Parameters of the step needed to set the contact laws.
+    type :: contact_law_t
+        !> Time step [s].
+        real(wp) :: h = 0.0_wp
+        !> Theta of the scheme.
+        real(wp) :: theta = 0.5_wp
+        !> Create bonds on closed contacts with cohesion (first step only).
+        logical :: make_bonds = .false.
+        !> A bond exists while gap <= bond_ratio * mean radius of the pair.
+        real(wp) :: bond_ratio = 1.0e-6_wp
+    end type contact_law_t
+
+    !> The contact list (structure of arrays, capacity >= n).
+    type :: contact_set_t
+        !> Number of contacts.
+        integer :: n = 0
+        !> Allocated length of the per-contact arrays.
+        integer :: capacity = 0
+        !> First body (disk index, or -wall index) and second body (disk index).
+        integer, allocatable :: i1(:), i2(:)
+        !> Unit normal (2, n) from i1 to i2.
+        real(wp), allocatable :: nrm(:, :)
+        !> Gap at the detection configuration [m] (negative: overlap).
+        real(wp), allocatable :: gap(:)
+        !> Lever arms (c1, c2) of the rotations in u_t [m].
+        real(wp), allocatable :: lever(:, :)
+        !> Delassus block (W_nn, W_nt, W_tt) (3, n).
+        real(wp), allocatable :: w(:, :)
+        !> Constant velocity terms added to H^T v in the solver (wall motion, restitution
+        !> target) (2, n).
+        real(wp), allocatable :: shift(:, :)
+        !> Reaction impulse (r_n, r_t) (2, n) [N s/m].
+        real(wp), allocatable :: r(:, :)
+        !> End-of-step relative velocity (u_n, u_t) (2, n) [m/s].
+        real(wp), allocatable :: u(:, :)
+        !> Friction coefficient.
+        real(wp), allocatable :: mu(:)
+        !> Cohesive impulse r_cohe h of intact bonds (0 otherwise) [N s/m].
+        real(wp), allocatable :: coh(:)
+        !> Contact takes part in the solve this step.
+        logical, allocatable :: active(:)
+        !> status_open, status_stick, status_slip, status_cohesive or status_broken.
+        integer, allocatable :: status(:)
+        !> Previous list, for warm start: size, pairs, reactions, statuses.
+        integer :: n_prev = 0
+        !> Next entry of the previous list to compare with (merge).
+        integer :: merge_pos = 1
+        !> Pairs of the previous list.
+        integer, allocatable :: prev_i1(:), prev_i2(:)
+        !> Reactions of the previous list.
+        real(wp), allocatable :: prev_r(:, :)
+        !> Statuses of the previous list.
+        integer, allocatable :: prev_status(:)
+    end type contact_set_t
+
+contains
+
+    !> Keep the current list as the previous one and start an empty list.
+    subroutine contacts_begin_detection(cs)
+        !> Contacts.
+        type(contact_set_t), intent(inout) :: cs
+        integer, allocatable :: ti(:)
+        real(wp), allocatable :: tr(:, :)
+        call move_alloc(cs%prev_i1, ti)
+        if (allocated(cs%i1)) call move_alloc(cs%i1, cs%prev_i1)
+        if (allocated(ti)) call move_alloc(ti, cs%i1)
+        call move_alloc(cs%prev_i2, ti)
+        if (allocated(cs%i2)) call move_alloc(cs%i2, cs%prev_i2)
+        if (allocated(ti)) call move_alloc(ti, cs%i2)
+        call move_alloc(cs%prev_status, ti)
+        if (allocated(cs%status)) call move_alloc(cs%status, cs%prev_status)
+        if (allocated(ti)) call move_alloc(ti, cs%status)
+        call move_alloc(cs%prev_r, tr)
+        if (allocated(cs%r)) call move_alloc(cs%r, cs%prev_r)
+        if (allocated(tr)) call move_alloc(tr, cs%r)
+        cs%n_prev = cs%n
+        cs%n = 0
+        cs%merge_pos = 1
+        ! the swapped-in arrays may be shorter than the others
+        call grow_int(cs%i1, cs%capacity, 0)
+        call grow_int(cs%i2, cs%capacity, 0)
+        call grow_int(cs%status, cs%capacity, 0)
+        call grow_real2(cs%r, 2, cs%capacity, 0)
+        ! the new list is usually about as long as the previous one
+        call ensure_capacity(cs, cs%n_prev + cs%n_prev/8)
+    end subroutine contacts_begin_detection
+
+    !> Append a pair (in contact order) with its geometry; its reaction and status are carried
+    !> over from the previous list when the pair was already there (warm start, by merging the
+    !> two ordered lists), else r = 0 and open.
+    subroutine contacts_append(cs, i1, i2, nx, ny, gap)
+        !> Contacts.
+        type(contact_set_t), intent(inout) :: cs
+        !> First body (disk, or -wall) and second body (disk).
+        integer, intent(in) :: i1, i2
+        !> Unit normal from i1 to i2.
+        real(wp), intent(in) :: nx, ny
+        !> Gap [m].
+        real(wp), intent(in) :: gap
+        integer :: k, p, cmp
+        if (cs%n == cs%capacity) call ensure_capacity(cs, cs%n + 1)
+        k = cs%n + 1
+        cs%n = k
+        cs%i1(k) = i1
+        cs%i2(k) = i2
+        cs%nrm(1, k) = nx
+        cs%nrm(2, k) = ny
+        cs%gap(k) = gap
+        cs%r(:, k) = 0.0_wp
+        cs%status(k) = status_open
+        cmp = 1
+        do p = cs%merge_pos, cs%n_prev
+            cmp = compare(cs%prev_i1(p), cs%prev_i2(p), i1, i2)
+            if (cmp >= 0) exit
+        end do
+        cs%merge_pos = p
+        if (cmp == 0) then
+            cs%r(:, k) = cs%prev_r(:, p)
+            cs%status(k) = cs%prev_status(p)
+            cs%merge_pos = p + 1
+        end if
+    end subroutine contacts_append
+
+    !> Grow every per-contact array to hold at least m contacts (keeps the first n).
+    subroutine ensure_capacity(cs, m)
+        type(contact_set_t), intent(inout) :: cs
+        integer, intent(in) :: m
+        integer :: cap
+        if (m <= cs%capacity) return
+        cap = max(cs%capacity + cs%capacity/4, m, 64)
+        call grow_int(cs%i1, cap, cs%n)
+        call grow_int(cs%i2, cap, cs%n)
+        call grow_real2(cs%nrm, 2, cap, cs%n)
+        call grow_real1(cs%gap, cap, cs%n)
+        call grow_real2(cs%lever, 2, cap, cs%n)
+        call grow_real2(cs%w, 3, cap, cs%n)
+        call grow_real2(cs%shift, 2, cap, cs%n)
+        call grow_real2(cs%r, 2, cap, cs%n)
+        call grow_real2(cs%u, 2, cap, cs%n)
+        call grow_real1(cs%mu, cap, cs%n)
+        call grow_real1(cs%coh, cap, cs%n)
+        call grow_int(cs%status, cap, cs%n)
+        call grow_logical(cs%active, cap, cs%n)
+        cs%capacity = cap
+    end subroutine ensure_capacity
+
+    !> Order of two pairs: -1, 0, 1 as (a1, a2) comes before, equals, after (b1, b2).
+    pure integer function compare(a1, a2, b1, b2) result(c)
+        integer, intent(in) :: a1, a2, b1, b2
+        integer :: oa, ob, sa, sb
+        oa = merge(a1, a2, a1 > 0)
+        ob = merge(b1, b2, b1 > 0)
+        sa = merge(a2, a1, a1 > 0)
+        sb = merge(b2, b1, b1 > 0)
+        if (oa /= ob) then
+            c = merge(-1, 1, oa < ob)
+        else if (sa /= sb) then
+            c = merge(-1, 1, sa < sb)
+        else
+            c = 0
+        end if
+    end function compare
+
+    !> Lever arms and Delassus blocks from radii and inverse masses per DOF (0 when fixed).
+    pure subroutine contacts_set_frames(cs, radius, im)
+        !> Contacts.
+        type(contact_set_t), intent(inout) :: cs
+        !> Disk radii [m].
+        real(wp), intent(in) :: radius(:)
+        !> Inverse masses (3, n_disks).
+        real(wp), intent(in) :: im(:, :)
+        integer :: k, a, b
+        real(wp) :: nx, ny, tx, ty
+        do k = 1, cs%n
+            a = cs%i1(k)
+            b = cs%i2(k)
+            nx = cs%nrm(1, k)
+            ny = cs%nrm(2, k)
+            tx = -ny
+            ty = nx
+            cs%lever(2, k) = -radius(b)
+            cs%w(:, k) = block(im(:, b), cs%lever(2, k))
+            cs%lever(1, k) = 0.0_wp
+            if (a > 0) then
+                cs%lever(1, k) = -radius(a)
+                cs%w(:, k) = cs%w(:, k) + block(im(:, a), cs%lever(1, k))
+            end if
+        end do
+    contains
+        pure function block(imb, c) result(w)
+            real(wp), intent(in) :: imb(3), c
+            real(wp) :: w(3)
+            w(1) = nx*nx*imb(1) + ny*ny*imb(2)
+            w(2) = nx*tx*imb(1) + ny*ty*imb(2)
+            w(3) = tx*tx*imb(1) + ty*ty*imb(2) + c*c*imb(3)
+        end function block
+    end subroutine contacts_set_frames
+
+    !> Relative velocity (u_n, u_t) of contact k for body velocities vel (3, n_disks) and wall
+    !> velocities wall_vel (2, n_walls), without the solver shifts.
+    pure function contacts_local_velocity(cs, k, vel, wall_vel) result(u)
+        !> Contacts.
+        type(contact_set_t), intent(in) :: cs
+        !> Contact index.
+        integer, intent(in) :: k
+        !> Disk velocities (vx, vy, w).
+        real(wp), intent(in) :: vel(:, :)
+        !> Wall velocities.
+        real(wp), intent(in) :: wall_vel(:, :)
+        real(wp) :: u(2)
+        real(wp) :: dv(2), nx, ny
+        integer :: a, b
+        a = cs%i1(k)
+        b = cs%i2(k)
+        nx = cs%nrm(1, k)
+        ny = cs%nrm(2, k)
+        if (a > 0) then
+            dv = vel(1:2, b) - vel(1:2, a)
+            u(2) = cs%lever(1, k)*vel(3, a)
+        else
+            dv = vel(1:2, b) - wall_vel(:, -a)
+            u(2) = 0.0_wp
+        end if
+        u(1) = nx*dv(1) + ny*dv(2)
+        u(2) = u(2) - ny*dv(1) + nx*dv(2) + cs%lever(2, k)*vel(3, b)
+    end function contacts_local_velocity
+
+    !> Material law, bonds, solver shifts and activation of every contact for the step.
+    !> Active: intact bonds, and contacts whose predicted gap g + theta h u_n(free) <= 0.
+    !> Velocity target of the normal law (u_n >= target): Newton restitution
+    !> e max(-u_n(begin), 0). There is no position correction (standard Moreau-Jean): with
+    !> theta = 1 an active contact never closes past its gap at the start of the step; with
+    !> theta < 1 an impact may overlap by up to (1 - theta) h |u_n|, and the overlap is kept.
+    !> (A full push-out -g/(theta h) of overlaps was tried and makes dense packings unstable.)
+    pure subroutine contacts_set_laws(cs, law, radius, mat, wall_mat, materials, vel_begin, vel_free, &
+                                      wall_vel_begin, wall_vel_end)
+        !> Contacts.
+        type(contact_set_t), intent(inout) :: cs
+        !> Step parameters.
+        type(contact_law_t), intent(in) :: law
+        !> Disk radii [m].
+        real(wp), intent(in) :: radius(:)
+        !> Disk and wall materials.
+        integer, intent(in) :: mat(:), wall_mat(:)
+        !> Material pair table.
+        type(materials_t), intent(in) :: materials
+        !> Disk velocities at the start of the step and free velocities (3, n_disks).
+        real(wp), intent(in) :: vel_begin(:, :), vel_free(:, :)
+        !> Wall velocities at the start and at the end of the step (2, n_walls).
+        real(wp), intent(in) :: wall_vel_begin(:, :), wall_vel_end(:, :)
+        integer :: k, ma, mb
+        real(wp) :: ub(2), uf(2), uw(2), amoy, target, e
+        do k = 1, cs%n
+            mb = mat(cs%i2(k))
+            if (cs%i1(k) > 0) then
+                ma = mat(cs%i1(k))
+                amoy = 0.5_wp*(radius(cs%i1(k)) + radius(cs%i2(k)))
+            else
+                ma = wall_mat(-cs%i1(k))
+                amoy = radius(cs%i2(k))
+            end if
+            cs%mu(k) = materials%mu(ma, mb)
+            e = materials%restitution(ma, mb)
+            if (law%make_bonds .and. materials%cohesion(ma, mb) > 0.0_wp .and. &
+                cs%gap(k) <= law%bond_ratio*amoy) cs%status(k) = status_cohesive
+            cs%coh(k) = 0.0_wp
+            if (cs%status(k) == status_cohesive) cs%coh(k) = materials%cohesion(ma, mb)*amoy*law%h
+            ub = contacts_local_velocity(cs, k, vel_begin, wall_vel_begin)
+            uf = contacts_local_velocity(cs, k, vel_free, wall_vel_end)
+            uw = 0.0_wp
+            if (cs%i1(k) < 0) uw = -wall_term(cs%nrm(:, k), wall_vel_end(:, -cs%i1(k)))
+            target = e*max(-ub(1), 0.0_wp)
+            cs%shift(1, k) = uw(1) - target
+            cs%shift(2, k) = uw(2)
+            cs%active(k) = cs%status(k) == status_cohesive .or. &
+                           cs%gap(k) + law%theta*law%h*uf(1) <= 0.0_wp
+            if (.not. cs%active(k)) cs%r(:, k) = 0.0_wp
+        end do
+    end subroutine contacts_set_laws
+
+    !> Local components (n.v, t.v) of a wall velocity v.
+    pure function wall_term(nrm, v) result(u)
+        real(wp), intent(in) :: nrm(2), v(2)
+        real(wp) :: u(2)
+        u(1) = nrm(1)*v(1) + nrm(2)*v(2)
+        u(2) = -nrm(2)*v(1) + nrm(1)*v(2)
+    end function wall_term
+
+    !> After the solve: end-of-step relative velocities, statuses, broken bonds
+    !> (a bond breaks for good when its end-of-step gap g + theta h u_n exceeds
+    !> bond_ratio * mean radius).
+    pure subroutine contacts_finish(cs, law, radius, vel, wall_vel)
+        !> Contacts.
+        type(contact_set_t), intent(inout) :: cs
+        !> Step parameters.
+        type(contact_law_t), intent(in) :: law
+        !> Disk radii [m].
+        real(wp), intent(in) :: radius(:)
+        !> End-of-step disk velocities (3, n_disks).
+        real(wp), intent(in) :: vel(:, :)
+        !> End-of-step wall velocities (2, n_walls).
+        real(wp), intent(in) :: wall_vel(:, :)
+        integer :: k
+        real(wp) :: amoy, rn
+        do k = 1, cs%n
+            cs%u(:, k) = contacts_local_velocity(cs, k, vel, wall_vel)
+            if (cs%status(k) == status_cohesive) then
+                amoy = radius(cs%i2(k))
+                if (cs%i1(k) > 0) amoy = 0.5_wp*(amoy + radius(cs%i1(k)))
+                if (cs%gap(k) + law%theta*law%h*cs%u(1, k) > law%bond_ratio*amoy) &
+                    cs%status(k) = status_broken
+            else if (cs%status(k) /= status_broken) then
+                rn = cs%r(1, k)
+                if (rn <= 0.0_wp) then
+                    cs%status(k) = status_open
+                else if (abs(cs%r(2, k)) >= cs%mu(k)*rn*(1.0_wp - 1.0e-12_wp)) then
+                    cs%status(k) = status_slip
+                else
+                    cs%status(k) = status_stick
+                end if
+            end if
+        end do
+    end subroutine contacts_finish
+
+    !> Add the generalised contact impulses H r to p (3, n_disks).
+    pure subroutine contacts_impulses(cs, p)
+        !> Contacts.
+        type(contact_set_t), intent(in) :: cs
+        !> Impulses (px, py, torque impulse) per disk.
+        real(wp), intent(inout) :: p(:, :)
+        integer :: k, a, b
+        real(wp) :: f(2)
+        do k = 1, cs%n
+            a = cs%i1(k)
+            b = cs%i2(k)
+            f = cs%r(1, k)*cs%nrm(:, k) + cs%r(2, k)*[-cs%nrm(2, k), cs%nrm(1, k)]
+            p(1:2, b) = p(1:2, b) + f
+            p(3, b) = p(3, b) + cs%lever(2, k)*cs%r(2, k)
+            if (a > 0) then
+                p(1:2, a) = p(1:2, a) - f
+                p(3, a) = p(3, a) + cs%lever(1, k)*cs%r(2, k)
+            end if
+        end do
+    end subroutine contacts_impulses
+
+    !> Number of contacts with the given status.
+    pure integer function contacts_count_status(cs, status) result(m)
+        !> Contacts.
+        type(contact_set_t), intent(in) :: cs
+        !> One of the status_* values.
+        integer, intent(in) :: status
+        m = count(cs%status(1:cs%n) == status)
+    end function contacts_count_status
+
+    !> Memory held by the contact arrays (current and previous lists, full capacity) [bytes].
+    pure integer(i8) function contacts_bytes(cs) result(b)
+        !> Contacts.
+        type(contact_set_t), intent(in) :: cs
+        b = 0_i8
+        if (allocated(cs%i1)) b = b + 4_i8*(size(cs%i1) + size(cs%i2))
+        if (allocated(cs%nrm)) b = b + 8_i8*(size(cs%nrm) + size(cs%gap))
+        if (allocated(cs%lever)) b = b + 8_i8*(size(cs%lever) + size(cs%w) + size(cs%shift) + size(cs%r) &
+                                             + size(cs%u) + size(cs%mu) + size(cs%coh))
+        if (allocated(cs%status)) b = b + 4_i8*(size(cs%status) + size(cs%active))
+        if (allocated(cs%prev_i1)) b = b + 4_i8*(size(cs%prev_i1) + size(cs%prev_i2))
+        if (allocated(cs%prev_r)) b = b + 8_i8*size(cs%prev_r)
+        if (allocated(cs%prev_status)) b = b + 4_i8*size(cs%prev_status)
+    end function contacts_bytes
+
+    !> Resize an integer array to cap, keeping its first `keep` entries.
+    pure subroutine grow_int(a, cap, keep)
+        integer, allocatable, intent(inout) :: a(:)
+        integer, intent(in) :: cap, keep
+        integer, allocatable :: tmp(:)
+        if (allocated(a)) then
+            if (size(a) >= cap) return
+        end if
+        allocate (tmp(cap))
+        if (keep > 0) tmp(1:keep) = a(1:keep)
+        call move_alloc(tmp, a)
+    end subroutine grow_int
+
+    !> Resize a logical array to cap, keeping its first `keep` entries.
+    pure subroutine grow_logical(a, cap, keep)
+        logical, allocatable, intent(inout) :: a(:)
+        integer, intent(in) :: cap, keep
+        logical, allocatable :: tmp(:)
+        if (allocated(a)) then
+            if (size(a) >= cap) return
+        end if
+        allocate (tmp(cap))
+        if (keep > 0) tmp(1:keep) = a(1:keep)
+        call move_alloc(tmp, a)
+    end subroutine grow_logical
+
+    !> Resize a real array to cap, keeping its first `keep` entries.
+    pure subroutine grow_real1(a, cap, keep)
+        real(wp), allocatable, intent(inout) :: a(:)
+        integer, intent(in) :: cap, keep
+        real(wp), allocatable :: tmp(:)
+        if (allocated(a)) then
+            if (size(a) >= cap) return
+        end if
+        allocate (tmp(cap))
+        if (keep > 0) tmp(1:keep) = a(1:keep)
+        call move_alloc(tmp, a)
+    end subroutine grow_real1
+
+    !> Resize a (rows, :) real array to (rows, cap), keeping its first `keep` columns.
+    pure subroutine grow_real2(a, rows, cap, keep)
+        real(wp), allocatable, intent(inout) :: a(:, :)
+        integer, intent(in) :: rows, cap, keep
+        real(wp), allocatable :: tmp(:, :)
+        if (allocated(a)) then
+            if (size(a, 2) >= cap) return
+        end if
+        allocate (tmp(rows, cap))
+        if (keep > 0) tmp(:, 1:keep) = a(:, 1:keep)
+        call move_alloc(tmp, a)
+    end subroutine grow_real2
+end module dem_contacts

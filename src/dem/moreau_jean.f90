@@ -1,0 +1,302 @@
+!> Moreau-Jean theta-scheme for the discrete domain (THEORY.md 2), and the system that holds
+!> everything one simulation of disks needs (no module state: two systems can coexist).
+!>
+!> One step from t to t + h:
+!>   1. free velocities v_free = v + h M^-1 F_theta (F_theta = (1 - theta) F(t) + theta F(t + h));
+!>      imposed and fixed DOFs take their values at t + h;
+!>   2. detection on the mid configuration q + (1 - theta) h v (warm start by pair);
+!>   3. contact laws (activation on the predicted gap, Newton restitution, cohesion), frames;
+!>   4. NLGS with the bi-potential local solver: v+ and the impulses;
+!>   5. q+ = q + h [(1 - theta) v + theta v+]; bonds that opened break; energies.
+!> Energy audit (per unit thickness), exact for the discrete scheme up to round-off:
+!>   kinetic + potential - external_work - drive_work + contact_dissipation
+!>   + numerical_dissipation = initial,
+!> with numerical_dissipation = (theta - 1/2) sum |v+ - v|_M^2 (zero for theta = 1/2),
+!> contact_dissipation = - sum r . u_theta (>= 0 for dissipative contacts), drive_work the work
+!> of imposed velocities and moving walls on the disks.
+module dem_moreau_jean
+    use core_kinds, only: wp, i8
+    use core_error, only: error_t, make_error
+    use dem_particles, only: particles_t, particles_inverse_mass, particles_constrained_velocity, &
+                             particles_forces, particles_kinetic_energy, particles_potential_energy, &
+                             particles_bytes
+    use dem_walls, only: walls_t, walls_velocity, walls_advance
+    use dem_materials, only: materials_t
+    use dem_contacts, only: contact_set_t, contact_law_t, contacts_set_frames, &
+                            contacts_set_laws, contacts_finish, contacts_impulses, contacts_local_velocity, &
+                            contacts_bytes
+    use dem_detection, only: detector_t, detect_contacts, detector_bytes
+    use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_solve
+    implicit none
+    private
+    public :: mj_config_t, energies_t, dem_system_t, mj_init, mj_step, energies_balance, dem_system_bytes
+
+    !> Time-stepping settings.
+    type :: mj_config_t
+        !> Time step [s].
+        real(wp) :: h = 1.0e-4_wp
+        !> Theta in [1/2, 1]. theta = 1/2 conserves energy in free flight and at e = 1 impacts;
+        !> theta = 1 never lets a contact overlap.
+        real(wp) :: theta = 0.5_wp
+        !> Alert distance of the detection [m].
+        real(wp) :: alert = 0.0_wp
+        !> Bonds: created at the first step on contacts with cohesion and gap <= bond_ratio *
+        !> mean radius; broken for good once their gap exceeds it.
+        real(wp) :: bond_ratio = 1.0e-6_wp
+    end type mj_config_t
+
+    !> Energies and works per unit thickness [J/m] since the start.
+    type :: energies_t
+        !> Kinetic energy.
+        real(wp) :: kinetic = 0.0_wp
+        !> Gravity potential energy.
+        real(wp) :: potential = 0.0_wp
+        !> Work of the loads (not gravity).
+        real(wp) :: external_work = 0.0_wp
+        !> Work of imposed velocities and moving walls on the disks.
+        real(wp) :: drive_work = 0.0_wp
+        !> Energy dissipated by the contacts.
+        real(wp) :: contact_dissipation = 0.0_wp
+        !> Energy dissipated by the scheme (theta > 1/2).
+        real(wp) :: numerical_dissipation = 0.0_wp
+        !> kinetic + potential at the start.
+        real(wp) :: initial = 0.0_wp
+    end type energies_t
+
+    !> One discrete-element simulation: model, settings, contacts, solver state, statistics.
+    type :: dem_system_t
+        !> Disks.
+        type(particles_t) :: particles
+        !> Walls.
+        type(walls_t) :: walls
+        !> Contact law per pair of materials.
+        type(materials_t) :: materials
+        !> Time-stepping settings.
+        type(mj_config_t) :: scheme
+        !> Solver settings.
+        type(nlgs_config_t) :: solver
+        !> Contact list.
+        type(contact_set_t) :: contacts
+        !> Detection workspace.
+        type(detector_t) :: detector
+        !> Statistics of the last solve.
+        type(nlgs_stats_t) :: stats
+        !> Energy audit.
+        type(energies_t) :: energies
+        !> Current time [s].
+        real(wp) :: time = 0.0_wp
+        !> Steps done.
+        integer :: step = 0
+        !> Wall-clock time spent in detection and in the solver [s].
+        real(wp) :: time_detection = 0.0_wp, time_solver = 0.0_wp
+        !> Bonds are still to be created (first step).
+        logical :: bonds_pending = .true.
+        !> Work arrays (3, n): start and current velocities, inverse mass, loads, impulses.
+        real(wp), allocatable :: vel0(:, :), vel(:, :), im(:, :), load(:, :), impulse(:, :)
+        !> Work arrays: mid configuration of the disks and walls.
+        real(wp), allocatable :: xm(:), ym(:), wx1(:), wy1(:), wx2(:), wy2(:)
+        !> Wall velocities at the start and the end of the step (2, n_walls).
+        real(wp), allocatable :: wall_v0(:, :), wall_v1(:, :)
+    end type dem_system_t
+
+contains
+
+    !> Check the settings, size the work arrays and start the energy audit. Call once after
+    !> the model is built and before the first step.
+    subroutine mj_init(sys, error)
+        !> System.
+        type(dem_system_t), intent(inout) :: sys
+        !> Error on invalid settings or material indices.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: n, nw
+        call check_settings(sys, error)
+        if (allocated(error)) return
+        n = sys%particles%n
+        nw = sys%walls%n
+        if (allocated(sys%vel0)) deallocate (sys%vel0, sys%vel, sys%im, sys%load, sys%impulse, sys%xm, &
+                                             sys%ym, sys%wx1, sys%wy1, sys%wx2, sys%wy2, sys%wall_v0, sys%wall_v1)
+        allocate (sys%vel0(3, n), sys%vel(3, n), sys%im(3, n), sys%load(3, n), sys%impulse(3, n))
+        allocate (sys%xm(n), sys%ym(n), sys%wx1(nw), sys%wy1(nw), sys%wx2(nw), sys%wy2(nw))
+        allocate (sys%wall_v0(2, nw), sys%wall_v1(2, nw))
+        sys%energies = energies_t()
+        sys%energies%kinetic = particles_kinetic_energy(sys%particles)
+        sys%energies%potential = particles_potential_energy(sys%particles)
+        sys%energies%initial = sys%energies%kinetic + sys%energies%potential
+    end subroutine mj_init
+
+    !> Validate the time-stepping and solver settings and the material indices.
+    subroutine check_settings(sys, error)
+        type(dem_system_t), intent(in) :: sys
+        type(error_t), allocatable, intent(out) :: error
+        integer :: mmax
+        mmax = 0
+        if (sys%particles%n > 0) mmax = maxval(sys%particles%mat(1:sys%particles%n))
+        if (sys%walls%n > 0) mmax = max(mmax, maxval(sys%walls%mat(1:sys%walls%n)))
+        if (.not. (sys%scheme%h > 0.0_wp)) then
+            call make_error(error, 'DEM time step h must be > 0')
+        else if (sys%scheme%theta < 0.5_wp .or. sys%scheme%theta > 1.0_wp) then
+            call make_error(error, 'DEM theta must be in [0.5, 1]')
+        else if (sys%scheme%alert < 0.0_wp .or. sys%scheme%bond_ratio < 0.0_wp) then
+            call make_error(error, 'DEM alert distance and bond_ratio must be >= 0')
+        else if (sys%solver%tol <= 0.0_wp .or. sys%solver%max_sweeps < 1 .or. &
+                 sys%solver%local_max_iter < 1) then
+            call make_error(error, 'DEM solver needs tol > 0, max_sweeps >= 1, local_max_iter >= 1')
+        else if (mmax > sys%materials%n) then
+            call make_error(error, 'DEM material index exceeds the number of materials in the table')
+        else if (sys%particles%n > 0) then
+            if (minval(sys%particles%mat(1:sys%particles%n)) < 1) &
+                call make_error(error, 'DEM material indices must be >= 1')
+        end if
+    end subroutine check_settings
+
+    !> Advance the system by one time step.
+    subroutine mj_step(sys)
+        !> System (mj_init done).
+        type(dem_system_t), intent(inout) :: sys
+        type(contact_law_t) :: law
+        integer(i8) :: c0, c1, c2, rate
+        law = contact_law_t(h=sys%scheme%h, theta=sys%scheme%theta, make_bonds=sys%bonds_pending, &
+                            bond_ratio=sys%scheme%bond_ratio)
+        call free_velocities(sys)
+        call mid_configuration(sys)
+        call system_clock(c0, rate)
+        call detect_contacts(sys%detector, sys%xm, sys%ym, sys%particles%radius, sys%scheme%alert, &
+                             sys%wx1, sys%wy1, sys%wx2, sys%wy2, sys%contacts)
+        call system_clock(c1)
+        call contacts_set_frames(sys%contacts, sys%particles%radius, sys%im)
+        call contacts_set_laws(sys%contacts, law, sys%particles%radius, sys%particles%mat, sys%walls%mat, &
+                               sys%materials, sys%vel0, sys%vel, sys%wall_v0, sys%wall_v1)
+        call nlgs_solve(sys%solver, sys%contacts, sys%im, sys%vel, sys%stats)
+        call system_clock(c2)
+        sys%time_detection = sys%time_detection + real(c1 - c0, wp)/real(rate, wp)
+        sys%time_solver = sys%time_solver + real(c2 - c1, wp)/real(rate, wp)
+        call contacts_finish(sys%contacts, law, sys%particles%radius, sys%vel, sys%wall_v1)
+        call audit_energies(sys)
+        call update_configuration(sys)
+        sys%time = sys%time + sys%scheme%h
+        sys%step = sys%step + 1
+        sys%bonds_pending = .false.
+    end subroutine mj_step
+
+    !> vel0 = current velocities, im, theta-weighted loads, vel = free velocities, wall velocities.
+    subroutine free_velocities(sys)
+        type(dem_system_t), intent(inout) :: sys
+        real(wp) :: t, h, th
+        integer :: k
+        t = sys%time
+        h = sys%scheme%h
+        th = sys%scheme%theta
+        associate (p => sys%particles)
+            sys%vel0(1, :) = p%vx(1:p%n)
+            sys%vel0(2, :) = p%vy(1:p%n)
+            sys%vel0(3, :) = p%w(1:p%n)
+            call particles_inverse_mass(p, sys%im)
+            call particles_forces(p, t, .false., sys%impulse)
+            call particles_forces(p, t + h, .false., sys%load)
+            sys%load = (1.0_wp - th)*sys%impulse + th*sys%load
+            sys%vel(1, :) = sys%vel0(1, :) + h*sys%im(1, :)*(sys%load(1, :) + p%mass(1:p%n)*p%gravity(1))
+            sys%vel(2, :) = sys%vel0(2, :) + h*sys%im(2, :)*(sys%load(2, :) + p%mass(1:p%n)*p%gravity(2))
+            sys%vel(3, :) = sys%vel0(3, :) + h*sys%im(3, :)*sys%load(3, :)
+            call particles_constrained_velocity(p, t + h, sys%vel)
+        end associate
+        do k = 1, sys%walls%n
+            sys%wall_v0(:, k) = walls_velocity(sys%walls, k, t)
+            sys%wall_v1(:, k) = walls_velocity(sys%walls, k, t + h)
+        end do
+    end subroutine free_velocities
+
+    !> Mid configuration q + (1 - theta) h v of disks and walls (where contacts are detected).
+    subroutine mid_configuration(sys)
+        type(dem_system_t), intent(inout) :: sys
+        real(wp) :: a
+        a = (1.0_wp - sys%scheme%theta)*sys%scheme%h
+        sys%xm = sys%particles%x(1:sys%particles%n) + a*sys%vel0(1, :)
+        sys%ym = sys%particles%y(1:sys%particles%n) + a*sys%vel0(2, :)
+        if (sys%walls%n == 0) return
+        sys%wx1 = sys%walls%x1(1:sys%walls%n) + a*sys%wall_v0(1, :)
+        sys%wy1 = sys%walls%y1(1:sys%walls%n) + a*sys%wall_v0(2, :)
+        sys%wx2 = sys%walls%x2(1:sys%walls%n) + a*sys%wall_v0(1, :)
+        sys%wy2 = sys%walls%y2(1:sys%walls%n) + a*sys%wall_v0(2, :)
+    end subroutine mid_configuration
+
+    !> q+ = q + h [(1 - theta) v + theta v+], v = v+, walls moved.
+    subroutine update_configuration(sys)
+        type(dem_system_t), intent(inout) :: sys
+        real(wp) :: h, th
+        h = sys%scheme%h
+        th = sys%scheme%theta
+        associate (p => sys%particles)
+            p%x(1:p%n) = p%x(1:p%n) + h*((1.0_wp - th)*sys%vel0(1, :) + th*sys%vel(1, :))
+            p%y(1:p%n) = p%y(1:p%n) + h*((1.0_wp - th)*sys%vel0(2, :) + th*sys%vel(2, :))
+            p%rot(1:p%n) = p%rot(1:p%n) + h*((1.0_wp - th)*sys%vel0(3, :) + th*sys%vel(3, :))
+            p%vx(1:p%n) = sys%vel(1, :)
+            p%vy(1:p%n) = sys%vel(2, :)
+            p%w(1:p%n) = sys%vel(3, :)
+        end associate
+        call walls_advance(sys%walls, sys%time, h, th)
+        sys%energies%kinetic = particles_kinetic_energy(sys%particles)
+        sys%energies%potential = particles_potential_energy(sys%particles)
+    end subroutine update_configuration
+
+    !> Works of the step (see the module header): loads, drives, contacts, scheme.
+    subroutine audit_energies(sys)
+        type(dem_system_t), intent(inout) :: sys
+        real(wp) :: h, th, dv(3), vm(3), m(3), p(3)
+        integer :: i
+        h = sys%scheme%h
+        th = sys%scheme%theta
+        call contact_works(sys)
+        sys%impulse = 0.0_wp
+        call contacts_impulses(sys%contacts, sys%impulse)
+        associate (e => sys%energies, pt => sys%particles)
+            do i = 1, pt%n
+                m = [pt%mass(i), pt%mass(i), pt%inertia(i)]
+                dv = sys%vel(:, i) - sys%vel0(:, i)
+                vm = (1.0_wp - th)*sys%vel0(:, i) + th*sys%vel(:, i)
+                e%external_work = e%external_work + h*dot_product(sys%load(:, i), vm)
+                e%numerical_dissipation = e%numerical_dissipation + (th - 0.5_wp)*dot_product(m, dv*dv)
+                ! support impulse on constrained DOFs (zero work where the DOF is fixed)
+                p = m*dv - h*(sys%load(:, i) + [pt%mass(i)*pt%gravity, 0.0_wp]) - sys%impulse(:, i)
+                e%drive_work = e%drive_work + sum(merge(p*vm, 0.0_wp, sys%im(:, i) == 0.0_wp))
+            end do
+        end associate
+    end subroutine audit_energies
+
+    !> Contact dissipation -sum r.u_theta and work of moving walls sum r.(n.vw, t.vw)_theta.
+    subroutine contact_works(sys)
+        type(dem_system_t), intent(inout) :: sys
+        real(wp) :: th, u(2), vw(2), nx, ny
+        integer :: k, a
+        th = sys%scheme%theta
+        associate (cs => sys%contacts, e => sys%energies)
+            do k = 1, cs%n
+                u = (1.0_wp - th)*contacts_local_velocity(cs, k, sys%vel0, sys%wall_v0) + th*cs%u(:, k)
+                e%contact_dissipation = e%contact_dissipation - dot_product(cs%r(:, k), u)
+                a = cs%i1(k)
+                if (a > 0) cycle
+                vw = (1.0_wp - th)*sys%wall_v0(:, -a) + th*sys%wall_v1(:, -a)
+                nx = cs%nrm(1, k)
+                ny = cs%nrm(2, k)
+                e%drive_work = e%drive_work + cs%r(1, k)*(nx*vw(1) + ny*vw(2)) + cs%r(2, k)*(-ny*vw(1) + nx*vw(2))
+            end do
+        end associate
+    end subroutine contact_works
+
+    !> Memory held by the system: disks, walls, contacts, detection and work arrays [bytes].
+    pure integer(i8) function dem_system_bytes(sys) result(b)
+        !> System.
+        type(dem_system_t), intent(in) :: sys
+        b = particles_bytes(sys%particles) + contacts_bytes(sys%contacts) + detector_bytes(sys%detector)
+        b = b + 48_i8*sys%walls%n
+        if (allocated(sys%vel0)) b = b + 8_i8*(size(sys%vel0) + size(sys%vel) + size(sys%im) + size(sys%load) &
+                                               + size(sys%impulse) + size(sys%xm) + size(sys%ym))
+    end function dem_system_bytes
+
+    !> Closing error of the energy audit [J/m] (zero up to round-off).
+    pure real(wp) function energies_balance(e) result(b)
+        !> Energies.
+        type(energies_t), intent(in) :: e
+        b = e%kinetic + e%potential - e%external_work - e%drive_work + e%contact_dissipation &
+            + e%numerical_dissipation - e%initial
+    end function energies_balance
+end module dem_moreau_jean

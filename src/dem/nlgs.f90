@@ -1,0 +1,235 @@
+!> Non-linear Gauss-Seidel (NLGS) over the contacts with the bi-potential local solver.
+!>
+!> Body velocities v (3, n) start at the free velocities; the solver adds M^-1 H r of the
+!> warm-started reactions, then sweeps: for each active contact, u = H^T v + shift,
+!> b = u - W r, local solve for r, v += M^-1 H dr. Cohesion: the unknown of the local solve
+!> is the shifted reaction r_n + r_cohe h (THEORY.md 1), the impulse applied is r.
+!> Convergence norm (LMGC90 'Quad'-like): after a sweep,
+!>     sqrt(sum |W_aa dr_a|^2) / sqrt(sum |W_aa r_a|^2) <= tol,
+!> i.e. the change of local velocities over the sweep relative to W r. The Signorini-Coulomb
+!> residual of the final state (scaled frame, bipotential_residual) is reported too.
+!> Sweeps alternate direction when `symmetric` (symmetric Gauss-Seidel).
+module dem_nlgs
+    use core_kinds, only: wp, i8
+    use dem_contacts, only: contact_set_t
+    use dem_bipotential, only: bipotential_local_solve, bipotential_residual
+    implicit none
+    private
+    public :: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_apply_reactions, nlgs_residual
+
+    !> Solver settings.
+    type :: nlgs_config_t
+        !> Tolerance of the convergence norm.
+        real(wp) :: tol = 1.0e-6_wp
+        !> Maximum number of sweeps.
+        integer :: max_sweeps = 1000
+        !> Relative tolerance of the local predictor-corrector iterations.
+        real(wp) :: local_tol = 1.0e-10_wp
+        !> Maximum local iterations per contact visit.
+        integer :: local_max_iter = 8
+        !> Alternate the sweep direction.
+        logical :: symmetric = .true.
+    end type nlgs_config_t
+
+    !> Statistics of one solve.
+    type :: nlgs_stats_t
+        !> Sweeps done.
+        integer :: sweeps = 0
+        !> Contacts in the list and active contacts.
+        integer :: n_contacts = 0, n_active = 0
+        !> Local predictor-corrector iterations, all contacts and sweeps.
+        integer(i8) :: local_iterations = 0_i8
+        !> Contact updates (active contacts x sweeps).
+        integer(i8) :: updates = 0_i8
+        !> Convergence norm after the last sweep.
+        real(wp) :: error = 0.0_wp
+        !> Relative Signorini-Coulomb residual of the final state.
+        real(wp) :: residual = 0.0_wp
+        !> error <= tol reached.
+        logical :: converged = .true.
+    end type nlgs_stats_t
+
+contains
+
+    !> Solve the contact problem of one step. On entry vel holds the free velocities, on
+    !> exit the end-of-step velocities; cs%r holds the warm start on entry, the reactions on exit.
+    subroutine nlgs_solve(config, cs, im, vel, stats)
+        !> Settings.
+        type(nlgs_config_t), intent(in) :: config
+        !> Contacts (frames, laws and activity set).
+        type(contact_set_t), intent(inout) :: cs
+        !> Inverse mass per DOF (3, n_disks).
+        real(wp), intent(in) :: im(:, :)
+        !> Velocities (3, n_disks).
+        real(wp), intent(inout) :: vel(:, :)
+        !> Statistics.
+        type(nlgs_stats_t), intent(out) :: stats
+        real(wp) :: num, den
+        integer(i8) :: nloc
+        integer, allocatable :: list(:)
+        integer :: s, k
+        stats%n_contacts = cs%n
+        stats%n_active = count(cs%active(1:cs%n))
+        allocate (list(stats%n_active))
+        s = 0
+        do k = 1, cs%n
+            if (.not. cs%active(k)) cycle
+            s = s + 1
+            list(s) = k
+        end do
+        call nlgs_apply_reactions(cs, im, vel)
+        stats%converged = .true.
+        stats%error = 0.0_wp
+        if (stats%n_active > 0) then
+            stats%converged = .false.
+            do s = 1, config%max_sweeps
+                if (config%symmetric .and. mod(s, 2) == 0) then
+                    call sweep(config, cs, im, vel, list, stats%n_active, 1, -1, num, den, nloc)
+                else
+                    call sweep(config, cs, im, vel, list, 1, stats%n_active, 1, num, den, nloc)
+                end if
+                stats%sweeps = s
+                stats%local_iterations = stats%local_iterations + nloc
+                stats%error = relative(num, den)
+                if (stats%error <= config%tol) then
+                    stats%converged = .true.
+                    exit
+                end if
+            end do
+        end if
+        stats%updates = int(stats%n_active, i8)*stats%sweeps
+        stats%residual = nlgs_residual(cs, vel)
+    end subroutine nlgs_solve
+
+    !> sqrt(num/den), 0 for 0/0, huge for x/0.
+    pure real(wp) function relative(num, den) result(q)
+        real(wp), intent(in) :: num, den
+        if (den > 0.0_wp) then
+            q = sqrt(num/den)
+        else if (num > 0.0_wp) then
+            q = huge(1.0_wp)
+        else
+            q = 0.0_wp
+        end if
+    end function relative
+
+    !> Add M^-1 H r of every active contact to vel.
+    pure subroutine nlgs_apply_reactions(cs, im, vel)
+        !> Contacts.
+        type(contact_set_t), intent(in) :: cs
+        !> Inverse mass per DOF (3, n_disks).
+        real(wp), intent(in) :: im(:, :)
+        !> Velocities (3, n_disks).
+        real(wp), intent(inout) :: vel(:, :)
+        integer :: k
+        do k = 1, cs%n
+            if (.not. cs%active(k)) cycle
+            call apply(cs, k, im, vel, cs%r(1, k), cs%r(2, k))
+        end do
+    end subroutine nlgs_apply_reactions
+
+    !> vel += M^-1 H (drn, drt) for contact k.
+    pure subroutine apply(cs, k, im, vel, drn, drt)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: k
+        real(wp), intent(in) :: im(:, :)
+        real(wp), intent(inout) :: vel(:, :)
+        real(wp), intent(in) :: drn, drt
+        real(wp) :: px, py
+        integer :: a, b
+        a = cs%i1(k)
+        b = cs%i2(k)
+        px = drn*cs%nrm(1, k) - drt*cs%nrm(2, k)
+        py = drn*cs%nrm(2, k) + drt*cs%nrm(1, k)
+        vel(1, b) = vel(1, b) + im(1, b)*px
+        vel(2, b) = vel(2, b) + im(2, b)*py
+        vel(3, b) = vel(3, b) + im(3, b)*cs%lever(2, k)*drt
+        if (a > 0) then
+            vel(1, a) = vel(1, a) - im(1, a)*px
+            vel(2, a) = vel(2, a) - im(2, a)*py
+            vel(3, a) = vel(3, a) + im(3, a)*cs%lever(1, k)*drt
+        end if
+    end subroutine apply
+
+    !> Relative velocity H^T v + shift of contact k.
+    pure subroutine local_velocity(cs, k, vel, un, ut)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: k
+        real(wp), intent(in) :: vel(:, :)
+        real(wp), intent(out) :: un, ut
+        real(wp) :: dvx, dvy
+        integer :: a, b
+        a = cs%i1(k)
+        b = cs%i2(k)
+        dvx = vel(1, b)
+        dvy = vel(2, b)
+        ut = cs%lever(2, k)*vel(3, b) + cs%shift(2, k)
+        if (a > 0) then
+            dvx = dvx - vel(1, a)
+            dvy = dvy - vel(2, a)
+            ut = ut + cs%lever(1, k)*vel(3, a)
+        end if
+        un = cs%nrm(1, k)*dvx + cs%nrm(2, k)*dvy + cs%shift(1, k)
+        ut = ut - cs%nrm(2, k)*dvx + cs%nrm(1, k)*dvy
+    end subroutine local_velocity
+
+    !> One Gauss-Seidel sweep over the active contacts list(first), list(first + step), ...,
+    !> list(last). num = sum |W dr|^2, den = sum |W r~|^2, nloc = local iterations.
+    subroutine sweep(config, cs, im, vel, list, first, last, step, num, den, nloc)
+        type(nlgs_config_t), intent(in) :: config
+        type(contact_set_t), intent(inout) :: cs
+        real(wp), intent(in) :: im(:, :)
+        real(wp), intent(inout) :: vel(:, :)
+        integer, intent(in) :: list(:), first, last, step
+        real(wp), intent(out) :: num, den
+        integer(i8), intent(out) :: nloc
+        real(wp) :: un, ut, wnn, wnt, wtt, rn0, rt0, rn, rt, drn, drt
+        integer :: a, k, it, pcase
+        num = 0.0_wp
+        den = 0.0_wp
+        nloc = 0_i8
+        do a = first, last, step
+            k = list(a)
+            call local_velocity(cs, k, vel, un, ut)
+            wnn = cs%w(1, k)
+            wnt = cs%w(2, k)
+            wtt = cs%w(3, k)
+            rn0 = cs%r(1, k) + cs%coh(k)
+            rt0 = cs%r(2, k)
+            rn = rn0
+            rt = rt0
+            call bipotential_local_solve(wnn, wnt, wtt, un - wnn*rn0 - wnt*rt0, ut - wnt*rn0 - wtt*rt0, &
+                                         cs%mu(k), config%local_tol, config%local_max_iter, rn, rt, it, pcase)
+            nloc = nloc + it
+            drn = rn - rn0
+            drt = rt - rt0
+            cs%r(1, k) = rn - cs%coh(k)
+            cs%r(2, k) = rt
+            call apply(cs, k, im, vel, drn, drt)
+            num = num + (wnn*drn + wnt*drt)**2 + (wnt*drn + wtt*drt)**2
+            den = den + (wnn*rn + wnt*rt)**2 + (wnt*rn + wtt*rt)**2
+        end do
+    end subroutine sweep
+
+    !> Relative Signorini-Coulomb residual of the current state:
+    !> sqrt(sum res_a^2) / sqrt(sum |r~'_a|^2) over active contacts, with res_a from
+    !> bipotential_residual and r~' the shifted reaction in the scaled frame (0 if no reaction).
+    pure real(wp) function nlgs_residual(cs, vel) result(res)
+        !> Contacts.
+        type(contact_set_t), intent(in) :: cs
+        !> Velocities (3, n_disks).
+        real(wp), intent(in) :: vel(:, :)
+        real(wp) :: un, ut, rn, num, den
+        integer :: k
+        num = 0.0_wp
+        den = 0.0_wp
+        do k = 1, cs%n
+            if (.not. cs%active(k)) cycle
+            call local_velocity(cs, k, vel, un, ut)
+            rn = cs%r(1, k) + cs%coh(k)
+            num = num + bipotential_residual(cs%w(1, k), cs%w(2, k), cs%w(3, k), un, ut, cs%mu(k), rn, cs%r(2, k))**2
+            den = den + cs%w(1, k)*rn**2 + cs%w(3, k)*cs%r(2, k)**2
+        end do
+        res = relative(num, den)
+    end function nlgs_residual
+end module dem_nlgs
