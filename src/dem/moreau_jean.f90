@@ -14,6 +14,16 @@
 !> with numerical_dissipation = (theta - 1/2) sum |v+ - v|_M^2 (zero for theta = 1/2),
 !> contact_dissipation = - sum r . u_theta (>= 0 for dissipative contacts), drive_work the work
 !> of imposed velocities and moving walls on the disks.
+!>
+!> Coupled steps (Arlequin, coupling_arlequin): `mj_step` is also available in four parts,
+!> `mj_free_velocities` (1 and the mid configuration), `mj_detect` (2, 3; contacts are
+!> activated on the velocities found in `vel`, which the coupling may have changed),
+!> `mj_solve` (4, optionally with bilateral constraints kept by the NLGS) and `mj_end_step`
+!> (5); in that order they are `mj_step`, bit for bit. An external impulse applied to the
+!> disks during the step (e.g. the coupling multipliers) is recorded in `coupling_impulse`:
+!> the audit counts its work as `coupling_work` (coupling_work . v_theta), so that
+!>   kinetic + potential - external_work - drive_work - coupling_work + contact_dissipation
+!>   + numerical_dissipation = initial.
 module dem_moreau_jean
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
@@ -26,10 +36,11 @@ module dem_moreau_jean
                             contacts_set_laws, contacts_finish, contacts_impulses, contacts_local_velocity, &
                             contacts_bytes
     use dem_detection, only: detector_t, detect_contacts, detector_bytes
-    use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_solve
+    use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_bilateral_t
     implicit none
     private
     public :: mj_config_t, energies_t, dem_system_t, mj_init, mj_step, energies_balance, dem_system_bytes
+    public :: mj_free_velocities, mj_detect, mj_solve, mj_end_step
 
     !> Time-stepping settings.
     type :: mj_config_t
@@ -61,6 +72,8 @@ module dem_moreau_jean
         real(wp) :: numerical_dissipation = 0.0_wp
         !> kinetic + potential at the start.
         real(wp) :: initial = 0.0_wp
+        !> Work of the external coupling impulses (`dem_system_t%coupling_impulse`).
+        real(wp) :: coupling_work = 0.0_wp
     end type energies_t
 
     !> One discrete-element simulation: model, settings, contacts, solver state, statistics.
@@ -97,6 +110,10 @@ module dem_moreau_jean
         real(wp), allocatable :: xm(:), ym(:), wx1(:), wy1(:), wx2(:), wy2(:)
         !> Wall velocities at the start and the end of the step (2, n_walls).
         real(wp), allocatable :: wall_v0(:, :), wall_v1(:, :)
+        !> Impulse (3, n) applied to the disks during the current step by an external coupling
+        !> (set to zero by `mj_free_velocities`; the coupling adds its impulse to `vel` and
+        !> records it here before `mj_end_step`) [N s/m, N s].
+        real(wp), allocatable :: coupling_impulse(:, :)
     end type dem_system_t
 
 contains
@@ -115,7 +132,9 @@ contains
         nw = sys%walls%n
         if (allocated(sys%vel0)) deallocate (sys%vel0, sys%vel, sys%im, sys%load, sys%impulse, sys%xm, &
                                              sys%ym, sys%wx1, sys%wy1, sys%wx2, sys%wy2, sys%wall_v0, sys%wall_v1)
+        if (allocated(sys%coupling_impulse)) deallocate (sys%coupling_impulse)
         allocate (sys%vel0(3, n), sys%vel(3, n), sys%im(3, n), sys%load(3, n), sys%impulse(3, n))
+        allocate (sys%coupling_impulse(3, n), source=0.0_wp)
         allocate (sys%xm(n), sys%ym(n), sys%wx1(nw), sys%wy1(nw), sys%wx2(nw), sys%wy2(nw))
         allocate (sys%wall_v0(2, nw), sys%wall_v1(2, nw))
         sys%energies = energies_t()
@@ -153,30 +172,73 @@ contains
     subroutine mj_step(sys)
         !> System (mj_init done).
         type(dem_system_t), intent(inout) :: sys
-        type(contact_law_t) :: law
-        integer(i8) :: c0, c1, c2, rate
+        call mj_free_velocities(sys)
+        call mj_detect(sys)
+        call mj_solve(sys)
+        call mj_end_step(sys)
+    end subroutine mj_step
+
+    !> Contact law parameters of the current step.
+    pure type(contact_law_t) function step_law(sys) result(law)
+        type(dem_system_t), intent(in) :: sys
         law = contact_law_t(h=sys%scheme%h, theta=sys%scheme%theta, make_bonds=sys%bonds_pending, &
                             bond_ratio=sys%scheme%bond_ratio)
+    end function step_law
+
+    !> Part 1 of a step: start velocities vel0, free velocities vel (loads and gravity,
+    !> imposed DOFs), wall velocities, mid configuration; coupling_impulse = 0.
+    subroutine mj_free_velocities(sys)
+        !> System (mj_init done).
+        type(dem_system_t), intent(inout) :: sys
         call free_velocities(sys)
         call mid_configuration(sys)
+        sys%coupling_impulse = 0.0_wp
+    end subroutine mj_free_velocities
+
+    !> Part 2 of a step: detection on the mid configuration, frames and Delassus blocks,
+    !> contact laws; contacts are activated on the velocities in `vel` (the free velocities,
+    !> plus whatever a coupling added since `mj_free_velocities`).
+    subroutine mj_detect(sys)
+        !> System, after `mj_free_velocities`.
+        type(dem_system_t), intent(inout) :: sys
+        integer(i8) :: c0, c1, c2, rate
         call system_clock(c0, rate)
         call detect_contacts(sys%detector, sys%xm, sys%ym, sys%particles%radius, sys%scheme%alert, &
                              sys%wx1, sys%wy1, sys%wx2, sys%wy2, sys%contacts)
         call system_clock(c1)
         call contacts_set_frames(sys%contacts, sys%particles%radius, sys%im)
-        call contacts_set_laws(sys%contacts, law, sys%particles%radius, sys%particles%mat, sys%walls%mat, &
-                               sys%materials, sys%vel0, sys%vel, sys%wall_v0, sys%wall_v1)
-        call nlgs_solve(sys%solver, sys%contacts, sys%im, sys%vel, sys%stats)
+        call contacts_set_laws(sys%contacts, step_law(sys), sys%particles%radius, sys%particles%mat, &
+                               sys%walls%mat, sys%materials, sys%vel0, sys%vel, sys%wall_v0, sys%wall_v1)
         call system_clock(c2)
         sys%time_detection = sys%time_detection + real(c1 - c0, wp)/real(rate, wp)
         sys%time_solver = sys%time_solver + real(c2 - c1, wp)/real(rate, wp)
-        call contacts_finish(sys%contacts, law, sys%particles%radius, sys%vel, sys%wall_v1)
+    end subroutine mj_detect
+
+    !> Part 3 of a step: NLGS from the velocities in `vel`; end-of-step velocities in `vel`.
+    subroutine mj_solve(sys, bilateral)
+        !> System, after `mj_detect`.
+        type(dem_system_t), intent(inout) :: sys
+        !> Bilateral velocity constraints kept satisfied by the solver (default: none).
+        class(nlgs_bilateral_t), intent(inout), optional :: bilateral
+        integer(i8) :: c0, c1, rate
+        call system_clock(c0, rate)
+        call nlgs_solve(sys%solver, sys%contacts, sys%im, sys%vel, sys%stats, bilateral)
+        call system_clock(c1)
+        sys%time_solver = sys%time_solver + real(c1 - c0, wp)/real(rate, wp)
+    end subroutine mj_solve
+
+    !> Part 4 of a step: statuses and broken bonds, energy audit (coupling_impulse included),
+    !> new configuration and velocities, time.
+    subroutine mj_end_step(sys)
+        !> System, after `mj_solve`.
+        type(dem_system_t), intent(inout) :: sys
+        call contacts_finish(sys%contacts, step_law(sys), sys%particles%radius, sys%vel, sys%wall_v1)
         call audit_energies(sys)
         call update_configuration(sys)
         sys%time = sys%time + sys%scheme%h
         sys%step = sys%step + 1
         sys%bonds_pending = .false.
-    end subroutine mj_step
+    end subroutine mj_end_step
 
     !> vel0 = current velocities, im, theta-weighted loads, vel = free velocities, wall velocities.
     subroutine free_velocities(sys)
@@ -255,8 +317,10 @@ contains
                 vm = (1.0_wp - th)*sys%vel0(:, i) + th*sys%vel(:, i)
                 e%external_work = e%external_work + h*dot_product(sys%load(:, i), vm)
                 e%numerical_dissipation = e%numerical_dissipation + (th - 0.5_wp)*dot_product(m, dv*dv)
+                e%coupling_work = e%coupling_work + dot_product(sys%coupling_impulse(:, i), vm)
                 ! support impulse on constrained DOFs (zero work where the DOF is fixed)
-                p = m*dv - h*(sys%load(:, i) + [pt%mass(i)*pt%gravity, 0.0_wp]) - sys%impulse(:, i)
+                p = m*dv - h*(sys%load(:, i) + [pt%mass(i)*pt%gravity, 0.0_wp]) - sys%impulse(:, i) &
+                    - sys%coupling_impulse(:, i)
                 e%drive_work = e%drive_work + sum(merge(p*vm, 0.0_wp, sys%im(:, i) == 0.0_wp))
             end do
         end associate
@@ -290,6 +354,7 @@ contains
         b = b + 48_i8*sys%walls%n
         if (allocated(sys%vel0)) b = b + 8_i8*(size(sys%vel0) + size(sys%vel) + size(sys%im) + size(sys%load) &
                                                + size(sys%impulse) + size(sys%xm) + size(sys%ym))
+        if (allocated(sys%coupling_impulse)) b = b + 8_i8*size(sys%coupling_impulse)
     end function dem_system_bytes
 
     !> Closing error of the energy audit [J/m] (zero up to round-off).
@@ -297,6 +362,6 @@ contains
         !> Energies.
         type(energies_t), intent(in) :: e
         b = e%kinetic + e%potential - e%external_work - e%drive_work + e%contact_dissipation &
-            + e%numerical_dissipation - e%initial
+            + e%numerical_dissipation - e%initial - e%coupling_work
     end function energies_balance
 end module dem_moreau_jean

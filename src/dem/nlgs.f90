@@ -9,6 +9,13 @@
 !> i.e. the change of local velocities over the sweep relative to W r. The Signorini-Coulomb
 !> residual of the final state (scaled frame, bipotential_residual) is reported too.
 !> Sweeps alternate direction when `symmetric` (symmetric Gauss-Seidel).
+!>
+!> Bilateral constraints (optional, e.g. the Arlequin coupling rows, coupling_bilateral):
+!> an extension of `nlgs_bilateral_t` keeps linear velocity constraints on some disks
+!> satisfied exactly. It is called once after the warm-started reactions are applied
+!> (`restore`) and after every contact update that moved disks (`update`), and corrects the
+!> velocities of its disks there. The contacts then solve the problem with the constraints
+!> eliminated (give them the condensed Delassus blocks in cs%w for exact local solves).
 module dem_nlgs
     use core_kinds, only: wp, i8
     use dem_contacts, only: contact_set_t
@@ -16,6 +23,7 @@ module dem_nlgs
     implicit none
     private
     public :: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_apply_reactions, nlgs_residual
+    public :: nlgs_bilateral_t
 
     !> Solver settings.
     type :: nlgs_config_t
@@ -49,11 +57,42 @@ module dem_nlgs
         logical :: converged = .true.
     end type nlgs_stats_t
 
+    !> Linear velocity constraints kept satisfied during the sweeps (see the module header).
+    type, abstract :: nlgs_bilateral_t
+    contains
+        !> Restore the constraints after arbitrary changes of the velocities.
+        procedure(bilateral_restore), deferred :: restore
+        !> Restore the constraints after a contact update changed the velocities of two bodies.
+        procedure(bilateral_update), deferred :: update
+    end type nlgs_bilateral_t
+
+    abstract interface
+        !> Correct vel so that the constraints hold again, after any change of vel.
+        subroutine bilateral_restore(self, vel)
+            import :: nlgs_bilateral_t, wp
+            !> The constraints (their multipliers are updated).
+            class(nlgs_bilateral_t), intent(inout) :: self
+            !> Disk velocities (3, n_disks).
+            real(wp), intent(inout) :: vel(:, :)
+        end subroutine bilateral_restore
+
+        !> Correct vel after only bodies a and b changed velocity since the last call.
+        subroutine bilateral_update(self, a, b, vel)
+            import :: nlgs_bilateral_t, wp
+            !> The constraints (their multipliers are updated).
+            class(nlgs_bilateral_t), intent(inout) :: self
+            !> Bodies of the contact just updated: disk a (or -wall index, <= 0) and disk b.
+            integer, intent(in) :: a, b
+            !> Disk velocities (3, n_disks).
+            real(wp), intent(inout) :: vel(:, :)
+        end subroutine bilateral_update
+    end interface
+
 contains
 
     !> Solve the contact problem of one step. On entry vel holds the free velocities, on
     !> exit the end-of-step velocities; cs%r holds the warm start on entry, the reactions on exit.
-    subroutine nlgs_solve(config, cs, im, vel, stats)
+    subroutine nlgs_solve(config, cs, im, vel, stats, bilateral)
         !> Settings.
         type(nlgs_config_t), intent(in) :: config
         !> Contacts (frames, laws and activity set).
@@ -64,6 +103,8 @@ contains
         real(wp), intent(inout) :: vel(:, :)
         !> Statistics.
         type(nlgs_stats_t), intent(out) :: stats
+        !> Bilateral constraints kept satisfied (default: none).
+        class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         real(wp) :: num, den
         integer(i8) :: nloc
         integer, allocatable :: list(:)
@@ -78,15 +119,16 @@ contains
             list(s) = k
         end do
         call nlgs_apply_reactions(cs, im, vel)
+        if (present(bilateral)) call bilateral%restore(vel)
         stats%converged = .true.
         stats%error = 0.0_wp
         if (stats%n_active > 0) then
             stats%converged = .false.
             do s = 1, config%max_sweeps
                 if (config%symmetric .and. mod(s, 2) == 0) then
-                    call sweep(config, cs, im, vel, list, stats%n_active, 1, -1, num, den, nloc)
+                    call sweep(config, cs, im, vel, list, stats%n_active, 1, -1, num, den, nloc, bilateral)
                 else
-                    call sweep(config, cs, im, vel, list, 1, stats%n_active, 1, num, den, nloc)
+                    call sweep(config, cs, im, vel, list, 1, stats%n_active, 1, num, den, nloc, bilateral)
                 end if
                 stats%sweeps = s
                 stats%local_iterations = stats%local_iterations + nloc
@@ -175,7 +217,8 @@ contains
 
     !> One Gauss-Seidel sweep over the active contacts list(first), list(first + step), ...,
     !> list(last). num = sum |W dr|^2, den = sum |W r~|^2, nloc = local iterations.
-    subroutine sweep(config, cs, im, vel, list, first, last, step, num, den, nloc)
+    !> With bilateral constraints, they are restored after each contact update.
+    subroutine sweep(config, cs, im, vel, list, first, last, step, num, den, nloc, bilateral)
         type(nlgs_config_t), intent(in) :: config
         type(contact_set_t), intent(inout) :: cs
         real(wp), intent(in) :: im(:, :)
@@ -183,6 +226,7 @@ contains
         integer, intent(in) :: list(:), first, last, step
         real(wp), intent(out) :: num, den
         integer(i8), intent(out) :: nloc
+        class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         real(wp) :: un, ut, wnn, wnt, wtt, rn0, rt0, rn, rt, drn, drt
         integer :: a, k, it, pcase
         num = 0.0_wp
@@ -206,6 +250,7 @@ contains
             cs%r(1, k) = rn - cs%coh(k)
             cs%r(2, k) = rt
             call apply(cs, k, im, vel, drn, drt)
+            if (present(bilateral)) call bilateral%update(cs%i1(k), cs%i2(k), vel)
             num = num + (wnn*drn + wnt*drt)**2 + (wnt*drn + wtt*drt)**2
             den = den + (wnn*rn + wnt*rt)**2 + (wnt*rn + wtt*rt)**2
         end do

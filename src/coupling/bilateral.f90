@@ -1,0 +1,247 @@
+!> The Arlequin coupling rows as bilateral velocity constraints inside the NLGS contact solve
+!> (THEORY.md section 4; used by coupling_arlequin).
+!>
+!> Unknowns of a coupled step: the contact impulses r and the multipliers lambda (one per
+!> row of C). With G selecting the coupled particle DOFs, the end-of-step constraint is
+!>   rho = G v - C v_c + e/h = 0,
+!>   v   = v_free + M^-1 H r + h gamma M^-1 G^T lambda / t        (particles, per unit thickness t)
+!>   v_c = v_c,free - h gamma S^-1 C^T lambda                     (FE, Newmark)
+!> so that, for given contact impulses, lambda solves A lambda = -(g_free + G M^-1 H r) with
+!> A = h gamma (W + C S^-1 C^T), W = G M^-1 G^T / t. Here lambda is eliminated exactly: this
+!> type keeps rho = 0 at every stage of the Gauss-Seidel sweep. After a contact update has
+!> changed the velocities of its two bodies, rho changes only on their rows, by
+!> delta = G v - target (target = G v at the last correction); then
+!>   lambda += -A^-1 delta,   G v += h gamma W_row (-A^-1 delta)
+!> (A^-1 is dense and precomputed: one column per touched row, O(n_rows) per row).
+!> The contacts then see the condensed problem, whose local Delassus blocks are
+!>   W_eff = W_k - (h gamma / t) U^T A^-1 U,   U = G M^-1 H_k,
+!> (the particle mass in series with the FE's effective mass): `condense` writes them into
+!> the contact set, so that each local solve is exact and the NLGS converges as for plain
+!> contacts. Why not the alternatives: point Gauss-Seidel on the rows themselves converges
+!> slowly, because A is dense (the FE couples every row of an element); alternating between
+!> a full contact solve and a lambda solve (block Gauss-Seidel) contracts only by the ratio
+!> W_eff/W_k per pass for a contact between two coupled particles, which is near 1 when the
+!> FE is much heavier than the weighted particles.
+module coupling_bilateral
+    use core_kinds, only: wp
+    use dem_nlgs, only: nlgs_bilateral_t
+    use dem_contacts, only: contact_set_t
+    implicit none
+    private
+    public :: coupling_rows_t
+
+    !> Coupling rows kept satisfied by the NLGS (see the module description).
+    type, extends(nlgs_bilateral_t) :: coupling_rows_t
+        !> Number of rows (multipliers).
+        integer :: n_rows = 0
+        !> Rows per coupled point: 2 (x, y) or 3 (x, y, rotation).
+        integer :: rows_per_point = 2
+        !> Point (1..n_points) of each particle, 0 when the particle is not coupled (n_disks).
+        integer, allocatable :: point_of(:)
+        !> Particle of each row (n_rows).
+        integer, allocatable :: owner(:)
+        !> Particle DOF (1 = x, 2 = y, 3 = rotation) of each row (n_rows).
+        integer, allocatable :: dof(:)
+        !> A^-1 (n_rows, n_rows).
+        real(wp), allocatable :: ainv(:, :)
+        !> Velocity of each row per unit multiplier, h gamma / ((1 - alpha) m t) [m/(N s)].
+        real(wp), allocatable :: response(:)
+        !> h gamma / t, the factor of the condensation [s/m].
+        real(wp) :: scale = 0.0_wp
+        !> Multipliers of the current step [N, N.m] (n_rows).
+        real(wp), allocatable :: lambda(:)
+        !> G v at which the rows held at the last correction [m/s, rad/s] (n_rows).
+        real(wp), allocatable :: target(:)
+        !> Work array (n_rows).
+        real(wp), allocatable :: delta(:)
+        !> Corrections made since `begin` (restore + updates that touched coupled bodies).
+        integer :: corrections = 0
+    contains
+        !> Start a step: lambda = 0 and the free residual g of the rows.
+        procedure :: begin
+        !> See `nlgs_bilateral_t%restore`.
+        procedure :: restore
+        !> See `nlgs_bilateral_t%update`.
+        procedure :: update
+        !> Condensed Delassus blocks of the contacts that touch coupled particles.
+        procedure :: condense
+        !> G v: the velocities of the coupled DOFs.
+        procedure :: gather
+    end type coupling_rows_t
+
+contains
+
+    !> Start a step: lambda = 0, and the rows hold when G v = G vel - g, g being their
+    !> current residual (free velocities: g = G v_free - C v_c,free + e/h).
+    pure subroutine begin(self, vel, g)
+        !> The rows.
+        class(coupling_rows_t), intent(inout) :: self
+        !> Disk velocities (3, n_disks).
+        real(wp), intent(in) :: vel(:, :)
+        !> Residual of the rows at these velocities with lambda = 0 (n_rows) [m/s, rad/s].
+        real(wp), intent(in) :: g(:)
+        call self%gather(vel, self%target)
+        self%target = self%target - g
+        self%lambda = 0.0_wp
+        self%corrections = 0
+    end subroutine begin
+
+    !> G v: velocity of each coupled DOF (n_rows).
+    pure subroutine gather(self, vel, gv)
+        !> The rows.
+        class(coupling_rows_t), intent(in) :: self
+        !> Disk velocities (3, n_disks).
+        real(wp), intent(in) :: vel(:, :)
+        !> Velocities of the coupled DOFs (n_rows).
+        real(wp), intent(out) :: gv(:)
+        integer :: r
+        do r = 1, self%n_rows
+            gv(r) = vel(self%dof(r), self%owner(r))
+        end do
+    end subroutine gather
+
+    !> Correct the velocities after any change: delta = G v - target on every row.
+    subroutine restore(self, vel)
+        !> The rows.
+        class(coupling_rows_t), intent(inout) :: self
+        !> Disk velocities (3, n_disks).
+        real(wp), intent(inout) :: vel(:, :)
+        call self%gather(vel, self%delta)
+        self%delta = self%delta - self%target
+        call correct(self, vel)
+    end subroutine restore
+
+    !> Correct the velocities after a contact update moved bodies a and b (only their rows
+    !> can have changed).
+    subroutine update(self, a, b, vel)
+        !> The rows.
+        class(coupling_rows_t), intent(inout) :: self
+        !> Bodies of the contact (a <= 0: a wall).
+        integer, intent(in) :: a, b
+        !> Disk velocities (3, n_disks).
+        real(wp), intent(inout) :: vel(:, :)
+        integer :: rows(6), n, p, k, r
+        n = 0
+        p = self%point_of(b)
+        if (p > 0) then
+            do k = 1, self%rows_per_point
+                n = n + 1
+                rows(n) = (p - 1)*self%rows_per_point + k
+            end do
+        end if
+        if (a > 0) then
+            p = self%point_of(a)
+            if (p > 0) then
+                do k = 1, self%rows_per_point
+                    n = n + 1
+                    rows(n) = (p - 1)*self%rows_per_point + k
+                end do
+            end if
+        end if
+        if (n == 0) return
+        do k = 1, n
+            r = rows(k)
+            self%delta(r) = vel(self%dof(r), self%owner(r)) - self%target(r)
+        end do
+        call correct(self, vel, rows(1:n))
+    end subroutine update
+
+    !> dlambda = -A^-1 delta (delta given on `rows`, on every row when rows is absent),
+    !> lambda += dlambda, velocities of the coupled DOFs += response dlambda; target = G v.
+    subroutine correct(self, vel, rows)
+        type(coupling_rows_t), intent(inout) :: self
+        real(wp), intent(inout) :: vel(:, :)
+        integer, intent(in), optional :: rows(:)
+        real(wp) :: dl(self%n_rows)
+        integer :: k, r, i, d
+        if (.not. present(rows)) then
+            dl = -matmul(self%ainv, self%delta)
+        else
+            dl = 0.0_wp
+            do k = 1, size(rows)
+                r = rows(k)
+                dl = dl - self%ainv(:, r)*self%delta(r)
+            end do
+        end if
+        self%lambda = self%lambda + dl
+        do r = 1, self%n_rows
+            d = self%dof(r)
+            i = self%owner(r)
+            vel(d, i) = vel(d, i) + self%response(r)*dl(r)
+            self%target(r) = vel(d, i)
+        end do
+        self%corrections = self%corrections + 1
+    end subroutine correct
+
+    !> Replace the Delassus blocks (W_nn, W_nt, W_tt) of every contact that touches a coupled
+    !> particle by the condensed ones W - (h gamma/t) U^T A^-1 U (module description). Call
+    !> after `contacts_set_frames` (which sets W from im) and before the solve.
+    pure subroutine condense(self, cs, im)
+        !> The rows.
+        class(coupling_rows_t), intent(in) :: self
+        !> Contacts (frames and blocks set).
+        type(contact_set_t), intent(inout) :: cs
+        !> Inverse mass per DOF (3, n_disks), per unit thickness, as used by the contacts.
+        real(wp), intent(in) :: im(:, :)
+        integer :: k, a, b, n, i, j, rows(6)
+        real(wp) :: un(6), ut(6), nx, ny, snn, snt, stt, wnn, wnt, wtt, aij
+        do k = 1, cs%n
+            a = cs%i1(k)
+            b = cs%i2(k)
+            nx = cs%nrm(1, k)
+            ny = cs%nrm(2, k)
+            n = 0
+            call add_body(self, im, b, 1.0_wp, cs%lever(2, k), nx, ny, n, rows, un, ut)
+            if (a > 0) call add_body(self, im, a, -1.0_wp, cs%lever(1, k), nx, ny, n, rows, un, ut)
+            if (n == 0) cycle
+            snn = 0.0_wp
+            snt = 0.0_wp
+            stt = 0.0_wp
+            do j = 1, n
+                do i = 1, n
+                    aij = self%ainv(rows(i), rows(j))
+                    snn = snn + un(i)*aij*un(j)
+                    snt = snt + un(i)*aij*ut(j)
+                    stt = stt + ut(i)*aij*ut(j)
+                end do
+            end do
+            ! The condensed block is positive semi-definite in exact arithmetic; keep it so
+            ! against the rounding of the difference.
+            wnn = max(cs%w(1, k) - self%scale*snn, 0.0_wp)
+            wtt = max(cs%w(3, k) - self%scale*stt, 0.0_wp)
+            wnt = cs%w(2, k) - self%scale*snt
+            wnt = sign(min(abs(wnt), sqrt(wnn*wtt)), wnt)
+            cs%w(:, k) = [wnn, wnt, wtt]
+        end do
+    end subroutine condense
+
+    !> Rows of body c (if coupled) and the columns of U = G M^-1 H there, appended after the
+    !> first n: the impulse (r_n, r_t) acts on c with sign s (+ on i2, - on i1) through the
+    !> normal n, the tangent t = (-n_y, n_x) and the lever arm (rotation).
+    pure subroutine add_body(self, im, c, s, lever, nx, ny, n, rows, un, ut)
+        type(coupling_rows_t), intent(in) :: self
+        real(wp), intent(in) :: im(:, :)
+        integer, intent(in) :: c
+        real(wp), intent(in) :: s, lever, nx, ny
+        integer, intent(inout) :: n, rows(:)
+        real(wp), intent(inout) :: un(:), ut(:)
+        integer :: p, base
+        p = self%point_of(c)
+        if (p == 0) return
+        base = (p - 1)*self%rows_per_point
+        n = n + 1
+        rows(n) = base + 1
+        un(n) = s*im(1, c)*nx
+        ut(n) = -s*im(1, c)*ny
+        n = n + 1
+        rows(n) = base + 2
+        un(n) = s*im(2, c)*ny
+        ut(n) = s*im(2, c)*nx
+        if (self%rows_per_point == 3) then
+            n = n + 1
+            rows(n) = base + 3
+            un(n) = 0.0_wp
+            ut(n) = im(3, c)*lever
+        end if
+    end subroutine add_body
+end module coupling_bilateral
