@@ -21,5 +21,5 @@ configure_and_build build Release
 say "running $deck"
 build/src/multicor "$deck" --output "$out"
 say "plotting"
-.venv/bin/python postproc/plot_beam.py "$out/$name.h5" --out "$out"
+.venv/bin/python postproc/plot_results.py "$out/$name.h5" --out "$out"
 say "results in $MULTICOR_ROOT/$out"

@@ -93,6 +93,10 @@ contains
         !> Error naming file, line and keyword, if any.
         type(error_t), allocatable, intent(out) :: error
         integer, allocatable :: section_ids(:), function_ids(:), fix_line(:, :)
+        if (particles_only(deck)) then
+            call build_particles_only(deck, run, beam, error)
+            return
+        end if
         call build_sections(deck, beam, section_ids, error)
         if (allocated(error)) return
         call build_mesh(deck, section_ids, beam, error)
@@ -110,6 +114,48 @@ contains
         if (allocated(error)) return
         call build_initial(deck, beam, fix_line, run, error)
     end subroutine build_config
+
+    !> Whether the deck has [particles] entries and no [beam] entry.
+    pure logical function particles_only(deck)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        integer :: i
+        logical :: beam, particles
+        beam = .false.
+        particles = .false.
+        do i = 1, size(deck%entries)
+            beam = beam .or. deck%entries(i)%section == 'beam'
+            particles = particles .or. deck%entries(i)%section == 'particles'
+        end do
+        particles_only = particles .and. .not. beam
+    end function particles_only
+
+    !> Configuration of a deck without [beam]: an empty frame, the time functions, the run
+    !> settings (a time integration: particles have no static or modal analysis).
+    subroutine build_particles_only(deck, run, beam, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Run configuration.
+        type(run_config_t), intent(out) :: run
+        !> Beam configuration (empty, functions filled).
+        type(beam_config_t), intent(out) :: beam
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: function_ids(:), fix_line(:, :)
+        allocate (beam%x(0), beam%y(0), beam%node_id(0), beam%conn(2, 0), beam%elem_section(0))
+        allocate (beam%sections(0), beam%loads(0), beam%fixed(3, 0), fix_line(3, 0))
+        if (deck%get_word('run', 'analysis') /= 'dynamic') then
+            call make_input_error(error, deck%file, deck%line('run', 'analysis'), 'analysis', &
+                'particles are integrated in time: set analysis = dynamic (a '// &
+                deck%get_word('run', 'analysis')//' analysis needs a [beam] model)')
+            return
+        end if
+        call build_functions(deck, beam, function_ids, error)
+        if (allocated(error)) return
+        call build_run(deck, beam, run, error)
+        if (allocated(error)) return
+        call build_initial(deck, beam, fix_line, run, error)
+    end subroutine build_particles_only
 
     !> Sections, with unique ids.
     subroutine build_sections(deck, beam, ids, error)

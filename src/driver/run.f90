@@ -1,11 +1,16 @@
 !> Runs one deck: read and validate, build the model, run the analysis, write the results.
 !>
+!> Dispatch: a deck with [beam] and no [particles] is a finite-element run (static, modal or
+!> dynamic); a deck with [particles] and no [beam] is a discrete-element run (driver_run_dem);
+!> a deck with both is refused until coupled runs exist ([coupling]).
+!>
 !> Everything that can fail because of the input is checked before the results folder is
 !> touched; the HDF5 file is written as '<name>.h5.partial' and renamed only on success, so
 !> earlier results stay intact when a run fails.
 module driver_run
     use core_kinds, only: wp
     use core_error, only: error_t, make_input_error
+    use core_strings, only: to_str
     use io_deck_schema, only: multicor_schema
     use io_deck, only: deck_t, read_deck
     use io_paths, only: stem, mkdir_p
@@ -16,6 +21,9 @@ module driver_run
     use fem_modal, only: solve_modal
     use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
     use driver_config, only: run_config_t, build_config
+    use driver_config_dem, only: dem_config_t, build_dem_config, deck_has_particles, &
+        deck_has_beam, check_particle_keywords_unused, check_beam_keywords_unused
+    use driver_run_dem, only: run_dem
     use driver_results, only: results_writer_t
     implicit none
     private
@@ -54,32 +62,44 @@ contains
         type(run_config_t) :: run
         type(beam_config_t) :: beam
         type(beam_model_t) :: model
+        type(dem_config_t) :: dem
         class(time_integrator_t), allocatable :: integ
         type(results_writer_t) :: out
         character(len=:), allocatable :: dir, path, message
+        logical :: particles
 
         call read_deck(opts%deck_path, multicor_schema(), deck, error)
         if (allocated(error)) return
-        call build_config(deck, run, beam, error)
-        if (allocated(error)) return
-        call build_beam_model(beam, model, error)
-        ! A static solve needs supports that stop every rigid-body motion.
-        if (.not. allocated(error) .and. run%analysis == 'static') call model%check_supports(error)
-        if (allocated(error)) then
-            error%message = deck%file//': '//error%message
+        particles = deck_has_particles(deck)
+        if (particles .and. deck_has_beam(deck)) then
+            call make_input_error(error, deck%file, deck%line('run', 'analysis'), '', &
+                'this deck has both [beam] and [particles]: coupled runs need a [coupling] '// &
+                'section, which is not available yet; run the beam and the particles apart')
             return
         end if
-        if (run%analysis == 'dynamic') then
-            call make_integrator(run, model, integ, error)
-            if (allocated(error)) then
-                ! The integrator only refuses a time step (stability limit).
-                message = error%message
-                call make_input_error(error, deck%file, deck%line('time', 'step'), 'step', message)
-                return
-            end if
+        if (particles) then
+            call check_beam_keywords_unused(deck, error)
+        else
+            call check_particle_keywords_unused(deck, error)
+        end if
+        if (allocated(error)) return
+        call build_config(deck, run, beam, error)
+        if (allocated(error)) return
+        if (particles) then
+            call build_dem_config(deck, run, beam%functions, dem, error)
+            if (allocated(error)) return
+        else
+            call build_fe(error)
+            if (allocated(error)) return
         end if
         if (opts%check_only) then
-            call report(opts%deck_path//': deck is valid ('//run%analysis//' analysis)')
+            if (particles) then
+                call report(opts%deck_path//': deck is valid ('//run%analysis//' analysis, '// &
+                    to_str(dem%system%particles%n)//' disks, '//to_str(dem%system%walls%n)// &
+                    ' walls)')
+            else
+                call report(opts%deck_path//': deck is valid ('//run%analysis//' analysis)')
+            end if
             return
         end if
 
@@ -90,16 +110,10 @@ contains
         path = dir//'/'//stem(opts%deck_path)//'.h5'
         call out%open(path, opts%deck_path, deck%text, run%title, run%analysis, error)
         if (allocated(error)) return
-        call out%write_mesh(beam%node_id, beam%x, beam%y, beam%conn, error)
-        if (.not. allocated(error)) then
-            select case (run%analysis)
-            case ('static')
-                call run_static(model, out, report, error)
-            case ('modal')
-                call run_modal(run, model, out, report, error)
-            case ('dynamic')
-                call run_dynamic(run, model, integ, out, opts%quiet, report, error)
-            end select
+        if (particles) then
+            call run_dem(run, dem, out, opts%quiet, report, error)
+        else
+            call run_fe(error)
         end if
         if (allocated(error)) then
             call out%abort()
@@ -109,6 +123,45 @@ contains
         call out%close(error)
         if (allocated(error)) return
         call report('results written to '//path)
+
+    contains
+
+        !> Beam model and integrator; everything that can fail because of the input.
+        subroutine build_fe(error)
+            type(error_t), allocatable, intent(out) :: error
+            call build_beam_model(beam, model, error)
+            ! A static solve needs supports that stop every rigid-body motion.
+            if (.not. allocated(error) .and. run%analysis == 'static') &
+                call model%check_supports(error)
+            if (allocated(error)) then
+                error%message = deck%file//': '//error%message
+                return
+            end if
+            if (run%analysis == 'dynamic') then
+                call make_integrator(run, model, integ, error)
+                if (allocated(error)) then
+                    ! The integrator only refuses a time step (stability limit).
+                    message = error%message
+                    call make_input_error(error, deck%file, deck%line('time', 'step'), 'step', &
+                        message)
+                end if
+            end if
+        end subroutine build_fe
+
+        !> The finite-element analysis, results into `out`.
+        subroutine run_fe(error)
+            type(error_t), allocatable, intent(out) :: error
+            call out%write_mesh(beam%node_id, beam%x, beam%y, beam%conn, error)
+            if (allocated(error)) return
+            select case (run%analysis)
+            case ('static')
+                call run_static(model, out, report, error)
+            case ('modal')
+                call run_modal(run, model, out, report, error)
+            case ('dynamic')
+                call run_dynamic(run, model, integ, out, opts%quiet, report, error)
+            end select
+        end subroutine run_fe
     end subroutine run_deck
 
     !> Build the time integrator the deck asks for (refuses an unstable explicit step).

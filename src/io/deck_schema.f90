@@ -3,23 +3,30 @@
 !> its default and a one-line description.
 !>
 !> The reader (io_deck) validates a deck against a `schema_t`, and the reference
-!> documentation (doc/input.md) is generated from it by `schema_markdown`. A new section is
-!> added by a new `add_<section>` routine called from `multicor_schema` that declares its
-!> keywords with `add_section` / `add_keyword` and the field builders below: data only.
+!> documentation (doc/input.md) is generated from it by `schema_markdown`. This module holds
+!> the machinery (types, field builders, checks, documentation); the sections themselves are
+!> declared, as data, by `add_<section>` routines in io_schema_common (run, functions, time,
+!> output), io_schema_fem (beam, modal, initial) and io_schema_dem (particles, walls,
+!> contacts, solver). `multicor_schema` (submodule io_deck_schema_multicor) puts them
+!> together in documentation order.
 !>
 !> A keyword has fixed fields, then optionally a variable-length tail: a list of values
 !> whose count lies in [min_values, max_values], possibly made of repeated groups (pairs of a
 !> table). The tail may depend on a word field (the selector): `function = 1 table 0 0 1 1`
 !> takes the tail declared for `table`.
+!>
+!> A selection field (`field_selection`) names particles: a number `n`, a range `a:b` (either
+!> end may be `last`), `last` or `all`. Its syntax is checked here; whether the numbers exist
+!> is checked when the model is built.
 module io_deck_schema
     use core_kinds, only: wp
     use core_strings, only: string_t, split_words, join_words, to_str, parse_real, parse_int
     implicit none
     private
     public :: field_spec_t, tail_spec_t, condition_t, keyword_spec_t, section_spec_t, schema_t
-    public :: field_int, field_real, field_word, field_text
-    public :: int_field, real_field, positive, word_field, text_field, tail, when
-    public :: multicor_schema, schema_markdown, type_name
+    public :: field_int, field_real, field_word, field_text, field_selection
+    public :: int_field, real_field, positive, word_field, text_field, selection_field, tail, when
+    public :: multicor_schema, schema_markdown, type_name, parse_selection
 
     !> Field type: integer.
     integer, parameter :: field_int = 1
@@ -29,6 +36,9 @@ module io_deck_schema
     integer, parameter :: field_word = 3
     !> Field type: free text, the rest of the line (comment stripped); only as the single field.
     integer, parameter :: field_text = 4
+    !> Field type: a selection of particles: `n`, `a:b` (`last` allowed at either end),
+    !> `last` or `all`.
+    integer, parameter :: field_selection = 5
 
     !> One value of a keyword: name, type, unit, range, allowed words.
     type :: field_spec_t
@@ -151,152 +161,15 @@ module io_deck_schema
         procedure :: find_keyword => schema_find_keyword
     end type schema_t
 
+    interface
+        !> The complete MULTICOR deck schema (sections in documentation order).
+        module function multicor_schema() result(s)
+            !> The schema.
+            type(schema_t) :: s
+        end function multicor_schema
+    end interface
+
 contains
-
-    ! ---------------------------------------------------------------------------------------
-    ! The MULTICOR schema (data). Sections appear in the documentation in this order.
-    ! ---------------------------------------------------------------------------------------
-
-    !> The complete MULTICOR deck schema.
-    function multicor_schema() result(s)
-        !> The schema.
-        type(schema_t) :: s
-        allocate (s%sections(0), s%keywords(0))
-        call add_run(s)
-        call add_beam(s)
-        call add_functions(s)
-        call add_time(s)
-        call add_modal(s)
-        call add_initial(s)
-        call add_output(s)
-    end function multicor_schema
-
-    !> [run]: title and kind of analysis.
-    subroutine add_run(s)
-        !> Schema to extend.
-        type(schema_t), intent(inout) :: s
-        call s%add_section('run', 'What to compute.')
-        call s%add_keyword('run', 'title', [text_field('title')], &
-            'Free text stored with the results.', default='')
-        call s%add_keyword('run', 'analysis', [word_field('analysis', 'static modal dynamic')], &
-            'Kind of analysis: static equilibrium, natural modes, or time integration.', &
-            required=.true.)
-    end subroutine add_run
-
-    !> [beam]: planar Euler-Bernoulli frame (sections, nodes, elements, supports, loads).
-    subroutine add_beam(s)
-        !> Schema to extend.
-        type(schema_t), intent(inout) :: s
-        call s%add_section('beam', &
-            'Planar Euler-Bernoulli frame: geometry, material, supports, loads.')
-        call s%add_keyword('beam', 'mass', [word_field('mass', 'consistent lumped')], &
-            'Mass matrix: consistent, or lumped (HRZ, diagonal).', default='consistent')
-        call s%add_keyword('beam', 'section', [int_field('id', lower=1), &
-            positive('young', 'Pa'), positive('density', 'kg/m^3'), positive('area', 'm^2'), &
-            positive('inertia', 'm^4')], &
-            'Cross-section and material: Young modulus, density, area, second moment of area.', &
-            repeatable=.true.)
-        call s%add_keyword('beam', 'node', &
-            [int_field('id', lower=1), real_field('x', 'm'), real_field('y', 'm')], &
-            'A node at (x, y).', repeatable=.true.)
-        call s%add_keyword('beam', 'line', [int_field('first_node', lower=1), &
-            real_field('x1', 'm'), real_field('y1', 'm'), real_field('x2', 'm'), &
-            real_field('y2', 'm'), int_field('elements', lower=1), int_field('section', lower=1)], &
-            'Generator: nodes first_node..first_node+elements equally spaced from (x1, y1) to '// &
-            '(x2, y2) and the elements between them; existing coincident nodes are reused.', &
-            repeatable=.true.)
-        call s%add_keyword('beam', 'element', [int_field('id', lower=1), &
-            int_field('node1', lower=1), int_field('node2', lower=1), &
-            int_field('section', lower=1)], &
-            'An element from node1 to node2 with the given section.', repeatable=.true.)
-        call s%add_keyword('beam', 'fix', [int_field('node', lower=1)], &
-            'Clamp DOFs of a node to zero: u (x), w (y), theta (rotation), or all.', &
-            tails=[tail([word_field('dof', 'u w theta all')], 1, 3, cyclic=.true.)], &
-            repeatable=.true.)
-        call s%add_keyword('beam', 'load', [int_field('node', lower=1), &
-            word_field('dof', 'u w theta'), real_field('value', 'N or N.m')], &
-            'Nodal force (u, w) or moment (theta) times a time function (none: constant 1).', &
-            tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
-        call s%add_keyword('beam', 'rayleigh', &
-            [real_field('a0', '1/s', lower=0.0_wp), real_field('a1', 's', lower=0.0_wp)], &
-            'Rayleigh damping C = a0 M + a1 K.', default='0 0')
-    end subroutine add_beam
-
-    !> [functions]: time functions multiplying loads.
-    subroutine add_functions(s)
-        !> Schema to extend.
-        type(schema_t), intent(inout) :: s
-        type(tail_spec_t), allocatable :: tails(:)
-        call s%add_section('functions', 'Time functions f(t) that multiply loads.')
-        tails = [tail([real_field('c', '')], 1, 1, selected_by='constant'), &
-            tail([positive('t1', 's')], 1, 1, selected_by='ramp'), &
-            tail([real_field('t0', 's', lower=0.0_wp)], 1, 1, selected_by='step'), &
-            tail([real_field('t', 's'), real_field('f', '')], 4, -1, cyclic=.true., &
-            selected_by='table'), &
-            tail([positive('freq', 'Hz'), real_field('phase', 'rad')], 1, 2, &
-            selected_by='harmonic')]
-        call s%add_keyword('functions', 'function', &
-            [int_field('id', lower=1), word_field('kind', 'constant ramp step table harmonic')], &
-            'constant: f = c; ramp: f = min(t/t1, 1); step: f = 0 before t0, 1 after; '// &
-            'table: linear in (t, f) pairs, t increasing, constant outside; '// &
-            'harmonic: f = sin(2 pi freq t + phase).', &
-            selector=2, tails=tails, repeatable=.true.)
-    end subroutine add_functions
-
-    !> [time]: time integration.
-    subroutine add_time(s)
-        !> Schema to extend.
-        type(schema_t), intent(inout) :: s
-        call s%add_section('time', 'Time integration (dynamic analysis).')
-        call s%add_keyword('time', 'step', [positive('step', 's')], &
-            'Time step h.', required_when=when('run', 'analysis', 'dynamic'))
-        call s%add_keyword('time', 'end', [positive('end', 's')], &
-            'End time (the run starts at t = 0).', required_when=when('run', 'analysis', 'dynamic'))
-        call s%add_keyword('time', 'scheme', &
-            [word_field('scheme', 'average_acceleration newmark central_difference')], &
-            'Newmark family: average_acceleration (beta 1/4, gamma 1/2), newmark (beta and '// &
-            'gamma below), central_difference (beta 0, gamma 1/2, explicit).', &
-            default='average_acceleration')
-        call s%add_keyword('time', 'beta', [real_field('beta', '', lower=0.0_wp, upper=0.5_wp)], &
-            'Newmark beta.', default='0.25', allowed_when=when('time', 'scheme', 'newmark'))
-        call s%add_keyword('time', 'gamma', [real_field('gamma', '', lower=0.5_wp, upper=1.0_wp)], &
-            'Newmark gamma (> 1/2 adds numerical damping).', default='0.5', &
-            allowed_when=when('time', 'scheme', 'newmark'))
-    end subroutine add_time
-
-    !> [modal]: natural modes.
-    subroutine add_modal(s)
-        !> Schema to extend.
-        type(schema_t), intent(inout) :: s
-        call s%add_section('modal', 'Natural modes (modal analysis).')
-        call s%add_keyword('modal', 'modes', [int_field('modes', lower=1)], &
-            'Number of lowest modes to compute.', default='3')
-    end subroutine add_modal
-
-    !> [initial]: initial conditions.
-    subroutine add_initial(s)
-        !> Schema to extend.
-        type(schema_t), intent(inout) :: s
-        call s%add_section('initial', &
-            'Initial conditions on free DOFs (dynamic analysis); the others start at zero.')
-        call s%add_keyword('initial', 'velocity', [int_field('node', lower=1), &
-            word_field('dof', 'u w theta'), real_field('value', 'm/s or rad/s')], &
-            'Initial velocity of one DOF of a node.', repeatable=.true.)
-        call s%add_keyword('initial', 'displacement', [int_field('node', lower=1), &
-            word_field('dof', 'u w theta'), real_field('value', 'm or rad')], &
-            'Initial displacement of one DOF of a node.', repeatable=.true.)
-    end subroutine add_initial
-
-    !> [output]: what is stored and shown.
-    subroutine add_output(s)
-        !> Schema to extend.
-        type(schema_t), intent(inout) :: s
-        call s%add_section('output', 'Results and progress reports.')
-        call s%add_keyword('output', 'interval', [int_field('interval', lower=1)], &
-            'Time steps between stored states.', default='1')
-        call s%add_keyword('output', 'progress', [real_field('progress', 's', lower=0.0_wp)], &
-            'Wall-clock seconds between progress lines (0 = none).', default='5')
-    end subroutine add_output
 
     ! ---------------------------------------------------------------------------------------
     ! Builders
@@ -389,6 +262,88 @@ contains
         f%unit = ''
         allocate (f%allowed(0))
     end function text_field
+
+    !> A selection of particles: `n`, `a:b` (`last` allowed at either end), `last` or `all`.
+    pure function selection_field(name) result(f)
+        !> Field name.
+        character(len=*), intent(in) :: name
+        type(field_spec_t) :: f
+        f%name = name
+        f%value_type = field_selection
+        f%unit = ''
+        allocate (f%allowed(0))
+    end function selection_field
+
+    !> Parse a selection of items numbered 1..n: `k` (1 <= k), `a:b` (1 <= a <= b, either end
+    !> may be `last` = n), `last` (= n) or `all` (= 1:n). On success [first, last_item] is the
+    !> range; numbers above n are reported as out of range (pass n = huge(1) to check the
+    !> syntax only). On failure `message` says what is expected.
+    subroutine parse_selection(token, n, first, last_item, ok, message, noun)
+        !> The selection as written.
+        character(len=*), intent(in) :: token
+        !> Number of items.
+        integer, intent(in) :: n
+        !> First and last selected items.
+        integer, intent(out) :: first, last_item
+        !> Whether the selection is valid.
+        logical, intent(out) :: ok
+        !> Explanation when not valid ('' otherwise).
+        character(len=:), allocatable, intent(out) :: message
+        !> What the items are, plural, for messages (default 'items').
+        character(len=*), intent(in), optional :: noun
+        character(len=*), parameter :: expected = &
+            "expected a number, a range 'a:b' (a <= b, 'last' allowed at either end), "// &
+            "'last' or 'all'"
+        integer :: colon
+        message = ''
+        first = 0
+        last_item = 0
+        ok = .false.
+        colon = index(token, ':')
+        if (token == 'all') then
+            first = 1
+            last_item = n
+            ok = .true.
+        else if (colon == 0) then
+            call end_value(token, first)
+            last_item = first
+        else
+            call end_value(token(:colon - 1), first)
+            if (.not. ok) return
+            call end_value(token(colon + 1:), last_item)
+            if (ok .and. first > last_item) then
+                ok = .false.
+                message = "empty range '"//token//"': the first number must not exceed the last"
+                return
+            end if
+        end if
+        if (.not. ok) return
+        if (last_item > n) then
+            ok = .false.
+            if (present(noun)) then
+                message = "selection '"//token//"' is out of range: there are "//to_str(n)// &
+                    ' '//noun//' (1..'//to_str(n)//')'
+            else
+                message = "selection '"//token//"' is out of range: there are "//to_str(n)// &
+                    ' items (1..'//to_str(n)//')'
+            end if
+        end if
+    contains
+        !> One end of a range: a number >= 1 or `last`.
+        subroutine end_value(text, value)
+            character(len=*), intent(in) :: text
+            integer, intent(out) :: value
+            value = 0
+            if (text == 'last') then
+                value = n
+                ok = .true.
+                return
+            end if
+            call parse_int(text, value, ok)
+            if (ok) ok = value >= 1
+            if (.not. ok) message = "bad selection '"//token//"': "//expected
+        end subroutine end_value
+    end subroutine parse_selection
 
     !> A record tail: `fields` (repeated as a group if `cyclic`), between `min_values` and
     !> `max_values` values (-1 = no limit); `selected_by` is the selector word, if any.
@@ -535,6 +490,8 @@ contains
             name = 'real'
         case (field_word)
             name = 'word'
+        case (field_selection)
+            name = 'selection'
         case default
             name = 'text'
         end select
@@ -552,7 +509,7 @@ contains
         !> Explanation when not valid ('' otherwise).
         character(len=:), allocatable, intent(out) :: message
         real(wp) :: x
-        integer :: i
+        integer :: i, j
         message = ''
         select case (self%value_type)
         case (field_int)
@@ -575,6 +532,9 @@ contains
             end do
             if (.not. ok) message = "'"//token//"' is not allowed: expected one of "// &
                 join_words(self%allowed, ', ')
+            return
+        case (field_selection)
+            call parse_selection(token, huge(1), i, j, ok, message)
             return
         case default
             ok = .true.
@@ -606,6 +566,10 @@ contains
         text = ''
         if (self%value_type == field_word) then
             text = join_words(self%allowed, ', ')
+            return
+        end if
+        if (self%value_type == field_selection) then
+            text = 'n, a:b, last, all'
             return
         end if
         if (self%has_lower) then

@@ -8,6 +8,9 @@
 !>   C order with shape (n, 3).
 !> - Time series are chunked datasets whose LAST Fortran dimension is unlimited: records of
 !>   shape (3, n) build a Fortran array (3, n, n_records), i.e. (n_records, n, 3) in h5py.
+!>   `append` adds one record; `append_chunk` adds any number at once (variable-length
+!>   data such as contact lists, or buffered per-step values). Series hold reals, or
+!>   integers for scalar records (`create_int_series`).
 !> - Reals are stored as IEEE 64-bit little endian, integers as 32-bit little endian, string
 !>   attributes as variable-length UTF-8 (h5py returns them as `str`).
 !>
@@ -92,11 +95,17 @@ module io_hdf5_file
             read_int_2d
         procedure :: dataset_shape => file_dataset_shape
         procedure :: create_series => file_create_series
+        procedure :: create_int_series => file_create_int_series
         procedure, private :: append_0d, append_1d, append_2d
         !> Append one record (scalar, 1-D or 2-D) at the end of a series.
         generic :: append => append_0d, append_1d, append_2d
+        procedure, private :: append_chunk_real, append_chunk_real_2d, append_chunk_int
+        !> Append a variable number of records at once (possibly none): reals to a scalar
+        !> series, columns of a 2-D array to a series of 1-D records, integers to an
+        !> integer series.
+        generic :: append_chunk => append_chunk_real, append_chunk_real_2d, append_chunk_int
         procedure, private :: new_dataset, open_dataset, open_attribute_for_write, &
-            open_attribute_for_read, append_record
+            open_attribute_for_read, append_record, extend_series
     end type h5_file_t
 
 contains
@@ -999,6 +1008,186 @@ contains
         if (allocated(error)) return
         call release(dset)
     end subroutine file_create_series
+
+    !> Create an empty integer series of scalar records (a 1-D extendible dataset of 32-bit
+    !> integers); values are added with `append_chunk`.
+    subroutine file_create_int_series(self, path, error)
+        !> A file open for writing.
+        class(h5_file_t), intent(inout) :: self
+        !> Dataset path.
+        character(len=*), intent(in) :: path
+        !> Set on failure.
+        type(error_t), allocatable, intent(out) :: error
+        integer(hsize_t) :: dims(1), maxdims(1), chunk(1)
+        integer(hid_t) :: dset
+        dims = 0
+        maxdims = h5s_unlimited_f
+        chunk = max(1, min(max_chunk_records, chunk_bytes/4))
+        call self%new_dataset(path, h5t_std_i32le, dims, maxdims, dset, error, chunk)
+        if (allocated(error)) return
+        call release(dset)
+    end subroutine file_create_int_series
+
+    !> Append size(values) scalar records to a real scalar series.
+    subroutine append_chunk_real(self, path, values, error)
+        !> A file open for writing.
+        class(h5_file_t), intent(inout) :: self
+        !> Series path.
+        character(len=*), intent(in) :: path
+        !> The records (possibly none).
+        real(wp), intent(in) :: values(:)
+        !> Set when the series is missing, is not a real scalar series, or on failure.
+        type(error_t), allocatable, intent(out) :: error
+        integer(hid_t) :: dset, fspace, mspace
+        integer(hsize_t) :: mdims(1)
+        integer :: hdferr
+        call self%extend_series(path, h5t_float_f, 0, size(values), dset, fspace, mspace, &
+            error)
+        if (allocated(error) .or. dset < 0) return
+        mdims = size(values, kind=hsize_t)
+        call h5dwrite_f(dset, h5t_native_double, values, mdims, hdferr, mem_space_id=mspace, &
+            file_space_id=fspace)
+        call release(mspace)
+        call release(fspace)
+        call release(dset)
+        if (hdferr < 0) call dataset_error(self, 'append to', path, error)
+    end subroutine append_chunk_real
+
+    !> Append the size(values, 2) columns of `values` as records of a real series whose
+    !> records are 1-D of size(values, 1) values.
+    subroutine append_chunk_real_2d(self, path, values, error)
+        !> A file open for writing.
+        class(h5_file_t), intent(inout) :: self
+        !> Series path.
+        character(len=*), intent(in) :: path
+        !> The records, one per column (possibly none).
+        real(wp), intent(in) :: values(:, :)
+        !> Set when the series is missing, its records are not of size(values, 1) reals, or
+        !> on failure.
+        type(error_t), allocatable, intent(out) :: error
+        integer(hid_t) :: dset, fspace, mspace
+        integer(hsize_t) :: mdims(1)
+        integer :: hdferr
+        call self%extend_series(path, h5t_float_f, size(values, 1), size(values, 2), dset, &
+            fspace, mspace, error)
+        if (allocated(error) .or. dset < 0) return
+        mdims = size(values, kind=hsize_t)
+        call h5dwrite_f(dset, h5t_native_double, reshape(values, [size(values)]), mdims, &
+            hdferr, mem_space_id=mspace, file_space_id=fspace)
+        call release(mspace)
+        call release(fspace)
+        call release(dset)
+        if (hdferr < 0) call dataset_error(self, 'append to', path, error)
+    end subroutine append_chunk_real_2d
+
+    !> Append size(values) records to an integer series.
+    subroutine append_chunk_int(self, path, values, error)
+        !> A file open for writing.
+        class(h5_file_t), intent(inout) :: self
+        !> Series path.
+        character(len=*), intent(in) :: path
+        !> The records (possibly none).
+        integer, intent(in) :: values(:)
+        !> Set when the series is missing, is not an integer series, or on failure.
+        type(error_t), allocatable, intent(out) :: error
+        integer(hid_t) :: dset, fspace, mspace
+        integer(hsize_t) :: mdims(1)
+        integer :: hdferr
+        call self%extend_series(path, h5t_integer_f, 0, size(values), dset, fspace, mspace, &
+            error)
+        if (allocated(error) .or. dset < 0) return
+        mdims = size(values, kind=hsize_t)
+        call h5dwrite_f(dset, h5t_native_integer, values, mdims, hdferr, mem_space_id=mspace, &
+            file_space_id=fspace)
+        call release(mspace)
+        call release(fspace)
+        call release(dset)
+        if (hdferr < 0) call dataset_error(self, 'append to', path, error)
+    end subroutine append_chunk_int
+
+    !> Open a series, check its type class and record size, extend it by `count` records and
+    !> select them: on return the caller writes `count` records through `mspace` (memory)
+    !> and `fspace` (file) into `dset`, then releases the three ids. With count = 0 nothing
+    !> is changed and dset = -1 (nothing to write).
+    subroutine extend_series(self, path, type_class, record_size, count, dset, fspace, &
+        mspace, error)
+        !> A file open for writing.
+        class(h5_file_t), intent(inout) :: self
+        !> Series path.
+        character(len=*), intent(in) :: path
+        !> Expected type class (h5t_float_f or h5t_integer_f).
+        integer, intent(in) :: type_class
+        !> Values per record (0 for a scalar series).
+        integer, intent(in) :: record_size
+        !> Number of records to add.
+        integer, intent(in) :: count
+        !> Dataset, file space and memory space ids (-1 when nothing is to be written).
+        integer(hid_t), intent(out) :: dset, fspace, mspace
+        !> Set on failure.
+        type(error_t), allocatable, intent(out) :: error
+        integer(hsize_t), allocatable :: dims(:), start(:), counts(:)
+        integer(hsize_t) :: mdims(1)
+        integer(hid_t) :: dtype
+        integer :: r, hdferr, actual_class
+        dset = -1
+        fspace = -1
+        mspace = -1
+        call require_writable(self, path, error)
+        if (allocated(error)) return
+        call dataset_dims(self, path, dset, dims, error)
+        if (allocated(error)) return
+        r = merge(1, 0, record_size > 0)
+        if (size(dims) /= r + 1) then
+            call make_error(error, "HDF5: series '"//path//"': record rank does not match")
+            call release(dset)
+            return
+        end if
+        if (r == 1) then
+            if (dims(1) /= int(record_size, hsize_t)) then
+                call make_error(error, "HDF5: series '"//path//"': record shape does not match")
+                call release(dset)
+                return
+            end if
+        end if
+        dtype = -1
+        actual_class = -1
+        call h5dget_type_f(dset, dtype, hdferr)
+        if (hdferr >= 0) call h5tget_class_f(dtype, actual_class, hdferr)
+        call release(dtype)
+        if (hdferr < 0 .or. actual_class /= type_class) then
+            call make_error(error, "HDF5: series '"//path//"' in '"//self%path// &
+                "' does not hold the type of the records appended (real or integer)")
+            call release(dset)
+            return
+        end if
+        if (count == 0) then
+            call release(dset)
+            return
+        end if
+        allocate (start(r + 1), counts(r + 1))
+        start = 0
+        start(r + 1) = dims(r + 1)
+        counts(:r) = dims(:r)
+        counts(r + 1) = int(count, hsize_t)
+        dims(r + 1) = dims(r + 1) + int(count, hsize_t)
+        mdims = product(counts)
+        ops: block
+            call h5dset_extent_f(dset, dims, hdferr)
+            if (hdferr < 0) exit ops
+            call h5dget_space_f(dset, fspace, hdferr)
+            if (hdferr < 0) exit ops
+            call h5sselect_hyperslab_f(fspace, h5s_select_set_f, start, counts, hdferr)
+            if (hdferr < 0) exit ops
+            call h5screate_simple_f(1, mdims, mspace, hdferr)
+        end block ops
+        if (hdferr < 0) then
+            call release(mspace)
+            call release(fspace)
+            call release(dset)
+            dset = -1
+            call dataset_error(self, 'extend', path, error)
+        end if
+    end subroutine extend_series
 
     !> Append a scalar record to a scalar series.
     subroutine append_0d(self, path, record, error)

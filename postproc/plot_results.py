@@ -1,0 +1,74 @@
+#!/usr/bin/env python3
+"""Plot a MULTICOR results file to PNG files and print their paths.
+
+    plot_results.py results.h5 [--time T] [--out DIR] [--node ID] [--scale S]
+
+Plots what the file holds: the beam (finite-element) plots of plot_beam.py when it has a
+/fem/mesh, and the particle plots when it has a /dem group -- <name>_particles.png (disks,
+walls and contact force network at the stored time nearest to T; default the last, plus
+<name>_particles_start.png at t = 0), <name>_dem_energy.png (energy audit),
+<name>_solver.png (contact solver statistics of every step) and, for up to 50 disks,
+<name>_velocities.png. Exit code 1 with a message on a missing or invalid file.
+"""
+import argparse
+import os
+import sys
+
+import h5py
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+from multicor_post import beam, particles  # noqa: E402
+from multicor_post.results import ResultsError, load_results  # noqa: E402
+
+
+def contents(path):
+    """(has beam results, has particle results) of a results file."""
+    if not os.path.exists(path):
+        hint = ""
+        if os.path.exists(path + ".partial"):
+            hint = f" ('{path}.partial' exists: the run did not finish)"
+        raise ResultsError(f"results file '{path}' does not exist{hint}")
+    try:
+        with h5py.File(path, "r") as f:
+            return "fem/mesh" in f, "dem" in f
+    except OSError as exc:
+        raise ResultsError(f"'{path}' is not a readable HDF5 file ({exc})") from None
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="plot_results.py", description=__doc__.split("\n")[0])
+    parser.add_argument("results", help="results file (.h5) written by multicor")
+    parser.add_argument("--time", type=float, default=None,
+                        help="time [s] of the snapshot plots (nearest stored output; default: "
+                             "the last one)")
+    parser.add_argument("--out", default=None,
+                        help="folder for the PNG files (default: the results file's folder)")
+    parser.add_argument("--node", type=int, default=None,
+                        help="beam: deck id of the node whose history is plotted (default: the "
+                             "tip)")
+    parser.add_argument("--scale", type=float, default=None,
+                        help="beam: displacement scale factor of deformed shapes (default: auto)")
+    args = parser.parse_args(argv)
+    out = args.out if args.out is not None else (os.path.dirname(args.results) or ".")
+    try:
+        has_beam, has_particles = contents(args.results)
+        if not (has_beam or has_particles):
+            raise ResultsError(f"{args.results}: neither /fem/mesh nor /dem: not a MULTICOR "
+                               "results file")
+        paths = []
+        if has_beam:
+            paths += beam.write_all(load_results(args.results), out, time=args.time,
+                                    node_id=args.node, scale=args.scale)
+        if has_particles:
+            paths += particles.write_all(particles.load_dem(args.results), out, time=args.time)
+    except ResultsError as exc:
+        print(f"plot_results.py: error: {exc}", file=sys.stderr)
+        return 1
+    for path in paths:
+        print(path)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

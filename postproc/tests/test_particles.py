@@ -1,0 +1,132 @@
+"""Particle results: loading of the /dem group, the force network drawn from the contacts
+(segments between centres, or to the contact point on a wall; widths proportional to r_n),
+and plot_results.py dispatching to the beam and particle plots."""
+import numpy as np
+import pytest
+from synthetic import cantilever_layout, write_results
+from synthetic_dem import G, MASS, N_DISKS, N_OUT, R, column_state, write_dem
+
+import plot_results
+from multicor_post.particles import (MAX_FORCE_WIDTH, force_segments, force_widths, load_dem,
+                                     plot_configuration, plot_solver)
+from multicor_post.results import ResultsError
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def test_loader_reads_the_documented_layout(tmp_path):
+    res = load_dem(write_dem(tmp_path / "col.h5"))
+    assert res.n == N_DISKS + 2
+    assert res.position.shape == (N_OUT, N_DISKS + 2, 3)
+    assert res.walls.shape == (N_OUT, 1, 4)
+    assert list(res.material) == [1, 1, 1, 2, 2]
+    # compressed rows: no contact at output 0, then N_DISKS + 1 per output
+    c = res.contacts
+    assert c.at(0) == slice(0, 0)
+    assert c.at(2) == slice(N_DISKS + 1, 2 * (N_DISKS + 1))
+    assert res.solver.time[0] == pytest.approx(1e-3, rel=1e-12)   # step 1 ends at h
+    assert int(np.count_nonzero(~res.solver.converged)) == 1
+    assert res.nearest_index(0.0126) == 3                           # outputs every 5 ms
+    assert res.title == "synthetic column"
+
+
+def test_force_segments_join_centres_and_reach_the_wall(tmp_path):
+    res = load_dem(write_dem(tmp_path / "col.h5"))
+    k = 2
+    seg, rn, status = force_segments(res, k)
+    pos = column_state(k)
+    # floor contact of disk 1: from its centre down by R along -n to the floor (y = 0 + shift)
+    np.testing.assert_allclose(seg[0], [pos[0, :2], pos[0, :2] - [0.0, R]], rtol=0, atol=1e-15)
+    # pair (1, 2): from disk 2 to disk 1
+    np.testing.assert_allclose(seg[1], [pos[1, :2], pos[0, :2]], rtol=0, atol=1e-15)
+    # the bond of the hanging disk: from disk 5 to disk 4, in tension
+    np.testing.assert_allclose(seg[-1], [pos[4, :2], pos[3, :2]], rtol=0, atol=1e-15)
+    # column at rest: r_n = disks above x m g (the synthetic data state it; checks the slice)
+    np.testing.assert_allclose(rn[:N_DISKS], MASS * G * np.arange(N_DISKS, 0, -1), rtol=1e-14)
+    assert rn[-1] < 0 and list(status) == [1] * N_DISKS + [3]
+
+
+def test_line_width_grows_in_proportion_to_the_normal_force():
+    rn = np.array([4.0, 2.0, -1.0, 0.0])
+    widths = force_widths(rn)
+    np.testing.assert_allclose(widths, MAX_FORCE_WIDTH * np.array([1.0, 0.5, 0.25, 0.0]),
+                               rtol=1e-15)
+    assert np.all(force_widths(np.zeros(3)) == 0.0)
+
+
+def test_configuration_draws_disks_forces_and_walls(tmp_path):
+    res = load_dem(write_dem(tmp_path / "col.h5"))
+    fig = plot_configuration(res, 2)
+    ax = fig.axes[0]
+    disks, marks, walls, forces = ax.collections
+    assert len(disks.get_offsets()) == N_DISKS + 2
+    assert len(walls.get_segments()) == 1
+    widths = np.asarray(forces.get_linewidths())
+    # widths follow |r_n| (floor 3 m g, then 2, 1, and the bond 1 m g)
+    np.testing.assert_allclose(widths / widths[0], [1.0, 2 / 3, 1 / 3, 1 / 3], rtol=1e-12)
+    colors = forces.get_colors()
+    assert tuple(colors[-1][:3]) != tuple(colors[0][:3])          # tension drawn red
+    assert "4 contacts (4 carrying a force)" in ax.get_title()
+    # output 0 has no contact: only disks, rotation marks and walls
+    assert len(plot_configuration(res, 0).axes[0].collections) == 3
+
+
+def test_solver_plot_marks_the_unconverged_step(tmp_path):
+    res = load_dem(write_dem(tmp_path / "col.h5"))
+    ax = plot_solver(res).axes[0]
+    marked = [line for line in ax.get_lines() if line.get_marker() == "o"]
+    assert len(marked) == 1 and len(marked[0].get_xdata()) == 1
+    # step 8 (index 7) ends at t = 8 ms
+    assert marked[0].get_xdata()[0] == pytest.approx(8.0)
+
+
+def check_pngs(paths):
+    assert paths
+    for path in paths:
+        with open(path, "rb") as f:
+            assert f.read(8) == PNG_SIGNATURE
+
+
+def test_cli_writes_the_particle_plots(tmp_path, capsys):
+    path = write_dem(tmp_path / "col.h5")
+    out = tmp_path / "png"
+    assert plot_results.main([str(path), "--out", str(out)]) == 0
+    names = sorted(p.name for p in out.iterdir())
+    assert names == ["col_dem_energy.png", "col_particles.png", "col_particles_start.png",
+                     "col_solver.png", "col_velocities.png"]
+    assert sorted(capsys.readouterr().out.split()) == sorted(str(out / n) for n in names)
+    check_pngs(list(out.iterdir()))
+
+
+def test_cli_snapshot_at_a_time_and_without_contacts_or_walls(tmp_path):
+    path = write_dem(tmp_path / "bare.h5", with_contacts=False, with_walls=False)
+    out = tmp_path / "png"
+    assert plot_results.main([str(path), "--time", "0.01", "--out", str(out)]) == 0
+    names = sorted(p.name for p in out.iterdir())
+    assert "bare_particles.png" in names and "bare_particles_start.png" not in names
+    res = load_dem(path)
+    assert res.contacts is None and res.walls is None
+    assert "t = 10 ms" in plot_configuration(res, res.nearest_index(0.01)).axes[0].get_title()
+
+
+def test_cli_dispatches_to_beam_and_particles(tmp_path):
+    beam_only = tmp_path / "beam.h5"
+    ids, xy, conn, d = cantilever_layout()
+    write_results(beam_only, ids, xy, conn, d, parts=("static",))
+    both = write_dem(tmp_path / "both.h5", with_beam=True)
+    out = tmp_path / "png"
+    assert plot_results.main([str(beam_only), "--out", str(out)]) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["beam_static.png"]
+    assert plot_results.main([str(both), "--out", str(out)]) == 0
+    names = {p.name for p in out.iterdir()}
+    assert {"both_static.png", "both_particles.png", "both_solver.png"} <= names
+
+
+def test_cli_reports_missing_files_and_datasets(tmp_path, capsys):
+    assert plot_results.main([str(tmp_path / "none.h5")]) == 1
+    assert "does not exist" in capsys.readouterr().err
+    path = write_dem(tmp_path / "broken.h5", drop=("dem/contacts/rn",))
+    assert plot_results.main([str(path)]) == 1
+    assert "missing dataset '/dem/contacts/rn'" in capsys.readouterr().err
+    with pytest.raises(ResultsError, match="no /dem group"):
+        load_dem(write_results(tmp_path / "b.h5", *cantilever_layout(), parts=("static",)))

@@ -1,0 +1,767 @@
+!> From a validated deck to a discrete-element system (`dem_config_t`): materials, disks from
+!> the `disk` records and the generators, gravity, DOF conditions, loads and initial
+!> velocities on selections of disks, walls, contact laws, time-stepping and solver settings.
+!> The deck reader has checked each line on its own; here come the checks across lines: ids
+!> of materials and functions, selections against the number of disks, conflicting
+!> conditions on a DOF, duplicate laws, walls of zero length, disks that overlap each other or
+!> a wall at t = 0. Each error names the deck file, the line and the keyword concerned.
+!>
+!> Disks are numbered 1..N in the order the deck creates them (file order of `disk`, `row`,
+!> `square_lattice`, `hex_lattice` and `deposit`, each generator in its own order); materials
+!> and walls are numbered in file order; a time function is referred to by its [functions]
+!> id and stored by its position among the `function` records (as driver_config does).
+!> The model types of the DEM library (particles_t, walls_t, materials_t) are plain data, so
+!> they are filled directly: `dem_config_t%system` is ready for `mj_init`.
+module driver_config_dem
+    use core_kinds, only: wp, i8
+    use core_error, only: error_t, make_input_error
+    use core_strings, only: to_str
+    use core_timefunc, only: time_function_t
+    use io_deck, only: deck_t, deck_entry_t
+    use io_deck_schema, only: parse_selection
+    use dem_particles, only: particles_add_disks, particles_fix, particles_impose_velocity, &
+        particles_add_load, dof_x, dof_y, dof_rot
+    use dem_generators, only: generate_row, generate_square_lattice, generate_hex_lattice, &
+        generate_random_deposit
+    use dem_walls, only: walls_add
+    use dem_materials, only: materials_init, materials_set_pair
+    use dem_contacts, only: contact_set_t
+    use dem_detection, only: detector_t, detect_contacts
+    use dem_moreau_jean, only: dem_system_t
+    use driver_config, only: run_config_t
+    implicit none
+    private
+    public :: dem_config_t, build_dem_config, deck_has_particles, deck_has_beam
+    public :: check_particle_keywords_unused, check_beam_keywords_unused
+    public :: default_alert_ratio, overlap_tolerance, default_gap_ratio
+
+    !> Default alert distance as a fraction of the mean disk radius.
+    real(wp), parameter :: default_alert_ratio = 0.25_wp
+    !> Overlaps at t = 0 larger than this fraction of the pair's mean radius are errors.
+    real(wp), parameter :: overlap_tolerance = 1.0e-6_wp
+    !> Largest number of disks of a deck (keeps 3 N DOF indices in default integers).
+    integer(i8), parameter :: max_disks = 500000000_i8
+    !> Default gap_ratio of the `deposit` generator.
+    real(wp), parameter :: default_gap_ratio = 0.1_wp
+    !> Condition kinds on a DOF while building (free, fixed, imposed velocity).
+    integer, parameter :: free = 0, fixed = 1, imposed = 2
+    !> DOF words of the deck, in DOF order.
+    character(len=3), parameter :: dof_names(3) = ['x  ', 'y  ', 'rot']
+
+    !> A discrete-element model ready to run, with what is needed to report and store it.
+    type :: dem_config_t
+        !> Disks, walls, materials, scheme and solver settings (mj_init not called yet).
+        type(dem_system_t) :: system
+        !> Deck id of each material (position = material index of the system).
+        integer, allocatable :: material_id(:)
+        !> Deck line that created each disk.
+        integer, allocatable :: disk_line(:)
+        !> Deck line of each wall.
+        integer, allocatable :: wall_line(:)
+        !> Store the contact network with every stored state.
+        logical :: store_contacts = .true.
+        !> The alert distance is the default one (not given in the deck).
+        logical :: default_alert = .true.
+    end type dem_config_t
+
+contains
+
+    !> Whether the deck has [particles] entries.
+    pure logical function deck_has_particles(deck)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        deck_has_particles = has_section(deck, 'particles')
+    end function deck_has_particles
+
+    !> Whether the deck has [beam] entries.
+    pure logical function deck_has_beam(deck)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        deck_has_beam = has_section(deck, 'beam')
+    end function deck_has_beam
+
+    !> Whether any entry of the deck belongs to `section`.
+    pure logical function has_section(deck, section)
+        type(deck_t), intent(in) :: deck
+        character(len=*), intent(in) :: section
+        integer :: i
+        has_section = .false.
+        do i = 1, size(deck%entries)
+            if (deck%entries(i)%section == section) then
+                has_section = .true.
+                return
+            end if
+        end do
+    end function has_section
+
+    !> Error for a deck without [particles] that sets particle-only keywords ([walls],
+    !> [contacts], [solver], [time] theta, [output] contacts): they would have no effect.
+    subroutine check_particle_keywords_unused(deck, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Error naming the first such keyword, if any.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: i
+        do i = 1, size(deck%entries)
+            associate (e => deck%entries(i))
+                select case (e%section)
+                case ('walls', 'contacts', 'solver')
+                case ('time')
+                    if (e%keyword /= 'theta') cycle
+                case ('output')
+                    if (e%keyword /= 'contacts') cycle
+                case default
+                    cycle
+                end select
+                call make_input_error(error, deck%file, e%line, e%keyword, '['//e%section// &
+                    '] '//e%keyword//' applies to particles, and this deck has no [particles]'// &
+                    ': remove it or add particles')
+                return
+            end associate
+        end do
+    end subroutine check_particle_keywords_unused
+
+    !> Error for a deck of particles without [beam] that sets beam-only keywords ([time]
+    !> scheme, beta, gamma, [modal], [initial]): they would have no effect.
+    subroutine check_beam_keywords_unused(deck, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Error naming the first such keyword, if any.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: i
+        do i = 1, size(deck%entries)
+            associate (e => deck%entries(i))
+                select case (e%section)
+                case ('modal')
+                case ('initial')
+                    call make_input_error(error, deck%file, e%line, e%keyword, '[initial] '// &
+                        'sets beam nodes, and this deck has no [beam]; the initial velocities '// &
+                        'of disks are [particles] initial_velocity records')
+                    return
+                case ('time')
+                    if (e%keyword /= 'scheme' .and. e%keyword /= 'beta' .and. &
+                        e%keyword /= 'gamma') cycle
+                case default
+                    cycle
+                end select
+                call make_input_error(error, deck%file, e%line, e%keyword, '['//e%section// &
+                    '] '//e%keyword//' applies to the beam, and this deck has no [beam]: '// &
+                    'remove it (particles use [time] theta)')
+                return
+            end associate
+        end do
+    end subroutine check_beam_keywords_unused
+
+    !> Build the discrete-element system of a deck with [particles].
+    subroutine build_dem_config(deck, run, functions, cfg, error)
+        !> Deck read by io_deck::read_deck with the MULTICOR schema.
+        type(deck_t), intent(in) :: deck
+        !> Run settings built by driver_config::build_config (time step).
+        type(run_config_t), intent(in) :: run
+        !> Time functions of the deck, in the order of the `function` records (as built by
+        !> driver_config::build_config).
+        type(time_function_t), intent(in) :: functions(:)
+        !> The model.
+        type(dem_config_t), intent(out) :: cfg
+        !> Error naming file, line and keyword, if any.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: function_ids(:)
+        type(deck_entry_t), allocatable :: list(:)
+        real(wp), allocatable :: density(:)
+        integer :: i
+        allocate (list, source=deck%records('functions', 'function'))
+        allocate (function_ids(size(list)))
+        do i = 1, size(list)
+            function_ids(i) = list(i)%int(1)
+        end do
+        call build_materials(deck, cfg, density, error)
+        if (allocated(error)) return
+        call build_disks(deck, density, cfg, error)
+        if (allocated(error)) return
+        cfg%system%particles%functions = functions
+        cfg%system%walls%functions = functions
+        cfg%system%particles%gravity = [deck%get_real('particles', 'gravity', 1), &
+            deck%get_real('particles', 'gravity', 2)]
+        call build_walls(deck, function_ids, cfg, error)
+        if (allocated(error)) return
+        call build_conditions(deck, function_ids, cfg, error)
+        if (allocated(error)) return
+        call build_laws(deck, cfg, error)
+        if (allocated(error)) return
+        call build_settings(deck, run, cfg)
+        call check_overlaps(deck, cfg, error)
+    end subroutine build_dem_config
+
+    !> Materials: unique ids, densities; the material table of the contact laws.
+    subroutine build_materials(deck, cfg, density, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> The model (material_id filled, material table initialised).
+        type(dem_config_t), intent(inout) :: cfg
+        !> Density of each material [kg/m^3].
+        real(wp), allocatable, intent(out) :: density(:)
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        type(deck_entry_t), allocatable :: list(:)
+        integer :: i, j
+        allocate (list, source=deck%records('particles', 'material'))
+        allocate (cfg%material_id(size(list)), density(size(list)))
+        do i = 1, size(list)
+            cfg%material_id(i) = list(i)%int(1)
+            density(i) = list(i)%real(2)
+            j = find_id(cfg%material_id(:i - 1), cfg%material_id(i))
+            if (j > 0) then
+                call make_input_error(error, deck%file, list(i)%line, 'material', &
+                    'duplicate material id '//list(i)%word(1)//': already defined on line '// &
+                    to_str(list(j)%line))
+                return
+            end if
+        end do
+        if (size(list) > 0) call materials_init(cfg%system%materials, size(list), error)
+    end subroutine build_materials
+
+    !> Disks from `disk` records and generators, in file order.
+    subroutine build_disks(deck, density, cfg, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Density of each material [kg/m^3].
+        real(wp), intent(in) :: density(:)
+        !> The model (disks and disk_line filled).
+        type(dem_config_t), intent(inout) :: cfg
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: x(:), y(:), r(:), gx(:), gy(:), gr(:)
+        integer, allocatable :: mat(:), line(:)
+        integer(i8) :: total
+        integer :: i, n, k, stat, first_line
+        ! Sizes first, so that arrays are allocated once.
+        total = 0
+        first_line = 0
+        do i = 1, size(deck%entries)
+            associate (e => deck%entries(i))
+                if (e%section /= 'particles') cycle
+                if (first_line == 0) first_line = e%line
+                select case (e%keyword)
+                case ('disk')
+                    total = total + 1
+                case ('row', 'deposit')
+                    total = total + e%int(1)
+                case ('square_lattice', 'hex_lattice')
+                    total = total + int(e%int(1), i8)*int(e%int(2), i8)
+                end select
+            end associate
+        end do
+        if (total == 0) then
+            call make_input_error(error, deck%file, first_line, '', 'no disk: add [particles] '// &
+                'disk records or generators (row, square_lattice, hex_lattice, deposit)')
+            return
+        end if
+        stat = 1
+        if (total < max_disks) allocate (x(total), y(total), r(total), mat(total), line(total), &
+            stat=stat)
+        if (stat /= 0) then
+            call make_input_error(error, deck%file, 0, '', 'the model is too large: cannot '// &
+                'hold '//to_str(real(total, wp))//' disks in memory')
+            return
+        end if
+        n = 0
+        do i = 1, size(deck%entries)
+            associate (e => deck%entries(i))
+                if (e%section /= 'particles') cycle
+                select case (e%keyword)
+                case ('disk', 'row', 'square_lattice', 'hex_lattice', 'deposit')
+                case default
+                    cycle
+                end select
+                call generate(e, gx, gy, gr, error)
+                if (allocated(error)) return
+                k = material_index(e%int(material_field(e%keyword)))
+                if (k == 0) then
+                    call make_input_error(error, deck%file, e%line, e%keyword, 'material '// &
+                        e%word(material_field(e%keyword))//' is not defined (no [particles] '// &
+                        'material record with this id)')
+                    return
+                end if
+                x(n + 1:n + size(gx)) = gx
+                y(n + 1:n + size(gx)) = gy
+                r(n + 1:n + size(gx)) = gr
+                mat(n + 1:n + size(gx)) = k
+                line(n + 1:n + size(gx)) = e%line
+                n = n + size(gx)
+            end associate
+        end do
+        call particles_add_disks(cfg%system%particles, x(:n), y(:n), r(:n), density(mat(:n)), &
+            error)
+        if (allocated(error)) return
+        cfg%system%particles%mat(1:n) = mat(:n)
+        cfg%disk_line = line(:n)
+
+    contains
+
+        !> Position of the material with deck id `id` (0 if none).
+        integer function material_index(id)
+            integer, intent(in) :: id
+            material_index = find_id(cfg%material_id, id)
+        end function material_index
+
+        !> Centres and radii of one record.
+        subroutine generate(e, gx, gy, gr, error)
+            type(deck_entry_t), intent(in) :: e
+            real(wp), allocatable, intent(out) :: gx(:), gy(:), gr(:)
+            type(error_t), allocatable, intent(out) :: error
+            real(wp), parameter :: degree = 3.141592653589793238462643383279502884_wp/180.0_wp
+            real(wp) :: gap_ratio, pitch
+            character(len=:), allocatable :: message
+            select case (e%keyword)
+            case ('disk')
+                gx = [e%real(1)]
+                gy = [e%real(2)]
+                gr = [e%real(3)]
+            case ('row')
+                call generate_row(e%int(1), e%real(2), e%real(3), e%real(4), e%real(6), &
+                    e%real(7)*degree, gx, gy, gr, error)
+            case ('square_lattice')
+                call generate_square_lattice(e%int(1), e%int(2), e%real(3), e%real(4), &
+                    e%real(5), e%real(7), gx, gy, gr, error)
+            case ('hex_lattice')
+                call generate_hex_lattice(e%int(1), e%int(2), e%real(3), e%real(4), &
+                    e%real(5), e%real(7), gx, gy, gr, error)
+            case ('deposit')
+                gap_ratio = default_gap_ratio
+                if (e%n_values() >= 9) gap_ratio = e%real(9)
+                if (e%real(6) < e%real(5)) then
+                    call make_input_error(error, deck%file, e%line, e%keyword, 'rmax '// &
+                        e%word(6)//' is smaller than rmin '//e%word(5))
+                    return
+                end if
+                pitch = 2.0_wp*e%real(6)*(1.0_wp + gap_ratio)
+                if (e%real(3) - e%real(2) < pitch) then
+                    call make_input_error(error, deck%file, e%line, e%keyword, 'the box from '// &
+                        'xmin = '//e%word(2)//' to xmax = '//e%word(3)//' is narrower than one '// &
+                        'site 2 rmax (1 + gap_ratio) = '//to_str(pitch)//' m')
+                    return
+                end if
+                call generate_random_deposit(e%int(1), e%real(2), e%real(3), e%real(4), &
+                    e%real(5), e%real(6), gap_ratio, e%int(8), gx, gy, gr, error)
+            end select
+            if (allocated(error)) then
+                message = error%message
+                call make_input_error(error, deck%file, e%line, e%keyword, message)
+            end if
+        end subroutine generate
+    end subroutine build_disks
+
+    !> Position of the material field in a disk-creating record.
+    pure integer function material_field(keyword)
+        !> disk, row, square_lattice, hex_lattice or deposit.
+        character(len=*), intent(in) :: keyword
+        select case (keyword)
+        case ('disk')
+            material_field = 4
+        case ('row')
+            material_field = 5
+        case ('deposit')
+            material_field = 7
+        case default
+            material_field = 6
+        end select
+    end function material_field
+
+    !> Walls: 4, 5, 7 or 8 values; known material and function; non-zero length.
+    subroutine build_walls(deck, function_ids, cfg, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Deck id of each time function.
+        integer, intent(in) :: function_ids(:)
+        !> The model (walls and wall_line filled).
+        type(dem_config_t), intent(inout) :: cfg
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        type(deck_entry_t), allocatable :: list(:)
+        real(wp) :: vx, vy, length, size_model
+        character(len=:), allocatable :: message
+        integer :: i, nv, mat, func
+        allocate (list, source=deck%records('walls', 'wall'))
+        allocate (cfg%wall_line(size(list)))
+        size_model = model_size(cfg, list)
+        do i = 1, size(list)
+            associate (e => list(i))
+                cfg%wall_line(i) = e%line
+                nv = e%n_values()
+                if (nv == 6) then
+                    call make_input_error(error, deck%file, e%line, 'wall', 'the wall velocity '// &
+                        "needs both vx and vy: expected 'x1 y1 x2 y2 [material] [vx vy "// &
+                        "[function]]', got 6 values")
+                    return
+                end if
+                mat = 1
+                if (nv >= 5) then
+                    mat = find_id(cfg%material_id, e%int(5))
+                    if (mat == 0) then
+                        call make_input_error(error, deck%file, e%line, 'wall', 'material '// &
+                            e%word(5)//' is not defined (no [particles] material record with '// &
+                            'this id)')
+                        return
+                    end if
+                end if
+                vx = e%real(6)
+                vy = e%real(7)
+                func = 0
+                if (nv == 8) then
+                    func = find_id(function_ids, e%int(8))
+                    if (func == 0) then
+                        call unknown_function(deck, e, 8, error)
+                        return
+                    end if
+                end if
+                length = hypot(e%real(3) - e%real(1), e%real(4) - e%real(2))
+                if (length <= 1.0e-9_wp*size_model) then
+                    call make_input_error(error, deck%file, e%line, 'wall', &
+                        'zero-length wall: (x1, y1) and (x2, y2) coincide')
+                    return
+                end if
+                call walls_add(cfg%system%walls, e%real(1), e%real(2), e%real(3), e%real(4), &
+                    error, mat=mat, vx=vx, vy=vy, func=func)
+                if (allocated(error)) then
+                    message = error%message
+                    call make_input_error(error, deck%file, e%line, 'wall', message)
+                    return
+                end if
+            end associate
+        end do
+    end subroutine build_walls
+
+    !> Size of the model: diagonal of the bounding box of the disks and wall ends [m].
+    function model_size(cfg, walls) result(size_model)
+        type(dem_config_t), intent(in) :: cfg
+        type(deck_entry_t), intent(in) :: walls(:)
+        real(wp) :: size_model
+        real(wp) :: lo(2), hi(2)
+        integer :: i
+        associate (p => cfg%system%particles)
+            lo = [minval(p%x(1:p%n) - p%radius(1:p%n)), minval(p%y(1:p%n) - p%radius(1:p%n))]
+            hi = [maxval(p%x(1:p%n) + p%radius(1:p%n)), maxval(p%y(1:p%n) + p%radius(1:p%n))]
+        end associate
+        do i = 1, size(walls)
+            lo = min(lo, [walls(i)%real(1), walls(i)%real(2)], [walls(i)%real(3), walls(i)%real(4)])
+            hi = max(hi, [walls(i)%real(1), walls(i)%real(2)], [walls(i)%real(3), walls(i)%real(4)])
+        end do
+        size_model = hypot(hi(1) - lo(1), hi(2) - lo(2))
+    end function model_size
+
+    !> Conditions on selections of disks: fixed and imposed DOFs (file order, no DOF
+    !> constrained twice in conflicting ways), then forces and initial velocities (free DOFs
+    !> only).
+    subroutine build_conditions(deck, function_ids, cfg, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Deck id of each time function.
+        integer, intent(in) :: function_ids(:)
+        !> The model (conditions, loads, initial velocities filled).
+        type(dem_config_t), intent(inout) :: cfg
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: state(:, :), line(:, :)
+        integer :: i, pass
+        associate (n => cfg%system%particles%n)
+            allocate (state(3, n), line(3, n))
+        end associate
+        state = free
+        line = 0
+        do pass = 1, 2
+            do i = 1, size(deck%entries)
+                associate (e => deck%entries(i))
+                    if (e%section /= 'particles') cycle
+                    select case (e%keyword)
+                    case ('fix', 'velocity')
+                        if (pass == 1) call constrain(e)
+                    case ('force', 'initial_velocity')
+                        if (pass == 2) call load(e)
+                    end select
+                    if (allocated(error)) return
+                end associate
+            end do
+        end do
+
+    contains
+
+        !> Selected disks of a record, as a range; error set when the selection is invalid.
+        subroutine select_disks(e, first, last)
+            type(deck_entry_t), intent(in) :: e
+            integer, intent(out) :: first, last
+            character(len=:), allocatable :: message
+            logical :: ok
+            call parse_selection(e%word(1), cfg%system%particles%n, first, last, ok, message, &
+                'disks')
+            if (.not. ok) call make_input_error(error, deck%file, e%line, e%keyword, message)
+        end subroutine select_disks
+
+        !> Time function index of field k of a record (0 if absent); error if unknown.
+        integer function function_of(e, k)
+            type(deck_entry_t), intent(in) :: e
+            integer, intent(in) :: k
+            function_of = 0
+            if (e%n_values() < k) return
+            function_of = find_id(function_ids, e%int(k))
+            if (function_of == 0) call unknown_function(deck, e, k, error)
+        end function function_of
+
+        !> A `fix` or `velocity` record.
+        subroutine constrain(e)
+            type(deck_entry_t), intent(in) :: e
+            integer :: first, last, j, k, dof, func
+            character(len=:), allocatable :: word
+            call select_disks(e, first, last)
+            if (allocated(error)) return
+            if (e%keyword == 'fix') then
+                do k = 2, e%n_values()
+                    word = e%word(k)
+                    do dof = 1, 3
+                        if (word /= 'all' .and. word /= trim(dof_names(dof))) cycle
+                        do j = first, last
+                            if (state(dof, j) == imposed) then
+                                call conflict(e, j, dof, 'cannot be fixed')
+                                return
+                            end if
+                            if (state(dof, j) == fixed) cycle
+                            call particles_fix(cfg%system%particles, j, dof, error)
+                            if (allocated(error)) return
+                            state(dof, j) = fixed
+                            line(dof, j) = e%line
+                        end do
+                    end do
+                end do
+            else
+                dof = dof_index(e%word(2))
+                func = function_of(e, 4)
+                if (allocated(error)) return
+                do j = first, last
+                    if (state(dof, j) /= free) then
+                        call conflict(e, j, dof, 'cannot also have an imposed velocity')
+                        return
+                    end if
+                    call particles_impose_velocity(cfg%system%particles, j, dof, e%real(3), &
+                        error, func)
+                    if (allocated(error)) return
+                    state(dof, j) = imposed
+                    line(dof, j) = e%line
+                end do
+            end if
+        end subroutine constrain
+
+        !> A `force` or `initial_velocity` record (free DOFs only).
+        subroutine load(e)
+            type(deck_entry_t), intent(in) :: e
+            integer :: first, last, j, dof, func
+            call select_disks(e, first, last)
+            if (allocated(error)) return
+            dof = dof_index(e%word(2))
+            func = 0
+            if (e%keyword == 'force') func = function_of(e, 4)
+            if (allocated(error)) return
+            do j = first, last
+                if (state(dof, j) /= free) then
+                    call conflict(e, j, dof, 'takes no '//trim(merge('force           ', &
+                        'initial velocity', e%keyword == 'force'))// &
+                        ' (they apply to free DOFs only)')
+                    return
+                end if
+                if (e%keyword == 'force') then
+                    call particles_add_load(cfg%system%particles, j, dof, e%real(3), error, func)
+                    if (allocated(error)) return
+                else
+                    select case (dof)
+                    case (dof_x)
+                        cfg%system%particles%vx(j) = e%real(3)
+                    case (dof_y)
+                        cfg%system%particles%vy(j) = e%real(3)
+                    case default
+                        cfg%system%particles%w(j) = e%real(3)
+                    end select
+                end if
+            end do
+        end subroutine load
+
+        !> Error: DOF `dof` of disk j already has a condition.
+        subroutine conflict(e, j, dof, what)
+            type(deck_entry_t), intent(in) :: e
+            integer, intent(in) :: j, dof
+            character(len=*), intent(in) :: what
+            character(len=:), allocatable :: now
+            if (state(dof, j) == fixed) then
+                now = 'is fixed'
+            else
+                now = 'has an imposed velocity'
+            end if
+            call make_input_error(error, deck%file, e%line, e%keyword, 'DOF '// &
+                trim(dof_names(dof))//' of disk '//to_str(j)//' '//now//' (line '// &
+                to_str(line(dof, j))//'): it '//trim(what))
+        end subroutine conflict
+    end subroutine build_conditions
+
+    !> Contact laws: known materials, one law per pair.
+    subroutine build_laws(deck, cfg, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> The model (material table filled).
+        type(dem_config_t), intent(inout) :: cfg
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        type(deck_entry_t), allocatable :: list(:)
+        integer, allocatable :: law_line(:, :)
+        character(len=:), allocatable :: message
+        integer :: i, k, a, b
+        allocate (list, source=deck%records('contacts', 'law'))
+        allocate (law_line(size(cfg%material_id), size(cfg%material_id)))
+        law_line = 0
+        do i = 1, size(list)
+            associate (e => list(i))
+                do k = 1, 2
+                    if (find_id(cfg%material_id, e%int(k)) == 0) then
+                        call make_input_error(error, deck%file, e%line, 'law', 'material '// &
+                            e%word(k)//' is not defined (no [particles] material record with '// &
+                            'this id)')
+                        return
+                    end if
+                end do
+                a = find_id(cfg%material_id, e%int(1))
+                b = find_id(cfg%material_id, e%int(2))
+                if (law_line(a, b) > 0) then
+                    call make_input_error(error, deck%file, e%line, 'law', 'the law between '// &
+                        'materials '//e%word(1)//' and '//e%word(2)//' is already given on '// &
+                        'line '//to_str(law_line(a, b)))
+                    return
+                end if
+                law_line(a, b) = e%line
+                law_line(b, a) = e%line
+                call materials_set_pair(cfg%system%materials, a, b, e%real(3), e%real(4), &
+                    e%real(5), error)
+                if (allocated(error)) then
+                    message = error%message
+                    call make_input_error(error, deck%file, e%line, 'law', message)
+                    return
+                end if
+            end associate
+        end do
+    end subroutine build_laws
+
+    !> Time stepping, detection, solver and output settings.
+    subroutine build_settings(deck, run, cfg)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Run settings (time step).
+        type(run_config_t), intent(in) :: run
+        !> The model (scheme, solver, store_contacts filled).
+        type(dem_config_t), intent(inout) :: cfg
+        associate (sys => cfg%system)
+            sys%scheme%h = run%h
+            sys%scheme%theta = deck%get_real('time', 'theta')
+            cfg%default_alert = .not. deck%has('contacts', 'alert')
+            if (cfg%default_alert) then
+                sys%scheme%alert = default_alert_ratio* &
+                    sum(sys%particles%radius(1:sys%particles%n))/real(sys%particles%n, wp)
+            else
+                sys%scheme%alert = deck%get_real('contacts', 'alert')
+            end if
+            sys%solver%tol = deck%get_real('solver', 'tolerance')
+            sys%solver%max_sweeps = deck%get_int('solver', 'max_sweeps')
+            sys%solver%local_tol = deck%get_real('solver', 'local_tolerance')
+            sys%solver%local_max_iter = deck%get_int('solver', 'local_iterations')
+        end associate
+        cfg%store_contacts = deck%get_word('output', 'contacts') == 'yes'
+    end subroutine build_settings
+
+    !> Error when two disks, or a disk and a wall, overlap at t = 0 by more than
+    !> overlap_tolerance times their mean radius (touching is fine).
+    subroutine check_overlaps(deck, cfg, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> The model.
+        type(dem_config_t), intent(in) :: cfg
+        !> Error naming the pair, if any.
+        type(error_t), allocatable, intent(out) :: error
+        type(detector_t) :: det
+        type(contact_set_t) :: cs
+        real(wp) :: amoy
+        integer :: k, a, b
+        associate (p => cfg%system%particles, w => cfg%system%walls)
+            if (w%n > 0) then
+                call detect_contacts(det, p%x(1:p%n), p%y(1:p%n), p%radius(1:p%n), 0.0_wp, &
+                    w%x1(1:w%n), w%y1(1:w%n), w%x2(1:w%n), w%y2(1:w%n), cs)
+            else
+                call detect_contacts(det, p%x(1:p%n), p%y(1:p%n), p%radius(1:p%n), 0.0_wp, &
+                    [real(wp) ::], [real(wp) ::], [real(wp) ::], [real(wp) ::], cs)
+            end if
+            do k = 1, cs%n
+                a = cs%i1(k)
+                b = cs%i2(k)
+                amoy = p%radius(b)
+                if (a > 0) amoy = 0.5_wp*(p%radius(a) + p%radius(b))
+                if (cs%gap(k) >= -overlap_tolerance*amoy) cycle
+                if (a > 0) then
+                    call make_input_error(error, deck%file, &
+                        max(cfg%disk_line(a), cfg%disk_line(b)), '', 'disks '//to_str(min(a, b))// &
+                        ' (line '//to_str(cfg%disk_line(min(a, b)))//') and '//to_str(max(a, b))// &
+                        ' (line '//to_str(cfg%disk_line(max(a, b)))//') overlap by '// &
+                        length_text(-cs%gap(k))//' m at t = 0: move them apart')
+                else
+                    call make_input_error(error, deck%file, cfg%wall_line(-a), 'wall', 'disk '// &
+                        to_str(b)//' (line '//to_str(cfg%disk_line(b))//') overlaps wall '// &
+                        to_str(-a)//' by '//length_text(-cs%gap(k))//' m at t = 0: move it off '// &
+                        'the wall')
+                end if
+                return
+            end do
+        end associate
+    end subroutine check_overlaps
+
+    !> A length with 4 significant digits, e.g. '5.000E-03'.
+    pure function length_text(x) result(text)
+        !> The length [m].
+        real(wp), intent(in) :: x
+        character(len=:), allocatable :: text
+        character(len=16) :: buf
+        write (buf, '(es10.3)') x
+        text = trim(adjustl(buf))
+    end function length_text
+
+    !> Error: a record refers to a time function id that is not defined.
+    subroutine unknown_function(deck, e, k, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> The record.
+        type(deck_entry_t), intent(in) :: e
+        !> Field holding the function id.
+        integer, intent(in) :: k
+        !> The error.
+        type(error_t), allocatable, intent(out) :: error
+        call make_input_error(error, deck%file, e%line, e%keyword, 'function '//e%word(k)// &
+            ' is not defined (no [functions] function record with this id)')
+    end subroutine unknown_function
+
+    !> DOF index of a DOF word (x, y, rot).
+    pure integer function dof_index(word)
+        !> 'x', 'y' or 'rot'.
+        character(len=*), intent(in) :: word
+        select case (word)
+        case ('x')
+            dof_index = dof_x
+        case ('y')
+            dof_index = dof_y
+        case default
+            dof_index = dof_rot
+        end select
+    end function dof_index
+
+    !> Position of `id` in a short unsorted list (0 if absent).
+    pure integer function find_id(ids, id) result(k)
+        !> Ids.
+        integer, intent(in) :: ids(:)
+        !> Id wanted.
+        integer, intent(in) :: id
+        do k = 1, size(ids)
+            if (ids(k) == id) return
+        end do
+        k = 0
+    end function find_id
+end module driver_config_dem

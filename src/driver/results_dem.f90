@@ -1,0 +1,374 @@
+!> Discrete-element results in the run's HDF5 file (layout in doc/output.md, group /dem):
+!> disk properties, the state of the disks (and of the walls) at every stored output, the
+!> contact network at the stored outputs in compressed-row form, the energy audit at the
+!> stored outputs, and the solver statistics of EVERY time step (buffered in memory and
+!> written in chunks).
+!>
+!> Per-disk arrays are (3, n) in Fortran = (n, 3) in h5py with columns x, y, rot; series add
+!> a first h5py axis per stored output. Contacts of output k are the entries
+!> offset[k]:offset[k+1] (h5py, 0-based) of the concatenated lists i, j, normal, rn, rt,
+!> status: disk i touches body j (j > 0: disk j, j < 0: wall -j), the unit normal goes from
+!> j to i, and (rn, rt) is the mean contact force on i over the step (impulse / h) per unit
+!> thickness, in the frame (n, t = (-n_y, n_x)); j receives the opposite force.
+module driver_results_dem
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_error
+    use io_hdf5_file, only: h5_file_t
+    use dem_nlgs, only: nlgs_stats_t
+    use dem_moreau_jean, only: dem_system_t, energies_balance
+    implicit none
+    private
+    public :: dem_writer_t
+
+    !> Steps of solver statistics kept in memory before they are written.
+    integer, parameter :: stats_buffer = 4096
+    !> Meaning of the contact status codes (stored as an attribute).
+    character(len=*), parameter :: status_codes = &
+        '0 = open (no force), 1 = stick (inside the Coulomb cone), 2 = slip (on the cone), '// &
+        '3 = cohesive (intact bond), 4 = broken (bond broken for good)'
+
+    !> Writes the discrete-element part of a results file.
+    type :: dem_writer_t
+        !> Number of disks and walls.
+        integer :: n_particles = 0, n_walls = 0
+        !> Store the contact network.
+        logical :: store_contacts = .true.
+        !> Outputs stored so far.
+        integer :: n_out = 0
+        !> Contacts stored so far (all outputs).
+        integer :: n_contacts_stored = 0
+        !> Time steps whose statistics are buffered, and steps recorded in all.
+        integer :: n_buffered = 0, n_steps = 0
+        !> Buffered statistics per step: sweeps, contacts in the list, active contacts,
+        !> converged (1) or not (0).
+        integer, allocatable :: sweeps(:), contacts(:), active(:), converged(:)
+        !> Buffered convergence norms and Signorini-Coulomb residuals per step.
+        real(wp), allocatable :: norm(:), residual(:)
+    contains
+        !> Write disk and wall properties, settings, and create every series.
+        procedure :: begin => writer_begin
+        !> Store the current state (an output): disks, walls, energies, contacts.
+        procedure :: store => writer_store
+        !> Record the solver statistics of the step just done.
+        procedure :: record_step => writer_record_step
+        !> Write what is buffered and the closing attributes.
+        procedure :: finish => writer_finish
+    end type dem_writer_t
+
+contains
+
+    !> Write /dem/particles, /dem/walls/material, the settings as attributes of /dem and
+    !> /dem/solver, and create the empty series.
+    subroutine writer_begin(self, file, sys, material_id, store_contacts, error)
+        !> The writer.
+        class(dem_writer_t), intent(inout) :: self
+        !> A results file open for writing.
+        type(h5_file_t), intent(inout) :: file
+        !> The system (mj_init done).
+        type(dem_system_t), intent(in) :: sys
+        !> Deck id of each material index.
+        integer, intent(in) :: material_id(:)
+        !> Store the contact network at the outputs.
+        logical, intent(in) :: store_contacts
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: n
+        n = sys%particles%n
+        self%n_particles = n
+        self%n_walls = sys%walls%n
+        self%store_contacts = store_contacts
+        self%n_out = 0
+        self%n_contacts_stored = 0
+        self%n_buffered = 0
+        self%n_steps = 0
+        allocate (self%sweeps(stats_buffer), self%contacts(stats_buffer), &
+            self%active(stats_buffer), self%converged(stats_buffer), self%norm(stats_buffer), &
+            self%residual(stats_buffer))
+        call properties(error)
+        if (allocated(error)) return
+        call settings(error)
+        if (allocated(error)) return
+        call series(error)
+    contains
+        subroutine properties(error)
+            type(error_t), allocatable, intent(out) :: error
+            call dataset('/dem/particles/radius', sys%particles%radius(1:n), 'm', error)
+            if (allocated(error)) return
+            call dataset('/dem/particles/mass', sys%particles%mass(1:n), 'kg/m', error)
+            if (allocated(error)) return
+            call dataset('/dem/particles/inertia', sys%particles%inertia(1:n), 'kg m', error)
+            if (allocated(error)) return
+            call file%write_dataset('/dem/particles/material', &
+                material_id(sys%particles%mat(1:n)), error)
+            if (allocated(error) .or. sys%walls%n == 0) return
+            call file%write_dataset('/dem/walls/material', &
+                material_id(sys%walls%mat(1:sys%walls%n)), error)
+        end subroutine properties
+
+        subroutine settings(error)
+            type(error_t), allocatable, intent(out) :: error
+            call file%write_attribute('/dem', 'n_particles', n, error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem', 'n_walls', sys%walls%n, error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem', 'time_step', sys%scheme%h, error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem', 'theta', sys%scheme%theta, error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem', 'alert', sys%scheme%alert, error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem', 'gravity', sys%particles%gravity, error)
+            if (allocated(error)) return
+            call file%create_group('/dem/solver', error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem/solver', 'tolerance', sys%solver%tol, error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem/solver', 'max_sweeps', sys%solver%max_sweeps, error)
+        end subroutine settings
+
+        subroutine series(error)
+            type(error_t), allocatable, intent(out) :: error
+            character(len=*), parameter :: energies(7) = [character(len=13) :: 'kinetic', &
+                'potential', 'external_work', 'drive_work', 'dissipated', 'numerical', 'balance']
+            character(len=*), parameter :: stats_int(4) = [character(len=9) :: 'sweeps', &
+                'contacts', 'active', 'converged']
+            integer :: k
+            call real_series('/dem/time', [integer ::], 's', error)
+            if (allocated(error)) return
+            call real_series('/dem/position', [3, n], 'm, m, rad', error)
+            if (allocated(error)) return
+            call real_series('/dem/velocity', [3, n], 'm/s, m/s, rad/s', error)
+            if (allocated(error)) return
+            if (sys%walls%n > 0) then
+                call real_series('/dem/walls/position', [4, sys%walls%n], 'm', error)
+                if (allocated(error)) return
+            end if
+            call real_series('/dem/energy/time', [integer ::], 's', error)
+            if (allocated(error)) return
+            do k = 1, size(energies)
+                call real_series('/dem/energy/'//trim(energies(k)), [integer ::], 'J/m', error)
+                if (allocated(error)) return
+            end do
+            do k = 1, size(stats_int)
+                call file%create_int_series('/dem/solver/'//trim(stats_int(k)), error)
+                if (allocated(error)) return
+            end do
+            call real_series('/dem/solver/error', [integer ::], '', error)
+            if (allocated(error)) return
+            call real_series('/dem/solver/residual', [integer ::], '', error)
+            if (allocated(error) .or. .not. self%store_contacts) return
+            call file%create_int_series('/dem/contacts/offset', error)
+            if (allocated(error)) return
+            call file%append_chunk('/dem/contacts/offset', [0], error)
+            if (allocated(error)) return
+            call file%create_int_series('/dem/contacts/i', error)
+            if (allocated(error)) return
+            call file%create_int_series('/dem/contacts/j', error)
+            if (allocated(error)) return
+            call file%create_int_series('/dem/contacts/status', error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem/contacts/status', 'codes', status_codes, error)
+            if (allocated(error)) return
+            call real_series('/dem/contacts/normal', [2], '', error)
+            if (allocated(error)) return
+            call real_series('/dem/contacts/rn', [integer ::], 'N/m', error)
+            if (allocated(error)) return
+            call real_series('/dem/contacts/rt', [integer ::], 'N/m', error)
+        end subroutine series
+
+        subroutine dataset(path, values, units, error)
+            character(len=*), intent(in) :: path, units
+            real(wp), intent(in) :: values(:)
+            type(error_t), allocatable, intent(out) :: error
+            call file%write_dataset(path, values, error)
+            if (allocated(error)) return
+            call file%write_attribute(path, 'units', units, error)
+        end subroutine dataset
+
+        subroutine real_series(path, record_shape, units, error)
+            character(len=*), intent(in) :: path, units
+            integer, intent(in) :: record_shape(:)
+            type(error_t), allocatable, intent(out) :: error
+            call file%create_series(path, record_shape, error)
+            if (allocated(error) .or. len(units) == 0) return
+            call file%write_attribute(path, 'units', units, error)
+        end subroutine real_series
+    end subroutine writer_begin
+
+    !> Store the current state as one output: time, positions and velocities of the disks,
+    !> positions of the walls, energies, and the contact network.
+    subroutine writer_store(self, file, sys, error)
+        !> The writer (begin done).
+        class(dem_writer_t), intent(inout) :: self
+        !> The results file.
+        type(h5_file_t), intent(inout) :: file
+        !> The system.
+        type(dem_system_t), intent(in) :: sys
+        !> Set on a size mismatch or a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: state(:, :)
+        integer :: n
+        n = sys%particles%n
+        if (n /= self%n_particles .or. .not. allocated(self%sweeps)) then
+            call make_error(error, 'results: DEM store: begin was not called for this system')
+            return
+        end if
+        call file%append('/dem/time', sys%time, error)
+        if (allocated(error)) return
+        allocate (state(3, n))
+        state(1, :) = sys%particles%x(1:n)
+        state(2, :) = sys%particles%y(1:n)
+        state(3, :) = sys%particles%rot(1:n)
+        call file%append('/dem/position', state, error)
+        if (allocated(error)) return
+        state(1, :) = sys%particles%vx(1:n)
+        state(2, :) = sys%particles%vy(1:n)
+        state(3, :) = sys%particles%w(1:n)
+        call file%append('/dem/velocity', state, error)
+        if (allocated(error)) return
+        if (sys%walls%n > 0) then
+            associate (w => sys%walls)
+                call file%append('/dem/walls/position', reshape([w%x1(1:w%n), w%y1(1:w%n), &
+                    w%x2(1:w%n), w%y2(1:w%n)], [4, w%n], order=[2, 1]), error)
+            end associate
+            if (allocated(error)) return
+        end if
+        call store_energies(file, sys, error)
+        if (allocated(error)) return
+        if (self%store_contacts) call store_contacts(self, file, sys, error)
+        if (allocated(error)) return
+        self%n_out = self%n_out + 1
+    end subroutine writer_store
+
+    !> Append the energy record of the current state.
+    subroutine store_energies(file, sys, error)
+        type(h5_file_t), intent(inout) :: file
+        type(dem_system_t), intent(in) :: sys
+        type(error_t), allocatable, intent(out) :: error
+        associate (e => sys%energies)
+            call file%append('/dem/energy/time', sys%time, error)
+            if (allocated(error)) return
+            call file%append('/dem/energy/kinetic', e%kinetic, error)
+            if (allocated(error)) return
+            call file%append('/dem/energy/potential', e%potential, error)
+            if (allocated(error)) return
+            call file%append('/dem/energy/external_work', e%external_work, error)
+            if (allocated(error)) return
+            call file%append('/dem/energy/drive_work', e%drive_work, error)
+            if (allocated(error)) return
+            call file%append('/dem/energy/dissipated', e%contact_dissipation, error)
+            if (allocated(error)) return
+            call file%append('/dem/energy/numerical', e%numerical_dissipation, error)
+            if (allocated(error)) return
+            call file%append('/dem/energy/balance', energies_balance(e), error)
+        end associate
+    end subroutine store_energies
+
+    !> Append the contacts of the current list and the offset of the next output.
+    subroutine store_contacts(self, file, sys, error)
+        type(dem_writer_t), intent(inout) :: self
+        type(h5_file_t), intent(inout) :: file
+        type(dem_system_t), intent(in) :: sys
+        type(error_t), allocatable, intent(out) :: error
+        integer :: m
+        m = sys%contacts%n
+        if (m > huge(0) - self%n_contacts_stored) then
+            call make_error(error, 'results: more than 2**31 - 1 contacts stored: store fewer '// &
+                'outputs ([output] interval) or no contacts ([output] contacts = no)')
+            return
+        end if
+        if (m > 0) then
+            associate (cs => sys%contacts)
+                call file%append_chunk('/dem/contacts/i', cs%i2(1:m), error)
+                if (allocated(error)) return
+                call file%append_chunk('/dem/contacts/j', cs%i1(1:m), error)
+                if (allocated(error)) return
+                call file%append_chunk('/dem/contacts/status', cs%status(1:m), error)
+                if (allocated(error)) return
+                call file%append_chunk('/dem/contacts/normal', cs%nrm(:, 1:m), error)
+                if (allocated(error)) return
+                call file%append_chunk('/dem/contacts/rn', cs%r(1, 1:m)/sys%scheme%h, error)
+                if (allocated(error)) return
+                call file%append_chunk('/dem/contacts/rt', cs%r(2, 1:m)/sys%scheme%h, error)
+                if (allocated(error)) return
+            end associate
+        end if
+        self%n_contacts_stored = self%n_contacts_stored + m
+        call file%append_chunk('/dem/contacts/offset', [self%n_contacts_stored], error)
+    end subroutine store_contacts
+
+    !> Record the statistics of the last solve (one time step); written every
+    !> `stats_buffer` steps and by `finish`.
+    subroutine writer_record_step(self, file, stats, error)
+        !> The writer (begin done).
+        class(dem_writer_t), intent(inout) :: self
+        !> The results file.
+        type(h5_file_t), intent(inout) :: file
+        !> Statistics of the step.
+        type(nlgs_stats_t), intent(in) :: stats
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: k
+        if (.not. allocated(self%sweeps)) then
+            call make_error(error, 'results: DEM record_step: begin was not called')
+            return
+        end if
+        if (self%n_buffered == stats_buffer) call flush_stats(self, file, error)
+        if (allocated(error)) return
+        k = self%n_buffered + 1
+        self%sweeps(k) = stats%sweeps
+        self%contacts(k) = stats%n_contacts
+        self%active(k) = stats%n_active
+        self%converged(k) = merge(1, 0, stats%converged)
+        self%norm(k) = stats%error
+        self%residual(k) = stats%residual
+        self%n_buffered = k
+        self%n_steps = self%n_steps + 1
+    end subroutine writer_record_step
+
+    !> Write the buffered solver statistics.
+    subroutine flush_stats(self, file, error)
+        type(dem_writer_t), intent(inout) :: self
+        type(h5_file_t), intent(inout) :: file
+        type(error_t), allocatable, intent(out) :: error
+        integer :: k
+        k = self%n_buffered
+        call file%append_chunk('/dem/solver/sweeps', self%sweeps(:k), error)
+        if (allocated(error)) return
+        call file%append_chunk('/dem/solver/contacts', self%contacts(:k), error)
+        if (allocated(error)) return
+        call file%append_chunk('/dem/solver/active', self%active(:k), error)
+        if (allocated(error)) return
+        call file%append_chunk('/dem/solver/converged', self%converged(:k), error)
+        if (allocated(error)) return
+        call file%append_chunk('/dem/solver/error', self%norm(:k), error)
+        if (allocated(error)) return
+        call file%append_chunk('/dem/solver/residual', self%residual(:k), error)
+        if (allocated(error)) return
+        self%n_buffered = 0
+    end subroutine flush_stats
+
+    !> Write the buffered statistics and the closing attributes of /dem/solver (steps,
+    !> unconverged steps, time spent in detection and in the solver).
+    subroutine writer_finish(self, file, sys, unconverged, error)
+        !> The writer.
+        class(dem_writer_t), intent(inout) :: self
+        !> The results file.
+        type(h5_file_t), intent(inout) :: file
+        !> The system at the end of the run.
+        type(dem_system_t), intent(in) :: sys
+        !> Number of steps whose solve did not converge.
+        integer, intent(in) :: unconverged
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call flush_stats(self, file, error)
+        if (allocated(error)) return
+        call file%write_attribute('/dem/solver', 'steps', self%n_steps, error)
+        if (allocated(error)) return
+        call file%write_attribute('/dem/solver', 'unconverged_steps', unconverged, error)
+        if (allocated(error)) return
+        call file%write_attribute('/dem/solver', 'detection_seconds', sys%time_detection, error)
+        if (allocated(error)) return
+        call file%write_attribute('/dem/solver', 'solver_seconds', sys%time_solver, error)
+    end subroutine writer_finish
+end module driver_results_dem

@@ -1,0 +1,142 @@
+!> Time integration of a discrete-element model (Moreau-Jean steps) with its results:
+!> states, energies and contacts at the stored outputs, solver statistics at every step.
+!>
+!> Warnings go through the report callback: a step whose contact solve did not converge
+!> (the first `max_warnings` ones, then only the count in the summary), and, once, a step in
+!> which a disk moved farther than the alert distance (contacts may then be found late).
+module driver_run_dem
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_error
+    use core_strings, only: to_str
+    use io_progress, only: progress_t
+    use dem_moreau_jean, only: mj_init, mj_step, energies_balance
+    use driver_config, only: run_config_t
+    use driver_config_dem, only: dem_config_t
+    use driver_results, only: results_writer_t
+    use driver_results_dem, only: dem_writer_t
+    implicit none
+    private
+    public :: run_dem, max_warnings, report_line_iface
+
+    !> Unconverged steps reported one by one; later ones are only counted.
+    integer, parameter :: max_warnings = 5
+
+    abstract interface
+        !> Receives one line of progress, warning or summary text.
+        subroutine report_line_iface(line)
+            character(len=*), intent(in) :: line
+        end subroutine report_line_iface
+    end interface
+
+contains
+
+    !> Integrate the model from t = 0 to the end time and write its results into `out`.
+    subroutine run_dem(run, cfg, out, quiet, report, error)
+        !> Run settings (time step, end time, output interval, progress).
+        type(run_config_t), intent(in) :: run
+        !> The model (its system advances).
+        type(dem_config_t), intent(inout) :: cfg
+        !> An open results writer.
+        type(results_writer_t), intent(inout) :: out
+        !> No progress lines (warnings and the summary are still reported).
+        logical, intent(in) :: quiet
+        !> Where progress, warning and summary lines go.
+        procedure(report_line_iface) :: report
+        !> Set on a run or write failure.
+        type(error_t), allocatable, intent(out) :: error
+        type(dem_writer_t) :: writer
+        type(progress_t) :: progress
+        integer :: n_steps, k, unconverged
+        logical :: speed_warned
+        character(len=:), allocatable :: message
+        character(len=512) :: buf
+
+        call mj_init(cfg%system, error)
+        if (allocated(error)) then
+            message = error%message
+            call make_error(error, 'particles: '//message)
+            return
+        end if
+        ! Whole steps up to the end time (the last one may end slightly after it).
+        n_steps = ceiling(run%t_end/run%h*(1.0_wp - 1.0e-12_wp))
+        call writer%begin(out%file, cfg%system, cfg%material_id, cfg%store_contacts, error)
+        if (allocated(error)) return
+        call writer%store(out%file, cfg%system, error)
+        if (allocated(error)) return
+        unconverged = 0
+        speed_warned = .false.
+        call progress%start(n_steps, run%t_end, run%progress_seconds)
+        do k = 1, n_steps
+            call mj_step(cfg%system)
+            call writer%record_step(out%file, cfg%system%stats, error)
+            if (allocated(error)) return
+            if (.not. cfg%system%stats%converged) call warn_unconverged()
+            if (.not. speed_warned) call check_speed()
+            if (mod(k, run%output_interval) == 0 .or. k == n_steps) then
+                call writer%store(out%file, cfg%system, error)
+                if (allocated(error)) return
+            end if
+            if (quiet) cycle
+            if (progress%due()) call report(progress%line(k, cfg%system%time))
+        end do
+        call writer%finish(out%file, cfg%system, unconverged, error)
+        if (allocated(error)) return
+        call summary()
+        call out%write_summary(n_steps, progress%elapsed(), error)
+
+    contains
+
+        !> Warning for an unconverged step (the first max_warnings ones).
+        subroutine warn_unconverged()
+            unconverged = unconverged + 1
+            if (unconverged > max_warnings) return
+            write (buf, '(a,i0,a,es11.4,a,i0,a,es9.2,a,es9.2,a)') 'warning: step ', k, &
+                ' (t = ', cfg%system%time, ' s): the contact solver did not converge in ', &
+                cfg%system%stats%sweeps, ' sweeps (error ', cfg%system%stats%error, &
+                ' > tolerance ', cfg%system%solver%tol, ')'
+            call report(trim(buf))
+            if (unconverged == max_warnings) call report('warning: further unconverged steps '// &
+                'are only counted (total in the summary); raise [solver] max_sweeps or the '// &
+                'tolerance, or lower [time] step')
+        end subroutine warn_unconverged
+
+        !> Warning (once) when a disk moved farther than the alert distance in the step.
+        subroutine check_speed()
+            real(wp) :: vmax
+            integer :: n
+            n = cfg%system%particles%n
+            associate (p => cfg%system%particles)
+                vmax = sqrt(maxval(p%vx(1:n)**2 + p%vy(1:n)**2))
+            end associate
+            if (vmax*run%h <= cfg%system%scheme%alert) return
+            speed_warned = .true.
+            write (buf, '(a,es11.4,a,es9.2,a,es9.2,a,es9.2,a)') 'warning: at t = ', &
+                cfg%system%time, ' s a disk moves ', vmax*run%h, ' m in one step (speed ', &
+                vmax, ' m/s), more than the alert distance ', cfg%system%scheme%alert, &
+                ' m: contacts may be found late (overlaps); lower [time] step or raise '// &
+                '[contacts] alert'
+            call report(trim(buf))
+        end subroutine check_speed
+
+        !> Closing lines: contacts, solver effort, unconverged steps, energy balance, times.
+        subroutine summary()
+            associate (sys => cfg%system)
+                write (buf, '(a,i0,a,i0,a,i0,a,es12.5,a)') 'particles: ', sys%particles%n, &
+                    ' disks, ', sys%walls%n, ' walls, ', n_steps, ' steps to t = ', sys%time, ' s'
+                call report(trim(buf))
+                write (buf, '(a,i0,a,i0,a,es10.3,a,es10.3,a)') 'contacts at the end: ', &
+                    sys%contacts%n, ' (', sys%stats%n_active, ' active); time in detection ', &
+                    sys%time_detection, ' s, in the solver ', sys%time_solver, ' s'
+                call report(trim(buf))
+                call report('unconverged steps: '//to_str(unconverged)//' of '//to_str(n_steps)// &
+                    ' (tolerance '//to_str(sys%solver%tol)//', at most '// &
+                    to_str(sys%solver%max_sweeps)//' sweeps)')
+                write (buf, '(a,es10.3,a,es10.3,a)') 'energy balance residual ', &
+                    energies_balance(sys%energies), ' J/m (dissipated in contacts ', &
+                    sys%energies%contact_dissipation, ' J/m)'
+                call report(trim(buf))
+            end associate
+            call report(progress%summary_line(n_steps, cfg%system%time))
+        end subroutine summary
+    end subroutine run_dem
+end module driver_run_dem

@@ -1,0 +1,262 @@
+#!/usr/bin/env python3
+"""Regression runs of the multicor executable on particle (discrete-element) decks, checked
+against closed forms and invariants read back from the HDF5 results.
+
+Decks: tests/regression/decks/dem_*.dat (their headers state the reference) and the examples
+input/incline.dat and input/cohesive_row.dat. Kept small: the Debug build runs them.
+Usage (ctest does this): test_dem_runs.py --exe multicor --work DIR --source REPO
+"""
+import argparse
+import math
+import pathlib
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+G = 9.81
+FAILED = []
+
+
+def check(name, ok, detail=""):
+    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
+    if not ok:
+        FAILED.append(name)
+
+
+def run(exe, deck, work, quiet=True):
+    """Run a deck; return (open results file, stdout)."""
+    out = work / deck.stem
+    args = [str(exe), str(deck), "--output", str(out)] + (["--quiet"] if quiet else [])
+    proc = subprocess.run(args, capture_output=True, text=True)
+    if proc.returncode != 0:
+        print(proc.stdout, proc.stderr)
+        raise SystemExit(f"multicor failed on {deck} (exit {proc.returncode})")
+    return h5py.File(out / f"{deck.stem}.h5", "r"), proc.stdout
+
+
+def contacts_at(f, k):
+    """Contacts of output k as a dict of arrays (CSR slice)."""
+    o = f["dem/contacts/offset"][...]
+    s = slice(int(o[k]), int(o[k + 1]))
+    names = ("i", "j", "normal", "rn", "rt", "status")
+    return {name: f[f"dem/contacts/{name}"][s] for name in names}
+
+
+def incline(exe, src, work):
+    """input/incline.dat: slope 3/4; disk 1 rolls (mu 0.5), disk 2 slips (mu 0.1)."""
+    sin_phi, cos_phi, radius = 0.6, 0.8, 0.05
+    f, _ = run(exe, src / "input" / "incline.dat", work)
+    with f:
+        t = f["dem/time"][...]
+        v = f["dem/velocity"][...]            # (n_out, 2, 3)
+        status = f["dem/contacts/status"][...]
+    # Speed down the slope (0.8, -0.6); accelerations from the last 40 outputs (after the
+    # first step, whose contact activation may lag by one step).
+    along = cos_phi * v[:, :, 0] - sin_phi * v[:, :, 1]
+    sel = slice(len(t) - 41, len(t))
+    acc = np.polyfit(t[sel], along[sel], 1)[0]
+    spin = np.polyfit(t[sel], v[sel, :, 2], 1)[0]
+    a_roll, a_slip = 2.0 / 3.0 * G * sin_phi, G * (sin_phi - 0.1 * cos_phi)
+    # Each step solves one contact exactly (local tolerance 1e-10); the scheme is exact for
+    # constant accelerations: 1e-8 relative covers the least-squares fit's round-off.
+    check("incline: rolling disk a = (2/3) g sin(phi)", abs(acc[0] / a_roll - 1) < 1e-8,
+          f"{acc[0]:.10g} vs {a_roll:.10g} m/s^2")
+    check("incline: rolling disk omega' = -a/R", abs(spin[0] / (-a_roll / radius) - 1) < 1e-8,
+          f"{spin[0]:.10g} vs {-a_roll / radius:.10g} rad/s^2")
+    check("incline: slipping disk a = g (sin - mu cos)", abs(acc[1] / a_slip - 1) < 1e-8,
+          f"{acc[1]:.10g} vs {a_slip:.10g} m/s^2")
+    w_slip = -2 * 0.1 * G * cos_phi / radius
+    check("incline: slipping disk omega' = -2 mu g cos/R", abs(spin[1] / w_slip - 1) < 1e-8,
+          f"{spin[1]:.10g} vs {w_slip:.10g} rad/s^2")
+    # Contact statuses of the stored outputs: stick for the rolling disk, slip for the other
+    # (contacts are ordered by disk: disk 1 first).
+    check("incline: statuses stick / slip", bool(np.all(status.reshape(-1, 2) == [1, 2])),
+          f"{np.unique(status.reshape(-1, 2), axis=0).tolist()}")
+
+
+def column(exe, decks, work):
+    """dem_column.dat: 5 disks at rest on a floor carry the weight of the disks above."""
+    f, _ = run(exe, decks / "dem_column.dat", work)
+    with f:
+        m = f["dem/particles/mass"][0]
+        n_out = f["dem/time"].shape[0]
+        y = f["dem/position"][:, :, 1]
+        first, last = contacts_at(f, 1), contacts_at(f, n_out - 1)
+    for name, c in (("after one step", first), ("at the end", last)):
+        # Disk i touches the floor (i = 1, j = -1) or disk j = i - 1 below it: the contact
+        # below disk i carries disks i..5.
+        above = 5 - c["i"] + 1
+        err = np.max(np.abs(c["rn"] - above * m * G)) / (m * G)
+        # Solver tolerance 1e-13 on a 5-contact chain: a few times 1e-13; 1e-9 leaves room
+        # for the warm start after the contacts settle.
+        check(f"column {name}: r_n = disks above x m g", c["rn"].size == 5 and err < 1e-9,
+              f"max error {err:.2e} m g; r_n / m g = {np.round(c['rn'] / (m * G), 6).tolist()}")
+        check(f"column {name}: no friction force", np.max(np.abs(c["rt"])) < 1e-9 * m * G,
+              f"max |r_t| = {np.max(np.abs(c['rt'])):.2e} N/m")
+    # Touching disks at rest may sink by a few free-fall steps g h^2 while contacts
+    # (re)activate; bound: 10 g h^2 = 1e-4 m, far below the radius.
+    check("column stays in place", np.max(np.abs(y - y[0])) < 10 * G * 1e-6,
+          f"max |dy| = {np.max(np.abs(y - y[0])):.2e} m")
+
+
+def hanging(exe, decks, work):
+    """dem_hang_hold.dat / dem_hang_break.dat: cohesive bond under the weight of a disk."""
+    h, radius = 1e-3, 0.125
+    f, _ = run(exe, decks / "dem_hang_hold.dat", work)
+    with f:
+        m = f["dem/particles/mass"][1]
+        y = f["dem/position"][:, 1, 1]
+        c = contacts_at(f, f["dem/time"].shape[0] - 1)
+    check("cohesion holds: bond intact", list(c["status"]) == [3], f"status {list(c['status'])}")
+    # The bond carries the weight: r_n = -m g (tension), to the solver tolerance 1e-13.
+    check("cohesion holds: r_n = -m g", abs(c["rn"][0] / (-m * G) - 1) < 1e-9,
+          f"{c['rn'][0]:.10g} vs {-m * G:.10g} N/m")
+    check("cohesion holds: disk does not move", np.max(np.abs(y + 2 * radius)) < 1e-12,
+          f"max |y + 2R| = {np.max(np.abs(y + 2 * radius)):.2e} m")
+
+    f, _ = run(exe, decks / "dem_hang_break.dat", work)
+    with f:
+        m = f["dem/particles/mass"][1]
+        t = f["dem/time"][...]
+        vy = f["dem/velocity"][:, 1, 1]
+        status = f["dem/contacts/status"][...]
+    r_cohe = 1926.2 * radius
+    v_ref = -(G - r_cohe / m) * h - G * (t[1:] - h)
+    err = np.max(np.abs(vy[1:] - v_ref)) / (G * t[-1])
+    # Exact for the scheme: round-off of 50 velocity updates (relative 1e-12).
+    check("cohesion breaks: first step pulled by r_cohe, then free fall", err < 1e-12,
+          f"max error {err:.2e} (relative to g t)")
+    check("cohesion breaks: bond broken for good", int(status[0]) == 4,
+          f"first stored status {status[:1].tolist()}")
+
+
+def cohesive_row(exe, src, work):
+    """input/cohesive_row.dat: top bond breaks at t = 0.08711 s, the bottom one at 0.15 s."""
+    f, _ = run(exe, src / "input" / "cohesive_row.dat", work)
+    with f:
+        t = f["dem/time"][...]
+        m = f["dem/particles/mass"][0]
+        h = f["dem"].attrs["time_step"]
+        rows = [contacts_at(f, k) for k in range(len(t))]
+    r_cohe = 2.0e4 * 0.01
+    t_top = (r_cohe - 9 * m * G) / 1500.0
+    t_bottom = 225.0 / 1500.0
+
+    def bond(c, j):
+        hit = np.flatnonzero(c["j"] == j)
+        return (int(c["status"][hit[0]]), float(c["rn"][hit[0]])) if hit.size else (None, 0.0)
+
+    ok_top = all(bond(c, 1)[0] == (3 if tk < t_top - h else 4)
+                 for c, tk in zip(rows[1:], t[1:]) if abs(tk - t_top) > h and bond(c, 1)[0])
+    check("cohesive row: top bond breaks at (r_cohe - 9 m g) / 1500 N/m/s", ok_top,
+          f"t_break = {t_top:.5f} s; statuses {[bond(c, 1)[0] for c in rows[1:]]}")
+    ok_bottom = all(bond(c, 9)[0] == 3 for c, tk in zip(rows[1:], t[1:]) if tk < t_bottom - h) \
+        and all(bond(c, 9)[0] in (4, None) for c, tk in zip(rows[1:], t[1:]) if tk > t_bottom + h)
+    check("cohesive row: bottom bond breaks when 8 F / 9 = r_cohe", ok_bottom,
+          f"t_break = {t_bottom:.5f} s; statuses {[bond(c, 9)[0] for c in rows[1:]]}")
+    # Before the first break the row hangs at rest: the bond above disk k + 1 carries the
+    # weight of the 9 - k disks below plus the load of the step, F(t - h/2) for theta = 1/2.
+    # The sweeps stop when their change is below 1e-8 of W r; on a chain the remaining error
+    # is a few times the last change: 1e-7.
+    k = int(np.flatnonzero(t < t_top - h)[-1])
+    rn = np.array([bond(rows[k], j)[1] for j in range(1, 10)])
+    ref = -((9 - np.arange(9)) * m * G + 1500.0 * (t[k] - h / 2))
+    check("cohesive row: bond tensions = weight below + F", np.max(np.abs(rn / ref - 1)) < 1e-7,
+          f"t = {t[k]:.4f} s, max relative error {np.max(np.abs(rn / ref - 1)):.1e}")
+
+
+def small_deposit(exe, decks, work):
+    """dem_small_deposit.dat: energy audit, contact network consistency, disks in the box."""
+    f, out = run(exe, decks / "dem_small_deposit.dat", work)
+    with f:
+        e = {k: f[f"dem/energy/{k}"][...] for k in f["dem/energy"]}
+        n = f["dem/particles/radius"].shape[0]
+        r = f["dem/particles/radius"][...]
+        pos = f["dem/position"][...]
+        vel0 = f["dem/velocity"][0]
+        material = f["dem/particles/material"][...]
+        offset = f["dem/contacts/offset"][...]
+        c = {k: f[f"dem/contacts/{k}"][...] for k in ("i", "j", "normal", "rn", "rt", "status")}
+        n_out = f["dem/time"].shape[0]
+        n_steps = f["dem/solver/sweeps"].shape[0]
+        walls = f["dem/walls/material"][...]
+    drop = e["potential"][0] - e["potential"][-1]
+    check("deposit: 40 disks numbered deposit first, then lattice", n == 40
+          and list(material[:30]) == [1] * 30 and list(material[30:]) == [2] * 10, "")
+    check("deposit: initial velocity on 31:last", bool(np.all(vel0[30:, 0] == 0.2)
+          and np.all(vel0[:30, 0] == 0.0)), "")
+    check("deposit: wall materials (default = first declared)", list(walls) == [1, 1, 2], "")
+    check("deposit: it fell", drop > 0 and e["dissipated"][-1] > 0 and e["numerical"][-1] > 0,
+          f"potential drop {drop:.4g} J/m")
+    # The audit is an identity of the scheme: round-off only (1e-10 of the energy in play).
+    check("deposit: energy balance closes", np.max(np.abs(e["balance"])) < 1e-10 * drop,
+          f"max |balance| = {np.max(np.abs(e['balance'])):.2e} J/m")
+    check("deposit: one solver record per step", n_steps == 300, f"{n_steps}")
+    check("deposit: CSR offsets", offset.size == n_out + 1 and offset[0] == 0
+          and bool(np.all(np.diff(offset) >= 0)) and offset[-1] == c["i"].size, f"{offset}")
+    check("deposit: contact indices", bool(np.all((c["i"] >= 1) & (c["i"] <= n)))
+          and bool(np.all((c["j"] <= n) & (c["j"] != 0) & (c["j"] >= -3))), "")
+    check("deposit: unit normals", np.max(np.abs(np.hypot(*c["normal"].T) - 1)) < 1e-12, "")
+    coulomb = np.abs(c["rt"]) <= 0.5 * np.maximum(c["rn"], 0) * (1 + 1e-9) + 1e-12
+    check("deposit: statuses and Coulomb cone", bool(np.all(np.isin(c["status"], [0, 1, 2])))
+          and bool(np.all(c["rn"] >= 0)) and bool(np.all(coulomb)), "")
+    k = n_out - 1
+    s = slice(offset[k], offset[k + 1])
+    i, j = c["i"][s] - 1, c["j"][s]
+    disk = j > 0
+    gap = np.hypot(*(pos[k, i[disk], :2] - pos[k, j[disk] - 1, :2]).T) - r[i[disk]] - r[j[disk] - 1]
+    centre_distance = gap + r[i[disk]] + r[j[disk] - 1]
+    dirn = (pos[k, i[disk], :2] - pos[k, j[disk] - 1, :2]) / centre_distance[:, None]
+    # The stored normal is the one of the detection (mid configuration of the last step):
+    # it agrees with the end configuration to the motion of one step.
+    check("deposit: normals point from j to i", bool(np.all(np.sum(dirn * c["normal"][s][disk],
+                                                                 axis=1) > 0.99)), "")
+    # Overlaps stay small against the radius (impacts may overlap by (1 - theta) h |u_n|).
+    check("deposit: small overlaps", np.min(gap) > -0.01 * np.min(r),
+          f"min gap {np.min(gap):.2e} m")
+    inside = (pos[:, :, 0] - r > -1e-3) & (pos[:, :, 0] + r < 0.201) & (pos[:, :, 1] - r > -1e-3)
+    check("deposit: disks stay in the box", bool(np.all(inside)), "")
+    check("deposit: no progress lines with progress = 0 and --quiet", "step " not in out, "")
+
+
+def unconverged(exe, decks, work):
+    """dem_unconverged.dat: warnings for the first 5 steps, then a count in the summary."""
+    f, out = run(exe, decks / "dem_unconverged.dat", work, quiet=False)
+    with f:
+        converged = f["dem/solver/converged"][...]
+        sweeps = f["dem/solver/sweeps"][...]
+        attrs = dict(f["dem/solver"].attrs)
+        has_contacts = "dem/contacts" in f
+    warnings = [line for line in out.splitlines() if line.startswith("warning: step")]
+    check("unconverged: every step flagged", converged.size == 10 and not converged.any()
+          and bool(np.all(sweeps == 2)), f"converged {converged.tolist()}")
+    check("unconverged: 5 warning lines, then counted", len(warnings) == 5
+          and "further unconverged steps are only counted" in out, f"{len(warnings)} lines")
+    check("unconverged: summary count", "unconverged steps: 10 of 10" in out
+          and int(attrs["unconverged_steps"]) == 10, "")
+    check("unconverged: contacts = no stores no network", not has_contacts, "")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--exe", required=True)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("--source", required=True)
+    args = ap.parse_args()
+    exe, work, src = pathlib.Path(args.exe), pathlib.Path(args.work), pathlib.Path(args.source)
+    work.mkdir(parents=True, exist_ok=True)
+    decks = src / "tests" / "regression" / "decks"
+    incline(exe, src, work)
+    column(exe, decks, work)
+    hanging(exe, decks, work)
+    cohesive_row(exe, src, work)
+    small_deposit(exe, decks, work)
+    unconverged(exe, decks, work)
+    print(f"{len(FAILED)} failed checks")
+    return 1 if FAILED else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
