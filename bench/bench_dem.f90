@@ -1,109 +1,290 @@
 !> Speed and memory of the discrete-element kernel (issue 3, "Speed").
 !>
-!> For N = 1e3, 1e4, 1e5 disks: a dense packing at rest in a box under gravity (hexagonal
-!> lattice of touching disks of radius 1 mm, densities drawn at random in [1250, 3750] kg/m^3
-!> with a fixed seed, so that the weight is carried by an irregular force network through
-!> every contact), mu = 0.5, e = 0, h = 1 ms, theta = 1/2, alert 5 % of the radius, NLGS
-!> tolerance 1.666e-4 (LMGC90's default), at most 200 sweeps. After 10 steps,
-!> max(5, 1e5/N) steps are timed. Printed per N:
-!> contacts in the list and active, sweeps per step, wall-clock time per step of the detection
-!> (broad + narrow phase + warm start; mean and best step, the machine being shared) and of the
-!> solver (laws, frames, NLGS, residual), contact
-!> updates per second (active contacts x sweeps / solver time) and bytes per particle (all
-!> arrays of the system at their allocated size).
-!> Run: cmake --build <build> --target bench_dem && <build>/bench/bench_dem
+!> For N = 1e3, 1e4, 1e5 disks: a dense random packing at rest in a box under gravity
+!> (bench_packing: sequential deposition with rolling, radii uniform in [0.8, 1.2] mm, seed 42,
+!> box about as high as wide, floor and two side walls; radii then enlarged by 1e-6 so that
+!> every contact of the deposit starts closed), density 2500 kg/m^3, mu = 0.5, e = 0,
+!> h = 1 ms, theta = 1/2, alert 5 % of the mean radius, NLGS tolerance
+!> 1.666e-4 (LMGC90's default), at most 200 sweeps. The packing is built (timed apart, not
+!> part of the figures), n_settle steps are run (the warm start fills up), then n_steps steps
+!> are timed one by one; at the end the detection alone is timed again on the last
+!> configuration of each N, the sizes taking turns (time_detection). Printed per N:
+!>   contacts found by the detection (gap <= alert) and active in the solver (predicted gap
+!>   <= 0 or bonded), sweeps per step, wall-clock time per step of the detection (broad + narrow
+!>   phase + warm-start matching) and of the solver (laws, frames, NLGS sweeps, residual):
+!>   median and best over the timed steps, and median and best of the repeated detection
+!>   (per call);
+!>   solver contact updates per second = active contacts x sweeps / solver time of a step
+!>   (median and best over the timed steps); bytes per particle = every array of the system (disks,
+!>   walls, contacts, previous contact list, detection grid, work arrays) at its allocated size,
+!>   divided by N; and the detection scaling ratio t(1e5)/t(1e4).
+!> With the argument `--convergence`, prints instead the sweeps one step needs to reach the
+!> tolerance from a cold start (no warm start, cap 50000) on packings of 250 to 16000 disks:
+!> what limits the solver on tall static packings.
+!> Run: cmake --build <build> --target bench_dem && OMP_NUM_THREADS=1 <build>/bench/bench_dem
 program bench_dem
-    use, intrinsic :: iso_fortran_env, only: output_unit
+    use, intrinsic :: iso_fortran_env, only: output_unit, compiler_version, compiler_options
     use core_kinds, only: wp, i8
     use core_error, only: error_t
-    use dem_random, only: rng_t, rng_seed, rng_uniform_in
     use dem_particles, only: particles_add_disks
-    use dem_generators, only: generate_hex_lattice
     use dem_walls, only: walls_add
     use dem_materials, only: materials_init, materials_set_pair
+    use dem_detection, only: detect_contacts
     use dem_moreau_jean, only: dem_system_t, mj_init, mj_step, dem_system_bytes
+    use bench_packing, only: deposit_disks, deposit_width
     implicit none
+
+    !> Figures of one N.
+    type :: case_t
+        !> Disks, contacts found, active contacts (last step), disks stuck in the deposition.
+        integer :: n = 0, contacts = 0, active = 0, stuck = 0
+        !> Box width and deposit height [m], packing fraction, build time [s].
+        real(wp) :: width = 0.0_wp, height = 0.0_wp, solid_fraction = 0.0_wp, t_build = 0.0_wp
+        !> Mean and max speed after the timed steps / (g h).
+        real(wp) :: v_mean = 0.0_wp, v_max = 0.0_wp
+        !> Sweeps per step: mean and max; fraction of converged steps.
+        real(wp) :: sweeps = 0.0_wp, converged = 0.0_wp
+        integer :: sweeps_max = 0
+        !> Detection per step [s]: median and best over the steps, and over the repetitions.
+        real(wp) :: det_med = 0.0_wp, det_best = 0.0_wp, rep_med = 0.0_wp, rep_best = 0.0_wp
+        !> Solver per step [s]: median and best.
+        real(wp) :: sol_med = 0.0_wp, sol_best = 0.0_wp
+        !> Contact updates per second: median and best over the timed steps.
+        real(wp) :: rate = 0.0_wp, rate_best = 0.0_wp
+        !> Bytes per particle.
+        real(wp) :: bytes = 0.0_wp
+    end type case_t
+
     integer, parameter :: sizes(3) = [1000, 10000, 100000]
+    !> Steps before timing (the warm start fills up).
     integer, parameter :: n_settle = 10
-    real(wp) :: det_mean(size(sizes)), det_min(size(sizes))
+    real(wp), parameter :: radius_mean = 1.0e-3_wp, gravity = 9.81_wp, step = 1.0e-3_wp
+    !> Rounds of the interleaved detection timing.
+    integer, parameter :: n_rounds = 30
+    type(case_t) :: res(size(sizes))
+    type(dem_system_t), allocatable :: systems(:)
+    character(len=32) :: arg
     integer :: k
-    write (output_unit, '(a)') '# DEM kernel benchmark (1 core): dense packing at rest under gravity'
-    write (output_unit, '(a)') '#       N  contacts    active  sweeps/step   detect[ms] (min)   solve[ms]' &
-        //'  updates/s  bytes/particle'
-    do k = 1, size(sizes)
-        call run_case(sizes(k), det_mean(k), det_min(k))
-    end do
-    write (output_unit, '(a, f6.2, a, f6.2, a)') '# detection time 1e5 / 1e4: ', det_mean(3)/det_mean(2), &
-        ' (mean), ', det_min(3)/det_min(2), ' (best step)'
+    write (output_unit, '(a)') '# DEM kernel benchmark, 1 core: dense random packing in a box under gravity'
+    write (output_unit, '(a)') '# compiler: '//compiler_version()
+    write (output_unit, '(a)') '# options:  '//compiler_options()
+    call get_command_argument(1, arg)
+    if (arg == '--convergence') then
+        call cold_start_sweeps()
+    else
+        allocate (systems(size(sizes)))
+        do k = 1, size(sizes)
+            call run_case(systems(k), sizes(k), res(k))
+        end do
+        call time_detection(systems, res)
+        call print_table(res)
+    end if
 contains
 
-    !> Build, settle, time and print one case.
-    subroutine run_case(n, t_det, t_best)
+    !> Build, settle, time and measure one case (the system is kept for time_detection).
+    subroutine run_case(sys, n, c)
+        type(dem_system_t), intent(out) :: sys
         integer, intent(in) :: n
-        real(wp), intent(out) :: t_det, t_best
-        type(dem_system_t) :: sys
-        integer(i8) :: updates, sweeps
-        integer :: step, contacts, active, n_measure
-        real(wp) :: t_sol, before
-        ! at least 5 timed steps, and about 1e5 disk-steps, to average out timer noise
-        n_measure = max(5, 100000/n)
-        call build(sys, n)
-        do step = 1, n_settle
+        type(case_t), intent(out) :: c
+        real(wp), allocatable :: t_det(:), t_sol(:), rate(:)
+        integer :: s, n_steps, sweeps, n_conv
+        real(wp) :: before_det, before_sol
+        ! at least 8 steps, and ~2e5 disk-steps for the small cases
+        n_steps = max(8, 200000/n)
+        call build(sys, n, c)
+        do s = 1, n_settle
             call mj_step(sys)
         end do
-        sys%time_detection = 0.0_wp
-        sys%time_solver = 0.0_wp
-        updates = 0_i8
-        sweeps = 0_i8
-        t_best = huge(1.0_wp)
-        do step = 1, n_measure
-            before = sys%time_detection
+        allocate (t_det(n_steps), t_sol(n_steps), rate(n_steps))
+        sweeps = 0
+        n_conv = 0
+        do s = 1, n_steps
+            before_det = sys%time_detection
+            before_sol = sys%time_solver
             call mj_step(sys)
-            t_best = min(t_best, sys%time_detection - before)
-            updates = updates + sys%stats%updates
+            t_det(s) = sys%time_detection - before_det
+            t_sol(s) = sys%time_solver - before_sol
+            rate(s) = real(sys%stats%updates, wp)/max(t_sol(s), tiny(1.0_wp))
             sweeps = sweeps + sys%stats%sweeps
+            c%sweeps_max = max(c%sweeps_max, sys%stats%sweeps)
+            if (sys%stats%converged) n_conv = n_conv + 1
         end do
-        contacts = sys%contacts%n
-        active = sys%stats%n_active
-        t_det = sys%time_detection/n_measure
-        t_sol = sys%time_solver/n_measure
-        write (output_unit, '(i9, 2i10, f13.1, f13.2, f7.2, f12.2, es11.3, i16)') sys%particles%n, contacts, &
-            active, real(sweeps, wp)/n_measure, 1.0e3_wp*t_det, 1.0e3_wp*t_best, 1.0e3_wp*t_sol, &
-            real(updates, wp)/sys%time_solver, dem_system_bytes(sys)/sys%particles%n
+        c%contacts = sys%contacts%n
+        c%active = sys%stats%n_active
+        c%sweeps = real(sweeps, wp)/n_steps
+        c%converged = real(n_conv, wp)/n_steps
+        c%det_med = median(t_det)
+        c%det_best = minval(t_det)
+        c%sol_med = median(t_sol)
+        c%sol_best = minval(t_sol)
+        c%rate = median(rate)
+        c%rate_best = maxval(rate)
+        c%bytes = real(dem_system_bytes(sys), wp)/sys%particles%n
+        associate (p => sys%particles)
+            c%v_mean = sum(hypot(p%vx(1:p%n), p%vy(1:p%n)))/p%n/(gravity*step)
+            c%v_max = maxval(hypot(p%vx(1:p%n), p%vy(1:p%n)))/(gravity*step)
+        end associate
+        write (output_unit, '(a, i0, a, f0.1, a)') '# N = ', c%n, ' done (', sum(t_det) + sum(t_sol), &
+            ' s timed)'
         flush (output_unit)
     end subroutine run_case
 
-    !> Hexagonal packing of about n disks (square box), walls, law, scheme.
-    subroutine build(sys, n)
+    !> The detection alone, again on the configuration of the last step of each system (it
+    !> finds the same list), in interleaved rounds so that the load of a shared machine hits
+    !> every size alike: per round, each size is timed over max(1, 1e5/N) calls. Median and
+    !> best per call over the rounds.
+    subroutine time_detection(systems, res)
+        type(dem_system_t), intent(inout) :: systems(:)
+        type(case_t), intent(inout) :: res(:)
+        real(wp), allocatable :: t(:, :)
+        integer(i8) :: t0, t1, clock_rate
+        integer :: round, k, call_no, calls
+        allocate (t(n_rounds, size(systems)))
+        do round = 1, n_rounds
+            do k = 1, size(systems)
+                associate (sys => systems(k))
+                    calls = max(1, 100000/sys%particles%n)
+                    call system_clock(t0, clock_rate)
+                    do call_no = 1, calls
+                        call detect_contacts(sys%detector, sys%xm, sys%ym, sys%particles%radius, &
+                                             sys%scheme%alert, sys%wx1, sys%wy1, sys%wx2, sys%wy2, &
+                                             sys%contacts)
+                    end do
+                    call system_clock(t1)
+                    t(round, k) = real(t1 - t0, wp)/real(clock_rate, wp)/calls
+                end associate
+            end do
+        end do
+        do k = 1, size(systems)
+            res(k)%rep_med = median(t(:, k))
+            res(k)%rep_best = minval(t(:, k))
+        end do
+    end subroutine time_detection
+
+    !> Sweeps of the first step (reactions start at zero) until the tolerance, for packings of
+    !> increasing height: the weight has to travel from the top layer to the floor.
+    subroutine cold_start_sweeps()
+        integer, parameter :: cold_sizes(4) = [250, 1000, 4000, 16000]
+        type(dem_system_t) :: sys
+        type(case_t) :: c
+        integer :: k
+        write (output_unit, '(a)') '# first step from rest, no warm start, tolerance 1.666e-4, ' &
+            //'cap 50000 sweeps; height/d: deposit height in mean diameters'
+        write (output_unit, '(a)') '#      N  height/d  active  sweeps  converged  solve[s]  updates/s' &
+            //'   v_mean[g h]'
+        do k = 1, size(cold_sizes)
+            call build(sys, cold_sizes(k), c)
+            sys%solver%max_sweeps = 50000
+            call mj_step(sys)
+            associate (p => sys%particles)
+                write (output_unit, '(i8, f10.0, i8, i8, l11, f10.2, es11.3, f14.3)') c%n, &
+                    c%height/(2.0_wp*radius_mean), sys%stats%n_active, sys%stats%sweeps, &
+                    sys%stats%converged, sys%time_solver, real(sys%stats%updates, wp)/sys%time_solver, &
+                    sum(hypot(p%vx(1:p%n), p%vy(1:p%n)))/p%n/(gravity*step)
+            end associate
+            flush (output_unit)
+        end do
+    end subroutine cold_start_sweeps
+
+    !> Random packing of n disks in a box, walls, law, scheme.
+    subroutine build(sys, n, c)
         type(dem_system_t), intent(out) :: sys
         integer, intent(in) :: n
-        real(wp), parameter :: r = 1.0e-3_wp
-        real(wp), allocatable :: x(:), y(:), radius(:), density(:)
+        type(case_t), intent(inout) :: c
+        real(wp), parameter :: pi = 3.141592653589793238462643383279502884_wp
+        real(wp), parameter :: rmin = 0.8_wp*radius_mean, rmax = 1.2_wp*radius_mean
+        real(wp), allocatable :: x(:), y(:), radius(:)
         type(error_t), allocatable :: error
-        type(rng_t) :: rng
-        real(wp) :: top
-        integer :: nx, ny, i
-        nx = nint(sqrt(n*sqrt(3.0_wp)/2.0_wp))
-        ny = n/nx
-        call generate_hex_lattice(nx, ny, 0.0_wp, 0.0_wp, r, 0.0_wp, x, y, radius, error)
-        call rng_seed(rng, 42)
-        allocate (density(size(x)))
-        do i = 1, size(x)
-            call rng_uniform_in(rng, 1250.0_wp, 3750.0_wp, density(i))
-        end do
-        call particles_add_disks(sys%particles, x, y, radius, density, error)
-        top = maxval(y) + 10.0_wp*r
-        call walls_add(sys%walls, -r, -r, 2.0_wp*r*nx + r, -r, error)
-        call walls_add(sys%walls, -r, -r, -r, top, error)
-        call walls_add(sys%walls, 2.0_wp*r*nx, -r, 2.0_wp*r*nx, top, error)
+        integer(i8) :: t0, t1, clock_rate
+        real(wp) :: width, top
+        call system_clock(t0, clock_rate)
+        width = deposit_width(n, rmin, rmax, 1.0_wp)
+        call deposit_disks(n, width, rmin, rmax, 42, x, y, radius, c%stuck)
+        call system_clock(t1)
+        c%n = n
+        c%t_build = real(t1 - t0, wp)/real(clock_rate, wp)
+        c%width = width
+        c%height = maxval(y + radius)
+        ! solid fraction below the height where the surface roughness starts (90 % of the top)
+        c%solid_fraction = sum(pi*radius**2, mask=y + radius < 0.9_wp*c%height)/(width*0.9_wp*c%height)
+        call particles_add_disks(sys%particles, x, y, (1.0_wp + 1.0e-6_wp)*radius, [2500.0_wp], error)
+        if (allocated(error)) error stop 'bench_dem: invalid disks'
+        top = c%height + 10.0_wp*rmax
+        call walls_add(sys%walls, 0.0_wp, 0.0_wp, width, 0.0_wp, error)
+        call walls_add(sys%walls, 0.0_wp, 0.0_wp, 0.0_wp, top, error)
+        call walls_add(sys%walls, width, 0.0_wp, width, top, error)
+        if (allocated(error)) error stop 'bench_dem: invalid walls'
         call materials_init(sys%materials, 1, error)
+        if (allocated(error)) error stop 'bench_dem: invalid material table'
         call materials_set_pair(sys%materials, 1, 1, 0.5_wp, 0.0_wp, 0.0_wp, error)
-        sys%particles%gravity = [0.0_wp, -9.81_wp]
-        sys%scheme%h = 1.0e-3_wp
-        sys%scheme%alert = 0.05_wp*r
+        if (allocated(error)) error stop 'bench_dem: invalid material pair'
+        sys%particles%gravity = [0.0_wp, -gravity]
+        sys%scheme%h = step
+        sys%scheme%alert = 0.05_wp*radius_mean
         sys%solver%tol = 1.666e-4_wp
         sys%solver%max_sweeps = 200
         call mj_init(sys, error)
         if (allocated(error)) error stop 'bench_dem: invalid setup'
     end subroutine build
+
+    !> The tables of figures and the detection scaling ratio.
+    subroutine print_table(res)
+        type(case_t), intent(in) :: res(:)
+        integer :: k
+        write (output_unit, '(a)') '#'
+        write (output_unit, '(a)') '# packing: box width x height [mm], solid fraction (below 90 % of ' &
+            //'the height), build time [s], disks left stuck, contacts per disk; mean and max speed ' &
+            //'after the timed steps [g h]'
+        write (output_unit, '(a)') '#      N   width  height  solid  build[s] stuck  contacts/disk' &
+            //'   v_mean   v_max'
+        do k = 1, size(res)
+            associate (c => res(k))
+                write (output_unit, '(i8, 2f8.1, f7.3, f10.3, i6, f15.2, 2f9.2)') c%n, &
+                    1.0e3_wp*c%width, 1.0e3_wp*c%height, c%solid_fraction, c%t_build, c%stuck, &
+                    real(c%contacts, wp)/c%n, c%v_mean, c%v_max
+            end associate
+        end do
+        write (output_unit, '(a)') '#'
+        write (output_unit, '(a)') '# times per step [ms]: median and best over the timed steps; ' &
+            //'detect(rep): the detection alone repeated on one configuration, sizes interleaved'
+        write (output_unit, '(a)') '#      N  contacts    active  sweeps(mean,max)  conv   detect(step)' &
+            //'     detect(rep)      solve(step)   updates/s(step)       bytes/disk'
+        do k = 1, size(res)
+            associate (c => res(k))
+                write (output_unit, '(i8, 2i10, f9.1, i6, f7.2, 2(f9.2, f7.2), f10.1, f8.1, 2es11.3, &
+                    &f10.0)') &
+                    c%n, c%contacts, c%active, c%sweeps, c%sweeps_max, c%converged, 1.0e3_wp*c%det_med, &
+                    1.0e3_wp*c%det_best, 1.0e3_wp*c%rep_med, 1.0e3_wp*c%rep_best, 1.0e3_wp*c%sol_med, &
+                    1.0e3_wp*c%sol_best, c%rate, c%rate_best, c%bytes
+            end associate
+        end do
+        if (size(res) >= 3) then
+            write (output_unit, '(a, 4(f6.2, a))') '# detection time 1e5 / 1e4: ', &
+                res(3)%rep_best/res(2)%rep_best, ' (repeated, best), ', res(3)%rep_med/res(2)%rep_med, &
+                ' (repeated, median), ', res(3)%det_best/res(2)%det_best, ' (steps, best), ', &
+                res(3)%det_med/res(2)%det_med, ' (steps, median)'
+        end if
+    end subroutine print_table
+
+    !> Median of a sample.
+    real(wp) function median(a) result(m)
+        real(wp), intent(in) :: a(:)
+        real(wp), allocatable :: s(:)
+        real(wp) :: key
+        integer :: i, j, n
+        allocate (s, source=a)
+        n = size(s)
+        do i = 2, n
+            key = s(i)
+            j = i - 1
+            do while (j >= 1)
+                if (s(j) <= key) exit
+                s(j + 1) = s(j)
+                j = j - 1
+            end do
+            s(j + 1) = key
+        end do
+        m = s((n + 1)/2)
+        if (mod(n, 2) == 0) m = 0.5_wp*(s(n/2) + s(n/2 + 1))
+    end function median
 end program bench_dem

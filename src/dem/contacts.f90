@@ -18,7 +18,7 @@ module dem_contacts
     private
     public :: contact_set_t, contact_law_t
     public :: status_open, status_stick, status_slip, status_cohesive, status_broken
-    public :: contacts_begin_detection, contacts_append
+    public :: contacts_begin_detection, contacts_append, contacts_append_owner
     public :: contacts_set_frames, contacts_set_laws, contacts_finish, contacts_impulses
     public :: contacts_local_velocity, contacts_count_status, contacts_bytes
 
@@ -132,8 +132,42 @@ contains
         real(wp), intent(in) :: nx, ny
         !> Gap [m].
         real(wp), intent(in) :: gap
-        integer :: k, p, cmp
         if (cs%n == cs%capacity) call ensure_capacity(cs, cs%n + 1)
+        call append_one(cs, i1, i2, nx, ny, gap)
+    end subroutine contacts_append
+
+    !> Append the contacts of one owner disk, in contact order (as contacts_append for each):
+    !> other(a) < 0 is wall -other(a) (pair (other(a), owner)), other(a) > owner is a disk
+    !> (pair (owner, other(a))); walls first, then disks, each by increasing index.
+    subroutine contacts_append_owner(cs, owner, other, nrm, gap)
+        !> Contacts.
+        type(contact_set_t), intent(inout) :: cs
+        !> Owner disk.
+        integer, intent(in) :: owner
+        !> Other bodies, sorted.
+        integer, intent(in) :: other(:)
+        !> Unit normals (2, :) from the first body of each pair to the second.
+        real(wp), intent(in) :: nrm(:, :)
+        !> Gaps [m].
+        real(wp), intent(in) :: gap(:)
+        integer :: a
+        if (cs%n + size(other) > cs%capacity) call ensure_capacity(cs, cs%n + size(other))
+        do a = 1, size(other)
+            if (other(a) < 0) then
+                call append_one(cs, other(a), owner, nrm(1, a), nrm(2, a), gap(a))
+            else
+                call append_one(cs, owner, other(a), nrm(1, a), nrm(2, a), gap(a))
+            end if
+        end do
+    end subroutine contacts_append_owner
+
+    !> Append one pair (capacity available), merging with the previous list for the warm start.
+    pure subroutine append_one(cs, i1, i2, nx, ny, gap)
+        type(contact_set_t), intent(inout) :: cs
+        integer, intent(in) :: i1, i2
+        real(wp), intent(in) :: nx, ny, gap
+        integer(i8) :: key
+        integer :: k, p
         k = cs%n + 1
         cs%n = k
         cs%i1(k) = i1
@@ -141,20 +175,27 @@ contains
         cs%nrm(1, k) = nx
         cs%nrm(2, k) = ny
         cs%gap(k) = gap
-        cs%r(:, k) = 0.0_wp
-        cs%status(k) = status_open
-        cmp = 1
-        do p = cs%merge_pos, cs%n_prev
-            cmp = compare(cs%prev_i1(p), cs%prev_i2(p), i1, i2)
-            if (cmp >= 0) exit
+        ! skip the previous pairs that come before this one
+        key = pair_key(i1, i2)
+        p = cs%merge_pos
+        do while (p <= cs%n_prev)
+            if (pair_key(cs%prev_i1(p), cs%prev_i2(p)) >= key) exit
+            p = p + 1
         end do
         cs%merge_pos = p
-        if (cmp == 0) then
-            cs%r(:, k) = cs%prev_r(:, p)
-            cs%status(k) = cs%prev_status(p)
-            cs%merge_pos = p + 1
+        if (p <= cs%n_prev) then
+            if (cs%prev_i1(p) == i1 .and. cs%prev_i2(p) == i2) then
+                cs%r(1, k) = cs%prev_r(1, p)
+                cs%r(2, k) = cs%prev_r(2, p)
+                cs%status(k) = cs%prev_status(p)
+                cs%merge_pos = p + 1
+                return
+            end if
         end if
-    end subroutine contacts_append
+        cs%r(1, k) = 0.0_wp
+        cs%r(2, k) = 0.0_wp
+        cs%status(k) = status_open
+    end subroutine append_one
 
     !> Grow every per-contact array to hold at least m contacts (keeps the first n).
     subroutine ensure_capacity(cs, m)
@@ -179,22 +220,16 @@ contains
         cs%capacity = cap
     end subroutine ensure_capacity
 
-    !> Order of two pairs: -1, 0, 1 as (a1, a2) comes before, equals, after (b1, b2).
-    pure integer function compare(a1, a2, b1, b2) result(c)
-        integer, intent(in) :: a1, a2, b1, b2
-        integer :: oa, ob, sa, sb
-        oa = merge(a1, a2, a1 > 0)
-        ob = merge(b1, b2, b1 > 0)
-        sa = merge(a2, a1, a1 > 0)
-        sb = merge(b2, b1, b1 > 0)
-        if (oa /= ob) then
-            c = merge(-1, 1, oa < ob)
-        else if (sa /= sb) then
-            c = merge(-1, 1, sa < sb)
+    !> Sort key of a pair: (owner, other) in lexicographic order, owner = the disk i1 of a
+    !> disk pair or the disk i2 of a wall contact, other = the other body (walls negative).
+    pure integer(i8) function pair_key(i1, i2) result(key)
+        integer, intent(in) :: i1, i2
+        if (i1 > 0) then
+            key = ishft(int(i1, i8), 32) + int(i2, i8)
         else
-            c = 0
+            key = ishft(int(i2, i8), 32) + int(i1, i8)
         end if
-    end function compare
+    end function pair_key
 
     !> Lever arms and Delassus blocks from radii and inverse masses per DOF (0 when fixed).
     pure subroutine contacts_set_frames(cs, radius, im)

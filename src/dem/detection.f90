@@ -2,13 +2,17 @@
 !> disk-wall pairs within an alert distance.
 !>
 !> Cells are squares of side max diameter + alert (enlarged if the bounding box would need more
-!> than 4 N + 64 cells), built by a counting sort of the disks. A disk meets only disks of its
-!> own and the 8 surrounding cells; each cell also lists the walls that pass within reach of it.
+!> than 4 N + 64 cells), built by a counting sort of the disks that also copies their centres
+!> and radii in cell order (the broad phase then reads contiguous memory: the three cells of a
+!> row of neighbours are one range). A disk meets only disks of its own and the 8 surrounding
+!> cells; each cell also lists the walls that pass within reach of it. No allocation once the
+!> work arrays have reached their size.
 !> Candidates of each owner disk are sorted so that the list comes out in the contact order of
 !> `dem_contacts`, which matches them with the previous list for the warm start.
 module dem_detection
     use core_kinds, only: wp, i8
-    use dem_contacts, only: contact_set_t, contacts_begin_detection, contacts_append
+    use dem_contacts, only: contact_set_t, contacts_begin_detection, contacts_append, &
+                            contacts_append_owner
     use dem_walls, only: segment_closest_point
     implicit none
     private
@@ -26,8 +30,14 @@ module dem_detection
         integer, allocatable :: cell_of(:)
         !> Disks sorted by cell; disks of cell c are sorted(start(c):start(c+1)-1).
         integer, allocatable :: sorted(:), start(:)
+        !> Centres and radii of the disks in cell order: xs(p) = x(sorted(p)).
+        real(wp), allocatable :: xs(:), ys(:), rs(:)
+        !> Most disks in one cell (sizes the candidate buffer).
+        integer :: max_occupancy = 0
         !> Walls near cell c are wall_list(wall_start(c):wall_start(c+1)-1).
         integer, allocatable :: wall_list(:), wall_start(:)
+        !> Fill pointers of the wall lists (work array).
+        integer, allocatable :: wall_pos(:)
         !> Candidate buffer of one owner: other body, normal, gap.
         integer, allocatable :: cand(:)
         !> Candidate normals (2, :) and gaps.
@@ -49,16 +59,20 @@ contains
         real(wp), intent(in) :: wx1(:), wy1(:), wx2(:), wy2(:)
         !> Contacts.
         type(contact_set_t), intent(inout) :: cs
-        integer :: i, n
+        integer :: need
         call contacts_begin_detection(cs)
-        n = size(x)
-        if (n == 0) return
+        if (size(x) == 0) return
         call build_grid(det, x, y, radius, alert)
         call build_wall_lists(det, maxval(radius) + alert, wx1, wy1, wx2, wy2)
-        if (.not. allocated(det%cand)) allocate (det%cand(64), det%cand_n(2, 64), det%cand_gap(64))
-        do i = 1, n
-            call owner_candidates(det, i, x, y, radius, alert, wx1, wy1, wx2, wy2, cs)
-        end do
+        ! room for every candidate of one owner: its walls and the disks of 9 cells
+        need = size(wx1) + 9*det%max_occupancy
+        if (allocated(det%cand)) then
+            if (size(det%cand) < need) deallocate (det%cand, det%cand_n, det%cand_gap)
+        end if
+        if (.not. allocated(det%cand)) allocate (det%cand(need), det%cand_n(2, need), det%cand_gap(need))
+        call scan_owners(alert, det%x0, det%y0, det%inv_cell, det%ncx, det%ncy, x, y, radius, &
+                         det%cell_of, det%start, det%sorted, det%xs, det%ys, det%rs, det%wall_start, &
+                         det%wall_list, wx1, wy1, wx2, wy2, det%cand, det%cand_n, det%cand_gap, cs)
     end subroutine detect_contacts
 
     !> Grid geometry and counting sort of the disks by cell.
@@ -66,7 +80,7 @@ contains
         type(detector_t), intent(inout) :: det
         real(wp), intent(in) :: x(:), y(:), radius(:), alert
         real(wp) :: ex, ey, limit
-        integer :: i, n, c, ncell
+        integer :: i, n, c, ncell, p
         n = size(x)
         det%x0 = minval(x)
         det%y0 = minval(y)
@@ -82,12 +96,16 @@ contains
         call resize(det%cell_of, n)
         call resize(det%sorted, n)
         call resize(det%start, ncell + 1)
+        call resize_real(det%xs, n)
+        call resize_real(det%ys, n)
+        call resize_real(det%rs, n)
         det%start = 0
         do i = 1, n
             c = cell_index(det, x(i), y(i))
             det%cell_of(i) = c
             det%start(c + 1) = det%start(c + 1) + 1
         end do
+        det%max_occupancy = maxval(det%start(2:ncell + 1))
         det%start(1) = 1
         do c = 1, ncell
             det%start(c + 1) = det%start(c + 1) + det%start(c)
@@ -95,8 +113,12 @@ contains
         ! fill, then shift the starts back
         do i = 1, n
             c = det%cell_of(i)
-            det%sorted(det%start(c)) = i
-            det%start(c) = det%start(c) + 1
+            p = det%start(c)
+            det%sorted(p) = i
+            det%xs(p) = x(i)
+            det%ys(p) = y(i)
+            det%rs(p) = radius(i)
+            det%start(c) = p + 1
         end do
         do c = ncell, 1, -1
             det%start(c + 1) = det%start(c)
@@ -119,13 +141,14 @@ contains
     subroutine build_wall_lists(det, reach, wx1, wy1, wx2, wy2)
         type(detector_t), intent(inout) :: det
         real(wp), intent(in) :: reach, wx1(:), wy1(:), wx2(:), wy2(:)
-        integer, allocatable :: pos(:)
         integer :: ncell, k, c
         ncell = det%ncx*det%ncy
         call resize(det%wall_start, ncell + 1)
         det%wall_start = 0
         if (size(wx1) == 0) then
             det%wall_start = 1
+            ! allocated all the same: it is passed to scan_owners
+            call resize(det%wall_list, 1)
             return
         end if
         ! pass 1: count the walls of cell c in wall_start(c + 1), then prefix sums
@@ -137,11 +160,12 @@ contains
             det%wall_start(c + 1) = det%wall_start(c + 1) + det%wall_start(c)
         end do
         call resize(det%wall_list, max(det%wall_start(ncell + 1) - 1, 1))
-        ! pass 2: store, pos(c + 1) being the next free slot of cell c
-        pos = det%wall_start(1:ncell + 1)
-        pos(2:ncell + 1) = pos(1:ncell)
+        ! pass 2: store, wall_pos(c + 1) being the next free slot of cell c
+        call resize(det%wall_pos, ncell + 1)
+        det%wall_pos(2:ncell + 1) = det%wall_start(1:ncell)
         do k = 1, size(wx1)
-            call visit_wall_cells(det, k, reach, wx1(k), wy1(k), wx2(k), wy2(k), pos, fill=.true.)
+            call visit_wall_cells(det, k, reach, wx1(k), wy1(k), wx2(k), wy2(k), det%wall_pos, &
+                                  fill=.true.)
         end do
     end subroutine build_wall_lists
 
@@ -181,103 +205,94 @@ contains
         c = int(floor(min(max(s, -1.0_wp), real(nc, wp))))
     end function clamp_cell
 
-    !> Candidates of owner disk i (walls near its cell, disks j > i in the 9 cells around it),
-    !> sorted and appended to the list.
-    subroutine owner_candidates(det, i, x, y, radius, alert, wx1, wy1, wx2, wy2, cs)
-        type(detector_t), intent(inout) :: det
-        integer, intent(in) :: i
-        real(wp), intent(in) :: x(:), y(:), radius(:), alert, wx1(:), wy1(:), wx2(:), wy2(:)
+    !> Broad and narrow phase, owner by owner (i = 1, 2, ...): the walls listed for the cell of
+    !> disk i, then the disks j > i of the 9 cells around it (three contiguous ranges of the
+    !> cell-ordered arrays); the hits are sorted by the other body and appended to the list.
+    !> The grid is passed as plain arrays so that the compiler keeps them in registers.
+    subroutine scan_owners(alert, x0, y0, inv_cell, ncx, ncy, x, y, radius, cell_of, start, &
+                           sorted, xs, ys, rs, wall_start, wall_list, wx1, wy1, wx2, wy2, &
+                           cand, cand_n, cand_gap, cs)
+        real(wp), intent(in) :: alert, x0, y0, inv_cell
+        integer, intent(in) :: ncx, ncy
+        real(wp), intent(in), contiguous :: x(:), y(:), radius(:)
+        integer, intent(in), contiguous :: cell_of(:), start(:), sorted(:)
+        integer, intent(in), contiguous :: wall_start(:), wall_list(:)
+        real(wp), intent(in), contiguous :: xs(:), ys(:), rs(:)
+        real(wp), intent(in) :: wx1(:), wy1(:), wx2(:), wy2(:)
+        integer, intent(inout), contiguous :: cand(:)
+        real(wp), intent(inout), contiguous :: cand_n(:, :), cand_gap(:)
         type(contact_set_t), intent(inout) :: cs
-        integer :: m, c, cx, cy, dx, dy, p, j, k
-        real(wp) :: nx, ny, gap
+        integer :: i, m, c, cx, cy, dy, p, j, k, row
+        real(wp) :: nx, ny, gap, xi, yi, ri
         logical :: hit
-        m = 0
-        c = det%cell_of(i)
-        do p = det%wall_start(c), det%wall_start(c + 1) - 1
-            k = det%wall_list(p)
-            call disk_wall(x(i), y(i), radius(i), wx1(k), wy1(k), wx2(k), wy2(k), alert, hit, nx, ny, gap)
-            if (hit) call push(det, m, -k, nx, ny, gap)
-        end do
-        cx = mod(c - 1, det%ncx)
-        cy = (c - 1)/det%ncx
-        do dy = max(cy - 1, 0), min(cy + 1, det%ncy - 1)
-            do dx = max(cx - 1, 0), min(cx + 1, det%ncx - 1)
-                c = dx + det%ncx*dy + 1
-                do p = det%start(c), det%start(c + 1) - 1
-                    j = det%sorted(p)
+        do i = 1, size(x)
+            m = 0
+            xi = x(i)
+            yi = y(i)
+            ri = radius(i)
+            c = cell_of(i)
+            do p = wall_start(c), wall_start(c + 1) - 1
+                k = wall_list(p)
+                call disk_wall(xi, yi, ri, wx1(k), wy1(k), wx2(k), wy2(k), alert, hit, nx, ny, gap)
+                if (.not. hit) cycle
+                m = m + 1
+                cand(m) = -k
+                cand_n(1, m) = nx
+                cand_n(2, m) = ny
+                cand_gap(m) = gap
+            end do
+            ! cell coordinates from the position (same clamping as cell_index, no integer division)
+            cx = min(max(int((xi - x0)*inv_cell), 0), ncx - 1)
+            cy = min(max(int((yi - y0)*inv_cell), 0), ncy - 1)
+            do dy = max(cy - 1, 0), min(cy + 1, ncy - 1)
+                row = ncx*dy + 1
+                do p = start(row + max(cx - 1, 0)), start(row + min(cx + 1, ncx - 1) + 1) - 1
+                    j = sorted(p)
                     if (j <= i) cycle
-                    call disk_disk(x(i), y(i), radius(i), x(j), y(j), radius(j), alert, hit, nx, ny, gap)
+                    ! xs(p) = x(j) etc.: the same numbers as the brute-force search
+                    call disk_disk(xi, yi, ri, xs(p), ys(p), rs(p), alert, hit, nx, ny, gap)
                     if (.not. hit) cycle
-                    if (m == size(det%cand)) then
-                        call push(det, m, j, nx, ny, gap)
-                    else
-                        m = m + 1
-                        det%cand(m) = j
-                        det%cand_n(1, m) = nx
-                        det%cand_n(2, m) = ny
-                        det%cand_gap(m) = gap
-                    end if
+                    m = m + 1
+                    cand(m) = j
+                    cand_n(1, m) = nx
+                    cand_n(2, m) = ny
+                    cand_gap(m) = gap
                 end do
             end do
+            call sort_candidates(m, cand, cand_n, cand_gap)
+            call contacts_append_owner(cs, i, cand(1:m), cand_n(:, 1:m), cand_gap(1:m))
         end do
-        call emit_sorted(det, m, i, cs)
-    end subroutine owner_candidates
+    end subroutine scan_owners
 
-    !> Append one candidate to the buffer (grown as needed).
-    subroutine push(det, m, other, nx, ny, gap)
-        type(detector_t), intent(inout) :: det
-        integer, intent(inout) :: m
-        integer, intent(in) :: other
-        real(wp), intent(in) :: nx, ny, gap
-        integer, allocatable :: ti(:)
-        real(wp), allocatable :: tn(:, :), tg(:)
-        if (m == size(det%cand)) then
-            allocate (ti(2*m), tn(2, 2*m), tg(2*m))
-            ti(1:m) = det%cand(1:m)
-            tn(:, 1:m) = det%cand_n(:, 1:m)
-            tg(1:m) = det%cand_gap(1:m)
-            call move_alloc(ti, det%cand)
-            call move_alloc(tn, det%cand_n)
-            call move_alloc(tg, det%cand_gap)
-        end if
-        m = m + 1
-        det%cand(m) = other
-        det%cand_n(:, m) = [nx, ny]
-        det%cand_gap(m) = gap
-    end subroutine push
-
-    !> Insertion sort of the m candidates of owner i by the other body (walls, negative,
-    !> first), then append them to the list.
-    subroutine emit_sorted(det, m, i, cs)
-        type(detector_t), intent(inout) :: det
-        integer, intent(in) :: m, i
-        type(contact_set_t), intent(inout) :: cs
+    !> Insertion sort of the m candidates of one owner by the other body (walls, negative,
+    !> first); they come nearly sorted when disks are numbered by position.
+    pure subroutine sort_candidates(m, cand, cand_n, cand_gap)
+        integer, intent(in) :: m
+        integer, intent(inout) :: cand(:)
+        real(wp), intent(inout) :: cand_n(:, :), cand_gap(:)
         integer :: a, b, key
-        real(wp) :: nrm(2), gap
+        real(wp) :: nx, ny, gap
         do a = 2, m
-            key = det%cand(a)
-            nrm = det%cand_n(:, a)
-            gap = det%cand_gap(a)
+            key = cand(a)
+            if (cand(a - 1) <= key) cycle
+            nx = cand_n(1, a)
+            ny = cand_n(2, a)
+            gap = cand_gap(a)
             b = a - 1
             do while (b >= 1)
-                if (det%cand(b) <= key) exit
-                det%cand(b + 1) = det%cand(b)
-                det%cand_n(:, b + 1) = det%cand_n(:, b)
-                det%cand_gap(b + 1) = det%cand_gap(b)
+                if (cand(b) <= key) exit
+                cand(b + 1) = cand(b)
+                cand_n(1, b + 1) = cand_n(1, b)
+                cand_n(2, b + 1) = cand_n(2, b)
+                cand_gap(b + 1) = cand_gap(b)
                 b = b - 1
             end do
-            det%cand(b + 1) = key
-            det%cand_n(:, b + 1) = nrm
-            det%cand_gap(b + 1) = gap
+            cand(b + 1) = key
+            cand_n(1, b + 1) = nx
+            cand_n(2, b + 1) = ny
+            cand_gap(b + 1) = gap
         end do
-        do a = 1, m
-            if (det%cand(a) < 0) then
-                call contacts_append(cs, det%cand(a), i, det%cand_n(1, a), det%cand_n(2, a), det%cand_gap(a))
-            else
-                call contacts_append(cs, i, det%cand(a), det%cand_n(1, a), det%cand_n(2, a), det%cand_gap(a))
-            end if
-        end do
-    end subroutine emit_sorted
+    end subroutine sort_candidates
 
     !> Reference detection by testing every pair (O(N^2)); same output and order as
     !> detect_contacts. For tests and small systems.
@@ -354,8 +369,9 @@ contains
         !> Detection workspace.
         type(detector_t), intent(in) :: det
         b = 4_i8*(isize(det%cell_of) + isize(det%sorted) + isize(det%start) + isize(det%wall_list) &
-                  + isize(det%wall_start) + isize(det%cand))
+                  + isize(det%wall_start) + isize(det%wall_pos) + isize(det%cand))
         if (allocated(det%cand_n)) b = b + 8_i8*(size(det%cand_n) + size(det%cand_gap))
+        if (allocated(det%xs)) b = b + 8_i8*(size(det%xs) + size(det%ys) + size(det%rs))
     contains
         pure integer(i8) function isize(a)
             integer, allocatable, intent(in) :: a(:)
@@ -374,4 +390,15 @@ contains
         end if
         allocate (a(m))
     end subroutine resize
+
+    !> Make sure a real work array has at least m entries.
+    subroutine resize_real(a, m)
+        real(wp), allocatable, intent(inout) :: a(:)
+        integer, intent(in) :: m
+        if (allocated(a)) then
+            if (size(a) >= m) return
+            deallocate (a)
+        end if
+        allocate (a(m))
+    end subroutine resize_real
 end module dem_detection
