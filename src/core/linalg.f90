@@ -17,7 +17,6 @@ module core_linalg
     private
     public :: band_spd_t, dense_spd_t, band_generalized_eigen, largest_generalized_eigenvalue
 
-
     !> Symmetric positive-definite band matrix (upper band storage) and its Cholesky factor.
     type :: band_spd_t
         !> Order of the matrix.

@@ -43,7 +43,7 @@ contains
         !> One character.
         character(len=1), intent(in) :: c
         is_blank_char = c == ' ' .or. c == achar(9) .or. c == achar(13) .or. c == achar(10) &
-            .or. c == achar(12)
+                        .or. c == achar(12)
     end function is_blank_char
 
     !> Copy of a string without leading and trailing blanks (tabs included).
@@ -192,7 +192,7 @@ contains
         call scan_real(text, ok, magnitude)
         ! range() is 307 for IEEE double: |x| < 1e308 cannot overflow, |x| >= 1e-307 is normal.
         if (ok) ok = magnitude <= range(value) .and. (magnitude >= -range(value) .or. &
-            magnitude == -huge(0))
+                                                      magnitude == -huge(0))
         if (.not. ok) return
         read (text, *, iostat=ios) value
         ok = ios == 0

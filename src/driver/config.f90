@@ -146,8 +146,8 @@ contains
         allocate (beam%sections(0), beam%loads(0), beam%fixed(3, 0), fix_line(3, 0))
         if (deck%get_word('run', 'analysis') /= 'dynamic') then
             call make_input_error(error, deck%file, deck%line('run', 'analysis'), 'analysis', &
-                'particles are integrated in time: set analysis = dynamic (a '// &
-                deck%get_word('run', 'analysis')//' analysis needs a [beam] model)')
+                                  'particles are integrated in time: set analysis = dynamic (a '// &
+                                  deck%get_word('run', 'analysis')//' analysis needs a [beam] model)')
             return
         end if
         call build_functions(deck, beam, function_ids, error)
@@ -179,8 +179,8 @@ contains
             j = find_id(ids(:i - 1), ids(i))
             if (j > 0) then
                 call make_input_error(error, deck%file, e%line, 'section', &
-                    'duplicate section id '// &
-                    to_str(ids(i))//': already defined on line '//to_str(list(j)%line))
+                                      'duplicate section id '// &
+                                      to_str(ids(i))//': already defined on line '//to_str(list(j)%line))
                 return
             end if
             beam%sections(i)%young = e%real(2)
@@ -211,11 +211,11 @@ contains
         if (allocated(error)) return
         if (n_elements == 0) then
             call make_input_error(error, deck%file, 0, '', 'the model has no element: '// &
-                'add [beam] line or element records')
+                                  'add [beam] line or element records')
             return
         end if
         call resolve_elements(deck, elements(:n_elements), section_ids, def_line, &
-            def_generated, beam, error)
+                              def_generated, beam, error)
     end subroutine build_mesh
 
     !> Walk the [beam] entries in file order; list node and element candidates.
@@ -249,7 +249,7 @@ contains
                 case ('line')
                     if (e%int(1) > huge(0) - e%int(6)) then
                         call make_input_error(error, deck%file, e%line, 'line', 'node ids '// &
-                            e%word(1)//' + '//e%word(6)//' exceed the largest integer')
+                                              e%word(1)//' + '//e%word(6)//' exceed the largest integer')
                         return
                     end if
                     total_nodes = total_nodes + e%int(6) + 1
@@ -263,7 +263,7 @@ contains
         end if
         if (stat /= 0) then
             call make_input_error(error, deck%file, 0, '', 'the model is too large: '// &
-                'cannot hold its nodes and elements in memory')
+                                  'cannot hold its nodes and elements in memory')
             return
         end if
         size_model = model_size(deck)
@@ -276,11 +276,11 @@ contains
                 case ('node')
                     n_nodes = n_nodes + 1
                     nodes(n_nodes) = node_candidate_t(e%int(1), e%real(2), e%real(3), 0.0_wp, &
-                        e%line, .false.)
+                                                      e%line, .false.)
                 case ('element')
                     n_elements = n_elements + 1
                     elements(n_elements) = element_candidate_t(e%int(1), [e%int(2), e%int(3)], &
-                        e%int(4), e%line, .false.)
+                                                               e%int(4), e%line, .false.)
                 case ('line')
                     first = e%int(1)
                     x1 = e%real(2)
@@ -291,20 +291,20 @@ contains
                     length = hypot(x2 - x1, y2 - y1)
                     if (length <= coincidence*size_model) then
                         call make_input_error(error, deck%file, e%line, 'line', &
-                            'zero-length line: (x1, y1) and (x2, y2) coincide')
+                                              'zero-length line: (x1, y1) and (x2, y2) coincide')
                         return
                     end if
                     do j = 0, ne
                         n_nodes = n_nodes + 1
                         nodes(n_nodes) = node_candidate_t(first + j, &
-                            x1 + (x2 - x1)*real(j, wp)/real(ne, wp), &
-                            y1 + (y2 - y1)*real(j, wp)/real(ne, wp), &
-                            coincidence*length, e%line, .true.)
+                                                          x1 + (x2 - x1)*real(j, wp)/real(ne, wp), &
+                                                          y1 + (y2 - y1)*real(j, wp)/real(ne, wp), &
+                                                          coincidence*length, e%line, .true.)
                     end do
                     do j = 1, ne
                         n_elements = n_elements + 1
                         elements(n_elements) = element_candidate_t(0, [first + j - 1, first + j], &
-                            e%int(7), e%line, .true.)
+                                                                   e%int(7), e%line, .true.)
                     end do
                 end select
             end associate
@@ -393,16 +393,16 @@ contains
             keyword = merge('line', 'node', again%generated)
             if (.not. again%generated) then
                 call make_input_error(error, deck%file, again%line, keyword, &
-                    'duplicate node id '// &
-                    to_str(again%id)//': already defined on line '// &
-                    to_str(first%line))
+                                      'duplicate node id '// &
+                                      to_str(again%id)//': already defined on line '// &
+                                      to_str(first%line))
             else if (abs(again%x - first%x) > again%tol .or. &
                      abs(again%y - first%y) > again%tol) then
                 call make_input_error(error, deck%file, again%line, keyword, 'node '// &
-                    to_str(again%id)//' would be at ('//to_str(again%x)//', '// &
-                    to_str(again%y)//') but already exists at ('//to_str(first%x)// &
-                    ', '//to_str(first%y)//') (line '//to_str(first%line)// &
-                    '); a line reuses an existing node only where they coincide')
+                                      to_str(again%id)//' would be at ('//to_str(again%x)//', '// &
+                                      to_str(again%y)//') but already exists at ('//to_str(first%x)// &
+                                      ', '//to_str(first%y)//') (line '//to_str(first%line)// &
+                                      '); a line reuses an existing node only where they coincide')
             end if
         end subroutine check_same_node
     end subroutine merge_nodes
@@ -433,23 +433,23 @@ contains
         allocate (beam%conn(2, ne), beam%elem_section(ne), keys(ne))
         size_model = 0.0_wp
         if (size(beam%x) > 0) size_model = hypot(maxval(beam%x) - minval(beam%x), &
-            maxval(beam%y) - minval(beam%y))
+                                                 maxval(beam%y) - minval(beam%y))
         do i = 1, ne
             associate (c => elements(i), kw => merge('line   ', 'element', elements(i)%generated))
                 do k = 1, 2
                     beam%conn(k, i) = find_node(beam%node_id, c%node(k))
                     if (beam%conn(k, i) == 0) then
                         call make_input_error(error, deck%file, c%line, trim(kw), 'node '// &
-                            to_str(c%node(k))//' is not defined (no node or '// &
-                            'line record creates it)')
+                                              to_str(c%node(k))//' is not defined (no node or '// &
+                                              'line record creates it)')
                         return
                     end if
                 end do
                 beam%elem_section(i) = find_id(section_ids, c%section)
                 if (beam%elem_section(i) == 0) then
                     call make_input_error(error, deck%file, c%line, trim(kw), 'section '// &
-                        to_str(c%section)//' is not defined (no [beam] section '// &
-                        'record with this id)')
+                                          to_str(c%section)//' is not defined (no [beam] section '// &
+                                          'record with this id)')
                     return
                 end if
                 a = beam%conn(1, i)
@@ -457,9 +457,9 @@ contains
                 length = hypot(beam%x(b) - beam%x(a), beam%y(b) - beam%y(a))
                 if (length <= coincidence*size_model) then
                     call make_input_error(error, deck%file, c%line, trim(kw), &
-                        'zero-length element: '// &
-                        'nodes '//to_str(c%node(1))//' and '//to_str(c%node(2))// &
-                        ' are at the same place')
+                                          'zero-length element: '// &
+                                          'nodes '//to_str(c%node(1))//' and '//to_str(c%node(2))// &
+                                          ' are at the same place')
                     return
                 end if
                 keys(i) = int(min(a, b), i8)*int(size(beam%x) + 1, i8) + int(max(a, b), i8)
@@ -467,13 +467,13 @@ contains
         end do
         ! Duplicate element ids (explicit elements) and duplicate node pairs.
         order = sort_index([(merge(0_i8, int(elements(i)%id, i8), elements(i)%generated), &
-            i=1, ne)])
+                             i=1, ne)])
         do i = 2, ne
             associate (c => elements(order(i)), prev => elements(order(i - 1)))
                 if (.not. c%generated .and. .not. prev%generated .and. c%id == prev%id) then
                     call make_input_error(error, deck%file, c%line, 'element', &
-                        'duplicate element id '// &
-                        to_str(c%id)//': already defined on line '//to_str(prev%line))
+                                          'duplicate element id '// &
+                                          to_str(c%id)//': already defined on line '//to_str(prev%line))
                     return
                 end if
             end associate
@@ -483,10 +483,10 @@ contains
             if (keys(order(i)) == keys(order(i - 1))) then
                 associate (c => elements(order(i)), prev => elements(order(i - 1)))
                     call make_input_error(error, deck%file, c%line, &
-                        trim(merge('line   ', 'element', c%generated)), &
-                        'element between nodes '//to_str(c%node(1))//' and '// &
-                        to_str(c%node(2))//' duplicates one defined on line '// &
-                        to_str(prev%line))
+                                          trim(merge('line   ', 'element', c%generated)), &
+                                          'element between nodes '//to_str(c%node(1))//' and '// &
+                                          to_str(c%node(2))//' duplicates one defined on line '// &
+                                          to_str(prev%line))
                     return
                 end associate
             end if
@@ -498,8 +498,8 @@ contains
         do i = 1, size(connected)
             if (.not. connected(i)) then
                 call make_input_error(error, deck%file, def_line(i), &
-                    trim(merge('line', 'node', def_generated(i))), 'node '// &
-                    to_str(beam%node_id(i))//' is connected to no element')
+                                      trim(merge('line', 'node', def_generated(i))), 'node '// &
+                                      to_str(beam%node_id(i))//' is connected to no element')
                 return
             end if
         end do
@@ -528,8 +528,8 @@ contains
             j = find_id(ids(:i - 1), ids(i))
             if (j > 0) then
                 call make_input_error(error, deck%file, e%line, 'function', &
-                    'duplicate function id '// &
-                    to_str(ids(i))//': already defined on line '//to_str(list(j)%line))
+                                      'duplicate function id '// &
+                                      to_str(ids(i))//': already defined on line '//to_str(list(j)%line))
                 return
             end if
             tail = e%reals_from(3)
@@ -552,8 +552,8 @@ contains
                     do j = 2, size(f%t)
                         if (f%t(j) <= f%t(j - 1)) then
                             call make_input_error(error, deck%file, e%line, 'function', &
-                                'table times must increase strictly: t = '// &
-                                e%word(2*j + 1)//' follows t = '//e%word(2*j - 1))
+                                                  'table times must increase strictly: t = '// &
+                                                  e%word(2*j + 1)//' follows t = '//e%word(2*j - 1))
                             return
                         end if
                     end do
@@ -637,8 +637,8 @@ contains
                     load%func = find_id(function_ids, e%int(4))
                     if (load%func == 0) then
                         call make_input_error(error, deck%file, e%line, 'load', 'function '// &
-                            e%word(4)//' is not defined (no [functions] '// &
-                            'function record with this id)')
+                                              e%word(4)//' is not defined (no [functions] '// &
+                                              'function record with this id)')
                         return
                     end if
                 end if
@@ -674,25 +674,25 @@ contains
         if (run%analysis == 'dynamic' .and. run%scheme == 'central_difference' .and. &
             .not. beam%lumped_mass) then
             call make_input_error(error, deck%file, deck%line('time', 'scheme'), 'scheme', &
-                'the central-difference scheme needs a lumped mass matrix: set [beam] '// &
-                'mass = lumped, or use scheme = average_acceleration')
+                                  'the central-difference scheme needs a lumped mass matrix: set [beam] '// &
+                                  'mass = lumped, or use scheme = average_acceleration')
             return
         end if
         run%h = deck%get_real('time', 'step')
         run%t_end = deck%get_real('time', 'end')
         if (run%analysis == 'dynamic' .and. run%h > run%t_end) then
             call make_input_error(error, deck%file, deck%line('time', 'step'), 'step', &
-                'time step '// &
-                deck%get_word('time', 'step')//' is larger than the end time '// &
-                deck%get_word('time', 'end'))
+                                  'time step '// &
+                                  deck%get_word('time', 'step')//' is larger than the end time '// &
+                                  deck%get_word('time', 'end'))
             return
         end if
         run%n_modes = deck%get_int('modal', 'modes')
         n_free = count(.not. beam%fixed)
         if (run%analysis == 'modal' .and. run%n_modes > n_free) then
             call make_input_error(error, deck%file, deck%line('modal', 'modes'), 'modes', &
-                to_str(run%n_modes)//' modes asked but the model has only '// &
-                to_str(n_free)//' free DOFs')
+                                  to_str(run%n_modes)//' modes asked but the model has only '// &
+                                  to_str(n_free)//' free DOFs')
             return
         end if
         run%output_interval = deck%get_int('output', 'interval')
@@ -756,7 +756,7 @@ contains
         !> The error.
         type(error_t), allocatable, intent(out) :: error
         call make_input_error(error, deck%file, e%line, keyword, 'node '//e%word(1)// &
-            ' is not defined (no node or line record creates it)')
+                              ' is not defined (no node or line record creates it)')
     end subroutine unknown_node
 
     !> Error: a load or initial condition on a fixed DOF.
@@ -772,8 +772,8 @@ contains
         !> The error.
         type(error_t), allocatable, intent(out) :: error
         call make_input_error(error, deck%file, e%line, keyword, 'DOF '//e%word(2)//' of node '// &
-            e%word(1)//' is fixed (fix on line '//to_str(fixed_on)// &
-            '); a '//keyword//' applies only to a free DOF')
+                              e%word(1)//' is fixed (fix on line '//to_str(fixed_on)// &
+                              '); a '//keyword//' applies only to a free DOF')
     end subroutine on_fixed_dof
 
     !> DOF index of a DOF word (u, w, theta).
@@ -843,7 +843,7 @@ contains
                 do k = lo, hi - 1
                     ! min() keeps the indices valid: Fortran does not short-circuit .or.
                     if (i < mid .and. (j >= hi .or. &
-                        keys(order(min(i, n))) <= keys(order(min(j, n))))) then
+                                       keys(order(min(i, n))) <= keys(order(min(j, n))))) then
                         buffer(k) = order(i)
                         i = i + 1
                     else

@@ -20,9 +20,9 @@ module driver_config_dem
     use io_deck, only: deck_t, deck_entry_t
     use io_deck_schema, only: parse_selection
     use dem_particles, only: particles_add_disks, particles_fix, particles_impose_velocity, &
-        particles_add_load, dof_x, dof_y, dof_rot
+                             particles_add_load, dof_x, dof_y, dof_rot
     use dem_generators, only: generate_row, generate_square_lattice, generate_hex_lattice, &
-        generate_random_deposit
+                              generate_random_deposit
     use dem_walls, only: walls_add
     use dem_materials, only: materials_init, materials_set_pair
     use dem_contacts, only: contact_set_t
@@ -114,8 +114,8 @@ contains
                     cycle
                 end select
                 call make_input_error(error, deck%file, e%line, e%keyword, '['//e%section// &
-                    '] '//e%keyword//' applies to particles, and this deck has no [particles]'// &
-                    ': remove it or add particles')
+                                      '] '//e%keyword//' applies to particles, and this deck has no [particles]'// &
+                                      ': remove it or add particles')
                 return
             end associate
         end do
@@ -135,8 +135,8 @@ contains
                 case ('modal')
                 case ('initial')
                     call make_input_error(error, deck%file, e%line, e%keyword, '[initial] '// &
-                        'sets beam nodes, and this deck has no [beam]; the initial velocities '// &
-                        'of disks are [particles] initial_velocity records')
+                                          'sets beam nodes, and this deck has no [beam]; the initial velocities '// &
+                                          'of disks are [particles] initial_velocity records')
                     return
                 case ('time')
                     if (e%keyword /= 'scheme' .and. e%keyword /= 'beta' .and. &
@@ -145,8 +145,8 @@ contains
                     cycle
                 end select
                 call make_input_error(error, deck%file, e%line, e%keyword, '['//e%section// &
-                    '] '//e%keyword//' applies to the beam, and this deck has no [beam]: '// &
-                    'remove it (particles use [time] theta)')
+                                      '] '//e%keyword//' applies to the beam, and this deck has no [beam]: '// &
+                                      'remove it (particles use [time] theta)')
                 return
             end associate
         end do
@@ -181,7 +181,7 @@ contains
         cfg%system%particles%functions = functions
         cfg%system%walls%functions = functions
         cfg%system%particles%gravity = [deck%get_real('particles', 'gravity', 1), &
-            deck%get_real('particles', 'gravity', 2)]
+                                        deck%get_real('particles', 'gravity', 2)]
         call build_walls(deck, function_ids, cfg, error)
         if (allocated(error)) return
         call build_conditions(deck, function_ids, cfg, error)
@@ -212,8 +212,8 @@ contains
             j = find_id(cfg%material_id(:i - 1), cfg%material_id(i))
             if (j > 0) then
                 call make_input_error(error, deck%file, list(i)%line, 'material', &
-                    'duplicate material id '//list(i)%word(1)//': already defined on line '// &
-                    to_str(list(j)%line))
+                                      'duplicate material id '//list(i)%word(1)//': already defined on line '// &
+                                      to_str(list(j)%line))
                 return
             end if
         end do
@@ -253,15 +253,15 @@ contains
         end do
         if (total == 0) then
             call make_input_error(error, deck%file, first_line, '', 'no disk: add [particles] '// &
-                'disk records or generators (row, square_lattice, hex_lattice, deposit)')
+                                  'disk records or generators (row, square_lattice, hex_lattice, deposit)')
             return
         end if
         stat = 1
         if (total < max_disks) allocate (x(total), y(total), r(total), mat(total), line(total), &
-            stat=stat)
+                                         stat=stat)
         if (stat /= 0) then
             call make_input_error(error, deck%file, 0, '', 'the model is too large: cannot '// &
-                'hold '//to_str(real(total, wp))//' disks in memory')
+                                  'hold '//to_str(real(total, wp))//' disks in memory')
             return
         end if
         n = 0
@@ -278,8 +278,8 @@ contains
                 k = material_index(e%int(material_field(e%keyword)))
                 if (k == 0) then
                     call make_input_error(error, deck%file, e%line, e%keyword, 'material '// &
-                        e%word(material_field(e%keyword))//' is not defined (no [particles] '// &
-                        'material record with this id)')
+                                          e%word(material_field(e%keyword))//' is not defined (no [particles] '// &
+                                          'material record with this id)')
                     return
                 end if
                 x(n + 1:n + size(gx)) = gx
@@ -291,7 +291,7 @@ contains
             end associate
         end do
         call particles_add_disks(cfg%system%particles, x(:n), y(:n), r(:n), density(mat(:n)), &
-            error)
+                                 error)
         if (allocated(error)) return
         cfg%system%particles%mat(1:n) = mat(:n)
         cfg%disk_line = line(:n)
@@ -319,30 +319,30 @@ contains
                 gr = [e%real(3)]
             case ('row')
                 call generate_row(e%int(1), e%real(2), e%real(3), e%real(4), e%real(6), &
-                    e%real(7)*degree, gx, gy, gr, error)
+                                  e%real(7)*degree, gx, gy, gr, error)
             case ('square_lattice')
                 call generate_square_lattice(e%int(1), e%int(2), e%real(3), e%real(4), &
-                    e%real(5), e%real(7), gx, gy, gr, error)
+                                             e%real(5), e%real(7), gx, gy, gr, error)
             case ('hex_lattice')
                 call generate_hex_lattice(e%int(1), e%int(2), e%real(3), e%real(4), &
-                    e%real(5), e%real(7), gx, gy, gr, error)
+                                          e%real(5), e%real(7), gx, gy, gr, error)
             case ('deposit')
                 gap_ratio = default_gap_ratio
                 if (e%n_values() >= 9) gap_ratio = e%real(9)
                 if (e%real(6) < e%real(5)) then
                     call make_input_error(error, deck%file, e%line, e%keyword, 'rmax '// &
-                        e%word(6)//' is smaller than rmin '//e%word(5))
+                                          e%word(6)//' is smaller than rmin '//e%word(5))
                     return
                 end if
                 pitch = 2.0_wp*e%real(6)*(1.0_wp + gap_ratio)
                 if (e%real(3) - e%real(2) < pitch) then
                     call make_input_error(error, deck%file, e%line, e%keyword, 'the box from '// &
-                        'xmin = '//e%word(2)//' to xmax = '//e%word(3)//' is narrower than one '// &
-                        'site 2 rmax (1 + gap_ratio) = '//to_str(pitch)//' m')
+                                          'xmin = '//e%word(2)//' to xmax = '//e%word(3)//' is narrower than one '// &
+                                          'site 2 rmax (1 + gap_ratio) = '//to_str(pitch)//' m')
                     return
                 end if
                 call generate_random_deposit(e%int(1), e%real(2), e%real(3), e%real(4), &
-                    e%real(5), e%real(6), gap_ratio, e%int(8), gx, gy, gr, error)
+                                             e%real(5), e%real(6), gap_ratio, e%int(8), gx, gy, gr, error)
             end select
             if (allocated(error)) then
                 message = error%message
@@ -390,8 +390,8 @@ contains
                 nv = e%n_values()
                 if (nv == 6) then
                     call make_input_error(error, deck%file, e%line, 'wall', 'the wall velocity '// &
-                        "needs both vx and vy: expected 'x1 y1 x2 y2 [material] [vx vy "// &
-                        "[function]]', got 6 values")
+                                          "needs both vx and vy: expected 'x1 y1 x2 y2 [material] [vx vy "// &
+                                          "[function]]', got 6 values")
                     return
                 end if
                 mat = 1
@@ -399,8 +399,8 @@ contains
                     mat = find_id(cfg%material_id, e%int(5))
                     if (mat == 0) then
                         call make_input_error(error, deck%file, e%line, 'wall', 'material '// &
-                            e%word(5)//' is not defined (no [particles] material record with '// &
-                            'this id)')
+                                              e%word(5)//' is not defined (no [particles] material record with '// &
+                                              'this id)')
                         return
                     end if
                 end if
@@ -417,11 +417,11 @@ contains
                 length = hypot(e%real(3) - e%real(1), e%real(4) - e%real(2))
                 if (length <= 1.0e-9_wp*size_model) then
                     call make_input_error(error, deck%file, e%line, 'wall', &
-                        'zero-length wall: (x1, y1) and (x2, y2) coincide')
+                                          'zero-length wall: (x1, y1) and (x2, y2) coincide')
                     return
                 end if
                 call walls_add(cfg%system%walls, e%real(1), e%real(2), e%real(3), e%real(4), &
-                    error, mat=mat, vx=vx, vy=vy, func=func)
+                               error, mat=mat, vx=vx, vy=vy, func=func)
                 if (allocated(error)) then
                     message = error%message
                     call make_input_error(error, deck%file, e%line, 'wall', message)
@@ -492,7 +492,7 @@ contains
             character(len=:), allocatable :: message
             logical :: ok
             call parse_selection(e%word(1), cfg%system%particles%n, first, last, ok, message, &
-                'disks')
+                                 'disks')
             if (.not. ok) call make_input_error(error, deck%file, e%line, e%keyword, message)
         end subroutine select_disks
 
@@ -541,7 +541,7 @@ contains
                         return
                     end if
                     call particles_impose_velocity(cfg%system%particles, j, dof, e%real(3), &
-                        error, func)
+                                                   error, func)
                     if (allocated(error)) return
                     state(dof, j) = imposed
                     line(dof, j) = e%line
@@ -562,8 +562,8 @@ contains
             do j = first, last
                 if (state(dof, j) /= free) then
                     call conflict(e, j, dof, 'takes no '//trim(merge('force           ', &
-                        'initial velocity', e%keyword == 'force'))// &
-                        ' (they apply to free DOFs only)')
+                                                                     'initial velocity', e%keyword == 'force'))// &
+                                  ' (they apply to free DOFs only)')
                     return
                 end if
                 if (e%keyword == 'force') then
@@ -594,8 +594,8 @@ contains
                 now = 'has an imposed velocity'
             end if
             call make_input_error(error, deck%file, e%line, e%keyword, 'DOF '// &
-                trim(dof_names(dof))//' of disk '//to_str(j)//' '//now//' (line '// &
-                to_str(line(dof, j))//'): it '//trim(what))
+                                  trim(dof_names(dof))//' of disk '//to_str(j)//' '//now//' (line '// &
+                                  to_str(line(dof, j))//'): it '//trim(what))
         end subroutine conflict
     end subroutine build_conditions
 
@@ -619,8 +619,8 @@ contains
                 do k = 1, 2
                     if (find_id(cfg%material_id, e%int(k)) == 0) then
                         call make_input_error(error, deck%file, e%line, 'law', 'material '// &
-                            e%word(k)//' is not defined (no [particles] material record with '// &
-                            'this id)')
+                                              e%word(k)//' is not defined (no [particles] material record with '// &
+                                              'this id)')
                         return
                     end if
                 end do
@@ -628,14 +628,14 @@ contains
                 b = find_id(cfg%material_id, e%int(2))
                 if (law_line(a, b) > 0) then
                     call make_input_error(error, deck%file, e%line, 'law', 'the law between '// &
-                        'materials '//e%word(1)//' and '//e%word(2)//' is already given on '// &
-                        'line '//to_str(law_line(a, b)))
+                                          'materials '//e%word(1)//' and '//e%word(2)//' is already given on '// &
+                                          'line '//to_str(law_line(a, b)))
                     return
                 end if
                 law_line(a, b) = e%line
                 law_line(b, a) = e%line
                 call materials_set_pair(cfg%system%materials, a, b, e%real(3), e%real(4), &
-                    e%real(5), error)
+                                        e%real(5), error)
                 if (allocated(error)) then
                     message = error%message
                     call make_input_error(error, deck%file, e%line, 'law', message)
@@ -659,7 +659,7 @@ contains
             cfg%default_alert = .not. deck%has('contacts', 'alert')
             if (cfg%default_alert) then
                 sys%scheme%alert = default_alert_ratio* &
-                    sum(sys%particles%radius(1:sys%particles%n))/real(sys%particles%n, wp)
+                                   sum(sys%particles%radius(1:sys%particles%n))/real(sys%particles%n, wp)
             else
                 sys%scheme%alert = deck%get_real('contacts', 'alert')
             end if
@@ -687,10 +687,10 @@ contains
         associate (p => cfg%system%particles, w => cfg%system%walls)
             if (w%n > 0) then
                 call detect_contacts(det, p%x(1:p%n), p%y(1:p%n), p%radius(1:p%n), 0.0_wp, &
-                    w%x1(1:w%n), w%y1(1:w%n), w%x2(1:w%n), w%y2(1:w%n), cs)
+                                     w%x1(1:w%n), w%y1(1:w%n), w%x2(1:w%n), w%y2(1:w%n), cs)
             else
                 call detect_contacts(det, p%x(1:p%n), p%y(1:p%n), p%radius(1:p%n), 0.0_wp, &
-                    [real(wp) ::], [real(wp) ::], [real(wp) ::], [real(wp) ::], cs)
+                                     [real(wp) ::], [real(wp) ::], [real(wp) ::], [real(wp) ::], cs)
             end if
             do k = 1, cs%n
                 a = cs%i1(k)
@@ -700,15 +700,15 @@ contains
                 if (cs%gap(k) >= -overlap_tolerance*amoy) cycle
                 if (a > 0) then
                     call make_input_error(error, deck%file, &
-                        max(cfg%disk_line(a), cfg%disk_line(b)), '', 'disks '//to_str(min(a, b))// &
-                        ' (line '//to_str(cfg%disk_line(min(a, b)))//') and '//to_str(max(a, b))// &
-                        ' (line '//to_str(cfg%disk_line(max(a, b)))//') overlap by '// &
-                        length_text(-cs%gap(k))//' m at t = 0: move them apart')
+                                          max(cfg%disk_line(a), cfg%disk_line(b)), '', 'disks '//to_str(min(a, b))// &
+                                          ' (line '//to_str(cfg%disk_line(min(a, b)))//') and '//to_str(max(a, b))// &
+                                          ' (line '//to_str(cfg%disk_line(max(a, b)))//') overlap by '// &
+                                          length_text(-cs%gap(k))//' m at t = 0: move them apart')
                 else
                     call make_input_error(error, deck%file, cfg%wall_line(-a), 'wall', 'disk '// &
-                        to_str(b)//' (line '//to_str(cfg%disk_line(b))//') overlaps wall '// &
-                        to_str(-a)//' by '//length_text(-cs%gap(k))//' m at t = 0: move it off '// &
-                        'the wall')
+                                          to_str(b)//' (line '//to_str(cfg%disk_line(b))//') overlaps wall '// &
+                                          to_str(-a)//' by '//length_text(-cs%gap(k))//' m at t = 0: move it off '// &
+                                          'the wall')
                 end if
                 return
             end do
@@ -736,7 +736,7 @@ contains
         !> The error.
         type(error_t), allocatable, intent(out) :: error
         call make_input_error(error, deck%file, e%line, e%keyword, 'function '//e%word(k)// &
-            ' is not defined (no [functions] function record with this id)')
+                              ' is not defined (no [functions] function record with this id)')
     end subroutine unknown_function
 
     !> DOF index of a DOF word (x, y, rot).

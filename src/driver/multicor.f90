@@ -46,7 +46,7 @@ program multicor
         case default
             if (arg(1:1) == '-') call usage_error("unknown option '"//arg//"'")
             if (allocated(opts%deck_path)) call usage_error("more than one deck given ('"// &
-                                                          opts%deck_path//"' and '"//arg//"')")
+                                                            opts%deck_path//"' and '"//arg//"')")
             opts%deck_path = arg
         end select
     end do
@@ -56,7 +56,7 @@ program multicor
     call run_deck(opts, report, error)
     if (allocated(error)) then
         write (error_unit, '(a)') 'multicor: error: '//error%message
-        stop 1, quiet=.true.
+        stop 1, quiet = .true.
     end if
 
 contains
@@ -82,7 +82,7 @@ contains
         write (error_unit, '(a)') 'multicor: error: '//message
         write (error_unit, '(a)') "usage: multicor [--check] [--output DIR] [--quiet] deck.dat; " &
             //"'multicor --help' for more"
-        stop 2, quiet=.true.
+        stop 2, quiet = .true.
     end subroutine usage_error
 
     subroutine print_help()

@@ -67,7 +67,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         if (self%is_open()) then
             call make_error(error, "results: cannot open '"//final_path//"': '" &
-                //self%final_path//"' is still open")
+                            //self%final_path//"' is still open")
             return
         end if
         self%final_path = final_path
@@ -118,7 +118,7 @@ contains
         if (allocated(error)) return
         if (size(x) /= size(node_id) .or. size(y) /= size(node_id) .or. size(conn, 1) /= 2) then
             call make_error(error, 'results: write_mesh: node_id, x, y must have the same size ' &
-                //'and conn must be (2, n_elements)')
+                            //'and conn must be (2, n_elements)')
             return
         end if
         call check_nodes(self, size(node_id), 'write_mesh', error)
@@ -137,7 +137,7 @@ contains
         call self%file%write_dataset('/fem/mesh/connectivity', conn, error)
         if (allocated(error)) return
         call self%file%write_attribute('/fem/mesh/connectivity', 'description', &
-            'node indices (1-based positions in node_id) of the 2 ends of each element', error)
+                                       'node indices (1-based positions in node_id) of the 2 ends of each element', error)
     end subroutine writer_write_mesh
 
     !> Append one output state: /fem/{time, displacement, velocity, acceleration}.
@@ -274,7 +274,7 @@ contains
         if (allocated(error)) return
         if (size(shapes, 1) /= 3 .or. size(shapes, 3) /= size(omega)) then
             call make_error(error, 'results: write_modal: shapes must be (3, n_nodes, n_modes) ' &
-                //'with n_modes = size(omega)')
+                            //'with n_modes = size(omega)')
             return
         end if
         call check_nodes(self, size(shapes, 2), 'write_modal', error)
@@ -290,7 +290,7 @@ contains
         call self%file%write_dataset('/modal/shapes', shapes, error)
         if (allocated(error)) return
         call self%file%write_attribute('/modal/shapes', 'units', 'm, m, rad (arbitrary scale)', &
-            error)
+                                       error)
     end subroutine writer_write_modal
 
     !> Write run statistics as attributes of /summary.
@@ -333,7 +333,7 @@ contains
         end if
         call rename_file(self%partial_path, self%final_path, error)
         if (allocated(error)) error%message = 'results: '//error%message//' (the results are ' &
-            //"kept in '"//self%partial_path//"')"
+                                              //"kept in '"//self%partial_path//"')"
     end subroutine writer_close
 
     !> Close and delete the partial file after a failed run (an earlier result is untouched).
@@ -412,6 +412,6 @@ contains
         character(len=5) :: zone
         call date_and_time(date, time, zone)
         text = date(1:4)//'-'//date(5:6)//'-'//date(7:8)//'T'//time(1:2)//':'//time(3:4)//':' &
-            //time(5:6)//zone(1:3)//':'//zone(4:5)
+               //time(5:6)//zone(1:3)//':'//zone(4:5)
     end function iso_date_time
 end module driver_results

@@ -24,8 +24,8 @@ module driver_results_dem
     integer, parameter :: stats_buffer = 4096
     !> Meaning of the contact status codes (stored as an attribute).
     character(len=*), parameter :: status_codes = &
-        '0 = open (no force), 1 = stick (inside the Coulomb cone), 2 = slip (on the cone), '// &
-        '3 = cohesive (intact bond), 4 = broken (bond broken for good)'
+                                   '0 = open (no force), 1 = stick (inside the Coulomb cone), 2 = slip (on the cone), '// &
+                                   '3 = cohesive (intact bond), 4 = broken (bond broken for good)'
 
     !> Writes the discrete-element part of a results file.
     type :: dem_writer_t
@@ -82,8 +82,8 @@ contains
         self%n_buffered = 0
         self%n_steps = 0
         allocate (self%sweeps(stats_buffer), self%contacts(stats_buffer), &
-            self%active(stats_buffer), self%converged(stats_buffer), self%norm(stats_buffer), &
-            self%residual(stats_buffer))
+                  self%active(stats_buffer), self%converged(stats_buffer), self%norm(stats_buffer), &
+                  self%residual(stats_buffer))
         call properties(error)
         if (allocated(error)) return
         call settings(error)
@@ -99,10 +99,10 @@ contains
             call dataset('/dem/particles/inertia', sys%particles%inertia(1:n), 'kg m', error)
             if (allocated(error)) return
             call file%write_dataset('/dem/particles/material', &
-                material_id(sys%particles%mat(1:n)), error)
+                                    material_id(sys%particles%mat(1:n)), error)
             if (allocated(error) .or. sys%walls%n == 0) return
             call file%write_dataset('/dem/walls/material', &
-                material_id(sys%walls%mat(1:sys%walls%n)), error)
+                                    material_id(sys%walls%mat(1:sys%walls%n)), error)
         end subroutine properties
 
         subroutine settings(error)
@@ -128,10 +128,12 @@ contains
 
         subroutine series(error)
             type(error_t), allocatable, intent(out) :: error
+            !&<
             character(len=*), parameter :: energies(7) = [character(len=13) :: 'kinetic', &
                 'potential', 'external_work', 'drive_work', 'dissipated', 'numerical', 'balance']
             character(len=*), parameter :: stats_int(4) = [character(len=9) :: 'sweeps', &
                 'contacts', 'active', 'converged']
+            !&>
             integer :: k
             call real_series('/dem/time', [integer ::], 's', error)
             if (allocated(error)) return
@@ -229,7 +231,7 @@ contains
         if (sys%walls%n > 0) then
             associate (w => sys%walls)
                 call file%append('/dem/walls/position', reshape([w%x1(1:w%n), w%y1(1:w%n), &
-                    w%x2(1:w%n), w%y2(1:w%n)], [4, w%n], order=[2, 1]), error)
+                                                                 w%x2(1:w%n), w%y2(1:w%n)], [4, w%n], order=[2, 1]), error)
             end associate
             if (allocated(error)) return
         end if
@@ -274,7 +276,7 @@ contains
         m = sys%contacts%n
         if (m > huge(0) - self%n_contacts_stored) then
             call make_error(error, 'results: more than 2**31 - 1 contacts stored: store fewer '// &
-                'outputs ([output] interval) or no contacts ([output] contacts = no)')
+                            'outputs ([output] interval) or no contacts ([output] contacts = no)')
             return
         end if
         if (m > 0) then

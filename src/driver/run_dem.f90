@@ -95,9 +95,10 @@ contains
                 cfg%system%stats%sweeps, ' sweeps (error ', cfg%system%stats%error, &
                 ' > tolerance ', cfg%system%solver%tol, ')'
             call report(trim(buf))
-            if (unconverged == max_warnings) call report('warning: further unconverged steps '// &
-                'are only counted (total in the summary); raise [solver] max_sweeps or the '// &
-                'tolerance, or lower [time] step')
+            if (unconverged == max_warnings) then
+                call report('warning: further unconverged steps are only counted (total in the '// &
+                            'summary); raise [solver] max_sweeps or the tolerance, or lower [time] step')
+            end if
         end subroutine warn_unconverged
 
         !> Warning (once) when a disk moved farther than the alert distance in the step.
@@ -129,8 +130,8 @@ contains
                     sys%time_detection, ' s, in the solver ', sys%time_solver, ' s'
                 call report(trim(buf))
                 call report('unconverged steps: '//to_str(unconverged)//' of '//to_str(n_steps)// &
-                    ' (tolerance '//to_str(sys%solver%tol)//', at most '// &
-                    to_str(sys%solver%max_sweeps)//' sweeps)')
+                            ' (tolerance '//to_str(sys%solver%tol)//', at most '// &
+                            to_str(sys%solver%max_sweeps)//' sweeps)')
                 write (buf, '(a,es10.3,a,es10.3,a)') 'energy balance residual ', &
                     energies_balance(sys%energies), ' J/m (dissipated in contacts ', &
                     sys%energies%contact_dissipation, ' J/m)'

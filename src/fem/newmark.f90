@@ -278,7 +278,7 @@ contains
         call self%s%add_scaled(model%k, self%gamma*h*model%rayleigh_a1 + self%beta*h**2)
         call self%s%factor(error)
         if (allocated(error)) error%message = 'Newmark effective matrix M + gamma h C + '// &
-            'beta h^2 K: '//error%message
+                                              'beta h^2 K: '//error%message
     end subroutine newmark_init
 
     !> Newmark step: predictor, solve for a_{n+1}, corrector, energies.

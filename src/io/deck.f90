@@ -19,7 +19,7 @@ module io_deck
     use core_kinds, only: wp
     use core_error, only: error_t, make_input_error
     use core_strings, only: string_t, strip, split_words, join_words, &
-        closest_match, parse_real, parse_int, to_str
+                            closest_match, parse_real, parse_int, to_str
     use io_deck_schema, only: schema_t, keyword_spec_t, field_spec_t, condition_t, field_text
     implicit none
     private
@@ -101,7 +101,7 @@ contains
             return
         end if
         open (newunit=unit, file=path, access='stream', form='unformatted', status='old', &
-            action='read', iostat=ios, iomsg=msg)
+              action='read', iostat=ios, iomsg=msg)
         if (ios /= 0) then
             call make_input_error(error, path, 0, '', 'cannot open the deck: '//trim(msg))
             return
@@ -162,7 +162,7 @@ contains
         deck%entries = entries(:n)
         if (n == 0) then
             call make_input_error(error, file, 0, '', 'the deck is empty (no keyword found); '// &
-                'it needs at least '//required_list(schema))
+                                  'it needs at least '//required_list(schema))
             return
         end if
         call check_required(deck, first_line, section_line, error)
@@ -190,7 +190,7 @@ contains
             if (eq == 0) then
                 call split_words(s, tokens)
                 call make_input_error(error, file, line_no, tokens(1)%s, &
-                    "expected 'keyword = value', found no '='")
+                                      "expected 'keyword = value', found no '='")
                 return
             end if
             key = strip(s(:eq - 1))
@@ -205,19 +205,19 @@ contains
             end if
             if (len(current) == 0) then
                 call make_input_error(error, file, line_no, key, &
-                    'appears before any [section] header'//home_of(schema, key))
+                                      'appears before any [section] header'//home_of(schema, key))
                 return
             end if
             k = schema%find_keyword(current, key)
             if (k == 0) then
                 call make_input_error(error, file, line_no, key, &
-                    unknown_keyword(schema, current, key))
+                                      unknown_keyword(schema, current, key))
                 return
             end if
             if (.not. schema%keywords(k)%repeatable .and. first_line(k) > 0) then
                 call make_input_error(error, file, line_no, key, 'given twice in section ['// &
-                    current//'] (first on line '//to_str(first_line(k))// &
-                    ', again on line '//to_str(line_no)//'); it may appear only once')
+                                      current//'] (first on line '//to_str(first_line(k))// &
+                                      ', again on line '//to_str(line_no)//'); it may appear only once')
                 return
             end if
             if (schema%keywords(k)%fields(1)%value_type == field_text) then
@@ -249,7 +249,7 @@ contains
             integer :: k, best, d
             if (s(len(s):len(s)) /= ']') then
                 call make_input_error(error, file, line_no, '', "malformed section header '"// &
-                    s//"': expected '[name]'")
+                                      s//"': expected '[name]'")
                 return
             end if
             name = strip(s(2:len(s) - 1))
@@ -262,11 +262,11 @@ contains
                 call closest_match(name, names, best, d)
                 if (best > 0 .and. d <= tolerance(name)) then
                     call make_input_error(error, file, line_no, '', 'unknown section ['//name// &
-                        ']; did you mean ['//names(best)%s//']? (sections: '// &
-                        join_words(names, ', ')//')')
+                                          ']; did you mean ['//names(best)%s//']? (sections: '// &
+                                          join_words(names, ', ')//')')
                 else
                     call make_input_error(error, file, line_no, '', 'unknown section ['//name// &
-                        '] (sections: '//join_words(names, ', ')//')')
+                                          '] (sections: '//join_words(names, ', ')//')')
                 end if
                 return
             end if
@@ -306,11 +306,11 @@ contains
             ! A better match in another section.
             if (everywhere(best_all)%s == key) then
                 message = message//"; keyword '"//key//"' belongs to section ["// &
-                    schema%keywords(best_all)%section//']: move it there'
+                          schema%keywords(best_all)%section//']: move it there'
             else
                 message = message//"; did you mean '"//everywhere(best_all)%s//"'? keyword '"// &
-                    everywhere(best_all)%s//"' belongs to section ["// &
-                    schema%keywords(best_all)%section//']'
+                          everywhere(best_all)%s//"' belongs to section ["// &
+                          schema%keywords(best_all)%section//']'
             end if
         else if (best_local > 0 .and. d_local <= tolerance(key)) then
             message = message//"; did you mean '"//local(best_local)%s//"'?"
@@ -373,7 +373,7 @@ contains
             call spec%fields(i)%check(tokens(i)%s, ok, message)
             if (.not. ok) then
                 call make_input_error(error, file, line, spec%name, 'value '//to_str(i)//' ('// &
-                    spec%fields(i)%name//'): '//message)
+                                      spec%fields(i)%name//'): '//message)
                 return
             end if
         end do
@@ -400,9 +400,9 @@ contains
             end if
             if (t%cyclic .and. modulo(ntok - nf, g) /= 0) then
                 call make_input_error(error, file, line, spec%name, "incomplete group: '"// &
-                    spec%usage(selector)//"' takes values after '"// &
-                    spec%fields(nf)%name//"' in groups of "//to_str(g)// &
-                    ', got '//to_str(ntok - nf))
+                                      spec%usage(selector)//"' takes values after '"// &
+                                      spec%fields(nf)%name//"' in groups of "//to_str(g)// &
+                                      ', got '//to_str(ntok - nf))
                 return
             end if
             do i = 1, ntok - nf
@@ -410,7 +410,7 @@ contains
                 call field%check(tokens(nf + i)%s, ok, message)
                 if (.not. ok) then
                     call make_input_error(error, file, line, spec%name, 'value '//to_str(nf + i)// &
-                        ' ('//field%name//'): '//message)
+                                          ' ('//field%name//'): '//message)
                     return
                 end if
             end do
@@ -422,7 +422,7 @@ contains
         subroutine count_error(what)
             character(len=*), intent(in) :: what
             call make_input_error(error, file, line, spec%name, what//' values (got '// &
-                to_str(ntok)//"): expected '"//spec%usage(selector)//"'")
+                                  to_str(ntok)//"): expected '"//spec%usage(selector)//"'")
         end subroutine count_error
     end subroutine check_values
 
@@ -442,9 +442,9 @@ contains
             associate (kw => deck%schema%keywords(k))
                 if (kw%required .and. first_line(k) == 0) then
                     call make_input_error(error, deck%file, &
-                        section_line(deck%schema%find_section(kw%section)), kw%name, &
-                        'missing: this keyword is required in section ['// &
-                        kw%section//'] ('//kw%name//' = '//value_hint(kw)//')')
+                                          section_line(deck%schema%find_section(kw%section)), kw%name, &
+                                          'missing: this keyword is required in section ['// &
+                                          kw%section//'] ('//kw%name//' = '//value_hint(kw)//')')
                     return
                 end if
             end associate
@@ -454,8 +454,8 @@ contains
                 if (c%active .and. first_line(k) == 0) then
                     if (deck%get_word(c%section, c%keyword) == c%word) then
                         call make_input_error(error, deck%file, deck%line(c%section, c%keyword), &
-                            kw%name, 'missing: ['//kw%section//'] '//kw%name// &
-                            ' is required when '//c%text())
+                                              kw%name, 'missing: ['//kw%section//'] '//kw%name// &
+                                              ' is required when '//c%text())
                         return
                     end if
                 end if
@@ -467,9 +467,9 @@ contains
                     actual = deck%get_word(c%section, c%keyword)
                     if (actual /= c%word) then
                         call make_input_error(error, deck%file, first_line(k), kw%name, &
-                            'only allowed when '//c%text()//'; here '//c%keyword// &
-                            ' = '//actual//condition_origin(deck, c)// &
-                            ': remove '//kw%name//' or set '//c%keyword//' = '//c%word)
+                                              'only allowed when '//c%text()//'; here '//c%keyword// &
+                                              ' = '//actual//condition_origin(deck, c)// &
+                                              ': remove '//kw%name//' or set '//c%keyword//' = '//c%word)
                         return
                     end if
                 end if

@@ -292,8 +292,8 @@ contains
         !> What the items are, plural, for messages (default 'items').
         character(len=*), intent(in), optional :: noun
         character(len=*), parameter :: expected = &
-            "expected a number, a range 'a:b' (a <= b, 'last' allowed at either end), "// &
-            "'last' or 'all'"
+                                       "expected a number, a range 'a:b' (a <= b, 'last' allowed at either end), "// &
+                                       "'last' or 'all'"
         integer :: colon
         message = ''
         first = 0
@@ -322,10 +322,10 @@ contains
             ok = .false.
             if (present(noun)) then
                 message = "selection '"//token//"' is out of range: there are "//to_str(n)// &
-                    ' '//noun//' (1..'//to_str(n)//')'
+                          ' '//noun//' (1..'//to_str(n)//')'
             else
                 message = "selection '"//token//"' is out of range: there are "//to_str(n)// &
-                    ' items (1..'//to_str(n)//')'
+                          ' items (1..'//to_str(n)//')'
             end if
         end if
     contains
@@ -399,7 +399,7 @@ contains
 
     !> Declare a keyword of an already declared section.
     subroutine schema_add_keyword(self, section, name, fields, description, required, repeatable, &
-        default, selector, tails, required_when, allowed_when)
+                                  default, selector, tails, required_when, allowed_when)
         !> The schema.
         class(schema_t), intent(inout) :: self
         !> Section.
@@ -531,7 +531,7 @@ contains
                 if (self%allowed(i)%s == token) ok = .true.
             end do
             if (.not. ok) message = "'"//token//"' is not allowed: expected one of "// &
-                join_words(self%allowed, ', ')
+                                    join_words(self%allowed, ', ')
             return
         case (field_selection)
             call parse_selection(token, huge(1), i, j, ok, message)
@@ -634,8 +634,8 @@ contains
                 text = text//' ... ('//count_text(self%min_values, self%max_values, 'value')//')'
             else
                 text = text//' ... ('// &
-                    count_text(self%min_values/g, group_max(self%max_values, g), 'group')// &
-                    ' of '//to_str(g)//')'
+                       count_text(self%min_values/g, group_max(self%max_values, g), 'group')// &
+                       ' of '//to_str(g)//')'
             end if
         else
             do i = 1, g
@@ -772,7 +772,7 @@ contains
         end if
         description = kw%description
         if (kw%allowed_when%active) description = description//' Only allowed if '// &
-            kw%allowed_when%text()//'.'
+                                                  kw%allowed_when%text()//'.'
         started = .false.
         do i = 1, size(kw%fields)
             values = '`'//kw%fields(i)%name//'` ('//type_name(kw%fields(i)%value_type)//')'
@@ -782,9 +782,9 @@ contains
             do i = 1, size(kw%tails(j)%fields)
                 values = ''
                 if (len(kw%tails(j)%when) > 0) values = 'if `'//kw%fields(kw%selector)%name// &
-                    '` = '//kw%tails(j)%when//': '
+                                                        '` = '//kw%tails(j)%when//': '
                 values = values//'`'//kw%tails(j)%fields(i)%name//'` ('// &
-                    type_name(kw%tails(j)%fields(i)%value_type)//tail_note(kw%tails(j), i)//')'
+                         type_name(kw%tails(j)%fields(i)%value_type)//tail_note(kw%tails(j), i)//')'
                 call add_row(kw%tails(j)%fields(i), values)
             end do
         end do
@@ -798,11 +798,11 @@ contains
             character(len=*), parameter :: lf = new_line('a')
             if (.not. started) then
                 text = text//'|'//cell(first)//cell(values)//cell(field%unit)//cell(default)// &
-                    cell(field%constraint())//cell(description)//lf
+                       cell(field%constraint())//cell(description)//lf
                 started = .true.
             else
                 text = text//'|'//cell('')//cell(values)//cell(field%unit)//cell('')// &
-                    cell(field%constraint())//cell('')//lf
+                       cell(field%constraint())//cell('')//lf
             end if
         end subroutine add_row
 
@@ -834,7 +834,7 @@ contains
                     note = ', repeated: '//count_text(t%min_values, t%max_values, 'value')
                 else
                     note = ', repeated with the next: '// &
-                        count_text(t%min_values/g, group_max(t%max_values, g), 'group')
+                           count_text(t%min_values/g, group_max(t%max_values, g), 'group')
                 end if
             end if
         else if (i > t%min_values) then

@@ -20,25 +20,25 @@
 !> HDF5 error stack is switched off: errors are reported through `error_t` only.
 module io_hdf5_file
     use, intrinsic :: iso_c_binding, only: c_ptr, c_char, c_size_t, c_null_char, c_null_ptr, &
-        c_loc, c_f_pointer, c_associated
+                                                                              c_loc, c_f_pointer, c_associated
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
     use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5eset_auto_f, h5iis_valid_f, &
-        h5iget_type_f, h5i_dataset_f, h5i_dataspace_f, h5i_datatype_f, h5i_attr_f, h5i_group_f, &
-        h5i_genprop_lst_f, h5i_file_f, h5fcreate_f, h5fopen_f, h5fclose_f, h5f_acc_trunc_f, &
-        h5f_acc_rdonly_f, h5f_libver_v18_f, h5f_libver_latest_f, h5pcreate_f, h5pclose_f, &
-        h5pset_libver_bounds_f, h5pset_create_inter_group_f, h5pset_chunk_f, &
-        h5p_file_access_f, h5p_link_create_f, h5p_dataset_create_f, h5gcreate_f, h5gclose_f, &
-        h5lexists_f, h5oopen_f, h5oclose_f, h5screate_f, h5screate_simple_f, h5sclose_f, &
-        h5s_scalar_f, h5s_unlimited_f, h5s_select_set_f, h5sselect_hyperslab_f, &
-        h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, h5acreate_f, h5aopen_f, &
-        h5aclose_f, h5awrite_f, h5aread_f, h5aexists_f, h5adelete_f, h5aget_space_f, &
-        h5aget_type_f, h5dcreate_f, h5dopen_f, h5dclose_f, h5dwrite_f, h5dread_f, &
-        h5dget_space_f, h5dget_type_f, h5dset_extent_f, h5tcopy_f, h5tclose_f, h5tset_size_f, &
-        h5tset_strpad_f, h5tset_cset_f, h5tget_class_f, &
-        h5t_native_double, h5t_native_integer, h5t_ieee_f64le, h5t_std_i32le, &
-        h5t_str_nullterm_f, h5t_cset_utf8_f, h5t_float_f, h5t_integer_f, &
-        h5t_string_f, h5t_c_s1, h5tis_variable_str_f, h5dvlen_reclaim_f, h5p_default_f
+                    h5iget_type_f, h5i_dataset_f, h5i_dataspace_f, h5i_datatype_f, h5i_attr_f, h5i_group_f, &
+                    h5i_genprop_lst_f, h5i_file_f, h5fcreate_f, h5fopen_f, h5fclose_f, h5f_acc_trunc_f, &
+                    h5f_acc_rdonly_f, h5f_libver_v18_f, h5f_libver_latest_f, h5pcreate_f, h5pclose_f, &
+                    h5pset_libver_bounds_f, h5pset_create_inter_group_f, h5pset_chunk_f, &
+                    h5p_file_access_f, h5p_link_create_f, h5p_dataset_create_f, h5gcreate_f, h5gclose_f, &
+                    h5lexists_f, h5oopen_f, h5oclose_f, h5screate_f, h5screate_simple_f, h5sclose_f, &
+                    h5s_scalar_f, h5s_unlimited_f, h5s_select_set_f, h5sselect_hyperslab_f, &
+                    h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, h5acreate_f, h5aopen_f, &
+                    h5aclose_f, h5awrite_f, h5aread_f, h5aexists_f, h5adelete_f, h5aget_space_f, &
+                    h5aget_type_f, h5dcreate_f, h5dopen_f, h5dclose_f, h5dwrite_f, h5dread_f, &
+                    h5dget_space_f, h5dget_type_f, h5dset_extent_f, h5tcopy_f, h5tclose_f, h5tset_size_f, &
+                    h5tset_strpad_f, h5tset_cset_f, h5tget_class_f, &
+                    h5t_native_double, h5t_native_integer, h5t_ieee_f64le, h5t_std_i32le, &
+                    h5t_str_nullterm_f, h5t_cset_utf8_f, h5t_float_f, h5t_integer_f, &
+                    h5t_string_f, h5t_c_s1, h5tis_variable_str_f, h5dvlen_reclaim_f, h5p_default_f
     implicit none
     private
     public :: h5_file_t
@@ -122,7 +122,7 @@ contains
         integer :: hdferr
         if (self%is_open()) then
             call make_error(error, "HDF5: cannot create '"//path//"': this object still has '" &
-                //self%path//"' open")
+                            //self%path//"' open")
             return
         end if
         call ensure_library(error)
@@ -141,7 +141,7 @@ contains
         if (hdferr < 0) then
             self%id = -1
             call make_error(error, "HDF5: cannot create file '"//path// &
-                "' (does its folder exist, is it writable?)")
+                            "' (does its folder exist, is it writable?)")
             return
         end if
         self%writable = .true.
@@ -158,7 +158,7 @@ contains
         integer :: hdferr
         if (self%is_open()) then
             call make_error(error, "HDF5: cannot open '"//path//"': this object still has '" &
-                //self%path//"' open")
+                            //self%path//"' open")
             return
         end if
         call ensure_library(error)
@@ -168,7 +168,7 @@ contains
         if (hdferr < 0) then
             self%id = -1
             call make_error(error, "HDF5: cannot open file '"//path// &
-                "' for reading (missing, or not an HDF5 file)")
+                            "' for reading (missing, or not an HDF5 file)")
             return
         end if
         self%writable = .false.
@@ -243,7 +243,7 @@ contains
         call release(group)
         call release(lcpl)
         if (hdferr < 0) call make_error(error, "HDF5: cannot create group '"//path//"' in '" &
-            //self%path//"'")
+                                        //self%path//"'")
     end subroutine file_create_group
 
     ! ---------------------------------------------------------------------------------------
@@ -292,7 +292,7 @@ contains
         call release(space)
         call release(stype)
         if (.not. allocated(error) .and. hdferr < 0) call attr_error(self, 'write', object, &
-            name, error)
+                                                                     name, error)
     end subroutine write_attr_string
 
     !> Write a real scalar attribute.
@@ -323,7 +323,7 @@ contains
         call release(attr)
         call release(space)
         if (.not. allocated(error) .and. hdferr < 0) call attr_error(self, 'write', object, &
-            name, error)
+                                                                     name, error)
     end subroutine write_attr_real
 
     !> Write an integer scalar attribute.
@@ -354,7 +354,7 @@ contains
         call release(attr)
         call release(space)
         if (.not. allocated(error) .and. hdferr < 0) call attr_error(self, 'write', object, &
-            name, error)
+                                                                     name, error)
     end subroutine write_attr_int
 
     !> Write a 1-D real array attribute.
@@ -385,7 +385,7 @@ contains
         call release(attr)
         call release(space)
         if (.not. allocated(error) .and. hdferr < 0) call attr_error(self, 'write', object, &
-            name, error)
+                                                                     name, error)
     end subroutine write_attr_real_1d
 
     !> Read a (variable-length) string attribute.
@@ -418,7 +418,7 @@ contains
             if (hdferr < 0) exit ops
             if (.not. variable) then
                 call make_error(error, "HDF5: attribute '"//name//"' of '"//object//"' in '" &
-                    //self%path//"' is not a variable-length string")
+                                //self%path//"' is not a variable-length string")
                 exit ops
             end if
             call h5aget_space_f(attr, space, hdferr)
@@ -432,7 +432,7 @@ contains
         call release(ftype)
         call release(attr)
         if (.not. allocated(error) .and. hdferr < 0) call attr_error(self, 'read', object, &
-            name, error)
+                                                                     name, error)
     end subroutine read_attr_string
 
     !> Read one variable-length string attribute and free HDF5's copy of it.
@@ -540,7 +540,7 @@ contains
             if (hdferr < 0) exit ops
             if (rank /= 1) then
                 call make_error(error, "HDF5: attribute '"//name//"' of '"//object//"' in '" &
-                    //self%path//"' is not a 1-D array")
+                                //self%path//"' is not a 1-D array")
                 exit ops
             end if
             call h5sget_simple_extent_dims_f(space, dims, maxdims, hdferr)
@@ -551,7 +551,7 @@ contains
         call release(space)
         call release(attr)
         if (.not. allocated(error) .and. hdferr < 0) call attr_error(self, 'read', object, &
-            name, error)
+                                                                     name, error)
     end subroutine read_attr_real_1d
 
     !> Create attribute `name` on `object` (replacing an existing one) and return its id.
@@ -579,7 +579,7 @@ contains
         if (allocated(error)) return
         if (.not. self%exists(object)) then
             call make_error(error, "HDF5: cannot write attribute '"//name//"': no object '" &
-                //object//"' in '"//self%path//"'")
+                            //object//"' in '"//self%path//"'")
             return
         end if
         ops: block
@@ -631,7 +631,7 @@ contains
         if (hdferr < 0 .or. .not. found) then
             attr = -1
             call make_error(error, "HDF5: no attribute '"//name//"' on '"//object//"' in '" &
-                //self%path//"'")
+                            //self%path//"'")
         end if
     end subroutine open_attribute_for_read
 
@@ -902,7 +902,7 @@ contains
         if (allocated(error)) return
         if (self%exists(path)) then
             call make_error(error, "HDF5: dataset '"//path//"' already exists in '" &
-                //self%path//"'")
+                            //self%path//"'")
             return
         end if
         space = -1
@@ -920,7 +920,7 @@ contains
                 if (hdferr < 0) exit ops
             end if
             call h5dcreate_f(self%id, path, file_type, space, dset, hdferr, dcpl_id=dcpl, &
-                lcpl_id=lcpl)
+                             lcpl_id=lcpl)
         end block ops
         call release(dcpl)
         call release(lcpl)
@@ -956,7 +956,7 @@ contains
         if (size(hdims) /= size(dims)) then
             write (buf, '(i0,a,i0)') size(hdims), ' instead of ', size(dims)
             call make_error(error, "HDF5: dataset '"//path//"' in '"//self%path// &
-                "' has rank "//trim(buf))
+                            "' has rank "//trim(buf))
             call release(dset)
             return
         end if
@@ -967,7 +967,7 @@ contains
         call release(dtype)
         if (hdferr < 0 .or. actual_class /= type_class) then
             call make_error(error, "HDF5: dataset '"//path//"' in '"//self%path// &
-                "' does not hold the expected type (real or integer)")
+                            "' does not hold the expected type (real or integer)")
             call release(dset)
         end if
     end subroutine open_dataset
@@ -994,7 +994,7 @@ contains
         r = size(record_shape)
         if (r > 2 .or. any(record_shape < 1)) then
             call make_error(error, "HDF5: series '"//path//"': records must be scalars, 1-D or " &
-                //"2-D with positive extents")
+                            //"2-D with positive extents")
             return
         end if
         n_per_record = product(record_shape)
@@ -1042,11 +1042,11 @@ contains
         integer(hsize_t) :: mdims(1)
         integer :: hdferr
         call self%extend_series(path, h5t_float_f, 0, size(values), dset, fspace, mspace, &
-            error)
+                                error)
         if (allocated(error) .or. dset < 0) return
         mdims = size(values, kind=hsize_t)
         call h5dwrite_f(dset, h5t_native_double, values, mdims, hdferr, mem_space_id=mspace, &
-            file_space_id=fspace)
+                        file_space_id=fspace)
         call release(mspace)
         call release(fspace)
         call release(dset)
@@ -1069,11 +1069,11 @@ contains
         integer(hsize_t) :: mdims(1)
         integer :: hdferr
         call self%extend_series(path, h5t_float_f, size(values, 1), size(values, 2), dset, &
-            fspace, mspace, error)
+                                fspace, mspace, error)
         if (allocated(error) .or. dset < 0) return
         mdims = size(values, kind=hsize_t)
         call h5dwrite_f(dset, h5t_native_double, reshape(values, [size(values)]), mdims, &
-            hdferr, mem_space_id=mspace, file_space_id=fspace)
+                        hdferr, mem_space_id=mspace, file_space_id=fspace)
         call release(mspace)
         call release(fspace)
         call release(dset)
@@ -1094,11 +1094,11 @@ contains
         integer(hsize_t) :: mdims(1)
         integer :: hdferr
         call self%extend_series(path, h5t_integer_f, 0, size(values), dset, fspace, mspace, &
-            error)
+                                error)
         if (allocated(error) .or. dset < 0) return
         mdims = size(values, kind=hsize_t)
         call h5dwrite_f(dset, h5t_native_integer, values, mdims, hdferr, mem_space_id=mspace, &
-            file_space_id=fspace)
+                        file_space_id=fspace)
         call release(mspace)
         call release(fspace)
         call release(dset)
@@ -1110,7 +1110,7 @@ contains
     !> and `fspace` (file) into `dset`, then releases the three ids. With count = 0 nothing
     !> is changed and dset = -1 (nothing to write).
     subroutine extend_series(self, path, type_class, record_size, count, dset, fspace, &
-        mspace, error)
+                             mspace, error)
         !> A file open for writing.
         class(h5_file_t), intent(inout) :: self
         !> Series path.
@@ -1156,7 +1156,7 @@ contains
         call release(dtype)
         if (hdferr < 0 .or. actual_class /= type_class) then
             call make_error(error, "HDF5: series '"//path//"' in '"//self%path// &
-                "' does not hold the type of the records appended (real or integer)")
+                            "' does not hold the type of the records appended (real or integer)")
             call release(dset)
             return
         end if
@@ -1278,7 +1278,7 @@ contains
             call h5screate_simple_f(1, mdims, mspace, hdferr)
             if (hdferr < 0) exit ops
             call h5dwrite_f(dset, h5t_native_double, values, mdims, hdferr, mem_space_id=mspace, &
-                file_space_id=fspace)
+                            file_space_id=fspace)
         end block ops
         call release(mspace)
         call release(fspace)
@@ -1326,7 +1326,7 @@ contains
             call release(dset)
             dset = -1
             call make_error(error, "HDF5: '"//path//"' in '"//self%path//"' is not a readable " &
-                //"dataset")
+                            //"dataset")
         end if
     end subroutine dataset_dims
 
@@ -1357,7 +1357,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         if (.not. self%writable .or. .not. self%is_open()) then
             call make_error(error, "HDF5: cannot write '"//path//"': file '"//file_name(self) &
-                //"' is not open for writing")
+                            //"' is not open for writing")
         end if
     end subroutine require_writable
 
@@ -1443,7 +1443,7 @@ contains
         !> The error.
         type(error_t), allocatable, intent(out) :: error
         call make_error(error, "HDF5: cannot "//what//" attribute '"//name//"' of '"//object// &
-            "' in '"//file_name(self)//"'")
+                        "' in '"//file_name(self)//"'")
     end subroutine attr_error
 
     !> Error for a failed dataset operation.
@@ -1457,6 +1457,6 @@ contains
         !> The error.
         type(error_t), allocatable, intent(out) :: error
         call make_error(error, "HDF5: cannot "//what//" dataset '"//path//"' in '" &
-            //file_name(self)//"'")
+                        //file_name(self)//"'")
     end subroutine dataset_error
 end module io_hdf5_file

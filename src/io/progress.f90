@@ -145,7 +145,7 @@ contains
             text = text//' / '//trim(adjustl(buf))
         end if
         text = text//' s  wall '//format_hms(elapsed)//'  ETA ' &
-            //format_hms(eta_seconds(step, total_steps, elapsed))
+               //format_hms(eta_seconds(step, total_steps, elapsed))
     end function format_progress_line
 
     !> Summary line built from explicit values (see `progress_t%summary_line`).

@@ -4,7 +4,7 @@
 module io_schema_common
     use core_kinds, only: wp
     use io_deck_schema, only: schema_t, tail_spec_t, int_field, real_field, positive, &
-        word_field, text_field, tail, when
+                              word_field, text_field, tail, when
     implicit none
     private
     public :: add_run, add_functions, add_time, add_output
@@ -17,10 +17,10 @@ contains
         type(schema_t), intent(inout) :: s
         call s%add_section('run', 'What to compute.')
         call s%add_keyword('run', 'title', [text_field('title')], &
-            'Free text stored with the results.', default='')
+                           'Free text stored with the results.', default='')
         call s%add_keyword('run', 'analysis', [word_field('analysis', 'static modal dynamic')], &
-            'Kind of analysis: static equilibrium, natural modes, or time integration '// &
-            '(particles: dynamic only).', required=.true.)
+                           'Kind of analysis: static equilibrium, natural modes, or time integration '// &
+                           '(particles: dynamic only).', required=.true.)
     end subroutine add_run
 
     !> [functions]: time functions multiplying loads.
@@ -29,20 +29,20 @@ contains
         type(schema_t), intent(inout) :: s
         type(tail_spec_t), allocatable :: tails(:)
         call s%add_section('functions', &
-            'Time functions f(t) that multiply loads, imposed velocities and wall velocities.')
+                           'Time functions f(t) that multiply loads, imposed velocities and wall velocities.')
         tails = [tail([real_field('c', '')], 1, 1, selected_by='constant'), &
-            tail([positive('t1', 's')], 1, 1, selected_by='ramp'), &
-            tail([real_field('t0', 's', lower=0.0_wp)], 1, 1, selected_by='step'), &
-            tail([real_field('t', 's'), real_field('f', '')], 4, -1, cyclic=.true., &
-            selected_by='table'), &
-            tail([positive('freq', 'Hz'), real_field('phase', 'rad')], 1, 2, &
-            selected_by='harmonic')]
+                 tail([positive('t1', 's')], 1, 1, selected_by='ramp'), &
+                 tail([real_field('t0', 's', lower=0.0_wp)], 1, 1, selected_by='step'), &
+                 tail([real_field('t', 's'), real_field('f', '')], 4, -1, cyclic=.true., &
+                      selected_by='table'), &
+                 tail([positive('freq', 'Hz'), real_field('phase', 'rad')], 1, 2, &
+                      selected_by='harmonic')]
         call s%add_keyword('functions', 'function', &
-            [int_field('id', lower=1), word_field('kind', 'constant ramp step table harmonic')], &
-            'constant: f = c; ramp: f = min(t/t1, 1); step: f = 0 before t0, 1 after; '// &
-            'table: linear in (t, f) pairs, t increasing, constant outside; '// &
-            'harmonic: f = sin(2 pi freq t + phase).', &
-            selector=2, tails=tails, repeatable=.true.)
+                           [int_field('id', lower=1), word_field('kind', 'constant ramp step table harmonic')], &
+                           'constant: f = c; ramp: f = min(t/t1, 1); step: f = 0 before t0, 1 after; '// &
+                           'table: linear in (t, f) pairs, t increasing, constant outside; '// &
+                           'harmonic: f = sin(2 pi freq t + phase).', &
+                           selector=2, tails=tails, repeatable=.true.)
     end subroutine add_functions
 
     !> [time]: time integration.
@@ -51,23 +51,23 @@ contains
         type(schema_t), intent(inout) :: s
         call s%add_section('time', 'Time integration (dynamic analysis).')
         call s%add_keyword('time', 'step', [positive('step', 's')], &
-            'Time step h.', required_when=when('run', 'analysis', 'dynamic'))
+                           'Time step h.', required_when=when('run', 'analysis', 'dynamic'))
         call s%add_keyword('time', 'end', [positive('end', 's')], &
-            'End time (the run starts at t = 0).', required_when=when('run', 'analysis', 'dynamic'))
+                           'End time (the run starts at t = 0).', required_when=when('run', 'analysis', 'dynamic'))
         call s%add_keyword('time', 'scheme', &
-            [word_field('scheme', 'average_acceleration newmark central_difference')], &
-            'Newmark family: average_acceleration (beta 1/4, gamma 1/2), newmark (beta and '// &
-            'gamma below), central_difference (beta 0, gamma 1/2, explicit).', &
-            default='average_acceleration')
+                           [word_field('scheme', 'average_acceleration newmark central_difference')], &
+                           'Newmark family: average_acceleration (beta 1/4, gamma 1/2), newmark (beta and '// &
+                           'gamma below), central_difference (beta 0, gamma 1/2, explicit).', &
+                           default='average_acceleration')
         call s%add_keyword('time', 'beta', [real_field('beta', '', lower=0.0_wp, upper=0.5_wp)], &
-            'Newmark beta.', default='0.25', allowed_when=when('time', 'scheme', 'newmark'))
+                           'Newmark beta.', default='0.25', allowed_when=when('time', 'scheme', 'newmark'))
         call s%add_keyword('time', 'gamma', [real_field('gamma', '', lower=0.5_wp, upper=1.0_wp)], &
-            'Newmark gamma (> 1/2 adds numerical damping).', default='0.5', &
-            allowed_when=when('time', 'scheme', 'newmark'))
+                           'Newmark gamma (> 1/2 adds numerical damping).', default='0.5', &
+                           allowed_when=when('time', 'scheme', 'newmark'))
         call s%add_keyword('time', 'theta', [real_field('theta', '', lower=0.5_wp, upper=1.0_wp)], &
-            'Moreau-Jean theta of the particles: positions advance with (1 - theta) v(t) + '// &
-            'theta v(t + h); 1/2 conserves energy in free flight and elastic impacts, '// &
-            '1 is fully implicit (dissipative, never overlaps).', default='0.5')
+                           'Moreau-Jean theta of the particles: positions advance with (1 - theta) v(t) + '// &
+                           'theta v(t + h); 1/2 conserves energy in free flight and elastic impacts, '// &
+                           '1 is fully implicit (dissipative, never overlaps).', default='0.5')
     end subroutine add_time
 
     !> [output]: what is stored and shown.
@@ -76,11 +76,11 @@ contains
         type(schema_t), intent(inout) :: s
         call s%add_section('output', 'Results and progress reports.')
         call s%add_keyword('output', 'interval', [int_field('interval', lower=1)], &
-            'Time steps between stored states.', default='1')
+                           'Time steps between stored states.', default='1')
         call s%add_keyword('output', 'progress', [real_field('progress', 's', lower=0.0_wp)], &
-            'Wall-clock seconds between progress lines (0 = none).', default='5')
+                           'Wall-clock seconds between progress lines (0 = none).', default='5')
         call s%add_keyword('output', 'contacts', [word_field('contacts', 'yes no')], &
-            'Store the contact network (pairs, normals, forces, statuses) with every stored '// &
-            'state of the particles.', default='yes')
+                           'Store the contact network (pairs, normals, forces, statuses) with every stored '// &
+                           'state of the particles.', default='yes')
     end subroutine add_output
 end module io_schema_common

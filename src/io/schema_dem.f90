@@ -6,7 +6,7 @@
 module io_schema_dem
     use core_kinds, only: wp
     use io_deck_schema, only: schema_t, int_field, real_field, positive, word_field, &
-        selection_field, tail
+                              selection_field, tail
     implicit none
     private
     public :: add_particles, add_walls, add_contacts, add_solver
@@ -18,68 +18,68 @@ contains
         !> Schema to extend.
         type(schema_t), intent(inout) :: s
         call s%add_section('particles', 'Rigid disks (discrete elements), per unit thickness: '// &
-            'materials, disks and generators, gravity, conditions. Disks are numbered 1..N in '// &
-            'the order the deck creates them; conditions select them by number (`5`), range '// &
-            '(`1:10`, `11:last`), `last` (= N) or `all`.')
+                           'materials, disks and generators, gravity, conditions. Disks are numbered 1..N in '// &
+                           'the order the deck creates them; conditions select them by number (`5`), range '// &
+                           '(`1:10`, `11:last`), `last` (= N) or `all`.')
         call s%add_keyword('particles', 'material', [int_field('id', lower=1), &
-            positive('density', 'kg/m^3')], &
-            'A disk material: mass m = density pi R^2 and inertia I = m R^2 / 2 per unit '// &
-            'thickness; contact laws between materials are in [contacts].', repeatable=.true.)
+                                                     positive('density', 'kg/m^3')], &
+                           'A disk material: mass m = density pi R^2 and inertia I = m R^2 / 2 per unit '// &
+                           'thickness; contact laws between materials are in [contacts].', repeatable=.true.)
         call s%add_keyword('particles', 'disk', [real_field('x', 'm'), real_field('y', 'm'), &
-            positive('radius', 'm'), int_field('material', lower=1)], &
-            'One disk centred at (x, y).', repeatable=.true.)
+                                                 positive('radius', 'm'), int_field('material', lower=1)], &
+                           'One disk centred at (x, y).', repeatable=.true.)
         call s%add_keyword('particles', 'row', [int_field('n', lower=1), real_field('x0', 'm'), &
-            real_field('y0', 'm'), positive('radius', 'm'), int_field('material', lower=1)], &
-            'Generator: n disks in a straight chain from the centre (x0, y0) in the direction '// &
-            'angle_deg from the x axis (default 0), centres 2 radius + gap apart (default '// &
-            'gap 0: touching).', &
-            tails=[tail([real_field('gap', 'm', lower=0.0_wp), real_field('angle_deg', 'deg')], &
-            0, 2)], repeatable=.true.)
+                                                real_field('y0', 'm'), positive('radius', 'm'), int_field('material', lower=1)], &
+                           'Generator: n disks in a straight chain from the centre (x0, y0) in the direction '// &
+                           'angle_deg from the x axis (default 0), centres 2 radius + gap apart (default '// &
+                           'gap 0: touching).', &
+                           tails=[tail([real_field('gap', 'm', lower=0.0_wp), real_field('angle_deg', 'deg')], &
+                                       0, 2)], repeatable=.true.)
         call s%add_keyword('particles', 'square_lattice', [int_field('nx', lower=1), &
-            int_field('ny', lower=1), real_field('x0', 'm'), real_field('y0', 'm'), &
-            positive('radius', 'm'), int_field('material', lower=1)], &
-            'Generator: ny rows of nx disks on a square lattice of pitch 2 radius + gap '// &
-            '(default gap 0: touching), lower-left centre (x0, y0), numbered row by row.', &
-            tails=[tail([real_field('gap', 'm', lower=0.0_wp)], 0, 1)], repeatable=.true.)
+                                                           int_field('ny', lower=1), real_field('x0', 'm'), real_field('y0', 'm'), &
+                                                           positive('radius', 'm'), int_field('material', lower=1)], &
+                           'Generator: ny rows of nx disks on a square lattice of pitch 2 radius + gap '// &
+                           '(default gap 0: touching), lower-left centre (x0, y0), numbered row by row.', &
+                           tails=[tail([real_field('gap', 'm', lower=0.0_wp)], 0, 1)], repeatable=.true.)
         call s%add_keyword('particles', 'hex_lattice', [int_field('nx', lower=1), &
-            int_field('ny', lower=1), real_field('x0', 'm'), real_field('y0', 'm'), &
-            positive('radius', 'm'), int_field('material', lower=1)], &
-            'Generator: ny rows of nx disks on a hexagonal lattice of pitch 2 radius + gap '// &
-            '(default gap 0: touching), rows sqrt(3)/2 pitch apart, every other row shifted by '// &
-            'half a pitch, lower-left centre (x0, y0), numbered row by row.', &
-            tails=[tail([real_field('gap', 'm', lower=0.0_wp)], 0, 1)], repeatable=.true.)
+                                                        int_field('ny', lower=1), real_field('x0', 'm'), real_field('y0', 'm'), &
+                                                        positive('radius', 'm'), int_field('material', lower=1)], &
+                           'Generator: ny rows of nx disks on a hexagonal lattice of pitch 2 radius + gap '// &
+                           '(default gap 0: touching), rows sqrt(3)/2 pitch apart, every other row shifted by '// &
+                           'half a pitch, lower-left centre (x0, y0), numbered row by row.', &
+                           tails=[tail([real_field('gap', 'm', lower=0.0_wp)], 0, 1)], repeatable=.true.)
         call s%add_keyword('particles', 'deposit', [int_field('n', lower=1), &
-            real_field('xmin', 'm'), real_field('xmax', 'm'), real_field('ymin', 'm'), &
-            positive('rmin', 'm'), positive('rmax', 'm'), int_field('material', lower=1), &
-            int_field('seed')], &
-            'Generator: n disks of radii uniform in [rmin, rmax], loose in the box x in '// &
-            '[xmin, xmax], y >= ymin: one per site of a square grid of pitch 2 rmax '// &
-            '(1 + gap_ratio) (default gap_ratio 0.1), filled row by row from the bottom, '// &
-            'shifted at random in its site without overlap; the same seed gives the same '// &
-            'deposit.', tails=[tail([real_field('gap_ratio', '', lower=0.0_wp)], 0, 1)], &
-            repeatable=.true.)
+                                                    real_field('xmin', 'm'), real_field('xmax', 'm'), real_field('ymin', 'm'), &
+                                                    positive('rmin', 'm'), positive('rmax', 'm'), int_field('material', lower=1), &
+                                                    int_field('seed')], &
+                           'Generator: n disks of radii uniform in [rmin, rmax], loose in the box x in '// &
+                           '[xmin, xmax], y >= ymin: one per site of a square grid of pitch 2 rmax '// &
+                           '(1 + gap_ratio) (default gap_ratio 0.1), filled row by row from the bottom, '// &
+                           'shifted at random in its site without overlap; the same seed gives the same '// &
+                           'deposit.', tails=[tail([real_field('gap_ratio', '', lower=0.0_wp)], 0, 1)], &
+                           repeatable=.true.)
         call s%add_keyword('particles', 'gravity', [real_field('gx', 'm/s^2'), &
-            real_field('gy', 'm/s^2')], &
-            'Gravity acceleration (the default is none; write gravity = 0 -9.81 for the usual '// &
-            'one).', default='0 0')
+                                                    real_field('gy', 'm/s^2')], &
+                           'Gravity acceleration (the default is none; write gravity = 0 -9.81 for the usual '// &
+                           'one).', default='0 0')
         call s%add_keyword('particles', 'fix', [selection_field('particles')], &
-            'Hold DOFs of the selected disks at zero velocity: x, y, rot (rotation), or all.', &
-            tails=[tail([word_field('dof', 'x y rot all')], 1, 3, cyclic=.true.)], &
-            repeatable=.true.)
+                           'Hold DOFs of the selected disks at zero velocity: x, y, rot (rotation), or all.', &
+                           tails=[tail([word_field('dof', 'x y rot all')], 1, 3, cyclic=.true.)], &
+                           repeatable=.true.)
         call s%add_keyword('particles', 'velocity', [selection_field('particles'), &
-            word_field('dof', 'x y rot'), real_field('value', 'm/s or rad/s')], &
-            'Impose the velocity of one DOF of the selected disks: value times a time '// &
-            'function (none: constant 1).', &
-            tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
+                                                     word_field('dof', 'x y rot'), real_field('value', 'm/s or rad/s')], &
+                           'Impose the velocity of one DOF of the selected disks: value times a time '// &
+                           'function (none: constant 1).', &
+                           tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
         call s%add_keyword('particles', 'force', [selection_field('particles'), &
-            word_field('dof', 'x y rot'), real_field('value', 'N/m or N')], &
-            'Force per unit thickness (x, y) or torque (rot) on each selected disk, times a '// &
-            'time function (none: constant 1); forces on the same DOF add up.', &
-            tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
+                                                  word_field('dof', 'x y rot'), real_field('value', 'N/m or N')], &
+                           'Force per unit thickness (x, y) or torque (rot) on each selected disk, times a '// &
+                           'time function (none: constant 1); forces on the same DOF add up.', &
+                           tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
         call s%add_keyword('particles', 'initial_velocity', [selection_field('particles'), &
-            word_field('dof', 'x y rot'), real_field('value', 'm/s or rad/s')], &
-            'Velocity at t = 0 of one free DOF of the selected disks (the others start at '// &
-            'rest); a later record overrides an earlier one.', repeatable=.true.)
+                                                             word_field('dof', 'x y rot'), real_field('value', 'm/s or rad/s')], &
+                           'Velocity at t = 0 of one free DOF of the selected disks (the others start at '// &
+                           'rest); a later record overrides an earlier one.', repeatable=.true.)
     end subroutine add_particles
 
     !> [walls]: straight walls, fixed or driven.
@@ -87,14 +87,14 @@ contains
         !> Schema to extend.
         type(schema_t), intent(inout) :: s
         call s%add_section('walls', 'Rigid straight walls (segments of zero thickness, touched '// &
-            'on either side), fixed or driven in translation; numbered 1..n in deck order.')
+                           'on either side), fixed or driven in translation; numbered 1..n in deck order.')
         call s%add_keyword('walls', 'wall', [real_field('x1', 'm'), real_field('y1', 'm'), &
-            real_field('x2', 'm'), real_field('y2', 'm')], &
-            'A wall from (x1, y1) to (x2, y2), of a [particles] material (default: the first '// &
-            'one declared), moving at the velocity (vx, vy) times a time function (default '// &
-            'fixed; function none: constant 1). Write 4, 5, 7 or 8 values.', &
-            tails=[tail([int_field('material', lower=1), real_field('vx', 'm/s'), &
-            real_field('vy', 'm/s'), int_field('function', lower=1)], 0, 4)], repeatable=.true.)
+                                             real_field('x2', 'm'), real_field('y2', 'm')], &
+                           'A wall from (x1, y1) to (x2, y2), of a [particles] material (default: the first '// &
+                           'one declared), moving at the velocity (vx, vy) times a time function (default '// &
+                           'fixed; function none: constant 1). Write 4, 5, 7 or 8 values.', &
+                           tails=[tail([int_field('material', lower=1), real_field('vx', 'm/s'), &
+                                        real_field('vy', 'm/s'), int_field('function', lower=1)], 0, 4)], repeatable=.true.)
     end subroutine add_walls
 
     !> [contacts]: contact laws and detection.
@@ -102,21 +102,21 @@ contains
         !> Schema to extend.
         type(schema_t), intent(inout) :: s
         call s%add_section('contacts', 'Contact laws between materials (Signorini, Coulomb '// &
-            'friction, Newton restitution, cohesion) and contact detection. A pair of '// &
-            'materials without a law is frictionless, perfectly plastic (e = 0), not cohesive.')
+                           'friction, Newton restitution, cohesion) and contact detection. A pair of '// &
+                           'materials without a law is frictionless, perfectly plastic (e = 0), not cohesive.')
         call s%add_keyword('contacts', 'law', [int_field('material1', lower=1), &
-            int_field('material2', lower=1), real_field('mu', '', lower=0.0_wp), &
-            real_field('restitution', '', lower=0.0_wp, upper=1.0_wp), &
-            real_field('cohesion', 'Pa', lower=0.0_wp)], &
-            'Law of the contacts between two materials (either order): friction coefficient, '// &
-            'restitution coefficient, cohesion stress sigma_cohe (the bond holds a tension '// &
-            'sigma_cohe times the mean radius of the pair per unit thickness; bonds form '// &
-            'between touching disks at t = 0 and break for good once they open).', &
-            repeatable=.true.)
+                                               int_field('material2', lower=1), real_field('mu', '', lower=0.0_wp), &
+                                               real_field('restitution', '', lower=0.0_wp, upper=1.0_wp), &
+                                               real_field('cohesion', 'Pa', lower=0.0_wp)], &
+                           'Law of the contacts between two materials (either order): friction coefficient, '// &
+                           'restitution coefficient, cohesion stress sigma_cohe (the bond holds a tension '// &
+                           'sigma_cohe times the mean radius of the pair per unit thickness; bonds form '// &
+                           'between touching disks at t = 0 and break for good once they open).', &
+                           repeatable=.true.)
         call s%add_keyword('contacts', 'alert', [real_field('alert', 'm', lower=0.0_wp)], &
-            'Alert distance: pairs closer than this are candidate contacts of the step '// &
-            '(default 0.25 times the mean disk radius); it must exceed the distance a disk '// &
-            'travels in one step (a warning says when it does not).')
+                           'Alert distance: pairs closer than this are candidate contacts of the step '// &
+                           '(default 0.25 times the mean disk radius); it must exceed the distance a disk '// &
+                           'travels in one step (a warning says when it does not).')
     end subroutine add_contacts
 
     !> [solver]: non-linear Gauss-Seidel settings.
@@ -124,18 +124,18 @@ contains
         !> Schema to extend.
         type(schema_t), intent(inout) :: s
         call s%add_section('solver', 'Contact solver of the particles: non-linear Gauss-Seidel '// &
-            'sweeps over the contacts with the bi-potential local solver, at every time step.')
+                           'sweeps over the contacts with the bi-potential local solver, at every time step.')
         call s%add_keyword('solver', 'tolerance', [positive('tolerance', '')], &
-            'Convergence of the sweeps: change of the local velocities over a sweep relative '// &
-            'to W r (quadratic mean over the active contacts).', default='1.666e-4')
+                           'Convergence of the sweeps: change of the local velocities over a sweep relative '// &
+                           'to W r (quadratic mean over the active contacts).', default='1.666e-4')
         call s%add_keyword('solver', 'max_sweeps', [int_field('max_sweeps', lower=1)], &
-            'Largest number of sweeps per step; a step that reaches it without converging is '// &
-            'reported (warning) and counted.', default='1000')
+                           'Largest number of sweeps per step; a step that reaches it without converging is '// &
+                           'reported (warning) and counted.', default='1000')
         call s%add_keyword('solver', 'local_tolerance', [positive('local_tolerance', '')], &
-            'Relative tolerance of the local prediction-correction iterations of one contact.', &
-            default='1e-10')
+                           'Relative tolerance of the local prediction-correction iterations of one contact.', &
+                           default='1e-10')
         call s%add_keyword('solver', 'local_iterations', [int_field('local_iterations', lower=1)], &
-            'Largest number of local prediction-correction iterations per contact visit.', &
-            default='8')
+                           'Largest number of local prediction-correction iterations per contact visit.', &
+                           default='8')
     end subroutine add_solver
 end module io_schema_dem

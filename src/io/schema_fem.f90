@@ -15,38 +15,38 @@ contains
         !> Schema to extend.
         type(schema_t), intent(inout) :: s
         call s%add_section('beam', &
-            'Planar Euler-Bernoulli frame: geometry, material, supports, loads.')
+                           'Planar Euler-Bernoulli frame: geometry, material, supports, loads.')
         call s%add_keyword('beam', 'mass', [word_field('mass', 'consistent lumped')], &
-            'Mass matrix: consistent, or lumped (HRZ, diagonal).', default='consistent')
+                           'Mass matrix: consistent, or lumped (HRZ, diagonal).', default='consistent')
         call s%add_keyword('beam', 'section', [int_field('id', lower=1), &
-            positive('young', 'Pa'), positive('density', 'kg/m^3'), positive('area', 'm^2'), &
-            positive('inertia', 'm^4')], &
-            'Cross-section and material: Young modulus, density, area, second moment of area.', &
-            repeatable=.true.)
+                                               positive('young', 'Pa'), positive('density', 'kg/m^3'), positive('area', 'm^2'), &
+                                               positive('inertia', 'm^4')], &
+                           'Cross-section and material: Young modulus, density, area, second moment of area.', &
+                           repeatable=.true.)
         call s%add_keyword('beam', 'node', &
-            [int_field('id', lower=1), real_field('x', 'm'), real_field('y', 'm')], &
-            'A node at (x, y).', repeatable=.true.)
+                           [int_field('id', lower=1), real_field('x', 'm'), real_field('y', 'm')], &
+                           'A node at (x, y).', repeatable=.true.)
         call s%add_keyword('beam', 'line', [int_field('first_node', lower=1), &
-            real_field('x1', 'm'), real_field('y1', 'm'), real_field('x2', 'm'), &
-            real_field('y2', 'm'), int_field('elements', lower=1), int_field('section', lower=1)], &
-            'Generator: nodes first_node..first_node+elements equally spaced from (x1, y1) to '// &
-            '(x2, y2) and the elements between them; existing coincident nodes are reused.', &
-            repeatable=.true.)
+                                            real_field('x1', 'm'), real_field('y1', 'm'), real_field('x2', 'm'), &
+                                            real_field('y2', 'm'), int_field('elements', lower=1), int_field('section', lower=1)], &
+                           'Generator: nodes first_node..first_node+elements equally spaced from (x1, y1) to '// &
+                           '(x2, y2) and the elements between them; existing coincident nodes are reused.', &
+                           repeatable=.true.)
         call s%add_keyword('beam', 'element', [int_field('id', lower=1), &
-            int_field('node1', lower=1), int_field('node2', lower=1), &
-            int_field('section', lower=1)], &
-            'An element from node1 to node2 with the given section.', repeatable=.true.)
+                                               int_field('node1', lower=1), int_field('node2', lower=1), &
+                                               int_field('section', lower=1)], &
+                           'An element from node1 to node2 with the given section.', repeatable=.true.)
         call s%add_keyword('beam', 'fix', [int_field('node', lower=1)], &
-            'Clamp DOFs of a node to zero: u (x), w (y), theta (rotation), or all.', &
-            tails=[tail([word_field('dof', 'u w theta all')], 1, 3, cyclic=.true.)], &
-            repeatable=.true.)
+                           'Clamp DOFs of a node to zero: u (x), w (y), theta (rotation), or all.', &
+                           tails=[tail([word_field('dof', 'u w theta all')], 1, 3, cyclic=.true.)], &
+                           repeatable=.true.)
         call s%add_keyword('beam', 'load', [int_field('node', lower=1), &
-            word_field('dof', 'u w theta'), real_field('value', 'N or N.m')], &
-            'Nodal force (u, w) or moment (theta) times a time function (none: constant 1).', &
-            tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
+                                            word_field('dof', 'u w theta'), real_field('value', 'N or N.m')], &
+                           'Nodal force (u, w) or moment (theta) times a time function (none: constant 1).', &
+                           tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
         call s%add_keyword('beam', 'rayleigh', &
-            [real_field('a0', '1/s', lower=0.0_wp), real_field('a1', 's', lower=0.0_wp)], &
-            'Rayleigh damping C = a0 M + a1 K.', default='0 0')
+                           [real_field('a0', '1/s', lower=0.0_wp), real_field('a1', 's', lower=0.0_wp)], &
+                           'Rayleigh damping C = a0 M + a1 K.', default='0 0')
     end subroutine add_beam
 
     !> [modal]: natural modes.
@@ -55,7 +55,7 @@ contains
         type(schema_t), intent(inout) :: s
         call s%add_section('modal', 'Natural modes (modal analysis).')
         call s%add_keyword('modal', 'modes', [int_field('modes', lower=1)], &
-            'Number of lowest modes to compute.', default='3')
+                           'Number of lowest modes to compute.', default='3')
     end subroutine add_modal
 
     !> [initial]: initial conditions.
@@ -63,12 +63,12 @@ contains
         !> Schema to extend.
         type(schema_t), intent(inout) :: s
         call s%add_section('initial', &
-            'Initial conditions on free DOFs (dynamic analysis); the others start at zero.')
+                           'Initial conditions on free DOFs (dynamic analysis); the others start at zero.')
         call s%add_keyword('initial', 'velocity', [int_field('node', lower=1), &
-            word_field('dof', 'u w theta'), real_field('value', 'm/s or rad/s')], &
-            'Initial velocity of one DOF of a node.', repeatable=.true.)
+                                                   word_field('dof', 'u w theta'), real_field('value', 'm/s or rad/s')], &
+                           'Initial velocity of one DOF of a node.', repeatable=.true.)
         call s%add_keyword('initial', 'displacement', [int_field('node', lower=1), &
-            word_field('dof', 'u w theta'), real_field('value', 'm or rad')], &
-            'Initial displacement of one DOF of a node.', repeatable=.true.)
+                                                       word_field('dof', 'u w theta'), real_field('value', 'm or rad')], &
+                           'Initial displacement of one DOF of a node.', repeatable=.true.)
     end subroutine add_initial
 end module io_schema_fem
