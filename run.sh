@@ -1,25 +1,52 @@
 #!/usr/bin/env bash
 # Run a MULTICOR deck and plot its results.
-#   ./run.sh [deck.dat]       default: the reference deck (input/cantilever.dat for now)
+#   ./run.sh [deck.dat]       default: reference experiment 1 (input/bending_case1.dat)
+#   ./run.sh --experiments    all reference experiments and their figures (doc/experiments.md)
 # Installs what is missing, builds a Release build in build/, runs the deck, writes
-# results/<deck name>/<deck name>.h5 and its plots, and prints where they are.
+# results/<deck name>/<deck name>.h5 and its plots, and prints where they are. With
+# --experiments: input/bending_case1.dat, bending_case2.dat and bending_stack.dat into
+# results/experiments/<case>/, then the figures (PNG and PDF) and a summary of the measured
+# figures in results/experiments/ (postproc/plot_experiments.py).
 set -euo pipefail
 source "$(cd "$(dirname "$0")" && pwd)/scripts/bootstrap.sh"
 
-deck=${1:-$MULTICOR_ROOT/input/cantilever.dat}
-[ -f "$deck" ] || die "no such deck: $deck"
-deck=$(realpath "$deck")
+experiments=0
+if [ "${1:-}" = "--experiments" ]; then
+    experiments=1
+    shift
+    [ $# -eq 0 ] || die "--experiments takes no deck"
+fi
+deck=${1:-$MULTICOR_ROOT/input/bending_case1.dat}
+# Experiment 1 is plotted at t = 5 ms (doc/experiments.md); other decks at their last output.
+plot_time=()
+[ $# -gt 0 ] || plot_time=(--time 5e-3)
+if [ $experiments -eq 0 ]; then
+    [ -f "$deck" ] || die "no such deck: $deck"
+    deck=$(realpath "$deck")
+fi
 cd "$MULTICOR_ROOT"
-name=$(basename "$deck")
-name=${name%.*}
-out="results/$name"
 
 ensure_system_deps
 ensure_venv
 configure_and_build build Release
 
+if [ $experiments -eq 1 ]; then
+    out=results/experiments
+    for name in bending_case1 bending_case2 bending_stack; do
+        say "running input/$name.dat"
+        build/src/multicor "input/$name.dat" --output "$out/$name"
+    done
+    say "plotting the experiments"
+    .venv/bin/python postproc/plot_experiments.py --results "$out"
+    say "figures in $MULTICOR_ROOT/$out"
+    exit 0
+fi
+
+name=$(basename "$deck")
+name=${name%.*}
+out="results/$name"
 say "running $deck"
 build/src/multicor "$deck" --output "$out"
 say "plotting"
-.venv/bin/python postproc/plot_results.py "$out/$name.h5" --out "$out"
+.venv/bin/python postproc/plot_results.py "$out/$name.h5" --out "$out" "${plot_time[@]}"
 say "results in $MULTICOR_ROOT/$out"

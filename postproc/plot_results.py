@@ -8,7 +8,11 @@ Plots what the file holds: the beam (finite-element) plots of plot_beam.py when 
 walls and contact force network at the stored time nearest to T; default the last, plus
 <name>_particles_start.png at t = 0), <name>_dem_energy.png (energy audit),
 <name>_solver.png (contact solver statistics of every step) and, for up to 50 disks,
-<name>_velocities.png. Exit code 1 with a message on a missing or invalid file.
+<name>_velocities.png; and, for a coupled run (a /coupling group), both of these and
+<name>_profiles.png (displacement and velocity along x of the beam nodes and the disks),
+<name>_configuration.png (deformed beam, disks, overlap) and <name>_coupling.png (constraint
+residuals, multipliers, energy audit). Exit code 1 with a message on a missing or invalid
+file.
 """
 import argparse
 import os
@@ -18,12 +22,12 @@ import h5py
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from multicor_post import beam, particles  # noqa: E402
+from multicor_post import beam, coupled, particles  # noqa: E402
 from multicor_post.results import ResultsError, load_results  # noqa: E402
 
 
 def contents(path):
-    """(has beam results, has particle results) of a results file."""
+    """(has beam results, has particle results, is a coupled run) of a results file."""
     if not os.path.exists(path):
         hint = ""
         if os.path.exists(path + ".partial"):
@@ -31,7 +35,7 @@ def contents(path):
         raise ResultsError(f"results file '{path}' does not exist{hint}")
     try:
         with h5py.File(path, "r") as f:
-            return "fem/mesh" in f, "dem" in f
+            return "fem/mesh" in f, "dem" in f, "coupling" in f
     except OSError as exc:
         raise ResultsError(f"'{path}' is not a readable HDF5 file ({exc})") from None
 
@@ -52,11 +56,14 @@ def main(argv=None):
     args = parser.parse_args(argv)
     out = args.out if args.out is not None else (os.path.dirname(args.results) or ".")
     try:
-        has_beam, has_particles = contents(args.results)
+        has_beam, has_particles, is_coupled = contents(args.results)
         if not (has_beam or has_particles):
             raise ResultsError(f"{args.results}: neither /fem/mesh nor /dem: not a MULTICOR "
                                "results file")
         paths = []
+        if is_coupled:
+            paths += coupled.write_all(coupled.load_coupled(args.results), out, time=args.time,
+                                       scale=args.scale)
         if has_beam:
             paths += beam.write_all(load_results(args.results), out, time=args.time,
                                     node_id=args.node, scale=args.scale)

@@ -80,13 +80,14 @@ configure_and_build() {
     local dir="$1" type="$2"
     shift 2
     ensure_cmake_version
+    mkdir -p "$dir"
     if [ ! -f "$dir/build.ninja" ]; then
         say "configuring $type build in $dir"
         cmake -S "$MULTICOR_ROOT" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE="$type" \
-            -DPython3_EXECUTABLE="$MULTICOR_ROOT/.venv/bin/python" "$@" >"$dir.configure.log" 2>&1 \
-            || { cat "$dir.configure.log" >&2; die "CMake configuration failed (log: $dir.configure.log)"; }
+            -DPython3_EXECUTABLE="$MULTICOR_ROOT/.venv/bin/python" "$@" >"$dir/configure.log" 2>&1 \
+            || { cat "$dir/configure.log" >&2; die "CMake configuration failed (log: $dir/configure.log)"; }
     fi
     say "building ($type)"
-    cmake --build "$dir" -j "$(nproc)" >"$dir.build.log" 2>&1 \
-        || { tail -n 60 "$dir.build.log" >&2; die "build failed (log: $dir.build.log)"; }
+    cmake --build "$dir" -j "$(nproc)" >"$dir/build.log" 2>&1 \
+        || { tail -n 60 "$dir/build.log" >&2; die "build failed (log: $dir/build.log)"; }
 }

@@ -2,7 +2,8 @@
 !>
 !> Dispatch: a deck with [beam] and no [particles] is a finite-element run (static, modal or
 !> dynamic); a deck with [particles] and no [beam] is a discrete-element run (driver_run_dem);
-!> a deck with both is refused until coupled runs exist ([coupling]).
+!> a deck with both is a coupled (Arlequin) run and needs a [coupling] section
+!> (driver_config_coupling, driver_run_coupled); [coupling] without both models is an error.
 !>
 !> Everything that can fail because of the input is checked before the results folder is
 !> touched; the HDF5 file is written as '<name>.h5.partial' and renamed only on success, so
@@ -22,8 +23,11 @@ module driver_run
     use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
     use driver_config, only: run_config_t, build_config
     use driver_config_dem, only: dem_config_t, build_dem_config, deck_has_particles, &
-        deck_has_beam, check_particle_keywords_unused, check_beam_keywords_unused
+                                 deck_has_beam, check_particle_keywords_unused, check_beam_keywords_unused
     use driver_run_dem, only: run_dem
+    use driver_config_coupling, only: coupled_setup_t, deck_has_coupling, build_coupling_config
+    use driver_run_coupled, only: build_coupled, run_coupled
+    use coupling_arlequin, only: coupled_system_t
     use driver_results, only: results_writer_t
     implicit none
     private
@@ -63,23 +67,24 @@ contains
         type(beam_config_t) :: beam
         type(beam_model_t) :: model
         type(dem_config_t) :: dem
+        type(coupled_setup_t) :: coupling
+        type(coupled_system_t), allocatable :: coupled_sys
         class(time_integrator_t), allocatable :: integ
         type(results_writer_t) :: out
         character(len=:), allocatable :: dir, path, message
-        logical :: particles
+        logical :: particles, coupled
+        integer :: i
 
         call read_deck(opts%deck_path, multicor_schema(), deck, error)
         if (allocated(error)) return
         particles = deck_has_particles(deck)
-        if (particles .and. deck_has_beam(deck)) then
-            call make_input_error(error, deck%file, deck%line('run', 'analysis'), '', &
-                'this deck has both [beam] and [particles]: coupled runs need a [coupling] '// &
-                'section, which is not available yet; run the beam and the particles apart')
-            return
-        end if
-        if (particles) then
+        coupled = particles .and. deck_has_beam(deck)
+        call check_sections(error)
+        if (allocated(error)) return
+        ! A coupled deck uses the keywords of both models.
+        if (particles .and. .not. coupled) then
             call check_beam_keywords_unused(deck, error)
-        else
+        else if (.not. particles) then
             call check_particle_keywords_unused(deck, error)
         end if
         if (allocated(error)) return
@@ -88,15 +93,24 @@ contains
         if (particles) then
             call build_dem_config(deck, run, beam%functions, dem, error)
             if (allocated(error)) return
-        else
+        end if
+        if (coupled) then
+            call build_coupling(error)
+            if (allocated(error)) return
+        else if (.not. particles) then
             call build_fe(error)
             if (allocated(error)) return
         end if
         if (opts%check_only) then
-            if (particles) then
+            if (coupled) then
+                call report(opts%deck_path//': deck is valid (coupled '//run%analysis// &
+                            ' analysis, '//to_str(size(beam%x))//' beam nodes, '// &
+                            to_str(dem%system%particles%n)//' disks, '// &
+                            to_str(coupled_sys%op%n_points)//' coupled)')
+            else if (particles) then
                 call report(opts%deck_path//': deck is valid ('//run%analysis//' analysis, '// &
-                    to_str(dem%system%particles%n)//' disks, '//to_str(dem%system%walls%n)// &
-                    ' walls)')
+                            to_str(dem%system%particles%n)//' disks, '//to_str(dem%system%walls%n)// &
+                            ' walls)')
             else
                 call report(opts%deck_path//': deck is valid ('//run%analysis//' analysis)')
             end if
@@ -110,7 +124,9 @@ contains
         path = dir//'/'//stem(opts%deck_path)//'.h5'
         call out%open(path, opts%deck_path, deck%text, run%title, run%analysis, error)
         if (allocated(error)) return
-        if (particles) then
+        if (coupled) then
+            call run_coupled(run, beam, dem, coupled_sys, out, opts%quiet, report, error)
+        else if (particles) then
             call run_dem(run, dem, out, opts%quiet, report, error)
         else
             call run_fe(error)
@@ -125,6 +141,44 @@ contains
         call report('results written to '//path)
 
     contains
+
+        !> Which kind of run: [beam] and [particles] need [coupling], and [coupling] needs
+        !> both.
+        subroutine check_sections(error)
+            type(error_t), allocatable, intent(out) :: error
+            integer :: k
+            if (coupled .and. .not. deck_has_coupling(deck)) then
+                call make_input_error(error, deck%file, deck%line('run', 'analysis'), '', &
+                                      'this deck has both [beam] and [particles]: coupled runs need a '// &
+                                      '[coupling] section (at least overlap = s_fe s_particle and thickness; '// &
+                                      'doc/input.md), or run the beam and the particles apart')
+            else if (.not. coupled .and. deck_has_coupling(deck)) then
+                do k = 1, size(deck%entries)
+                    if (deck%entries(k)%section == 'coupling') exit
+                end do
+                call make_input_error(error, deck%file, deck%entries(k)%line, &
+                                      deck%entries(k)%keyword, '[coupling] glues particles to a beam, and this '// &
+                                      'deck has no '//trim(merge('[particles]', '[beam]     ',.not. particles))// &
+                                      ': remove [coupling] or add the missing model')
+            end if
+        end subroutine check_sections
+
+        !> Coupling description and coupled system; everything that can fail because of the
+        !> input (library errors are attached to the [coupling] overlap line).
+        subroutine build_coupling(error)
+            type(error_t), allocatable, intent(out) :: error
+            call build_coupling_config(deck, run, beam, dem, coupling, error)
+            if (allocated(error)) return
+            do i = 1, size(coupling%warnings)
+                call report(coupling%warnings(i)%s)
+            end do
+            allocate (coupled_sys)
+            call build_coupled(run, beam, dem, coupling, coupled_sys, error)
+            if (allocated(error)) then
+                message = error%message
+                call make_input_error(error, deck%file, coupling%overlap_line, 'overlap', message)
+            end if
+        end subroutine build_coupling
 
         !> Beam model and integrator; everything that can fail because of the input.
         subroutine build_fe(error)
@@ -143,7 +197,7 @@ contains
                     ! The integrator only refuses a time step (stability limit).
                     message = error%message
                     call make_input_error(error, deck%file, deck%line('time', 'step'), 'step', &
-                        message)
+                                          message)
                 end if
             end if
         end subroutine build_fe

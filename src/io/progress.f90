@@ -42,7 +42,7 @@ contains
         integer, intent(in) :: total_steps
         !> End time of the run [s].
         real(wp), intent(in) :: t_end
-        !> Minimum wall time between two progress lines [s] (0: every call to `due`).
+        !> Minimum wall time between two progress lines [s] (0: never).
         real(wp), intent(in) :: interval_seconds
         self%total_steps = total_steps
         self%t_end = t_end
@@ -59,7 +59,9 @@ contains
         class(progress_t), intent(inout) :: self
         integer(i8) :: now
         call system_clock(now)
-        progress_due = real(now - self%last_count, wp)/real(self%rate, wp) >= self%interval
+        ! An interval of 0 means no progress lines at all ([output] progress = 0).
+        progress_due = self%interval > 0.0_wp .and. &
+                       real(now - self%last_count, wp)/real(self%rate, wp) >= self%interval
         if (progress_due) self%last_count = now
     end function progress_due
 

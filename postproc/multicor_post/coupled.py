@@ -1,0 +1,446 @@
+"""Coupled (Arlequin beam + particles) results: loading of the /fem, /dem and /coupling groups
+of a MULTICOR results file (layout in doc/output.md) and the figures of the reference
+experiments (doc/experiments.md): profiles of displacement and velocity along x with the FE
+nodes and the disks on the same axes, the deformed configuration with the overlap shaded,
+the history of a tracked disk in several runs, the profiles of several runs against each
+other, and the coupling diagnostics (constraint residuals, multipliers, energy audit).
+Figures use matplotlib's object API and the Agg renderer.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import Optional, Sequence
+
+import h5py
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import EllipseCollection
+from matplotlib.figure import Figure
+
+from .results import ResultsError, _decode_attrs
+
+#: Columns of the nodal and per-disk arrays: x (u), y (w), rotation.
+X, Y, ROT = 0, 1, 2
+#: Colours: beam (FE) and disks (DEM), coupled disks, overlap shading.
+FE_COLOUR, DEM_COLOUR, COUPLED_COLOUR, OVERLAP_COLOUR = "C0", "C3", "C2", "0.85"
+
+
+@dataclass
+class CoupledResults:
+    """The three parts of a coupled results file, at the stored outputs."""
+
+    path: str
+    attrs: dict                  # root attributes (title, ...)
+    node_x: np.ndarray           # (n_nodes,) [m]
+    node_y: np.ndarray           # (n_nodes,) [m]
+    connectivity: np.ndarray     # (n_elements, 2), 0-based
+    time: np.ndarray             # (n_out,) [s] (the same outputs for /fem, /dem, /coupling)
+    fe_displacement: np.ndarray  # (n_out, n_nodes, 3): u, w, theta
+    fe_velocity: np.ndarray      # (n_out, n_nodes, 3)
+    radius: np.ndarray           # (n,) [m]
+    position: np.ndarray         # (n_out, n, 3): x, y, rot
+    velocity: np.ndarray         # (n_out, n, 3)
+    overlap: np.ndarray          # (2,): s_fe, s_particle [m]
+    coupled: np.ndarray          # (n_points,) 0-based disk indices
+    alpha: np.ndarray            # (n_points,) weight at the coupled disks
+    lam: np.ndarray              # (n_out, n_rows) [N]
+    steps: dict                  # per-step arrays: g_norm, position_residual, ...
+    energy: dict                 # /coupling/energy/<name> (n_out,) [J], with "time"
+    coupling_attrs: dict
+    summary: dict                # /summary attributes (steps, wall_seconds, ...) or {}
+
+    @property
+    def title(self) -> str:
+        return self.attrs.get("title", "") or os.path.basename(self.path)
+
+    @property
+    def n_disks(self) -> int:
+        return int(self.radius.size)
+
+    @property
+    def length(self) -> float:
+        """Extent of the model along x [m] (beam and disks at t = 0)."""
+        lo = min(self.node_x.min(), (self.position[0, :, X] - self.radius).min())
+        hi = max(self.node_x.max(), (self.position[0, :, X] + self.radius).max())
+        return float(hi - lo)
+
+    def nearest_index(self, t: Optional[float]) -> int:
+        """Index of the stored output nearest to ``t`` (the last one when ``t`` is None)."""
+        if t is None:
+            return self.time.size - 1
+        return int(np.argmin(np.abs(self.time - t)))
+
+    def node_abscissa(self) -> np.ndarray:
+        """Curvilinear abscissa of each node along the elements, from node 0 [m]."""
+        s = np.zeros(self.node_x.size)
+        for a, b in self.connectivity:
+            s[b] = s[a] + np.hypot(self.node_x[b] - self.node_x[a], self.node_y[b] - self.node_y[a])
+        return s
+
+    def overlap_x(self) -> tuple[float, float]:
+        """x coordinates of the overlap's ends (beam along x: interpolation of the nodes)."""
+        s = self.node_abscissa()
+        order = np.argsort(s)
+        return tuple(float(np.interp(v, s[order], self.node_x[order])) for v in self.overlap)
+
+
+def is_coupled(path) -> bool:
+    """Whether a results file holds a coupled run (a /coupling group)."""
+    with h5py.File(os.fspath(path), "r") as f:
+        return "coupling" in f
+
+
+def load_coupled(path) -> CoupledResults:
+    """Read a coupled results file. Raises ResultsError with a clear message when the file is
+    missing, unreadable, not a coupled run, or a dataset does not follow the layout."""
+    path = os.fspath(path)
+    if not os.path.exists(path):
+        hint = ""
+        if os.path.exists(path + ".partial"):
+            hint = f" ('{path}.partial' exists: the run did not finish)"
+        raise ResultsError(f"results file '{path}' does not exist{hint}")
+    try:
+        f = h5py.File(path, "r")
+    except OSError as exc:
+        raise ResultsError(f"'{path}' is not a readable HDF5 file ({exc})") from None
+    with f:
+        if "coupling" not in f:
+            raise ResultsError(f"{path}: no /coupling group (not a coupled run)")
+        get = _Getter(f, path)
+        xy = get("fem/mesh/coordinates", (None, 2))
+        n_nodes = xy.shape[0]
+        time = get("fem/time", (None,))
+        n_out = time.size
+        radius = get("dem/particles/radius", (None,))
+        n = radius.size
+        dem_time = get("dem/time", (n_out,))
+        if not np.allclose(dem_time, time, rtol=0, atol=1e-12 * max(1.0, abs(time).max())):
+            raise ResultsError(f"{path}: /fem/time and /dem/time differ")
+        n_rows = int(f["coupling"].attrs.get("n_rows", 0))
+        step_names = ("g_norm", "position_residual", "velocity_residual", "rotation_residual",
+                      "coordinate_residual", "lambda_norm", "sweeps", "corrections")
+        n_steps = get("coupling/g_norm", (None,)).size
+        steps = {name: get(f"coupling/{name}", (n_steps,)) for name in step_names}
+        energy = {name: get(f"coupling/energy/{name}", (n_out,))
+                  for name in f["coupling/energy"].keys()}
+        return CoupledResults(
+            path=path, attrs=_decode_attrs(f.attrs), node_x=xy[:, 0], node_y=xy[:, 1],
+            connectivity=get("fem/mesh/connectivity", (None, 2)).astype(int) - 1, time=time,
+            fe_displacement=get("fem/displacement", (n_out, n_nodes, 3)),
+            fe_velocity=get("fem/velocity", (n_out, n_nodes, 3)), radius=radius,
+            position=get("dem/position", (n_out, n, 3)),
+            velocity=get("dem/velocity", (n_out, n, 3)),
+            overlap=get("coupling/overlap", (2,)),
+            coupled=get("coupling/particles", (None,)).astype(int) - 1,
+            alpha=get("coupling/alpha", (None,)),
+            lam=get("coupling/lambda", (n_out, n_rows)), steps=steps, energy=energy,
+            coupling_attrs=_decode_attrs(f["coupling"].attrs),
+            summary=_decode_attrs(f["summary"].attrs) if "summary" in f else {})
+
+
+class _Getter:
+    """Reads a dataset and checks its shape (None = any extent)."""
+
+    def __init__(self, f, path):
+        self.f = f
+        self.path = path
+
+    def __call__(self, name, shape):
+        if name not in self.f or not isinstance(self.f[name], h5py.Dataset):
+            raise ResultsError(f"{self.path}: missing dataset '/{name}' (not a MULTICOR "
+                               "coupled results file, or one from another version)")
+        data = np.asarray(self.f[name][()])
+        if data.ndim != len(shape) or any(w is not None and g != w
+                                          for g, w in zip(data.shape, shape)):
+            want = tuple("n" if s is None else s for s in shape)
+            raise ResultsError(f"{self.path}: dataset '/{name}' has shape {data.shape}, "
+                               f"expected {want}")
+        return data
+
+
+# --------------------------------------------------------------------------------------------
+# Profiles
+# --------------------------------------------------------------------------------------------
+
+@dataclass
+class Profile:
+    """Fields along x at one output: FE nodes (sorted by x) and disks (by initial x)."""
+
+    time: float
+    node_x: np.ndarray      # (n_nodes,) initial x [m]
+    node_d: np.ndarray      # (n_nodes, 2) displacement u, w [m]
+    node_v: np.ndarray      # (n_nodes, 2) velocity [m/s]
+    disk_x: np.ndarray      # (n,) initial x [m]
+    disk_y: np.ndarray      # (n,) initial y [m]
+    disk_d: np.ndarray      # (n, 2) displacement of the centre [m]
+    disk_v: np.ndarray      # (n, 2) velocity [m/s]
+
+
+def profile(res: CoupledResults, k: int) -> Profile:
+    """Displacements and velocities of the FE nodes and the disks at output ``k``."""
+    order = np.argsort(res.node_x)
+    p0 = res.position[0]
+    return Profile(time=float(res.time[k]), node_x=res.node_x[order],
+                   node_d=res.fe_displacement[k][order, :2],
+                   node_v=res.fe_velocity[k][order, :2],
+                   disk_x=p0[:, X].copy(), disk_y=p0[:, Y].copy(),
+                   disk_d=res.position[k, :, :2] - p0[:, :2],
+                   disk_v=res.velocity[k, :, :2])
+
+
+def history(res: CoupledResults, disk: int) -> tuple[np.ndarray, np.ndarray]:
+    """Time and displacement (n_out, 2) of one disk (0-based index)."""
+    if not 0 <= disk < res.n_disks:
+        raise ResultsError(f"{res.path}: no disk {disk + 1} (the run has {res.n_disks})")
+    return res.time, res.position[:, disk, :2] - res.position[0, disk, :2]
+
+
+def rigid_fit(x: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, float]:
+    """Least-squares straight line through (x, d): coefficients (slope, intercept) and the
+    largest deviation from it, the measure of a rigid-body (linear) profile."""
+    if x.size < 2:
+        return np.array([0.0, float(d[0]) if d.size else 0.0]), 0.0
+    fit = np.polyfit(x, d, 1)
+    return fit, float(np.max(np.abs(np.polyval(fit, x) - d)))
+
+
+# --------------------------------------------------------------------------------------------
+# Figures
+# --------------------------------------------------------------------------------------------
+
+def _new_figure(width=8.0, height=6.0, rows=1):
+    fig = Figure(figsize=(width, height), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = [fig.add_subplot(rows, 1, i + 1) for i in range(rows)]
+    return fig, axes
+
+
+def _unit(values, base: str) -> tuple[float, str]:
+    vmax = float(np.max(np.abs(values))) if np.size(values) else 0.0
+    for factor, prefix in ((1.0, ""), (1e3, "m"), (1e6, "µ"), (1e9, "n")):
+        if vmax * factor >= 1.0 or vmax == 0.0:
+            return factor, prefix + base
+    return 1e9, "n" + base
+
+
+def _shade_overlap(ax, res: CoupledResults, label: bool = True):
+    a, b = res.overlap_x()
+    ax.axvspan(min(a, b), max(a, b), color=OVERLAP_COLOUR, zorder=0,
+               label="overlap" if label else None)
+
+
+def plot_profiles(res: CoupledResults, time: Optional[float] = None,
+                  component: int = Y) -> Figure:
+    """Displacement (top) and velocity (bottom) along x of the FE nodes (line) and the disks
+    (markers; coupled disks filled) at the stored output nearest to ``time``: vertical
+    components by default, horizontal with ``component = X``."""
+    k = res.nearest_index(time)
+    p = profile(res, k)
+    name = "vertical" if component == Y else "horizontal"
+    fig, (ax_d, ax_v) = _new_figure(8.0, 7.0, rows=2)
+    coupled = np.zeros(res.n_disks, bool)
+    coupled[res.coupled] = True
+    for ax, fe, dem, base, what in ((ax_d, p.node_d, p.disk_d, "m", "displacement"),
+                                    (ax_v, p.node_v, p.disk_v, "m/s", "velocity")):
+        scale, unit = _unit(np.concatenate([fe[:, component], dem[:, component]]), base)
+        _shade_overlap(ax, res)
+        ax.plot(p.node_x, scale * fe[:, component], "-o", color=FE_COLOUR, ms=3,
+                label="beam (FE nodes)")
+        ax.plot(p.disk_x[~coupled], scale * dem[~coupled, component], "s", color=DEM_COLOUR,
+                mfc="none", ms=5, label="disks")
+        if coupled.any():
+            ax.plot(p.disk_x[coupled], scale * dem[coupled, component], "s",
+                    color=COUPLED_COLOUR, ms=5, label="coupled disks")
+        ax.set_ylabel(f"{name} {what} [{unit}]")
+        ax.grid(True, alpha=0.3)
+    ax_v.set_xlabel("x at t = 0 [m]")
+    ax_d.legend(loc="best", fontsize="small")
+    ax_d.set_title(f"{res.title}\nt = {p.time * 1e3:.3g} ms")
+    return fig
+
+
+def auto_scale(res: CoupledResults, k: int, fraction: float = 0.08) -> float:
+    """Displacement scale factor of a configuration plot: the largest displacement is drawn
+    as ``fraction`` of the model's length, unless it is already larger, or larger than a
+    quarter of the smallest disk radius (then the true geometry is drawn: magnifying would
+    draw the disks overlapping): scale 1."""
+    p = profile(res, k)
+    dmax = max(float(np.abs(p.node_d).max(initial=0.0)), float(np.abs(p.disk_d).max(initial=0.0)))
+    if dmax == 0.0 or dmax >= 0.25 * float(res.radius.min()):
+        return 1.0
+    return max(1.0, fraction * res.length / dmax)
+
+
+def plot_configuration(res: CoupledResults, time: Optional[float] = None,
+                       scale: Optional[float] = None) -> Figure:
+    """The deformed configuration at the stored output nearest to ``time``: the beam through
+    its displaced nodes, the disks as circles at their displaced centres (coupled disks in
+    green), the initial beam dashed, the overlap shaded; displacements times ``scale``
+    (default: auto_scale)."""
+    k = res.nearest_index(time)
+    if scale is None:
+        scale = auto_scale(res, k)
+    d = res.fe_displacement[k]
+    p0 = res.position[0]
+    centres = p0[:, :2] + scale * (res.position[k, :, :2] - p0[:, :2])
+    # Figure height from the drawing's aspect ratio (equal axes).
+    xs = np.concatenate([res.node_x + scale * d[:, X], centres[:, 0] - res.radius,
+                         centres[:, 0] + res.radius])
+    ys = np.concatenate([res.node_y + scale * d[:, Y], centres[:, 1] - res.radius,
+                         centres[:, 1] + res.radius, res.node_y])
+    pad = 0.04 * (xs.max() - xs.min())
+    width = 9.0
+    height = min(9.0, max(3.0, 1.6 + 7.8 * (ys.max() - ys.min() + 2 * pad) / (xs.max() - xs.min()
+                                                                              + 2 * pad)))
+    fig, (ax,) = _new_figure(width, height)
+    _shade_overlap(ax, res)
+    for a, b in res.connectivity:
+        ax.plot(res.node_x[[a, b]], res.node_y[[a, b]], "--", color="0.6", lw=1)
+        ax.plot(res.node_x[[a, b]] + scale * d[[a, b], X], res.node_y[[a, b]] + scale * d[[a, b], Y],
+                "-", color=FE_COLOUR, lw=2.5, zorder=3)
+    colours = np.array([DEM_COLOUR] * res.n_disks, dtype=object)
+    colours[res.coupled] = COUPLED_COLOUR
+    ax.add_collection(EllipseCollection(2 * res.radius, 2 * res.radius, 0.0, units="xy",
+                                        offsets=centres, offset_transform=ax.transData,
+                                        facecolors=(0, 0, 0, 0), edgecolors=list(colours),
+                                        lw=1.2, zorder=2))
+    ax.set_xlim(xs.min() - pad, xs.max() + pad)
+    ax.set_ylim(ys.min() - pad, ys.max() + pad)
+    ax.plot([], [], "-", color=FE_COLOUR, lw=2.5, label="beam (deformed)")
+    ax.plot([], [], "o", mfc="none", color=DEM_COLOUR, label="disks")
+    ax.plot([], [], "o", mfc="none", color=COUPLED_COLOUR, label="coupled disks")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.legend(loc="lower left", fontsize="small")
+    ax.set_title(f"{res.title}\nt = {res.time[k] * 1e3:.3g} ms, displacements x {scale:.3g}")
+    return fig
+
+
+def plot_histories(runs: Sequence[CoupledResults], disk: int, labels: Sequence[str],
+                   component: int = Y) -> Figure:
+    """Displacement (top) and velocity (bottom) history of one disk (0-based index; the same
+    disk at the same abscissa) in several runs."""
+    fig, (ax_d, ax_v) = _new_figure(8.0, 6.5, rows=2)
+    d_all = np.concatenate([history(r, disk)[1][:, component] for r in runs])
+    v_all = np.concatenate([r.velocity[:, disk, component] for r in runs])
+    sd, ud = _unit(d_all, "m")
+    sv, uv = _unit(v_all, "m/s")
+    for r, label in zip(runs, labels):
+        t, d = history(r, disk)
+        ax_d.plot(t * 1e3, sd * d[:, component], label=label)
+        ax_v.plot(t * 1e3, sv * r.velocity[:, disk, component], label=label)
+    name = "vertical" if component == Y else "horizontal"
+    x0 = runs[0].position[0, disk, X]
+    ax_d.set_ylabel(f"{name} displacement [{ud}]")
+    ax_v.set_ylabel(f"{name} velocity [{uv}]")
+    ax_v.set_xlabel("t [ms]")
+    for ax in (ax_d, ax_v):
+        ax.grid(True, alpha=0.3)
+    ax_d.legend(loc="best", fontsize="small")
+    ax_d.set_title(f"disk {disk + 1} (x = {x0:.3g} m)")
+    return fig
+
+
+def plot_compare_profiles(runs: Sequence[CoupledResults], labels: Sequence[str],
+                          time: Optional[float] = None, component: int = Y,
+                          zoom_run: Optional[int] = None) -> Figure:
+    """Displacement (top) and velocity (bottom) along x of several runs at the stored output
+    nearest to ``time``: beam as lines, disks as markers (all disks of every layer). With
+    ``zoom_run``, the vertical axes span that run's values (with a margin) and the points of
+    the other runs beyond them are drawn at the edge and labelled with their value."""
+    fig, (ax_d, ax_v) = _new_figure(8.0, 7.0, rows=2)
+    profiles = [profile(r, r.nearest_index(time)) for r in runs]
+
+    def values(p, field):
+        return np.concatenate([getattr(p, f"node_{field}")[:, component],
+                               getattr(p, f"disk_{field}")[:, component]])
+
+    _shade_overlap(ax_d, runs[0])
+    _shade_overlap(ax_v, runs[0], label=False)
+    markers = "soD^v"
+    name = "vertical" if component == Y else "horizontal"
+    for ax, field, base, what in ((ax_d, "d", "m", "displacement"), (ax_v, "v", "m/s", "velocity")):
+        ref = values(profiles[zoom_run], field) if zoom_run is not None else \
+            np.concatenate([values(p, field) for p in profiles])
+        scale, unit = _unit(ref, base)
+        lo, hi = float(ref.min()), float(ref.max())
+        pad = 0.15 * max(hi - lo, 1e-300)
+        lo, hi = lo - pad, hi + pad
+        for i, (p, label) in enumerate(zip(profiles, labels)):
+            colour = f"C{i}"
+            node = getattr(p, f"node_{field}")[:, component]
+            disk = getattr(p, f"disk_{field}")[:, component]
+            shown = np.clip(disk, lo, hi) if zoom_run is not None else disk
+            ax.plot(p.node_x, scale * (np.clip(node, lo, hi) if zoom_run is not None else node), "-",
+                    color=colour, label=f"{label}: beam")
+            ax.plot(p.disk_x, scale * shown, markers[i % 5], color=colour, mfc="none", ms=4,
+                    label=f"{label}: disks")
+            off = [(x, v, c) for x, v, c in zip(p.disk_x, disk, shown) if v != c]
+            for x, v, c in off:
+                ax.plot(x, scale * c, "v" if c <= lo else "^", color=colour, ms=7)
+            if off:
+                ax.text(0.5, 0.04 + 0.5 * i, "off scale, " + label + ":\n" + "\n".join(
+                    f"disk at x = {x:.3g} m: {scale * v:.3g} {unit}" for x, v, _ in off),
+                    transform=ax.transAxes, ha="center", va="bottom", fontsize="small",
+                    color=colour, bbox=dict(facecolor="white", edgecolor=colour, alpha=0.9))
+        if zoom_run is not None:
+            ax.set_ylim(scale * lo, scale * hi)
+        ax.set_ylabel(f"{name} {what} [{unit}]")
+        ax.grid(True, alpha=0.3)
+    ax_v.set_xlabel("x at t = 0 [m]")
+    ax_d.legend(loc="best", fontsize="small")
+    ax_d.set_title(f"t = {profiles[0].time * 1e3:.3g} ms")
+    return fig
+
+
+def plot_coupling(res: CoupledResults) -> Figure:
+    """Coupling diagnostics: constraint residuals and sweeps of every step, multipliers and
+    energy balance at the outputs."""
+    fig, (ax_r, ax_l, ax_e) = _new_figure(8.0, 9.0, rows=3)
+    steps = res.steps
+    h = float(res.coupling_attrs.get("time_step", np.nan))
+    t = (np.arange(steps["g_norm"].size) + 1) * h * 1e3
+    for name, label in (("position_residual", "|q - C u| [m]"),
+                        ("coordinate_residual", "|x - x0 - C(u - u0)| [m]"),
+                        ("velocity_residual", "velocity residual [m/s]")):
+        ax_r.semilogy(t, np.maximum(steps[name], 1e-300), label=label)
+    ax_r.set_ylabel("residual")
+    ax_r.legend(loc="best", fontsize="small")
+    ax_s = ax_r.twinx()
+    ax_s.plot(t, steps["sweeps"], color="0.5", lw=0.6)
+    ax_s.set_ylabel("sweeps per step", color="0.4")
+    ax_l.plot(res.time * 1e3, res.lam, lw=0.8)
+    ax_l.set_ylabel("multipliers λ [N]")
+    e = res.energy
+    ax_e.plot(e["time"] * 1e3, e["fe_kinetic"] + e["fe_strain"], label="beam: kinetic + strain")
+    ax_e.plot(e["time"] * 1e3, e["dem_kinetic"] + e["dem_potential"], label="disks: kinetic + potential")
+    ax_e.plot(e["time"] * 1e3, e["external_work"], label="external work")
+    ax_e.plot(e["time"] * 1e3, e["contact_dissipation"], label="dissipated in contacts")
+    ax_e.plot(e["time"] * 1e3, e["balance"], "k", lw=1.5, label="balance (0 = exact)")
+    ax_e.set_ylabel("energy [J]")
+    ax_e.set_xlabel("t [ms]")
+    ax_e.legend(loc="best", fontsize="small")
+    for ax in (ax_r, ax_l, ax_e):
+        ax.grid(True, alpha=0.3)
+    ax_r.set_title(f"{res.title}: coupling")
+    return fig
+
+
+def write_all(res: CoupledResults, out_dir, time: Optional[float] = None,
+              scale: Optional[float] = None, dpi: int = 120) -> list[str]:
+    """Write the plots of one coupled run as PNG files in ``out_dir``; return their paths:
+    <name>_profiles.png, <name>_configuration.png (at the output nearest to ``time``, default
+    the last) and <name>_coupling.png."""
+    out_dir = os.fspath(out_dir)
+    os.makedirs(out_dir, exist_ok=True)
+    stem = os.path.splitext(os.path.basename(res.path))[0]
+    written = []
+    for fig, name in ((plot_profiles(res, time), "profiles"),
+                      (plot_configuration(res, time, scale), "configuration"),
+                      (plot_coupling(res), "coupling")):
+        path = os.path.join(out_dir, f"{stem}_{name}.png")
+        fig.savefig(path, dpi=dpi)
+        written.append(path)
+    return written

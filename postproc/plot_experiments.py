@@ -1,0 +1,120 @@
+#!/usr/bin/env python3
+"""Figures of the reference experiments (doc/experiments.md), PNG and PDF, and a summary of
+the measured figures.
+
+    plot_experiments.py [--results DIR] [--out DIR] [--time T] [--track ID ...]
+
+Reads DIR/<case>/<case>.h5 for the cases bending_case1, bending_case2 and bending_stack
+(the layout `./run.sh --experiments` writes; default DIR results/experiments) and writes
+into --out (default DIR):
+- <case>_profiles: vertical displacement and velocity along x at t = T (default 5e-3 s),
+  beam nodes and disks on the same axes, overlap shaded (one per case);
+- <case>_configuration: deformed beam, disks as circles, overlap shaded, at t = T;
+- history_case1_case2_disk<ID>: displacement and velocity history of the tracked disk
+  (the same disk at the same abscissa) in case 1 and case 2 (default disks 7, 11 and 17);
+- stack_vs_row: displacement and velocity profiles of the stack against the single row;
+- experiments_summary.txt: constraint residuals, energy balance, wall times, rigid fits.
+Prints the paths written. Exit code 1 with a message when a results file is missing.
+"""
+import argparse
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+from multicor_post import coupled  # noqa: E402
+from multicor_post.results import ResultsError  # noqa: E402
+
+CASES = ("bending_case1", "bending_case2", "bending_stack")
+LABELS = {"bending_case1": "case 1 (overlap 6 layers)",
+          "bending_case2": "case 2 (overlap 3 layers)",
+          "bending_stack": "stack (3 layers of disks)"}
+
+
+def save(fig, out, name, written):
+    """Save a figure as PNG and PDF."""
+    for ext in ("png", "pdf"):
+        path = os.path.join(out, f"{name}.{ext}")
+        fig.savefig(path, dpi=150)
+        written.append(path)
+
+
+def summary_lines(runs, time):
+    """Measured figures of each run (text)."""
+    lines = [f"{'case':<15} {'steps':>6} {'max|q-Cu| [m]':>14} {'max|x-Cu| [m]':>14} "
+             f"{'max|bal| [J]':>12} {'ext. work [J]':>13} {'wall [s]':>9}"]
+    for name, r in runs.items():
+        s, e = r.steps, r.energy
+        wall = float(r.summary.get("wall_seconds", np.nan))
+        lines.append(f"{name:<15} {s['g_norm'].size:>6d} {s['position_residual'].max():>14.3e} "
+                     f"{s['coordinate_residual'].max():>14.3e} {np.abs(e['balance']).max():>12.3e} "
+                     f"{e['external_work'][-1]:>13.4e} {wall:>9.2f}")
+    lines.append("")
+    lines.append(f"profiles at t = {time:g} s (vertical displacement; rigid fit = straight line "
+                 "through the disks beyond the overlap):")
+    for name, r in runs.items():
+        k = r.nearest_index(time)
+        p = coupled.profile(r, k)
+        beyond = p.disk_x > r.overlap.max() + 1e-9
+        on_axis = np.abs(p.disk_y) < 1e-9
+        sel = beyond & on_axis
+        fit, dev = coupled.rigid_fit(p.disk_x[sel], p.disk_d[sel, 1])
+        tip_beam = p.node_d[np.argmax(p.node_x), 1]
+        lines.append(f"  {name}: beam end w = {tip_beam:.4e} m, loaded disk dy = "
+                     f"{p.disk_d[np.argmax(np.where(on_axis, p.disk_x, -np.inf)), 1]:.4e} m, "
+                     f"rigid fit slope {fit[0]:.4e}, max deviation {dev:.3e} m "
+                     f"({dev / max(np.abs(p.disk_d[sel, 1]).max(initial=0.0), 1e-300):.2e} "
+                     "of the largest)")
+    return lines
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="plot_experiments.py",
+                                     description=__doc__.split("\n")[0])
+    parser.add_argument("--results", default="results/experiments",
+                        help="folder holding <case>/<case>.h5 (default results/experiments)")
+    parser.add_argument("--out", default=None, help="folder of the figures (default: --results)")
+    parser.add_argument("--time", type=float, default=5e-3,
+                        help="time of the snapshots [s] (nearest stored output; default 5e-3)")
+    parser.add_argument("--track", type=int, nargs="+", default=[7, 11, 17],
+                        help="disks (1-based) whose histories are compared (default 7 11 17: "
+                             "the last disk of the overlap of case 1, a disk of the particle "
+                             "zone, the loaded disk)")
+    args = parser.parse_args(argv)
+    out = args.out or args.results
+    os.makedirs(out, exist_ok=True)
+    written = []
+    try:
+        runs = {}
+        for name in CASES:
+            path = os.path.join(args.results, name, f"{name}.h5")
+            runs[name] = coupled.load_coupled(path)
+        for name, r in runs.items():
+            save(coupled.plot_profiles(r, args.time), out, f"{name}_profiles", written)
+            save(coupled.plot_configuration(r, args.time), out, f"{name}_configuration", written)
+        rows = [runs["bending_case1"], runs["bending_case2"]]
+        for disk in args.track:
+            save(coupled.plot_histories(rows, disk - 1, [LABELS[c] for c in CASES[:2]]), out,
+                 f"history_case1_case2_disk{disk}", written)
+        save(coupled.plot_compare_profiles([runs["bending_case1"], runs["bending_stack"]],
+                                           ["single row (case 1)", "stack"], args.time,
+                                           zoom_run=1),
+             out, "stack_vs_row", written)
+    except ResultsError as exc:
+        print(f"plot_experiments.py: error: {exc}", file=sys.stderr)
+        return 1
+    text = "\n".join(summary_lines(runs, args.time)) + "\n"
+    path = os.path.join(out, "experiments_summary.txt")
+    with open(path, "w") as f:
+        f.write(text)
+    written.append(path)
+    print(text, end="")
+    for p in written:
+        print(p)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,145 @@
+"""Tests of the coupled-results loader and figures (multicor_post.coupled), of
+plot_results.py on a coupled file and of plot_experiments.py, on synthetic files whose
+fields are known in closed form (synthetic_coupled)."""
+import os
+
+import numpy as np
+import pytest
+
+import plot_experiments
+import plot_results
+from multicor_post import coupled
+from multicor_post.results import ResultsError
+from synthetic import cantilever_layout, write_results
+from synthetic_coupled import (COUPLED, DISK_X, NODE_X, OVERLAP, V, beam_w, disk_dy,
+                               write_coupled)
+from synthetic_dem import H, N_OUT, STEPS_PER_OUT
+
+# Values written as float64 and read back: exact; derived ones (differences of positions
+# of O(0.1 m)): a few ulps of 0.2.
+EXACT = 0.0
+ULPS = 8 * np.spacing(0.2)
+
+
+@pytest.fixture
+def coupled_file(tmp_path):
+    return write_coupled(tmp_path / "coupled.h5")
+
+
+def test_loader_reads_the_three_parts_with_zero_based_coupled_disks(coupled_file):
+    res = coupled.load_coupled(coupled_file)
+    assert res.n_disks == DISK_X.size
+    assert res.time.shape == (N_OUT,)
+    assert res.fe_displacement.shape == (N_OUT, NODE_X.size, 3)
+    assert res.lam.shape == (N_OUT, 2 * COUPLED.size)
+    np.testing.assert_array_equal(res.coupled, COUPLED - 1)
+    np.testing.assert_allclose(res.overlap, OVERLAP, rtol=0, atol=EXACT)
+    assert res.steps["g_norm"].size == (N_OUT - 1) * STEPS_PER_OUT
+    assert res.summary["wall_seconds"] == 0.25
+    assert res.title == "synthetic coupled"
+
+
+def test_profile_gives_displacements_from_the_initial_positions(coupled_file):
+    res = coupled.load_coupled(coupled_file)
+    k = 2
+    p = coupled.profile(res, k)
+    np.testing.assert_allclose(p.node_d[:, 1], beam_w(NODE_X, k), rtol=0, atol=EXACT)
+    np.testing.assert_allclose(p.disk_d[:, 1], disk_dy(DISK_X, k), rtol=0, atol=ULPS)
+    np.testing.assert_allclose(p.disk_v[:, 1], V * disk_dy(DISK_X, k), rtol=1e-12, atol=ULPS)
+    np.testing.assert_allclose(p.disk_x, DISK_X, rtol=0, atol=EXACT)
+
+
+def test_nearest_output_and_default_last(coupled_file):
+    res = coupled.load_coupled(coupled_file)
+    dt = H * STEPS_PER_OUT
+    assert res.nearest_index(1.1 * dt) == 1
+    assert res.nearest_index(None) == N_OUT - 1
+    assert res.nearest_index(100.0) == N_OUT - 1
+
+
+def test_rigid_fit_is_exact_on_a_line_and_measures_curvature():
+    x = np.array([0.1, 0.2, 0.3, 0.5])
+    fit, dev = coupled.rigid_fit(x, 2.0 - 3.0 * x)
+    # A least-squares line through collinear points: round-off only.
+    assert abs(fit[0] + 3.0) < 1e-12
+    assert dev < 1e-14
+    _, dev = coupled.rigid_fit(x, x**2)
+    # x^2 deviates from its best line by a visible amount on [0.1, 0.5].
+    assert dev > 1e-3
+
+
+def test_history_of_the_tracked_disk_and_unknown_disk(coupled_file):
+    res = coupled.load_coupled(coupled_file)
+    t, d = coupled.history(res, 4)
+    np.testing.assert_allclose(d[:, 1], [disk_dy(DISK_X[4], k) for k in range(N_OUT)],
+                               rtol=0, atol=ULPS)
+    with pytest.raises(ResultsError, match="no disk 9"):
+        coupled.history(res, 8)
+
+
+def test_overlap_ends_in_x_on_a_beam_along_x(coupled_file):
+    res = coupled.load_coupled(coupled_file)
+    a, b = res.overlap_x()
+    assert (a, b) == pytest.approx(OVERLAP, abs=1e-15)
+
+
+def test_loader_refuses_an_uncoupled_file_and_a_missing_dataset(tmp_path, coupled_file):
+    ids, xy, conn, d = cantilever_layout()
+    beam_only = write_results(tmp_path / "beam.h5", ids, xy, conn, d)
+    with pytest.raises(ResultsError, match="no /coupling group"):
+        coupled.load_coupled(beam_only)
+    broken = write_coupled(tmp_path / "broken.h5", drop=("coupling/lambda",))
+    with pytest.raises(ResultsError, match="missing dataset '/coupling/lambda'"):
+        coupled.load_coupled(broken)
+    with pytest.raises(ResultsError, match="does not exist"):
+        coupled.load_coupled(tmp_path / "none.h5")
+
+
+def test_write_all_writes_the_coupled_plots(tmp_path, coupled_file):
+    paths = coupled.write_all(coupled.load_coupled(coupled_file), tmp_path / "out", time=5e-3)
+    names = sorted(os.path.basename(p) for p in paths)
+    assert names == ["coupled_configuration.png", "coupled_coupling.png", "coupled_profiles.png"]
+    assert all(os.path.getsize(p) > 10000 for p in paths)
+
+
+def test_auto_scale_magnifies_small_displacements_only(coupled_file):
+    res = coupled.load_coupled(coupled_file)
+    # Output 1: largest displacement 1.7 mm < R/4 = 2.5 mm, drawn as 8 % of the length.
+    dmax = abs(disk_dy(DISK_X[-1], 1))
+    assert coupled.auto_scale(res, 1) == pytest.approx(0.08 * res.length / dmax, rel=1e-12)
+    # Output 3: 5 mm > R/4: true geometry; output 0: no displacement.
+    assert coupled.auto_scale(res, N_OUT - 1) == 1.0
+    assert coupled.auto_scale(res, 0) == 1.0
+
+
+def test_plot_results_handles_a_coupled_file(tmp_path, coupled_file, capsys):
+    assert plot_results.main([str(coupled_file), "--out", str(tmp_path / "p")]) == 0
+    printed = capsys.readouterr().out.split()
+    names = {os.path.basename(p) for p in printed}
+    # Coupled plots, beam plots and particle plots of the same file.
+    assert {"coupled_profiles.png", "coupled_configuration.png", "coupled_coupling.png",
+            "coupled_deflection.png", "coupled_particles.png"} <= names
+
+
+def test_plot_experiments_writes_png_pdf_and_summary(tmp_path, capsys):
+    for case in plot_experiments.CASES:
+        (tmp_path / case).mkdir()
+        write_coupled(tmp_path / case / f"{case}.h5", title=case)
+    assert plot_experiments.main(["--results", str(tmp_path), "--time", "5e-3",
+                                  "--track", "5"]) == 0
+    out = capsys.readouterr().out
+    for name in ("bending_case1_profiles", "bending_stack_configuration",
+                 "history_case1_case2_disk5", "stack_vs_row"):
+        for ext in ("png", "pdf"):
+            assert (tmp_path / f"{name}.{ext}").stat().st_size > 5000
+    summary = (tmp_path / "experiments_summary.txt").read_text()
+    assert "bending_stack" in summary and "max|q-Cu|" in summary
+    # Beyond the overlap the synthetic disks lie on a straight line: rigid fit exact.
+    line = [s for s in summary.splitlines() if s.strip().startswith("bending_case1:")][0]
+    assert float(line.split("max deviation")[1].split()[0]) < 1e-15
+    assert "experiments_summary.txt" in out
+
+
+def test_plot_experiments_reports_a_missing_case(tmp_path, capsys):
+    assert plot_experiments.main(["--results", str(tmp_path)]) == 1
+    assert "does not exist" in capsys.readouterr().err

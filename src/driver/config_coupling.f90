@@ -1,0 +1,345 @@
+!> From a validated deck with [beam], [particles] and [coupling] to the description of the
+!> Arlequin coupling (`coupling_arlequin::coupling_config_t`), with the checks across
+!> sections that the library would otherwise report without a deck line:
+!> - a coupled run is a time integration (analysis = dynamic);
+!> - the schemes: the coupling exchanges the impulse h ((1 - gamma) lambda_n + gamma
+!>   lambda_{n+1}) between the beam (Newmark) and the disks (Moreau-Jean), which is exact in
+!>   momentum and energy only with average acceleration (beta = 1/4, gamma = 1/2) and
+!>   theta = 1/2 (THEORY.md section 4, coupling_arlequin). Another beta or gamma (or the
+!>   explicit central difference, whose lumped, undamped beta = 0 predictor the multiplier
+!>   matrix does not model) is an error; theta > 1/2 is accepted with a warning (the
+!>   constraint still holds, but the balance then shows the scheme's numerical dissipation
+!>   and a net coupling work of order h);
+!> - the overlap lies on the beam (0 <= s <= length along the elements) and is not empty;
+!> - every disk centre lies beyond s_fe (a disk in the FE-only zone would get alpha = 1, a
+!>   zero weighted mass);
+!> - listed coupled disks exist, are listed once, and lie inside the overlap (alpha strictly
+!>   between 0 and 1), within max_offset of the axis when it is given; with coupled = auto at
+!>   least one disk centre lies in the overlap.
+!> Each error names the deck file, the line and the keyword concerned, and the disk by its
+!> number and the line that created it.
+module driver_config_coupling
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_input_error
+    use core_strings, only: string_t, to_str
+    use io_deck, only: deck_t, deck_entry_t
+    use io_deck_schema, only: parse_selection
+    use fem_beam_config, only: beam_config_t
+    use fem_beam_model, only: beam_model_t, build_beam_model
+    use coupling_weights, only: weight_config_t, overlap_weight_t, make_weight
+    use coupling_arlequin, only: coupling_config_t
+    use driver_config, only: run_config_t
+    use driver_config_dem, only: dem_config_t
+    implicit none
+    private
+    public :: coupled_setup_t, deck_has_coupling, build_coupling_config, disk_abscissa
+
+    !> The coupling of a deck, with what the driver reports and stores about it.
+    type :: coupled_setup_t
+        !> Description handed to coupling_arlequin::build_coupled_system.
+        type(coupling_config_t) :: config
+        !> Deck line of the overlap keyword (messages of the library are attached to it).
+        integer :: overlap_line = 0
+        !> Warnings to report before the run (e.g. theta > 1/2).
+        type(string_t), allocatable :: warnings(:)
+    end type coupled_setup_t
+
+contains
+
+    !> Whether the deck has [coupling] entries.
+    pure logical function deck_has_coupling(deck)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        integer :: i
+        deck_has_coupling = .false.
+        do i = 1, size(deck%entries)
+            if (deck%entries(i)%section /= 'coupling') cycle
+            deck_has_coupling = .true.
+            return
+        end do
+    end function deck_has_coupling
+
+    !> Build and check the coupling of a deck with [beam], [particles] and [coupling].
+    subroutine build_coupling_config(deck, run, beam, dem, setup, error)
+        !> Deck read with the MULTICOR schema.
+        type(deck_t), intent(in) :: deck
+        !> Run settings (driver_config::build_config).
+        type(run_config_t), intent(in) :: run
+        !> The beam (driver_config::build_config).
+        type(beam_config_t), intent(in) :: beam
+        !> The particles (driver_config_dem::build_dem_config).
+        type(dem_config_t), intent(in) :: dem
+        !> The coupling.
+        type(coupled_setup_t), intent(out) :: setup
+        !> Error naming file, line and keyword, if any.
+        type(error_t), allocatable, intent(out) :: error
+        type(beam_model_t) :: model
+        type(overlap_weight_t) :: weight
+        real(wp), allocatable :: s(:), off(:)
+        integer :: first_line, i
+        allocate (setup%warnings(0))
+        first_line = coupling_first_line(deck)
+        call check_schemes(deck, run, setup, error)
+        if (allocated(error)) return
+        call require(deck, 'overlap', first_line, 's_fe s_particle [m]', error)
+        if (allocated(error)) return
+        call require(deck, 'thickness', first_line, 'depth of the disks [m], usually the '// &
+                     'width of the beam section', error)
+        if (allocated(error)) return
+        setup%overlap_line = deck%line('coupling', 'overlap')
+        associate (c => setup%config)
+            c%weight = weight_config_t(shape=deck%get_word('coupling', 'weight'), &
+                                       s_fe=deck%get_real('coupling', 'overlap', 1), &
+                                       s_particle=deck%get_real('coupling', 'overlap', 2), &
+                                       alpha_min=deck%get_real('coupling', 'alpha_min'), &
+                                       constant=deck%get_real('coupling', 'constant'))
+            c%thickness = deck%get_real('coupling', 'thickness')
+            c%rotation_row = deck%get_word('coupling', 'rotation') == 'on'
+            c%max_offset = deck%get_real('coupling', 'max_offset')
+        end associate
+        ! The unweighted beam gives the abscissas (it was built without error before).
+        call build_beam_model(beam, model, error)
+        if (allocated(error)) return
+        call check_overlap(deck, setup, model, error)
+        if (allocated(error)) return
+        call make_weight(setup%config%weight, weight, error)
+        if (allocated(error)) then
+            call reattach(deck, setup%overlap_line, 'overlap', error)
+            return
+        end if
+        associate (p => dem%system%particles)
+            allocate (s(p%n), off(p%n))
+            do i = 1, p%n
+                call disk_abscissa(model, p%x(i), p%y(i), s(i), off(i))
+            end do
+        end associate
+        call check_fe_zone(deck, setup, weight, dem, s, error)
+        if (allocated(error)) return
+        call select_coupled(deck, setup, weight, dem, s, off, error)
+    end subroutine build_coupling_config
+
+    !> First line of the [coupling] entries (0 if none).
+    pure integer function coupling_first_line(deck) result(line)
+        type(deck_t), intent(in) :: deck
+        integer :: i
+        line = 0
+        do i = 1, size(deck%entries)
+            if (deck%entries(i)%section /= 'coupling') cycle
+            line = deck%entries(i)%line
+            return
+        end do
+    end function coupling_first_line
+
+    !> Error when a keyword a coupled deck needs is absent.
+    subroutine require(deck, keyword, line, hint, error)
+        type(deck_t), intent(in) :: deck
+        character(len=*), intent(in) :: keyword, hint
+        integer, intent(in) :: line
+        type(error_t), allocatable, intent(out) :: error
+        if (deck%has('coupling', keyword)) return
+        call make_input_error(error, deck%file, line, keyword, 'missing: a coupled deck '// &
+                              'needs [coupling] '//keyword//' = '//hint)
+    end subroutine require
+
+    !> Analysis and time schemes of a coupled run (see the module description).
+    subroutine check_schemes(deck, run, setup, error)
+        type(deck_t), intent(in) :: deck
+        type(run_config_t), intent(in) :: run
+        type(coupled_setup_t), intent(inout) :: setup
+        type(error_t), allocatable, intent(out) :: error
+        real(wp) :: theta
+        character(len=*), parameter :: why = 'the coupling exchanges the impulse h ((1 - '// &
+                                       'gamma) lambda_n + gamma lambda_{n+1}) between the beam and the disks, which '// &
+                                       'conserves momentum and energy only with beta = 1/4, gamma = 1/2 and theta = 1/2'
+        if (run%analysis /= 'dynamic') then
+            call make_input_error(error, deck%file, deck%line('run', 'analysis'), 'analysis', &
+                                  'a coupled run (beam, particles and [coupling]) is a time integration: set '// &
+                                  'analysis = dynamic (the particles have no '//run%analysis//' analysis)')
+            return
+        end if
+        if (run%scheme == 'central_difference') then
+            call make_input_error(error, deck%file, deck%line('time', 'scheme'), 'scheme', &
+                                  'coupled runs need the implicit average-acceleration scheme for the beam '// &
+                                  '(the multipliers are solved with the effective matrix M + h^2 K / 4): set '// &
+                                  'scheme = average_acceleration; '//why)
+            return
+        end if
+        if (abs(run%beta - 0.25_wp) > 0 .or. abs(run%gamma - 0.5_wp) > 0) then
+            call make_input_error(error, deck%file, deck%line('time', 'scheme'), 'scheme', &
+                                  'coupled runs need beta = 0.25 and gamma = 0.5 (here beta = '// &
+                                  to_str(run%beta)//', gamma = '//to_str(run%gamma)//'): set scheme = '// &
+                                  'average_acceleration; '//why)
+            return
+        end if
+        theta = deck%get_real('time', 'theta')
+        if (abs(theta - 0.5_wp) > 0) setup%warnings = [setup%warnings, string_t( &
+                                                    'warning: '//deck%file//':'//to_str(deck%line('time', 'theta'))//': [time] '// &
+                                                   'theta = '//to_str(theta)//' in a coupled run: the constraint q = C u still '// &
+                                              'holds, but the particles dissipate numerically and the coupling does a net work '// &
+                                                       'of order h, so /coupling/energy/balance does not close; '//why)]
+    end subroutine check_schemes
+
+    !> The overlap lies on the beam: both ends within [0, length].
+    subroutine check_overlap(deck, setup, model, error)
+        type(deck_t), intent(in) :: deck
+        type(coupled_setup_t), intent(in) :: setup
+        type(beam_model_t), intent(in) :: model
+        type(error_t), allocatable, intent(out) :: error
+        real(wp) :: length, ends(2)
+        integer :: k
+        character(len=*), parameter :: names(2) = ['s_fe      ', 's_particle']
+        length = maxval(model%abscissa)
+        ends = [setup%config%weight%s_fe, setup%config%weight%s_particle]
+        do k = 1, 2
+            if (ends(k) <= length*(1 + 1.0e-12_wp)) cycle
+            call make_input_error(error, deck%file, setup%overlap_line, 'overlap', &
+                                  trim(names(k))//' = '//to_str(ends(k))//' m lies beyond the end of the beam '// &
+                                  '(abscissas along the beam run from 0 at its first node to '// &
+                                  to_str(length)//' m): the overlap must lie on the beam')
+            return
+        end do
+        if (.not. (abs(ends(2) - ends(1)) > 0)) then
+            call make_input_error(error, deck%file, setup%overlap_line, 'overlap', &
+                                  'the overlap is empty (s_fe = s_particle = '//to_str(ends(1))//' m)')
+        end if
+    end subroutine check_overlap
+
+    !> No disk centre in the FE-only zone (alpha = 1: zero weighted mass).
+    subroutine check_fe_zone(deck, setup, weight, dem, s, error)
+        type(deck_t), intent(in) :: deck
+        type(coupled_setup_t), intent(in) :: setup
+        type(overlap_weight_t), intent(in) :: weight
+        type(dem_config_t), intent(in) :: dem
+        real(wp), intent(in) :: s(:)
+        type(error_t), allocatable, intent(out) :: error
+        integer :: i
+        do i = 1, size(s)
+            if (weight%value(s(i)) < 1) cycle
+            call make_input_error(error, deck%file, setup%overlap_line, 'overlap', 'disk '// &
+                                  to_str(i)//' (line '//to_str(dem%disk_line(i))//', abscissa '//to_str(s(i))// &
+                                  ' m along the beam) lies in the FE-only zone before s_fe = '// &
+                                  to_str(weight%s_fe)//' m, where alpha = 1 would leave it no mass: start the '// &
+                                  'overlap at or before it, or remove the disk')
+            return
+        end do
+    end subroutine check_fe_zone
+
+    !> The coupled disks: `auto` or selections, checked against the overlap.
+    subroutine select_coupled(deck, setup, weight, dem, s, off, error)
+        type(deck_t), intent(in) :: deck
+        type(coupled_setup_t), intent(inout) :: setup
+        type(overlap_weight_t), intent(in) :: weight
+        type(dem_config_t), intent(in) :: dem
+        real(wp), intent(in) :: s(:), off(:)
+        type(error_t), allocatable, intent(out) :: error
+        type(deck_entry_t) :: e
+        integer, allocatable :: list(:)
+        character(len=:), allocatable :: message
+        real(wp) :: alpha, max_offset
+        integer :: k, first, last, i, n, line
+        logical :: ok, auto
+        n = size(s)
+        max_offset = setup%config%max_offset
+        e = deck%record('coupling', 'coupled', 1)
+        line = e%line
+        auto = e%n_values() == 0
+        if (.not. auto) auto = e%word(1) == 'auto'
+        if (auto) then
+            if (e%n_values() > 1) then
+                call make_input_error(error, deck%file, line, 'coupled', "'auto' stands alone:"// &
+                                      ' write coupled = auto, or a list of selections of disks')
+                return
+            end if
+            do i = 1, n
+                alpha = weight%value(s(i))
+                if (alpha > 0 .and. alpha < 1 .and. &
+                    (max_offset <= 0 .or. abs(off(i)) <= max_offset)) return
+            end do
+            message = ''
+            if (max_offset > 0) message = ' within max_offset = '//to_str(max_offset)// &
+                                          ' m of the axis'
+            call make_input_error(error, deck%file, setup%overlap_line, 'overlap', 'no disk '// &
+                                  'centre lies in the overlap ['//to_str(weight%s_fe)//', '// &
+                                  to_str(weight%s_particle)//'] m'//message//': nothing to couple')
+            return
+        end if
+        allocate (list(0))
+        do k = 1, e%n_values()
+            call parse_selection(e%word(k), n, first, last, ok, message, 'disks')
+            if (.not. ok) then
+                call make_input_error(error, deck%file, line, 'coupled', message// &
+                                      " (or 'auto')")
+                return
+            end if
+            do i = first, last
+                if (any(list == i)) then
+                    call make_input_error(error, deck%file, line, 'coupled', 'disk '// &
+                                          to_str(i)//' is selected twice')
+                    return
+                end if
+                alpha = weight%value(s(i))
+                if (.not. (alpha > 0 .and. alpha < 1)) then
+                    call make_input_error(error, deck%file, line, 'coupled', 'disk '// &
+                                          to_str(i)//' (line '//to_str(dem%disk_line(i))//', abscissa '// &
+                                          to_str(s(i))//' m along the beam) is outside the overlap ['// &
+                                          to_str(weight%s_fe)//', '//to_str(weight%s_particle)//'] m: its '// &
+                                          'weight alpha = '//to_str(alpha)//' would leave it no mass on one '// &
+                                          'side of the coupling (a singular multiplier system); couple only '// &
+                                          'disks inside the overlap')
+                    return
+                end if
+                if (max_offset > 0 .and. abs(off(i)) > max_offset) then
+                    call make_input_error(error, deck%file, line, 'coupled', 'disk '// &
+                                          to_str(i)//' (line '//to_str(dem%disk_line(i))//') is '// &
+                                          to_str(abs(off(i)))//' m from the beam axis, more than max_offset = '// &
+                                          to_str(max_offset)//' m')
+                    return
+                end if
+                list = [list, i]
+            end do
+        end do
+        setup%config%particles = list
+    end subroutine select_coupled
+
+    !> Prefix a library error with the deck file, line and keyword.
+    subroutine reattach(deck, line, keyword, error)
+        type(deck_t), intent(in) :: deck
+        integer, intent(in) :: line
+        character(len=*), intent(in) :: keyword
+        type(error_t), allocatable, intent(inout) :: error
+        character(len=:), allocatable :: message
+        message = error%message
+        call make_input_error(error, deck%file, line, keyword, message)
+    end subroutine reattach
+
+    !> Curvilinear abscissa of (px, py) on the nearest element of the beam (distance to the
+    !> segment; the first in element order on ties) and its signed offset from the axis
+    !> (positive to the left of the element's direction); the abscissa is linear in the
+    !> reduced coordinate, also past the element's ends. The same projection as the coupling
+    !> library uses.
+    pure subroutine disk_abscissa(model, px, py, s, off)
+        !> The beam model.
+        type(beam_model_t), intent(in) :: model
+        !> The point [m].
+        real(wp), intent(in) :: px, py
+        !> Abscissa [m] and offset [m].
+        real(wp), intent(out) :: s, off
+        integer :: e, n1
+        real(wp) :: dx, dy, xi, o, d, d_best
+        d_best = huge(1.0_wp)
+        s = 0.0_wp
+        off = 0.0_wp
+        do e = 1, model%n_elements
+            n1 = model%conn(1, e)
+            dx = px - model%x(n1)
+            dy = py - model%y(n1)
+            xi = (dx*model%cosine(e) + dy*model%sine(e))/model%length(e)
+            o = -dx*model%sine(e) + dy*model%cosine(e)
+            d = hypot(max(0.0_wp, -xi, xi - 1)*model%length(e), o)
+            if (d >= d_best) cycle
+            d_best = d
+            s = model%abscissa_at(e, xi)
+            off = o
+        end do
+    end subroutine disk_abscissa
+end module driver_config_coupling

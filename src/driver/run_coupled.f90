@@ -1,0 +1,189 @@
+!> Time integration of a coupled beam/particle model (THEORY.md section 4): one call of the
+!> coupling step (coupling_arlequin::arlequin_step) per time step, which predicts both
+!> domains, solves the multipliers jointly with the contacts and corrects both. Results: the
+!> beam's fields in /fem, the disks' in /dem, the multipliers, residuals and energy audit in
+!> /coupling (doc/output.md).
+!>
+!> `build_coupled` does everything that can fail because of the input (called before the
+!> results folder is touched); `run_coupled` integrates and writes. Warnings go through the
+!> report callback: steps whose contact solve did not converge (the first `max_warnings`,
+!> then only the count) and, once, a disk moving farther than the alert distance in a step.
+module driver_run_coupled
+    use core_kinds, only: wp
+    use core_error, only: error_t
+    use core_strings, only: to_str
+    use io_progress, only: progress_t
+    use fem_beam_config, only: beam_config_t
+    use coupling_arlequin, only: coupled_system_t, coupled_energies_t, build_coupled_system, &
+                                 arlequin_step, coupled_energies
+    use driver_config, only: run_config_t
+    use driver_config_dem, only: dem_config_t
+    use driver_config_coupling, only: coupled_setup_t
+    use driver_results, only: results_writer_t
+    use driver_results_dem, only: dem_writer_t
+    use driver_results_coupled, only: coupled_writer_t
+    use driver_run_dem, only: max_warnings, report_line_iface
+    implicit none
+    private
+    public :: build_coupled, run_coupled
+
+contains
+
+    !> Build the coupled system of a deck (weighted beam, weighted disks, coupling operator,
+    !> factored multiplier matrix). Errors come from the coupling library, without a deck
+    !> line (the caller attaches one).
+    subroutine build_coupled(run, beam, dem, setup, sys, error)
+        !> Run settings (time step, Newmark beta and gamma, initial beam state).
+        type(run_config_t), intent(in) :: run
+        !> The beam (unweighted).
+        type(beam_config_t), intent(in) :: beam
+        !> The particles (unweighted, before mj_init).
+        type(dem_config_t), intent(in) :: dem
+        !> The coupling.
+        type(coupled_setup_t), intent(in) :: setup
+        !> The coupled system.
+        type(coupled_system_t), intent(out) :: sys
+        !> Set when the library refuses the model.
+        type(error_t), allocatable, intent(out) :: error
+        if (allocated(run%u0) .and. allocated(run%v0)) then
+            call build_coupled_system(setup%config, beam, dem%system, sys, error, &
+                                      beta=run%beta, gamma=run%gamma, fe_u0=run%u0, fe_v0=run%v0)
+        else
+            call build_coupled_system(setup%config, beam, dem%system, sys, error, &
+                                      beta=run%beta, gamma=run%gamma)
+        end if
+    end subroutine build_coupled
+
+    !> Integrate the coupled model from t = 0 to the end time and write its results.
+    subroutine run_coupled(run, beam, dem, sys, out, quiet, report, error)
+        !> Run settings (end time, output interval, progress).
+        type(run_config_t), intent(in) :: run
+        !> The beam (mesh for the results).
+        type(beam_config_t), intent(in) :: beam
+        !> The particles' deck data (material ids, contact storage).
+        type(dem_config_t), intent(in) :: dem
+        !> The coupled system (built; it advances).
+        type(coupled_system_t), intent(inout) :: sys
+        !> An open results writer.
+        type(results_writer_t), intent(inout) :: out
+        !> No progress lines (warnings and the summary are still reported).
+        logical, intent(in) :: quiet
+        !> Where progress, warning and summary lines go.
+        procedure(report_line_iface) :: report
+        !> Set on a run or write failure.
+        type(error_t), allocatable, intent(out) :: error
+        type(dem_writer_t) :: dem_out
+        type(coupled_writer_t) :: cpl_out
+        type(progress_t) :: progress
+        real(wp), allocatable :: d(:, :), v(:, :), a(:, :)
+        integer :: n_steps, k, unconverged
+        logical :: speed_warned
+        character(len=512) :: buf
+
+        n_steps = ceiling(run%t_end/run%h*(1.0_wp - 1.0e-12_wp))
+        allocate (d(3, sys%model%n_nodes), v(3, sys%model%n_nodes), a(3, sys%model%n_nodes))
+        call out%write_mesh(beam%node_id, beam%x, beam%y, beam%conn, error)
+        if (allocated(error)) return
+        call dem_out%begin(out%file, sys%dem, dem%material_id, dem%store_contacts, error)
+        if (allocated(error)) return
+        call cpl_out%begin(out%file, sys, error)
+        if (allocated(error)) return
+        call store(error)
+        if (allocated(error)) return
+        unconverged = 0
+        speed_warned = .false.
+        call progress%start(n_steps, run%t_end, run%progress_seconds)
+        do k = 1, n_steps
+            call arlequin_step(sys, error)
+            if (allocated(error)) return
+            call dem_out%record_step(out%file, sys%dem%stats, error)
+            if (allocated(error)) return
+            call cpl_out%record_step(out%file, sys, error)
+            if (allocated(error)) return
+            if (.not. sys%stats%converged) call warn_unconverged()
+            if (.not. speed_warned) call check_speed()
+            if (mod(k, run%output_interval) == 0 .or. k == n_steps) then
+                call store(error)
+                if (allocated(error)) return
+            end if
+            if (quiet) cycle
+            if (progress%due()) call report(progress%line(k, sys%fe%t))
+        end do
+        call dem_out%finish(out%file, sys%dem, unconverged, error)
+        if (allocated(error)) return
+        call cpl_out%finish(out%file, error)
+        if (allocated(error)) return
+        call summary()
+        call out%write_summary(n_steps, progress%elapsed(), error)
+
+    contains
+
+        !> One stored output of the three parts.
+        subroutine store(error)
+            type(error_t), allocatable, intent(out) :: error
+            call sys%model%expand(sys%fe%u, d)
+            call sys%model%expand(sys%fe%v, v)
+            call sys%model%expand(sys%fe%a, a)
+            call out%append_state(sys%fe%t, d, v, a, error)
+            if (allocated(error)) return
+            call dem_out%store(out%file, sys%dem, error)
+            if (allocated(error)) return
+            call cpl_out%store(out%file, sys, error)
+        end subroutine store
+
+        !> Warning for an unconverged step (the first max_warnings ones).
+        subroutine warn_unconverged()
+            unconverged = unconverged + 1
+            if (unconverged > max_warnings) return
+            write (buf, '(a,i0,a,es11.4,a,i0,a,es9.2,a,es9.2,a)') 'warning: step ', k, &
+                ' (t = ', sys%fe%t, ' s): the joint contact/multiplier solve did not '// &
+                'converge in ', sys%stats%sweeps, ' sweeps (error ', sys%stats%nlgs_error, &
+                ' > tolerance ', sys%dem%solver%tol, '); the constraint q = C u still holds'
+            call report(trim(buf))
+            if (unconverged == max_warnings) call report('warning: further unconverged steps '// &
+                                                    'are only counted (total in the summary); raise [solver] max_sweeps or the '// &
+                                                         'tolerance, or lower [time] step')
+        end subroutine warn_unconverged
+
+        !> Warning (once) when a disk moved farther than the alert distance in the step.
+        subroutine check_speed()
+            real(wp) :: vmax
+            integer :: n
+            n = sys%dem%particles%n
+            associate (p => sys%dem%particles)
+                vmax = sqrt(maxval(p%vx(1:n)**2 + p%vy(1:n)**2))
+            end associate
+            if (vmax*run%h <= sys%dem%scheme%alert) return
+            speed_warned = .true.
+            write (buf, '(a,es11.4,a,es9.2,a,es9.2,a,es9.2,a)') 'warning: at t = ', &
+                sys%fe%t, ' s a disk moves ', vmax*run%h, ' m in one step (speed ', &
+                vmax, ' m/s), more than the alert distance ', sys%dem%scheme%alert, &
+                ' m: contacts may be found late (overlaps); lower [time] step or raise '// &
+                '[contacts] alert'
+            call report(trim(buf))
+        end subroutine check_speed
+
+        !> Closing lines: model, residuals, solver effort, energy balance, times.
+        subroutine summary()
+            type(coupled_energies_t) :: en
+            en = coupled_energies(sys)
+            write (buf, '(a,i0,a,i0,a,i0,a,i0,a,es12.5,a)') 'coupled run: ', &
+                sys%model%n_nodes, ' beam nodes, ', sys%dem%particles%n, ' disks (', &
+                sys%op%n_points, ' coupled), ', n_steps, ' steps to t = ', sys%fe%t, ' s'
+            call report(trim(buf))
+            write (buf, '(a,es10.3,a,es10.3,a,es10.3,a)') 'constraint: max |q - C u| = ', &
+                cpl_out%max_position, ' m (from the coordinates ', cpl_out%max_coordinate, &
+                ' m), max velocity residual ', cpl_out%max_velocity, ' m/s'
+            call report(trim(buf))
+            call report('unconverged steps: '//to_str(unconverged)//' of '//to_str(n_steps)// &
+                        ' (tolerance '//to_str(sys%dem%solver%tol)//', at most '// &
+                        to_str(sys%dem%solver%max_sweeps)//' sweeps)')
+            write (buf, '(a,es10.3,a,es10.3,a,es10.3,a)') 'energy balance residual ', &
+                en%balance, ' J (max over the outputs ', cpl_out%max_balance, &
+                ' J; external work ', en%fe_external_work + en%dem_external_work + &
+                en%dem_drive_work, ' J)'
+            call report(trim(buf))
+            call report(progress%summary_line(n_steps, sys%fe%t))
+        end subroutine summary
+    end subroutine run_coupled
+end module driver_run_coupled

@@ -1,0 +1,62 @@
+!> Deck section of the Arlequin DEM-FEM coupling, declared as data: [coupling] (overlap
+!> interval along the beam, weight function, out-of-plane thickness of the particles, which
+!> disks are glued to the beam). Machinery and field builders: io_deck_schema. Checks across
+!> sections (overlap inside the beam, coupled disks inside the overlap, time scheme) are in
+!> driver_config_coupling.
+module io_schema_coupling
+    use core_kinds, only: wp
+    use io_deck_schema, only: schema_t, real_field, positive, word_field, selection_field, &
+                              tail, when
+    implicit none
+    private
+    public :: add_coupling
+
+contains
+
+    !> [coupling]: the Arlequin overlap of a deck with both [beam] and [particles].
+    subroutine add_coupling(s)
+        !> Schema to extend.
+        type(schema_t), intent(inout) :: s
+        call s%add_section('coupling', 'Arlequin coupling of a deck with both [beam] and '// &
+                           '[particles]: in the overlap the energies of both models are weighted by alpha '// &
+                           '(beam) and 1 - alpha (disks), and one Lagrange multiplier per coupled DOF glues '// &
+                           'each coupled disk centre to the beam (doc/input.md, section Coupled runs). '// &
+                           'Coupled runs are dynamic, with [time] scheme = average_acceleration and '// &
+                           'theta = 0.5.')
+        call s%add_keyword('coupling', 'overlap', [real_field('s_fe', 'm', lower=0.0_wp), &
+                                                   real_field('s_particle', 'm', lower=0.0_wp)], &
+                           'Overlap interval, as abscissas along the beam from its first node: s_fe is the '// &
+                           'end next to the FE-only zone (alpha = 1 before it), s_particle the end next to '// &
+                           'the particle-only zone (alpha = 0 beyond it; the beam must end there). Required '// &
+                           'in a coupled deck.')
+        call s%add_keyword('coupling', 'weight', [word_field('weight', 'constant linear cubic')], &
+                           'Shape of alpha across the overlap (xi = 0 at s_fe, 1 at s_particle): constant, '// &
+                           'linear 1 - xi, or cubic 1 - 3 xi^2 + 2 xi^3 (zero slope at both ends).', &
+                           default='cubic')
+        call s%add_keyword('coupling', 'constant', [real_field('constant', '', lower=0.0_wp, &
+                                                               upper=1.0_wp, lower_strict=.true., upper_strict=.true.)], &
+                           'Value of alpha inside the overlap for weight = constant.', default='0.5', &
+                           allowed_when=when('coupling', 'weight', 'constant'))
+        call s%add_keyword('coupling', 'alpha_min', [real_field('alpha_min', '', lower=0.0_wp, &
+                                                                upper=0.5_wp, lower_strict=.true., upper_strict=.true.)], &
+                           'Floor of the weight inside the overlap: alpha stays in [alpha_min, 1 - '// &
+                           'alpha_min], so that no coupled disk gets a zero mass on one side (which would '// &
+                           'make the multiplier system singular).', default='1e-3')
+        call s%add_keyword('coupling', 'thickness', [positive('thickness', 'm')], &
+                           'Out-of-plane depth of the disks (the particles are per unit thickness; the beam '// &
+                           'is not): usually the width of the beam section. Required in a coupled deck.')
+        call s%add_keyword('coupling', 'rotation', [word_field('rotation', 'off on')], &
+                           'Also glue the rotation of each coupled disk to the beam rotation theta.', &
+                           default='off')
+        call s%add_keyword('coupling', 'coupled', [word_field('coupled', '')], &
+                           'Which disks are glued to the beam: auto (every disk whose centre lies in the '// &
+                           'overlap, within max_offset of the axis), or selections of disks (`5`, `1:7`, '// &
+                           '`last`, several allowed), each inside the overlap.', &
+                           tails=[tail([selection_field('more')], 0, -1)], default='auto')
+        call s%add_keyword('coupling', 'max_offset', [real_field('max_offset', 'm', &
+                                                                 lower=0.0_wp)], &
+                           'Couple only disks whose centre lies at most this far from the beam axis (with '// &
+                           'coupled = auto; a listed disk farther away is an error); 0: any distance.', &
+                           default='0')
+    end subroutine add_coupling
+end module io_schema_coupling
