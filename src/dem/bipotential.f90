@@ -26,6 +26,7 @@ module dem_bipotential
     private
     public :: bipotential_predictor, coulomb_projection, bipotential_local_solve
     public :: bipotential_residual, case_separation, case_stick, case_slip
+    public :: bipotential_scaling, bipotential_local_solve_scaled, bipotential_n_scaling
 
     !> Projection case: separation (r = 0).
     integer, parameter :: case_separation = 1
@@ -33,6 +34,8 @@ module dem_bipotential
     integer, parameter :: case_stick = 2
     !> Projection case: slip (r on the boundary of the cone).
     integer, parameter :: case_slip = 3
+    !> Number of constants per contact computed by `bipotential_scaling`.
+    integer, parameter :: bipotential_n_scaling = 8
 
 contains
 
@@ -99,36 +102,95 @@ contains
         integer, intent(out) :: n_iter
         !> Case of the last projection.
         integer, intent(out) :: pcase
-        real(wp) :: sn, st, c, mup, bnp, btp, rnp, rtp, unp, utp, taun, taut, qn, qt, change
+        real(wp) :: sc(bipotential_n_scaling)
+        call bipotential_scaling(wnn, wnt, wtt, mu, sc)
+        call bipotential_local_solve_scaled(sc, bn, bt, tol, max_iter, rn, rt, n_iter, pcase)
+    end subroutine bipotential_local_solve
+
+    !> Constants of the scaled frame of one contact, for bipotential_local_solve_scaled:
+    !> sc = (s_n, s_t, 1/s_n, 1/s_t, c, mu', 1/(1 + mu'^2), 1/(1 - c^2) or 0 when c^2 >= 1), with
+    !> s_n = sqrt(W_nn), s_t = sqrt(W_tt) (floored, see `scaling`), c = W_nt/(s_n s_t) and
+    !> mu' = mu s_t/s_n; all zero when W_nn + W_tt <= 0 (both bodies immobile).
+    pure subroutine bipotential_scaling(wnn, wnt, wtt, mu, sc)
+        !> Delassus block entries.
+        real(wp), intent(in) :: wnn, wnt, wtt
+        !> Friction coefficient (>= 0).
+        real(wp), intent(in) :: mu
+        !> The constants.
+        real(wp), intent(out) :: sc(bipotential_n_scaling)
+        sc = 0.0_wp
+        if (wnn + wtt <= 0.0_wp) return
+        call scaling(wnn, wnt, wtt, mu, sc(1), sc(2), sc(5), sc(6))
+        sc(3) = 1.0_wp/sc(1)
+        sc(4) = 1.0_wp/sc(2)
+        sc(7) = 1.0_wp/(1.0_wp + sc(6)**2)
+        if (1.0_wp - sc(5)**2 > 0.0_wp) sc(8) = 1.0_wp/(1.0_wp - sc(5)**2)
+    end subroutine bipotential_scaling
+
+    !> `bipotential_local_solve` with the constants of the scaled frame computed beforehand by
+    !> `bipotential_scaling` (the NLGS computes them once per contact and solve). The
+    !> projection on the cone is written out here (multiplying by 1/(1 + mu'^2) instead of
+    !> dividing): this is the innermost loop of the solver.
+    pure subroutine bipotential_local_solve_scaled(sc, bn, bt, tol, max_iter, rn, rt, n_iter, pcase)
+        !> Constants of the scaled frame (`bipotential_scaling`).
+        real(wp), intent(in) :: sc(bipotential_n_scaling)
+        !> Velocity without this contact's reaction (normal, tangential).
+        real(wp), intent(in) :: bn, bt
+        !> Relative tolerance on the change of the scaled reaction.
+        real(wp), intent(in) :: tol
+        !> Iteration cap (>= 1).
+        integer, intent(in) :: max_iter
+        !> Reaction: initial guess in, solution out (unchanged when sc(1) = 0).
+        real(wp), intent(inout) :: rn, rt
+        !> Iterations done.
+        integer, intent(out) :: n_iter
+        !> Case of the last projection.
+        integer, intent(out) :: pcase
+        real(wp) :: c, mup, bnp, btp, rnp, rtp, unp, utp, taun, taut, qn, qt, change
         logical :: done
         pcase = case_separation
         n_iter = 0
-        if (wnn + wtt <= 0.0_wp) return
-        call scaling(wnn, wnt, wtt, mu, sn, st, c, mup)
-        bnp = bn/sn
-        btp = bt/st
-        rnp = rn*sn
-        rtp = rt*st
+        if (sc(1) <= 0.0_wp) return
+        c = sc(5)
+        mup = sc(6)
+        bnp = bn*sc(3)
+        btp = bt*sc(4)
+        rnp = rn*sc(1)
+        rtp = rt*sc(2)
         do n_iter = 1, max_iter
             unp = bnp + rnp + c*rtp
             utp = btp + c*rnp + rtp
-            call bipotential_predictor(rnp, rtp, unp, utp, mup, 1.0_wp, taun, taut)
-            call coulomb_projection(taun, taut, mup, qn, qt, pcase)
+            taun = rnp - (unp + mup*abs(utp))
+            taut = rtp - utp
+            if (mup*abs(taut) <= -taun) then
+                qn = 0.0_wp
+                qt = 0.0_wp
+                pcase = case_separation
+            else if (abs(taut) <= mup*taun) then
+                qn = taun
+                qt = taut
+                pcase = case_stick
+            else
+                qn = (taun + mup*abs(taut))*sc(7)
+                qt = sign(mup*qn, taut)
+                pcase = case_slip
+            end if
             change = abs(qn - rnp) + abs(qt - rtp)
             rnp = qn
             rtp = qt
             if (change <= tol*(abs(rnp) + abs(rtp))) exit
+            done = .false.
             if (pcase == case_slip) then
                 call slip_branch(bnp, btp, c, mup, rnp, rtp, done)
             else if (pcase == case_stick) then
-                call stick_branch(bnp, btp, c, mup, rnp, rtp, done)
+                call stick_branch(bnp, btp, c, mup, sc(8), rnp, rtp, done)
             end if
             if (done) exit
         end do
         n_iter = min(n_iter, max_iter)
-        rn = rnp/sn
-        rt = rtp/st
-    end subroutine bipotential_local_solve
+        rn = rnp*sc(3)
+        rt = rtp*sc(4)
+    end subroutine bipotential_local_solve_scaled
 
     !> Slip acceleration (scaled frame). After a slip projection r lies on the cone boundary,
     !> r_t = s mu' r_n (s = sign of r_t). Along that branch the predictor-corrector step with
@@ -154,17 +216,17 @@ contains
 
     !> Stick acceleration (scaled frame). After a stick projection, the stick solution
     !> u = 0, r' = -W'^-1 b' is the limit of the stick branch (rate |c| with rho = 1); it is
-    !> accepted when it lies in the cone, i.e. when it satisfies the law.
-    pure subroutine stick_branch(bnp, btp, c, mup, rnp, rtp, done)
-        real(wp), intent(in) :: bnp, btp, c, mup
+    !> accepted when it lies in the cone, i.e. when it satisfies the law. inv_det = 1/(1 - c^2),
+    !> 0 when W' is singular (no acceleration then).
+    pure subroutine stick_branch(bnp, btp, c, mup, inv_det, rnp, rtp, done)
+        real(wp), intent(in) :: bnp, btp, c, mup, inv_det
         real(wp), intent(inout) :: rnp, rtp
         logical, intent(out) :: done
-        real(wp) :: det, qn, qt
+        real(wp) :: qn, qt
         done = .false.
-        det = 1.0_wp - c*c
-        if (det <= 0.0_wp) return
-        qn = (-bnp + c*btp)/det
-        qt = (-btp + c*bnp)/det
+        if (inv_det <= 0.0_wp) return
+        qn = (-bnp + c*btp)*inv_det
+        qt = (-btp + c*bnp)*inv_det
         if (abs(qt) > mup*qn) return
         rnp = qn
         rtp = qt

@@ -41,8 +41,13 @@ module dem_contacts
         real(wp) :: theta = 0.5_wp
         !> Create bonds on closed contacts with cohesion (first step only).
         logical :: make_bonds = .false.
-        !> A bond exists while gap <= bond_ratio * mean radius of the pair.
+        !> Bonds are created (first step) on contacts with gap <= bond_ratio * mean radius of
+        !> the pair; a bond that cannot take part in the solve (blocked) breaks when its gap
+        !> opens beyond that.
         real(wp) :: bond_ratio = 1.0e-6_wp
+        !> Round-off allowance of the activation, relative to the mean radius of the pair: a
+        !> contact whose predicted gap is at most gap_allowance * mean radius is active.
+        real(wp) :: gap_allowance = 1.0e-10_wp
     end type contact_law_t
 
     !> The contact list (structure of arrays, capacity >= n).
@@ -296,12 +301,26 @@ contains
     end function contacts_local_velocity
 
     !> Material law, bonds, solver shifts and activation of every contact for the step.
-    !> Active: intact bonds, and contacts whose predicted gap g + theta h u_n(free) <= 0.
-    !> Velocity target of the normal law (u_n >= target): Newton restitution
-    !> e max(-u_n(begin), 0). There is no position correction (standard Moreau-Jean): with
-    !> theta = 1 an active contact never closes past its gap at the start of the step; with
-    !> theta < 1 an impact may overlap by up to (1 - theta) h |u_n|, and the overlap is kept.
-    !> (A full push-out -g/(theta h) of overlaps was tried and makes dense packings unstable.)
+    !> With g the gap at the detection (mid) configuration and g_p = g + theta h u_n(free) the
+    !> gap predicted with the free velocities, a contact is active (takes part in the solve) if
+    !>  - it is an intact bond, or
+    !>  - g_p <= gap_allowance * mean radius (a round-off allowance: disks that touch at rest
+    !>    have g and g_p of either sign at the level of the rounding of their coordinates), or
+    !>  - it carried a compressive reaction at the previous step (warm start r_n > 0): a
+    !>    loaded contact stays in the solve even when the rounding or the solver tolerance left
+    !>    it slightly open.
+    !> Normal law of an active contact, u_n >= target (the solver shifts u_n by -target):
+    !>  - g_p <= 0 (the free motion closes it), and intact bonds: Newton restitution,
+    !>    target = e max(-u_n(begin), 0) (a bond holds its gap, <= bond_ratio * mean radius,
+    !>    rather than pulling it shut with its cohesion);
+    !>  - otherwise (g_p > 0): gap term, target = -max(g, 0)/(theta h), i.e. the end-of-step gap
+    !>    g + theta h u_n >= 0: the contact may close its gap during the step but not overlap;
+    !>    it then carries a reaction only if the other contacts push it shut. Activating such
+    !>    a contact is therefore exact: it changes the work of the solver, not the solution.
+    !> There is no position correction (standard Moreau-Jean): with theta = 1 an active
+    !> contact never closes past its gap at the start of the step; with theta < 1 an impact
+    !> may overlap by up to (1 - theta) h |u_n|, and the overlap is kept. (A full push-out
+    !> -g/(theta h) of overlaps was tried and makes dense packings unstable.)
     pure subroutine contacts_set_laws(cs, law, radius, mat, wall_mat, materials, vel_begin, vel_free, &
                                       wall_vel_begin, wall_vel_end)
         !> Contacts.
@@ -319,7 +338,7 @@ contains
         !> Wall velocities at the start and at the end of the step (2, n_walls).
         real(wp), intent(in) :: wall_vel_begin(:, :), wall_vel_end(:, :)
         integer :: k, ma, mb
-        real(wp) :: ub(2), uf(2), uw(2), amoy, target, e
+        real(wp) :: ub(2), uf(2), uw(2), amoy, target, e, gp
         do k = 1, cs%n
             mb = mat(cs%i2(k))
             if (cs%i1(k) > 0) then
@@ -339,11 +358,16 @@ contains
             uf = contacts_local_velocity(cs, k, vel_free, wall_vel_end)
             uw = 0.0_wp
             if (cs%i1(k) < 0) uw = -wall_term(cs%nrm(:, k), wall_vel_end(:, -cs%i1(k)))
-            target = e*max(-ub(1), 0.0_wp)
+            gp = cs%gap(k) + law%theta*law%h*uf(1)
+            if (gp <= 0.0_wp .or. cs%status(k) == status_cohesive) then
+                target = e*max(-ub(1), 0.0_wp)
+            else
+                target = -max(cs%gap(k), 0.0_wp)/(law%theta*law%h)
+            end if
             cs%shift(1, k) = uw(1) - target
             cs%shift(2, k) = uw(2)
-            cs%active(k) = cs%status(k) == status_cohesive .or. &
-                           cs%gap(k) + law%theta*law%h*uf(1) <= 0.0_wp
+            cs%active(k) = cs%status(k) == status_cohesive .or. gp <= law%gap_allowance*amoy .or. &
+                           cs%r(1, k) > 0.0_wp
             if (.not. cs%active(k)) cs%r(:, k) = 0.0_wp
         end do
     end subroutine contacts_set_laws
@@ -356,9 +380,14 @@ contains
         u(2) = -nrm(2)*v(1) + nrm(1)*v(2)
     end function wall_term
 
-    !> After the solve: end-of-step relative velocities, statuses, broken bonds
-    !> (a bond breaks for good when its end-of-step gap g + theta h u_n exceeds
-    !> bond_ratio * mean radius).
+    !> After the solve: end-of-step relative velocities, statuses, broken bonds.
+    !> A bond breaks for good when the solution needs more tension than the cohesion holds:
+    !> its shifted reaction is at the apex of the cone (r_n + r_cohe h = 0, full tension, the
+    !> separation case of the law) and the contact opens (u_n > 0). This depends on the
+    !> converged forces, not on an opening of round-off size (which the solver tolerance
+    !> does not resolve). A bond left out of the solve (blocked: both bodies immobile along
+    !> the normal, see dem_nlgs) has no force to judge by: it breaks when its end-of-step gap
+    !> g + theta h u_n exceeds bond_ratio * mean radius.
     pure subroutine contacts_finish(cs, law, radius, vel, wall_vel)
         !> Contacts.
         type(contact_set_t), intent(inout) :: cs
@@ -372,13 +401,18 @@ contains
         real(wp), intent(in) :: wall_vel(:, :)
         integer :: k
         real(wp) :: amoy, rn
+        logical :: breaks
         do k = 1, cs%n
             cs%u(:, k) = contacts_local_velocity(cs, k, vel, wall_vel)
             if (cs%status(k) == status_cohesive) then
-                amoy = radius(cs%i2(k))
-                if (cs%i1(k) > 0) amoy = 0.5_wp*(amoy + radius(cs%i1(k)))
-                if (cs%gap(k) + law%theta*law%h*cs%u(1, k) > law%bond_ratio*amoy) &
-                    cs%status(k) = status_broken
+                if (cs%active(k)) then
+                    breaks = cs%r(1, k) + cs%coh(k) <= 0.0_wp .and. cs%u(1, k) > 0.0_wp
+                else
+                    amoy = radius(cs%i2(k))
+                    if (cs%i1(k) > 0) amoy = 0.5_wp*(amoy + radius(cs%i1(k)))
+                    breaks = cs%gap(k) + law%theta*law%h*cs%u(1, k) > law%bond_ratio*amoy
+                end if
+                if (breaks) cs%status(k) = status_broken
             else if (cs%status(k) /= status_broken) then
                 rn = cs%r(1, k)
                 if (rn <= 0.0_wp) then
@@ -430,7 +464,7 @@ contains
         if (allocated(cs%i1)) b = b + 4_i8*(size(cs%i1) + size(cs%i2))
         if (allocated(cs%nrm)) b = b + 8_i8*(size(cs%nrm) + size(cs%gap))
         if (allocated(cs%lever)) b = b + 8_i8*(size(cs%lever) + size(cs%w) + size(cs%shift) + size(cs%r) &
-                                             + size(cs%u) + size(cs%mu) + size(cs%coh))
+                                               + size(cs%u) + size(cs%mu) + size(cs%coh))
         if (allocated(cs%status)) b = b + 4_i8*(size(cs%status) + size(cs%active))
         if (allocated(cs%prev_i1)) b = b + 4_i8*(size(cs%prev_i1) + size(cs%prev_i2))
         if (allocated(cs%prev_r)) b = b + 8_i8*size(cs%prev_r)

@@ -52,7 +52,7 @@ contains
         !> Broad-phase workspace.
         type(detector_t), intent(inout) :: det
         !> Disk centres and radii [m].
-        real(wp), intent(in) :: x(:), y(:), radius(:)
+        real(wp), intent(in), contiguous :: x(:), y(:), radius(:)
         !> Alert distance [m] (>= 0).
         real(wp), intent(in) :: alert
         !> Wall end points [m].

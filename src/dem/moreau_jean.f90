@@ -5,9 +5,12 @@
 !>   1. free velocities v_free = v + h M^-1 F_theta (F_theta = (1 - theta) F(t) + theta F(t + h));
 !>      imposed and fixed DOFs take their values at t + h;
 !>   2. detection on the mid configuration q + (1 - theta) h v (warm start by pair);
-!>   3. contact laws (activation on the predicted gap, Newton restitution, cohesion), frames;
-!>   4. NLGS with the bi-potential local solver: v+ and the impulses;
-!>   5. q+ = q + h [(1 - theta) v + theta v+]; bonds that opened break; energies.
+!>   3. contact laws (activation on the predicted gap with a round-off allowance, or on the
+!>      previous reaction; Newton restitution or gap term; cohesion), frames;
+!>   4. NLGS with the bi-potential local solver: v+ and the impulses (blocked contacts, whose
+!>      bodies are both immobile along the normal, are left out and counted in `stats`);
+!>   5. q+ = q + h [(1 - theta) v + theta v+]; bonds pulled beyond their cohesion break;
+!>      energies.
 !> Energy audit (per unit thickness), exact for the discrete scheme up to round-off:
 !>   kinetic + potential - external_work - drive_work + contact_dissipation
 !>   + numerical_dissipation = initial,
@@ -52,8 +55,13 @@ module dem_moreau_jean
         !> Alert distance of the detection [m].
         real(wp) :: alert = 0.0_wp
         !> Bonds: created at the first step on contacts with cohesion and gap <= bond_ratio *
-        !> mean radius; broken for good once their gap exceeds it.
+        !> mean radius; broken for good once the solution needs more tension than the
+        !> cohesion (dem_contacts, contacts_finish).
         real(wp) :: bond_ratio = 1.0e-6_wp
+        !> Round-off allowance of the contact activation and of the detection, relative to the
+        !> (mean) radius: contacts whose predicted gap is at most this are active
+        !> (dem_contacts, contacts_set_laws).
+        real(wp) :: gap_allowance = 1.0e-10_wp
     end type mj_config_t
 
     !> Energies and works per unit thickness [J/m] since the start.
@@ -155,8 +163,9 @@ contains
             call make_error(error, 'DEM time step h must be > 0')
         else if (sys%scheme%theta < 0.5_wp .or. sys%scheme%theta > 1.0_wp) then
             call make_error(error, 'DEM theta must be in [0.5, 1]')
-        else if (sys%scheme%alert < 0.0_wp .or. sys%scheme%bond_ratio < 0.0_wp) then
-            call make_error(error, 'DEM alert distance and bond_ratio must be >= 0')
+        else if (sys%scheme%alert < 0.0_wp .or. sys%scheme%bond_ratio < 0.0_wp .or. &
+                 sys%scheme%gap_allowance < 0.0_wp) then
+            call make_error(error, 'DEM alert distance, bond_ratio and gap_allowance must be >= 0')
         else if (sys%solver%tol <= 0.0_wp .or. sys%solver%max_sweeps < 1 .or. &
                  sys%solver%local_max_iter < 1) then
             call make_error(error, 'DEM solver needs tol > 0, max_sweeps >= 1, local_max_iter >= 1')
@@ -182,7 +191,7 @@ contains
     pure type(contact_law_t) function step_law(sys) result(law)
         type(dem_system_t), intent(in) :: sys
         law = contact_law_t(h=sys%scheme%h, theta=sys%scheme%theta, make_bonds=sys%bonds_pending, &
-                            bond_ratio=sys%scheme%bond_ratio)
+                            bond_ratio=sys%scheme%bond_ratio, gap_allowance=sys%scheme%gap_allowance)
     end function step_law
 
     !> Part 1 of a step: start velocities vel0, free velocities vel (loads and gravity,
@@ -202,8 +211,14 @@ contains
         !> System, after `mj_free_velocities`.
         type(dem_system_t), intent(inout) :: sys
         integer(i8) :: c0, c1, c2, rate
+        real(wp) :: alert
         call system_clock(c0, rate)
-        call detect_contacts(sys%detector, sys%xm, sys%ym, sys%particles%radius, sys%scheme%alert, &
+        ! touching disks must be found whatever the sign of their rounded gap
+        alert = sys%scheme%alert
+        if (sys%particles%n > 0) then
+            alert = alert + sys%scheme%gap_allowance*maxval(sys%particles%radius(1:sys%particles%n))
+        end if
+        call detect_contacts(sys%detector, sys%xm, sys%ym, sys%particles%radius, alert, &
                              sys%wx1, sys%wy1, sys%wx2, sys%wy2, sys%contacts)
         call system_clock(c1)
         call contacts_set_frames(sys%contacts, sys%particles%radius, sys%im)
@@ -326,7 +341,8 @@ contains
         end associate
     end subroutine audit_energies
 
-    !> Contact dissipation -sum r.u_theta and work of moving walls sum r.(n.vw, t.vw)_theta.
+    !> Contact dissipation -sum r.u_theta and work of moving walls sum r.(n.vw, t.vw)_theta,
+    !> over the contacts of the solve (inactive and blocked contacts have r = 0 and are skipped).
     subroutine contact_works(sys)
         type(dem_system_t), intent(inout) :: sys
         real(wp) :: th, u(2), vw(2), nx, ny
@@ -334,6 +350,7 @@ contains
         th = sys%scheme%theta
         associate (cs => sys%contacts, e => sys%energies)
             do k = 1, cs%n
+                if (.not. cs%active(k)) cycle
                 u = (1.0_wp - th)*contacts_local_velocity(cs, k, sys%vel0, sys%wall_v0) + th*cs%u(:, k)
                 e%contact_dissipation = e%contact_dissipation - dot_product(cs%r(:, k), u)
                 a = cs%i1(k)

@@ -9,6 +9,10 @@
 !> i.e. the change of local velocities over the sweep relative to W r. The Signorini-Coulomb
 !> residual of the final state (scaled frame, bipotential_residual) is reported too.
 !> Sweeps alternate direction when `symmetric` (symmetric Gauss-Seidel).
+!> Blocked contacts (both bodies immobile along the normal: W_nn = 0) are taken out of the
+!> solve with r = 0 and counted in the statistics (`nlgs_stats_t%n_blocked`).
+!> The constants of each contact's scaled frame (bipotential_scaling) are computed once per
+!> solve.
 !>
 !> Bilateral constraints (optional, e.g. the Arlequin coupling rows, coupling_bilateral):
 !> an extension of `nlgs_bilateral_t` keeps linear velocity constraints on some disks
@@ -19,11 +23,16 @@
 module dem_nlgs
     use core_kinds, only: wp, i8
     use dem_contacts, only: contact_set_t
-    use dem_bipotential, only: bipotential_local_solve, bipotential_residual
+    use dem_bipotential, only: bipotential_residual, bipotential_scaling, bipotential_local_solve_scaled, &
+                               bipotential_n_scaling
     implicit none
     private
     public :: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_apply_reactions, nlgs_residual
     public :: nlgs_bilateral_t
+
+    !> A contact is blocked when W_nn <= blocked_ratio (W_nn + W_tt) (the floor of the scaled
+    !> frame in dem_bipotential: below it the normal reaction would be unbounded).
+    real(wp), parameter :: blocked_ratio = 1.0e-12_wp
 
     !> Solver settings.
     type :: nlgs_config_t
@@ -43,8 +52,11 @@ module dem_nlgs
     type :: nlgs_stats_t
         !> Sweeps done.
         integer :: sweeps = 0
-        !> Contacts in the list and active contacts.
+        !> Contacts in the list and contacts in the solve (active, not blocked).
         integer :: n_contacts = 0, n_active = 0
+        !> Active contacts left out of the solve because both bodies are immobile along the
+        !> normal (fixed or imposed velocities, W_nn = 0): their reaction is set to zero.
+        integer :: n_blocked = 0
         !> Local predictor-corrector iterations, all contacts and sweeps.
         integer(i8) :: local_iterations = 0_i8
         !> Contact updates (active contacts x sweeps).
@@ -108,15 +120,20 @@ contains
         real(wp) :: num, den
         integer(i8) :: nloc
         integer, allocatable :: list(:)
+        ! per contact of the solve, constant over the solve: the scaled frame of its local
+        ! problem (bipotential_scaling)
+        real(wp), allocatable :: sc(:, :)
         integer :: s, k
         stats%n_contacts = cs%n
+        call skip_blocked(cs, stats%n_blocked)
         stats%n_active = count(cs%active(1:cs%n))
-        allocate (list(stats%n_active))
+        allocate (list(stats%n_active), sc(bipotential_n_scaling, stats%n_active))
         s = 0
         do k = 1, cs%n
             if (.not. cs%active(k)) cycle
             s = s + 1
             list(s) = k
+            call bipotential_scaling(cs%w(1, k), cs%w(2, k), cs%w(3, k), cs%mu(k), sc(:, s))
         end do
         call nlgs_apply_reactions(cs, im, vel)
         if (present(bilateral)) call bilateral%restore(vel)
@@ -126,9 +143,11 @@ contains
             stats%converged = .false.
             do s = 1, config%max_sweeps
                 if (config%symmetric .and. mod(s, 2) == 0) then
-                    call sweep(config, cs, im, vel, list, stats%n_active, 1, -1, num, den, nloc, bilateral)
+                    call sweep(config, cs, im, vel, list, sc, stats%n_active, 1, -1, num, den, nloc, &
+                               bilateral)
                 else
-                    call sweep(config, cs, im, vel, list, 1, stats%n_active, 1, num, den, nloc, bilateral)
+                    call sweep(config, cs, im, vel, list, sc, 1, stats%n_active, 1, num, den, nloc, &
+                               bilateral)
                 end if
                 stats%sweeps = s
                 stats%local_iterations = stats%local_iterations + nloc
@@ -154,6 +173,26 @@ contains
             q = 0.0_wp
         end if
     end function relative
+
+    !> Take the blocked active contacts out of the solve (active = .false., r = 0) and count
+    !> them: those whose normal direction is held by the fixities, W_nn <= blocked_ratio
+    !> (W_nn + W_tt) (both bodies with fixed or imposed translations; W = 0 when their
+    !> rotations are held too). Their normal reaction is not determined by the law (the imposed
+    !> motion fixes u_n whatever r_n), so they are left out rather than given an unbounded
+    !> reaction.
+    pure subroutine skip_blocked(cs, n_blocked)
+        type(contact_set_t), intent(inout) :: cs
+        integer, intent(out) :: n_blocked
+        integer :: k
+        n_blocked = 0
+        do k = 1, cs%n
+            if (.not. cs%active(k)) cycle
+            if (cs%w(1, k) > blocked_ratio*(cs%w(1, k) + cs%w(3, k))) cycle
+            cs%active(k) = .false.
+            cs%r(:, k) = 0.0_wp
+            n_blocked = n_blocked + 1
+        end do
+    end subroutine skip_blocked
 
     !> Add M^-1 H r of every active contact to vel.
     pure subroutine nlgs_apply_reactions(cs, im, vel)
@@ -218,12 +257,13 @@ contains
     !> One Gauss-Seidel sweep over the active contacts list(first), list(first + step), ...,
     !> list(last). num = sum |W dr|^2, den = sum |W r~|^2, nloc = local iterations.
     !> With bilateral constraints, they are restored after each contact update.
-    subroutine sweep(config, cs, im, vel, list, first, last, step, num, den, nloc, bilateral)
+    subroutine sweep(config, cs, im, vel, list, sc, first, last, step, num, den, nloc, bilateral)
         type(nlgs_config_t), intent(in) :: config
         type(contact_set_t), intent(inout) :: cs
         real(wp), intent(in) :: im(:, :)
         real(wp), intent(inout) :: vel(:, :)
         integer, intent(in) :: list(:), first, last, step
+        real(wp), intent(in), contiguous :: sc(:, :)
         real(wp), intent(out) :: num, den
         integer(i8), intent(out) :: nloc
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
@@ -242,8 +282,8 @@ contains
             rt0 = cs%r(2, k)
             rn = rn0
             rt = rt0
-            call bipotential_local_solve(wnn, wnt, wtt, un - wnn*rn0 - wnt*rt0, ut - wnt*rn0 - wtt*rt0, &
-                                         cs%mu(k), config%local_tol, config%local_max_iter, rn, rt, it, pcase)
+            call bipotential_local_solve_scaled(sc(:, a), un - wnn*rn0 - wnt*rt0, ut - wnt*rn0 - wtt*rt0, &
+                                                config%local_tol, config%local_max_iter, rn, rt, it, pcase)
             nloc = nloc + it
             drn = rn - rn0
             drt = rt - rt0
