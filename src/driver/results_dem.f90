@@ -41,7 +41,7 @@ module driver_results_dem
         integer :: n_buffered = 0, n_steps = 0
         !> Buffered statistics per step: sweeps, contacts in the list, active contacts,
         !> converged (1) or not (0).
-        integer, allocatable :: sweeps(:), contacts(:), active(:), converged(:)
+        integer, allocatable :: sweeps(:), contacts(:), active(:), blocked(:), converged(:)
         !> Buffered convergence norms and Signorini-Coulomb residuals per step.
         real(wp), allocatable :: norm(:), residual(:)
     contains
@@ -82,7 +82,8 @@ contains
         self%n_buffered = 0
         self%n_steps = 0
         allocate (self%sweeps(stats_buffer), self%contacts(stats_buffer), &
-                  self%active(stats_buffer), self%converged(stats_buffer), self%norm(stats_buffer), &
+                  self%active(stats_buffer), self%blocked(stats_buffer), self%converged(stats_buffer), &
+                  self%norm(stats_buffer), &
                   self%residual(stats_buffer))
         call properties(error)
         if (allocated(error)) return
@@ -131,8 +132,8 @@ contains
             !&<
             character(len=*), parameter :: energies(7) = [character(len=13) :: 'kinetic', &
                 'potential', 'external_work', 'drive_work', 'dissipated', 'numerical', 'balance']
-            character(len=*), parameter :: stats_int(4) = [character(len=9) :: 'sweeps', &
-                'contacts', 'active', 'converged']
+            character(len=*), parameter :: stats_int(5) = [character(len=9) :: 'sweeps', &
+                'contacts', 'active', 'blocked', 'converged']
             !&>
             integer :: k
             call real_series('/dem/time', [integer ::], 's', error)
@@ -321,6 +322,7 @@ contains
         self%sweeps(k) = stats%sweeps
         self%contacts(k) = stats%n_contacts
         self%active(k) = stats%n_active
+        self%blocked(k) = stats%n_blocked
         self%converged(k) = merge(1, 0, stats%converged)
         self%norm(k) = stats%error
         self%residual(k) = stats%residual
@@ -340,6 +342,8 @@ contains
         call file%append_chunk('/dem/solver/contacts', self%contacts(:k), error)
         if (allocated(error)) return
         call file%append_chunk('/dem/solver/active', self%active(:k), error)
+        if (allocated(error)) return
+        call file%append_chunk('/dem/solver/blocked', self%blocked(:k), error)
         if (allocated(error)) return
         call file%append_chunk('/dem/solver/converged', self%converged(:k), error)
         if (allocated(error)) return

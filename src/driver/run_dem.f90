@@ -47,6 +47,7 @@ contains
         type(dem_writer_t) :: writer
         type(progress_t) :: progress
         integer :: n_steps, k, unconverged
+        logical :: blocked_warned
         logical :: speed_warned
         character(len=:), allocatable :: message
         character(len=512) :: buf
@@ -65,12 +66,18 @@ contains
         if (allocated(error)) return
         unconverged = 0
         speed_warned = .false.
+        blocked_warned = .false.
         call progress%start(n_steps, run%t_end, run%progress_seconds)
         do k = 1, n_steps
             call mj_step(cfg%system)
             call writer%record_step(out%file, cfg%system%stats, error)
             if (allocated(error)) return
             if (.not. cfg%system%stats%converged) call warn_unconverged()
+            if (cfg%system%stats%n_blocked > 0 .and. .not. blocked_warned) then
+                call report('warning: contacts between bodies that cannot move (fixed or imposed '// &
+                            'velocities) are left out of the solve; count per step in /dem/solver/blocked')
+                blocked_warned = .true.
+            end if
             if (.not. speed_warned) call check_speed()
             if (mod(k, run%output_interval) == 0 .or. k == n_steps) then
                 call writer%store(out%file, cfg%system, error)
