@@ -2,6 +2,17 @@
 !> model (Newmark) and weighted disks (Moreau-Jean, contacts) glued in the overlap by one
 !> multiplier per coupled DOF, explicitly in the coupling, at velocity level.
 !>
+!> Multiplier space (`multipliers`): one multiplier per coupled DOF (`multipliers_particles`,
+!> the reference work: every coupled disk centre follows C u), or on the FE nodes that carry
+!> coupled points (`multipliers_nodes`, a coarser mediator space, coupling_operator's
+!> `build_mediator`): the constraint is then Pi (q - C u) = 0, the disks receive Pi^T lambda
+!> and the FE -(Pi C)^T lambda, and A_m = Pi A Pi^T. A disk may move relative to the beam in
+!> the kernel of Pi (e.g. a zig-zag between the nodes). Both are handled by the same rows
+!> (coupling_bilateral with A^-1 replaced by B = Pi^T A_m^-1 Pi): `lambda` is always the force
+!> mu on the coupled DOFs (mu = Pi^T lambda_m), `multiplier` the multipliers themselves.
+!> The statistics' position/velocity/rotation residuals are those of the imposed constraint
+!> (Pi e with the mediator space), `particle_residual` the per-disk residual ||e||.
+!>
 !> Build (`build_coupled_system`): the beam is assembled with the weight alpha(s) (mass,
 !> stiffness and loads integrated with alpha); every disk gets the weight alpha at the
 !> abscissa of its centre (projection on the nearest element, extended past the beam's ends)
@@ -51,6 +62,7 @@
 module coupling_arlequin
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
+    use core_linalg, only: dense_spd_t
     use fem_beam_config, only: beam_config_t
     use fem_beam_model, only: beam_model_t, build_beam_model
     use fem_newmark, only: newmark_t
@@ -58,13 +70,20 @@ module coupling_arlequin
     use dem_moreau_jean, only: dem_system_t, mj_init, mj_free_velocities, mj_detect, mj_solve, &
                                mj_end_step, energies_balance
     use coupling_weights, only: weight_config_t, overlap_weight_t, make_weight
-    use coupling_operator, only: coupling_operator_t, build_coupling_operator
+    use coupling_operator, only: coupling_operator_t, build_coupling_operator, mediator_t, &
+                                 build_mediator
     use coupling_lambda, only: coupling_system_t, fe_coupling_force
     use coupling_bilateral, only: coupling_rows_t
     implicit none
     private
     public :: coupling_config_t, coupled_system_t, coupled_stats_t, coupled_energies_t
     public :: build_coupled_system, arlequin_step, coupled_energies, coordinate_residual
+    public :: multipliers_particles, multipliers_nodes
+
+    !> One multiplier per coupled DOF (the reference work).
+    integer, parameter :: multipliers_particles = 1
+    !> Multipliers on the FE nodes carrying coupled points (mediator space).
+    integer, parameter :: multipliers_nodes = 2
 
     !> Description of the coupling, as read from the deck ([coupling] section).
     type :: coupling_config_t
@@ -84,6 +103,8 @@ module coupling_arlequin
         !> Contacts on coupled disks use the condensed Delassus blocks (exact local solves);
         !> switch off only to compare convergence.
         logical :: condensed_contacts = .true.
+        !> Multiplier space: multipliers_particles or multipliers_nodes.
+        integer :: multipliers = multipliers_particles
     end type coupling_config_t
 
     !> Statistics of the last coupled step (norms over the translation rows unless said).
@@ -101,13 +122,18 @@ module coupling_arlequin
         real(wp) :: nlgs_error = 0.0_wp
         !> ||g||: free velocity residual before the multipliers [m/s].
         real(wp) :: free_residual = 0.0_wp
-        !> ||G v - C v_c + e_n/h|| after the step [m/s] (round-off).
+        !> ||G v - C v_c + e_n/h|| after the step [m/s] (round-off); ||Pi (...)|| with the
+        !> mediator space.
         real(wp) :: velocity_residual = 0.0_wp
-        !> ||q - C (u - u_0)|| after the step [m] (round-off).
+        !> ||q - C (u - u_0)|| after the step [m] (round-off); ||Pi (...)|| with the mediator
+        !> space.
         real(wp) :: position_residual = 0.0_wp
+        !> ||q - C (u - u_0)|| per disk [m]: the position residual with multipliers on the
+        !> particles, free in the kernel of Pi with the mediator space.
+        real(wp) :: particle_residual = 0.0_wp
         !> Same for the rotation rows [rad] (0 without rotation rows).
         real(wp) :: rotation_residual = 0.0_wp
-        !> ||lambda|| over all rows [N, N.m].
+        !> ||lambda|| over all multipliers (mediator ones with multipliers_nodes) [N, N.m].
         real(wp) :: lambda_norm = 0.0_wp
     end type coupled_stats_t
 
@@ -149,8 +175,16 @@ module coupling_arlequin
         type(coupling_operator_t) :: op
         !> Factored A.
         type(coupling_system_t) :: multipliers
-        !> Coupling rows as NLGS bilateral constraints (holds A^-1).
+        !> Coupling rows as NLGS bilateral constraints (holds A^-1 or B).
         type(coupling_rows_t) :: rows
+        !> Multipliers on the FE nodes (mediator space) instead of the coupled DOFs.
+        logical :: on_nodes = .false.
+        !> The mediator space (with on_nodes).
+        type(mediator_t) :: mediator
+        !> lambda_m = R mu, R = A_m^-1 Pi A (n_mult, n_rows) (with on_nodes).
+        real(wp), allocatable :: recover(:, :)
+        !> Multipliers after a step: lambda (per DOF) or lambda_m (mediator) [N, N.m].
+        real(wp), allocatable :: multiplier(:)
         !> Out-of-plane thickness of the particle domain [m].
         real(wp) :: thickness = 0.0_wp
         !> Contacts on coupled disks use the condensed Delassus blocks.
@@ -159,7 +193,8 @@ module coupling_arlequin
         integer, allocatable :: coupled(:)
         !> Weight alpha of every disk (n_disks): its mass is (1 - alpha) times the physical one.
         real(wp), allocatable :: alpha(:)
-        !> Multipliers at t_{n+1} (after a step) and t_n [N, N.m] (n_rows).
+        !> Forces of the multipliers on the coupled DOFs (lambda, or Pi^T lambda_m) at t_{n+1}
+        !> (after a step) and t_n [N, N.m] (n_rows).
         real(wp), allocatable :: lambda(:), lambda_old(:)
         !> Free residual g of the last step [m/s, rad/s] (n_rows).
         real(wp), allocatable :: g(:)
@@ -265,17 +300,50 @@ contains
         end do
         call sys%multipliers%assemble(sys%op, sys%fe, error, inverse_mass=sys%fe%gamma*iw)
         if (allocated(error)) return
-        allocate (sys%rows%ainv(sys%op%n_rows, sys%op%n_rows), source=0.0_wp)
-        do i = 1, sys%op%n_rows
-            sys%rows%ainv(i, i) = 1.0_wp
-        end do
-        call sys%multipliers%a%solve(sys%rows%ainv, error)
-        if (allocated(error)) return
+        sys%on_nodes = config%multipliers == multipliers_nodes
+        if (sys%on_nodes) then
+            call mediator_inverse(sys, error)
+            if (allocated(error)) return
+        else
+            allocate (sys%rows%ainv(sys%op%n_rows, sys%op%n_rows), source=0.0_wp)
+            do i = 1, sys%op%n_rows
+                sys%rows%ainv(i, i) = 1.0_wp
+            end do
+            call sys%multipliers%a%solve(sys%rows%ainv, error)
+            if (allocated(error)) return
+        end if
         sys%rows%ainv = 0.5_wp*(sys%rows%ainv + transpose(sys%rows%ainv))
         sys%rows%response = h*sys%fe%gamma*iw
         sys%rows%scale = h*sys%fe%gamma/sys%thickness
         call init_state(sys)
     end subroutine build_coupled_system
+
+    !> Mediator space: Pi, A_m = Pi A Pi^T (factored: SPD when the rows of Pi are
+    !> independent, checked by build_mediator), B = Pi^T A_m^-1 Pi in the rows, R = A_m^-1 Pi A.
+    subroutine mediator_inverse(sys, error)
+        type(coupled_system_t), intent(inout) :: sys
+        type(error_t), allocatable, intent(out) :: error
+        type(dense_spd_t) :: am
+        real(wp), allocatable :: p(:, :)
+        call build_mediator(sys%model, sys%op, sys%mediator, error)
+        if (allocated(error)) return
+        associate (pi => sys%mediator%pi, a => sys%multipliers%a%a)
+            call am%init(sys%mediator%n_mult)
+            am%a = matmul(pi, matmul(a, transpose(pi)))
+            am%a = 0.5_wp*(am%a + transpose(am%a))
+            call am%factor(error)
+            if (allocated(error)) then
+                error%message = 'coupling: multipliers = nodes: A_m = Pi A Pi^T is singular; '// &
+                                error%message
+                return
+            end if
+            p = pi
+            call am%solve(p, error)
+            if (allocated(error)) return
+            sys%rows%ainv = matmul(transpose(pi), p)
+            sys%recover = matmul(p, a)
+        end associate
+    end subroutine mediator_inverse
 
     !> Error when an element lies wholly where alpha = 0 (beyond the overlap's particle end):
     !> it would have neither mass nor stiffness.
@@ -448,6 +516,11 @@ contains
         allocate (sys%lambda(nr), sys%lambda_old(nr), sys%g(nr), sys%q(nr), sys%drift(nr), &
                   sys%cv(nr), sys%gv(nr), sys%cu0(nr), sys%start(nr), source=0.0_wp)
         allocate (sys%fc(sys%op%n_free), source=0.0_wp)
+        if (sys%on_nodes) then
+            allocate (sys%multiplier(sys%mediator%n_mult), source=0.0_wp)
+        else
+            allocate (sys%multiplier(nr), source=0.0_wp)
+        end if
         call sys%op%apply(sys%fe%u, sys%cu0)
         associate (p => sys%dem%particles)
             do r = 1, nr
@@ -465,7 +538,7 @@ contains
         call sys%op%apply(sys%fe%v, sys%cv)
         sys%g = sys%gv - sys%cv
         sys%stats = coupled_stats_t()
-        sys%stats%free_residual = row_norm(sys, sys%g, .false.)
+        sys%stats%free_residual = constraint_norm(sys, sys%g, .false.)
         sys%stats%velocity_residual = sys%stats%free_residual
         sys%step = 0
     end subroutine init_state
@@ -497,6 +570,20 @@ contains
         logical, intent(in) :: rotation
         nrm = norm2(merge(v, 0.0_wp, (sys%rows%dof == dof_rot) .eqv. rotation))
     end function row_norm
+
+    !> Norm of the imposed part of a row vector v: row_norm(v), or the norm of Pi v over the
+    !> translation (or rotation) multipliers of the mediator space.
+    pure real(wp) function constraint_norm(sys, v, rotation) result(nrm)
+        type(coupled_system_t), intent(in) :: sys
+        real(wp), intent(in) :: v(:)
+        logical, intent(in) :: rotation
+        if (sys%on_nodes) then
+            nrm = norm2(merge(matmul(sys%mediator%pi, v), 0.0_wp, &
+                              (sys%mediator%comp == dof_rot) .eqv. rotation))
+        else
+            nrm = row_norm(sys, v, rotation)
+        end if
+    end function constraint_norm
 
     !> Advance the coupled system by one time step (see the module description).
     subroutine arlequin_step(sys, error)
@@ -557,18 +644,24 @@ contains
             st%n_active = sys%dem%stats%n_active
             st%converged = sys%dem%stats%converged
             st%nlgs_error = sys%dem%stats%error
-            st%free_residual = row_norm(sys, sys%g, .false.)
+            st%free_residual = constraint_norm(sys, sys%g, .false.)
             ! Velocity constraint at t_{n+1} with the drift term of the step.
             call disk_velocities(sys, sys%gv)
             call sys%op%apply(sys%fe%v, sys%cv)
             sys%gv = sys%gv - sys%cv + sys%drift/sys%fe%h
-            st%velocity_residual = row_norm(sys, sys%gv, .false.)
+            st%velocity_residual = constraint_norm(sys, sys%gv, .false.)
             ! New position residual.
             call sys%op%apply(sys%fe%u, sys%cv)
             sys%drift = sys%q - (sys%cv - sys%cu0)
-            st%position_residual = row_norm(sys, sys%drift, .false.)
-            st%rotation_residual = row_norm(sys, sys%drift, .true.)
-            st%lambda_norm = norm2(sys%lambda)
+            st%position_residual = constraint_norm(sys, sys%drift, .false.)
+            st%rotation_residual = constraint_norm(sys, sys%drift, .true.)
+            st%particle_residual = row_norm(sys, sys%drift, .false.)
+            if (sys%on_nodes) then
+                sys%multiplier = matmul(sys%recover, sys%lambda)
+            else
+                sys%multiplier = sys%lambda
+            end if
+            st%lambda_norm = norm2(sys%multiplier)
         end associate
         sys%lambda_old = sys%lambda
         sys%step = sys%step + 1

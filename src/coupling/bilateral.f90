@@ -22,6 +22,12 @@
 !> a full contact solve and a lambda solve (block Gauss-Seidel) contracts only by the ratio
 !> W_eff/W_k per pass for a contact between two coupled particles, which is near 1 when the
 !> FE is much heavier than the weighted particles.
+!>
+!> Mediator space (multipliers on the beam nodes, coupling_operator's `mediator_t`): the
+!> constraint is Pi rho = 0 with forces mu = Pi^T lambda_m on the rows. Everything above holds
+!> with A^-1 replaced by B = Pi^T (Pi A Pi^T)^-1 Pi (symmetric, positive semi-definite):
+!> dmu = -B delta keeps Pi rho = 0 (Pi rho changes by Pi (delta + A dmu) = 0), the rows carry
+!> the forces mu and the condensed blocks use B. `ainv` holds B, `lambda` holds mu.
 module coupling_bilateral
     use core_kinds, only: wp
     use dem_nlgs, only: nlgs_bilateral_t
@@ -42,13 +48,14 @@ module coupling_bilateral
         integer, allocatable :: owner(:)
         !> Particle DOF (1 = x, 2 = y, 3 = rotation) of each row (n_rows).
         integer, allocatable :: dof(:)
-        !> A^-1 (n_rows, n_rows).
+        !> A^-1, or B = Pi^T (Pi A Pi^T)^-1 Pi with the mediator space (n_rows, n_rows).
         real(wp), allocatable :: ainv(:, :)
         !> Velocity of each row per unit multiplier, h gamma / ((1 - alpha) m t) [m/(N s)].
         real(wp), allocatable :: response(:)
         !> h gamma / t, the factor of the condensation [s/m].
         real(wp) :: scale = 0.0_wp
-        !> Multipliers of the current step [N, N.m] (n_rows).
+        !> Multipliers of the current step, as forces on the rows (mu = Pi^T lambda_m with the
+        !> mediator space) [N, N.m] (n_rows).
         real(wp), allocatable :: lambda(:)
         !> G v at which the rows held at the last correction [m/s, rad/s] (n_rows).
         real(wp), allocatable :: target(:)

@@ -9,6 +9,14 @@
 !> DOFs of one element: C is stored as 6 (column, value) pairs per row, in the model's
 !> free-DOF numbering (column 0 = a fixed DOF, value 0, skipped). Rows are ordered point by
 !> point: (x, y) or (x, y, phi) for point 1, then point 2, ...
+!>
+!> Mediator space (`build_mediator`, [coupling] multipliers = nodes): the multipliers live on
+!> the beam nodes that carry coupled points, one per node and row component (x, y and, with
+!> rotation rows, phi), and the constraint is the projection Pi (q - C u) = 0 of the
+!> per-point residual. Pi(k, p) is the linear hat function of node k at point p (1 - xi and
+!> xi on the element holding p), the same for every component: the coarsest interpolation
+!> the beam's nodes carry, the same for axial and transverse displacements, and a partition
+!> of unity (a uniform residual is seen fully). Pi (n_mult, n_rows) is dense (small).
 module coupling_operator
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
@@ -18,6 +26,7 @@ module coupling_operator
     implicit none
     private
     public :: coupling_operator_t, build_coupling_operator, row_x, row_y, row_phi
+    public :: mediator_t, build_mediator
 
     !> Component of a point's rows: x displacement.
     integer, parameter :: row_x = 1
@@ -61,7 +70,98 @@ module coupling_operator
         procedure :: point_weights
     end type coupling_operator_t
 
+    !> Mediator space of the multipliers on the beam nodes (see the module description).
+    type :: mediator_t
+        !> Number of mediator nodes.
+        integer :: n_nodes = 0
+        !> Multipliers per node (= rows per point: 2 or 3).
+        integer :: per_node = 2
+        !> Number of multipliers n_nodes*per_node.
+        integer :: n_mult = 0
+        !> Beam node (model numbering) of each mediator node (n_nodes), increasing.
+        integer, allocatable :: node(:)
+        !> Component (row_x, row_y, row_phi) of each multiplier (n_mult).
+        integer, allocatable :: comp(:)
+        !> Pi (n_mult, n_rows): hat function of the multiplier's node at the row's point,
+        !> for rows of the same component, else 0.
+        real(wp), allocatable :: pi(:, :)
+    end type mediator_t
+
 contains
+
+    !> Pi of the mediator space for the coupled points of op: the mediator nodes are the beam
+    !> nodes with a non-zero hat function at some coupled point (shape values below 1e-9, a
+    !> point on a node up to rounding, count as 0). Multipliers are ordered node by node,
+    !> (x, y[, phi]) per node. Error when a node's row of Pi is (numerically) a combination
+    !> of the rows of other nodes, which makes Pi A Pi^T singular: too few coupled points
+    !> around that node (e.g. a single point inside an element whose nodes carry no other).
+    subroutine build_mediator(model, op, med, error)
+        !> The beam model.
+        type(beam_model_t), intent(in) :: model
+        !> The coupling operator (points projected on the beam).
+        type(coupling_operator_t), intent(in) :: op
+        !> The mediator space built.
+        type(mediator_t), intent(out) :: med
+        !> Set when Pi has dependent rows.
+        type(error_t), allocatable, intent(out) :: error
+        ! Hat values below this are a point on the other node (rounding of the projection).
+        real(wp), parameter :: snap = 1.0e-9_wp
+        ! A row keeping less than this fraction of its norm once projected out of the
+        ! previous rows is a combination of them.
+        real(wp), parameter :: independent = 1.0e-6_wp
+        real(wp), allocatable :: hat(:, :), basis(:, :)
+        integer, allocatable :: slot(:)
+        real(wp) :: nk(2), r0
+        integer :: p, j, k, c, m, rpp
+        character(len=400) :: buf
+        rpp = op%rows_per_point
+        ! Hat functions of every node at every point, then the nodes that carry points.
+        allocate (hat(model%n_nodes, op%n_points), source=0.0_wp)
+        do p = 1, op%n_points
+            nk = [1 - op%xi(p), op%xi(p)]
+            do j = 1, 2
+                if (nk(j) >= snap) hat(model%conn(j, op%element(p)), p) = nk(j)
+            end do
+        end do
+        med%node = pack([(k, k=1, model%n_nodes)], any(hat > 0, dim=2))
+        med%n_nodes = size(med%node)
+        med%per_node = rpp
+        med%n_mult = med%n_nodes*rpp
+        allocate (slot(model%n_nodes), source=0)
+        slot(med%node) = [(k, k=1, med%n_nodes)]
+        allocate (med%pi(med%n_mult, op%n_rows), source=0.0_wp)
+        allocate (med%comp(med%n_mult))
+        do k = 1, med%n_nodes
+            do c = 1, rpp
+                m = (k - 1)*rpp + c
+                med%comp(m) = c
+                do p = 1, op%n_points
+                    med%pi(m, op%row_of(p, c)) = hat(med%node(k), p)
+                end do
+            end do
+        end do
+        ! Independence of the nodes' rows (one component suffices: the same hats), by
+        ! modified Gram-Schmidt in node order.
+        allocate (basis(op%n_points, med%n_nodes), source=0.0_wp)
+        do k = 1, med%n_nodes
+            basis(:, k) = hat(med%node(k), :)
+            r0 = norm2(basis(:, k))
+            do j = 1, k - 1
+                basis(:, k) = basis(:, k) - dot_product(basis(:, j), basis(:, k))*basis(:, j)
+            end do
+            if (norm2(basis(:, k)) < independent*r0) then
+                write (buf, '(a,i0,a)') 'coupling: multipliers = nodes: beam node ', &
+                    model%node_id(med%node(k)), ' of the mediator space is not resolved by '// &
+                    'the coupled points (its hat functions at the points are a combination '// &
+                    'of those of the other mediator nodes, e.g. a single coupled point inside '// &
+                    'an element whose nodes carry no other point): couple more disks around '// &
+                    'it, or use multipliers = particles'
+                call make_error(error, trim(buf))
+                return
+            end if
+            basis(:, k) = basis(:, k)/norm2(basis(:, k))
+        end do
+    end subroutine build_mediator
 
     !> Project the points on the beam and build C.
     subroutine build_coupling_operator(model, x, y, op, error, with_rotation, max_offset)

@@ -27,7 +27,7 @@ module driver_config_coupling
     use fem_beam_config, only: beam_config_t
     use fem_beam_model, only: beam_model_t, build_beam_model
     use coupling_weights, only: weight_config_t, overlap_weight_t, make_weight
-    use coupling_arlequin, only: coupling_config_t
+    use coupling_arlequin, only: coupling_config_t, multipliers_particles, multipliers_nodes
     use driver_config, only: run_config_t
     use driver_config_dem, only: dem_config_t
     implicit none
@@ -96,6 +96,8 @@ contains
             c%thickness = deck%get_real('coupling', 'thickness')
             c%rotation_row = deck%get_word('coupling', 'rotation') == 'on'
             c%max_offset = deck%get_real('coupling', 'max_offset')
+            c%multipliers = merge(multipliers_nodes, multipliers_particles, &
+                                  deck%get_word('coupling', 'multipliers') == 'nodes')
         end associate
         ! The unweighted beam gives the abscissas (it was built without error before).
         call build_beam_model(beam, model, error)

@@ -58,5 +58,12 @@ contains
                            'Couple only disks whose centre lies at most this far from the beam axis (with '// &
                            'coupled = auto; a listed disk farther away is an error); 0: any distance.', &
                            default='0')
+        call s%add_keyword('coupling', 'multipliers', [word_field('multipliers', &
+                                                                  'particles nodes')], &
+                           'Space of the Lagrange multipliers: particles (one per coupled DOF: every '// &
+                           'coupled disk centre follows the beam) or nodes (one per FE node carrying '// &
+                           'coupled disks, x and y: only the projection of the disks'' residual on the '// &
+                           'beam''s linear hat functions vanishes; a coarser mediator space).', &
+                           default='particles')
     end subroutine add_coupling
 end module io_schema_coupling
