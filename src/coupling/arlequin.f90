@@ -466,9 +466,11 @@ contains
             if (config%max_offset > 0) take = take .and. abs(off) <= config%max_offset
             sys%coupled = pack([(i, i=1, n)], take)
         end if
-        if (size(sys%coupled) == 0) call make_error(error, 'coupling: no disk centre lies in '// &
-            'the overlap (within max_offset of the beam axis): nothing to couple; check the '// &
-            'overlap interval against the positions of the disks')
+        if (size(sys%coupled) == 0) then
+            call make_error(error, 'coupling: no disk centre lies in the overlap (within '// &
+                            'max_offset of the beam axis): nothing to couple; check the overlap '// &
+                            'interval against the positions of the disks')
+        end if
     end subroutine select_coupled
 
     !> Masses, inertias and loads of the disks times (1 - alpha).

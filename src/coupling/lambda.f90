@@ -116,10 +116,12 @@ contains
         ! Symmetric up to the rounding of the solves; keep it exactly symmetric.
         self%a%a = self%h*0.5_wp*(self%a%a + transpose(self%a%a))
         call self%a%factor(error)
-        if (allocated(error)) error%message = 'coupling multipliers: A = h (W + gamma C '// &
-            'S^-1 C^T) is singular: a coupled DOF without weighted mass on the particle side '// &
-            '(alpha = 1), or more multipliers than the FE can resolve (too many coupled points '// &
-            'per element: couple fewer or use the mediator space); '//error%message
+        if (allocated(error)) then
+            error%message = 'coupling multipliers: A = h (W + gamma C S^-1 C^T) is singular: '// &
+                            'a coupled DOF without weighted mass on the particle side (alpha = 1), '// &
+                            'or more multipliers than the FE can resolve (too many coupled points '// &
+                            'per element: couple fewer or use the mediator space); '//error%message
+        end if
     end subroutine assemble
 
     !> lambda = -A^-1 g: the multipliers that cancel the free velocity residual

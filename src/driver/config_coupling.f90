@@ -150,6 +150,7 @@ contains
         type(coupled_setup_t), intent(inout) :: setup
         type(error_t), allocatable, intent(out) :: error
         real(wp) :: theta
+        character(len=:), allocatable :: message
         character(len=*), parameter :: why = 'the coupling exchanges the impulse h ((1 - '// &
                                        'gamma) lambda_n + gamma lambda_{n+1}) between the beam and the disks, which '// &
                                        'conserves momentum and energy only with beta = 1/4, gamma = 1/2 and theta = 1/2'
@@ -174,11 +175,14 @@ contains
             return
         end if
         theta = deck%get_real('time', 'theta')
-        if (abs(theta - 0.5_wp) > 0) setup%warnings = [setup%warnings, string_t( &
-                                                    'warning: '//deck%file//':'//to_str(deck%line('time', 'theta'))//': [time] '// &
-                                                   'theta = '//to_str(theta)//' in a coupled run: the constraint q = C u still '// &
-                                              'holds, but the particles dissipate numerically and the coupling does a net work '// &
-                                                       'of order h, so /coupling/energy/balance does not close; '//why)]
+        if (abs(theta - 0.5_wp) > 0) then
+            message = 'warning: '//deck%file//':'//to_str(deck%line('time', 'theta'))// &
+                      ': [time] theta = '//to_str(theta)//' in a coupled run: the constraint '// &
+                      'q = C u still holds, but the particles dissipate numerically and the '// &
+                      'coupling does a net work of order h, so /coupling/energy/balance does not '// &
+                      'close; '//why
+            setup%warnings = [setup%warnings, string_t(message)]
+        end if
     end subroutine check_schemes
 
     !> The overlap lies on the beam: both ends within [0, length].

@@ -20,18 +20,19 @@ module driver_results_coupled
     !> Steps of statistics kept in memory before they are written.
     integer, parameter :: stats_buffer = 4096
     !> Datasets of /coupling/energy (besides time), in the order of `energy_values`.
+    !&<
     character(len=*), parameter :: energy_names(15) = [character(len=23) :: 'fe_kinetic', &
-                                                 'fe_strain', 'fe_external_work', 'fe_damping', 'fe_coupling_work', 'dem_kinetic', &
-                                                    'dem_potential', 'dem_external_work', 'dem_drive_work', 'contact_dissipation', &
-                                                   'numerical_dissipation', 'dem_coupling_work', 'external_work', 'coupling_work', &
-                                                                                                                          'balance']
+        'fe_strain', 'fe_external_work', 'fe_damping', 'fe_coupling_work', 'dem_kinetic', &
+        'dem_potential', 'dem_external_work', 'dem_drive_work', 'contact_dissipation', &
+        'numerical_dissipation', 'dem_coupling_work', 'external_work', 'coupling_work', 'balance']
     !> Real per-step datasets of /coupling, in the order of the buffer's columns.
     character(len=*), parameter :: step_names(6) = [character(len=19) :: 'g_norm', &
-                                                                    'position_residual', 'velocity_residual', 'rotation_residual', &
-                                                                                               'coordinate_residual', 'lambda_norm']
+        'position_residual', 'velocity_residual', 'rotation_residual', 'coordinate_residual', &
+        'lambda_norm']
     !> Units of step_names.
     character(len=*), parameter :: step_units(6) = [character(len=5) :: 'm/s', 'm', 'm/s', &
-                                                                                                                    'rad', 'm', 'N']
+        'rad', 'm', 'N']
+    !&>
 
     !> Writes the coupling part of a results file.
     type :: coupled_writer_t

@@ -140,9 +140,10 @@ contains
                 'converge in ', sys%stats%sweeps, ' sweeps (error ', sys%stats%nlgs_error, &
                 ' > tolerance ', sys%dem%solver%tol, '); the constraint q = C u still holds'
             call report(trim(buf))
-            if (unconverged == max_warnings) call report('warning: further unconverged steps '// &
-                                                    'are only counted (total in the summary); raise [solver] max_sweeps or the '// &
-                                                         'tolerance, or lower [time] step')
+            if (unconverged == max_warnings) then
+                call report('warning: further unconverged steps are only counted (total in the '// &
+                            'summary); raise [solver] max_sweeps or the tolerance, or lower [time] step')
+            end if
         end subroutine warn_unconverged
 
         !> Warning (once) when a disk moved farther than the alert distance in the step.
