@@ -22,7 +22,7 @@ module driver_run_coupled
     use driver_results, only: results_writer_t
     use driver_results_dem, only: dem_writer_t
     use driver_results_coupled, only: coupled_writer_t
-    use driver_run_dem, only: max_warnings, report_line_iface
+    use driver_run_dem, only: max_warnings, report_line_iface, speed_warning, last_unconverged_warning
     implicit none
     private
     public :: build_coupled, run_coupled
@@ -140,28 +140,16 @@ contains
                 'converge in ', sys%stats%sweeps, ' sweeps (error ', sys%stats%nlgs_error, &
                 ' > tolerance ', sys%dem%solver%tol, '); the constraint q = C u still holds'
             call report(trim(buf))
-            if (unconverged == max_warnings) then
-                call report('warning: further unconverged steps are only counted (total in the '// &
-                            'summary); raise [solver] max_sweeps or the tolerance, or lower [time] step')
-            end if
+            if (unconverged == max_warnings) call report(last_unconverged_warning())
         end subroutine warn_unconverged
 
         !> Warning (once) when a disk moved farther than the alert distance in the step.
         subroutine check_speed()
-            real(wp) :: vmax
-            integer :: n
-            n = sys%dem%particles%n
-            associate (p => sys%dem%particles)
-                vmax = sqrt(maxval(p%vx(1:n)**2 + p%vy(1:n)**2))
-            end associate
-            if (vmax*run%h <= sys%dem%scheme%alert) return
+            character(len=:), allocatable :: line
+            line = speed_warning(sys%dem%particles, run%h, sys%dem%scheme%alert, sys%fe%t)
+            if (len(line) == 0) return
             speed_warned = .true.
-            write (buf, '(a,es11.4,a,es9.2,a,es9.2,a,es9.2,a)') 'warning: at t = ', &
-                sys%fe%t, ' s a disk moves ', vmax*run%h, ' m in one step (speed ', &
-                vmax, ' m/s), more than the alert distance ', sys%dem%scheme%alert, &
-                ' m: contacts may be found late (overlaps); lower [time] step or raise '// &
-                '[contacts] alert'
-            call report(trim(buf))
+            call report(line)
         end subroutine check_speed
 
         !> Closing lines: model, residuals, solver effort, energy balance, times.

@@ -9,6 +9,7 @@ module driver_run_dem
     use core_error, only: error_t, make_error
     use core_strings, only: to_str
     use io_progress, only: progress_t
+    use dem_particles, only: particles_t
     use dem_moreau_jean, only: mj_init, mj_step, energies_balance
     use driver_config, only: run_config_t
     use driver_config_dem, only: dem_config_t
@@ -16,7 +17,7 @@ module driver_run_dem
     use driver_results_dem, only: dem_writer_t
     implicit none
     private
-    public :: run_dem, max_warnings, report_line_iface
+    public :: run_dem, max_warnings, report_line_iface, speed_warning, last_unconverged_warning
 
     !> Unconverged steps reported one by one; later ones are only counted.
     integer, parameter :: max_warnings = 5
@@ -102,28 +103,16 @@ contains
                 cfg%system%stats%sweeps, ' sweeps (error ', cfg%system%stats%error, &
                 ' > tolerance ', cfg%system%solver%tol, ')'
             call report(trim(buf))
-            if (unconverged == max_warnings) then
-                call report('warning: further unconverged steps are only counted (total in the '// &
-                            'summary); raise [solver] max_sweeps or the tolerance, or lower [time] step')
-            end if
+            if (unconverged == max_warnings) call report(last_unconverged_warning())
         end subroutine warn_unconverged
 
         !> Warning (once) when a disk moved farther than the alert distance in the step.
         subroutine check_speed()
-            real(wp) :: vmax
-            integer :: n
-            n = cfg%system%particles%n
-            associate (p => cfg%system%particles)
-                vmax = sqrt(maxval(p%vx(1:n)**2 + p%vy(1:n)**2))
-            end associate
-            if (vmax*run%h <= cfg%system%scheme%alert) return
+            character(len=:), allocatable :: line
+            line = speed_warning(cfg%system%particles, run%h, cfg%system%scheme%alert, cfg%system%time)
+            if (len(line) == 0) return
             speed_warned = .true.
-            write (buf, '(a,es11.4,a,es9.2,a,es9.2,a,es9.2,a)') 'warning: at t = ', &
-                cfg%system%time, ' s a disk moves ', vmax*run%h, ' m in one step (speed ', &
-                vmax, ' m/s), more than the alert distance ', cfg%system%scheme%alert, &
-                ' m: contacts may be found late (overlaps); lower [time] step or raise '// &
-                '[contacts] alert'
-            call report(trim(buf))
+            call report(line)
         end subroutine check_speed
 
         !> Closing lines: contacts, solver effort, unconverged steps, energy balance, times.
@@ -147,4 +136,35 @@ contains
             call report(progress%summary_line(n_steps, cfg%system%time))
         end subroutine summary
     end subroutine run_dem
+    !> Warning text when the fastest disk moves farther than the alert distance in one step
+    !> ('' when it does not): contacts could then be found late.
+    function speed_warning(p, h, alert, t) result(line)
+        !> The disks.
+        type(particles_t), intent(in) :: p
+        !> Time step [s].
+        real(wp), intent(in) :: h
+        !> Alert distance [m].
+        real(wp), intent(in) :: alert
+        !> Current time [s].
+        real(wp), intent(in) :: t
+        character(len=:), allocatable :: line
+        character(len=240) :: buf
+        real(wp) :: vmax
+        line = ''
+        if (p%n == 0) return
+        vmax = sqrt(maxval(p%vx(1:p%n)**2 + p%vy(1:p%n)**2))
+        if (vmax*h <= alert) return
+        write (buf, '(a,es11.4,a,es9.2,a,es9.2,a,es9.2,a)') 'warning: at t = ', t, &
+            ' s a disk moves ', vmax*h, ' m in one step (speed ', vmax, &
+            ' m/s), more than the alert distance ', alert, &
+            ' m: contacts may be found late (overlaps); lower [time] step or raise [contacts] alert'
+        line = trim(buf)
+    end function speed_warning
+
+    !> Line closing the series of per-step warnings about unconverged steps.
+    pure function last_unconverged_warning() result(line)
+        character(len=:), allocatable :: line
+        line = 'warning: further unconverged steps are only counted (total in the summary); '// &
+               'raise [solver] max_sweeps or the tolerance, or lower [time] step'
+    end function last_unconverged_warning
 end module driver_run_dem
