@@ -26,6 +26,7 @@ program bench_dem
     use, intrinsic :: iso_fortran_env, only: output_unit, compiler_version, compiler_options
     use core_kinds, only: wp, i8
     use core_error, only: error_t
+    use core_sort, only: sort_in_place
     use dem_particles, only: particles_add_disks
     use dem_walls, only: walls_add
     use dem_materials, only: materials_init, materials_set_pair
@@ -270,20 +271,10 @@ contains
     real(wp) function median(a) result(m)
         real(wp), intent(in) :: a(:)
         real(wp), allocatable :: s(:)
-        real(wp) :: key
-        integer :: i, j, n
+        integer :: n
         allocate (s, source=a)
         n = size(s)
-        do i = 2, n
-            key = s(i)
-            j = i - 1
-            do while (j >= 1)
-                if (s(j) <= key) exit
-                s(j + 1) = s(j)
-                j = j - 1
-            end do
-            s(j + 1) = key
-        end do
+        call sort_in_place(s)
         m = s((n + 1)/2)
         if (mod(n, 2) == 0) m = 0.5_wp*(s(n/2) + s(n/2 + 1))
     end function median

@@ -18,7 +18,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import EllipseCollection
 from matplotlib.figure import Figure
 
-from .results import ResultsError, _decode_attrs
+from .results import ResultsError, _decode_attrs, _Getter, _open_results
 
 #: Columns of the nodal and per-disk arrays: x (u), y (w), rotation.
 X, Y, ROT = 0, 1, 2
@@ -95,19 +95,11 @@ def load_coupled(path) -> CoupledResults:
     """Read a coupled results file. Raises ResultsError with a clear message when the file is
     missing, unreadable, not a coupled run, or a dataset does not follow the layout."""
     path = os.fspath(path)
-    if not os.path.exists(path):
-        hint = ""
-        if os.path.exists(path + ".partial"):
-            hint = f" ('{path}.partial' exists: the run did not finish)"
-        raise ResultsError(f"results file '{path}' does not exist{hint}")
-    try:
-        f = h5py.File(path, "r")
-    except OSError as exc:
-        raise ResultsError(f"'{path}' is not a readable HDF5 file ({exc})") from None
+    f = _open_results(path)
     with f:
         if "coupling" not in f:
             raise ResultsError(f"{path}: no /coupling group (not a coupled run)")
-        get = _Getter(f, path)
+        get = _Getter(f, path, kind="coupled results file")
         xy = get("fem/mesh/coordinates", (None, 2))
         n_nodes = xy.shape[0]
         time = get("fem/time", (None,))
@@ -137,26 +129,6 @@ def load_coupled(path) -> CoupledResults:
             lam=get("coupling/lambda", (n_out, n_rows)), steps=steps, energy=energy,
             coupling_attrs=_decode_attrs(f["coupling"].attrs),
             summary=_decode_attrs(f["summary"].attrs) if "summary" in f else {})
-
-
-class _Getter:
-    """Reads a dataset and checks its shape (None = any extent)."""
-
-    def __init__(self, f, path):
-        self.f = f
-        self.path = path
-
-    def __call__(self, name, shape):
-        if name not in self.f or not isinstance(self.f[name], h5py.Dataset):
-            raise ResultsError(f"{self.path}: missing dataset '/{name}' (not a MULTICOR "
-                               "coupled results file, or one from another version)")
-        data = np.asarray(self.f[name][()])
-        if data.ndim != len(shape) or any(w is not None and g != w
-                                          for g, w in zip(data.shape, shape)):
-            want = tuple("n" if s is None else s for s in shape)
-            raise ResultsError(f"{self.path}: dataset '/{name}' has shape {data.shape}, "
-                               f"expected {want}")
-        return data
 
 
 # --------------------------------------------------------------------------------------------

@@ -17,7 +17,7 @@ from matplotlib.collections import EllipseCollection, LineCollection
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from .results import ResultsError, _decode_attrs
+from .results import ResultsError, _decode_attrs, _Getter, _open_results
 
 #: Columns of the per-disk arrays: x [m], y [m], rotation [rad].
 X, Y, ROT = 0, 1, 2
@@ -123,15 +123,7 @@ def load_dem(path) -> DemResults:
     """Read the /dem group of a results file. Raises ResultsError with a clear message when
     the file is missing, unreadable, or a dataset does not follow the documented layout."""
     path = os.fspath(path)
-    if not os.path.exists(path):
-        hint = ""
-        if os.path.exists(path + ".partial"):
-            hint = f" ('{path}.partial' exists: the run did not finish)"
-        raise ResultsError(f"results file '{path}' does not exist{hint}")
-    try:
-        f = h5py.File(path, "r")
-    except OSError as exc:
-        raise ResultsError(f"'{path}' is not a readable HDF5 file ({exc})") from None
+    f = _open_results(path)
     with f:
         if "dem" not in f:
             raise ResultsError(f"{path}: no /dem group (no particles in this run)")
@@ -176,26 +168,6 @@ def load_dem(path) -> DemResults:
                                     rt=get("dem/contacts/rt", (m,)),
                                     status=get("dem/contacts/status", (m,)).astype(int))
     return res
-
-
-class _Getter:
-    """Reads a dataset and checks its shape (None = any extent)."""
-
-    def __init__(self, f, path):
-        self.f = f
-        self.path = path
-
-    def __call__(self, name, shape):
-        if name not in self.f or not isinstance(self.f[name], h5py.Dataset):
-            raise ResultsError(f"{self.path}: missing dataset '/{name}' (not a MULTICOR "
-                               "results file, or one from another version)")
-        data = np.asarray(self.f[name][()])
-        if data.ndim != len(shape) or any(w is not None and g != w
-                                          for g, w in zip(data.shape, shape)):
-            want = tuple("n" if s is None else s for s in shape)
-            raise ResultsError(f"{self.path}: dataset '/{name}' has shape {data.shape}, "
-                               f"expected {want}")
-        return data
 
 
 # --------------------------------------------------------------------------------------------

@@ -119,15 +119,7 @@ def load_results(path) -> Results:
     """Read a results file. Raises ResultsError with a clear message when it is missing,
     not an HDF5 file, or lacks a dataset of the documented layout."""
     path = os.fspath(path)
-    if not os.path.exists(path):
-        hint = ""
-        if os.path.exists(path + ".partial"):
-            hint = f" ('{path}.partial' exists: the run did not finish)"
-        raise ResultsError(f"results file '{path}' does not exist{hint}")
-    try:
-        f = h5py.File(path, "r")
-    except OSError as exc:
-        raise ResultsError(f"'{path}' is not a readable HDF5 file ({exc})") from None
+    f = _open_results(path)
     with f:
         reader = _Reader(f, path)
         mesh = Mesh(node_id=reader.array("fem/mesh/node_id", ndim=1).astype(int),
@@ -168,6 +160,20 @@ def load_results(path) -> Results:
     return res
 
 
+def _open_results(path: str) -> h5py.File:
+    """Open a results file for reading. Raises ResultsError when it is missing (saying so
+    when the run left a '.partial' file) or is not a readable HDF5 file."""
+    if not os.path.exists(path):
+        hint = ""
+        if os.path.exists(path + ".partial"):
+            hint = f" ('{path}.partial' exists: the run did not finish)"
+        raise ResultsError(f"results file '{path}' does not exist{hint}")
+    try:
+        return h5py.File(path, "r")
+    except OSError as exc:
+        raise ResultsError(f"'{path}' is not a readable HDF5 file ({exc})") from None
+
+
 class _Reader:
     """Reads datasets with shape checks and messages that name the file and the dataset."""
 
@@ -188,6 +194,28 @@ class _Reader:
                                f"expected {ndim}")
         if shape is not None and any(want is not None and got != want
                                      for got, want in zip(data.shape, shape)):
+            want = tuple("n" if s is None else s for s in shape)
+            raise ResultsError(f"{self.path}: dataset '/{name}' has shape {data.shape}, "
+                               f"expected {want}")
+        return data
+
+
+class _Getter:
+    """Reads a dataset and checks its shape (None = any extent); `kind` names the file in the
+    message for a missing dataset."""
+
+    def __init__(self, f, path, kind="results file"):
+        self.f = f
+        self.path = path
+        self.kind = kind
+
+    def __call__(self, name, shape):
+        if name not in self.f or not isinstance(self.f[name], h5py.Dataset):
+            raise ResultsError(f"{self.path}: missing dataset '/{name}' (not a MULTICOR "
+                               f"{self.kind}, or one from another version)")
+        data = np.asarray(self.f[name][()])
+        if data.ndim != len(shape) or any(w is not None and g != w
+                                          for g, w in zip(data.shape, shape)):
             want = tuple("n" if s is None else s for s in shape)
             raise ResultsError(f"{self.path}: dataset '/{name}' has shape {data.shape}, "
                                f"expected {want}")

@@ -18,6 +18,7 @@
 module coupling_weights
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
+    use core_sort, only: sort_in_place
     use core_weight, only: weight_function_t
     implicit none
     private
@@ -130,9 +131,9 @@ contains
         !> The weight.
         class(overlap_weight_t), intent(in) :: self
         real(wp), allocatable :: s(:)
-        real(wp) :: xi(4), tmp
+        real(wp) :: xi(4)
         logical :: found
-        integer :: n, i, j
+        integer :: n
         xi(1) = 0.0_wp
         xi(2) = 1.0_wp
         n = 2
@@ -141,16 +142,7 @@ contains
         call ramp_crossing(self, self%alpha_min, xi(n + 1), found)
         if (found) n = n + 1
         s = self%s_fe + xi(1:n)*(self%s_particle - self%s_fe)
-        do i = 2, n
-            tmp = s(i)
-            j = i - 1
-            do while (j >= 1)
-                if (s(j) <= tmp) exit
-                s(j + 1) = s(j)
-                j = j - 1
-            end do
-            s(j + 1) = tmp
-        end do
+        call sort_in_place(s)
     end function overlap_breakpoints
 
     !> The xi in (0, 1) where the ramp crosses level (bisection to the last bit); found is

@@ -53,21 +53,7 @@ contains
         real(wp), allocatable, intent(out) :: x(:), y(:), radius(:)
         !> Error on invalid input.
         type(error_t), allocatable, intent(out) :: error
-        integer :: i, j, k
-        real(wp) :: pitch
-        call check_lattice(nx, ny, r, gap, error)
-        if (allocated(error)) return
-        pitch = 2.0_wp*r + gap
-        allocate (x(nx*ny), y(nx*ny), radius(nx*ny))
-        k = 0
-        do j = 1, ny
-            do i = 1, nx
-                k = k + 1
-                x(k) = x0 + (i - 1)*pitch
-                y(k) = y0 + (j - 1)*pitch
-            end do
-        end do
-        radius = r
+        call generate_lattice(nx, ny, x0, y0, r, gap, 0.0_wp, 1.0_wp, x, y, radius, error)
     end subroutine generate_square_lattice
 
     !> nx * ny disks of radius r on a hexagonal (triangular) lattice of pitch 2r + gap: rows
@@ -85,6 +71,19 @@ contains
         real(wp), allocatable, intent(out) :: x(:), y(:), radius(:)
         !> Error on invalid input.
         type(error_t), allocatable, intent(out) :: error
+        call generate_lattice(nx, ny, x0, y0, r, gap, 0.5_wp, sqrt(3.0_wp)/2.0_wp, x, y, radius, &
+                              error)
+    end subroutine generate_hex_lattice
+
+    !> nx * ny disks of radius r on a lattice of pitch 2r + gap along the rows, rows `rise`
+    !> pitches apart, every even row shifted by `shift` pitches; first centre (x0, y0).
+    subroutine generate_lattice(nx, ny, x0, y0, r, gap, shift, rise, x, y, radius, error)
+        integer, intent(in) :: nx, ny
+        real(wp), intent(in) :: x0, y0, r, gap
+        !> Shift of the even rows and distance between rows, in pitches.
+        real(wp), intent(in) :: shift, rise
+        real(wp), allocatable, intent(out) :: x(:), y(:), radius(:)
+        type(error_t), allocatable, intent(out) :: error
         integer :: i, j, k
         real(wp) :: pitch
         call check_lattice(nx, ny, r, gap, error)
@@ -95,12 +94,12 @@ contains
         do j = 1, ny
             do i = 1, nx
                 k = k + 1
-                x(k) = x0 + (i - 1)*pitch + merge(0.5_wp*pitch, 0.0_wp, mod(j, 2) == 0)
-                y(k) = y0 + (j - 1)*pitch*sqrt(3.0_wp)/2.0_wp
+                x(k) = x0 + (i - 1)*pitch + merge(shift*pitch, 0.0_wp, mod(j, 2) == 0)
+                y(k) = y0 + (j - 1)*pitch*rise
             end do
         end do
         radius = r
-    end subroutine generate_hex_lattice
+    end subroutine generate_lattice
 
     !> n disks with radii uniform in [rmin, rmax], loosely deposited in the box
     !> [xmin, xmax] x [ymin, ...): one disk per site of a square grid of pitch

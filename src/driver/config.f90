@@ -19,7 +19,7 @@ module driver_config
     use io_deck, only: deck_t, deck_entry_t
     implicit none
     private
-    public :: run_config_t, build_config
+    public :: run_config_t, build_config, find_id
 
     !> What to compute and how (everything but the model itself).
     type :: run_config_t

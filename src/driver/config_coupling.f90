@@ -81,6 +81,15 @@ contains
         first_line = coupling_first_line(deck)
         call check_schemes(deck, run, setup, error)
         if (allocated(error)) return
+        ! The beam has no self-weight load: gravity on the disks alone would load one side of
+        ! the coupling only.
+        if (any(dem%system%particles%gravity /= 0.0_wp)) then
+            call make_input_error(error, deck%file, deck%line('particles', 'gravity'), 'gravity', &
+                                  'coupled runs do not support gravity yet (the beam carries no '// &
+                                  'self-weight, so the two sides of the overlap would not be loaded '// &
+                                  'alike): set gravity = 0 0 and apply loads instead')
+            return
+        end if
         call require(deck, 'overlap', first_line, 's_fe s_particle [m]', error)
         if (allocated(error)) return
         call require(deck, 'thickness', first_line, 'depth of the disks [m], usually the '// &

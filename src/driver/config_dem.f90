@@ -28,7 +28,7 @@ module driver_config_dem
     use dem_contacts, only: contact_set_t
     use dem_detection, only: detector_t, detect_contacts
     use dem_moreau_jean, only: dem_system_t
-    use driver_config, only: run_config_t
+    use driver_config, only: run_config_t, find_id
     implicit none
     private
     public :: dem_config_t, build_dem_config, deck_has_particles, deck_has_beam
@@ -752,16 +752,4 @@ contains
             dof_index = dof_rot
         end select
     end function dof_index
-
-    !> Position of `id` in a short unsorted list (0 if absent).
-    pure integer function find_id(ids, id) result(k)
-        !> Ids.
-        integer, intent(in) :: ids(:)
-        !> Id wanted.
-        integer, intent(in) :: id
-        do k = 1, size(ids)
-            if (ids(k) == id) return
-        end do
-        k = 0
-    end function find_id
 end module driver_config_dem

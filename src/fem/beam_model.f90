@@ -14,6 +14,7 @@ module fem_beam_model
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
     use core_linalg, only: band_spd_t
+    use core_sort, only: sort_in_place
     use core_timefunc, only: time_function_t
     use core_weight, only: weight_function_t
     use fem_beam_config, only: beam_config_t, beam_load_t, beam_section_t
@@ -472,7 +473,7 @@ contains
         class(weight_function_t), intent(in) :: weight
         real(wp), allocatable :: cuts(:)
         real(wp), allocatable :: bp(:)
-        real(wp) :: s1, s2, xi, tmp
+        real(wp) :: s1, s2, xi
         integer :: i, j
         ! Cuts closer than this to an end or to each other are dropped: pieces of relative
         ! length 1e-12 carry nothing at double precision.
@@ -488,16 +489,7 @@ contains
             end do
         end if
         ! Sort (breakpoints are increasing in s, but s may decrease along the element).
-        do i = 2, size(cuts)
-            tmp = cuts(i)
-            j = i - 1
-            do while (j >= 1)
-                if (cuts(j) <= tmp) exit
-                cuts(j + 1) = cuts(j)
-                j = j - 1
-            end do
-            cuts(j + 1) = tmp
-        end do
+        call sort_in_place(cuts)
         ! Drop coincident breakpoints, then close with 1.
         j = 1
         do i = 2, size(cuts)
