@@ -78,7 +78,7 @@ module coupling_arlequin
     private
     public :: coupling_config_t, coupled_system_t, coupled_stats_t, coupled_energies_t
     public :: build_coupled_system, arlequin_step, coupled_energies, coordinate_residual
-    public :: multipliers_particles, multipliers_nodes
+    public :: multipliers_particles, multipliers_nodes, nearest_abscissa
 
     !> One multiplier per coupled DOF (the reference work).
     integer, parameter :: multipliers_particles = 1
@@ -413,8 +413,11 @@ contains
     !> the segment; the first in element order on ties); the abscissa is linear in the reduced
     !> coordinate, also past the element's ends.
     pure subroutine nearest_abscissa(model, px, py, s, off)
+        !> The beam model.
         type(beam_model_t), intent(in) :: model
+        !> The point [m].
         real(wp), intent(in) :: px, py
+        !> Abscissa [m] and signed offset [m] (positive to the left of the element's direction).
         real(wp), intent(out) :: s, off
         integer :: e, n1
         real(wp) :: dx, dy, xi, o, d, d_best

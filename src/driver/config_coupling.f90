@@ -27,7 +27,9 @@ module driver_config_coupling
     use fem_beam_config, only: beam_config_t
     use fem_beam_model, only: beam_model_t, build_beam_model
     use coupling_weights, only: weight_config_t, overlap_weight_t, make_weight
-    use coupling_arlequin, only: coupling_config_t, multipliers_particles, multipliers_nodes
+    ! The deck checks project disks on the beam exactly as the coupling library does.
+    use coupling_arlequin, only: coupling_config_t, multipliers_particles, multipliers_nodes, &
+                                 disk_abscissa => nearest_abscissa
     use driver_config, only: run_config_t
     use driver_config_dem, only: dem_config_t
     implicit none
@@ -326,35 +328,4 @@ contains
         message = error%message
         call make_input_error(error, deck%file, line, keyword, message)
     end subroutine reattach
-
-    !> Curvilinear abscissa of (px, py) on the nearest element of the beam (distance to the
-    !> segment; the first in element order on ties) and its signed offset from the axis
-    !> (positive to the left of the element's direction); the abscissa is linear in the
-    !> reduced coordinate, also past the element's ends. The same projection as the coupling
-    !> library uses.
-    pure subroutine disk_abscissa(model, px, py, s, off)
-        !> The beam model.
-        type(beam_model_t), intent(in) :: model
-        !> The point [m].
-        real(wp), intent(in) :: px, py
-        !> Abscissa [m] and offset [m].
-        real(wp), intent(out) :: s, off
-        integer :: e, n1
-        real(wp) :: dx, dy, xi, o, d, d_best
-        d_best = huge(1.0_wp)
-        s = 0.0_wp
-        off = 0.0_wp
-        do e = 1, model%n_elements
-            n1 = model%conn(1, e)
-            dx = px - model%x(n1)
-            dy = py - model%y(n1)
-            xi = (dx*model%cosine(e) + dy*model%sine(e))/model%length(e)
-            o = -dx*model%sine(e) + dy*model%cosine(e)
-            d = hypot(max(0.0_wp, -xi, xi - 1)*model%length(e), o)
-            if (d >= d_best) cycle
-            d_best = d
-            s = model%abscissa_at(e, xi)
-            off = o
-        end do
-    end subroutine disk_abscissa
 end module driver_config_coupling
