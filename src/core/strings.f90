@@ -15,13 +15,17 @@ module core_strings
         character(len=:), allocatable :: s
     end type string_t
 
-    !> Text form of a number: integers with `i0`; reals in the shortest form that reads back
-    !> to the same value (`0.5`, `2.1e11`, `1e-09`).
+    !> Text form of a number for messages: integers with `i0`; reals rounded to at most
+    !> `max_digits` significant digits, in the shortest form (`0.5`, `2.1e11`, `1e-9`), so that
+    !> rounding noise never shows (`0.0019999999999999996` prints `0.002`).
     interface to_str
         module procedure int_to_str, real_to_str
     end interface to_str
 
     character(len=*), parameter :: digits = '0123456789'
+    !> Significant digits kept by `to_str` for reals: well above what a deck value needs, well
+    !> below the 15-17 digits where the rounding of a computation (Debug or Release) shows.
+    integer, parameter :: max_digits = 10
 
 contains
 
@@ -318,31 +322,38 @@ contains
         text = trim(buf)
     end function int_to_str
 
-    !> Real as the shortest text that reads back to the same value: plain decimals for
-    !> magnitudes in [1e-4, 1e7) (`0.25`, `7800`), otherwise mantissa and exponent (`2.1e11`).
-    function real_to_str(x) result(text)
+    !> Real rounded to at most `max_digits` significant digits, as the shortest text that
+    !> reads back to the rounded value: plain decimals for magnitudes in [1e-4, 1e7) (`0.25`,
+    !> `7800`), otherwise mantissa and exponent (`2.1e11`).
+    function real_to_str(x_in) result(text)
         !> The real.
-        real(wp), intent(in) :: x
+        real(wp), intent(in) :: x_in
         character(len=:), allocatable :: text
         character(len=40) :: buf, fmt
         character(len=:), allocatable :: mantissa
-        real(wp) :: back
-        integer :: d, ios, e_pos, expo
-        if (.not. ieee_is_finite(x)) then
-            write (buf, *) x
+        real(wp) :: back, x
+        integer :: d, ios, e_pos, expo, pass
+        if (.not. ieee_is_finite(x_in)) then
+            write (buf, *) x_in
             text = strip(buf)
             return
         end if
-        if (x == 0.0_wp) then
+        if (x_in == 0.0_wp) then
             text = '0'
             return
         end if
-        ! Fewest significant digits that round-trip.
-        do d = 1, 17
-            write (fmt, '(a,i0,a,i0,a)') '(es', d + 8, '.', d - 1, 'e3)'
-            write (buf, fmt) x
-            read (buf, *, iostat=ios) back
-            if (ios == 0 .and. back == x) exit
+        ! Fewest significant digits that round-trip; if more than max_digits are needed, the
+        ! value rounded to max_digits digits, whose own shortest form is found in pass 2.
+        x = x_in
+        do pass = 1, 2
+            do d = 1, max_digits
+                write (fmt, '(a,i0,a,i0,a)') '(es', d + 8, '.', d - 1, 'e3)'
+                write (buf, fmt) x
+                read (buf, *, iostat=ios) back
+                if (ios == 0 .and. back == x) exit
+            end do
+            if (d <= max_digits) exit
+            x = back
         end do
         buf = adjustl(buf)
         e_pos = index(buf, 'E')

@@ -1,13 +1,32 @@
 #!/usr/bin/env python3
 """Fallback for pFUnit: turn pFUnit 4 ``.pf`` test modules into plain Fortran.
 
-Used only when CMake does not find a real pFUnit.  Supports the subset of pFUnit
-syntax that MULTICOR's tests are allowed to use (see README "Tests"):
+Used only when CMake does not find a real pFUnit. It accepts a subset of what pFUnit 4.12's
+preprocessor (``funitproc``, ``bin/funit/pFUnitParser.py``) accepts, and refuses at
+generation time what real pFUnit would refuse, at generation or at compile time:
 
-* ``@test``, ``@before``, ``@after`` annotations on module procedures;
-* one-line ``@assertEqual``, ``@assertTrue``, ``@assertFalse``, ``@assertLessThan``,
-  ``@assertGreaterThan``, ``@assertRelativelyEqual``, ``@assertIsFinite`` with an
-  optional ``tolerance=`` and ``message=``.
+* directives are matched with pFUnit's own patterns: ``@test`` (no options), ``@before``
+  and ``@after`` alone on their line; ``@assert<Variant>(...)`` alone on its line, ending
+  with ``)``: no trailing comment and no ``&`` continuation (pFUnit would copy such a line
+  unchanged and the compiler would reject the ``@``); at least as many comma-separated
+  arguments as pFUnit requires for the variant;
+* the line after ``@before``/``@after`` (comments aside) must be the ``subroutine``
+  statement, as pFUnit reads it;
+* test procedure names <= 63 characters (Fortran), module name = file name (pFUnit's
+  registry calls ``<file name>_suite``) and <= 57 characters (pFUnit generates
+  ``<module>_suite`` and ``Wrap<module>``);
+* no code line longer than 132 characters in what pFUnit generates (gfortran's default
+  free-form limit: ``add_pfunit_ctest`` adds no line-length flag); for an assert, the line
+  ``  call assert<Variant>(<arguments>, &`` that pFUnit writes.
+
+Supported asserts: ``@assertEqual``, ``@assertTrue``, ``@assertFalse``, ``@assertLessThan``,
+``@assertGreaterThan``, ``@assertRelativelyEqual`` (tolerance required, as in pFUnit),
+``@assertIsFinite`` (scalar). The generated code calls the same procedures with the same
+``location=SourceLocation(file, line)`` argument as pFUnit; the fallback's ``funit`` module
+(funit.f90) exports pFUnit's public names, so a helper named like one of them (``run``...)
+fails to compile as under pFUnit. After the module, a ``<module>_suite`` subroutine uses the
+test module and ``funit`` unrestricted and declares ``suite`` and ``t``, as pFUnit's
+generated suite function does, so the same name clashes fail.
 
 Line numbers are preserved (annotations become blank lines, asserts stay on their line),
 so compiler messages and failure reports point into the ``.pf`` file.
@@ -15,24 +34,36 @@ so compiler messages and failure reports point into the ``.pf`` file.
 Usage:
     pf2f90.py module  <in.pf> <out.F90>
     pf2f90.py driver  <out.f90> <in.pf> [<in.pf> ...]
+    pf2f90.py check   <in.pf> [<in.pf> ...]
 """
 import os
 import re
 import sys
 
-ASSERTS = {
-    "assertequal": "funit_assert_equal",
-    "asserttrue": "funit_assert_true",
-    "assertfalse": "funit_assert_false",
-    "assertlessthan": "funit_assert_less_than",
-    "assertgreaterthan": "funit_assert_greater_than",
-    "assertrelativelyequal": "funit_assert_relatively_equal",
-    "assertisfinite": "funit_assert_is_finite",
+# pFUnit 4.12 pFUnitParser.py: minimum operand count per @assert variant.
+PFUNIT_ASSERT_OPERANDS = {
+    'fail': 0, 'equal': 2, 'notequal': 2, 'true': 1, 'false': 1, 'lessthan': 2,
+    'lessthanorequal': 2, 'greaterthan': 2, 'greaterthanorequal': 2, 'relativelyequal': 2,
+    'isinfinite': 1, 'isfinite': 1, 'isnan': 1, 'ismemberof': 2, 'contains': 2, 'any': 1,
+    'all': 1, 'notall': 1, 'none': 1, 'ispermutationof': 2, 'exceptionraised': 0,
+    'sameshape': 2, 'that': 2, '_that': 2,
 }
-ANNOT = re.compile(r"^\s*@(\w+)\s*(\((.*)\))?\s*$")
-ASSERT = re.compile(r"^(\s*)@(assert\w+)\s*\((.*)\)\s*(!.*)?$", re.IGNORECASE)
-SUB = re.compile(r"^\s*subroutine\s+(\w+)", re.IGNORECASE)
-MOD = re.compile(r"^\s*module\s+(\w+)\s*$", re.IGNORECASE)
+# The variants the fallback implements (funit.f90).
+SUPPORTED = {'equal', 'true', 'false', 'lessthan', 'greaterthan', 'relativelyequal', 'isfinite'}
+
+# pFUnit's patterns (same regular expressions, anchored with re.match).
+ASSERT = re.compile(r'\s*@assert(' + '|'.join(PFUNIT_ASSERT_OPERANDS) + r')\s*\((.*)\)\s*$',
+                    re.IGNORECASE)
+AT_TEST = re.compile(r'\s*@test(\s*(\(.*\))?\s*$)', re.IGNORECASE)
+AT_BEFORE = re.compile(r'\s*@before\s*$', re.IGNORECASE)
+AT_AFTER = re.compile(r'\s*@after\s*$', re.IGNORECASE)
+SUBROUTINE = re.compile(r'\s*subroutine\s+(\w*)\s*(\([\w\s,]*\))?\s*(!.*)*$', re.IGNORECASE)
+MODULE = re.compile(r'\s*module\s+(\w*)\s*$', re.IGNORECASE)
+COMMENT = re.compile(r'\s*(!.*|)$')
+
+MAX_NAME = 63          # Fortran 2008 name length
+MAX_MODULE = MAX_NAME - len('_suite')
+MAX_LINE = 132         # gfortran default free-form line length
 
 
 class PfError(Exception):
@@ -43,95 +74,174 @@ def fortran_string(text):
     return "'" + text.replace("'", "''") + "'"
 
 
+def check_arguments(args, where):
+    """Balanced parentheses and no '!' outside character literals."""
+    depth, quote = 0, None
+    for c in args:
+        if quote:
+            if c == quote:
+                quote = None
+        elif c in "'\"":
+            quote = c
+        elif c == '!':
+            raise PfError(f"{where}: comment inside an @assert line (pFUnit would pass it into "
+                          "the generated call)")
+        elif c == '(':
+            depth += 1
+        elif c == ')':
+            depth -= 1
+            if depth < 0:
+                raise PfError(f"{where}: unbalanced parentheses in @assert arguments")
+    if depth != 0 or quote:
+        raise PfError(f"{where}: unbalanced parentheses or quotes in @assert arguments")
+
+
 def parse(path):
     """Return (module name, tests, befores, afters, translated lines)."""
-    with open(path, encoding="utf-8") as f:
+    with open(path, encoding='utf-8') as f:
         lines = f.read().splitlines()
+    base = os.path.basename(path)
+    stem = os.path.splitext(base)[0]
     module = None
     tests, befores, afters = [], [], []
-    pending = None
+    looking_for_test = False
+    expect_sub = None      # 'before'/'after': next non-comment line must be the subroutine
     out = []
-    base = os.path.basename(path)
     for number, line in enumerate(lines, start=1):
-        m = MOD.match(line)
-        if m and module is None and m.group(1).lower() != "procedure":
-            module = m.group(1)
-        a = ASSERT.match(line)
-        if a:
-            name = a.group(2).lower()
-            if name not in ASSERTS:
-                raise PfError(f"{base}:{number}: @{a.group(2)} is not supported by the fallback")
-            args = a.group(3)
-            call = (f"{a.group(1)}call {ASSERTS[name]}({args}, file={fortran_string(base)}, "
-                    f"line={number}); if (funit_any_failure()) return")
-            out.append(call)
+        where = f"{base}:{number}"
+        if COMMENT.match(line):
+            out.append(line)
             continue
-        if line.strip().startswith("@"):
-            m = ANNOT.match(line)
-            if not m:
-                raise PfError(f"{base}:{number}: cannot parse annotation: {line.strip()}")
-            kind = m.group(1).lower()
-            if kind not in ("test", "before", "after"):
-                raise PfError(f"{base}:{number}: @{m.group(1)} is not supported by the fallback")
-            pending = kind
-            out.append("")
+        if expect_sub:
+            s = SUBROUTINE.match(line)
+            if not s or not s.group(1):
+                raise PfError(f"{where}: @{expect_sub} must be followed by its subroutine "
+                              "statement (pFUnit: 'Improper format in declaration of test "
+                              "procedure')")
+            (befores if expect_sub == 'before' else afters).append(s.group(1))
+            expect_sub = None
+            out.append(line)
             continue
-        s = SUB.match(line)
-        if s and pending:
-            {"test": tests, "before": befores, "after": afters}[pending].append(s.group(1))
-            pending = None
+        if line.lstrip().startswith('@'):
+            a = ASSERT.match(line)
+            if a:
+                variant, args = a.group(1), a.group(2)
+                n = args.count(',') + (1 if args.strip() else 0)
+                if n < PFUNIT_ASSERT_OPERANDS[variant.lower()]:
+                    raise PfError(f"{where}: @assert{variant} needs at least "
+                                  f"{PFUNIT_ASSERT_OPERANDS[variant.lower()]} arguments")
+                if variant.lower() not in SUPPORTED:
+                    raise PfError(f"{where}: @assert{variant} is not supported by the fallback")
+                check_arguments(args, where)
+                generated = f"  call assert{variant}({args}, &"
+                if len(generated) > MAX_LINE:
+                    raise PfError(f"{where}: pFUnit would generate a {len(generated)}-character "
+                                  f"line ('  call assert{variant}(..., &'), more than gfortran's "
+                                  f"default {MAX_LINE}: shorten the assert")
+                indent = line[:len(line) - len(line.lstrip())]
+                out.append(f"{indent}call assert{variant}({args}, location=SourceLocation("
+                           f"{fortran_string(base)}, {number})); if (anyExceptions()) return")
+                continue
+            if AT_TEST.match(line):
+                if line.strip().lower() != '@test':
+                    raise PfError(f"{where}: @test options are not supported by the fallback")
+                looking_for_test = True
+            elif AT_BEFORE.match(line):
+                expect_sub = 'before'
+            elif AT_AFTER.match(line):
+                expect_sub = 'after'
+            else:
+                raise PfError(f"{where}: not a pFUnit 4.12 directive form (pFUnit would copy "
+                              f"it unchanged and the compiler would reject it): {line.strip()}")
+            out.append('')
+            continue
+        if '@assert' in line.lower().split('!')[0]:
+            raise PfError(f"{where}: an @assert must stand alone on its line")
+        if len(line) > MAX_LINE:
+            raise PfError(f"{where}: line of {len(line)} characters, more than gfortran's "
+                          f"default {MAX_LINE} (pFUnit copies it unchanged)")
+        m = MODULE.match(line)
+        if m and m.group(1).lower() != 'procedure':
+            module = m.group(1)   # as pFUnit: the last 'module <name>' line wins
+        if looking_for_test:
+            s = SUBROUTINE.match(line)
+            if s:
+                tests.append(s.group(1))
+                looking_for_test = False
         out.append(line)
+    if expect_sub:
+        raise PfError(f"{base}: @{expect_sub} at the end of the file")
+    if looking_for_test:
+        raise PfError(f"{base}: @test not followed by a subroutine statement")
     if module is None:
         raise PfError(f"{base}: no module found")
-    stem = os.path.splitext(base)[0]
     if module.lower() != stem.lower():
-        raise PfError(f"{base}: module '{module}' must be named like the file ('{stem}')")
+        raise PfError(f"{base}: module '{module}' must be named like the file ('{stem}'): "
+                      f"pFUnit's registry calls {stem}_suite")
+    if len(module) > MAX_MODULE:
+        raise PfError(f"{base}: module name longer than {MAX_MODULE} characters (pFUnit "
+                      f"generates '{module}_suite')")
+    for t in tests + befores + afters:
+        if len(t) > MAX_NAME:
+            raise PfError(f"{base}: procedure name '{t}' is longer than {MAX_NAME} characters")
     if not tests:
         raise PfError(f"{base}: no @test procedure found")
     if len(befores) > 1 or len(afters) > 1:
         raise PfError(f"{base}: at most one @before and one @after per module")
-    # every translated source needs the fallback's funit module
     return module, tests, befores, afters, out
 
 
+def suite_lines(module, tests, befores, afters):
+    """`<module>_suite`: runs every test, with pFUnit's suite-function scope."""
+    text = [f"subroutine {module}_suite()",
+            "    use funit",
+            f"    use {module}",
+            "    use funit_fallback_runner, only: fallback_start_test, fallback_end_test",
+            "    implicit none",
+            "    ! as in pFUnit's generated suite function (name clashes fail the same way)",
+            "    type(TestSuite) :: suite",
+            "    class(Test), allocatable :: t"]
+    for name in tests:
+        text.append(f"    call fallback_start_test('{module}', '{name}')")
+        if befores:
+            text.append(f"    call {befores[0]}()")
+        text.append(f"    if (.not. anyExceptions()) call {name}()")
+        if afters:
+            text.append(f"    call {afters[0]}()")
+        text.append("    call fallback_end_test()")
+    text.append(f"end subroutine {module}_suite")
+    return text
+
+
 def write_module(src, dst):
-    _, _, _, _, out = parse(src)
-    with open(dst, "w", encoding="utf-8") as f:
-        f.write("\n".join(out) + "\n")
+    module, tests, befores, afters, out = parse(src)
+    with open(dst, 'w', encoding='utf-8') as f:
+        f.write('\n'.join(out + [''] + suite_lines(module, tests, befores, afters)) + '\n')
 
 
 def write_driver(dst, sources):
-    body = ["! Generated by pf2f90.py (pFUnit fallback). Do not edit.", "program funit_driver",
-            "    use funit, only: funit_start_test, funit_end_test, funit_finish", "    implicit none"]
-    calls = []
-    for src in sources:
-        module, tests, befores, afters, _ = parse(src)
-        names = sorted(set(tests + befores + afters))
-        body.append(f"    use {module}, only: " + ", ".join(names))
-        for t in tests:
-            calls.append(f"    call funit_start_test('{module}', '{t}')")
-            if befores:
-                calls.append(f"    call {befores[0]}()")
-            calls.append(f"    call {t}()")
-            if afters:
-                calls.append(f"    call {afters[0]}()")
-            calls.append("    call funit_end_test()")
-    text = body + calls + ["    call funit_finish()", "end program funit_driver"]
-    # the 'use' lines must come before 'implicit none'
-    uses = [l for l in text if l.startswith("    use ")]
-    rest = [l for l in text if not l.startswith("    use ")]
-    idx = rest.index("    implicit none")
-    text = rest[:idx] + uses + rest[idx:]
-    with open(dst, "w", encoding="utf-8") as f:
-        f.write("\n".join(text) + "\n")
+    modules = [parse(src)[0] for src in sources]
+    text = ["! Generated by pf2f90.py (pFUnit fallback). Do not edit.", "program funit_driver",
+            "    use funit_fallback_runner, only: fallback_finish", "    implicit none",
+            "    interface"]
+    for m in modules:
+        text += [f"        subroutine {m}_suite()", f"        end subroutine {m}_suite"]
+    text.append("    end interface")
+    text += [f"    call {m}_suite()" for m in modules]
+    text += ["    call fallback_finish()", "end program funit_driver"]
+    with open(dst, 'w', encoding='utf-8') as f:
+        f.write('\n'.join(text) + '\n')
 
 
 def main(argv):
     try:
-        if len(argv) == 4 and argv[1] == "module":
+        if len(argv) == 4 and argv[1] == 'module':
             write_module(argv[2], argv[3])
-        elif len(argv) >= 4 and argv[1] == "driver":
+        elif len(argv) >= 4 and argv[1] == 'driver':
             write_driver(argv[2], argv[3:])
+        elif len(argv) >= 3 and argv[1] == 'check':
+            for src in argv[2:]:
+                parse(src)
         else:
             print(__doc__, file=sys.stderr)
             return 2
@@ -141,5 +251,5 @@ def main(argv):
     return 0
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     sys.exit(main(sys.argv))

@@ -1,0 +1,184 @@
+#!/usr/bin/env python3
+"""The pFUnit fallback refuses what real pFUnit 4.12 refuses.
+
+Each case is a small .pf module. Generation-time cases must make pf2f90.py fail with the
+expected message; compile-time cases must generate, then fail to compile against the
+fallback's funit module with the expected compiler message; run-time cases must compile
+and the test executable must fail with the expected output. A correct module must
+generate, compile and pass, so that the refusals are not caused by a broken set-up.
+
+Usage: test_strictness.py --fc gfortran --moddir <funit .mod dir> --lib <libfunit.a>
+                          --work <scratch dir>
+"""
+import argparse
+import pathlib
+import re
+import shutil
+import subprocess
+import sys
+
+HERE = pathlib.Path(__file__).resolve().parent
+PF2F90 = HERE / 'pf2f90.py'
+
+
+def module(name, body, helpers=''):
+    """A .pf test module `name` with one test whose body is `body`."""
+    return (f"module {name}\n    use funit\n    use, intrinsic :: iso_fortran_env, only: real64\n"
+            f"    implicit none\ncontains\n    @test\n    subroutine test_one()\n{body}\n"
+            f"    end subroutine test_one\n{helpers}end module {name}\n")
+
+
+GOOD = module('strict_good', "        real(real64) :: x\n        x = 2.0_real64\n"
+              "        @assertEqual(2.0_real64, x, tolerance=0.0_real64)\n"
+              "        @assertRelativelyEqual(2.0_real64, x, tolerance=1.0e-15_real64)\n"
+              "        @assertTrue(x > 1.0_real64, message='x > 1')")
+
+# (name, .pf text, regex the pf2f90 error must match)
+GENERATION = [
+    ('strict_comment', module('strict_comment', "        @assertTrue(.true.) ! why"),
+     r'not a pFUnit 4\.12 directive form'),
+    ('strict_continued', module('strict_continued', "        @assertEqual(1, &\n            1)"),
+     r'not a pFUnit 4\.12 directive form'),
+    ('strict_operands', module('strict_operands', "        @assertEqual(1)"),
+     r'needs at least 2 arguments'),
+    ('strict_typo', module('strict_typo', "        @asertTrue(.true.)"),
+     r'not a pFUnit 4\.12 directive form'),
+    ('strict_not_alone', module('strict_not_alone', "        if (.true.) @assertTrue(.true.)"),
+     r'must stand alone'),
+    ('strict_long_name', module('strict_long_name', "        @assertTrue(.true.)").replace(
+        'test_one', 't' * 64), r'longer than 63'),
+    ('strict_long_line', module('strict_long_line', "        call sleep(0)" + ' ' * 120 + '; continue'),
+     r'more than gfortran'),
+    ('strict_long_assert', module('strict_long_assert', "        @assertTrue(" + '.true. .and. ' * 10
+                                  + ".true.)"), r'would generate a 1[0-9][0-9]-character line'),
+    ('strict_before_args', module('strict_before_args', "        @assertTrue(.true.)",
+                                  "    @before(x)\n    subroutine set_up()\n    end subroutine set_up\n"),
+     r'not a pFUnit 4\.12 directive form'),
+    ('strict_before_line', module('strict_before_line', "        @assertTrue(.true.)",
+                                  "    @before\n    recursive subroutine set_up()\n"
+                                  "    end subroutine set_up\n"),
+     r'must be followed by its subroutine statement'),
+    ('strict_module_name', module('other_name', "        @assertTrue(.true.)"),
+     r'must be named like the file'),
+]
+
+# (name, .pf text, regex the compiler output must match)
+COMPILE = [
+    ('strict_helper_run', module('strict_helper_run', "        call run(1)",
+                                 "    subroutine run(n)\n        integer, intent(in) :: n\n"
+                                 "        if (n < 0) stop\n    end subroutine run\n"),
+     r"Procedure .run. at \(1\) is already defined"),
+    ('strict_helper_assert', module('strict_helper_assert', "        call assertEqual()",
+                                    "    subroutine assertEqual()\n    end subroutine assertEqual\n"),
+     r"Cannot change attributes of USE-associated symbol assertequal"),
+    ('strict_relative_no_tol', module('strict_relative_no_tol',
+                                      "        @assertRelativelyEqual(1.0_real64, 1.0_real64)"),
+     r"no specific subroutine for the generic .assertrelativelyequal."),
+]
+
+# (name, .pf text, regex the run output must match)
+RUN = [
+    ('strict_relative_zero', module('strict_relative_zero',
+                                    "        @assertRelativelyEqual(0.0_real64, 0.0_real64, "
+                                    "tolerance=1.0e-12_real64)"),
+     r'Zero denominator detected in AssertRelativelyEqual\.'),
+    ('strict_relative_zero_1d', module('strict_relative_zero_1d',
+                                       "        @assertRelativelyEqual([1.0_real64, 0.0_real64], "
+                                       "[1.0_real64, 0.0_real64], tolerance=1.0e-12_real64)"),
+     r'Zero denominator detected in AssertRelativelyEqual\.'),
+]
+
+
+def run(cmd, cwd):
+    p = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True)
+    return p.returncode, p.stdout + p.stderr
+
+
+class Case:
+    def __init__(self, args, name, text):
+        self.args = args
+        self.dir = pathlib.Path(args.work) / name
+        shutil.rmtree(self.dir, ignore_errors=True)
+        self.dir.mkdir(parents=True)
+        self.name = name
+        self.pf = self.dir / f'{name}.pf'
+        self.pf.write_text(text)
+
+    def generate(self):
+        rc, out = run([sys.executable, str(PF2F90), 'module', str(self.pf),
+                       str(self.dir / f'{self.name}.F90')], self.dir)
+        if rc == 0:
+            rc, out2 = run([sys.executable, str(PF2F90), 'driver', str(self.dir / 'driver.f90'),
+                            str(self.pf)], self.dir)
+            out += out2
+        return rc, out
+
+    def compile(self):
+        fc = [self.args.fc, '-ffree-line-length-none', f'-I{self.args.moddir}']
+        rc, out = run(fc + ['-c', f'{self.name}.F90'], self.dir)
+        if rc == 0:
+            rc, out2 = run(fc + ['-c', 'driver.f90'], self.dir)
+            out += out2
+        if rc == 0:
+            rc, out2 = run(fc + ['-o', 'suite', f'{self.name}.o', 'driver.o', self.args.lib],
+                           self.dir)
+            out += out2
+        return rc, out
+
+    def execute(self):
+        return run([str(self.dir / 'suite')], self.dir)
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    for opt in ('--fc', '--moddir', '--lib', '--work'):
+        parser.add_argument(opt, required=True)
+    args = parser.parse_args()
+    failures = []
+
+    def expect(cond, name, what, out):
+        print(('ok      ' if cond else 'FAILED  ') + f'{name}: {what}')
+        if not cond:
+            failures.append(name)
+            print('    ' + out.replace('\n', '\n    '))
+
+    c = Case(args, 'strict_good', GOOD)
+    rc, out = c.generate()
+    if rc == 0:
+        rc, out = c.compile()
+    if rc == 0:
+        rc, out = c.execute()
+    expect(rc == 0 and '1 passed, 0 failed' in out, 'strict_good', 'generates, compiles, passes', out)
+
+    for name, text, pattern in GENERATION:
+        rc, out = Case(args, name, text).generate()
+        expect(rc == 1 and re.search(pattern, out), name, f'pf2f90 refuses ({pattern})', out)
+
+    for name, text, pattern in COMPILE:
+        c = Case(args, name, text)
+        rc, out = c.generate()
+        ok = rc == 0
+        if ok:
+            rc, out = c.compile()
+            ok = rc != 0 and re.search(pattern, out, re.IGNORECASE) is not None
+        expect(ok, name, f'generates, then does not compile ({pattern})', out)
+
+    for name, text, pattern in RUN:
+        c = Case(args, name, text)
+        rc, out = c.generate()
+        if rc == 0:
+            rc, out = c.compile()
+            ok = rc == 0
+            if ok:
+                rc, out = c.execute()
+                ok = rc != 0 and re.search(pattern, out) is not None
+        else:
+            ok = False
+        expect(ok, name, f'compiles, then fails at run time ({pattern})', out)
+
+    print(f'{len(failures)} failed')
+    return 1 if failures else 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
