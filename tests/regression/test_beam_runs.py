@@ -102,7 +102,7 @@ def dynamic_cantilever(exe, src, work):
     up = np.where((s[:-1] < 0) & (s[1:] >= 0))[0]
     tc = t[up] - s[up] * (t[up + 1] - t[up]) / (s[up + 1] - s[up])
     period = np.mean(np.diff(tc))
-    # 600 steps per period: average acceleration period error (pi^2/12)(h/T)^2 ~ 2e-6, plus
+    # 600 steps per period: average acceleration period error (omega h)^2/12 = (pi^2/3)(h/T)^2 ~ 9e-6, plus
     # higher-mode ripple on the crossings: 1 %.
     check("dynamic period = first cantilever period", abs(period / T1 - 1) < 1e-2, f"{period:.6f} s vs {T1:.6f} s")
     # Average acceleration conserves energy exactly for a linear undamped system: balance
