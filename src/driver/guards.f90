@@ -28,15 +28,14 @@ module driver_guards
     public :: check_beam_state, check_disks_state, step_start_t, take_step_start, check_tunnelling
     public :: model_memory_bytes, check_memory, bytes_per_disk, bytes_per_node, bytes_per_element
 
-    !> Peak memory per disk of a run [bytes]: state, properties and work arrays (about 40
-    !> reals), detection grid, about three candidate contacts of some 300 bytes each, and the
-    !> output buffers; measured peak (maximum resident size) of a 10^5-disk deposit run, 2.4 kB per
-    !> disk, rounded up.
-    integer(i8), parameter :: bytes_per_disk = 3000
+    !> Peak memory per disk of a run [bytes]: state, properties and work arrays, detection
+    !> grid, contact candidates, output buffers. Measured: 0.79 kB per disk (maximum resident
+    !> size of a 90,000-disk lattice run, contacts included, minus that of a 900-disk one).
+    integer(i8), parameter :: bytes_per_disk = 1000
     !> Peak memory per beam node [bytes]: 3 DOFs, band matrices (stiffness, mass, effective
-    !> matrix: 3 x 6 x 3 reals per node) and state vectors; measured 1.6 kB per node on a
-    !> 10^5-element beam, rounded up.
-    integer(i8), parameter :: bytes_per_node = 2000
+    !> matrix) and state vectors. Measured: 1.28 kB per node and element of a 100,000-element
+    !> beam run (same difference as for the disks).
+    integer(i8), parameter :: bytes_per_node = 1200
     !> Peak memory per element [bytes] (connectivity, section, element matrices).
     integer(i8), parameter :: bytes_per_element = 200
 

@@ -10,8 +10,9 @@
 !> into a crash without a message.
 program multicor
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
-    use, intrinsic :: ieee_exceptions, only: ieee_set_halting_mode, ieee_overflow, ieee_invalid, &
-                                                                                ieee_divide_by_zero
+    use, intrinsic :: ieee_exceptions, only: ieee_status_type, ieee_get_status, ieee_set_status
+    use, intrinsic :: ieee_exceptions, only: ieee_set_halting_mode, ieee_overflow, ieee_invalid
+    use, intrinsic :: ieee_exceptions, only: ieee_divide_by_zero
     use core_error, only: error_t
     use core_version, only: multicor_version
     use io_deck_schema, only: multicor_schema, schema_markdown
@@ -19,6 +20,7 @@ program multicor
     implicit none
 
     type(run_options_t) :: opts
+    type(ieee_status_type) :: fp_status
     type(error_t), allocatable :: error
     character(len=:), allocatable :: arg, text
     integer :: i, n
@@ -63,8 +65,14 @@ program multicor
     if (take_output) call usage_error('--output needs a folder name')
     if (.not. allocated(opts%deck_path)) call usage_error('no deck given')
 
-    call ieee_set_halting_mode([ieee_overflow, ieee_invalid, ieee_divide_by_zero], .false.)
+    call ieee_get_status(fp_status)
+    call ieee_set_halting_mode(ieee_overflow, .false.)
+    call ieee_set_halting_mode(ieee_invalid, .false.)
+    call ieee_set_halting_mode(ieee_divide_by_zero, .false.)
     call run_deck(opts, report, error)
+    ! The exceptions raised on the way are handled (guards): back to the quiet flags and the
+    ! modes of the start, or the end of the program would signal them again.
+    call ieee_set_status(fp_status)
     if (allocated(error)) then
         write (error_unit, '(a)') 'multicor: error: '//error%message
         stop 1, quiet = .true.
