@@ -276,12 +276,7 @@ contains
             call build_coupled(run, beam, dem, coupling, coupled_sys, error)
             if (allocated(error)) then
                 message = error%message
-                if (index(message, 'critical time step') > 0) then
-                    ! the Newmark scheme refuses the step (stability limit)
-                    call make_input_error(error, deck%file, deck%line('time', 'step'), 'step', message)
-                else
-                    call make_input_error(error, deck%file, coupling%overlap_line, 'overlap', message)
-                end if
+                call make_input_error(error, deck%file, coupling%overlap_line, 'overlap', message)
             end if
         end subroutine build_coupling
 
