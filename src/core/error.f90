@@ -4,6 +4,7 @@
 !> the error on failure and returns. Callers propagate with `if (allocated(error)) return`.
 !> Only the main program stops, with a non-zero exit code.
 module core_error
+    use core_strings, only: shorten
     implicit none
     private
     public :: error_t, make_error, make_input_error
@@ -58,7 +59,7 @@ contains
         else
             error%message = file//': '
         end if
-        if (len(keyword) > 0) error%message = error%message//"keyword '"//keyword//"': "
+        if (len(keyword) > 0) error%message = error%message//"keyword '"//shorten(keyword)//"': "
         error%message = error%message//message
     end subroutine make_input_error
 end module core_error

@@ -7,7 +7,10 @@ module core_strings
     implicit none
     private
     public :: string_t, to_lower, strip, is_blank_char, split_words, join_words
-    public :: levenshtein, closest_match, parse_real, parse_int, to_str
+    public :: levenshtein, closest_match, parse_real, parse_int, to_str, shorten, max_echo
+
+    !> Longest token echoed whole in a message (see `shorten`).
+    integer, parameter :: max_echo = 40
 
     !> A string of any length, for arrays of strings of different lengths.
     type :: string_t
@@ -19,7 +22,7 @@ module core_strings
     !> `max_digits` significant digits, in the shortest form (`0.5`, `2.1e11`, `1e-9`), so that
     !> rounding noise never shows (`0.0019999999999999996` prints `0.002`).
     interface to_str
-        module procedure int_to_str, real_to_str
+        module procedure int_to_str, int8_to_str, real_to_str
     end interface to_str
 
     character(len=*), parameter :: digits = '0123456789'
@@ -321,6 +324,30 @@ contains
         write (buf, '(i0)') i
         text = trim(buf)
     end function int_to_str
+
+    !> 64-bit integer as text (`i0`).
+    pure function int8_to_str(i) result(text)
+        !> The integer.
+        integer(i8), intent(in) :: i
+        character(len=:), allocatable :: text
+        character(len=24) :: buf
+        write (buf, '(i0)') i
+        text = trim(buf)
+    end function int8_to_str
+
+    !> A token as echoed in a message: unchanged up to `max_echo` characters, otherwise its
+    !> first `max_echo` characters followed by '...' (a pasted line or a binary file then
+    !> gives a readable message).
+    pure function shorten(text) result(short)
+        !> The token as written.
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: short
+        if (len(text) <= max_echo) then
+            short = text
+        else
+            short = text(:max_echo)//'...'
+        end if
+    end function shorten
 
     !> Real rounded to at most `max_digits` significant digits, as the shortest text that
     !> reads back to the rounded value: plain decimals for magnitudes in [1e-4, 1e7) (`0.25`,

@@ -356,7 +356,7 @@ contains
             if (sys%weight%value(sys%model%abscissa_at(e, 1.0e-6_wp)) > 0 .or. &
                 sys%weight%value(sys%model%abscissa_at(e, 0.5_wp)) > 0 .or. &
                 sys%weight%value(sys%model%abscissa_at(e, 1 - 1.0e-6_wp)) > 0) cycle
-            write (buf, '(a,i0,a,es12.5,a,es12.5,a,es12.5,a)') 'coupling: beam element ', e, &
+            write (buf, '(a,i0,a,es13.5e3,a,es13.5e3,a,es13.5e3,a)') 'coupling: beam element ', e, &
                 ' (abscissa ', sys%model%abscissa_at(e, 0.0_wp), ' to ', &
                 sys%model%abscissa_at(e, 1.0_wp), ' m) lies beyond the overlap, where '// &
                 'alpha = 0: it would have neither mass nor stiffness; end the beam at '// &
@@ -399,7 +399,7 @@ contains
                                   s(i), off(i))
             sys%alpha(i) = sys%weight%value(s(i))
             if (sys%alpha(i) < 1) cycle
-            write (buf, '(a,i0,a,es12.5,a,es12.5,a,es12.5,a)') 'coupling: disk ', i, ' at (', &
+            write (buf, '(a,i0,a,es13.5e3,a,es13.5e3,a,es13.5e3,a)') 'coupling: disk ', i, ' at (', &
                 sys%dem%particles%x(i), ', ', sys%dem%particles%y(i), ') m (abscissa ', s(i), &
                 ' m) lies in the FE-only zone (alpha = 1), where its weighted mass '// &
                 '(1 - alpha) m would be zero; remove it or move the overlap so that it covers '// &

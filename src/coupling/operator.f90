@@ -198,7 +198,7 @@ contains
         do p = 1, op%n_points
             call project(model, x(p), y(p), e, xi, off)
             if (e == 0) then
-                write (buf, '(a,i0,a,es12.5,a,es12.5,a)') 'coupling operator: coupled point ', &
+                write (buf, '(a,i0,a,es13.5e3,a,es13.5e3,a)') 'coupling operator: coupled point ', &
                     p, ' at (', x(p), ', ', y(p), ') m is not over the beam (its projection '// &
                     'on the axis falls outside every element); move it or extend the beam'
                 call make_error(error, trim(buf))
@@ -206,7 +206,7 @@ contains
             end if
             if (present(max_offset)) then
                 if (abs(off) > max_offset) then
-                    write (buf, '(a,i0,a,es12.5,a,es12.5,a,es10.3,a,es10.3,a)') &
+                    write (buf, '(a,i0,a,es13.5e3,a,es13.5e3,a,es11.3e3,a,es11.3e3,a)') &
                         'coupling operator: coupled point ', p, ' at (', x(p), ', ', y(p), &
                         ') m is ', abs(off), ' m from the beam axis, more than the ', &
                         max_offset, ' m allowed'
@@ -357,7 +357,7 @@ contains
         do p = 1, self%n_points
             alpha(p) = weight%value(self%abscissa(p))
             if (alpha(p) > 0 .and. alpha(p) < 1) cycle
-            write (buf, '(a,i0,a,es12.5,a,f5.3,a)') 'coupling: coupled point ', p, &
+            write (buf, '(a,i0,a,es13.5e3,a,f5.3,a)') 'coupling: coupled point ', p, &
                 ' (abscissa ', self%abscissa(p), ' m) has weight alpha = ', alpha(p), &
                 ', outside the overlap: only points inside the overlap can be coupled'
             call make_error(error, trim(buf))

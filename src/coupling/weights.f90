@@ -72,7 +72,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         character(len=200) :: buf
         if (.not. (config%alpha_min > 0 .and. config%alpha_min < 0.5_wp)) then
-            write (buf, '(a,es10.3,a)') 'coupling weight: alpha_min = ', config%alpha_min, &
+            write (buf, '(a,es11.3e3,a)') 'coupling weight: alpha_min = ', config%alpha_min, &
                 ' must lie in (0, 0.5) (a coupled point with alpha = 0 or 1 makes the '// &
                 'multiplier system singular); 1e-3 is a usual value'
             call make_error(error, trim(buf))
@@ -87,7 +87,7 @@ contains
         case ('constant')
             if (.not. (config%constant >= config%alpha_min .and. &
                        config%constant <= 1 - config%alpha_min)) then
-                write (buf, '(a,es10.3,a)') 'coupling weight: constant = ', config%constant, &
+                write (buf, '(a,es11.3e3,a)') 'coupling weight: constant = ', config%constant, &
                     ' must lie in [alpha_min, 1 - alpha_min]'
                 call make_error(error, trim(buf))
                 return

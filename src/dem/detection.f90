@@ -9,14 +9,21 @@
 !> work arrays have reached their size.
 !> Candidates of each owner disk are sorted so that the list comes out in the contact order of
 !> `dem_contacts`, which matches them with the previous list for the warm start.
+!>
+!> Coordinates must lie in the box |x|, |y| <= coordinate_limit(smallest radius): there a
+!> coordinate is known to 1e-6 of the smallest radius, and the grid and gap arithmetic cannot
+!> overflow. Outside it (or for a non-finite coordinate), `detect_contacts` finds nothing and
+!> returns an error instead of building a grid it cannot index.
 module dem_detection
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp, i8
+    use core_error, only: error_t, make_error
     use dem_contacts, only: contact_set_t, contacts_begin_detection, contacts_append, &
                             contacts_append_owner
     use dem_walls, only: segment_closest_point
     implicit none
     private
-    public :: detector_t, detect_contacts, detect_brute_force, detector_bytes
+    public :: detector_t, detect_contacts, detect_brute_force, detector_bytes, coordinate_limit
 
     !> Reusable grid of the broad phase.
     type :: detector_t
@@ -48,7 +55,7 @@ contains
 
     !> Find every disk-disk and disk-wall pair with gap <= alert; the new list replaces the
     !> current one in cs, with reactions and statuses carried over by pair (warm start).
-    subroutine detect_contacts(det, x, y, radius, alert, wx1, wy1, wx2, wy2, cs)
+    subroutine detect_contacts(det, x, y, radius, alert, wx1, wy1, wx2, wy2, cs, error)
         !> Broad-phase workspace.
         type(detector_t), intent(inout) :: det
         !> Disk centres and radii [m].
@@ -59,9 +66,20 @@ contains
         real(wp), intent(in) :: wx1(:), wy1(:), wx2(:), wy2(:)
         !> Contacts.
         type(contact_set_t), intent(inout) :: cs
+        !> Set when a coordinate is outside the representable box (the list is then empty).
+        type(error_t), allocatable, intent(out), optional :: error
         integer :: need
+        real(wp) :: limit
         call contacts_begin_detection(cs)
         if (size(x) == 0) return
+        limit = coordinate_limit(minval(radius))
+        if (.not. (inside(x) .and. inside(y) .and. inside(wx1) .and. inside(wy1) .and. inside(wx2) &
+                   .and. inside(wy2))) then
+            if (present(error)) call make_error(error, 'contact detection: a coordinate is beyond '// &
+                                                'the representable box (|x|, |y| <= 4.5e9 times the '// &
+                                                'smallest radius, at most 1e100 m) or is not a number')
+            return
+        end if
         call build_grid(det, x, y, radius, alert)
         call build_wall_lists(det, maxval(radius) + alert, wx1, wy1, wx2, wy2)
         ! room for every candidate of one owner: its walls and the disks of 9 cells
@@ -73,7 +91,25 @@ contains
         call scan_owners(alert, det%x0, det%y0, det%inv_cell, det%ncx, det%ncy, x, y, radius, &
                          det%cell_of, det%start, det%sorted, det%xs, det%ys, det%rs, det%wall_start, &
                          det%wall_list, wx1, wy1, wx2, wy2, det%cand, det%cand_n, det%cand_gap, cs)
+
+    contains
+
+        !> All values finite and within the box.
+        pure logical function inside(v)
+            real(wp), intent(in) :: v(:)
+            inside = all(ieee_is_finite(v))
+            if (inside) inside = all(abs(v) <= limit)
+        end function inside
     end subroutine detect_contacts
+
+    !> Half-side of the box of representable coordinates [m]: 1e-6 r_min/epsilon (about 4.5e9
+    !> r_min), where the rounding of a coordinate is a millionth of the smallest radius r_min,
+    !> and at most 1e100 m (squares of distances stay finite).
+    pure real(wp) function coordinate_limit(r_min) result(limit)
+        !> Smallest disk radius [m].
+        real(wp), intent(in) :: r_min
+        limit = min(1.0e-6_wp*(r_min/epsilon(1.0_wp)), 1.0e100_wp)
+    end function coordinate_limit
 
     !> Grid geometry and counting sort of the disks by cell.
     subroutine build_grid(det, x, y, radius, alert)

@@ -19,7 +19,11 @@ module driver_config
     use io_deck, only: deck_t, deck_entry_t
     implicit none
     private
-    public :: run_config_t, build_config, find_id
+    public :: run_config_t, build_config, find_id, max_steps
+
+    !> Largest number of time steps of a run. The step counter is 64-bit; the bound is that of
+    !> the 32-bit step counts stored in the results file (/summary steps, /dem/solver).
+    integer(i8), parameter :: max_steps = int(huge(0), i8)
 
     !> What to compute and how (everything but the model itself).
     type :: run_config_t
@@ -37,6 +41,9 @@ module driver_config
         real(wp) :: h = 0.0_wp
         !> End time [s] (dynamic; 0 otherwise).
         real(wp) :: t_end = 0.0_wp
+        !> Number of time steps: whole steps up to the end time, the last one may end slightly
+        !> after it (dynamic; 0 otherwise).
+        integer(i8) :: n_steps = 0
         !> Number of modes to compute (modal).
         integer :: n_modes = 3
         !> Time steps between stored states.
@@ -687,6 +694,10 @@ contains
                                   deck%get_word('time', 'end'))
             return
         end if
+        if (run%analysis == 'dynamic') then
+            call count_steps(error)
+            if (allocated(error)) return
+        end if
         run%n_modes = deck%get_int('modal', 'modes')
         n_free = count(.not. beam%fixed)
         if (run%analysis == 'modal' .and. run%n_modes > n_free) then
@@ -697,6 +708,32 @@ contains
         end if
         run%output_interval = deck%get_int('output', 'interval')
         run%progress_seconds = deck%get_real('output', 'progress')
+
+    contains
+
+        !> Number of steps end/step, computed in floating point first so that no integer
+        !> overflows; refused beyond max_steps.
+        subroutine count_steps(error)
+            type(error_t), allocatable, intent(out) :: error
+            real(wp) :: steps
+            steps = ceiling_real(run%t_end/run%h*(1.0_wp - 1.0e-12_wp))
+            if (steps > real(max_steps, wp)) then
+                call make_input_error(error, deck%file, deck%line('time', 'end'), 'end', &
+                                      'end time '//deck%get_word('time', 'end')//' with step '// &
+                                      deck%get_word('time', 'step')//' needs '//to_str(steps)// &
+                                      ' time steps, more than a run can count ('//to_str(max_steps)// &
+                                      '): lower the end time or raise the step')
+                return
+            end if
+            run%n_steps = max(ceiling(steps, i8), 1_i8)
+        end subroutine count_steps
+
+        !> ceiling(x) as a real (no integer conversion).
+        pure real(wp) function ceiling_real(x)
+            real(wp), intent(in) :: x
+            ceiling_real = aint(x)
+            if (ceiling_real < x) ceiling_real = ceiling_real + 1.0_wp
+        end function ceiling_real
     end subroutine build_run
 
     !> Initial displacements and velocities on free DOFs.

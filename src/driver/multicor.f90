@@ -3,8 +3,16 @@
 !>     multicor [--output DIR] [--quiet] deck.dat
 !>     multicor --check deck.dat
 !>     multicor --help | --version | --schema-markdown
+!>
+!> Floating-point exceptions do not stop the program (a Debug build traps them by default):
+!> the run checks its state after every step and stops with an error naming the step, the body
+!> and a likely cause at the first non-finite value (driver_guards), which a trap would turn
+!> into a crash without a message.
 program multicor
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
+    use, intrinsic :: ieee_exceptions, only: ieee_status_type, ieee_get_status, ieee_set_status
+    use, intrinsic :: ieee_exceptions, only: ieee_set_halting_mode, ieee_overflow, ieee_invalid
+    use, intrinsic :: ieee_exceptions, only: ieee_divide_by_zero
     use core_error, only: error_t
     use core_version, only: multicor_version
     use io_deck_schema, only: multicor_schema, schema_markdown
@@ -12,6 +20,7 @@ program multicor
     implicit none
 
     type(run_options_t) :: opts
+    type(ieee_status_type) :: fp_status
     type(error_t), allocatable :: error
     character(len=:), allocatable :: arg, text
     integer :: i, n
@@ -22,6 +31,9 @@ program multicor
     do i = 1, n
         call get_arg(i, arg)
         if (take_output) then
+            ! '' would make the results path '/<name>.h5', at the filesystem root
+            if (len_trim(arg) == 0) call usage_error("--output needs a folder name, got ''"// &
+                                                     " (use '.' for the current folder)")
             opts%output_dir = arg
             take_output = .false.
             cycle
@@ -53,7 +65,14 @@ program multicor
     if (take_output) call usage_error('--output needs a folder name')
     if (.not. allocated(opts%deck_path)) call usage_error('no deck given')
 
+    call ieee_get_status(fp_status)
+    call ieee_set_halting_mode(ieee_overflow, .false.)
+    call ieee_set_halting_mode(ieee_invalid, .false.)
+    call ieee_set_halting_mode(ieee_divide_by_zero, .false.)
     call run_deck(opts, report, error)
+    ! The exceptions raised on the way are handled (guards): back to the quiet flags and the
+    ! modes of the start, or the end of the program would signal them again.
+    call ieee_set_status(fp_status)
     if (allocated(error)) then
         write (error_unit, '(a)') 'multicor: error: '//error%message
         stop 1, quiet = .true.

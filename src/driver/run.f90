@@ -8,10 +8,19 @@
 !> Everything that can fail because of the input is checked before the results folder is
 !> touched; the HDF5 file is written as '<name>.h5.partial' and renamed only on success, so
 !> earlier results stay intact when a run fails.
+!>
+!> Guards (driver_guards): before anything is built, the model's memory estimate is checked
+!> against the available memory; disks and walls must lie in the box the detection can
+!> represent; after every time step the state must be finite (and, for particles, no disk
+!> may tunnel through a wall or another disk). One run at a time writes a results folder: a
+!> lock file (io_lock) is held while writing and removed on every way out.
 module driver_run
-    use core_kinds, only: wp
-    use core_error, only: error_t, make_input_error
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use core_kinds, only: wp, i8
+    use core_error, only: error_t, make_error, make_input_error
     use core_strings, only: to_str
+    use io_lock, only: lock_t, lock_acquire, lock_release
+    use io_memory, only: available_memory
     use io_deck_schema, only: multicor_schema
     use io_deck, only: deck_t, read_deck
     use io_paths, only: stem, mkdir_p
@@ -29,6 +38,8 @@ module driver_run
     use driver_run_coupled, only: build_coupled, run_coupled
     use coupling_arlequin, only: coupled_system_t
     use driver_results, only: results_writer_t
+    use driver_guards, only: check_beam_state, check_memory
+    use dem_detection, only: coordinate_limit
     implicit none
     private
     public :: run_options_t, run_deck, report_iface
@@ -71,7 +82,8 @@ contains
         type(coupled_system_t), allocatable :: coupled_sys
         class(time_integrator_t), allocatable :: integ
         type(results_writer_t) :: out
-        character(len=:), allocatable :: dir, path, message
+        type(lock_t) :: lock
+        character(len=:), allocatable :: dir, path, message, warning
         logical :: particles, coupled
         integer :: i
 
@@ -88,10 +100,14 @@ contains
             call check_particle_keywords_unused(deck, error)
         end if
         if (allocated(error)) return
+        call check_model_size(error)
+        if (allocated(error)) return
         call build_config(deck, run, beam, error)
         if (allocated(error)) return
         if (particles) then
             call build_dem_config(deck, run, beam%functions, dem, error)
+            if (allocated(error)) return
+            call check_coordinates(error)
             if (allocated(error)) return
         end if
         if (coupled) then
@@ -122,25 +138,109 @@ contains
         call mkdir_p(dir, error)
         if (allocated(error)) return
         path = dir//'/'//stem(opts%deck_path)//'.h5'
-        call out%open(path, opts%deck_path, deck%text, run%title, run%analysis, error)
+        call lock_acquire(lock, dir, warning, error)
         if (allocated(error)) return
-        if (coupled) then
-            call run_coupled(run, beam, dem, coupled_sys, out, opts%quiet, report, error)
-        else if (particles) then
-            call run_dem(run, dem, out, opts%quiet, report, error)
-        else
-            call run_fe(error)
-        end if
-        if (allocated(error)) then
-            call out%abort()
-            error%message = deck%file//': '//error%message
-            return
-        end if
-        call out%close(error)
+        if (len(warning) > 0) call report(warning)
+        call write_results(error)
+        call lock_release(lock)
         if (allocated(error)) return
         call report('results written to '//path)
 
     contains
+
+        !> Run the analysis into '<path>.partial', renamed to `path` on success (the caller
+        !> holds the folder's lock).
+        subroutine write_results(error)
+            type(error_t), allocatable, intent(out) :: error
+            call out%open(path, opts%deck_path, deck%text, run%title, run%analysis, error)
+            if (allocated(error)) return
+            if (coupled) then
+                call run_coupled(run, beam, dem, coupled_sys, out, opts%quiet, report, error)
+            else if (particles) then
+                call run_dem(run, dem, out, opts%quiet, report, error)
+            else
+                call run_fe(error)
+            end if
+            if (allocated(error)) then
+                call out%abort()
+                error%message = deck%file//': '//error%message
+                return
+            end if
+            call out%close(error)
+        end subroutine write_results
+
+        !> Refuse a model whose memory estimate exceeds the available memory, from the
+        !> numbers of disks, nodes and elements the deck asks for (before allocating them).
+        subroutine check_model_size(error)
+            type(error_t), allocatable, intent(out) :: error
+            integer(i8) :: n_disks, n_nodes, n_elements, m
+            integer :: k
+            character(len=:), allocatable :: message
+            n_disks = deck%count('particles', 'disk')
+            n_nodes = deck%count('beam', 'node')
+            n_elements = deck%count('beam', 'element')
+            do k = 1, size(deck%entries)
+                associate (e => deck%entries(k))
+                    select case (e%section//' '//e%keyword)
+                    case ('particles row', 'particles deposit')
+                        n_disks = n_disks + e%int(1)
+                    case ('particles square_lattice', 'particles hex_lattice')
+                        n_disks = n_disks + int(e%int(1), i8)*int(e%int(2), i8)
+                    case ('beam line')
+                        m = e%int(6)
+                        n_nodes = n_nodes + m + 1
+                        n_elements = n_elements + m
+                    end select
+                end associate
+            end do
+            if (n_disks > huge(0)) then
+                call make_error(error, deck%file//': the deck asks for '//to_str(n_disks)// &
+                                ' disks, more than a run can number ('//to_str(huge(0))//')')
+                return
+            end if
+            call check_memory(n_disks, n_nodes, n_elements, available_memory(), error)
+            if (allocated(error)) then
+                message = error%message
+                call make_error(error, deck%file//': '//message)
+            end if
+        end subroutine check_model_size
+
+        !> Disks and walls must lie in the box the contact detection can represent.
+        subroutine check_coordinates(error)
+            type(error_t), allocatable, intent(out) :: error
+            real(wp) :: limit
+            integer :: k
+            associate (p => dem%system%particles, w => dem%system%walls)
+                if (p%n == 0) return
+                limit = coordinate_limit(minval(p%radius(1:p%n)))
+                do k = 1, p%n
+                    if (max(abs(p%x(k)), abs(p%y(k))) <= limit) cycle
+                    call make_input_error(error, deck%file, dem%disk_line(k), '', 'disk '// &
+                                          to_str(k)//' at ('//num(p%x(k))//', '//num(p%y(k))// &
+                                          ') m lies beyond the box the run can represent: |x|, |y| <= '// &
+                                          num(limit)//' m (4.5e9 times the smallest radius, at most '// &
+                                          '1e100 m; coordinates are then known to 1e-6 of the radius)')
+                    return
+                end do
+                do k = 1, w%n
+                    if (max(abs(w%x1(k)), abs(w%y1(k)), abs(w%x2(k)), abs(w%y2(k))) <= limit) cycle
+                    call make_input_error(error, deck%file, dem%wall_line(k), 'wall', 'wall '// &
+                                          to_str(k)//' has an end beyond the box the run can represent: '// &
+                                          '|x|, |y| <= '//num(limit)//' m (4.5e9 times the smallest '// &
+                                          'disk radius, at most 1e100 m): shorten it')
+                    return
+                end do
+            end associate
+        end subroutine check_coordinates
+
+        !> A real with 3 significant digits.
+        function num(x) result(text)
+            real(wp), intent(in) :: x
+            character(len=:), allocatable :: text
+            character(len=24) :: buf
+            write (buf, '(es11.3e3)') x
+            text = trim(adjustl(buf))
+        end function num
 
         !> Which kind of run: [beam] and [particles] need [coupling], and [coupling] needs
         !> both.
@@ -213,7 +313,7 @@ contains
             case ('modal')
                 call run_modal(run, model, out, report, error)
             case ('dynamic')
-                call run_dynamic(run, model, integ, out, opts%quiet, report, error)
+                call run_dynamic(run, model, beam%node_id, integ, out, opts%quiet, report, error)
             end select
         end subroutine run_fe
     end subroutine run_deck
@@ -253,9 +353,15 @@ contains
         allocate (d(3, model%n_nodes), r(3, model%n_nodes))
         call model%expand(u, d)
         call model%reactions(u, 0.0_wp, r)
+        if (.not. (all(ieee_is_finite(d)) .and. all(ieee_is_finite(r)))) then
+            call make_error(error, 'static solution: a displacement or a reaction is not finite; '// &
+                            'likely cause: a load or a stiffness far too large or too small (check the '// &
+                            'magnitudes in [beam])')
+            return
+        end if
         call out%write_static(d, r, error)
         if (allocated(error)) return
-        write (buf, '(a,es12.5,a)') 'static solution: max |displacement| = ', &
+        write (buf, '(a,es13.5e3,a)') 'static solution: max |displacement| = ', &
             maxval(abs(d(1:2, :))), ' m'
         call report(trim(buf))
     end subroutine run_static
@@ -272,19 +378,26 @@ contains
         integer :: k
         call solve_modal(model, run%n_modes, omega, shapes, error)
         if (allocated(error)) return
+        if (.not. (all(ieee_is_finite(omega)) .and. all(ieee_is_finite(shapes)))) then
+            call make_error(error, 'modal analysis: a frequency or a mode shape is not finite; '// &
+                            'likely cause: a stiffness, density or section far too large or too small '// &
+                            '(check the magnitudes in [beam])')
+            return
+        end if
         allocate (full(3, model%n_nodes, run%n_modes))
         do k = 1, run%n_modes
             call model%expand(shapes(:, k), full(:, :, k))
-            write (buf, '(a,i3,a,es14.7,a,es14.7,a)') 'mode ', k, ': omega = ', omega(k), &
+            write (buf, '(a,i3,a,es15.7e3,a,es15.7e3,a)') 'mode ', k, ': omega = ', omega(k), &
                 ' rad/s, f = ', omega(k)/two_pi, ' Hz'
             call report(trim(buf))
         end do
         call out%write_modal(omega, full, error)
     end subroutine run_modal
 
-    subroutine run_dynamic(run, model, integ, out, quiet, report, error)
+    subroutine run_dynamic(run, model, node_id, integ, out, quiet, report, error)
         type(run_config_t), intent(in) :: run
         type(beam_model_t), intent(in) :: model
+        integer, intent(in) :: node_id(:)
         class(time_integrator_t), intent(inout) :: integ
         type(results_writer_t), intent(inout) :: out
         logical, intent(in) :: quiet
@@ -292,30 +405,45 @@ contains
         type(error_t), allocatable, intent(out) :: error
         type(progress_t) :: progress
         real(wp), allocatable :: d(:, :), v(:, :), a(:, :)
-        integer :: n_steps, k
+        integer(i8) :: n_steps, k
         character(len=160) :: buf
 
-        ! Whole steps up to the end time (the last one may end slightly after it).
-        n_steps = ceiling(run%t_end/run%h*(1.0_wp - 1.0e-12_wp))
+        n_steps = run%n_steps
         allocate (d(3, model%n_nodes), v(3, model%n_nodes), a(3, model%n_nodes))
         call progress%start(n_steps, run%t_end, run%progress_seconds)
+        call check(0_i8, error)
+        if (allocated(error)) return
         call store(error)
         if (allocated(error)) return
         do k = 1, n_steps
             call integ%step(model, error)
             if (allocated(error)) return
-            if (mod(k, run%output_interval) == 0 .or. k == n_steps) then
+            call check(k, error)
+            if (allocated(error)) return
+            if (mod(k, int(run%output_interval, i8)) == 0 .or. k == n_steps) then
                 call store(error)
                 if (allocated(error)) return
             end if
             if (.not. quiet .and. progress%due()) call report(progress%line(k, integ%t))
         end do
-        write (buf, '(a,i0,a,es12.5,a,es10.3)') 'dynamic run: ', n_steps, ' steps to t = ', &
+        write (buf, '(a,i0,a,es13.5e3,a,es11.3e3)') 'dynamic run: ', n_steps, ' steps to t = ', &
             integ%t, ' s; energy balance residual ', integ%energy_balance()
         call report(trim(buf))
         call report(progress%summary_line(n_steps))
-        call out%write_summary(n_steps, progress%elapsed(), error)
+        ! n_steps <= max_steps = huge(0) (driver_config)
+        call out%write_summary(int(n_steps), progress%elapsed(), error)
     contains
+        !> Guard after step k (0: the initial state).
+        subroutine check(k, error)
+            integer(i8), intent(in) :: k
+            type(error_t), allocatable, intent(out) :: error
+            call model%expand(integ%u, d)
+            call model%expand(integ%v, v)
+            call model%expand(integ%a, a)
+            call check_beam_state(k, integ%t, node_id, d, v, a, [integ%kinetic, integ%strain, &
+                                                                 integ%external_work, integ%damping_dissipation], error)
+        end subroutine check
+
         subroutine store(error)
             type(error_t), allocatable, intent(out) :: error
             call model%expand(integ%u, d)

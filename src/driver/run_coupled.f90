@@ -8,8 +8,10 @@
 !> results folder is touched); `run_coupled` integrates and writes. Warnings go through the
 !> report callback: steps whose contact solve did not converge (the first `max_warnings`,
 !> then only the count) and, once, a disk moving farther than the alert distance in a step.
+!> After every step the beam and the disks are checked as in the uncoupled runs
+!> (driver_guards): non-finite values, disks beyond the representable box, tunnelling.
 module driver_run_coupled
-    use core_kinds, only: wp
+    use core_kinds, only: wp, i8
     use core_error, only: error_t
     use core_strings, only: to_str
     use io_progress, only: progress_t
@@ -23,6 +25,8 @@ module driver_run_coupled
     use driver_results_dem, only: dem_writer_t
     use driver_results_coupled, only: coupled_writer_t
     use driver_run_dem, only: max_warnings, report_line_iface, speed_warning, last_unconverged_warning
+    use driver_guards, only: check_beam_state, check_disks_state, step_start_t, take_step_start, &
+                             check_tunnelling
     implicit none
     private
     public :: build_coupled, run_coupled
@@ -76,11 +80,13 @@ contains
         type(coupled_writer_t) :: cpl_out
         type(progress_t) :: progress
         real(wp), allocatable :: d(:, :), v(:, :), a(:, :)
-        integer :: n_steps, k, unconverged
+        type(step_start_t) :: start
+        integer(i8) :: n_steps, k
+        integer :: unconverged
         logical :: speed_warned
         character(len=512) :: buf
 
-        n_steps = ceiling(run%t_end/run%h*(1.0_wp - 1.0e-12_wp))
+        n_steps = run%n_steps
         allocate (d(3, sys%model%n_nodes), v(3, sys%model%n_nodes), a(3, sys%model%n_nodes))
         call out%write_mesh(beam%node_id, beam%x, beam%y, beam%conn, error)
         if (allocated(error)) return
@@ -88,13 +94,19 @@ contains
         if (allocated(error)) return
         call cpl_out%begin(out%file, sys, error)
         if (allocated(error)) return
+        k = 0
+        call check_step(error)
+        if (allocated(error)) return
         call store(error)
         if (allocated(error)) return
         unconverged = 0
         speed_warned = .false.
         call progress%start(n_steps, run%t_end, run%progress_seconds)
         do k = 1, n_steps
+            call take_step_start(start, sys%dem%particles, sys%dem%walls)
             call arlequin_step(sys, error)
+            if (allocated(error)) return
+            call check_step(error)
             if (allocated(error)) return
             call dem_out%record_step(out%file, sys%dem%stats, error)
             if (allocated(error)) return
@@ -102,7 +114,7 @@ contains
             if (allocated(error)) return
             if (.not. sys%stats%converged) call warn_unconverged()
             if (.not. speed_warned) call check_speed()
-            if (mod(k, run%output_interval) == 0 .or. k == n_steps) then
+            if (mod(k, int(run%output_interval, i8)) == 0 .or. k == n_steps) then
                 call store(error)
                 if (allocated(error)) return
             end if
@@ -114,9 +126,26 @@ contains
         call cpl_out%finish(out%file, error)
         if (allocated(error)) return
         call summary()
-        call out%write_summary(n_steps, progress%elapsed(), error)
+        ! n_steps <= max_steps = huge(0) (driver_config)
+        call out%write_summary(int(n_steps), progress%elapsed(), error)
 
     contains
+
+        !> Guards after a step: finite beam and disk states, disks in the box, no tunnelling.
+        subroutine check_step(error)
+            type(error_t), allocatable, intent(out) :: error
+            call sys%model%expand(sys%fe%u, d)
+            call sys%model%expand(sys%fe%v, v)
+            call sys%model%expand(sys%fe%a, a)
+            call check_beam_state(k, sys%fe%t, beam%node_id, d, v, a, [sys%fe%kinetic, sys%fe%strain, &
+                                                                       sys%fe%external_work, sys%fe%damping_dissipation], error)
+            if (allocated(error)) return
+            call check_disks_state(k, sys%fe%t, sys%dem%particles, sys%dem%energies, error)
+            if (allocated(error)) return
+            if (k == 0) return
+            call check_tunnelling(k, sys%fe%t, run%h, sys%dem%scheme%alert, start, sys%dem%particles, &
+                                  sys%dem%walls, sys%dem%contacts, error)
+        end subroutine check_step
 
         !> One stored output of the three parts.
         subroutine store(error)
@@ -135,7 +164,7 @@ contains
         subroutine warn_unconverged()
             unconverged = unconverged + 1
             if (unconverged > max_warnings) return
-            write (buf, '(a,i0,a,es11.4,a,i0,a,es9.2,a,es9.2,a)') 'warning: step ', k, &
+            write (buf, '(a,i0,a,es12.4e3,a,i0,a,es10.2e3,a,es10.2e3,a)') 'warning: step ', k, &
                 ' (t = ', sys%fe%t, ' s): the joint contact/multiplier solve did not '// &
                 'converge in ', sys%stats%sweeps, ' sweeps (error ', sys%stats%nlgs_error, &
                 ' > tolerance ', sys%dem%solver%tol, '); the constraint q = C u still holds'
@@ -156,19 +185,19 @@ contains
         subroutine summary()
             type(coupled_energies_t) :: en
             en = coupled_energies(sys)
-            write (buf, '(a,i0,a,i0,a,i0,a,i0,a,es12.5,a)') 'coupled run: ', &
+            write (buf, '(a,i0,a,i0,a,i0,a,i0,a,es13.5e3,a)') 'coupled run: ', &
                 sys%model%n_nodes, ' beam nodes, ', sys%dem%particles%n, ' disks (', &
                 sys%op%n_points, ' coupled), ', n_steps, ' steps to t = ', sys%fe%t, ' s'
             call report(trim(buf))
             if (sys%on_nodes) then
                 ! Only the projection on the mediator space is imposed: the per-disk residual
                 ! from the coordinates is free in the kernel of Pi.
-                write (buf, '(a,es10.3,a,es10.3,a,es10.3,a)') 'constraint (multipliers on '// &
+                write (buf, '(a,es11.3e3,a,es11.3e3,a,es11.3e3,a)') 'constraint (multipliers on '// &
                     'the nodes): max |Pi (q - C u)| = ', cpl_out%max_position, &
                     ' m (per disk, from the coordinates ', cpl_out%max_coordinate, &
                     ' m), max velocity residual ', cpl_out%max_velocity, ' m/s'
             else
-                write (buf, '(a,es10.3,a,es10.3,a,es10.3,a)') 'constraint: max |q - C u| = ', &
+                write (buf, '(a,es11.3e3,a,es11.3e3,a,es11.3e3,a)') 'constraint: max |q - C u| = ', &
                     cpl_out%max_position, ' m (from the coordinates ', cpl_out%max_coordinate, &
                     ' m), max velocity residual ', cpl_out%max_velocity, ' m/s'
             end if
@@ -176,7 +205,7 @@ contains
             call report('unconverged steps: '//to_str(unconverged)//' of '//to_str(n_steps)// &
                         ' (tolerance '//to_str(sys%dem%solver%tol)//', at most '// &
                         to_str(sys%dem%solver%max_sweeps)//' sweeps)')
-            write (buf, '(a,es10.3,a,es10.3,a,es10.3,a)') 'energy balance residual ', &
+            write (buf, '(a,es11.3e3,a,es11.3e3,a,es11.3e3,a)') 'energy balance residual ', &
                 en%balance, ' J (max over the outputs ', cpl_out%max_balance, &
                 ' J; external work ', en%fe_external_work + en%dem_external_work + &
                 en%dem_drive_work, ' J)'

@@ -4,8 +4,11 @@
 !> Warnings go through the report callback: a step whose contact solve did not converge
 !> (the first `max_warnings` ones, then only the count in the summary), and, once, a step in
 !> which a disk moved farther than the alert distance (contacts may then be found late).
+!> After every step the state is checked (driver_guards): a non-finite value, a disk beyond
+!> the representable box, or a disk that passed through a wall or another disk stops the run
+!> with an error.
 module driver_run_dem
-    use core_kinds, only: wp
+    use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
     use core_strings, only: to_str
     use io_progress, only: progress_t
@@ -15,6 +18,7 @@ module driver_run_dem
     use driver_config_dem, only: dem_config_t
     use driver_results, only: results_writer_t
     use driver_results_dem, only: dem_writer_t
+    use driver_guards, only: check_disks_state, step_start_t, take_step_start, check_tunnelling
     implicit none
     private
     public :: run_dem, max_warnings, report_line_iface, speed_warning, last_unconverged_warning
@@ -47,7 +51,9 @@ contains
         type(error_t), allocatable, intent(out) :: error
         type(dem_writer_t) :: writer
         type(progress_t) :: progress
-        integer :: n_steps, k, unconverged
+        type(step_start_t) :: start
+        integer(i8) :: n_steps, k
+        integer :: unconverged
         logical :: blocked_warned
         logical :: speed_warned
         character(len=:), allocatable :: message
@@ -59,9 +65,10 @@ contains
             call make_error(error, 'particles: '//message)
             return
         end if
-        ! Whole steps up to the end time (the last one may end slightly after it).
-        n_steps = ceiling(run%t_end/run%h*(1.0_wp - 1.0e-12_wp))
+        n_steps = run%n_steps
         call writer%begin(out%file, cfg%system, cfg%material_id, cfg%store_contacts, error)
+        if (allocated(error)) return
+        call check_disks_state(0_i8, cfg%system%time, cfg%system%particles, cfg%system%energies, error)
         if (allocated(error)) return
         call writer%store(out%file, cfg%system, error)
         if (allocated(error)) return
@@ -70,7 +77,10 @@ contains
         blocked_warned = .false.
         call progress%start(n_steps, run%t_end, run%progress_seconds)
         do k = 1, n_steps
+            call take_step_start(start, cfg%system%particles, cfg%system%walls)
             call mj_step(cfg%system)
+            call check_step(error)
+            if (allocated(error)) return
             call writer%record_step(out%file, cfg%system%stats, error)
             if (allocated(error)) return
             if (.not. cfg%system%stats%converged) call warn_unconverged()
@@ -80,7 +90,7 @@ contains
                 blocked_warned = .true.
             end if
             if (.not. speed_warned) call check_speed()
-            if (mod(k, run%output_interval) == 0 .or. k == n_steps) then
+            if (mod(k, int(run%output_interval, i8)) == 0 .or. k == n_steps) then
                 call writer%store(out%file, cfg%system, error)
                 if (allocated(error)) return
             end if
@@ -90,15 +100,27 @@ contains
         call writer%finish(out%file, cfg%system, unconverged, error)
         if (allocated(error)) return
         call summary()
-        call out%write_summary(n_steps, progress%elapsed(), error)
+        ! n_steps <= max_steps = huge(0) (driver_config)
+        call out%write_summary(int(n_steps), progress%elapsed(), error)
 
     contains
+
+        !> Guards after a step: finite state in the box, no tunnelling.
+        subroutine check_step(error)
+            type(error_t), allocatable, intent(out) :: error
+            associate (sys => cfg%system)
+                call check_disks_state(k, sys%time, sys%particles, sys%energies, error)
+                if (allocated(error)) return
+                call check_tunnelling(k, sys%time, run%h, sys%scheme%alert, start, sys%particles, &
+                                      sys%walls, sys%contacts, error)
+            end associate
+        end subroutine check_step
 
         !> Warning for an unconverged step (the first max_warnings ones).
         subroutine warn_unconverged()
             unconverged = unconverged + 1
             if (unconverged > max_warnings) return
-            write (buf, '(a,i0,a,es11.4,a,i0,a,es9.2,a,es9.2,a)') 'warning: step ', k, &
+            write (buf, '(a,i0,a,es12.4e3,a,i0,a,es10.2e3,a,es10.2e3,a)') 'warning: step ', k, &
                 ' (t = ', cfg%system%time, ' s): the contact solver did not converge in ', &
                 cfg%system%stats%sweeps, ' sweeps (error ', cfg%system%stats%error, &
                 ' > tolerance ', cfg%system%solver%tol, ')'
@@ -118,17 +140,17 @@ contains
         !> Closing lines: contacts, solver effort, unconverged steps, energy balance, times.
         subroutine summary()
             associate (sys => cfg%system)
-                write (buf, '(a,i0,a,i0,a,i0,a,es12.5,a)') 'particles: ', sys%particles%n, &
+                write (buf, '(a,i0,a,i0,a,i0,a,es13.5e3,a)') 'particles: ', sys%particles%n, &
                     ' disks, ', sys%walls%n, ' walls, ', n_steps, ' steps to t = ', sys%time, ' s'
                 call report(trim(buf))
-                write (buf, '(a,i0,a,i0,a,es10.3,a,es10.3,a)') 'contacts at the end: ', &
+                write (buf, '(a,i0,a,i0,a,es11.3e3,a,es11.3e3,a)') 'contacts at the end: ', &
                     sys%contacts%n, ' (', sys%stats%n_active, ' active); time in detection ', &
                     sys%time_detection, ' s, in the solver ', sys%time_solver, ' s'
                 call report(trim(buf))
                 call report('unconverged steps: '//to_str(unconverged)//' of '//to_str(n_steps)// &
                             ' (tolerance '//to_str(sys%solver%tol)//', at most '// &
                             to_str(sys%solver%max_sweeps)//' sweeps)')
-                write (buf, '(a,es10.3,a,es10.3,a)') 'energy balance residual ', &
+                write (buf, '(a,es11.3e3,a,es11.3e3,a)') 'energy balance residual ', &
                     energies_balance(sys%energies), ' J/m (dissipated in contacts ', &
                     sys%energies%contact_dissipation, ' J/m)'
                 call report(trim(buf))
@@ -154,7 +176,7 @@ contains
         if (p%n == 0) return
         vmax = sqrt(maxval(p%vx(1:p%n)**2 + p%vy(1:p%n)**2))
         if (vmax*h <= alert) return
-        write (buf, '(a,es11.4,a,es9.2,a,es9.2,a,es9.2,a)') 'warning: at t = ', t, &
+        write (buf, '(a,es12.4e3,a,es10.2e3,a,es10.2e3,a,es10.2e3,a)') 'warning: at t = ', t, &
             ' s a disk moves ', vmax*h, ' m in one step (speed ', vmax, &
             ' m/s), more than the alert distance ', alert, &
             ' m: contacts may be found late (overlaps); lower [time] step or raise [contacts] alert'

@@ -26,7 +26,7 @@ module fem_newmark
     use fem_beam_model, only: beam_model_t
     implicit none
     private
-    public :: time_integrator_t, newmark_t, central_difference_t, critical_time_step
+    public :: time_integrator_t, newmark_t, central_difference_t, critical_time_step, newmark_critical_step
 
     !> State and energy accounts common to all time integrators.
     type, abstract :: time_integrator_t
@@ -100,8 +100,11 @@ module fem_newmark
         end subroutine integrator_step
     end interface
 
-    !> Implicit Newmark scheme; unconditionally stable for gamma >= 1/2 and
-    !> beta >= (gamma + 1/2)^2/4. Set beta and gamma before `init`.
+    !> Implicit Newmark scheme; unconditionally stable for gamma >= 1/2 and beta >= gamma/2
+    !> (and free of spurious high-frequency oscillation for beta >= (gamma + 1/2)^2/4).
+    !> For beta < gamma/2 it is only conditionally stable: `init` refuses a step above
+    !> h_crit = 1/(omega_max sqrt(gamma/2 - beta)) (the undamped limit; damping only raises
+    !> it). Set beta and gamma before `init`.
     type, extends(time_integrator_t) :: newmark_t
         !> Newmark beta.
         real(wp) :: beta = 0.25_wp
@@ -258,11 +261,26 @@ contains
         !> Set on invalid parameters or a failed factorisation.
         type(error_t), allocatable, intent(out) :: error
         type(band_spd_t) :: mf
+        real(wp) :: h_crit
+        character(len=320) :: buf
         if (self%gamma < 0.5_wp .or. self%beta < 0.0_wp) then
             call make_error(error, 'Newmark scheme: gamma >= 1/2 and beta >= 0 are required '// &
                             '(gamma < 1/2 amplifies the solution); average acceleration is '// &
                             'beta = 1/4, gamma = 1/2')
             return
+        end if
+        if (self%beta < 0.5_wp*self%gamma) then
+            h_crit = newmark_critical_step(model, self%beta, self%gamma, error)
+            if (allocated(error)) return
+            if (h > h_crit) then
+                write (buf, '(a,es10.3e3,a,es10.3e3,a,g0.4,a,g0.4,a)') 'time step ', h, &
+                    ' s exceeds the critical time step ', h_crit, ' s of the Newmark scheme with beta = ', &
+                    self%beta, ' < gamma/2 (gamma = ', self%gamma, &
+                    '), which is only conditionally stable (h_crit = 1/(omega_max sqrt(gamma/2 - beta))); '// &
+                    'reduce [time] step or use beta >= gamma/2'
+                call make_error(error, trim(buf))
+                return
+            end if
         end if
         call self%start_state(model, h, t0, u0, v0, error)
         if (allocated(error)) return
@@ -436,6 +454,24 @@ contains
         if (lambda_max > 0) h_crit = 2.0_wp/sqrt(lambda_max)
     end function critical_time_step
 
+    !> Critical time step of the Newmark scheme with beta < gamma/2 [s]:
+    !> 1/(omega_max sqrt(gamma/2 - beta)), the undamped limit (2/omega_max for central
+    !> differences, beta = 0 and gamma = 1/2); omega_max^2 is the largest eigenvalue of
+    !> K phi = omega^2 M phi.
+    real(wp) function newmark_critical_step(model, beta, gamma, error) result(h_crit)
+        !> The model.
+        type(beam_model_t), intent(in) :: model
+        !> Newmark beta (< gamma/2).
+        real(wp), intent(in) :: beta
+        !> Newmark gamma (>= 1/2).
+        real(wp), intent(in) :: gamma
+        !> Set on eigensolver failure (h_crit is then 0).
+        type(error_t), allocatable, intent(out) :: error
+        h_crit = critical_time_step(model, error)
+        if (allocated(error)) return
+        if (h_crit < huge(1.0_wp)) h_crit = 0.5_wp*h_crit/sqrt(0.5_wp*gamma - beta)
+    end function newmark_critical_step
+
     !> Central difference: lumped mass required; refuses h above the critical step.
     subroutine central_difference_init(self, model, h, t0, u0, v0, error)
         !> The integrator.
@@ -483,7 +519,7 @@ contains
             what = '(2/omega_max, reduced by the stiffness-proportional damping)'
         end if
         if (h > self%h_crit) then
-            write (buf, '(a,es9.3,a,es9.3,a)') 'time step ', h, &
+            write (buf, '(a,es10.3e3,a,es10.3e3,a)') 'time step ', h, &
                 ' s exceeds the critical time step ', self%h_crit, &
                 ' s of the central-difference scheme '//what//'; reduce [time] step'
             call make_error(error, trim(buf))

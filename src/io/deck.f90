@@ -1,7 +1,8 @@
 !> Reader of plain-text input decks, validated against a declarative schema (io_deck_schema).
 !>
 !> Syntax: `[section]` headers, then `keyword = value value ...` lines; `#` starts a comment
-!> that runs to the end of the line; blank lines and tabs are fine. Every line is checked
+!> that runs to the end of the line; blank lines and tabs are fine. Lines end with LF, CR LF
+!> or a lone CR (old Mac files); a UTF-8 byte-order mark at the start of the file is skipped. Every line is checked
 !> against the schema as it is read (known section and keyword, number of values, types,
 !> ranges, allowed words, duplicates of scalar keywords); then required keywords and
 !> conditional ones (`required_when`, `allowed_when`) are checked. The first problem found
@@ -19,7 +20,7 @@ module io_deck
     use core_kinds, only: wp
     use core_error, only: error_t, make_input_error
     use core_strings, only: string_t, strip, split_words, join_words, &
-                            closest_match, parse_real, parse_int, to_str
+                            closest_match, parse_real, parse_int, to_str, shorten
     use io_deck_schema, only: schema_t, keyword_spec_t, field_spec_t, condition_t, field_text
     implicit none
     private
@@ -119,13 +120,14 @@ contains
         call read_deck_text(path, text, schema, deck, error)
     end subroutine read_deck
 
-    !> Validate deck text (lines separated by LF, CR LF accepted) against the schema;
-    !> `file` is the name used in error messages.
-    subroutine read_deck_text(file, text, schema, deck, error)
+    !> Validate deck text (lines separated by LF, CR LF or a lone CR; a leading UTF-8
+    !> byte-order mark is skipped) against the schema; `file` is the name used in error
+    !> messages.
+    subroutine read_deck_text(file, raw_text, schema, deck, error)
         !> Name of the deck in messages.
         character(len=*), intent(in) :: file
         !> Deck text.
-        character(len=*), intent(in) :: text
+        character(len=*), intent(in) :: raw_text
         !> Schema to validate against.
         type(schema_t), intent(in) :: schema
         !> The deck.
@@ -134,8 +136,9 @@ contains
         type(error_t), allocatable, intent(out) :: error
         type(deck_entry_t), allocatable :: entries(:), grown(:)
         integer, allocatable :: first_line(:), section_line(:)
-        character(len=:), allocatable :: current
+        character(len=:), allocatable :: current, text
         integer :: n, line_no, start, lf
+        text = normalized_text(raw_text)
         deck%file = file
         deck%text = text
         deck%schema = schema
@@ -249,7 +252,7 @@ contains
             integer :: k, best, d
             if (s(len(s):len(s)) /= ']') then
                 call make_input_error(error, file, line_no, '', "malformed section header '"// &
-                                      s//"': expected '[name]'")
+                                      shorten(s)//"': expected '[name]'")
                 return
             end if
             name = strip(s(2:len(s) - 1))
@@ -261,11 +264,11 @@ contains
                 end do
                 call closest_match(name, names, best, d)
                 if (best > 0 .and. d <= tolerance(name)) then
-                    call make_input_error(error, file, line_no, '', 'unknown section ['//name// &
+                    call make_input_error(error, file, line_no, '', 'unknown section ['//shorten(name)// &
                                           ']; did you mean ['//names(best)%s//']? (sections: '// &
                                           join_words(names, ', ')//')')
                 else
-                    call make_input_error(error, file, line_no, '', 'unknown section ['//name// &
+                    call make_input_error(error, file, line_no, '', 'unknown section ['//shorten(name)// &
                                           '] (sections: '//join_words(names, ', ')//')')
                 end if
                 return
@@ -274,6 +277,33 @@ contains
             if (section_line(k) == 0) section_line(k) = line_no
         end subroutine parse_header
     end subroutine read_deck_text
+
+    !> Deck text without a leading UTF-8 byte-order mark, and with lone CRs (lines ending in
+    !> CR only) turned into LFs; CR LF pairs are left for `strip`, which drops the CR.
+    pure function normalized_text(raw) result(text)
+        !> The file's bytes.
+        character(len=*), intent(in) :: raw
+        character(len=:), allocatable :: text
+        character(len=*), parameter :: bom = achar(239)//achar(187)//achar(191)
+        integer :: i
+        if (len(raw) >= 3) then
+            if (raw(1:3) == bom) then
+                text = raw(4:)
+            else
+                text = raw
+            end if
+        else
+            text = raw
+        end if
+        if (index(text, achar(13)) == 0) return
+        do i = 1, len(text)
+            if (text(i:i) /= achar(13)) cycle
+            if (i < len(text)) then
+                if (text(i + 1:i + 1) == achar(10)) cycle
+            end if
+            text(i:i) = achar(10)
+        end do
+    end function normalized_text
 
     !> Largest Levenshtein distance at which a name is suggested for a misspelt one.
     pure integer function tolerance(name)

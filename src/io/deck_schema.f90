@@ -20,7 +20,7 @@
 !> is checked when the model is built.
 module io_deck_schema
     use core_kinds, only: wp
-    use core_strings, only: string_t, split_words, join_words, to_str, parse_real, parse_int
+    use core_strings, only: string_t, split_words, join_words, to_str, parse_real, parse_int, shorten
     implicit none
     private
     public :: field_spec_t, tail_spec_t, condition_t, keyword_spec_t, section_spec_t, schema_t
@@ -313,7 +313,7 @@ contains
             call end_value(token(colon + 1:), last_item)
             if (ok .and. first > last_item) then
                 ok = .false.
-                message = "empty range '"//token//"': the first number must not exceed the last"
+                message = "empty range '"//shorten(token)//"': the first number must not exceed the last"
                 return
             end if
         end if
@@ -321,10 +321,10 @@ contains
         if (last_item > n) then
             ok = .false.
             if (present(noun)) then
-                message = "selection '"//token//"' is out of range: there are "//to_str(n)// &
+                message = "selection '"//shorten(token)//"' is out of range: there are "//to_str(n)// &
                           ' '//noun//' (1..'//to_str(n)//')'
             else
-                message = "selection '"//token//"' is out of range: there are "//to_str(n)// &
+                message = "selection '"//shorten(token)//"' is out of range: there are "//to_str(n)// &
                           ' items (1..'//to_str(n)//')'
             end if
         end if
@@ -341,7 +341,7 @@ contains
             end if
             call parse_int(text, value, ok)
             if (ok) ok = value >= 1
-            if (.not. ok) message = "bad selection '"//token//"': "//expected
+            if (.not. ok) message = "bad selection '"//shorten(token)//"': "//expected
         end subroutine end_value
     end subroutine parse_selection
 
@@ -515,14 +515,14 @@ contains
         case (field_int)
             call parse_int(token, i, ok)
             if (.not. ok) then
-                message = "expected an integer, got '"//token//"'"
+                message = "expected an integer, got '"//shorten(token)//"'"
                 return
             end if
             x = real(i, wp)
         case (field_real)
             call parse_real(token, x, ok)
             if (.not. ok) then
-                message = "expected a real number, got '"//token//"'"
+                message = "expected a real number, got '"//shorten(token)//"'"
                 return
             end if
         case (field_word)
@@ -530,7 +530,7 @@ contains
             do i = 1, size(self%allowed)
                 if (self%allowed(i)%s == token) ok = .true.
             end do
-            if (.not. ok) message = "'"//token//"' is not allowed: expected one of "// &
+            if (.not. ok) message = "'"//shorten(token)//"' is not allowed: expected one of "// &
                                     join_words(self%allowed, ', ')
             return
         case (field_selection)
@@ -555,7 +555,7 @@ contains
                 ok = x <= self%upper
             end if
         end if
-        if (.not. ok) message = 'out of range: must be '//self%constraint()//", got '"//token//"'"
+        if (.not. ok) message = 'out of range: must be '//self%constraint()//", got '"//shorten(token)//"'"
     end subroutine field_check
 
     !> Allowed range (`> 0`, `>= 0 and <= 0.5`) or words (`u, w, theta`); '' if unconstrained.

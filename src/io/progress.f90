@@ -13,7 +13,7 @@ module io_progress
     !> Progress of a time-stepping run.
     type :: progress_t
         !> Number of steps of the run.
-        integer :: total_steps = 0
+        integer(i8) :: total_steps = 0
         !> End time of the run [s].
         real(wp) :: t_end = 0.0_wp
         !> Minimum wall time between two progress lines [s].
@@ -39,7 +39,7 @@ contains
         !> The progress object.
         class(progress_t), intent(out) :: self
         !> Number of steps of the run.
-        integer, intent(in) :: total_steps
+        integer(i8), intent(in) :: total_steps
         !> End time of the run [s].
         real(wp), intent(in) :: t_end
         !> Minimum wall time between two progress lines [s] (0: never).
@@ -80,7 +80,7 @@ contains
         !> The progress object.
         class(progress_t), intent(in) :: self
         !> Steps done.
-        integer, intent(in) :: step
+        integer(i8), intent(in) :: step
         !> Simulated time reached [s].
         real(wp), intent(in) :: t
         !> The line (no trailing newline).
@@ -94,7 +94,7 @@ contains
         !> The progress object.
         class(progress_t), intent(in) :: self
         !> Steps done.
-        integer, intent(in) :: steps
+        integer(i8), intent(in) :: steps
         !> Simulated time reached [s] (not shown when absent).
         real(wp), intent(in), optional :: t
         !> The line.
@@ -106,24 +106,24 @@ contains
     !> seconds, assuming a constant cost per step; negative when unknown (no step done yet).
     pure real(wp) function eta_seconds(step, total_steps, elapsed)
         !> Steps done.
-        integer, intent(in) :: step
+        integer(i8), intent(in) :: step
         !> Number of steps of the run.
-        integer, intent(in) :: total_steps
+        integer(i8), intent(in) :: total_steps
         !> Wall time spent so far [s].
         real(wp), intent(in) :: elapsed
         if (step <= 0) then
             eta_seconds = -1.0_wp
         else
-            eta_seconds = elapsed*real(max(total_steps - step, 0), wp)/real(step, wp)
+            eta_seconds = elapsed*real(max(total_steps - step, 0_i8), wp)/real(step, wp)
         end if
     end function eta_seconds
 
     !> Progress line built from explicit values (see `progress_t%line`).
     pure function format_progress_line(step, total_steps, t, t_end, elapsed) result(text)
         !> Steps done.
-        integer, intent(in) :: step
+        integer(i8), intent(in) :: step
         !> Number of steps of the run.
-        integer, intent(in) :: total_steps
+        integer(i8), intent(in) :: total_steps
         !> Simulated time reached [s].
         real(wp), intent(in) :: t
         !> End time of the run [s] (not shown when <= 0).
@@ -140,10 +140,10 @@ contains
             percent = 100.0_wp*real(step, wp)/real(total_steps, wp)
             text = text//' ('//fixed(percent, '(f0.1)')//'%)'
         end if
-        write (buf, '(es11.4)') t
+        write (buf, '(es12.4e3)') t
         text = text//'  t = '//trim(adjustl(buf))
         if (t_end > 0.0_wp) then
-            write (buf, '(es11.4)') t_end
+            write (buf, '(es12.4e3)') t_end
             text = text//' / '//trim(adjustl(buf))
         end if
         text = text//' s  wall '//format_hms(elapsed)//'  ETA ' &
@@ -153,7 +153,7 @@ contains
     !> Summary line built from explicit values (see `progress_t%summary_line`).
     pure function format_summary_line(steps, elapsed, t) result(text)
         !> Steps done.
-        integer, intent(in) :: steps
+        integer(i8), intent(in) :: steps
         !> Wall time of the run [s].
         real(wp), intent(in) :: elapsed
         !> Simulated time reached [s] (not shown when absent).
@@ -164,7 +164,7 @@ contains
         write (buf, '(i0)') steps
         text = 'done: '//trim(buf)//' steps'
         if (present(t)) then
-            write (buf, '(es11.4)') t
+            write (buf, '(es12.4e3)') t
             text = text//', t = '//trim(adjustl(buf))//' s'
         end if
         text = text//', wall '//format_hms(elapsed)

@@ -1,0 +1,345 @@
+!> Checks of the state after every time step: a run stops at the first sign that it has gone
+!> wrong, with a message naming the step, the time, the model and the body, and a likely
+!> cause, instead of writing NaN or Inf to the end.
+!>
+!> - `check_beam_state`: displacements, velocities, accelerations and energy accounts of the
+!>   beam are finite.
+!> - `check_disks_state`: positions, rotations and velocities of the disks are finite and the
+!>   centres stay in the box the detection can represent (dem_detection::coordinate_limit);
+!>   energy accounts are finite.
+!> - Tunnelling (`step_start_t`, `check_tunnelling`): a disk whose centre crossed a wall
+!>   within the step, or two candidate disks (pairs found by the detection of the step) whose
+!>   centres passed each other while overlapping by more than half their radii, stop the run
+!>   with the step to use instead.
+!> - `model_memory_bytes`, `check_memory`: the memory a model will need, from the numbers of
+!>   disks, nodes and elements, against the memory available.
+module driver_guards
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
+    use core_kinds, only: wp, i8
+    use core_error, only: error_t, make_error
+    use core_strings, only: to_str
+    use dem_particles, only: particles_t
+    use dem_walls, only: walls_t
+    use dem_contacts, only: contact_set_t
+    use dem_moreau_jean, only: energies_t
+    use dem_detection, only: coordinate_limit
+    implicit none
+    private
+    public :: check_beam_state, check_disks_state, step_start_t, take_step_start, check_tunnelling
+    public :: model_memory_bytes, check_memory, bytes_per_disk, bytes_per_node, bytes_per_element
+
+    !> Peak memory per disk of a run [bytes]: state, properties and work arrays, detection
+    !> grid, contact candidates, output buffers. Measured: 0.79 kB per disk (maximum resident
+    !> size of a 90,000-disk lattice run, contacts included, minus that of a 900-disk one).
+    integer(i8), parameter :: bytes_per_disk = 1000
+    !> Peak memory per beam node [bytes]: 3 DOFs, band matrices (stiffness, mass, effective
+    !> matrix) and state vectors. Measured: 1.28 kB per node and element of a 100,000-element
+    !> beam run (same difference as for the disks).
+    integer(i8), parameter :: bytes_per_node = 1200
+    !> Peak memory per element [bytes] (connectivity, section, element matrices).
+    integer(i8), parameter :: bytes_per_element = 200
+
+    !> Where the disks and walls were at the start of a step.
+    type :: step_start_t
+        !> Disk centres [m].
+        real(wp), allocatable :: x(:), y(:)
+        !> Wall end points [m].
+        real(wp), allocatable :: wx1(:), wy1(:), wx2(:), wy2(:)
+    end type step_start_t
+
+    character(len=*), parameter :: dof_name(3) = ['u    ', 'w    ', 'theta']
+
+contains
+
+    !> Error at the first non-finite displacement, velocity or acceleration of the beam, or
+    !> non-finite energy account.
+    subroutine check_beam_state(step, t, node_id, d, v, a, energies, error)
+        !> Steps done.
+        integer(i8), intent(in) :: step
+        !> Time reached [s].
+        real(wp), intent(in) :: t
+        !> Deck id of each node.
+        integer, intent(in) :: node_id(:)
+        !> Displacements, velocities, accelerations (3, n_nodes).
+        real(wp), intent(in) :: d(:, :), v(:, :), a(:, :)
+        !> Energy accounts (kinetic, strain, external work, damping) [J].
+        real(wp), intent(in) :: energies(:)
+        !> Set at the first non-finite value.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=*), parameter :: cause = 'likely cause: a load, an initial condition or '// &
+                                       'a Rayleigh coefficient far too large, or a time step above the '// &
+                                       'stability limit of the scheme (check the magnitudes in [beam] '// &
+                                       'and [initial], or lower [time] step)'
+        call field(d, 'displacement')
+        if (allocated(error)) return
+        call field(v, 'velocity')
+        if (allocated(error)) return
+        call field(a, 'acceleration')
+        if (allocated(error)) return
+        if (.not. all(ieee_is_finite(energies))) then
+            call make_error(error, when(step, t)//'beam: an energy account (kinetic, strain, '// &
+                            'external work or damping) is not finite; '//cause)
+        end if
+    contains
+        subroutine field(f, what)
+            real(wp), intent(in) :: f(:, :)
+            character(len=*), intent(in) :: what
+            integer :: i, k
+            do i = 1, size(f, 2)
+                do k = 1, 3
+                    if (ieee_is_finite(f(k, i))) cycle
+                    call make_error(error, when(step, t)//'beam node '//to_str(node_id(i))//': '// &
+                                    what//' '//trim(dof_name(k))//' is '//kind_of(f(k, i))//'; '//cause)
+                    return
+                end do
+            end do
+        end subroutine field
+    end subroutine check_beam_state
+
+    !> Error at the first disk with a non-finite position, rotation or velocity, or a centre
+    !> beyond the representable box, or at a non-finite energy account.
+    subroutine check_disks_state(step, t, p, en, error)
+        !> Steps done.
+        integer(i8), intent(in) :: step
+        !> Time reached [s].
+        real(wp), intent(in) :: t
+        !> The disks.
+        type(particles_t), intent(in) :: p
+        !> Energy accounts of the particles.
+        type(energies_t), intent(in) :: en
+        !> Set at the first problem found.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=*), parameter :: cause = 'likely cause: a force, an imposed velocity or '// &
+                                       'gravity far too large (check the magnitudes in [particles]), or a '// &
+                                       'time step too large (lower [time] step)'
+        real(wp) :: limit, value(6)
+        character(len=16), parameter :: names(6) = [character(len=16) :: &
+                                                    'x', 'y', 'rotation', 'velocity x', 'velocity y', 'angular velocity']
+        integer :: i, k
+        if (p%n == 0) return
+        limit = coordinate_limit(minval(p%radius(1:p%n)))
+        do i = 1, p%n
+            value = [p%x(i), p%y(i), p%rot(i), p%vx(i), p%vy(i), p%w(i)]
+            do k = 1, 6
+                if (ieee_is_finite(value(k))) cycle
+                call make_error(error, when(step, t)//'disk '//to_str(i)//': '//trim(names(k))// &
+                                ' is '//kind_of(value(k))//'; '//cause)
+                return
+            end do
+            if (max(abs(p%x(i)), abs(p%y(i))) > limit) then
+                call make_error(error, when(step, t)//'disk '//to_str(i)//' is at ('//num(p%x(i))// &
+                                ', '//num(p%y(i))//') m, beyond the box the run can represent (|x|, '// &
+                                '|y| <= '//num(limit)//' m: 4.5e9 times the smallest radius); likely '// &
+                                'cause: a disk escaping with no wall to stop it, or a force or gravity far '// &
+                                'too large')
+                return
+            end if
+        end do
+        if (.not. all(ieee_is_finite([en%kinetic, en%potential, en%external_work, en%drive_work, &
+                                      en%contact_dissipation, en%numerical_dissipation, en%coupling_work]))) then
+            call make_error(error, when(step, t)//'particles: an energy account is not finite; '//cause)
+        end if
+    end subroutine check_disks_state
+
+    !> Record the disk centres and wall end points at the start of a step.
+    subroutine take_step_start(start, p, w)
+        !> The record (reused from step to step).
+        type(step_start_t), intent(inout) :: start
+        !> The disks.
+        type(particles_t), intent(in) :: p
+        !> The walls.
+        type(walls_t), intent(in) :: w
+        start%x = p%x(1:p%n)
+        start%y = p%y(1:p%n)
+        start%wx1 = w%x1(1:w%n)
+        start%wy1 = w%y1(1:w%n)
+        start%wx2 = w%x2(1:w%n)
+        start%wy2 = w%y2(1:w%n)
+    end subroutine take_step_start
+
+    !> Error when, within the step just done, a disk centre crossed a wall (the segment swept
+    !> by the centre relative to the wall meets the wall), or two disks of the step's contact
+    !> candidates passed each other (their centre line turned by more than 90 degrees while
+    !> they overlapped by more than half the sum of their radii).
+    subroutine check_tunnelling(step, t, h, alert, start, p, w, cs, error)
+        !> Steps done.
+        integer(i8), intent(in) :: step
+        !> Time reached [s].
+        real(wp), intent(in) :: t
+        !> Time step [s].
+        real(wp), intent(in) :: h
+        !> Alert distance [m].
+        real(wp), intent(in) :: alert
+        !> Disks and walls at the start of the step.
+        type(step_start_t), intent(in) :: start
+        !> The disks (end of the step).
+        type(particles_t), intent(in) :: p
+        !> The walls (end of the step).
+        type(walls_t), intent(in) :: w
+        !> The contact candidates of the step.
+        type(contact_set_t), intent(in) :: cs
+        !> Set at the first crossing found.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: i, j, k, c
+        real(wp) :: travel
+        do i = 1, p%n
+            do k = 1, w%n
+                if (.not. crosses_wall(i, k)) cycle
+                travel = hypot(p%x(i) - start%x(i), p%y(i) - start%y(i))
+                call make_error(error, when(step, t)//'disk '//to_str(i)//' passed through wall '// &
+                                to_str(k)//' within one step (its centre moved '//num(travel)// &
+                                ' m, its radius is '//num(p%radius(i))//' m): '//advice(travel))
+                return
+            end do
+        end do
+        do c = 1, cs%n
+            i = cs%i1(c)
+            j = cs%i2(c)
+            if (i <= 0 .or. j <= 0) cycle
+            if (.not. passed(i, j)) cycle
+            travel = hypot((p%x(j) - p%x(i)) - (start%x(j) - start%x(i)), &
+                           (p%y(j) - p%y(i)) - (start%y(j) - start%y(i)))
+            call make_error(error, when(step, t)//'disks '//to_str(i)//' and '//to_str(j)// &
+                            ' passed through each other within one step (relative motion '// &
+                            num(travel)//' m, radii '//num(p%radius(i))//' and '// &
+                            num(p%radius(j))//' m): '//advice(travel))
+            return
+        end do
+    contains
+        !> The centre path of disk i relative to wall k meets the wall: the signed distance to
+        !> the wall's line changes sign, at a point between the wall's ends.
+        logical function crosses_wall(i, k)
+            integer, intent(in) :: i, k
+            real(wp) :: s0, s1, f, px, py, ax, ay, bx, by, u
+            crosses_wall = .false.
+            s0 = side(start%x(i), start%y(i), start%wx1(k), start%wy1(k), start%wx2(k), start%wy2(k))
+            s1 = side(p%x(i), p%y(i), w%x1(k), w%y1(k), w%x2(k), w%y2(k))
+            if (s0*s1 >= 0.0_wp) return
+            ! fraction of the step at which the centre is on the line (linear motion)
+            f = s0/(s0 - s1)
+            px = start%x(i) + f*(p%x(i) - start%x(i))
+            py = start%y(i) + f*(p%y(i) - start%y(i))
+            ax = start%wx1(k) + f*(w%x1(k) - start%wx1(k))
+            ay = start%wy1(k) + f*(w%y1(k) - start%wy1(k))
+            bx = start%wx2(k) + f*(w%x2(k) - start%wx2(k))
+            by = start%wy2(k) + f*(w%y2(k) - start%wy2(k))
+            u = ((px - ax)*(bx - ax) + (py - ay)*(by - ay))/((bx - ax)**2 + (by - ay)**2)
+            crosses_wall = u >= 0.0_wp .and. u <= 1.0_wp
+        end function crosses_wall
+
+        !> Signed distance (times the wall length) of (x, y) to the line of the wall.
+        pure real(wp) function side(x, y, x1, y1, x2, y2)
+            real(wp), intent(in) :: x, y, x1, y1, x2, y2
+            side = (x2 - x1)*(y - y1) - (y2 - y1)*(x - x1)
+        end function side
+
+        !> Disks i and j passed each other: the centre line d turned by more than 90 degrees
+        !> (d0 . d1 < 0) and the relative path came closer than (r_i + r_j)/2.
+        logical function passed(i, j)
+            integer, intent(in) :: i, j
+            real(wp) :: d0x, d0y, d1x, d1y, ex, ey, s, dmin
+            d0x = start%x(j) - start%x(i)
+            d0y = start%y(j) - start%y(i)
+            d1x = p%x(j) - p%x(i)
+            d1y = p%y(j) - p%y(i)
+            passed = .false.
+            if (d0x*d1x + d0y*d1y >= 0.0_wp) return
+            ! closest point of the segment d0 -> d1 to the origin
+            ex = d1x - d0x
+            ey = d1y - d0y
+            s = min(max(-(d0x*ex + d0y*ey)/(ex*ex + ey*ey), 0.0_wp), 1.0_wp)
+            dmin = hypot(d0x + s*ex, d0y + s*ey)
+            passed = dmin < 0.5_wp*(p%radius(i) + p%radius(j))
+        end function passed
+
+        !> What to do: a step under which the same motion stays within the alert distance.
+        function advice(travel) result(text)
+            real(wp), intent(in) :: travel
+            character(len=:), allocatable :: text
+            real(wp) :: reach
+            reach = max(alert, 0.1_wp*minval(p%radius(1:p%n)))
+            if (.not. travel > 0.0_wp) then
+                text = 'the time step is too large for the speed of the bodies; lower [time] step'
+                return
+            end if
+            text = 'the time step is too large for this speed; lower [time] step to '// &
+                   num(real(h*reach/travel, wp))//' s or less (the motion of a step then stays within '// &
+                   num(reach)//' m)'
+        end function advice
+    end subroutine check_tunnelling
+
+    !> Memory a model will need at its peak [bytes] (see bytes_per_disk and bytes_per_node).
+    pure integer(i8) function model_memory_bytes(n_disks, n_nodes, n_elements) result(bytes)
+        !> Number of disks.
+        integer(i8), intent(in) :: n_disks
+        !> Number of beam nodes.
+        integer(i8), intent(in) :: n_nodes
+        !> Number of beam elements.
+        integer(i8), intent(in) :: n_elements
+        bytes = bytes_per_disk*n_disks + bytes_per_node*n_nodes + bytes_per_element*n_elements
+    end function model_memory_bytes
+
+    !> Error when the model's estimated memory exceeds what is available (nothing is checked
+    !> when the available memory is unknown, `available` < 0).
+    subroutine check_memory(n_disks, n_nodes, n_elements, available, error)
+        !> Number of disks.
+        integer(i8), intent(in) :: n_disks
+        !> Number of beam nodes.
+        integer(i8), intent(in) :: n_nodes
+        !> Number of beam elements.
+        integer(i8), intent(in) :: n_elements
+        !> Available memory [bytes] (-1: unknown).
+        integer(i8), intent(in) :: available
+        !> Set when the model does not fit.
+        type(error_t), allocatable, intent(out) :: error
+        integer(i8) :: need
+        if (available < 0) return
+        need = model_memory_bytes(n_disks, n_nodes, n_elements)
+        if (need <= available) return
+        call make_error(error, 'the model needs about '//gib(need)//' of memory ('// &
+                        to_str(n_disks)//' disks, '//to_str(n_nodes)//' beam nodes, '// &
+                        to_str(n_elements)//' elements) and only '//gib(available)// &
+                        ' are available (MemAvailable in /proc/meminfo): make the model smaller, or '// &
+                        'run it on a machine with more memory')
+    contains
+        function gib(b) result(text)
+            integer(i8), intent(in) :: b
+            character(len=:), allocatable :: text
+            character(len=32) :: buf
+            write (buf, '(f0.2)') real(b, wp)/1024.0_wp**3
+            text = trim(buf)
+            if (text(1:1) == '.') text = '0'//text
+            text = text//' GiB'
+        end function gib
+    end subroutine check_memory
+
+    !> 'step k (t = ... s): '
+    function when(step, t) result(text)
+        integer(i8), intent(in) :: step
+        real(wp), intent(in) :: t
+        character(len=:), allocatable :: text
+        character(len=24) :: buf
+        write (buf, '(es12.5e3)') t
+        text = 'step '//to_str(step)//' (t = '//trim(adjustl(buf))//' s): '
+    end function when
+
+    !> A real with 3 significant digits ('1.226E-002').
+    function num(x) result(text)
+        real(wp), intent(in) :: x
+        character(len=:), allocatable :: text
+        character(len=24) :: buf
+        write (buf, '(es11.3e3)') x
+        text = trim(adjustl(buf))
+    end function num
+
+    !> 'NaN', 'infinite'.
+    pure function kind_of(x) result(text)
+        real(wp), intent(in) :: x
+        character(len=:), allocatable :: text
+        if (ieee_is_nan(x)) then
+            text = 'NaN'
+        else
+            text = 'infinite'
+        end if
+    end function kind_of
+end module driver_guards

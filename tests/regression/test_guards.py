@@ -1,0 +1,238 @@
+#!/usr/bin/env python3
+"""Scenarios that used to run to NaN with exit 0, crash, or misbehave, and must now stop
+cleanly: guards after every step (non-finite state, disks beyond the representable box,
+tunnelling), one writer per results folder (lock file), --output '', three-digit exponents
+in messages, decks with a UTF-8 byte-order mark or CR-only line endings.
+
+Each failed run must exit 1 with a message naming the deck, the step and the body, and leave
+an earlier finished result in the folder byte for byte.
+Usage (ctest does this): test_guards.py --exe multicor --work DIR --source REPO
+"""
+import argparse
+import hashlib
+import os
+import pathlib
+import re
+import socket
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+FAILED = []
+
+
+def check(name, ok, detail=""):
+    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
+    if not ok:
+        FAILED.append(name)
+
+
+def multicor(exe, *args):
+    return subprocess.run([str(exe), *map(str, args)], capture_output=True, text=True, timeout=300)
+
+
+def digest(path):
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def failing_run(exe, work, name, text, expect, earlier_deck):
+    """Run `text` into a folder holding an earlier finished result of the same name (from
+    `earlier_deck`); it must exit 1 with `expect` in the message and keep that result."""
+    folder = work / name
+    folder.mkdir(parents=True, exist_ok=True)
+    deck = work / f"{name}.dat"
+    deck.write_text(earlier_deck)
+    first = multicor(exe, deck, "--output", folder, "--quiet")
+    earlier = folder / f"{name}.h5"
+    if first.returncode != 0 or not earlier.exists():
+        check(f"{name}: earlier run", False, first.stderr)
+        return ""
+    before = digest(earlier)
+    deck.write_text(text)
+    proc = multicor(exe, deck, "--output", folder, "--quiet")
+    check(f"{name}: exit 1", proc.returncode == 1, f"exit {proc.returncode}")
+    found = re.search(expect, proc.stderr) is not None
+    check(f"{name}: message", found and f"{name}.dat" in proc.stderr, proc.stderr.strip()[:400])
+    check(f"{name}: earlier result intact", digest(earlier) == before, "")
+    check(f"{name}: lock released", not (folder / ".multicor.lock").exists(), "")
+    return proc.stderr
+
+
+def beam_deck(load="-10.0", extra=""):
+    return f"""[run]
+analysis = dynamic
+[beam]
+section = 1 2.1e11 7800 2.0e-4 1.6666666666666667e-9
+line = 1 0 0 1 0 20 1
+fix = 1 all
+load = 21 w {load}
+{extra}
+[time]
+step = 2e-4
+end = 2e-3
+[output]
+progress = 0
+"""
+
+
+def dem_deck(step="1e-3", gravity="0 -9.81", n=200, end="0.01", solver=""):
+    return f"""[run]
+analysis = dynamic
+[particles]
+material = 1 2500
+deposit = {n} 0 0.2 0 0.004 0.005 1 7
+gravity = {gravity}
+[walls]
+wall = 0 0 0.2 0
+wall = 0 0 0 0.4
+wall = 0.2 0 0.2 0.4
+[contacts]
+law = 1 1 0.4 0.1 0
+{solver}
+[time]
+step = {step}
+end = {end}
+[output]
+progress = 0
+"""
+
+
+def non_finite(exe, work):
+    """Loads and gravity of 1e300 ran to the end writing NaN/Inf with exit 0."""
+    failing_run(exe, work, "beam_load_1e300", beam_deck(load="-1e300"),
+                r"step 1 \(t = 2\.00000E-004 s\): beam", beam_deck())
+    failing_run(exe, work, "dem_gravity_1e300", dem_deck(gravity="0 -1e300"),
+                r"step 1 \(t = 1\.00000E-003 s\): disk \d+ is at .* beyond the box", dem_deck())
+
+
+def coupled_non_finite(exe, work, decks):
+    """A coupled run with a beam load of 1e300 stops at the first step."""
+    text = (decks / "coupled_rigid_translation.dat").read_text()
+    bad = text.replace("line     = 1   0.0  0.0  0.10  0.0  10  1",
+                       "line     = 1   0.0  0.0  0.10  0.0  10  1\nload = 11 w -1e300", 1)
+    failing_run(exe, work, "coupled_load_1e300", bad, r"step 1 \(t = .*\): beam", text)
+
+
+def tunnelling(exe, work):
+    """A step so large that disks pass through the floor ran to the end with one warning."""
+    failing_run(exe, work, "dem_tunnelling_floor", dem_deck(step="0.05", end="1"),
+                r"disk \d+ passed through wall 1 within one step .* lower \[time\] step to", dem_deck())
+    pair = """[run]
+analysis = dynamic
+[particles]
+material = 1 2500
+disk = 0 0 0.01 1
+disk = 0.025 0 0.01 1
+initial_velocity = 2 x -6
+[contacts]
+law = 1 1 0.4 0 0
+[time]
+step = {h}
+end = 0.05
+[output]
+progress = 0
+"""
+    # Relative motion 6 m/s x 0.01 s = 0.06 m: the centres cross before mid-step (start gap
+    # 0.025 m), the contact of the step then pushes them further through.
+    failing_run(exe, work, "dem_tunnelling_pair", pair.format(h="0.01"),
+                r"disks 1 and 2 passed through each other within one step", pair.format(h="1e-4"))
+
+
+def lock(exe, work):
+    """One writer per results folder."""
+    deck = work / "locked.dat"
+    deck.write_text(beam_deck())
+    folder = work / "locked"
+    folder.mkdir(parents=True, exist_ok=True)
+    lockfile = folder / ".multicor.lock"
+    (folder / "locked.h5").unlink(missing_ok=True)
+    host = socket.gethostname()
+    # A live owner on this host: this very process.
+    lockfile.write_text(f"{host} {os.getpid()} 2026-01-01T00:00:00\n")
+    proc = multicor(exe, deck, "--output", folder, "--quiet")
+    check("lock: second writer refused (exit 1)", proc.returncode == 1, f"exit {proc.returncode}")
+    check("lock: message names the owner",
+          "in use by another run" in proc.stderr and f"{host} {os.getpid()}" in proc.stderr,
+          proc.stderr.strip())
+    check("lock: owner's lock kept, nothing written",
+          lockfile.exists() and not (folder / "locked.h5").exists(), "")
+    # A stale lock: a process that has ended.
+    dead = subprocess.Popen(["true"])
+    dead.wait()
+    lockfile.write_text(f"{host} {dead.pid} 2026-01-01T00:00:00\n")
+    proc = multicor(exe, deck, "--output", folder, "--quiet")
+    check("lock: stale lock taken over", proc.returncode == 0
+          and "taking over the stale lock" in proc.stdout, proc.stdout.strip()[:300] + proc.stderr)
+    check("lock: removed at the end", not lockfile.exists() and (folder / "locked.h5").exists(), "")
+    # A lock from another host cannot be checked: respected.
+    lockfile.write_text(f"another-host-{host} 1 2026-01-01T00:00:00\n")
+    proc = multicor(exe, deck, "--output", folder, "--quiet")
+    check("lock: another host's lock respected", proc.returncode == 1, proc.stderr.strip()[:200])
+    lockfile.unlink()
+
+
+def output_empty(exe, work):
+    deck = work / "empty_output.dat"
+    deck.write_text(beam_deck())
+    proc = multicor(exe, deck, "--output", "", "--quiet")
+    check("--output '': bad command line (exit 2)", proc.returncode == 2
+          and "--output needs a folder name" in proc.stderr, f"exit {proc.returncode} {proc.stderr}")
+    check("--output '': nothing at the root", not pathlib.Path("/empty_output.h5").exists()
+          and not pathlib.Path("/empty_output.h5.partial").exists(), "")
+
+
+def exponents(exe, work):
+    """tolerance = 1e-300 printed as '1.00-300' (no exponent letter) in the warnings."""
+    deck = work / "tiny_tolerance.dat"
+    deck.write_text(dem_deck(n=30, end="0.05", solver="[solver]\ntolerance = 1e-300\nmax_sweeps = 2"))
+    proc = multicor(exe, deck, "--output", work / "tiny_tolerance", "--quiet")
+    check("exponents: run", proc.returncode == 0, proc.stderr)
+    check("exponents: 'tolerance  1.00E-300' in the warning", "tolerance  1.00E-300" in proc.stdout
+          and not re.search(r"\d-300", proc.stdout.replace("E-300", "")), proc.stdout[:300])
+
+
+def line_endings(exe, work):
+    """A UTF-8 byte-order mark was refused; CR-only line endings read as an empty deck. Both
+    must give the same results as the plain deck."""
+    plain = beam_deck()
+    variants = {"plain": plain.encode(), "bom": b"\xef\xbb\xbf" + plain.encode(),
+                "cr": plain.replace("\n", "\r").encode(), "crlf": plain.replace("\n", "\r\n").encode()}
+    results = {}
+    for name, data in variants.items():
+        deck = work / f"endings_{name}.dat"
+        deck.write_bytes(data)
+        proc = multicor(exe, deck, "--output", work / "endings", "--quiet")
+        check(f"line endings: {name} runs", proc.returncode == 0, proc.stderr.strip())
+        if proc.returncode == 0:
+            with h5py.File(work / "endings" / f"endings_{name}.h5", "r") as f:
+                results[name] = f["fem/displacement"][...]
+    for name in ("bom", "cr", "crlf"):
+        if name in results and "plain" in results:
+            # Same deck, same arithmetic: bit-identical results.
+            check(f"line endings: {name} gives the plain deck's results",
+                  np.array_equal(results[name], results["plain"]), "")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--exe", required=True)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("--source", required=True)
+    args = ap.parse_args()
+    exe, work, src = pathlib.Path(args.exe), pathlib.Path(args.work), pathlib.Path(args.source)
+    work.mkdir(parents=True, exist_ok=True)
+    non_finite(exe, work)
+    coupled_non_finite(exe, work, src / "tests" / "regression" / "decks")
+    tunnelling(exe, work)
+    lock(exe, work)
+    output_empty(exe, work)
+    exponents(exe, work)
+    line_endings(exe, work)
+    print(f"{len(FAILED)} failed checks")
+    return 1 if FAILED else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
