@@ -7,6 +7,7 @@ program multicor
     use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
     use core_error, only: error_t
     use core_version, only: multicor_version
+    use core_signals, only: signal_exit_code
     use io_deck_schema, only: multicor_schema, schema_markdown
     use driver_run, only: run_options_t, run_deck
     implicit none
@@ -14,7 +15,7 @@ program multicor
     type(run_options_t) :: opts
     type(error_t), allocatable :: error
     character(len=:), allocatable :: arg, text
-    integer :: i, n
+    integer :: i, n, stopped_by
     logical :: take_output
 
     n = command_argument_count()
@@ -53,9 +54,14 @@ program multicor
     if (take_output) call usage_error('--output needs a folder name')
     if (.not. allocated(opts%deck_path)) call usage_error('no deck given')
 
-    call run_deck(opts, report, error)
-    if (allocated(error)) then
+    call run_deck(opts, report, error, stopped_by)
+    if (allocated(error) .and. stopped_by /= 0) then
+        write (error_unit, '(a)') 'multicor: stopped: '//error%message
+        flush (error_unit)
+        stop signal_exit_code(stopped_by), quiet = .true.
+    else if (allocated(error)) then
         write (error_unit, '(a)') 'multicor: error: '//error%message
+        flush (error_unit)
         stop 1, quiet = .true.
     end if
 
@@ -99,6 +105,8 @@ contains
             '  -h, --help           print this help', &
             '', &
             'Results: DIR/<deck name>.h5 (HDF5, layout in doc/output.md).', &
-            'Exit codes: 0 success, 1 error in the deck or the run, 2 bad command line.'
+            'Exit codes: 0 success, 1 error in the deck or the run, 2 bad command line,', &
+            '128 + signal number when SIGTERM (143), SIGINT (130) or SIGUSR1 (138) stopped the', &
+            'run: the results so far are then in DIR/<deck name>.h5.partial.'
     end subroutine print_help
 end program multicor

@@ -9,9 +9,11 @@
 !> report callback: steps whose contact solve did not converge (the first `max_warnings`,
 !> then only the count) and, once, a disk moving farther than the alert distance in a step.
 module driver_run_coupled
+    use, intrinsic :: iso_fortran_env, only: int64
     use core_kinds, only: wp
     use core_error, only: error_t
     use core_strings, only: to_str
+    use core_signals, only: caught_signal, signal_name
     use io_progress, only: progress_t
     use fem_beam_config, only: beam_config_t
     use coupling_arlequin, only: coupled_system_t, coupled_energies_t, build_coupled_system, &
@@ -106,6 +108,14 @@ contains
                 call store(error)
                 if (allocated(error)) return
             end if
+            if (k < n_steps .and. caught_signal() /= 0) then
+                ! Stop request: the step just done is the last output.
+                if (mod(k, run%output_interval) /= 0) call store(error)
+                if (allocated(error)) return
+                call out%stop_at(signal_name(caught_signal()), int(k, int64), sys%fe%t)
+                n_steps = k
+                exit
+            end if
             if (quiet) cycle
             if (progress%due()) call report(progress%line(k, sys%fe%t))
         end do
@@ -129,6 +139,8 @@ contains
             call dem_out%store(out%file, sys%dem, error)
             if (allocated(error)) return
             call cpl_out%store(out%file, sys, error)
+            if (allocated(error)) return
+            call out%flush(error)
         end subroutine store
 
         !> Warning for an unconverged step (the first max_warnings ones).

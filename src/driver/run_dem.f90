@@ -5,9 +5,11 @@
 !> (the first `max_warnings` ones, then only the count in the summary), and, once, a step in
 !> which a disk moved farther than the alert distance (contacts may then be found late).
 module driver_run_dem
+    use, intrinsic :: iso_fortran_env, only: int64
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
     use core_strings, only: to_str
+    use core_signals, only: caught_signal, signal_name
     use io_progress, only: progress_t
     use dem_particles, only: particles_t
     use dem_moreau_jean, only: mj_init, mj_step, energies_balance
@@ -63,7 +65,7 @@ contains
         n_steps = ceiling(run%t_end/run%h*(1.0_wp - 1.0e-12_wp))
         call writer%begin(out%file, cfg%system, cfg%material_id, cfg%store_contacts, error)
         if (allocated(error)) return
-        call writer%store(out%file, cfg%system, error)
+        call store(error)
         if (allocated(error)) return
         unconverged = 0
         speed_warned = .false.
@@ -81,8 +83,16 @@ contains
             end if
             if (.not. speed_warned) call check_speed()
             if (mod(k, run%output_interval) == 0 .or. k == n_steps) then
-                call writer%store(out%file, cfg%system, error)
+                call store(error)
                 if (allocated(error)) return
+            end if
+            if (k < n_steps .and. caught_signal() /= 0) then
+                ! Stop request: the step just done is the last output.
+                if (mod(k, run%output_interval) /= 0) call store(error)
+                if (allocated(error)) return
+                call out%stop_at(signal_name(caught_signal()), int(k, int64), cfg%system%time)
+                n_steps = k
+                exit
             end if
             if (quiet) cycle
             if (progress%due()) call report(progress%line(k, cfg%system%time))
@@ -93,6 +103,14 @@ contains
         call out%write_summary(n_steps, progress%elapsed(), error)
 
     contains
+
+        !> One stored output, flushed to the file.
+        subroutine store(error)
+            type(error_t), allocatable, intent(out) :: error
+            call writer%store(out%file, cfg%system, error)
+            if (allocated(error)) return
+            call out%flush(error)
+        end subroutine store
 
         !> Warning for an unconverged step (the first max_warnings ones).
         subroutine warn_unconverged()

@@ -16,19 +16,27 @@
 !>
 !> The HDF5 library is opened on first use (checked through the validity of a predefined
 !> type id, so no module state is kept) and never closed here: `h5close_f` would close every
-!> file of the process; the library closes itself at program exit. Automatic printing of the
-!> HDF5 error stack is switched off: errors are reported through `error_t` only.
+!> file of the process. Its exit handler is switched off (`h5dont_atexit_f`): after a failed
+!> write (full disk) HDF5 cannot close the file, and its exit handler then crashed trying
+!> again; every file written is closed explicitly, so nothing is lost. Automatic printing of
+!> the HDF5 error stack is switched off: errors are reported through `error_t` only.
+!>
+!> Crash safety: files are created with the file-space strategy NONE (space freed while the
+!> file is open is never reused) and `flush` writes everything HDF5 buffers; a writer killed
+!> between two flushes leaves the file as it was at the first one (doc/decisions.md).
 module io_hdf5_file
     use, intrinsic :: iso_c_binding, only: c_ptr, c_char, c_size_t, c_null_char, c_null_ptr, &
-                                                                              c_loc, c_f_pointer, c_associated
+                                                                              c_loc, c_f_pointer, c_associated, &
+                                                                              c_int, c_bool
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
-    use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5eset_auto_f, h5iis_valid_f, &
+    use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5dont_atexit_f, h5eset_auto_f, h5iis_valid_f, &
                     h5iget_type_f, h5i_dataset_f, h5i_dataspace_f, h5i_datatype_f, h5i_attr_f, h5i_group_f, &
                     h5i_genprop_lst_f, h5i_file_f, h5fcreate_f, h5fopen_f, h5fclose_f, h5f_acc_trunc_f, &
-                    h5f_acc_rdonly_f, h5f_libver_v18_f, h5f_libver_latest_f, h5pcreate_f, h5pclose_f, &
+                    h5f_acc_rdonly_f, h5fflush_f, h5f_scope_global_f, h5f_libver_v18_f, &
+                    h5f_libver_latest_f, h5pcreate_f, h5pclose_f, &
                     h5pset_libver_bounds_f, h5pset_create_inter_group_f, h5pset_chunk_f, &
-                    h5p_file_access_f, h5p_link_create_f, h5p_dataset_create_f, h5gcreate_f, h5gclose_f, &
+                    h5p_file_access_f, h5p_file_create_f, h5p_link_create_f, h5p_dataset_create_f, h5gcreate_f, h5gclose_f, &
                     h5lexists_f, h5oopen_f, h5oclose_f, h5screate_f, h5screate_simple_f, h5sclose_f, &
                     h5s_scalar_f, h5s_unlimited_f, h5s_select_set_f, h5sselect_hyperslab_f, &
                     h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, h5acreate_f, h5aopen_f, &
@@ -50,7 +58,21 @@ module io_hdf5_file
             type(c_ptr), value, intent(in) :: s
             integer(c_size_t) :: n
         end function c_strlen
+        !> H5Pset_file_space_strategy of the C library (no Fortran wrapper in HDF5 1.10).
+        integer(c_int) function c_h5pset_file_space_strategy(plist, strategy, persist, &
+                                                             threshold) &
+            bind(c, name='H5Pset_file_space_strategy')
+            import :: c_int, c_bool, hid_t, hsize_t
+            integer(hid_t), value, intent(in) :: plist
+            integer(c_int), value, intent(in) :: strategy
+            logical(c_bool), value, intent(in) :: persist
+            integer(hsize_t), value, intent(in) :: threshold
+        end function c_h5pset_file_space_strategy
     end interface
+
+    !> H5F_FSPACE_STRATEGY_NONE: every allocation at the end of the file, freed space never
+    !> reused while the file is open (see file_create).
+    integer(c_int), parameter :: fspace_strategy_none = 3
 
     !> Target size of one chunk of a time series [bytes].
     integer, parameter :: chunk_bytes = 65536
@@ -72,6 +94,7 @@ module io_hdf5_file
         procedure :: create => file_create
         procedure :: open => file_open
         procedure :: close => file_close
+        procedure :: flush => file_flush
         procedure :: is_open => file_is_open
         procedure :: exists => file_exists
         procedure :: create_group => file_create_group
@@ -118,7 +141,7 @@ contains
         character(len=*), intent(in) :: path
         !> Set when the library cannot start or the file cannot be created.
         type(error_t), allocatable, intent(out) :: error
-        integer(hid_t) :: fapl
+        integer(hid_t) :: fapl, fcpl
         integer :: hdferr
         if (self%is_open()) then
             call make_error(error, "HDF5: cannot create '"//path//"': this object still has '" &
@@ -128,6 +151,7 @@ contains
         call ensure_library(error)
         if (allocated(error)) return
         fapl = -1
+        fcpl = -1
         self%path = path
         ops: block
             ! The 1.8 file format allows attributes larger than 64 KiB (dense storage).
@@ -135,8 +159,18 @@ contains
             if (hdferr < 0) exit ops
             call h5pset_libver_bounds_f(fapl, h5f_libver_v18_f, h5f_libver_latest_f, hdferr)
             if (hdferr < 0) exit ops
-            call h5fcreate_f(path, h5f_acc_trunc_f, self%id, hdferr, access_prp=fapl)
+            ! Space freed while the file is open is never reused: what the last flush wrote is
+            ! never overwritten by later data, so a killed writer leaves the file as it was at
+            ! its last flush (doc/decisions.md).
+            call h5pcreate_f(h5p_file_create_f, fcpl, hdferr)
+            if (hdferr < 0) exit ops
+            hdferr = int(c_h5pset_file_space_strategy(fcpl, fspace_strategy_none, .false._c_bool, &
+                                                      1_hsize_t))
+            if (hdferr < 0) exit ops
+            call h5fcreate_f(path, h5f_acc_trunc_f, self%id, hdferr, creation_prp=fcpl, &
+                             access_prp=fapl)
         end block ops
+        call release(fcpl)
         call release(fapl)
         if (hdferr < 0) then
             self%id = -1
@@ -187,6 +221,22 @@ contains
         self%writable = .false.
         if (hdferr < 0) call make_error(error, "HDF5: cannot close file '"//self%path//"'")
     end subroutine file_close
+
+    !> Write everything HDF5 holds in memory for this file (raw data, metadata, superblock)
+    !> to the operating system: after a flush the file on disk is complete and readable as it
+    !> stands, even if the process is killed before the next flush (doc/decisions.md).
+    subroutine file_flush(self, error)
+        !> A file open for writing.
+        class(h5_file_t), intent(inout) :: self
+        !> Set when the data cannot be written (e.g. the disk is full).
+        type(error_t), allocatable, intent(out) :: error
+        integer :: hdferr
+        call require_writable(self, '(flush)', error)
+        if (allocated(error)) return
+        call h5fflush_f(self%id, h5f_scope_global_f, hdferr)
+        if (hdferr < 0) call make_error(error, "HDF5: cannot write to file '"//self%path// &
+                                        "' (disk full, quota or file size limit exceeded?)")
+    end subroutine file_flush
 
     !> Whether a file is open.
     pure logical function file_is_open(self)
@@ -1336,6 +1386,9 @@ contains
         type(error_t), allocatable, intent(out) :: error
         logical :: valid
         integer :: hdferr
+        ! Before any other HDF5 call (the first one starts the C library and registers its exit
+        ! handler); it fails harmlessly when called again.
+        call h5dont_atexit_f(hdferr)
         ! The predefined type ids are valid exactly while the Fortran library is open.
         call h5iis_valid_f(h5t_native_double, valid, hdferr)
         if (hdferr >= 0 .and. valid) return
