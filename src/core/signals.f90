@@ -14,7 +14,7 @@ module core_signals
     implicit none
     private
     public :: install_signal_handlers, caught_signal, signal_name, clear_caught_signal, &
-              signal_exit_code
+              signal_exit_code, stop_signals
 
     interface
         !> Install the handlers (0 on success).
@@ -80,6 +80,13 @@ contains
             name = trim(buf)
         end if
     end function signal_name
+
+    !> Numbers of the stop signals of this platform: SIGTERM, SIGINT, SIGUSR1.
+    function stop_signals() result(sigs)
+        !> The three numbers, in that order.
+        integer :: sigs(3)
+        sigs = [int(c_sigterm()), int(c_sigint()), int(c_sigusr1())]
+    end function stop_signals
 
     !> Exit code of a run stopped by a signal: 128 + the signal number, the shell's
     !> convention (SIGTERM 143, SIGINT 130, SIGUSR1 138 on Linux).
