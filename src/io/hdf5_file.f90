@@ -27,7 +27,7 @@
 module io_hdf5_file
     use, intrinsic :: iso_c_binding, only: c_ptr, c_char, c_size_t, c_null_char, c_null_ptr, &
                                                                               c_loc, c_f_pointer, c_associated, &
-                                                                              c_int, c_bool
+                                                                              c_int, c_bool, c_int64_t, c_long_long
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
     use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5dont_atexit_f, h5eset_auto_f, h5iis_valid_f, &
@@ -62,11 +62,13 @@ module io_hdf5_file
         integer(c_int) function c_h5pset_file_space_strategy(plist, strategy, persist, &
                                                              threshold) &
             bind(c, name='H5Pset_file_space_strategy')
-            import :: c_int, c_bool, hid_t, hsize_t
-            integer(hid_t), value, intent(in) :: plist
+            import :: c_int, c_bool, c_int64_t, c_long_long
+            !> File creation property list (hid_t is int64_t in HDF5 1.10).
+            integer(c_int64_t), value, intent(in) :: plist
             integer(c_int), value, intent(in) :: strategy
             logical(c_bool), value, intent(in) :: persist
-            integer(hsize_t), value, intent(in) :: threshold
+            !> hsize_t (unsigned long long).
+            integer(c_long_long), value, intent(in) :: threshold
         end function c_h5pset_file_space_strategy
     end interface
 
@@ -164,8 +166,8 @@ contains
             ! its last flush (doc/decisions.md).
             call h5pcreate_f(h5p_file_create_f, fcpl, hdferr)
             if (hdferr < 0) exit ops
-            hdferr = int(c_h5pset_file_space_strategy(fcpl, fspace_strategy_none, .false._c_bool, &
-                                                      1_hsize_t))
+            hdferr = int(c_h5pset_file_space_strategy(int(fcpl, c_int64_t), fspace_strategy_none, &
+                                                      .false._c_bool, 1_c_long_long))
             if (hdferr < 0) exit ops
             call h5fcreate_f(path, h5f_acc_trunc_f, self%id, hdferr, creation_prp=fcpl, &
                              access_prp=fapl)
@@ -338,7 +340,7 @@ contains
             if (allocated(error)) exit ops
             call h5awrite_f(attr, stype, buf, hdferr)
         end block ops
-        call release(attr)
+        call release_written(attr, hdferr)
         call release(space)
         call release(stype)
         if (.not. allocated(error) .and. hdferr < 0) call attr_error(self, 'write', object, &
@@ -370,7 +372,7 @@ contains
             if (allocated(error)) exit ops
             call h5awrite_f(attr, h5t_native_double, value, dims, hdferr)
         end block ops
-        call release(attr)
+        call release_written(attr, hdferr)
         call release(space)
         if (.not. allocated(error) .and. hdferr < 0) call attr_error(self, 'write', object, &
                                                                      name, error)
@@ -401,7 +403,7 @@ contains
             if (allocated(error)) exit ops
             call h5awrite_f(attr, h5t_native_integer, value, dims, hdferr)
         end block ops
-        call release(attr)
+        call release_written(attr, hdferr)
         call release(space)
         if (.not. allocated(error) .and. hdferr < 0) call attr_error(self, 'write', object, &
                                                                      name, error)
@@ -432,7 +434,7 @@ contains
             if (allocated(error)) exit ops
             if (size(value) > 0) call h5awrite_f(attr, h5t_native_double, value, dims, hdferr)
         end block ops
-        call release(attr)
+        call release_written(attr, hdferr)
         call release(space)
         if (.not. allocated(error) .and. hdferr < 0) call attr_error(self, 'write', object, &
                                                                      name, error)
@@ -707,7 +709,7 @@ contains
         if (allocated(error)) return
         hdferr = 0
         if (size(values) > 0) call h5dwrite_f(dset, h5t_native_double, values, dims, hdferr)
-        call release(dset)
+        call release_written(dset, hdferr)
         if (hdferr < 0) call dataset_error(self, 'write', path, error)
     end subroutine write_real_1d
 
@@ -729,7 +731,7 @@ contains
         if (allocated(error)) return
         hdferr = 0
         if (size(values) > 0) call h5dwrite_f(dset, h5t_native_double, values, dims, hdferr)
-        call release(dset)
+        call release_written(dset, hdferr)
         if (hdferr < 0) call dataset_error(self, 'write', path, error)
     end subroutine write_real_2d
 
@@ -751,7 +753,7 @@ contains
         if (allocated(error)) return
         hdferr = 0
         if (size(values) > 0) call h5dwrite_f(dset, h5t_native_double, values, dims, hdferr)
-        call release(dset)
+        call release_written(dset, hdferr)
         if (hdferr < 0) call dataset_error(self, 'write', path, error)
     end subroutine write_real_3d
 
@@ -773,7 +775,7 @@ contains
         if (allocated(error)) return
         hdferr = 0
         if (size(values) > 0) call h5dwrite_f(dset, h5t_native_integer, values, dims, hdferr)
-        call release(dset)
+        call release_written(dset, hdferr)
         if (hdferr < 0) call dataset_error(self, 'write', path, error)
     end subroutine write_int_1d
 
@@ -795,7 +797,7 @@ contains
         if (allocated(error)) return
         hdferr = 0
         if (size(values) > 0) call h5dwrite_f(dset, h5t_native_integer, values, dims, hdferr)
-        call release(dset)
+        call release_written(dset, hdferr)
         if (hdferr < 0) call dataset_error(self, 'write', path, error)
     end subroutine write_int_2d
 
@@ -1040,7 +1042,7 @@ contains
         integer(hsize_t) :: dims(size(record_shape) + 1), maxdims(size(record_shape) + 1)
         integer(hsize_t) :: chunk(size(record_shape) + 1)
         integer(hid_t) :: dset
-        integer :: r, n_per_record
+        integer :: r, n_per_record, hdferr
         r = size(record_shape)
         if (r > 2 .or. any(record_shape < 1)) then
             call make_error(error, "HDF5: series '"//path//"': records must be scalars, 1-D or " &
@@ -1056,7 +1058,9 @@ contains
         chunk(r + 1) = max(1, min(max_chunk_records, chunk_bytes/(8*n_per_record)))
         call self%new_dataset(path, h5t_ieee_f64le, dims, maxdims, dset, error, chunk)
         if (allocated(error)) return
-        call release(dset)
+        hdferr = 0
+        call release_written(dset, hdferr)
+        if (hdferr < 0) call dataset_error(self, 'create', path, error)
     end subroutine file_create_series
 
     !> Create an empty integer series of scalar records (a 1-D extendible dataset of 32-bit
@@ -1070,12 +1074,15 @@ contains
         type(error_t), allocatable, intent(out) :: error
         integer(hsize_t) :: dims(1), maxdims(1), chunk(1)
         integer(hid_t) :: dset
+        integer :: hdferr
         dims = 0
         maxdims = h5s_unlimited_f
         chunk = max(1, min(max_chunk_records, chunk_bytes/4))
         call self%new_dataset(path, h5t_std_i32le, dims, maxdims, dset, error, chunk)
         if (allocated(error)) return
-        call release(dset)
+        hdferr = 0
+        call release_written(dset, hdferr)
+        if (hdferr < 0) call dataset_error(self, 'create', path, error)
     end subroutine file_create_int_series
 
     !> Append size(values) scalar records to a real scalar series.
@@ -1099,7 +1106,7 @@ contains
                         file_space_id=fspace)
         call release(mspace)
         call release(fspace)
-        call release(dset)
+        call release_written(dset, hdferr)
         if (hdferr < 0) call dataset_error(self, 'append to', path, error)
     end subroutine append_chunk_real
 
@@ -1126,7 +1133,7 @@ contains
                         hdferr, mem_space_id=mspace, file_space_id=fspace)
         call release(mspace)
         call release(fspace)
-        call release(dset)
+        call release_written(dset, hdferr)
         if (hdferr < 0) call dataset_error(self, 'append to', path, error)
     end subroutine append_chunk_real_2d
 
@@ -1151,7 +1158,7 @@ contains
                         file_space_id=fspace)
         call release(mspace)
         call release(fspace)
-        call release(dset)
+        call release_written(dset, hdferr)
         if (hdferr < 0) call dataset_error(self, 'append to', path, error)
     end subroutine append_chunk_int
 
@@ -1332,7 +1339,7 @@ contains
         end block ops
         call release(mspace)
         call release(fspace)
-        call release(dset)
+        call release_written(dset, hdferr)
         if (hdferr < 0) call dataset_error(self, 'append to', path, error)
     end subroutine append_record
 
@@ -1441,6 +1448,30 @@ contains
         call h5tset_cset_f(stype, h5t_cset_utf8_f, hdferr)
     end subroutine vl_string_type
 
+    !> Close a dataset or an attribute just written and fold the status of the close into
+    !> `hdferr`: closing a dataset writes its cached chunks, so a full disk shows up here
+    !> (`release` ignores it).
+    subroutine release_written(id, hdferr)
+        !> Identifier; set to -1.
+        integer(hid_t), intent(inout) :: id
+        !> Status of the write so far; set to the failure of the close if it was fine.
+        integer, intent(inout) :: hdferr
+        integer :: id_type, status
+        if (id <= 0) return
+        call h5iget_type_f(id, id_type, status)
+        if (status >= 0) then
+            if (id_type == h5i_dataset_f) then
+                call h5dclose_f(id, status)
+                id = -1
+            else if (id_type == h5i_attr_f) then
+                call h5aclose_f(id, status)
+                id = -1
+            end if
+        end if
+        call release(id)
+        if (hdferr >= 0 .and. status < 0) hdferr = status
+    end subroutine release_written
+
     !> Close any HDF5 identifier we own (no-op for ids <= 0).
     subroutine release(id)
         !> Identifier; set to -1.
@@ -1511,5 +1542,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         call make_error(error, "HDF5: cannot "//what//" dataset '"//path//"' in '" &
                         //file_name(self)//"'")
+        if (what /= 'read') error%message = error%message// &
+                                            ' (disk full, quota or file size limit exceeded?)'
     end subroutine dataset_error
 end module io_hdf5_file

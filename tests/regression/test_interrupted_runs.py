@@ -7,8 +7,9 @@ input/bending_case2.dat with a far end time) are started, left to write a few ou
 killed or signalled. The '.partial' file must open in h5py and h5dump, say finished = 0 in
 /summary, and hold exactly (bit for bit) the values of an uninterrupted run of the same deck
 at the same steps; an earlier finished result in the same folder must stay untouched. A file
-size limit (RLIMIT_FSIZE, as `ulimit -f`, unprivileged) stands for a full disk: the run must
-stop with a clear error and exit code 1, not crash.
+size limit (RLIMIT_FSIZE, as `ulimit -f`, unprivileged) and, where root can mount one, a
+full 512 KiB tmpfs: the run must stop with a clear error at the write and exit code 1, not
+crash.
 Usage (ctest does this): test_interrupted_runs.py --exe multicor --work DIR --source REPO
 """
 import argparse
@@ -238,14 +239,41 @@ def write_error(exe, src, work):
     proc = subprocess.run([str(exe), str(deck), "--output", str(folder), "--quiet"],
                           capture_output=True, text=True, preexec_fn=limit_file_size,
                           timeout=300)
-    err = proc.stderr
-    check("file size limit: exit code 1 (no crash)", proc.returncode == 1,
-          f"exit {proc.returncode}: {err.strip()[-300:]}")
-    check("file size limit: reported at a write", "cannot write to file" in err and
-          "cannot close" not in err, err.strip()[-200:])
-    check("file size limit: no runtime error or signal", "Segmentation" not in err and
-          "Fortran runtime error" not in err, "")
+    write_failure_checks("file size limit", proc)
     check("file size limit: earlier result untouched", digest(earlier) == before, "")
+
+
+def full_disk(exe, src, work):
+    """A really full file system: a 512 KiB tmpfs (needs root and mount rights; skipped with
+    the reason otherwise)."""
+    mnt = work / "tmpfs"
+    mnt.mkdir()
+    mount = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=512k", "tmpfs", str(mnt)],
+                           capture_output=True, text=True) if shutil.which("mount") else None
+    if mount is None or mount.returncode != 0:
+        reason = "no mount command" if mount is None else mount.stderr.strip()
+        print(f"skip   full disk (tmpfs): cannot mount a tmpfs here ({reason})")
+        return
+    try:
+        deck = deck_with_end(src / "input" / "cantilever.dat", work / "full_beam.dat", 5.0)
+        proc = subprocess.run([str(exe), str(deck), "--output", str(mnt / "run"), "--quiet"],
+                              capture_output=True, text=True, timeout=300)
+        write_failure_checks("full disk", proc)
+        left = list((mnt / "run").glob("*"))
+        check("full disk: partial file deleted (space freed)", not left, str(left))
+    finally:
+        subprocess.run(["umount", str(mnt)], capture_output=True)
+
+
+def write_failure_checks(name, proc):
+    err = proc.stderr
+    check(f"{name}: exit code 1 (no crash)", proc.returncode == 1,
+          f"exit {proc.returncode}: {err.strip()[-300:]}")
+    check(f"{name}: reported at a write", ("cannot write to file" in err or
+                                           "cannot append to dataset" in err) and
+          "cannot close" not in err and "disk full" in err, err.strip()[-200:])
+    check(f"{name}: no runtime error or signal", "Segmentation" not in err and
+          "Fortran runtime error" not in err, "")
 
 
 def main():
@@ -262,6 +290,7 @@ def main():
     stop_by_signal(exe, src, work, "incline.dat", signal.SIGUSR1, "usr1_dem")
     stop_by_signal(exe, src, work, "bending_case2.dat", signal.SIGINT, "int_coupled")
     write_error(exe, src, work)
+    full_disk(exe, src, work)
     if FAILED:
         print(f"{len(FAILED)} check(s) failed: {', '.join(FAILED)}")
         sys.exit(1)
