@@ -15,6 +15,7 @@ program multicor
     use, intrinsic :: ieee_exceptions, only: ieee_divide_by_zero
     use core_error, only: error_t
     use core_version, only: multicor_version
+    use core_signals, only: signal_exit_code
     use io_deck_schema, only: multicor_schema, schema_markdown
     use driver_run, only: run_options_t, run_deck
     implicit none
@@ -23,7 +24,7 @@ program multicor
     type(ieee_status_type) :: fp_status
     type(error_t), allocatable :: error
     character(len=:), allocatable :: arg, text
-    integer :: i, n
+    integer :: i, n, stopped_by
     logical :: take_output
 
     n = command_argument_count()
@@ -69,12 +70,17 @@ program multicor
     call ieee_set_halting_mode(ieee_overflow, .false.)
     call ieee_set_halting_mode(ieee_invalid, .false.)
     call ieee_set_halting_mode(ieee_divide_by_zero, .false.)
-    call run_deck(opts, report, error)
+    call run_deck(opts, report, error, stopped_by)
     ! The exceptions raised on the way are handled (guards): back to the quiet flags and the
     ! modes of the start, or the end of the program would signal them again.
     call ieee_set_status(fp_status)
-    if (allocated(error)) then
+    if (allocated(error) .and. stopped_by /= 0) then
+        write (error_unit, '(a)') 'multicor: stopped: '//error%message
+        flush (error_unit)
+        stop signal_exit_code(stopped_by), quiet = .true.
+    else if (allocated(error)) then
         write (error_unit, '(a)') 'multicor: error: '//error%message
+        flush (error_unit)
         stop 1, quiet = .true.
     end if
 
@@ -118,6 +124,8 @@ contains
             '  -h, --help           print this help', &
             '', &
             'Results: DIR/<deck name>.h5 (HDF5, layout in doc/output.md).', &
-            'Exit codes: 0 success, 1 error in the deck or the run, 2 bad command line.'
+            'Exit codes: 0 success, 1 error in the deck or the run, 2 bad command line,', &
+            '128 + signal number when SIGTERM (143), SIGINT (130) or SIGUSR1 (138) stopped the', &
+            'run: the results so far are then in DIR/<deck name>.h5.partial.'
     end subroutine print_help
 end program multicor

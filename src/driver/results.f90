@@ -2,10 +2,15 @@
 !>
 !> The file is written as '<final_path>.partial' and renamed to `final_path` by `close` only
 !> when the run succeeded: an earlier result stays intact until then, and `abort` deletes the
-!> partial file. Arrays per node are (3, n_nodes) in Fortran = (n_nodes, 3) in h5py, with the
+!> partial file. /summary is written at creation with finished = 0 and set to 1 by `close`;
+!> the run loops `flush` after every output, so the partial file of a killed run opens and
+!> holds every output up to the last one. A run stopped by a signal (`stop_at`) is closed by
+!> `close_unfinished`: it stays '.partial' with finished = 0 and the reason in /summary.
+!> Arrays per node are (3, n_nodes) in Fortran = (n_nodes, 3) in h5py, with the
 !> DOFs u (x), w (y), theta (rotation about z); time series add a last Fortran dimension
 !> (the first in h5py) per stored output.
 module driver_results
+    use, intrinsic :: iso_fortran_env, only: int64
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
     use core_version, only: multicor_version, multicor_name
@@ -34,6 +39,10 @@ module driver_results
         logical :: have_energy = .false.
         !> Total energy of the first energy record [J] (reference of the balance).
         real(wp) :: energy0 = 0.0_wp
+        !> Why the run stopped before its end ('' while it runs; set by `stop_at`).
+        character(len=:), allocatable :: stop_reason
+        !> Time of the last output stored before a stop [s] (set by `stop_at`).
+        real(wp) :: stop_time = 0.0_wp
     contains
         procedure :: open => writer_open
         procedure :: write_mesh => writer_write_mesh
@@ -42,7 +51,11 @@ module driver_results
         procedure :: write_static => writer_write_static
         procedure :: write_modal => writer_write_modal
         procedure :: write_summary => writer_write_summary
+        procedure :: flush => writer_flush
+        procedure :: stop_at => writer_stop_at
+        procedure :: stopped => writer_stopped
         procedure :: close => writer_close
+        procedure :: close_unfinished => writer_close_unfinished
         procedure :: abort => writer_abort
         procedure :: is_open => writer_is_open
     end type results_writer_t
@@ -76,9 +89,16 @@ contains
         self%have_state = .false.
         self%have_energy = .false.
         self%energy0 = 0.0_wp
+        self%stop_reason = ''
+        self%stop_time = 0.0_wp
         call self%file%create(self%partial_path, error)
         if (allocated(error)) return
         call root_attributes(error)
+        if (.not. allocated(error)) call self%file%create_group('/summary', error)
+        if (.not. allocated(error)) call self%file%write_attribute('/summary', 'finished', 0, error)
+        if (.not. allocated(error)) call self%file%write_attribute('/summary', 'status', &
+                                                                   'running (or killed)', error)
+        if (.not. allocated(error)) call self%flush(error)
         if (allocated(error)) call self%abort()
     contains
         subroutine root_attributes(error)
@@ -305,14 +325,51 @@ contains
         type(error_t), allocatable, intent(out) :: error
         call require_open(self, 'write_summary', error)
         if (allocated(error)) return
-        call self%file%create_group('/summary', error)
-        if (allocated(error)) return
         call self%file%write_attribute('/summary', 'steps', steps, error)
         if (allocated(error)) return
         call self%file%write_attribute('/summary', 'wall_seconds', wall_seconds, error)
         if (allocated(error)) return
-        call self%file%write_attribute('/summary', 'finished', iso_date_time(), error)
+        call self%file%write_attribute('/summary', 'ended', iso_date_time(), error)
     end subroutine writer_write_summary
+
+    !> Write what HDF5 buffers to the file: called after every output, so that a killed run
+    !> leaves a readable file with every output up to this one.
+    subroutine writer_flush(self, error)
+        !> An open writer.
+        class(results_writer_t), intent(inout) :: self
+        !> Set when the data cannot be written (disk full, quota, file size limit).
+        type(error_t), allocatable, intent(out) :: error
+        call require_open(self, 'flush', error)
+        if (allocated(error)) return
+        call self%file%flush(error)
+        if (allocated(error)) error%message = 'results: '//error%message
+    end subroutine writer_flush
+
+    !> Record that the run stops early (a signal) after storing its state at time `t`.
+    subroutine writer_stop_at(self, signal, step, t)
+        !> An open writer.
+        class(results_writer_t), intent(inout) :: self
+        !> Name of the signal ('SIGTERM', ...).
+        character(len=*), intent(in) :: signal
+        !> Last time step done.
+        integer(int64), intent(in) :: step
+        !> Time of that step, stored as the last output [s].
+        real(wp), intent(in) :: t
+        character(len=40) :: sbuf, tbuf
+        write (sbuf, '(i0)') step
+        write (tbuf, '(es16.8e3)') t
+        self%stop_reason = 'signal '//signal//' at step '//trim(sbuf)//', t = '// &
+                           trim(adjustl(tbuf))//' s'
+        self%stop_time = t
+    end subroutine writer_stop_at
+
+    !> Whether `stop_at` was called.
+    pure logical function writer_stopped(self)
+        !> The writer.
+        class(results_writer_t), intent(in) :: self
+        writer_stopped = .false.
+        if (allocated(self%stop_reason)) writer_stopped = len(self%stop_reason) > 0
+    end function writer_stopped
 
     !> Close the file and rename '<final_path>.partial' to `final_path` (replacing an earlier
     !> file). If the rename fails, the results stay in the partial file (the error says so) and
@@ -324,6 +381,13 @@ contains
         type(error_t), allocatable, intent(out) :: error
         call require_open(self, 'close', error)
         if (allocated(error)) return
+        call self%file%write_attribute('/summary', 'finished', 1, error)
+        if (.not. allocated(error)) call self%file%write_attribute('/summary', 'status', 'finished', error)
+        if (allocated(error)) then
+            call self%abort()
+            error%message = 'results: '//error%message
+            return
+        end if
         call self%file%close(error)
         if (allocated(error)) then
             ! An HDF5 file that failed to close is not trustworthy.
@@ -335,6 +399,28 @@ contains
         if (allocated(error)) error%message = 'results: '//error%message//' (the results are ' &
                                               //"kept in '"//self%partial_path//"')"
     end subroutine writer_close
+
+    !> Close the file of a run stopped early (`stop_at`) and keep it as '<final_path>.partial'
+    !> with /summary finished = 0 and status = the reason: an earlier finished result is left
+    !> as it was.
+    subroutine writer_close_unfinished(self, error)
+        !> An open writer; closed on return.
+        class(results_writer_t), intent(inout) :: self
+        !> Set when the file cannot be written or closed.
+        type(error_t), allocatable, intent(out) :: error
+        call require_open(self, 'close', error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/summary', 'status', self%stop_reason, error)
+        if (.not. allocated(error)) call self%file%write_attribute('/summary', 'ended', &
+                                                                   iso_date_time(), error)
+        if (allocated(error)) then
+            call self%abort()
+            error%message = 'results: '//error%message
+            return
+        end if
+        call self%file%close(error)
+        if (allocated(error)) error%message = 'results: '//error%message
+    end subroutine writer_close_unfinished
 
     !> Close and delete the partial file after a failed run (an earlier result is untouched).
     !> Does nothing when the writer is not open.

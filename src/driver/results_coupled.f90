@@ -256,6 +256,8 @@ contains
         call file%append_chunk('/coupling/corrections', self%corrections(:k), error)
         if (allocated(error)) return
         self%n_buffered = 0
+        ! Every batch of writes ends with a flush (a killed run keeps a readable file).
+        call file%flush(error)
     end subroutine flush_steps
 
     !> Write the buffered values and the closing attributes of /coupling (steps, largest

@@ -352,6 +352,8 @@ contains
         call file%append_chunk('/dem/solver/residual', self%residual(:k), error)
         if (allocated(error)) return
         self%n_buffered = 0
+        ! Every batch of writes ends with a flush (a killed run keeps a readable file).
+        call file%flush(error)
     end subroutine flush_stats
 
     !> Write the buffered statistics and the closing attributes of /dem/solver (steps,

@@ -21,9 +21,10 @@ module driver_run
     use core_strings, only: to_str
     use io_lock, only: lock_t, lock_acquire, lock_release
     use io_memory, only: available_memory
+    use core_signals, only: caught_signal, signal_name, install_signal_handlers
     use io_deck_schema, only: multicor_schema
     use io_deck, only: deck_t, read_deck
-    use io_paths, only: stem, mkdir_p
+    use io_paths, only: stem, mkdir_p, file_exists
     use io_progress, only: progress_t
     use fem_beam_config, only: beam_config_t
     use fem_beam_model, only: beam_model_t, build_beam_model
@@ -66,13 +67,20 @@ module driver_run
 contains
 
     !> Read, check and run a deck; write results unless only checking.
-    subroutine run_deck(opts, report, error)
+    !>
+    !> From the opening of the results file on, SIGTERM, SIGINT and SIGUSR1 stop a time loop
+    !> after the step under way: that step is stored, the file is closed as
+    !> '<name>.h5.partial' with /summary finished = 0, and `error` says what was saved
+    !> (`stopped_by` is then the signal number).
+    subroutine run_deck(opts, report, error, stopped_by)
         !> What to run and where to write.
         type(run_options_t), intent(in) :: opts
         !> Where progress and summary lines go.
         procedure(report_iface) :: report
-        !> Set on any input or run error.
+        !> Set on any input or run error, and when a signal stopped the run.
         type(error_t), allocatable, intent(out) :: error
+        !> Signal that stopped the run early (0: none).
+        integer, intent(out), optional :: stopped_by
         type(deck_t) :: deck
         type(run_config_t) :: run
         type(beam_config_t) :: beam
@@ -86,7 +94,9 @@ contains
         character(len=:), allocatable :: dir, path, message, warning
         logical :: particles, coupled
         integer :: i
+        character(len=32) :: tbuf
 
+        if (present(stopped_by)) stopped_by = 0
         call read_deck(opts%deck_path, multicor_schema(), deck, error)
         if (allocated(error)) return
         particles = deck_has_particles(deck)
@@ -141,7 +151,9 @@ contains
         call lock_acquire(lock, dir, warning, error)
         if (allocated(error)) return
         if (len(warning) > 0) call report(warning)
-        call write_results(error)
+        ! Until here a signal kills the program at once (nothing is written yet).
+        call install_signal_handlers(error)
+        if (.not. allocated(error)) call write_results(error)
         call lock_release(lock)
         if (allocated(error)) return
         call report('results written to '//path)
@@ -164,6 +176,21 @@ contains
             if (allocated(error)) then
                 call out%abort()
                 error%message = deck%file//': '//error%message
+                return
+            end if
+            if (out%stopped()) then
+                call out%close_unfinished(error)
+                if (allocated(error)) return
+                if (present(stopped_by)) stopped_by = caught_signal()
+                write (tbuf, '(es16.8e3)') out%stop_time
+                call report('stopped: '//out%stop_reason)
+                call report('saved: every output up to t = '//trim(adjustl(tbuf))//' s (the last one '// &
+                            'at the stop) in '//out%partial_path//' (/summary finished = 0)')
+                if (file_exists(path)) call report('the earlier result '//path//' is left as it was')
+                call report('to continue: run the deck again (restart from a checkpoint is not '// &
+                            'available yet)')
+                call make_error(error, deck%file//': run stopped by '//signal_name(caught_signal())// &
+                                '; results so far in '//out%partial_path)
                 return
             end if
             call out%close(error)
@@ -424,6 +451,14 @@ contains
                 call store(error)
                 if (allocated(error)) return
             end if
+            if (k < n_steps .and. caught_signal() /= 0) then
+                ! Stop request: the step just done is the last output.
+                if (mod(k, int(run%output_interval, i8)) /= 0) call store(error)
+                if (allocated(error)) return
+                call out%stop_at(signal_name(caught_signal()), k, integ%t)
+                n_steps = k
+                exit
+            end if
             if (.not. quiet .and. progress%due()) call report(progress%line(k, integ%t))
         end do
         write (buf, '(a,i0,a,es13.5e3,a,es11.3e3)') 'dynamic run: ', n_steps, ' steps to t = ', &
@@ -453,6 +488,8 @@ contains
             if (allocated(error)) return
             call out%append_energy(integ%t, integ%kinetic, integ%strain, integ%external_work, &
                                    integ%damping_dissipation, error)
+            if (allocated(error)) return
+            call out%flush(error)
         end subroutine store
     end subroutine run_dynamic
 end module driver_run

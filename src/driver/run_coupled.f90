@@ -14,6 +14,7 @@ module driver_run_coupled
     use core_kinds, only: wp, i8
     use core_error, only: error_t
     use core_strings, only: to_str
+    use core_signals, only: caught_signal, signal_name
     use io_progress, only: progress_t
     use fem_beam_config, only: beam_config_t
     use coupling_arlequin, only: coupled_system_t, coupled_energies_t, build_coupled_system, &
@@ -118,6 +119,14 @@ contains
                 call store(error)
                 if (allocated(error)) return
             end if
+            if (k < n_steps .and. caught_signal() /= 0) then
+                ! Stop request: the step just done is the last output.
+                if (mod(k, int(run%output_interval, i8)) /= 0) call store(error)
+                if (allocated(error)) return
+                call out%stop_at(signal_name(caught_signal()), k, sys%fe%t)
+                n_steps = k
+                exit
+            end if
             if (quiet) cycle
             if (progress%due()) call report(progress%line(k, sys%fe%t))
         end do
@@ -158,6 +167,8 @@ contains
             call dem_out%store(out%file, sys%dem, error)
             if (allocated(error)) return
             call cpl_out%store(out%file, sys, error)
+            if (allocated(error)) return
+            call out%flush(error)
         end subroutine store
 
         !> Warning for an unconverged step (the first max_warnings ones).

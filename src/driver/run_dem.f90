@@ -11,6 +11,7 @@ module driver_run_dem
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
     use core_strings, only: to_str
+    use core_signals, only: caught_signal, signal_name
     use io_progress, only: progress_t
     use dem_particles, only: particles_t
     use dem_moreau_jean, only: mj_init, mj_step, energies_balance
@@ -70,7 +71,7 @@ contains
         if (allocated(error)) return
         call check_disks_state(0_i8, cfg%system%time, cfg%system%particles, cfg%system%energies, error)
         if (allocated(error)) return
-        call writer%store(out%file, cfg%system, error)
+        call store(error)
         if (allocated(error)) return
         unconverged = 0
         speed_warned = .false.
@@ -91,8 +92,16 @@ contains
             end if
             if (.not. speed_warned) call check_speed()
             if (mod(k, int(run%output_interval, i8)) == 0 .or. k == n_steps) then
-                call writer%store(out%file, cfg%system, error)
+                call store(error)
                 if (allocated(error)) return
+            end if
+            if (k < n_steps .and. caught_signal() /= 0) then
+                ! Stop request: the step just done is the last output.
+                if (mod(k, int(run%output_interval, i8)) /= 0) call store(error)
+                if (allocated(error)) return
+                call out%stop_at(signal_name(caught_signal()), k, cfg%system%time)
+                n_steps = k
+                exit
             end if
             if (quiet) cycle
             if (progress%due()) call report(progress%line(k, cfg%system%time))
@@ -115,6 +124,14 @@ contains
                                       sys%walls, sys%contacts, error)
             end associate
         end subroutine check_step
+
+        !> One stored output, flushed to the file.
+        subroutine store(error)
+            type(error_t), allocatable, intent(out) :: error
+            call writer%store(out%file, cfg%system, error)
+            if (allocated(error)) return
+            call out%flush(error)
+        end subroutine store
 
         !> Warning for an unconverged step (the first max_warnings ones).
         subroutine warn_unconverged()

@@ -16,19 +16,27 @@
 !>
 !> The HDF5 library is opened on first use (checked through the validity of a predefined
 !> type id, so no module state is kept) and never closed here: `h5close_f` would close every
-!> file of the process; the library closes itself at program exit. Automatic printing of the
-!> HDF5 error stack is switched off: errors are reported through `error_t` only.
+!> file of the process. Its exit handler is switched off (`h5dont_atexit_f`): after a failed
+!> write (full disk) HDF5 cannot close the file, and its exit handler then crashed trying
+!> again; every file written is closed explicitly, so nothing is lost. Automatic printing of
+!> the HDF5 error stack is switched off: errors are reported through `error_t` only.
+!>
+!> Crash safety: files are created with the file-space strategy NONE (space freed while the
+!> file is open is never reused) and `flush` writes everything HDF5 buffers; a writer killed
+!> between two flushes leaves the file as it was at the first one (doc/decisions.md).
 module io_hdf5_file
     use, intrinsic :: iso_c_binding, only: c_ptr, c_char, c_size_t, c_null_char, c_null_ptr, &
-                                                                              c_loc, c_f_pointer, c_associated
+                                                                              c_loc, c_f_pointer, c_associated, &
+                                                                              c_int, c_bool, c_int64_t, c_long_long
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
-    use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5eset_auto_f, h5iis_valid_f, &
+    use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5dont_atexit_f, h5eset_auto_f, h5iis_valid_f, &
                     h5iget_type_f, h5i_dataset_f, h5i_dataspace_f, h5i_datatype_f, h5i_attr_f, h5i_group_f, &
                     h5i_genprop_lst_f, h5i_file_f, h5fcreate_f, h5fopen_f, h5fclose_f, h5f_acc_trunc_f, &
-                    h5f_acc_rdonly_f, h5f_libver_v18_f, h5f_libver_latest_f, h5pcreate_f, h5pclose_f, &
+                    h5f_acc_rdonly_f, h5fflush_f, h5f_scope_global_f, h5f_libver_v18_f, &
+                    h5f_libver_latest_f, h5pcreate_f, h5pclose_f, &
                     h5pset_libver_bounds_f, h5pset_create_inter_group_f, h5pset_chunk_f, &
-                    h5p_file_access_f, h5p_link_create_f, h5p_dataset_create_f, h5gcreate_f, h5gclose_f, &
+                    h5p_file_access_f, h5p_file_create_f, h5p_link_create_f, h5p_dataset_create_f, h5gcreate_f, h5gclose_f, &
                     h5lexists_f, h5oopen_f, h5oclose_f, h5screate_f, h5screate_simple_f, h5sclose_f, &
                     h5s_scalar_f, h5s_unlimited_f, h5s_select_set_f, h5sselect_hyperslab_f, &
                     h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, h5acreate_f, h5aopen_f, &
@@ -50,7 +58,23 @@ module io_hdf5_file
             type(c_ptr), value, intent(in) :: s
             integer(c_size_t) :: n
         end function c_strlen
+        !> H5Pset_file_space_strategy of the C library (no Fortran wrapper in HDF5 1.10).
+        integer(c_int) function c_h5pset_file_space_strategy(plist, strategy, persist, &
+                                                             threshold) &
+            bind(c, name='H5Pset_file_space_strategy')
+            import :: c_int, c_bool, c_int64_t, c_long_long
+            !> File creation property list (hid_t is int64_t in HDF5 1.10).
+            integer(c_int64_t), value, intent(in) :: plist
+            integer(c_int), value, intent(in) :: strategy
+            logical(c_bool), value, intent(in) :: persist
+            !> hsize_t (unsigned long long).
+            integer(c_long_long), value, intent(in) :: threshold
+        end function c_h5pset_file_space_strategy
     end interface
+
+    !> H5F_FSPACE_STRATEGY_NONE: every allocation at the end of the file, freed space never
+    !> reused while the file is open (see file_create).
+    integer(c_int), parameter :: fspace_strategy_none = 3
 
     !> Target size of one chunk of a time series [bytes].
     integer, parameter :: chunk_bytes = 65536
@@ -72,6 +96,7 @@ module io_hdf5_file
         procedure :: create => file_create
         procedure :: open => file_open
         procedure :: close => file_close
+        procedure :: flush => file_flush
         procedure :: is_open => file_is_open
         procedure :: exists => file_exists
         procedure :: create_group => file_create_group
@@ -118,7 +143,7 @@ contains
         character(len=*), intent(in) :: path
         !> Set when the library cannot start or the file cannot be created.
         type(error_t), allocatable, intent(out) :: error
-        integer(hid_t) :: fapl
+        integer(hid_t) :: fapl, fcpl
         integer :: hdferr
         if (self%is_open()) then
             call make_error(error, "HDF5: cannot create '"//path//"': this object still has '" &
@@ -128,6 +153,7 @@ contains
         call ensure_library(error)
         if (allocated(error)) return
         fapl = -1
+        fcpl = -1
         self%path = path
         ops: block
             ! The 1.8 file format allows attributes larger than 64 KiB (dense storage).
@@ -135,8 +161,18 @@ contains
             if (hdferr < 0) exit ops
             call h5pset_libver_bounds_f(fapl, h5f_libver_v18_f, h5f_libver_latest_f, hdferr)
             if (hdferr < 0) exit ops
-            call h5fcreate_f(path, h5f_acc_trunc_f, self%id, hdferr, access_prp=fapl)
+            ! Space freed while the file is open is never reused: what the last flush wrote is
+            ! never overwritten by later data, so a killed writer leaves the file as it was at
+            ! its last flush (doc/decisions.md).
+            call h5pcreate_f(h5p_file_create_f, fcpl, hdferr)
+            if (hdferr < 0) exit ops
+            hdferr = int(c_h5pset_file_space_strategy(int(fcpl, c_int64_t), fspace_strategy_none, &
+                                                      .false._c_bool, 1_c_long_long))
+            if (hdferr < 0) exit ops
+            call h5fcreate_f(path, h5f_acc_trunc_f, self%id, hdferr, creation_prp=fcpl, &
+                             access_prp=fapl)
         end block ops
+        call release(fcpl)
         call release(fapl)
         if (hdferr < 0) then
             self%id = -1
@@ -187,6 +223,22 @@ contains
         self%writable = .false.
         if (hdferr < 0) call make_error(error, "HDF5: cannot close file '"//self%path//"'")
     end subroutine file_close
+
+    !> Write everything HDF5 holds in memory for this file (raw data, metadata, superblock)
+    !> to the operating system: after a flush the file on disk is complete and readable as it
+    !> stands, even if the process is killed before the next flush (doc/decisions.md).
+    subroutine file_flush(self, error)
+        !> A file open for writing.
+        class(h5_file_t), intent(inout) :: self
+        !> Set when the data cannot be written (e.g. the disk is full).
+        type(error_t), allocatable, intent(out) :: error
+        integer :: hdferr
+        call require_writable(self, '(flush)', error)
+        if (allocated(error)) return
+        call h5fflush_f(self%id, h5f_scope_global_f, hdferr)
+        if (hdferr < 0) call make_error(error, "HDF5: cannot write to file '"//self%path// &
+                                        "' (disk full, quota or file size limit exceeded?)")
+    end subroutine file_flush
 
     !> Whether a file is open.
     pure logical function file_is_open(self)
@@ -288,7 +340,7 @@ contains
             if (allocated(error)) exit ops
             call h5awrite_f(attr, stype, buf, hdferr)
         end block ops
-        call release(attr)
+        call release_written(attr, hdferr)
         call release(space)
         call release(stype)
         if (.not. allocated(error) .and. hdferr < 0) call attr_error(self, 'write', object, &
@@ -320,7 +372,7 @@ contains
             if (allocated(error)) exit ops
             call h5awrite_f(attr, h5t_native_double, value, dims, hdferr)
         end block ops
-        call release(attr)
+        call release_written(attr, hdferr)
         call release(space)
         if (.not. allocated(error) .and. hdferr < 0) call attr_error(self, 'write', object, &
                                                                      name, error)
@@ -351,7 +403,7 @@ contains
             if (allocated(error)) exit ops
             call h5awrite_f(attr, h5t_native_integer, value, dims, hdferr)
         end block ops
-        call release(attr)
+        call release_written(attr, hdferr)
         call release(space)
         if (.not. allocated(error) .and. hdferr < 0) call attr_error(self, 'write', object, &
                                                                      name, error)
@@ -382,7 +434,7 @@ contains
             if (allocated(error)) exit ops
             if (size(value) > 0) call h5awrite_f(attr, h5t_native_double, value, dims, hdferr)
         end block ops
-        call release(attr)
+        call release_written(attr, hdferr)
         call release(space)
         if (.not. allocated(error) .and. hdferr < 0) call attr_error(self, 'write', object, &
                                                                      name, error)
@@ -657,7 +709,7 @@ contains
         if (allocated(error)) return
         hdferr = 0
         if (size(values) > 0) call h5dwrite_f(dset, h5t_native_double, values, dims, hdferr)
-        call release(dset)
+        call release_written(dset, hdferr)
         if (hdferr < 0) call dataset_error(self, 'write', path, error)
     end subroutine write_real_1d
 
@@ -679,7 +731,7 @@ contains
         if (allocated(error)) return
         hdferr = 0
         if (size(values) > 0) call h5dwrite_f(dset, h5t_native_double, values, dims, hdferr)
-        call release(dset)
+        call release_written(dset, hdferr)
         if (hdferr < 0) call dataset_error(self, 'write', path, error)
     end subroutine write_real_2d
 
@@ -701,7 +753,7 @@ contains
         if (allocated(error)) return
         hdferr = 0
         if (size(values) > 0) call h5dwrite_f(dset, h5t_native_double, values, dims, hdferr)
-        call release(dset)
+        call release_written(dset, hdferr)
         if (hdferr < 0) call dataset_error(self, 'write', path, error)
     end subroutine write_real_3d
 
@@ -723,7 +775,7 @@ contains
         if (allocated(error)) return
         hdferr = 0
         if (size(values) > 0) call h5dwrite_f(dset, h5t_native_integer, values, dims, hdferr)
-        call release(dset)
+        call release_written(dset, hdferr)
         if (hdferr < 0) call dataset_error(self, 'write', path, error)
     end subroutine write_int_1d
 
@@ -745,7 +797,7 @@ contains
         if (allocated(error)) return
         hdferr = 0
         if (size(values) > 0) call h5dwrite_f(dset, h5t_native_integer, values, dims, hdferr)
-        call release(dset)
+        call release_written(dset, hdferr)
         if (hdferr < 0) call dataset_error(self, 'write', path, error)
     end subroutine write_int_2d
 
@@ -990,7 +1042,7 @@ contains
         integer(hsize_t) :: dims(size(record_shape) + 1), maxdims(size(record_shape) + 1)
         integer(hsize_t) :: chunk(size(record_shape) + 1)
         integer(hid_t) :: dset
-        integer :: r, n_per_record
+        integer :: r, n_per_record, hdferr
         r = size(record_shape)
         if (r > 2 .or. any(record_shape < 1)) then
             call make_error(error, "HDF5: series '"//path//"': records must be scalars, 1-D or " &
@@ -1006,7 +1058,9 @@ contains
         chunk(r + 1) = max(1, min(max_chunk_records, chunk_bytes/(8*n_per_record)))
         call self%new_dataset(path, h5t_ieee_f64le, dims, maxdims, dset, error, chunk)
         if (allocated(error)) return
-        call release(dset)
+        hdferr = 0
+        call release_written(dset, hdferr)
+        if (hdferr < 0) call dataset_error(self, 'create', path, error)
     end subroutine file_create_series
 
     !> Create an empty integer series of scalar records (a 1-D extendible dataset of 32-bit
@@ -1020,12 +1074,15 @@ contains
         type(error_t), allocatable, intent(out) :: error
         integer(hsize_t) :: dims(1), maxdims(1), chunk(1)
         integer(hid_t) :: dset
+        integer :: hdferr
         dims = 0
         maxdims = h5s_unlimited_f
         chunk = max(1, min(max_chunk_records, chunk_bytes/4))
         call self%new_dataset(path, h5t_std_i32le, dims, maxdims, dset, error, chunk)
         if (allocated(error)) return
-        call release(dset)
+        hdferr = 0
+        call release_written(dset, hdferr)
+        if (hdferr < 0) call dataset_error(self, 'create', path, error)
     end subroutine file_create_int_series
 
     !> Append size(values) scalar records to a real scalar series.
@@ -1049,7 +1106,7 @@ contains
                         file_space_id=fspace)
         call release(mspace)
         call release(fspace)
-        call release(dset)
+        call release_written(dset, hdferr)
         if (hdferr < 0) call dataset_error(self, 'append to', path, error)
     end subroutine append_chunk_real
 
@@ -1076,7 +1133,7 @@ contains
                         hdferr, mem_space_id=mspace, file_space_id=fspace)
         call release(mspace)
         call release(fspace)
-        call release(dset)
+        call release_written(dset, hdferr)
         if (hdferr < 0) call dataset_error(self, 'append to', path, error)
     end subroutine append_chunk_real_2d
 
@@ -1101,7 +1158,7 @@ contains
                         file_space_id=fspace)
         call release(mspace)
         call release(fspace)
-        call release(dset)
+        call release_written(dset, hdferr)
         if (hdferr < 0) call dataset_error(self, 'append to', path, error)
     end subroutine append_chunk_int
 
@@ -1282,7 +1339,7 @@ contains
         end block ops
         call release(mspace)
         call release(fspace)
-        call release(dset)
+        call release_written(dset, hdferr)
         if (hdferr < 0) call dataset_error(self, 'append to', path, error)
     end subroutine append_record
 
@@ -1336,6 +1393,9 @@ contains
         type(error_t), allocatable, intent(out) :: error
         logical :: valid
         integer :: hdferr
+        ! Before any other HDF5 call (the first one starts the C library and registers its exit
+        ! handler); it fails harmlessly when called again.
+        call h5dont_atexit_f(hdferr)
         ! The predefined type ids are valid exactly while the Fortran library is open.
         call h5iis_valid_f(h5t_native_double, valid, hdferr)
         if (hdferr >= 0 .and. valid) return
@@ -1387,6 +1447,30 @@ contains
         if (hdferr < 0) return
         call h5tset_cset_f(stype, h5t_cset_utf8_f, hdferr)
     end subroutine vl_string_type
+
+    !> Close a dataset or an attribute just written and fold the status of the close into
+    !> `hdferr`: closing a dataset writes its cached chunks, so a full disk shows up here
+    !> (`release` ignores it).
+    subroutine release_written(id, hdferr)
+        !> Identifier; set to -1.
+        integer(hid_t), intent(inout) :: id
+        !> Status of the write so far; set to the failure of the close if it was fine.
+        integer, intent(inout) :: hdferr
+        integer :: id_type, status
+        if (id <= 0) return
+        call h5iget_type_f(id, id_type, status)
+        if (status >= 0) then
+            if (id_type == h5i_dataset_f) then
+                call h5dclose_f(id, status)
+                id = -1
+            else if (id_type == h5i_attr_f) then
+                call h5aclose_f(id, status)
+                id = -1
+            end if
+        end if
+        call release(id)
+        if (hdferr >= 0 .and. status < 0) hdferr = status
+    end subroutine release_written
 
     !> Close any HDF5 identifier we own (no-op for ids <= 0).
     subroutine release(id)
@@ -1458,5 +1542,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         call make_error(error, "HDF5: cannot "//what//" dataset '"//path//"' in '" &
                         //file_name(self)//"'")
+        if (what /= 'read') error%message = error%message// &
+                                            ' (disk full, quota or file size limit exceeded?)'
     end subroutine dataset_error
 end module io_hdf5_file

@@ -1,0 +1,48 @@
+/* Signal handling for core_signals (src/core/signals.f90): the only C in MULTICOR.
+ *
+ * SIGTERM, SIGINT and SIGUSR1 set a flag and nothing else (the only thing a handler may
+ * safely do); the time loops poll it once per step and stop cleanly. SA_RESETHAND gives
+ * the signal back its default action after the first delivery: a second SIGTERM or Ctrl-C
+ * kills the program at once (the results file stays readable up to its last flush).
+ * SIGXFSZ (file size limit, `ulimit -f`) is ignored, so that exceeding the limit makes the
+ * write fail with EFBIG and is reported like a full disk instead of killing the process. */
+#include <signal.h>
+#include <string.h>
+
+static volatile sig_atomic_t multicor_caught = 0;
+
+static void multicor_on_signal(int sig)
+{
+    if (multicor_caught == 0) multicor_caught = sig;
+}
+
+/* Install the handlers; 0 on success, -1 when sigaction fails. */
+int multicor_signals_install(void)
+{
+    static const int handled[] = {SIGTERM, SIGINT, SIGUSR1};
+    struct sigaction sa;
+    size_t k;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = multicor_on_signal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESETHAND | SA_RESTART;
+    for (k = 0; k < sizeof handled / sizeof handled[0]; ++k) {
+        if (sigaction(handled[k], &sa, NULL) != 0) return -1;
+    }
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = SIG_IGN;
+    sigemptyset(&sa.sa_mask);
+    if (sigaction(SIGXFSZ, &sa, NULL) != 0) return -1;
+    return 0;
+}
+
+/* Number of the first signal caught (0: none). */
+int multicor_signals_caught(void) { return (int)multicor_caught; }
+
+/* Forget a caught signal (tests only; the handler stays reset after its first delivery). */
+void multicor_signals_clear(void) { multicor_caught = 0; }
+
+/* Signal numbers of this platform. */
+int multicor_sigterm(void) { return SIGTERM; }
+int multicor_sigint(void) { return SIGINT; }
+int multicor_sigusr1(void) { return SIGUSR1; }

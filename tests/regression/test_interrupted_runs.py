@@ -1,0 +1,301 @@
+#!/usr/bin/env python3
+"""Interrupted runs: results readable after `kill -9`, clean stop on SIGTERM / SIGINT /
+SIGUSR1, write errors reported at the write (doc/output.md, "Interrupted runs").
+
+Long versions of example decks (input/cantilever.dat, input/incline.dat,
+input/bending_case2.dat with a far end time) are started, left to write a few outputs, then
+killed or signalled. The '.partial' file must open in h5py and h5dump, say finished = 0 in
+/summary, and hold exactly (bit for bit) the values of an uninterrupted run of the same deck
+at the same steps; an earlier finished result in the same folder must stay untouched. A file
+size limit (RLIMIT_FSIZE, as `ulimit -f`, unprivileged) and, where root can mount one, a
+full 512 KiB tmpfs: the run must stop with a clear error at the write and exit code 1, not
+crash.
+Usage (ctest does this): test_interrupted_runs.py --exe multicor --work DIR --source REPO
+"""
+import argparse
+import hashlib
+import pathlib
+import re
+import resource
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+
+FAILED = []
+
+
+def check(name, ok, detail=""):
+    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
+    if not ok:
+        FAILED.append(name)
+
+
+def deck_with_end(src, dst, end, progress=None):
+    """Copy a deck with another [time] end (and [output] progress, in wall seconds)."""
+    text = re.sub(r"^end\s*=.*$", f"end = {end!r}", src.read_text(), count=1, flags=re.M)
+    if progress is not None:
+        text = re.sub(r"^progress\s*=.*$", "", text, flags=re.M)
+        text = re.sub(r"^\[output\]\s*$", f"[output]\nprogress = {progress!r}", text,
+                      count=1, flags=re.M)
+    dst.write_text(text)
+    return dst
+
+
+def digest(path):
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def start(exe, deck, out, **kw):
+    """Start a run with progress lines (the deck sets [output] progress)."""
+    return subprocess.Popen([str(exe), str(deck), "--output", str(out)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kw)
+
+
+def wait_for_step(proc, min_step, lines):
+    """Read progress lines ('step N/...') until step min_step is passed; the lines read are
+    appended to `lines`. False if the run ended first."""
+    for line in proc.stdout:
+        lines.append(line)
+        m = re.match(r"step (\d+)/", line)
+        if m and int(m.group(1)) >= min_step:
+            return True
+    return False
+
+
+def series_key(f):
+    return "fem/time" if "fem/time" in f else "dem/time"
+
+
+def compare_prefix(name, partial, reference, complete):
+    """Every dataset of the partial file equals the start of the same dataset of the
+    reference (bit for bit: same code, same inputs, same steps). `complete`: the partial file
+    must also hold every dataset of the reference."""
+    bad, n = [], 0
+    with h5py.File(partial, "r") as p, h5py.File(reference, "r") as r:
+        names = []
+        r.visititems(lambda k, o: names.append(k) if isinstance(o, h5py.Dataset) else None)
+        for k in names:
+            if k not in p:
+                if complete:
+                    bad.append(f"{k} missing")
+                continue
+            a, b = p[k][...], r[k][...]
+            n += 1
+            if a.shape[1:] != b.shape[1:] or len(a) > len(b):
+                bad.append(f"{k} shape {a.shape} vs {b.shape}")
+            elif not np.array_equal(a, b[: len(a)]):
+                bad.append(f"{k} differs")
+    check(name, not bad and n > 0, f"{n} datasets equal to the uninterrupted run" if not bad
+          else "; ".join(bad[:5]))
+
+
+def readable(name, path):
+    """Opens in h5py (every dataset read) and in h5dump."""
+    def read_all(_, obj):
+        if isinstance(obj, h5py.Dataset):
+            obj[...]  # a non-None return would stop visititems
+
+    try:
+        with h5py.File(path, "r") as f:
+            f.visititems(read_all)
+            n_out = len(f[series_key(f)])
+            summary = dict(f["summary"].attrs)
+    except Exception as e:  # noqa: BLE001 - any failure to read is the failure tested
+        check(f"{name}: opens in h5py", False, str(e))
+        return 0, {}
+    dump = subprocess.run(["h5dump", "-H", str(path)], capture_output=True, text=True) \
+        if shutil.which("h5dump") else None
+    if dump is None:
+        print(f"skip   {name}: h5dump not installed")
+    else:
+        check(f"{name}: opens in h5dump", dump.returncode == 0,
+              (dump.stderr + dump.stdout[-300:]).strip()[-600:])
+        if dump.returncode != 0:
+            shutil.copy(path, path.with_name(path.name + ".h5dump_failed"))
+    return n_out, summary
+
+
+def reference_run(exe, deck_src, t_last, margin, work, name):
+    """Uninterrupted run of the same deck to a little after t_last."""
+    deck = deck_with_end(deck_src, work / f"{name}.dat", t_last + margin)
+    proc = subprocess.run([str(exe), str(deck), "--output", str(work / name), "--quiet"],
+                          capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise SystemExit(f"reference run failed: {proc.stdout}{proc.stderr}")
+    return work / name / f"{name}.h5"
+
+
+def kill_9(exe, src, work):
+    """kill -9 a beam run several times at different moments: the partial file always opens
+    and holds the outputs so far; the earlier finished result is untouched."""
+    deck_src = src / "input" / "cantilever.dat"
+    folder = work / "kill9"
+    deck = deck_with_end(deck_src, work / "long_beam.dat", 0.05)
+    subprocess.run([str(exe), str(deck), "--output", str(folder), "--quiet"], check=True,
+                   capture_output=True)
+    earlier = folder / "long_beam.h5"
+    before = digest(earlier)
+    deck_with_end(deck_src, deck, 1000.0, progress=0.02)
+    partial = folder / "long_beam.h5.partial"
+    counts, unreadable = [], 0
+    for i, extra in enumerate([0.0, 0.05, 0.13, 0.21, 0.34, 0.55]):
+        partial.unlink(missing_ok=True)
+        proc = start(exe, deck, folder)
+        # Past step 100 (20 outputs); then a varying extra delay so that the kill falls at
+        # different moments of the write/flush cycle.
+        if not wait_for_step(proc, 100, []):
+            check("kill -9: run reached a few outputs", False, proc.communicate()[1][-300:])
+            return
+        time.sleep(extra)
+        proc.send_signal(signal.SIGKILL)
+        proc.communicate()
+        n_out, summary = readable(f"kill -9 #{i + 1}", partial)
+        if n_out == 0:
+            unreadable += 1
+            continue
+        counts.append(n_out)
+        if i == 0:
+            check("kill -9: /summary finished = 0", int(summary.get("finished", -1)) == 0,
+                  f"{summary}")
+            check("kill -9: at least 20 outputs", n_out >= 20, f"{n_out} outputs")
+            with h5py.File(partial, "r") as f:
+                t_last = float(f["fem/time"][-1])
+            ref = reference_run(exe, deck_src, t_last, 0.01, work, "ref_kill9")
+            compare_prefix("kill -9: outputs equal an uninterrupted run", partial, ref, False)
+    check("kill -9: every partial file readable", unreadable == 0,
+          f"{len(counts)} kills, {unreadable} unreadable, outputs held {counts}")
+    check("kill -9: earlier finished result untouched", digest(earlier) == before, str(earlier))
+
+
+def stop_by_signal(exe, src, work, deck_name, sig, name):
+    """Send `sig` to a long run: exit 128 + sig, message, partial closed with finished = 0
+    and every output up to the step of the stop, equal to an uninterrupted run."""
+    deck_src = src / "input" / deck_name
+    folder = work / name
+    deck = deck_with_end(deck_src, work / f"{name}.dat", 1000.0, progress=0.02)
+    partial = folder / f"{name}.h5.partial"
+    proc = start(exe, deck, folder)
+    lines = []
+    # Past step 100: at least 10 outputs in these decks (an output every 5 or 10 steps).
+    if not wait_for_step(proc, 100, lines):
+        check(f"{name}: run reached a few outputs", False, proc.communicate()[1][-300:])
+        return
+    t0 = time.monotonic()
+    proc.send_signal(sig)
+    out, err = proc.communicate()
+    out = "".join(lines) + out
+    delay = time.monotonic() - t0
+    signame = signal.Signals(sig).name
+    check(f"{name}: exit code 128 + {signame}", proc.returncode == 128 + sig,
+          f"{proc.returncode} ({delay:.2f} s after the signal)")
+    m = re.search(rf"stopped: signal {signame} at step (\d+), t = (\S+) s", out)
+    check(f"{name}: says at which step it stopped", m is not None, out.strip()[-300:])
+    check(f"{name}: says what was saved", f"saved: every output up to t = " in out and
+          str(partial) in out, "")
+    check(f"{name}: error line names the signal", f"run stopped by {signame}" in err,
+          err.strip()[-200:])
+    n_out, summary = readable(name, partial)
+    if not m or n_out == 0:
+        return
+    step, t_stop = int(m.group(1)), float(m.group(2))
+    check(f"{name}: at least 10 outputs", n_out >= 10, f"{n_out} outputs")
+    check(f"{name}: /summary finished = 0 with the reason",
+          int(summary.get("finished", -1)) == 0 and summary.get("status", "").startswith(
+              f"signal {signame} at step {step}, t = ") and int(summary["steps"]) == step,
+          f"{summary.get('finished')}, {summary.get('status')!r}, steps {summary.get('steps')}")
+    with h5py.File(partial, "r") as f:
+        t_last = float(f[series_key(f)][-1])
+    # The status prints t with 8 decimals (es16.8): the stored time agrees to 1e-8 relative.
+    check(f"{name}: last output is the stopped step", abs(t_last - t_stop) <= 1e-8 * t_stop,
+          f"t = {t_last} vs {t_stop}")
+    # The stopped step is an output: the reference ends there too.
+    ref = reference_run(exe, deck_src, t_last, 0.0, work, f"ref_{name}")
+    compare_prefix(f"{name}: outputs equal an uninterrupted run", partial, ref, True)
+
+
+def write_error(exe, src, work):
+    """A file size limit (like a full disk): clear error at the write, exit 1, no crash,
+    the earlier result untouched."""
+    deck_src = src / "input" / "cantilever.dat"
+    folder = work / "fsize"
+    deck = deck_with_end(deck_src, work / "fsize_beam.dat", 0.02)
+    subprocess.run([str(exe), str(deck), "--output", str(folder), "--quiet"], check=True,
+                   capture_output=True)
+    earlier = folder / "fsize_beam.h5"
+    before = digest(earlier)
+    deck_with_end(deck_src, deck, 5.0)
+    limit = 256 * 1024
+
+    def limit_file_size():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    # restore_signals (the default) gives the child SIGXFSZ's default action (terminate):
+    # multicor must ignore it itself.
+    proc = subprocess.run([str(exe), str(deck), "--output", str(folder), "--quiet"],
+                          capture_output=True, text=True, preexec_fn=limit_file_size,
+                          timeout=300)
+    write_failure_checks("file size limit", proc)
+    check("file size limit: earlier result untouched", digest(earlier) == before, "")
+
+
+def full_disk(exe, src, work):
+    """A really full file system: a 512 KiB tmpfs (needs root and mount rights; skipped with
+    the reason otherwise)."""
+    mnt = work / "tmpfs"
+    mnt.mkdir()
+    mount = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=512k", "tmpfs", str(mnt)],
+                           capture_output=True, text=True) if shutil.which("mount") else None
+    if mount is None or mount.returncode != 0:
+        reason = "no mount command" if mount is None else mount.stderr.strip()
+        print(f"skip   full disk (tmpfs): cannot mount a tmpfs here ({reason})")
+        return
+    try:
+        deck = deck_with_end(src / "input" / "cantilever.dat", work / "full_beam.dat", 5.0)
+        proc = subprocess.run([str(exe), str(deck), "--output", str(mnt / "run"), "--quiet"],
+                              capture_output=True, text=True, timeout=300)
+        write_failure_checks("full disk", proc)
+        left = list((mnt / "run").glob("*"))
+        check("full disk: partial file deleted (space freed)", not left, str(left))
+    finally:
+        subprocess.run(["umount", str(mnt)], capture_output=True)
+
+
+def write_failure_checks(name, proc):
+    err = proc.stderr
+    check(f"{name}: exit code 1 (no crash)", proc.returncode == 1,
+          f"exit {proc.returncode}: {err.strip()[-300:]}")
+    check(f"{name}: reported at a write", ("cannot write to file" in err or
+                                           "cannot append to dataset" in err) and
+          "cannot close" not in err and "disk full" in err, err.strip()[-200:])
+    check(f"{name}: no runtime error or signal", "Segmentation" not in err and
+          "Fortran runtime error" not in err, "")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--exe", required=True)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("--source", required=True)
+    a = ap.parse_args()
+    exe, src, work = pathlib.Path(a.exe), pathlib.Path(a.source), pathlib.Path(a.work)
+    shutil.rmtree(work, ignore_errors=True)
+    work.mkdir(parents=True)
+    kill_9(exe, src, work)
+    stop_by_signal(exe, src, work, "cantilever.dat", signal.SIGTERM, "term_beam")
+    stop_by_signal(exe, src, work, "incline.dat", signal.SIGUSR1, "usr1_dem")
+    stop_by_signal(exe, src, work, "bending_case2.dat", signal.SIGINT, "int_coupled")
+    write_error(exe, src, work)
+    full_disk(exe, src, work)
+    if FAILED:
+        print(f"{len(FAILED)} check(s) failed: {', '.join(FAILED)}")
+        sys.exit(1)
+    print("all checks passed")
+
+
+if __name__ == "__main__":
+    main()
