@@ -53,25 +53,25 @@ module core_sparse
     !> Symmetric sparse matrix: triplets until `finalize`, then compressed sparse columns of
     !> the lower triangle with the 0-based 64-bit offsets and row indices CHOLMOD reads.
     type :: sparse_matrix_t
+        private
         !> Order of the matrix.
-        integer :: n = 0
+        integer, public :: n = 0
         !> True once `finalize` has compressed the triplets (the pattern is fixed).
-        logical :: finalized = .false.
+        logical, public :: finalized = .false.
         !> Column starts (size n+1, 0-based offsets into `rowind`/`values`): the entries of
-        !> column j are values(colptr(j)+1 : colptr(j+1)).
-        integer(i8), allocatable :: colptr(:)
+        !> column j are values(colptr(j)+1 : colptr(j+1)). Read only.
+        integer(i8), allocatable, public :: colptr(:)
         !> 0-based row index of each stored entry (row >= column), sorted within each column.
-        integer(i8), allocatable :: rowind(:)
+        !> Read only.
+        integer(i8), allocatable, public :: rowind(:)
         !> Value of each stored entry; may be changed in place (see `position`).
-        real(wp), allocatable :: values(:)
-        !> Number of triplets held before `finalize`.
+        real(wp), allocatable, public :: values(:)
+        ! Triplets (0-based row, 0-based column, value) and their number, before `finalize`.
         integer(i8) :: ntriplets = 0
-        !> Triplets (0-based row, 0-based column, value) before `finalize`.
         integer(i8), allocatable :: ti(:), tj(:)
-        !> Values of the triplets.
         real(wp), allocatable :: tv(:)
-        !> First (i, j) given to `add` outside 1..n, or outside the fixed pattern after
-        !> `finalize` ((0, 0) when none): reported by `finalize` and `factor`.
+        ! First (i, j) given to `add` outside 1..n, or outside the fixed pattern after
+        ! `finalize` ((0, 0) when none): reported by `finalize` and `factor`.
         integer :: bad_entry(2) = 0
     contains
         !> Start an empty n x n matrix with room for nnz_hint triplets.
