@@ -3,7 +3,7 @@
 # creates .venv from postproc/requirements.txt; configures and builds with CMake + Ninja.
 
 MULTICOR_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-MULTICOR_APT_PACKAGES="gfortran cmake ninja-build libhdf5-dev hdf5-tools libopenblas-dev liblapack-dev python3 python3-venv python3-pip"
+MULTICOR_APT_PACKAGES="gfortran cmake ninja-build libhdf5-dev hdf5-tools libopenblas-dev liblapack-dev libsuitesparse-dev python3 python3-venv python3-pip"
 
 say() { printf '[multicor] %s\n' "$*"; }
 die() { printf '[multicor] error: %s\n' "$*" >&2; exit 1; }
