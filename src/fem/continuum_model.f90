@@ -98,6 +98,8 @@ contains
             call make_error(error, 'continuum model: the mesh has no element')
             return
         end if
+        call self%mesh%orient_edges(error)
+        if (allocated(error)) return
         do e = 1, mesh%element_count()
             associate (el => self%family(mesh%kind(e))%element)
                 if (.not. el%min_jacobian(mesh%element_coordinates(e)) > 0.0_wp) then
@@ -222,24 +224,21 @@ contains
         end do
     end subroutine model_add_body_force
 
-    !> Thickness of the material of an element on the edge (a, b), for edge loads.
-    subroutine edge_thickness(self, a, b, thickness, error)
+    !> Thickness of the material of the element carrying an edge, for edge loads.
+    subroutine edge_thickness(self, element, thickness, error)
         class(continuum_model_t), intent(in) :: self
-        integer, intent(in) :: a, b
+        integer, intent(in) :: element
         real(wp), intent(out) :: thickness
         type(error_t), allocatable, intent(out) :: error
-        integer :: e
-        integer, allocatable :: nodes(:)
+        character(len=120) :: buf
         thickness = 0.0_wp
-        do e = 1, self%mesh%element_count()
-            nodes = self%mesh%element_nodes(e)
-            if (any(nodes == a) .and. any(nodes == b)) then
-                if (self%element_material(e) == 0) exit
-                thickness = self%materials(self%element_material(e))%thickness
-                return
-            end if
-        end do
-        call make_error(error, 'continuum model: a loaded edge is not a side of an element with a material')
+        if (self%element_material(element) == 0) then
+            write (buf, '(a,i0,a)') 'continuum model: a loaded edge is a side of element ', element, &
+                ', which has no material'
+            call make_error(error, trim(buf))
+            return
+        end if
+        thickness = self%materials(self%element_material(element))%thickness
     end subroutine edge_thickness
 
     !> Add a uniform traction (tx, ty) (Pa) on the edges of a named edge set.
@@ -252,13 +251,13 @@ contains
         real(wp), intent(in) :: traction(2)
         !> Set when the set is unknown or an edge has no element with a material.
         type(error_t), allocatable, intent(out) :: error
-        integer, allocatable :: edges(:, :)
+        integer, allocatable :: edges(:, :), owner(:)
         integer :: k
         real(wp) :: t, xa(2), xb(2)
-        call self%mesh%edge_set(set_name, edges, error)
+        call self%mesh%edge_set(set_name, edges, error, owner)
         if (allocated(error)) return
         do k = 1, size(edges, 2)
-            call edge_thickness(self, edges(1, k), edges(2, k), t, error)
+            call edge_thickness(self, owner(k), t, error)
             if (allocated(error)) return
             xa = self%mesh%x(:, edges(1, k))
             xb = self%mesh%x(:, edges(2, k))
@@ -278,13 +277,13 @@ contains
         real(wp), intent(in) :: tangential
         !> Set when the set is unknown or an edge has no element with a material.
         type(error_t), allocatable, intent(out) :: error
-        integer, allocatable :: edges(:, :)
+        integer, allocatable :: edges(:, :), owner(:)
         integer :: k
         real(wp) :: t, xa(2), xb(2)
-        call self%mesh%edge_set(set_name, edges, error)
+        call self%mesh%edge_set(set_name, edges, error, owner)
         if (allocated(error)) return
         do k = 1, size(edges, 2)
-            call edge_thickness(self, edges(1, k), edges(2, k), t, error)
+            call edge_thickness(self, owner(k), t, error)
             if (allocated(error)) return
             xa = self%mesh%x(:, edges(1, k))
             xb = self%mesh%x(:, edges(2, k))
@@ -302,13 +301,13 @@ contains
         procedure(traction_field) :: traction
         !> Set when the set is unknown or an edge has no element with a material.
         type(error_t), allocatable, intent(out) :: error
-        integer, allocatable :: edges(:, :)
+        integer, allocatable :: edges(:, :), owner(:)
         integer :: k
         real(wp) :: t, xa(2), xb(2)
-        call self%mesh%edge_set(set_name, edges, error)
+        call self%mesh%edge_set(set_name, edges, error, owner)
         if (allocated(error)) return
         do k = 1, size(edges, 2)
-            call edge_thickness(self, edges(1, k), edges(2, k), t, error)
+            call edge_thickness(self, owner(k), t, error)
             if (allocated(error)) return
             xa = self%mesh%x(:, edges(1, k))
             xb = self%mesh%x(:, edges(2, k))

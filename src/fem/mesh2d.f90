@@ -32,6 +32,8 @@ module fem_mesh2d
         character(len=:), allocatable :: name
         !> Node indices of each edge (2, number of edges), body on the left of a -> b.
         integer, allocatable :: nodes(:, :)
+        !> Element of which each edge is a side (0 until `orient_edges` has run).
+        integer, allocatable :: elements(:)
     end type edge_set_t
 
     !> The mesh.
@@ -67,9 +69,10 @@ module fem_mesh2d
         procedure :: node_set => mesh_node_set
         !> Indices of a named element set (error when unknown).
         procedure :: element_set => mesh_element_set
-        !> Edges of a named edge set (error when unknown).
+        !> Edges of a named edge set and their elements (error when unknown).
         procedure :: edge_set => mesh_edge_set
-        !> Orient every edge of the edge sets so that an element containing it lies on its left.
+        !> Orient every edge of the edge sets so that an element containing it lies on its left,
+        !> and record that element.
         procedure :: orient_edges => mesh_orient_edges
         !> Reorder clockwise elements counter-clockwise (by signed area).
         procedure :: orient_elements => mesh_orient_elements
@@ -205,6 +208,7 @@ contains
                 merged(:, 1:size(self%edge_sets(k)%nodes, 2)) = self%edge_sets(k)%nodes
                 merged(:, size(self%edge_sets(k)%nodes, 2) + 1:) = edges
                 call move_alloc(merged, self%edge_sets(k)%nodes)
+                self%edge_sets(k)%elements = [self%edge_sets(k)%elements, spread(0, 1, size(edges, 2))]
                 return
             end if
         end do
@@ -212,9 +216,11 @@ contains
         do k = 1, size(self%edge_sets)
             call move_alloc(self%edge_sets(k)%name, grown(k)%name)
             call move_alloc(self%edge_sets(k)%nodes, grown(k)%nodes)
+            call move_alloc(self%edge_sets(k)%elements, grown(k)%elements)
         end do
         grown(size(grown))%name = name
         grown(size(grown))%nodes = edges
+        allocate (grown(size(grown))%elements(size(edges, 2)), source=0)
         call move_alloc(grown, self%edge_sets)
     end subroutine mesh_add_edge_set
 
@@ -257,7 +263,7 @@ contains
     end subroutine mesh_element_set
 
     !> Edges of a named edge set.
-    subroutine mesh_edge_set(self, name, edges, error)
+    subroutine mesh_edge_set(self, name, edges, error, elements)
         !> The mesh.
         class(mesh2d_t), intent(in) :: self
         !> Set name.
@@ -266,12 +272,15 @@ contains
         integer, allocatable, intent(out) :: edges(:, :)
         !> Set when no edge set has that name.
         type(error_t), allocatable, intent(out) :: error
+        !> Element of which each edge is a side (0 before `orient_edges`).
+        integer, allocatable, intent(out), optional :: elements(:)
         integer :: k
         character(len=:), allocatable :: names
         if (allocated(self%edge_sets)) then
             do k = 1, size(self%edge_sets)
                 if (self%edge_sets(k)%name == name) then
                     edges = self%edge_sets(k)%nodes
+                    if (present(elements)) elements = self%edge_sets(k)%elements
                     return
                 end if
             end do
@@ -366,6 +375,7 @@ contains
                             self%edge_sets(s)%nodes(:, k) = [b, a]
                             found = .true.
                         end if
+                        if (found) self%edge_sets(s)%elements(k) = list(m)
                         if (found) exit
                     end do
                     if (found) exit

@@ -84,6 +84,8 @@ contains
         call mesh%add_edge_set('right', edges)
         edges = reshape([(node(0, j + 1), node(0, j), j=ny - 1, 0, -1)], [2, ny])
         call mesh%add_edge_set('left', edges)
+        ! Records the element of each edge (the orientation above is already outward).
+        call mesh%orient_edges(error)
 
     contains
 
