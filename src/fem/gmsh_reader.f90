@@ -92,6 +92,10 @@ contains
                 exit
             end if
             cur%section = trim(text)
+            if (.not. seen_format .and. cur%section /= '$MeshFormat') then
+                call fail(cur, error, 'the file must start with $MeshFormat (is this a Gmsh .msh file?)')
+                exit
+            end if
             select case (cur%section)
             case ('$MeshFormat')
                 call read_format(cur, error)
@@ -114,10 +118,6 @@ contains
                 call skip_section(cur, error)
             end select
             if (allocated(error)) exit
-            if (.not. seen_format) then
-                call fail(cur, error, 'the file must start with $MeshFormat (is this a Gmsh .msh file?)')
-                exit
-            end if
             if (cur%section /= '$MeshFormat' .and. cur%section /= '$PhysicalNames' .and. &
                 cur%section /= '$Entities' .and. cur%section /= '$Nodes' .and. cur%section /= '$Elements') cycle
             call expect_end(cur, error)
