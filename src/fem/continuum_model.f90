@@ -87,7 +87,8 @@ contains
         class(continuum_model_t), intent(out) :: self
         !> The mesh (copied).
         type(mesh2d_t), intent(in) :: mesh
-        !> Set when the mesh is empty or an element has det J <= 0 somewhere.
+        !> Set when the mesh is empty, an element has det J <= 0 somewhere, or an edge of an
+        !> edge set is not a side of any element.
         type(error_t), allocatable, intent(out) :: error
         integer :: e
         character(len=120) :: buf
@@ -98,8 +99,6 @@ contains
             call make_error(error, 'continuum model: the mesh has no element')
             return
         end if
-        call self%mesh%orient_edges(error)
-        if (allocated(error)) return
         do e = 1, mesh%element_count()
             associate (el => self%family(mesh%kind(e))%element)
                 if (.not. el%min_jacobian(mesh%element_coordinates(e)) > 0.0_wp) then
@@ -110,6 +109,9 @@ contains
                 end if
             end associate
         end do
+        ! Edge loads need the body on the left of each edge and the element carrying it.
+        call self%mesh%orient_edges(error)
+        if (allocated(error)) return
         allocate (self%materials(0))
         allocate (self%element_material(mesh%element_count()), source=0)
         allocate (self%prescribed(self%dof_count()), source=.false.)
