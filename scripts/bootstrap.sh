@@ -3,7 +3,7 @@
 # creates .venv from postproc/requirements.txt; configures and builds with CMake + Ninja.
 
 MULTICOR_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-MULTICOR_APT_PACKAGES="gfortran cmake ninja-build libhdf5-dev hdf5-tools libopenblas-dev liblapack-dev libsuitesparse-dev python3 python3-venv python3-pip"
+MULTICOR_APT_PACKAGES="gfortran cmake ninja-build libhdf5-dev hdf5-tools libopenblas-dev liblapack-dev libsuitesparse-dev gmsh python3 python3-venv python3-pip"
 
 say() { printf '[multicor] %s\n' "$*"; }
 die() { printf '[multicor] error: %s\n' "$*" >&2; exit 1; }
@@ -13,7 +13,7 @@ missing_apt_packages() {
     local missing="" pkg
     if ! command -v dpkg-query >/dev/null 2>&1; then
         # Not a Debian system: check the tools themselves.
-        for tool in gfortran cmake ninja h5fc python3; do
+        for tool in gfortran cmake ninja h5fc gmsh python3; do
             command -v "$tool" >/dev/null 2>&1 || missing="$missing $tool"
         done
         echo "$missing"

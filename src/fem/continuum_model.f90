@@ -1,0 +1,485 @@
+!> A 2D linear-elastic continuum on a mesh: dof numbering, assembly and boundary conditions.
+!>
+!> Dofs: node a has dofs 2a - 1 (x) and 2a (y). Global matrices are assembled over all dofs as
+!> triplets (`fem_triplets_t`, both triangles, duplicates summed). Prescribed displacements are
+!> imposed by elimination: the free dofs are numbered 1..n_equations (`equation`), and
+!> `reduce` returns K_ff and f_f - K_fp u_p, which stay symmetric positive definite when the
+!> prescribed dofs remove the rigid motions; `expand` puts u_f and u_p back together.
+module fem_continuum_model
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_error
+    use fem_elastic2d, only: elastic2d_t
+    use fem_element2d, only: element2d_t
+    use fem_element_q4, only: element_q4_t
+    use fem_element_t3, only: element_t3_t
+    use fem_edge_load, only: edge_traction_linear, edge_traction_normal_tangential, &
+                             edge_traction_function, traction_field
+    use fem_mesh2d, only: mesh2d_t, element_t3, element_q4, nodes_per_element
+    use fem_triplets, only: fem_triplets_t
+    implicit none
+    private
+    public :: continuum_model_t
+
+    !> One element type of the family, indexed by the mesh's element kind code.
+    type :: element_slot_t
+        !> The element type.
+        class(element2d_t), allocatable :: element
+    end type element_slot_t
+
+    !> The continuum model.
+    type :: continuum_model_t
+        !> The mesh.
+        type(mesh2d_t) :: mesh
+        !> Materials.
+        type(elastic2d_t), allocatable :: materials(:)
+        !> Material index of each element (0 until assigned).
+        integer, allocatable :: element_material(:)
+        !> Element types by kind code (element_t3, element_q4).
+        type(element_slot_t) :: family(2)
+        !> Prescribed flag of each dof.
+        logical, allocatable :: prescribed(:)
+        !> Prescribed value of each dof (m; 0 where free).
+        real(wp), allocatable :: prescribed_value(:)
+        !> External nodal forces (N), size 2 * number of nodes.
+        real(wp), allocatable :: load(:)
+    contains
+        !> Take a mesh, check its elements, and start with no material, load or constraint.
+        procedure :: init => model_init
+        !> Number of dofs (2 per node).
+        procedure :: dof_count => model_dof_count
+        !> Assign a material to the elements of a named element set.
+        procedure :: set_material => model_set_material
+        !> Prescribe one dof (component 1 = x, 2 = y) of a node.
+        procedure :: prescribe => model_prescribe
+        !> Prescribe one component on every node of a named node set.
+        procedure :: prescribe_set => model_prescribe_set
+        !> Add a nodal force.
+        procedure :: add_nodal_load => model_add_nodal_load
+        !> Add the weight rho t g of every element.
+        procedure :: add_body_force => model_add_body_force
+        !> Add a uniform traction (tx, ty) on a named edge set.
+        procedure :: add_traction => model_add_traction
+        !> Add a uniform normal/tangential traction on a named edge set.
+        procedure :: add_traction_nt => model_add_traction_nt
+        !> Add a traction field t(x) on a named edge set.
+        procedure :: add_traction_field => model_add_traction_field
+        !> Check that every element has a material.
+        procedure :: check => model_check
+        !> Global stiffness (all dofs) as triplets.
+        procedure :: assemble_stiffness => model_assemble_stiffness
+        !> Global mass (all dofs), consistent or row-sum lumped, as triplets.
+        procedure :: assemble_mass => model_assemble_mass
+        !> Equation number of each dof (0 for prescribed dofs) and their count.
+        procedure :: equations => model_equations
+        !> Eliminate the prescribed dofs from K u = f.
+        procedure :: reduce => model_reduce
+        !> Full displacement vector from the free-dof solution and the prescribed values.
+        procedure :: expand => model_expand
+        !> Stress (xx, yy, xy) at every element centre.
+        procedure :: centre_stresses => model_centre_stresses
+    end type continuum_model_t
+
+contains
+
+    !> Take a mesh and check that no element is inverted or degenerate.
+    subroutine model_init(self, mesh, error)
+        !> The model.
+        class(continuum_model_t), intent(out) :: self
+        !> The mesh (copied).
+        type(mesh2d_t), intent(in) :: mesh
+        !> Set when the mesh is empty, an element has det J <= 0 somewhere, or an edge of an
+        !> edge set is not a side of any element.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: e
+        character(len=120) :: buf
+        allocate (element_t3_t :: self%family(element_t3)%element)
+        allocate (element_q4_t :: self%family(element_q4)%element)
+        self%mesh = mesh
+        if (mesh%element_count() == 0) then
+            call make_error(error, 'continuum model: the mesh has no element')
+            return
+        end if
+        do e = 1, mesh%element_count()
+            associate (el => self%family(mesh%kind(e))%element)
+                if (.not. el%min_jacobian(mesh%element_coordinates(e)) > 0.0_wp) then
+                    write (buf, '(a,i0,a)') 'continuum model: element ', e, &
+                        ' is inverted, degenerate or not convex (det J <= 0)'
+                    call make_error(error, trim(buf))
+                    return
+                end if
+            end associate
+        end do
+        ! Edge loads need the body on the left of each edge and the element carrying it.
+        call self%mesh%orient_edges(error)
+        if (allocated(error)) return
+        allocate (self%materials(0))
+        allocate (self%element_material(mesh%element_count()), source=0)
+        allocate (self%prescribed(self%dof_count()), source=.false.)
+        allocate (self%prescribed_value(self%dof_count()), self%load(self%dof_count()), source=0.0_wp)
+    end subroutine model_init
+
+    !> Number of dofs.
+    pure integer function model_dof_count(self)
+        !> The model.
+        class(continuum_model_t), intent(in) :: self
+        model_dof_count = 2*self%mesh%node_count()
+    end function model_dof_count
+
+    !> Global dofs of element e.
+    pure function element_dofs(self, e) result(dofs)
+        class(continuum_model_t), intent(in) :: self
+        integer, intent(in) :: e
+        integer, allocatable :: dofs(:)
+        integer :: n
+        n = nodes_per_element(self%mesh%kind(e))
+        allocate (dofs(2*n))
+        dofs(1::2) = 2*self%mesh%connectivity(1:n, e) - 1
+        dofs(2::2) = 2*self%mesh%connectivity(1:n, e)
+    end function element_dofs
+
+    !> Assign a material to the elements of a named set (later assignments override).
+    subroutine model_set_material(self, set_name, material, error)
+        !> The model.
+        class(continuum_model_t), intent(inout) :: self
+        !> Element set name ('all' for a generated mesh).
+        character(len=*), intent(in) :: set_name
+        !> The material.
+        type(elastic2d_t), intent(in) :: material
+        !> Set when the set is unknown.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: ids(:)
+        call self%mesh%element_set(set_name, ids, error)
+        if (allocated(error)) return
+        self%materials = [self%materials, material]
+        self%element_material(ids) = size(self%materials)
+    end subroutine model_set_material
+
+    !> Prescribe the displacement of one dof.
+    pure subroutine model_prescribe(self, node, component, value)
+        !> The model.
+        class(continuum_model_t), intent(inout) :: self
+        !> Node index.
+        integer, intent(in) :: node
+        !> 1 = x, 2 = y.
+        integer, intent(in) :: component
+        !> Displacement (m).
+        real(wp), intent(in) :: value
+        self%prescribed(2*node - 2 + component) = .true.
+        self%prescribed_value(2*node - 2 + component) = value
+    end subroutine model_prescribe
+
+    !> Prescribe one displacement component on every node of a named node set.
+    subroutine model_prescribe_set(self, set_name, component, value, error)
+        !> The model.
+        class(continuum_model_t), intent(inout) :: self
+        !> Node set name.
+        character(len=*), intent(in) :: set_name
+        !> 1 = x, 2 = y.
+        integer, intent(in) :: component
+        !> Displacement (m).
+        real(wp), intent(in) :: value
+        !> Set when the set is unknown or the component is not 1 or 2.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: ids(:)
+        integer :: k
+        if (component /= 1 .and. component /= 2) then
+            call make_error(error, 'continuum model: displacement component must be 1 (x) or 2 (y)')
+            return
+        end if
+        call self%mesh%node_set(set_name, ids, error)
+        if (allocated(error)) return
+        do k = 1, size(ids)
+            call self%prescribe(ids(k), component, value)
+        end do
+    end subroutine model_prescribe_set
+
+    !> Add a nodal force.
+    pure subroutine model_add_nodal_load(self, node, component, force)
+        !> The model.
+        class(continuum_model_t), intent(inout) :: self
+        !> Node index.
+        integer, intent(in) :: node
+        !> 1 = x, 2 = y.
+        integer, intent(in) :: component
+        !> Force (N).
+        real(wp), intent(in) :: force
+        self%load(2*node - 2 + component) = self%load(2*node - 2 + component) + force
+    end subroutine model_add_nodal_load
+
+    !> Add the equivalent nodal forces of the weight of every element.
+    subroutine model_add_body_force(self, g, error)
+        !> The model.
+        class(continuum_model_t), intent(inout) :: self
+        !> Acceleration of gravity (m/s^2).
+        real(wp), intent(in) :: g(2)
+        !> Set when an element has no material.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: e
+        integer, allocatable :: dofs(:)
+        call self%check(error)
+        if (allocated(error)) return
+        do e = 1, self%mesh%element_count()
+            dofs = element_dofs(self, e)
+            associate (el => self%family(self%mesh%kind(e))%element, mat => self%materials(self%element_material(e)))
+                self%load(dofs) = self%load(dofs) + el%body_force(self%mesh%element_coordinates(e), mat, g)
+            end associate
+        end do
+    end subroutine model_add_body_force
+
+    !> Thickness of the material of the element carrying an edge, for edge loads.
+    subroutine edge_thickness(self, element, thickness, error)
+        class(continuum_model_t), intent(in) :: self
+        integer, intent(in) :: element
+        real(wp), intent(out) :: thickness
+        type(error_t), allocatable, intent(out) :: error
+        character(len=120) :: buf
+        thickness = 0.0_wp
+        if (self%element_material(element) == 0) then
+            write (buf, '(a,i0,a)') 'continuum model: a loaded edge is a side of element ', element, &
+                ', which has no material'
+            call make_error(error, trim(buf))
+            return
+        end if
+        thickness = self%materials(self%element_material(element))%thickness
+    end subroutine edge_thickness
+
+    !> Add a uniform traction (tx, ty) (Pa) on the edges of a named edge set.
+    subroutine model_add_traction(self, set_name, traction, error)
+        !> The model.
+        class(continuum_model_t), intent(inout) :: self
+        !> Edge set name.
+        character(len=*), intent(in) :: set_name
+        !> Traction (tx, ty) (Pa).
+        real(wp), intent(in) :: traction(2)
+        !> Set when the set is unknown or an edge has no element with a material.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: edges(:, :), owner(:)
+        integer :: k
+        real(wp) :: t, xa(2), xb(2)
+        call self%mesh%edge_set(set_name, edges, error, owner)
+        if (allocated(error)) return
+        do k = 1, size(edges, 2)
+            call edge_thickness(self, owner(k), t, error)
+            if (allocated(error)) return
+            xa = self%mesh%x(:, edges(1, k))
+            xb = self%mesh%x(:, edges(2, k))
+            call scatter_edge(self, edges(:, k), edge_traction_linear(xa, xb, traction, traction, t))
+        end do
+    end subroutine model_add_traction
+
+    !> Add a uniform traction given by its normal (> 0 pulls) and tangential components (Pa).
+    subroutine model_add_traction_nt(self, set_name, normal, tangential, error)
+        !> The model.
+        class(continuum_model_t), intent(inout) :: self
+        !> Edge set name.
+        character(len=*), intent(in) :: set_name
+        !> Normal traction (Pa); a pressure p is -p.
+        real(wp), intent(in) :: normal
+        !> Tangential traction (Pa), positive counter-clockwise along the boundary.
+        real(wp), intent(in) :: tangential
+        !> Set when the set is unknown or an edge has no element with a material.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: edges(:, :), owner(:)
+        integer :: k
+        real(wp) :: t, xa(2), xb(2)
+        call self%mesh%edge_set(set_name, edges, error, owner)
+        if (allocated(error)) return
+        do k = 1, size(edges, 2)
+            call edge_thickness(self, owner(k), t, error)
+            if (allocated(error)) return
+            xa = self%mesh%x(:, edges(1, k))
+            xb = self%mesh%x(:, edges(2, k))
+            call scatter_edge(self, edges(:, k), edge_traction_normal_tangential(xa, xb, normal, tangential, t))
+        end do
+    end subroutine model_add_traction_nt
+
+    !> Add a traction field t(x) on the edges of a named edge set (3-point Gauss per edge).
+    subroutine model_add_traction_field(self, set_name, traction, error)
+        !> The model.
+        class(continuum_model_t), intent(inout) :: self
+        !> Edge set name.
+        character(len=*), intent(in) :: set_name
+        !> Traction field.
+        procedure(traction_field) :: traction
+        !> Set when the set is unknown or an edge has no element with a material.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: edges(:, :), owner(:)
+        integer :: k
+        real(wp) :: t, xa(2), xb(2)
+        call self%mesh%edge_set(set_name, edges, error, owner)
+        if (allocated(error)) return
+        do k = 1, size(edges, 2)
+            call edge_thickness(self, owner(k), t, error)
+            if (allocated(error)) return
+            xa = self%mesh%x(:, edges(1, k))
+            xb = self%mesh%x(:, edges(2, k))
+            call scatter_edge(self, edges(:, k), edge_traction_function(xa, xb, traction, t))
+        end do
+    end subroutine model_add_traction_field
+
+    !> Add edge forces (f_ax, f_ay, f_bx, f_by) to the load vector.
+    pure subroutine scatter_edge(self, nodes, f)
+        class(continuum_model_t), intent(inout) :: self
+        integer, intent(in) :: nodes(2)
+        real(wp), intent(in) :: f(4)
+        self%load(2*nodes(1) - 1:2*nodes(1)) = self%load(2*nodes(1) - 1:2*nodes(1)) + f(1:2)
+        self%load(2*nodes(2) - 1:2*nodes(2)) = self%load(2*nodes(2) - 1:2*nodes(2)) + f(3:4)
+    end subroutine scatter_edge
+
+    !> Check that every element has a material.
+    subroutine model_check(self, error)
+        !> The model.
+        class(continuum_model_t), intent(in) :: self
+        !> Set when an element has no material.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: e
+        character(len=120) :: buf
+        do e = 1, size(self%element_material)
+            if (self%element_material(e) == 0) then
+                write (buf, '(a,i0,a)') 'continuum model: element ', e, &
+                    ' has no material (assign one to an element set containing it)'
+                call make_error(error, trim(buf))
+                return
+            end if
+        end do
+    end subroutine model_check
+
+    !> Global stiffness over all dofs.
+    subroutine model_assemble_stiffness(self, k, error)
+        !> The model.
+        class(continuum_model_t), intent(in) :: self
+        !> Stiffness (dof_count x dof_count) as triplets.
+        type(fem_triplets_t), intent(out) :: k
+        !> Set when an element has no material.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: e
+        call self%check(error)
+        if (allocated(error)) return
+        call k%init(self%dof_count(), 64*self%mesh%element_count())
+        do e = 1, self%mesh%element_count()
+            associate (el => self%family(self%mesh%kind(e))%element, mat => self%materials(self%element_material(e)))
+                call k%add_block(element_dofs(self, e), el%stiffness(self%mesh%element_coordinates(e), mat))
+            end associate
+        end do
+    end subroutine model_assemble_stiffness
+
+    !> Global mass over all dofs: consistent, or row-sum lumped (diagonal triplets only).
+    subroutine model_assemble_mass(self, lumped, m, error)
+        !> The model.
+        class(continuum_model_t), intent(in) :: self
+        !> True: row-sum lumped; false: consistent.
+        logical, intent(in) :: lumped
+        !> Mass (dof_count x dof_count) as triplets.
+        type(fem_triplets_t), intent(out) :: m
+        !> Set when an element has no material.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: e, a
+        integer, allocatable :: dofs(:)
+        real(wp), allocatable :: diag(:)
+        call self%check(error)
+        if (allocated(error)) return
+        call m%init(self%dof_count(), merge(8, 64, lumped)*self%mesh%element_count())
+        do e = 1, self%mesh%element_count()
+            dofs = element_dofs(self, e)
+            associate (el => self%family(self%mesh%kind(e))%element, &
+                       xe => self%mesh%element_coordinates(e), mat => self%materials(self%element_material(e)))
+                if (lumped) then
+                    diag = el%mass_lumped(xe, mat)
+                    do a = 1, size(dofs)
+                        call m%add(dofs(a), dofs(a), diag(a))
+                    end do
+                else
+                    call m%add_block(dofs, el%mass_consistent(xe, mat))
+                end if
+            end associate
+        end do
+    end subroutine model_assemble_mass
+
+    !> Equation number of each dof: free dofs numbered 1..n in dof order, prescribed dofs 0.
+    pure subroutine model_equations(self, equation, n)
+        !> The model.
+        class(continuum_model_t), intent(in) :: self
+        !> Equation number of each dof (dof_count).
+        integer, allocatable, intent(out) :: equation(:)
+        !> Number of equations (free dofs).
+        integer, intent(out) :: n
+        integer :: i
+        allocate (equation(self%dof_count()), source=0)
+        n = 0
+        do i = 1, self%dof_count()
+            if (self%prescribed(i)) cycle
+            n = n + 1
+            equation(i) = n
+        end do
+    end subroutine model_equations
+
+    !> Eliminate the prescribed dofs: kr = K_ff, fr = f_f - K_fp u_p.
+    pure subroutine model_reduce(self, k, f, kr, fr)
+        !> The model.
+        class(continuum_model_t), intent(in) :: self
+        !> Stiffness over all dofs.
+        type(fem_triplets_t), intent(in) :: k
+        !> Forces over all dofs (dof_count).
+        real(wp), intent(in) :: f(:)
+        !> Stiffness over the free dofs (equation numbers).
+        type(fem_triplets_t), intent(out) :: kr
+        !> Right-hand side over the free dofs.
+        real(wp), allocatable, intent(out) :: fr(:)
+        integer, allocatable :: eq(:)
+        integer :: n, p, i, j
+        call self%equations(eq, n)
+        call kr%init(n, k%nnz)
+        allocate (fr(n))
+        do i = 1, size(eq)
+            if (eq(i) > 0) fr(eq(i)) = f(i)
+        end do
+        do p = 1, k%nnz
+            i = eq(k%i(p))
+            j = eq(k%j(p))
+            if (i == 0) cycle
+            if (j > 0) then
+                call kr%add(i, j, k%v(p))
+            else
+                fr(i) = fr(i) - k%v(p)*self%prescribed_value(k%j(p))
+            end if
+        end do
+    end subroutine model_reduce
+
+    !> Full displacement vector: free dofs from the solution, prescribed dofs from their values.
+    pure function model_expand(self, ur) result(u)
+        !> The model.
+        class(continuum_model_t), intent(in) :: self
+        !> Solution over the free dofs.
+        real(wp), intent(in) :: ur(:)
+        !> Displacements over all dofs.
+        real(wp), allocatable :: u(:)
+        integer, allocatable :: eq(:)
+        integer :: n, i
+        call self%equations(eq, n)
+        u = self%prescribed_value
+        do i = 1, size(eq)
+            if (eq(i) > 0) u(i) = ur(eq(i))
+        end do
+    end function model_expand
+
+    !> Stress (xx, yy, xy) at the centre of every element for the displacements u.
+    subroutine model_centre_stresses(self, u, stress, error)
+        !> The model.
+        class(continuum_model_t), intent(in) :: self
+        !> Displacements over all dofs.
+        real(wp), intent(in) :: u(:)
+        !> Stresses (3, number of elements) (Pa).
+        real(wp), allocatable, intent(out) :: stress(:, :)
+        !> Set when an element has no material.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: e
+        call self%check(error)
+        if (allocated(error)) return
+        allocate (stress(3, self%mesh%element_count()))
+        do e = 1, self%mesh%element_count()
+            associate (el => self%family(self%mesh%kind(e))%element, mat => self%materials(self%element_material(e)))
+                stress(:, e) = el%stress_centre(self%mesh%element_coordinates(e), mat, u(element_dofs(self, e)))
+            end associate
+        end do
+    end subroutine model_centre_stresses
+end module fem_continuum_model

@@ -1,0 +1,89 @@
+!> Linear isotropic elasticity in two dimensions, plane strain or plane stress, with thickness.
+!>
+!> Voigt order (xx, yy, xy) with engineering shear strain gamma_xy = 2 eps_xy, so that
+!> sigma = D eps and the strain energy density is eps^T D eps / 2. Plane stress:
+!> D = E/(1 - nu^2) [1 nu 0; nu 1 0; 0 0 (1 - nu)/2]. Plane strain:
+!> D = E/((1 + nu)(1 - 2 nu)) [1-nu nu 0; nu 1-nu 0; 0 0 (1 - 2 nu)/2].
+module fem_elastic2d
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_error
+    implicit none
+    private
+    public :: elastic2d_t, make_elastic2d
+
+    !> An isotropic linear-elastic material of a 2D continuum (SI units).
+    type :: elastic2d_t
+        !> Young's modulus E (Pa).
+        real(wp) :: young = 0.0_wp
+        !> Poisson's ratio nu.
+        real(wp) :: poisson = 0.0_wp
+        !> Mass density rho (kg/m^3).
+        real(wp) :: density = 0.0_wp
+        !> Out-of-plane thickness t (m); every integral over the area is multiplied by t.
+        real(wp) :: thickness = 1.0_wp
+        !> True: plane strain (eps_zz = 0); false: plane stress (sigma_zz = 0).
+        logical :: plane_strain = .false.
+    contains
+        !> Elasticity matrix D (3 x 3, Voigt order xx, yy, xy).
+        procedure :: d_matrix => elastic2d_d_matrix
+    end type elastic2d_t
+
+contains
+
+    !> Build a material, checking E > 0, rho >= 0, t > 0 and -1 < nu < 1/2 (nu < 1 is
+    !> enough in plane stress, but 1/2 bounds both cases and excludes incompressibility).
+    subroutine make_elastic2d(young, poisson, density, thickness, plane_strain, material, error)
+        !> Young's modulus E (Pa, > 0).
+        real(wp), intent(in) :: young
+        !> Poisson's ratio (-1 < nu < 0.5).
+        real(wp), intent(in) :: poisson
+        !> Mass density (kg/m^3, >= 0).
+        real(wp), intent(in) :: density
+        !> Thickness (m, > 0).
+        real(wp), intent(in) :: thickness
+        !> Plane strain (true) or plane stress (false).
+        logical, intent(in) :: plane_strain
+        !> The material.
+        type(elastic2d_t), intent(out) :: material
+        !> Set when a value is out of range.
+        type(error_t), allocatable, intent(out) :: error
+        if (.not. young > 0.0_wp) then
+            call make_error(error, 'elastic material: Young''s modulus must be > 0')
+        else if (.not. (poisson > -1.0_wp .and. poisson < 0.5_wp)) then
+            call make_error(error, 'elastic material: Poisson''s ratio must lie in (-1, 0.5)')
+        else if (.not. density >= 0.0_wp) then
+            call make_error(error, 'elastic material: density must be >= 0')
+        else if (.not. thickness > 0.0_wp) then
+            call make_error(error, 'elastic material: thickness must be > 0')
+        end if
+        if (allocated(error)) return
+        material = elastic2d_t(young=young, poisson=poisson, density=density, thickness=thickness, &
+                               plane_strain=plane_strain)
+    end subroutine make_elastic2d
+
+    !> Elasticity matrix D (Voigt xx, yy, xy with engineering shear strain).
+    pure function elastic2d_d_matrix(self) result(d)
+        !> The material.
+        class(elastic2d_t), intent(in) :: self
+        !> D (3 x 3).
+        real(wp) :: d(3, 3)
+        real(wp) :: e, nu, c
+        e = self%young
+        nu = self%poisson
+        d = 0.0_wp
+        if (self%plane_strain) then
+            c = e/((1.0_wp + nu)*(1.0_wp - 2.0_wp*nu))
+            d(1, 1) = c*(1.0_wp - nu)
+            d(2, 2) = c*(1.0_wp - nu)
+            d(1, 2) = c*nu
+            d(3, 3) = c*(1.0_wp - 2.0_wp*nu)/2.0_wp
+        else
+            c = e/(1.0_wp - nu*nu)
+            d(1, 1) = c
+            d(2, 2) = c
+            d(1, 2) = c*nu
+            d(3, 3) = c*(1.0_wp - nu)/2.0_wp
+        end if
+        d(2, 1) = d(1, 2)
+    end function elastic2d_d_matrix
+end module fem_elastic2d

@@ -1,0 +1,601 @@
+!> Reader of Gmsh meshes, format 4.1 ASCII (`gmsh -2 -format msh41`), into a `mesh2d_t`.
+!>
+!> Sections read: $MeshFormat (version 4.1, ASCII), $PhysicalNames, $Entities (physical tags of
+!> each point, curve and surface), $Nodes and $Elements; any other section is skipped. Element
+!> types: 2 (3-node triangle) and 3 (4-node quadrangle) become elements, 1 (2-node line) and
+!> 15 (point) only feed named sets. A physical group becomes a node set with the nodes of its
+!> elements, an element set when it is 2D and an edge set when it is 1D; it is named by its
+!> $PhysicalNames entry, or 'physical_<dim>_<tag>' when it has none. Nodes that belong to no
+!> triangle or quadrangle are dropped; elements are turned counter-clockwise and edges are
+!> oriented with the body on their left. Malformed input gives an error naming file and line.
+module fem_gmsh_reader
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_input_error
+    use fem_mesh2d, only: mesh2d_t, element_t3, element_q4
+    implicit none
+    private
+    public :: read_gmsh
+
+    !> A Gmsh entity (point, curve or surface) and its physical tags.
+    type :: entity_t
+        integer :: dim = 0
+        integer :: tag = 0
+        integer, allocatable :: physical(:)
+    end type entity_t
+
+    !> A physical name.
+    type :: physical_name_t
+        integer :: dim = 0
+        integer :: tag = 0
+        character(len=:), allocatable :: name
+    end type physical_name_t
+
+    !> A block of lower-dimensional or 2D elements attached to an entity.
+    type :: block_t
+        integer :: dim = 0
+        integer :: tag = 0
+        integer :: type = 0
+        !> Node tags (nodes per element, elements).
+        integer, allocatable :: nodes(:, :)
+        !> First index of the block's elements in the mesh (2D blocks).
+        integer :: first = 0
+        !> Line of the block header in the file.
+        integer :: line = 0
+    end type block_t
+
+    !> Line-by-line reading state.
+    type :: cursor_t
+        integer :: unit = -1
+        integer :: line = 0
+        character(len=:), allocatable :: path
+        character(len=:), allocatable :: section
+    end type cursor_t
+
+contains
+
+    !> Read a Gmsh 4.1 ASCII mesh.
+    subroutine read_gmsh(path, mesh, error)
+        !> File name.
+        character(len=*), intent(in) :: path
+        !> The mesh.
+        type(mesh2d_t), intent(out) :: mesh
+        !> Set when the file cannot be read or is malformed (message names file and line).
+        type(error_t), allocatable, intent(out) :: error
+        type(cursor_t) :: cur
+        character(len=:), allocatable :: text
+        type(entity_t), allocatable :: entities(:)
+        type(physical_name_t), allocatable :: names(:)
+        type(block_t), allocatable :: blocks(:)
+        real(wp), allocatable :: xtag(:, :)
+        integer :: ios, min_tag
+        logical :: eof, seen_format, seen_nodes, seen_elements
+        character(len=256) :: msg
+        cur%path = path
+        cur%section = ''
+        open (newunit=cur%unit, file=path, status='old', action='read', iostat=ios, iomsg=msg)
+        if (ios /= 0) then
+            call make_input_error(error, path, 0, '', 'cannot open the mesh file: '//trim(msg))
+            return
+        end if
+        allocate (entities(0), names(0), blocks(0))
+        min_tag = 1
+        seen_format = .false.
+        seen_nodes = .false.
+        seen_elements = .false.
+        do
+            call next_line(cur, text, eof, error)
+            if (allocated(error)) exit
+            if (eof) exit
+            if (len_trim(text) == 0) cycle
+            if (text(1:1) /= '$') then
+                call fail(cur, error, 'expected a section header ($Name), found "'//trim(text)//'"')
+                exit
+            end if
+            cur%section = trim(text)
+            if (.not. seen_format .and. cur%section /= '$MeshFormat') then
+                call fail(cur, error, 'the file must start with $MeshFormat (is this a Gmsh .msh file?)')
+                exit
+            end if
+            select case (cur%section)
+            case ('$MeshFormat')
+                call read_format(cur, error)
+                seen_format = .true.
+            case ('$PhysicalNames')
+                call read_physical_names(cur, names, error)
+            case ('$Entities')
+                call read_entities(cur, entities, error)
+            case ('$Nodes')
+                call read_nodes(cur, xtag, min_tag, error)
+                seen_nodes = .true.
+            case ('$Elements')
+                if (.not. seen_nodes) then
+                    call fail(cur, error, '$Elements before $Nodes')
+                    exit
+                end if
+                call read_elements(cur, xtag, min_tag, blocks, error)
+                seen_elements = .true.
+            case default
+                call skip_section(cur, error)
+            end select
+            if (allocated(error)) exit
+            if (cur%section /= '$MeshFormat' .and. cur%section /= '$PhysicalNames' .and. &
+                cur%section /= '$Entities' .and. cur%section /= '$Nodes' .and. cur%section /= '$Elements') cycle
+            call expect_end(cur, error)
+            if (allocated(error)) exit
+        end do
+        close (cur%unit)
+        if (allocated(error)) return
+        cur%line = 0
+        cur%section = ''
+        if (.not. (seen_format .and. seen_nodes .and. seen_elements)) then
+            call fail(cur, error, 'missing $MeshFormat, $Nodes or $Elements section')
+            return
+        end if
+        call build_mesh(cur, entities, names, blocks, xtag, min_tag, mesh, error)
+    end subroutine read_gmsh
+
+    !> Read the next line (any length) into text; eof at the end of the file.
+    subroutine next_line(cur, text, eof, error)
+        type(cursor_t), intent(inout) :: cur
+        character(len=:), allocatable, intent(out) :: text
+        logical, intent(out) :: eof
+        type(error_t), allocatable, intent(out) :: error
+        character(len=512) :: chunk
+        integer :: ios, n
+        character(len=256) :: msg
+        text = ''
+        eof = .false.
+        cur%line = cur%line + 1
+        do
+            read (cur%unit, '(a)', advance='no', iostat=ios, iomsg=msg, size=n) chunk
+            if (is_iostat_end(ios)) then
+                eof = .true.
+                return
+            end if
+            text = text//chunk(1:n)
+            if (is_iostat_eor(ios)) exit
+            if (ios /= 0) then
+                call fail(cur, error, 'read error: '//trim(msg))
+                return
+            end if
+        end do
+        ! Tolerate files written on Windows (CR LF).
+        n = len(text)
+        if (n > 0) then
+            if (text(n:n) == achar(13)) text = text(1:n - 1)
+        end if
+    end subroutine next_line
+
+    !> Next line of the current section (an error at the end of the file).
+    subroutine section_line(cur, text, error)
+        type(cursor_t), intent(inout) :: cur
+        character(len=:), allocatable, intent(out) :: text
+        type(error_t), allocatable, intent(out) :: error
+        logical :: eof
+        call next_line(cur, text, eof, error)
+        if (allocated(error)) return
+        if (eof) call fail(cur, error, 'unexpected end of file (missing $End'//cur%section(2:)//')')
+    end subroutine section_line
+
+    !> Error at the cursor's line, naming the section.
+    subroutine fail(cur, error, message)
+        type(cursor_t), intent(in) :: cur
+        type(error_t), allocatable, intent(out) :: error
+        character(len=*), intent(in) :: message
+        call make_input_error(error, cur%path, cur%line, cur%section, message)
+    end subroutine fail
+
+    !> Integers of a line: exactly n of them, or at least n when at_least.
+    subroutine read_ints(cur, text, n, values, error, at_least)
+        type(cursor_t), intent(in) :: cur
+        character(len=*), intent(in) :: text
+        integer, intent(in) :: n
+        integer, intent(out) :: values(n)
+        type(error_t), allocatable, intent(out) :: error
+        logical, intent(in), optional :: at_least
+        integer :: ios
+        character(len=32) :: buf
+        read (text, *, iostat=ios) values
+        if (ios /= 0) then
+            write (buf, '(i0)') n
+            call fail(cur, error, 'expected '//trim(buf)//' integers, found "'//trim(text)//'"')
+            return
+        end if
+        if (present(at_least)) then
+            if (at_least) return
+        end if
+        if (count_words(text) /= n) then
+            write (buf, '(i0)') n
+            call fail(cur, error, 'expected '//trim(buf)//' integers, found "'//trim(text)//'"')
+        end if
+    end subroutine read_ints
+
+    !> Number of blank-separated words of a line.
+    pure integer function count_words(text) result(n)
+        character(len=*), intent(in) :: text
+        integer :: i
+        logical :: inside
+        n = 0
+        inside = .false.
+        do i = 1, len(text)
+            if (text(i:i) == ' ' .or. text(i:i) == achar(9)) then
+                inside = .false.
+            else if (.not. inside) then
+                inside = .true.
+                n = n + 1
+            end if
+        end do
+    end function count_words
+
+    !> $MeshFormat: version 4.1, ASCII.
+    subroutine read_format(cur, error)
+        type(cursor_t), intent(inout) :: cur
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: text
+        real(wp) :: version
+        integer :: file_type, data_size, ios
+        call section_line(cur, text, error)
+        if (allocated(error)) return
+        read (text, *, iostat=ios) version, file_type, data_size
+        if (ios /= 0) then
+            call fail(cur, error, 'expected "version file-type data-size", found "'//trim(text)//'"')
+        else if (abs(version - 4.1_wp) > 1.0e-9_wp) then
+            call fail(cur, error, 'only format 4.1 is read, found version "'//trim(text)// &
+                      '" (write it with gmsh -format msh41)')
+        else if (file_type /= 0) then
+            call fail(cur, error, 'binary .msh files are not read: write ASCII (Mesh.Binary = 0)')
+        end if
+    end subroutine read_format
+
+    !> The next line must be $End<section>.
+    subroutine expect_end(cur, error)
+        type(cursor_t), intent(inout) :: cur
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: text
+        call section_line(cur, text, error)
+        if (allocated(error)) return
+        if (trim(text) /= '$End'//cur%section(2:)) then
+            call fail(cur, error, 'expected $End'//cur%section(2:)//', found "'//trim(text)//'"')
+        end if
+    end subroutine expect_end
+
+    !> Skip an unknown section up to its $End line.
+    subroutine skip_section(cur, error)
+        type(cursor_t), intent(inout) :: cur
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: text
+        do
+            call section_line(cur, text, error)
+            if (allocated(error)) return
+            if (trim(text) == '$End'//cur%section(2:)) return
+        end do
+    end subroutine skip_section
+
+    !> $PhysicalNames: count, then lines 'dim tag "name"'.
+    subroutine read_physical_names(cur, names, error)
+        type(cursor_t), intent(inout) :: cur
+        type(physical_name_t), allocatable, intent(out) :: names(:)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: text
+        integer :: n(1), k, dt(2), q1, q2
+        call section_line(cur, text, error)
+        if (allocated(error)) return
+        call read_ints(cur, text, 1, n, error)
+        if (allocated(error)) return
+        allocate (names(max(n(1), 0)))
+        do k = 1, n(1)
+            call section_line(cur, text, error)
+            if (allocated(error)) return
+            q1 = index(text, '"')
+            q2 = index(text, '"', back=.true.)
+            if (q1 == 0 .or. q2 <= q1 + 1) then
+                call fail(cur, error, 'expected dim tag "name", found "'//trim(text)//'"')
+                return
+            end if
+            call read_ints(cur, text(1:q1 - 1), 2, dt, error)
+            if (allocated(error)) return
+            names(k)%dim = dt(1)
+            names(k)%tag = dt(2)
+            names(k)%name = text(q1 + 1:q2 - 1)
+        end do
+    end subroutine read_physical_names
+
+    !> $Entities: points, curves, surfaces (and volumes, whose tags are ignored).
+    subroutine read_entities(cur, entities, error)
+        type(cursor_t), intent(inout) :: cur
+        type(entity_t), allocatable, intent(out) :: entities(:)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: text
+        integer :: counts(4), dim, k, ios, tag, nphys, m
+        real(wp) :: box(6)
+        integer, allocatable :: phys(:)
+        call section_line(cur, text, error)
+        if (allocated(error)) return
+        call read_ints(cur, text, 4, counts, error)
+        if (allocated(error)) return
+        if (any(counts < 0)) then
+            call fail(cur, error, 'negative number of entities')
+            return
+        end if
+        allocate (entities(sum(counts)))
+        m = 0
+        do dim = 0, 3
+            do k = 1, counts(dim + 1)
+                call section_line(cur, text, error)
+                if (allocated(error)) return
+                if (dim == 0) then
+                    read (text, *, iostat=ios) tag, box(1:3), nphys
+                else
+                    read (text, *, iostat=ios) tag, box(1:6), nphys
+                end if
+                if (ios == 0 .and. nphys >= 0) then
+                    allocate (phys(nphys))
+                    if (dim == 0) then
+                        read (text, *, iostat=ios) tag, box(1:3), nphys, phys
+                    else
+                        read (text, *, iostat=ios) tag, box(1:6), nphys, phys
+                    end if
+                end if
+                if (ios /= 0 .or. nphys < 0) then
+                    call fail(cur, error, 'malformed entity record "'//trim(text)//'"')
+                    return
+                end if
+                m = m + 1
+                entities(m)%dim = dim
+                entities(m)%tag = tag
+                call move_alloc(phys, entities(m)%physical)
+                entities(m)%physical = abs(entities(m)%physical)
+            end do
+        end do
+    end subroutine read_entities
+
+    !> $Nodes: blocks of tags then coordinates; xtag(:, tag - min_tag + 1) = (x, y), NaN when the
+    !> tag is unused.
+    subroutine read_nodes(cur, xtag, min_tag, error)
+        type(cursor_t), intent(inout) :: cur
+        real(wp), allocatable, intent(out) :: xtag(:, :)
+        integer, intent(out) :: min_tag
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: text
+        integer :: head(4), bh(4), b, k, ios
+        integer, allocatable :: tags(:)
+        real(wp) :: xyz(3)
+        call section_line(cur, text, error)
+        if (allocated(error)) return
+        call read_ints(cur, text, 4, head, error)
+        if (allocated(error)) return
+        min_tag = head(3)
+        if (head(2) > 0 .and. (head(3) < 1 .or. head(4) < head(3))) then
+            call fail(cur, error, 'invalid node tag range in "'//trim(text)//'"')
+            return
+        end if
+        allocate (xtag(2, max(head(4) - head(3) + 1, 0)), source=-huge(1.0_wp))
+        do b = 1, head(1)
+            call section_line(cur, text, error)
+            if (allocated(error)) return
+            call read_ints(cur, text, 4, bh, error)
+            if (allocated(error)) return
+            if (bh(4) < 0) then
+                call fail(cur, error, 'negative number of nodes in block')
+                return
+            end if
+            allocate (tags(bh(4)))
+            do k = 1, bh(4)
+                call section_line(cur, text, error)
+                if (allocated(error)) return
+                call read_ints(cur, text, 1, tags(k:k), error)
+                if (allocated(error)) return
+                if (tags(k) < head(3) .or. tags(k) > head(4)) then
+                    call fail(cur, error, 'node tag outside the range given in the $Nodes header')
+                    return
+                end if
+            end do
+            do k = 1, bh(4)
+                call section_line(cur, text, error)
+                if (allocated(error)) return
+                read (text, *, iostat=ios) xyz
+                if (ios /= 0) then
+                    call fail(cur, error, 'expected node coordinates "x y z", found "'//trim(text)//'"')
+                    return
+                end if
+                xtag(:, tags(k) - min_tag + 1) = xyz(1:2)
+            end do
+            deallocate (tags)
+        end do
+    end subroutine read_nodes
+
+    !> Number of nodes of a Gmsh element type this reader accepts (0 otherwise).
+    pure integer function type_nodes(type)
+        integer, intent(in) :: type
+        select case (type)
+        case (15)
+            type_nodes = 1
+        case (1)
+            type_nodes = 2
+        case (2)
+            type_nodes = 3
+        case (3)
+            type_nodes = 4
+        case default
+            type_nodes = 0
+        end select
+    end function type_nodes
+
+    !> $Elements: blocks 'dim entity type count' then 'tag node...' lines.
+    subroutine read_elements(cur, xtag, min_tag, blocks, error)
+        type(cursor_t), intent(inout) :: cur
+        real(wp), intent(in) :: xtag(:, :)
+        integer, intent(in) :: min_tag
+        type(block_t), allocatable, intent(out) :: blocks(:)
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: text
+        integer :: head(4), bh(4), b, k, nn
+        integer, allocatable :: values(:)
+        character(len=32) :: buf
+        call section_line(cur, text, error)
+        if (allocated(error)) return
+        call read_ints(cur, text, 4, head, error)
+        if (allocated(error)) return
+        allocate (blocks(max(head(1), 0)))
+        do b = 1, head(1)
+            call section_line(cur, text, error)
+            if (allocated(error)) return
+            call read_ints(cur, text, 4, bh, error)
+            if (allocated(error)) return
+            nn = type_nodes(bh(3))
+            if (nn == 0) then
+                write (buf, '(i0)') bh(3)
+                call fail(cur, error, 'element type '//trim(buf)//' is not supported (only 2-node lines, '// &
+                          '3-node triangles, 4-node quadrangles and points: mesh in 2D with Mesh.ElementOrder = 1)')
+                return
+            end if
+            if (bh(4) < 0) then
+                call fail(cur, error, 'negative number of elements in block')
+                return
+            end if
+            associate (blk => blocks(b))
+                blk%dim = bh(1)
+                blk%tag = bh(2)
+                blk%type = bh(3)
+                blk%line = cur%line
+                allocate (blk%nodes(nn, bh(4)), values(nn + 1))
+                do k = 1, bh(4)
+                    call section_line(cur, text, error)
+                    if (allocated(error)) return
+                    call read_ints(cur, text, nn + 1, values, error)
+                    if (allocated(error)) return
+                    blk%nodes(:, k) = values(2:)
+                    call check_tags(values(2:))
+                    if (allocated(error)) return
+                end do
+                deallocate (values)
+            end associate
+        end do
+
+    contains
+
+        !> Every node of an element must be a node of $Nodes.
+        subroutine check_tags(tags)
+            integer, intent(in) :: tags(:)
+            integer :: i
+            character(len=32) :: tb
+            do i = 1, size(tags)
+                if (tags(i) >= min_tag .and. tags(i) <= min_tag + size(xtag, 2) - 1) then
+                    if (xtag(1, tags(i) - min_tag + 1) /= -huge(1.0_wp)) cycle
+                end if
+                write (tb, '(i0)') tags(i)
+                call fail(cur, error, 'node '//trim(tb)//' is not defined in $Nodes')
+                return
+            end do
+        end subroutine check_tags
+    end subroutine read_elements
+
+    !> Name of a physical group.
+    pure function group_name(names, dim, tag) result(name)
+        type(physical_name_t), intent(in) :: names(:)
+        integer, intent(in) :: dim, tag
+        character(len=:), allocatable :: name
+        character(len=32) :: buf
+        integer :: k
+        do k = 1, size(names)
+            if (names(k)%dim == dim .and. names(k)%tag == tag) then
+                name = names(k)%name
+                return
+            end if
+        end do
+        write (buf, '(a,i0,a,i0)') 'physical_', dim, '_', tag
+        name = trim(buf)
+    end function group_name
+
+    !> Physical tags of entity (dim, tag) (empty when not listed).
+    pure function entity_physical(entities, dim, tag) result(phys)
+        type(entity_t), intent(in) :: entities(:)
+        integer, intent(in) :: dim, tag
+        integer, allocatable :: phys(:)
+        integer :: k
+        do k = 1, size(entities)
+            if (entities(k)%dim == dim .and. entities(k)%tag == tag) then
+                phys = entities(k)%physical
+                return
+            end if
+        end do
+        allocate (phys(0))
+    end function entity_physical
+
+    !> Assemble the mesh from the sections read.
+    subroutine build_mesh(cur, entities, names, blocks, xtag, min_tag, mesh, error)
+        type(cursor_t), intent(in) :: cur
+        type(entity_t), intent(in) :: entities(:)
+        type(physical_name_t), intent(in) :: names(:)
+        type(block_t), intent(inout) :: blocks(:)
+        real(wp), intent(in) :: xtag(:, :)
+        integer, intent(in) :: min_tag
+        type(mesh2d_t), intent(out) :: mesh
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: index_of_tag(:), phys(:), local(:, :)
+        integer :: b, ne, e, k, p, nnodes
+        character(len=64) :: buf
+        character(len=:), allocatable :: name
+        ! Map tags to compact node indices, keeping the nodes of triangles and quadrangles.
+        allocate (index_of_tag(size(xtag, 2)), source=0)
+        ne = 0
+        do b = 1, size(blocks)
+            if (blocks(b)%type == 2 .or. blocks(b)%type == 3) then
+                index_of_tag(reshape(blocks(b)%nodes, [size(blocks(b)%nodes)]) - min_tag + 1) = 1
+                ne = ne + size(blocks(b)%nodes, 2)
+            end if
+        end do
+        if (ne == 0) then
+            call fail(cur, error, 'the mesh has no triangle or quadrangle (mesh it in 2D: gmsh -2)')
+            return
+        end if
+        nnodes = 0
+        do k = 1, size(index_of_tag)
+            if (index_of_tag(k) == 0) cycle
+            nnodes = nnodes + 1
+            index_of_tag(k) = nnodes
+        end do
+        allocate (mesh%x(2, nnodes))
+        do k = 1, size(index_of_tag)
+            if (index_of_tag(k) == 0) cycle
+            mesh%x(:, index_of_tag(k)) = xtag(:, k)
+        end do
+        allocate (mesh%kind(ne), mesh%connectivity(4, ne), source=0)
+        e = 0
+        do b = 1, size(blocks)
+            if (blocks(b)%type /= 2 .and. blocks(b)%type /= 3) cycle
+            blocks(b)%first = e + 1
+            do k = 1, size(blocks(b)%nodes, 2)
+                e = e + 1
+                mesh%kind(e) = merge(element_t3, element_q4, blocks(b)%type == 2)
+                mesh%connectivity(1:size(blocks(b)%nodes, 1), e) = index_of_tag(blocks(b)%nodes(:, k) - min_tag + 1)
+            end do
+        end do
+        call mesh%orient_elements()
+        ! Named sets from the physical groups of each block's entity.
+        do b = 1, size(blocks)
+            phys = entity_physical(entities, blocks(b)%dim, blocks(b)%tag)
+            if (size(phys) == 0) cycle
+            local = reshape(index_of_tag(reshape(blocks(b)%nodes, [size(blocks(b)%nodes)]) - min_tag + 1), &
+                            shape(blocks(b)%nodes))
+            if (any(local == 0)) then
+                write (buf, '(i0,a,i0)') blocks(b)%dim, ', entity ', blocks(b)%tag
+                call make_input_error(error, cur%path, blocks(b)%line, '$Elements', 'physical group '''// &
+                                      group_name(names, blocks(b)%dim, phys(1))//''' (dimension '//trim(buf)// &
+                                      ') has nodes on no triangle or quadrangle')
+                return
+            end if
+            do p = 1, size(phys)
+                name = group_name(names, blocks(b)%dim, phys(p))
+                call mesh%add_node_set(name, reshape(local, [size(local)]))
+                if (blocks(b)%type == 1) call mesh%add_edge_set(name, local)
+                if (blocks(b)%first > 0) then
+                    call mesh%add_element_set(name, [(blocks(b)%first + k - 1, k=1, size(local, 2))])
+                end if
+            end do
+        end do
+        call mesh%orient_edges(error)
+        if (allocated(error)) error%message = cur%path//': '//error%message
+
+    end subroutine build_mesh
+end module fem_gmsh_reader

@@ -1,0 +1,392 @@
+!> A 2D finite-element mesh: nodes, Q4/T3 elements, and named node, element and edge sets.
+!>
+!> Elements are stored counter-clockwise in `connectivity(1:nodes_per_element, e)` (the fourth
+!> row is 0 for a triangle). Named sets carry the names the deck refers to (Gmsh physical
+!> groups, or left/right/bottom/top/all for generated rectangles). Edge sets hold 2-node
+!> boundary edges, oriented so that the body lies on their left (outward normal (s_y, -s_x)).
+module fem_mesh2d
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_error
+    implicit none
+    private
+    public :: mesh2d_t, named_set_t, edge_set_t, element_t3, element_q4, nodes_per_element
+
+    !> Element kind code of the linear triangle.
+    integer, parameter :: element_t3 = 1
+    !> Element kind code of the bilinear quadrilateral.
+    integer, parameter :: element_q4 = 2
+    !> Number of nodes of each element kind.
+    integer, parameter :: nodes_per_element(2) = [3, 4]
+
+    !> A named set of node or element indices.
+    type :: named_set_t
+        !> Name (case-sensitive).
+        character(len=:), allocatable :: name
+        !> Indices (sorted, unique).
+        integer, allocatable :: ids(:)
+    end type named_set_t
+
+    !> A named set of 2-node edges.
+    type :: edge_set_t
+        !> Name (case-sensitive).
+        character(len=:), allocatable :: name
+        !> Node indices of each edge (2, number of edges), body on the left of a -> b.
+        integer, allocatable :: nodes(:, :)
+        !> Element of which each edge is a side (0 until `orient_edges` has run).
+        integer, allocatable :: elements(:)
+    end type edge_set_t
+
+    !> The mesh.
+    type :: mesh2d_t
+        !> Node coordinates (2, number of nodes) (m).
+        real(wp), allocatable :: x(:, :)
+        !> Element kind (element_t3 or element_q4) of each element.
+        integer, allocatable :: kind(:)
+        !> Connectivity (4, number of elements), counter-clockwise; 0 beyond the element's nodes.
+        integer, allocatable :: connectivity(:, :)
+        !> Named node sets.
+        type(named_set_t), allocatable :: node_sets(:)
+        !> Named element sets.
+        type(named_set_t), allocatable :: element_sets(:)
+        !> Named edge sets.
+        type(edge_set_t), allocatable :: edge_sets(:)
+    contains
+        !> Number of nodes.
+        procedure :: node_count => mesh_node_count
+        !> Number of elements.
+        procedure :: element_count => mesh_element_count
+        !> Node indices of element e.
+        procedure :: element_nodes => mesh_element_nodes
+        !> Coordinates (2, n) of the nodes of element e.
+        procedure :: element_coordinates => mesh_element_coordinates
+        !> Add (or extend) a node set.
+        procedure :: add_node_set => mesh_add_node_set
+        !> Add (or extend) an element set.
+        procedure :: add_element_set => mesh_add_element_set
+        !> Add (or extend) an edge set.
+        procedure :: add_edge_set => mesh_add_edge_set
+        !> Indices of a named node set (error when unknown).
+        procedure :: node_set => mesh_node_set
+        !> Indices of a named element set (error when unknown).
+        procedure :: element_set => mesh_element_set
+        !> Edges of a named edge set and their elements (error when unknown).
+        procedure :: edge_set => mesh_edge_set
+        !> Orient every edge of the edge sets so that an element containing it lies on its left,
+        !> and record that element.
+        procedure :: orient_edges => mesh_orient_edges
+        !> Reorder clockwise elements counter-clockwise (by signed area).
+        procedure :: orient_elements => mesh_orient_elements
+    end type mesh2d_t
+
+contains
+
+    !> Number of nodes.
+    pure integer function mesh_node_count(self)
+        !> The mesh.
+        class(mesh2d_t), intent(in) :: self
+        mesh_node_count = 0
+        if (allocated(self%x)) mesh_node_count = size(self%x, 2)
+    end function mesh_node_count
+
+    !> Number of elements.
+    pure integer function mesh_element_count(self)
+        !> The mesh.
+        class(mesh2d_t), intent(in) :: self
+        mesh_element_count = 0
+        if (allocated(self%kind)) mesh_element_count = size(self%kind)
+    end function mesh_element_count
+
+    !> Node indices of element e.
+    pure function mesh_element_nodes(self, e) result(nodes)
+        !> The mesh.
+        class(mesh2d_t), intent(in) :: self
+        !> Element index.
+        integer, intent(in) :: e
+        !> Its nodes, counter-clockwise.
+        integer, allocatable :: nodes(:)
+        nodes = self%connectivity(1:nodes_per_element(self%kind(e)), e)
+    end function mesh_element_nodes
+
+    !> Coordinates of the nodes of element e.
+    pure function mesh_element_coordinates(self, e) result(xe)
+        !> The mesh.
+        class(mesh2d_t), intent(in) :: self
+        !> Element index.
+        integer, intent(in) :: e
+        !> Coordinates (2, nodes of the element).
+        real(wp), allocatable :: xe(:, :)
+        xe = self%x(:, self%connectivity(1:nodes_per_element(self%kind(e)), e))
+    end function mesh_element_coordinates
+
+    !> Sorted unique copy of a list of positive indices (by marking: O(size + max)).
+    pure function sorted_unique(ids) result(out)
+        integer, intent(in) :: ids(:)
+        integer, allocatable :: out(:)
+        logical, allocatable :: mark(:)
+        integer :: k
+        allocate (mark(max(0, maxval(ids))), source=.false.)
+        mark(ids) = .true.
+        out = pack([(k, k=1, size(mark))], mark)
+    end function sorted_unique
+
+    !> Index of the set called name in sets (0 if none).
+    pure integer function find_set(sets, name) result(k)
+        type(named_set_t), allocatable, intent(in) :: sets(:)
+        character(len=*), intent(in) :: name
+        k = 0
+        if (.not. allocated(sets)) return
+        do k = 1, size(sets)
+            if (sets(k)%name == name) return
+        end do
+        k = 0
+    end function find_set
+
+    !> Add ids to the named set, creating it when new.
+    pure subroutine add_to_sets(sets, name, ids)
+        type(named_set_t), allocatable, intent(inout) :: sets(:)
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: ids(:)
+        type(named_set_t), allocatable :: grown(:)
+        integer, allocatable :: merged(:)
+        integer :: k
+        if (.not. allocated(sets)) allocate (sets(0))
+        k = find_set(sets, name)
+        if (k == 0) then
+            allocate (grown(size(sets) + 1))
+            do k = 1, size(sets)
+                call move_alloc(sets(k)%name, grown(k)%name)
+                call move_alloc(sets(k)%ids, grown(k)%ids)
+            end do
+            grown(size(grown))%name = name
+            grown(size(grown))%ids = sorted_unique(ids)
+            call move_alloc(grown, sets)
+        else
+            allocate (merged(size(sets(k)%ids) + size(ids)))
+            merged(1:size(sets(k)%ids)) = sets(k)%ids
+            merged(size(sets(k)%ids) + 1:) = ids
+            sets(k)%ids = sorted_unique(merged)
+        end if
+    end subroutine add_to_sets
+
+    !> Add node indices to a named node set (created when new).
+    pure subroutine mesh_add_node_set(self, name, ids)
+        !> The mesh.
+        class(mesh2d_t), intent(inout) :: self
+        !> Set name.
+        character(len=*), intent(in) :: name
+        !> Node indices.
+        integer, intent(in) :: ids(:)
+        call add_to_sets(self%node_sets, name, ids)
+    end subroutine mesh_add_node_set
+
+    !> Add element indices to a named element set (created when new).
+    pure subroutine mesh_add_element_set(self, name, ids)
+        !> The mesh.
+        class(mesh2d_t), intent(inout) :: self
+        !> Set name.
+        character(len=*), intent(in) :: name
+        !> Element indices.
+        integer, intent(in) :: ids(:)
+        call add_to_sets(self%element_sets, name, ids)
+    end subroutine mesh_add_element_set
+
+    !> Add edges to a named edge set (created when new).
+    pure subroutine mesh_add_edge_set(self, name, edges)
+        !> The mesh.
+        class(mesh2d_t), intent(inout) :: self
+        !> Set name.
+        character(len=*), intent(in) :: name
+        !> Node indices of the edges (2, n).
+        integer, intent(in) :: edges(:, :)
+        integer :: k
+        integer, allocatable :: merged(:, :)
+        type(edge_set_t), allocatable :: grown(:)
+        if (.not. allocated(self%edge_sets)) allocate (self%edge_sets(0))
+        do k = 1, size(self%edge_sets)
+            if (self%edge_sets(k)%name == name) then
+                allocate (merged(2, size(self%edge_sets(k)%nodes, 2) + size(edges, 2)))
+                merged(:, 1:size(self%edge_sets(k)%nodes, 2)) = self%edge_sets(k)%nodes
+                merged(:, size(self%edge_sets(k)%nodes, 2) + 1:) = edges
+                call move_alloc(merged, self%edge_sets(k)%nodes)
+                self%edge_sets(k)%elements = [self%edge_sets(k)%elements, spread(0, 1, size(edges, 2))]
+                return
+            end if
+        end do
+        allocate (grown(size(self%edge_sets) + 1))
+        do k = 1, size(self%edge_sets)
+            call move_alloc(self%edge_sets(k)%name, grown(k)%name)
+            call move_alloc(self%edge_sets(k)%nodes, grown(k)%nodes)
+            call move_alloc(self%edge_sets(k)%elements, grown(k)%elements)
+        end do
+        grown(size(grown))%name = name
+        grown(size(grown))%nodes = edges
+        allocate (grown(size(grown))%elements(size(edges, 2)), source=0)
+        call move_alloc(grown, self%edge_sets)
+    end subroutine mesh_add_edge_set
+
+    !> Sorted node indices of a named node set.
+    subroutine mesh_node_set(self, name, ids, error)
+        !> The mesh.
+        class(mesh2d_t), intent(in) :: self
+        !> Set name.
+        character(len=*), intent(in) :: name
+        !> Node indices.
+        integer, allocatable, intent(out) :: ids(:)
+        !> Set when no node set has that name.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: k
+        k = find_set(self%node_sets, name)
+        if (k == 0) then
+            call make_error(error, "mesh: no node set named '"//name//"'"//known(self%node_sets))
+            return
+        end if
+        ids = self%node_sets(k)%ids
+    end subroutine mesh_node_set
+
+    !> Sorted element indices of a named element set.
+    subroutine mesh_element_set(self, name, ids, error)
+        !> The mesh.
+        class(mesh2d_t), intent(in) :: self
+        !> Set name.
+        character(len=*), intent(in) :: name
+        !> Element indices.
+        integer, allocatable, intent(out) :: ids(:)
+        !> Set when no element set has that name.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: k
+        k = find_set(self%element_sets, name)
+        if (k == 0) then
+            call make_error(error, "mesh: no element set named '"//name//"'"//known(self%element_sets))
+            return
+        end if
+        ids = self%element_sets(k)%ids
+    end subroutine mesh_element_set
+
+    !> Edges of a named edge set.
+    subroutine mesh_edge_set(self, name, edges, error, elements)
+        !> The mesh.
+        class(mesh2d_t), intent(in) :: self
+        !> Set name.
+        character(len=*), intent(in) :: name
+        !> Node indices of the edges (2, n).
+        integer, allocatable, intent(out) :: edges(:, :)
+        !> Set when no edge set has that name.
+        type(error_t), allocatable, intent(out) :: error
+        !> Element of which each edge is a side (0 before `orient_edges`).
+        integer, allocatable, intent(out), optional :: elements(:)
+        integer :: k
+        character(len=:), allocatable :: names
+        if (allocated(self%edge_sets)) then
+            do k = 1, size(self%edge_sets)
+                if (self%edge_sets(k)%name == name) then
+                    edges = self%edge_sets(k)%nodes
+                    if (present(elements)) elements = self%edge_sets(k)%elements
+                    return
+                end if
+            end do
+        end if
+        names = ''
+        if (allocated(self%edge_sets)) then
+            do k = 1, size(self%edge_sets)
+                names = names//merge(' ', ',', k == 1)//" '"//self%edge_sets(k)%name//"'"
+            end do
+        end if
+        if (len(names) == 0) names = ' (none)'
+        call make_error(error, "mesh: no edge set named '"//name//"' (known:"//names//')')
+    end subroutine mesh_edge_set
+
+    !> " (known: 'a', 'b')" listing the names of sets.
+    pure function known(sets) result(text)
+        type(named_set_t), allocatable, intent(in) :: sets(:)
+        character(len=:), allocatable :: text
+        integer :: k
+        text = ' (known:'
+        if (allocated(sets)) then
+            do k = 1, size(sets)
+                text = text//merge(' ', ',', k == 1)//" '"//sets(k)%name//"'"
+            end do
+            if (size(sets) == 0) text = text//' none'
+        else
+            text = text//' none'
+        end if
+        text = text//')'
+    end function known
+
+    !> Reorder the nodes of clockwise elements (negative signed area) counter-clockwise.
+    pure subroutine mesh_orient_elements(self)
+        !> The mesh.
+        class(mesh2d_t), intent(inout) :: self
+        integer :: e, n
+        integer, allocatable :: nodes(:)
+        real(wp), allocatable :: xe(:, :)
+        real(wp) :: twice_area
+        do e = 1, self%element_count()
+            nodes = self%element_nodes(e)
+            xe = self%x(:, nodes)
+            n = size(nodes)
+            twice_area = sum(xe(1, :)*cshift(xe(2, :), 1) - cshift(xe(1, :), 1)*xe(2, :))
+            if (twice_area < 0.0_wp) self%connectivity(1:n, e) = nodes(n:1:-1)
+        end do
+    end subroutine mesh_orient_elements
+
+    !> Orient each edge a -> b of the edge sets as a side of a counter-clockwise element (a
+    !> followed by b among its nodes), so that the element lies on the edge's left.
+    !> An edge in no element is an error; an interior edge takes the first element found.
+    subroutine mesh_orient_edges(self, error)
+        !> The mesh.
+        class(mesh2d_t), intent(inout) :: self
+        !> Set when an edge is not a side of any element.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: start(:), list(:), fill(:), nodes(:)
+        integer :: e, k, a, b, s, m, i, n, p
+        character(len=80) :: buf
+        logical :: found
+        if (.not. allocated(self%edge_sets)) return
+        ! Node -> elements adjacency in compressed rows.
+        allocate (start(self%node_count() + 1), source=0)
+        do e = 1, self%element_count()
+            nodes = self%element_nodes(e)
+            start(nodes + 1) = start(nodes + 1) + 1
+        end do
+        start(1) = 1
+        do i = 1, self%node_count()
+            start(i + 1) = start(i + 1) + start(i)
+        end do
+        allocate (list(start(self%node_count() + 1) - 1), fill(self%node_count()), source=0)
+        fill = start(1:self%node_count())
+        do e = 1, self%element_count()
+            nodes = self%element_nodes(e)
+            list(fill(nodes)) = e
+            fill(nodes) = fill(nodes) + 1
+        end do
+        do s = 1, size(self%edge_sets)
+            do k = 1, size(self%edge_sets(s)%nodes, 2)
+                a = self%edge_sets(s)%nodes(1, k)
+                b = self%edge_sets(s)%nodes(2, k)
+                found = .false.
+                do m = start(a), start(a + 1) - 1
+                    nodes = self%element_nodes(list(m))
+                    n = size(nodes)
+                    do i = 1, n
+                        p = merge(1, i + 1, i == n)
+                        if (nodes(i) == a .and. nodes(p) == b) then
+                            found = .true.
+                        else if (nodes(i) == b .and. nodes(p) == a) then
+                            self%edge_sets(s)%nodes(:, k) = [b, a]
+                            found = .true.
+                        end if
+                        if (found) self%edge_sets(s)%elements(k) = list(m)
+                        if (found) exit
+                    end do
+                    if (found) exit
+                end do
+                if (.not. found) then
+                    write (buf, '(a,i0,a,i0,a,i0)') ': edge ', k, ' (nodes ', a, ', ', b
+                    call make_error(error, "mesh: edge set '"//self%edge_sets(s)%name//"'"// &
+                                    trim(buf)//') is not a side of any element')
+                    return
+                end if
+            end do
+        end do
+    end subroutine mesh_orient_edges
+end module fem_mesh2d
