@@ -1,4 +1,4 @@
-!> Abstract weight function alpha(s) of the Arlequin energy partition (THEORY.md section 4),
+!> Abstract weight function alpha(s) of the Arlequin energy partition (doc/theory.md section 6.1),
 !> s being the curvilinear abscissa along the beam axis.
 !>
 !> Only the interface lives here, so that the FE assembly (fem) can integrate with a weight

@@ -1,4 +1,4 @@
-!> Arlequin DEM-FEM coupled system and its time step (THEORY.md section 4): a weighted beam
+!> Arlequin DEM-FEM coupled system and its time step (doc/theory.md section 6): a weighted beam
 !> model (Newmark) and weighted disks (Moreau-Jean, contacts) glued in the overlap by one
 !> multiplier per coupled DOF, explicitly in the coupling, at velocity level.
 !>

@@ -1,4 +1,4 @@
-!> Lagrange multipliers of the Arlequin coupling at velocity level (THEORY.md section 4).
+!> Lagrange multipliers of the Arlequin coupling at velocity level (doc/theory.md section 6.4).
 !>
 !> Conventions: on the particle side the multiplier lambda acts as a force +lambda on the
 !> coupled DOF ((1 - alpha) m qdd = (1 - alpha) F + lambda), on the FE side as -C^T lambda

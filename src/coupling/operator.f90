@@ -1,4 +1,4 @@
-!> Coupling operator C of the Arlequin method (THEORY.md section 4): the beam's displacement
+!> Coupling operator C of the Arlequin method (doc/theory.md sections 6.3, 6.6): the beam's displacement
 !> field interpolated at the coupled points (particle centres).
 !>
 !> Each point (x_p, y_p) is projected on the beam axis: element e, reduced coordinate xi in

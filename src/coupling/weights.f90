@@ -1,4 +1,4 @@
-!> Arlequin weight functions alpha(s) along the beam (THEORY.md section 4): constant, linear
+!> Arlequin weight functions alpha(s) along the beam (doc/theory.md section 6.1): constant, linear
 !> and cubic ramps over an overlap interval, with a floor.
 !>
 !> The overlap runs from `s_fe` (the end next to the FE-only zone) to `s_particle` (the end

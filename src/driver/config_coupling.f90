@@ -5,7 +5,7 @@
 !> - the schemes: the coupling exchanges the impulse h ((1 - gamma) lambda_n + gamma
 !>   lambda_{n+1}) between the beam (Newmark) and the disks (Moreau-Jean), which is exact in
 !>   momentum and energy only with average acceleration (beta = 1/4, gamma = 1/2) and
-!>   theta = 1/2 (THEORY.md section 4, coupling_arlequin). Another beta or gamma (or the
+!>   theta = 1/2 (doc/theory.md section 6.5, coupling_arlequin). Another beta or gamma (or the
 !>   explicit central difference, whose lumped, undamped beta = 0 predictor the multiplier
 !>   matrix does not model) is an error; theta > 1/2 is accepted with a warning (the
 !>   constraint still holds, but the balance then shows the scheme's numerical dissipation

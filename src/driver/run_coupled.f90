@@ -1,4 +1,4 @@
-!> Time integration of a coupled beam/particle model (THEORY.md section 4): one call of the
+!> Time integration of a coupled beam/particle model (doc/theory.md section 6.8): one call of the
 !> coupling step (coupling_arlequin::arlequin_step) per time step, which predicts both
 !> domains, solves the multipliers jointly with the contacts and corrects both. Results: the
 !> beam's fields in /fem, the disks' in /dem, the multipliers, residuals and energy audit in

@@ -1,4 +1,4 @@
-!> Planar Euler-Bernoulli frame element (THEORY.md section 3): local stiffness, consistent
+!> Planar Euler-Bernoulli frame element (doc/theory.md, sections 5.1-5.2): local stiffness, consistent
 !> and HRZ-lumped mass, rotation to global axes, shape functions.
 !>
 !> Local DOFs of an element from node 1 to node 2: [u1, w1, theta1, u2, w2, theta2], u along

@@ -5,7 +5,7 @@
 !> 3*(largest node-number difference in an element) + 2. All vectors of size `n_free`
 !> are in that numbering; `expand` and `restrict` convert to and from (3, n_nodes) arrays.
 !>
-!> Arlequin weighting (THEORY.md section 4): given a weight alpha(s) (s = `abscissa`, the
+!> Arlequin weighting (doc/theory.md, section 6.2): given a weight alpha(s) (s = `abscissa`, the
 !> distance from node 1 along the elements), mass and stiffness are integrated as
 !> int alpha(s) (...) ds by Gauss quadrature (6 points on each piece of an element between
 !> the weight's breakpoints: exact for a piecewise cubic alpha times the degree-6 Hermite

@@ -1,4 +1,4 @@
-!> Time integrators of M a + C v + K u = F(t) for the frame model (THEORY.md section 3).
+!> Time integrators of M a + C v + K u = F(t) for the frame model (doc/theory.md, sections 5.4-5.5).
 !>
 !> `time_integrator_t` holds the state (t, u, v, a) and the energy accounts, and defers
 !> `init` and `step` to the schemes:
@@ -13,7 +13,7 @@
 !> and `energy_balance()` = kinetic + strain + D - W - W_c - (initial kinetic + strain),
 !> W_c being the work of the coupling forces (same rule, zero without coupling).
 !>
-!> Coupled steps (Arlequin, THEORY.md section 4) split `newmark_t%step` in two:
+!> Coupled steps (Arlequin, doc/theory.md section 6.5) split `newmark_t%step` in two:
 !> `predict` advances to t_{n+1} without coupling force (the free state: u, v, a), then
 !> `correct(f_c)` adds the response to an extra force f_c (= -C^T lambda) and finishes the
 !> step. The scheme being linear, a = a_free + S^-1 f_c, u = u_free + beta h^2 S^-1 f_c,
