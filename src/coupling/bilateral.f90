@@ -180,9 +180,10 @@ contains
         self%corrections = self%corrections + 1
     end subroutine correct
 
-    !> Replace the Delassus blocks (W_nn, W_nt, W_tt) of every contact that touches a coupled
-    !> particle by the condensed ones W - (h gamma/t) U^T A^-1 U (module description). Call
-    !> after `contacts_set_frames` (which sets W from im) and before the solve.
+    !> Replace the Delassus block (W_nn, W_nt, W_tt, W_nm, W_tm, W_mm) of every contact that
+    !> touches a coupled particle by the condensed one W - (h gamma/t) U^T A^-1 U (module
+    !> description). Call after `contacts_set_frames` (which sets W from im) and before the
+    !> solve.
     pure subroutine condense(self, cs, im)
         !> The rows.
         class(coupling_rows_t), intent(in) :: self
@@ -190,65 +191,66 @@ contains
         type(contact_set_t), intent(inout) :: cs
         !> Inverse mass per DOF (3, n_disks), per unit thickness, as used by the contacts.
         real(wp), intent(in) :: im(:, :)
-        integer :: k, a, b, n, i, j, rows(6)
-        real(wp) :: un(6), ut(6), nx, ny, snn, snt, stt, wnn, wnt, wtt, aij
+        ! entries of the symmetric 3x3 block in the storage order of cs%w
+        integer, parameter :: ii(6) = [1, 1, 2, 1, 2, 3], jj(6) = [1, 2, 2, 3, 3, 3]
+        integer :: k, a, b, n, i, j, e, rows(6)
+        real(wp) :: us(6, 3), s(6), aij, wk(6), d(3)
         do k = 1, cs%n
             a = cs%i1(k)
             b = cs%i2(k)
-            nx = cs%nrm(1, k)
-            ny = cs%nrm(2, k)
             n = 0
-            call add_body(self, im, b, 1.0_wp, cs%lever(2, k), nx, ny, n, rows, un, ut)
-            if (a > 0) call add_body(self, im, a, -1.0_wp, cs%lever(1, k), nx, ny, n, rows, un, ut)
+            call add_body(self, im, b, 1.0_wp, cs%lever(2, k), cs%nrm(:, k), n, rows, us)
+            if (a > 0) call add_body(self, im, a, -1.0_wp, cs%lever(1, k), cs%nrm(:, k), n, rows, us)
             if (n == 0) cycle
-            snn = 0.0_wp
-            snt = 0.0_wp
-            stt = 0.0_wp
+            s = 0.0_wp
             do j = 1, n
                 do i = 1, n
                     aij = self%ainv(rows(i), rows(j))
-                    snn = snn + un(i)*aij*un(j)
-                    snt = snt + un(i)*aij*ut(j)
-                    stt = stt + ut(i)*aij*ut(j)
+                    do e = 1, 6
+                        s(e) = s(e) + us(i, ii(e))*aij*us(j, jj(e))
+                    end do
                 end do
             end do
-            ! The condensed block is positive semi-definite in exact arithmetic; keep it so
-            ! against the rounding of the difference.
-            wnn = max(cs%w(1, k) - self%scale*snn, 0.0_wp)
-            wtt = max(cs%w(3, k) - self%scale*stt, 0.0_wp)
-            wnt = cs%w(2, k) - self%scale*snt
-            wnt = sign(min(abs(wnt), sqrt(wnn*wtt)), wnt)
-            cs%w(:, k) = [wnn, wnt, wtt]
+            ! The condensed block is positive semi-definite in exact arithmetic; keep its
+            ! diagonal >= 0 and each off-diagonal entry within sqrt(W_ii W_jj) against the
+            ! rounding of the difference.
+            wk = cs%w(:, k) - self%scale*s
+            d = max(wk([1, 3, 6]), 0.0_wp)
+            wk(1) = d(1)
+            wk(3) = d(2)
+            wk(6) = d(3)
+            wk(2) = sign(min(abs(wk(2)), sqrt(d(1)*d(2))), wk(2))
+            wk(4) = sign(min(abs(wk(4)), sqrt(d(1)*d(3))), wk(4))
+            wk(5) = sign(min(abs(wk(5)), sqrt(d(2)*d(3))), wk(5))
+            cs%w(:, k) = wk
         end do
     end subroutine condense
 
-    !> Rows of body c (if coupled) and the columns of U = G M^-1 H there, appended after the
-    !> first n: the impulse (r_n, r_t) acts on c with sign s (+ on i2, - on i1) through the
-    !> normal n, the tangent t = (-n_y, n_x) and the lever arm (rotation).
-    pure subroutine add_body(self, im, c, s, lever, nx, ny, n, rows, un, ut)
+    !> Rows of body c (if coupled) and the rows of U = G M^-1 H there (columns r_n, r_t, M),
+    !> appended after the first n: the impulse (r_n, r_t, M) acts on c with sign s (+ on i2,
+    !> - on i1) through the normal n, the tangent t = (-n_y, n_x), the lever arm and the
+    !> moment (rotation).
+    pure subroutine add_body(self, im, c, s, lever, nrm, n, rows, us)
         type(coupling_rows_t), intent(in) :: self
         real(wp), intent(in) :: im(:, :)
         integer, intent(in) :: c
-        real(wp), intent(in) :: s, lever, nx, ny
+        real(wp), intent(in) :: s, lever, nrm(2)
         integer, intent(inout) :: n, rows(:)
-        real(wp), intent(inout) :: un(:), ut(:)
+        real(wp), intent(inout) :: us(:, :)
         integer :: p, base
         p = self%point_of(c)
         if (p == 0) return
         base = (p - 1)*self%rows_per_point
         n = n + 1
         rows(n) = base + 1
-        un(n) = s*im(1, c)*nx
-        ut(n) = -s*im(1, c)*ny
+        us(n, :) = [s*im(1, c)*nrm(1), -s*im(1, c)*nrm(2), 0.0_wp]
         n = n + 1
         rows(n) = base + 2
-        un(n) = s*im(2, c)*ny
-        ut(n) = s*im(2, c)*nx
+        us(n, :) = [s*im(2, c)*nrm(2), s*im(2, c)*nrm(1), 0.0_wp]
         if (self%rows_per_point == 3) then
             n = n + 1
             rows(n) = base + 3
-            un(n) = 0.0_wp
-            ut(n) = im(3, c)*lever
+            us(n, :) = [0.0_wp, im(3, c)*lever, s*im(3, c)]
         end if
     end subroutine add_body
 end module coupling_bilateral

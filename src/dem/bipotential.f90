@@ -27,6 +27,8 @@ module dem_bipotential
     public :: bipotential_predictor, coulomb_projection, bipotential_local_solve
     public :: bipotential_residual, case_separation, case_stick, case_slip
     public :: bipotential_scaling, bipotential_local_solve_scaled, bipotential_n_scaling
+    public :: rolling_projection, rolling_local_solve, rolling_scaling, rolling_local_solve_scaled
+    public :: rolling_residual, rolling_n_scaling, case_roll, case_slip_roll
 
     !> Projection case: separation (r = 0).
     integer, parameter :: case_separation = 1
@@ -34,8 +36,20 @@ module dem_bipotential
     integer, parameter :: case_stick = 2
     !> Projection case: slip (r on the boundary of the cone).
     integer, parameter :: case_slip = 3
+    !> Projection case of the rolling cone: |M| = e r_n, |r_t| < mu r_n (rolling, no sliding).
+    integer, parameter :: case_roll = 4
+    !> Projection case of the rolling cone: both bounds reached (sliding and rolling).
+    integer, parameter :: case_slip_roll = 5
     !> Number of constants per contact computed by `bipotential_scaling`.
     integer, parameter :: bipotential_n_scaling = 8
+    !> Number of constants per contact computed by `rolling_scaling`.
+    integer, parameter :: rolling_n_scaling = 18
+    !> Floor of a diagonal entry of W relative to its trace, so that a direction held by the
+    !> fixities does not divide by zero (the floored direction then barely responds).
+    real(wp), parameter :: scaling_floor = 1.0e-12_wp
+    !> Determinant below which a scaled block (unit diagonal) is treated as singular and its
+    !> branch is not solved directly (the iterations still converge, only slower).
+    real(wp), parameter :: singular_det = 1.0e-12_wp
 
 contains
 
@@ -260,10 +274,282 @@ contains
         real(wp), intent(in) :: wnn, wnt, wtt, mu
         real(wp), intent(out) :: sn, st, c, mup
         real(wp) :: floor
-        floor = 1.0e-12_wp*(wnn + wtt)
+        floor = scaling_floor*(wnn + wtt)
         sn = sqrt(max(wnn, floor))
         st = sqrt(max(wtt, floor))
         c = wnt/(sn*st)
         mup = mu*st/sn
     end subroutine scaling
+    ! ---------------------------------------------------------------------------------------
+    ! Three-component law (r_n, r_t, M): Signorini, Coulomb and rolling resistance
+    ! (doc/theory.md, "Rolling resistance and bonded contacts"). The cone is
+    !     K = {|r_t| <= mu r_n, |M| <= e r_n},  e a length,
+    ! De Saxce's modified velocity u_hat = (u_n + mu |u_t| + e |w_r|, u_t, w_r) and the law is
+    ! r = proj_K(r - rho u_hat). As for two components the iterations run in the frame where
+    ! the 3x3 block W has a unit diagonal: r' = D r, u' = D^-1 u, D = diag(sqrt(W_nn),
+    ! sqrt(W_tt), sqrt(W_mm)); there mu' = mu sqrt(W_tt/W_nn), e' = e sqrt(W_mm/W_nn) (both
+    ! dimensionless: M is scaled by a length). The scaled block has a unit diagonal but, unlike a
+    ! 2x2 one, its largest eigenvalue may reach 3, beyond the 2/rho that a fixed-point step
+    ! rho = 1 tolerates: rho = 1/(1 + largest off-diagonal row sum) (Gershgorin: rho
+    ! lambda_max <= 1). After each projection the branch it landed on (stick, slip, roll, slip
+    ! and roll) is solved exactly and kept when it satisfies the law.
+    ! ---------------------------------------------------------------------------------------
+
+    !> Euclidean projection of (taun, taut, taum) on K = {|t| <= mu n, |m| <= e n} (mu, e >= 0).
+    !> The five cases are the active sets of the projection's optimality conditions:
+    !> separation (apex), stick (interior), slip (|t| face), roll (|m| face), slip and roll
+    !> (the edge where both faces meet).
+    pure elemental subroutine rolling_projection(taun, taut, taum, mu, e, rn, rt, rm, pcase)
+        !> Point to project (normal, tangential, moment component).
+        real(wp), intent(in) :: taun, taut, taum
+        !> Friction coefficient and rolling length of the cone (in consistent units).
+        real(wp), intent(in) :: mu, e
+        !> Projection.
+        real(wp), intent(out) :: rn, rt, rm
+        !> case_separation, case_stick, case_slip, case_roll or case_slip_roll.
+        integer, intent(out) :: pcase
+        real(wp) :: at, am, n1
+        at = abs(taut)
+        am = abs(taum)
+        if (mu*at + e*am <= -taun) then
+            rn = 0.0_wp
+            rt = 0.0_wp
+            rm = 0.0_wp
+            pcase = case_separation
+            return
+        end if
+        if (at <= mu*taun .and. am <= e*taun) then
+            rn = taun
+            rt = taut
+            rm = taum
+            pcase = case_stick
+            return
+        end if
+        n1 = (taun + mu*at + e*am)/(1.0_wp + mu*mu + e*e)
+        if (at > mu*n1 .and. am > e*n1) then
+            rn = n1
+            rt = sign(mu*n1, taut)
+            rm = sign(e*n1, taum)
+            pcase = case_slip_roll
+            return
+        end if
+        n1 = (taun + mu*at)/(1.0_wp + mu*mu)
+        if (am <= e*n1) then
+            rn = n1
+            rt = sign(mu*n1, taut)
+            rm = taum
+            pcase = case_slip
+            return
+        end if
+        n1 = (taun + e*am)/(1.0_wp + e*e)
+        rn = n1
+        rt = taut
+        rm = sign(e*n1, taum)
+        pcase = case_roll
+    end subroutine rolling_projection
+
+    !> Solve the three-component law for r given u = b + W r (W symmetric positive
+    !> semi-definite, w = (W_nn, W_nt, W_tt, W_nm, W_tm, W_mm)), from the given r, until the
+    !> change of the scaled reaction is at most tol times its size or max_iter iterations.
+    pure subroutine rolling_local_solve(w, b, mu, e, tol, max_iter, r, n_iter, pcase)
+        !> Delassus block (nn, nt, tt, nm, tm, mm).
+        real(wp), intent(in) :: w(6)
+        !> Velocity without this contact's reaction (u_n, u_t, w_r).
+        real(wp), intent(in) :: b(3)
+        !> Friction coefficient and rolling length [m] (>= 0).
+        real(wp), intent(in) :: mu, e
+        !> Relative tolerance of the local iterations.
+        real(wp), intent(in) :: tol
+        !> Iteration cap (>= 1).
+        integer, intent(in) :: max_iter
+        !> Reaction (r_n, r_t, M): initial guess in, solution out.
+        real(wp), intent(inout) :: r(3)
+        !> Iterations done.
+        integer, intent(out) :: n_iter
+        !> Case of the last projection.
+        integer, intent(out) :: pcase
+        real(wp) :: sc(rolling_n_scaling)
+        call rolling_scaling(w, mu, e, sc)
+        call rolling_local_solve_scaled(sc, b, tol, max_iter, r, n_iter, pcase)
+    end subroutine rolling_local_solve
+
+    !> Constants of the scaled frame of one three-component contact: sc = (s_n, s_t, s_m,
+    !> 1/s_n, 1/s_t, 1/s_m, c_nt, c_nm, c_tm, mu', e', inverse of the scaled block (6 entries:
+    !> nn, nt, tt, nm, tm, mm; zero when it is singular), rho); all zero when the trace of W is 0.
+    pure subroutine rolling_scaling(w, mu, e, sc)
+        !> Delassus block (nn, nt, tt, nm, tm, mm).
+        real(wp), intent(in) :: w(6)
+        !> Friction coefficient and rolling length [m].
+        real(wp), intent(in) :: mu, e
+        !> The constants.
+        real(wp), intent(out) :: sc(rolling_n_scaling)
+        real(wp) :: fl, a, bb, d, det
+        sc = 0.0_wp
+        if (w(1) + w(3) + w(6) <= 0.0_wp) return
+        ! a direction held by the fixities has a zero diagonal: floor it as in `scaling`
+        fl = scaling_floor*(w(1) + w(3) + w(6))
+        sc(1) = sqrt(max(w(1), fl))
+        sc(2) = sqrt(max(w(3), fl))
+        sc(3) = sqrt(max(w(6), fl))
+        sc(4:6) = 1.0_wp/sc(1:3)
+        a = w(2)*sc(4)*sc(5)
+        bb = w(4)*sc(4)*sc(6)
+        d = w(5)*sc(5)*sc(6)
+        sc(7) = a
+        sc(8) = bb
+        sc(9) = d
+        sc(10) = mu*sc(2)*sc(4)
+        sc(11) = e*sc(3)*sc(4)
+        sc(18) = 1.0_wp/(1.0_wp + max(abs(a) + abs(bb), abs(a) + abs(d), abs(bb) + abs(d)))
+        ! inverse of [1 a b; a 1 d; b d 1] by cofactors
+        det = 1.0_wp + 2.0_wp*a*bb*d - a*a - bb*bb - d*d
+        if (det > singular_det) then
+            sc(12) = (1.0_wp - d*d)/det
+            sc(13) = (bb*d - a)/det
+            sc(14) = (1.0_wp - bb*bb)/det
+            sc(15) = (a*d - bb)/det
+            sc(16) = (a*bb - d)/det
+            sc(17) = (1.0_wp - a*a)/det
+        end if
+    end subroutine rolling_scaling
+
+    !> `rolling_local_solve` with the constants of `rolling_scaling` computed beforehand.
+    pure subroutine rolling_local_solve_scaled(sc, b, tol, max_iter, r, n_iter, pcase)
+        !> Constants of the scaled frame (`rolling_scaling`).
+        real(wp), intent(in) :: sc(rolling_n_scaling)
+        !> Velocity without this contact's reaction (u_n, u_t, w_r).
+        real(wp), intent(in) :: b(3)
+        !> Relative tolerance of the local iterations.
+        real(wp), intent(in) :: tol
+        !> Iteration cap (>= 1).
+        integer, intent(in) :: max_iter
+        !> Reaction (r_n, r_t, M): initial guess in, solution out (unchanged when sc(1) = 0).
+        real(wp), intent(inout) :: r(3)
+        !> Iterations done.
+        integer, intent(out) :: n_iter
+        !> Case of the last projection.
+        integer, intent(out) :: pcase
+        real(wp) :: bp(3), rp(3), up(3), tau(3), q(3), change
+        logical :: done
+        pcase = case_separation
+        n_iter = 0
+        if (sc(1) <= 0.0_wp) return
+        bp = b*sc(4:6)
+        rp = r*sc(1:3)
+        do n_iter = 1, max_iter
+            up = scaled_velocity(sc, bp, rp)
+            tau(1) = rp(1) - sc(18)*(up(1) + sc(10)*abs(up(2)) + sc(11)*abs(up(3)))
+            tau(2:3) = rp(2:3) - sc(18)*up(2:3)
+            call rolling_projection(tau(1), tau(2), tau(3), sc(10), sc(11), q(1), q(2), q(3), pcase)
+            change = sum(abs(q - rp))
+            rp = q
+            if (change <= tol*sum(abs(rp))) exit
+            if (pcase == case_separation) cycle
+            call branch(sc, bp, pcase, rp, done)
+            if (done) exit
+        end do
+        n_iter = min(n_iter, max_iter)
+        r = rp*sc(4:6)
+    end subroutine rolling_local_solve_scaled
+
+    !> u' = b' + W' r' in the scaled frame.
+    pure function scaled_velocity(sc, bp, rp) result(up)
+        real(wp), intent(in) :: sc(rolling_n_scaling), bp(3), rp(3)
+        real(wp) :: up(3)
+        up(1) = bp(1) + rp(1) + sc(7)*rp(2) + sc(8)*rp(3)
+        up(2) = bp(2) + sc(7)*rp(1) + rp(2) + sc(9)*rp(3)
+        up(3) = bp(3) + sc(8)*rp(1) + sc(9)*rp(2) + rp(3)
+    end function scaled_velocity
+
+    !> Exact solution of the branch of the law on which the last projection landed (scaled
+    !> frame), kept (done) only when it satisfies the whole law:
+    !>  - stick: u' = 0, r' = -W'^-1 b', inside the cone;
+    !>  - slip: r' = (n, s mu' n, m), u'_n = u'_m = 0, with n >= 0, |m| <= e' n, s u'_t <= 0;
+    !>  - roll: r' = (n, t, s e' n), u'_n = u'_t = 0, with n >= 0, |t| <= mu' n, s u'_m <= 0;
+    !>  - slip and roll: r' = n (1, s mu', s' e'), u'_n = 0, n >= 0, s u'_t <= 0, s' u'_m <= 0.
+    !> (s, s' are the signs of the projected r'_t, M'.)
+    pure subroutine branch(sc, bp, pcase, rp, done)
+        real(wp), intent(in) :: sc(rolling_n_scaling), bp(3)
+        integer, intent(in) :: pcase
+        real(wp), intent(inout) :: rp(3)
+        logical, intent(out) :: done
+        real(wp) :: q(3), up(3), mup, ep, s, sm, a11, a12, a21, a22, det, x1, x2
+        done = .false.
+        mup = sc(10)
+        ep = sc(11)
+        s = sign(1.0_wp, rp(2))
+        sm = sign(1.0_wp, rp(3))
+        select case (pcase)
+        case (case_stick)
+            if (sc(12) <= 0.0_wp) return
+            q(1) = -(sc(12)*bp(1) + sc(13)*bp(2) + sc(15)*bp(3))
+            q(2) = -(sc(13)*bp(1) + sc(14)*bp(2) + sc(16)*bp(3))
+            q(3) = -(sc(15)*bp(1) + sc(16)*bp(2) + sc(17)*bp(3))
+            if (abs(q(2)) > mup*q(1) .or. abs(q(3)) > ep*q(1)) return
+        case (case_slip)
+            ! unknowns (n, m): rows u'_n = 0 and u'_m = 0
+            a11 = 1.0_wp + sc(7)*s*mup
+            a12 = sc(8)
+            a21 = sc(8) + sc(9)*s*mup
+            a22 = 1.0_wp
+            det = a11*a22 - a12*a21
+            if (det <= singular_det) return
+            x1 = (-bp(1)*a22 + a12*bp(3))/det
+            x2 = (-a11*bp(3) + a21*bp(1))/det
+            q = [x1, s*mup*x1, x2]
+            if (x1 < 0.0_wp .or. abs(x2) > ep*x1) return
+            up = scaled_velocity(sc, bp, q)
+            if (s*up(2) > 0.0_wp) return
+        case (case_roll)
+            ! unknowns (n, t): rows u'_n = 0 and u'_t = 0
+            a11 = 1.0_wp + sc(8)*sm*ep
+            a12 = sc(7)
+            a21 = sc(7) + sc(9)*sm*ep
+            a22 = 1.0_wp
+            det = a11*a22 - a12*a21
+            if (det <= singular_det) return
+            x1 = (-bp(1)*a22 + a12*bp(2))/det
+            x2 = (-a11*bp(2) + a21*bp(1))/det
+            q = [x1, x2, sm*ep*x1]
+            if (x1 < 0.0_wp .or. abs(x2) > mup*x1) return
+            up = scaled_velocity(sc, bp, q)
+            if (sm*up(3) > 0.0_wp) return
+        case (case_slip_roll)
+            a11 = 1.0_wp + sc(7)*s*mup + sc(8)*sm*ep
+            if (a11 <= 0.0_wp) return
+            x1 = -bp(1)/a11
+            q = [x1, s*mup*x1, sm*ep*x1]
+            if (x1 < 0.0_wp) return
+            up = scaled_velocity(sc, bp, q)
+            if (s*up(2) > 0.0_wp .or. sm*up(3) > 0.0_wp) return
+        case default
+            return
+        end select
+        rp = q
+        done = .true.
+    end subroutine branch
+
+    !> Residual of the three-component law at (r, u), in the scaled frame:
+    !> |r' - proj(r' - u_hat')|. Zero iff (r, u) satisfies the law.
+    pure real(wp) function rolling_residual(w, u, mu, e, r) result(res)
+        !> Delassus block (nn, nt, tt, nm, tm, mm).
+        real(wp), intent(in) :: w(6)
+        !> Relative velocity (u_n, u_t, w_r).
+        real(wp), intent(in) :: u(3)
+        !> Friction coefficient and rolling length [m].
+        real(wp), intent(in) :: mu, e
+        !> Reaction (r_n, r_t, M).
+        real(wp), intent(in) :: r(3)
+        real(wp) :: sc(rolling_n_scaling), rp(3), up(3), tau(3), q(3)
+        integer :: pcase
+        res = 0.0_wp
+        call rolling_scaling(w, mu, e, sc)
+        if (sc(1) <= 0.0_wp) return
+        rp = r*sc(1:3)
+        up = u*sc(4:6)
+        tau(1) = rp(1) - (up(1) + sc(10)*abs(up(2)) + sc(11)*abs(up(3)))
+        tau(2:3) = rp(2:3) - up(2:3)
+        call rolling_projection(tau(1), tau(2), tau(3), sc(10), sc(11), q(1), q(2), q(3), pcase)
+        res = norm2(rp - q)
+    end function rolling_residual
 end module dem_bipotential

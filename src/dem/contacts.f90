@@ -3,9 +3,11 @@
 !> Contact k joins body i1(k) to disk i2(k); i1 < 0 means wall -i1. The normal n goes from
 !> body i1 to disk i2 (from the wall into the disk), t = (-n_y, n_x). Local velocity of i2
 !> relative to i1 at the contact point: u_n = n.(v2 - v1),
-!> u_t = t.(v2 - v1) + c1 w1 + c2 w2 with lever arms c = -radius. Reaction r = (r_n, r_t)
-!> (impulse per unit thickness) acts on i2, -r on i1. W = H^T M^-1 H is the local 2x2
-!> Delassus block (W_nn, W_nt, W_tt).
+!> u_t = t.(v2 - v1) + c1 w1 + c2 w2 with lever arms c = -radius, and the relative rotation
+!> w_r = w2 - w1. Reaction r = (r_n, r_t, M) (impulses per unit thickness): the force
+!> r_n n + r_t t acts on i2 at the contact point, its opposite on i1, and the moment M acts
+!> on i2, -M on i1. W = H^T M^-1 H is the local 3x3 Delassus block, stored as
+!> (W_nn, W_nt, W_tt, W_nm, W_tm, W_mm) (doc/theory.md, "Contact kinematics").
 !>
 !> Order: by owner disk (i1 for disk pairs, i2 for wall contacts), then walls before disks,
 !> then by the other index; the detection emits contacts in this order so that consecutive
@@ -13,14 +15,16 @@
 !> contacts are appended (warm start).
 module dem_contacts
     use core_kinds, only: wp, i8
-    use dem_materials, only: materials_t
+    use dem_materials, only: materials_t, bond_e_default
+    use dem_bipotential, only: case_separation, case_slip, case_roll, case_slip_roll
+    use dem_bonds, only: break_none, break_tension, break_shear, break_moment, break_shear_moment
     implicit none
     private
     public :: contact_set_t, contact_law_t
     public :: status_open, status_stick, status_slip, status_cohesive, status_broken
     public :: contacts_begin_detection, contacts_append, contacts_append_owner
     public :: contacts_set_frames, contacts_set_laws, contacts_finish, contacts_impulses
-    public :: contacts_local_velocity, contacts_count_status, contacts_bytes
+    public :: contacts_local_velocity, contacts_count_status, contacts_bytes, contacts_moments_active
 
     !> Status: no reaction (separated or not active this step).
     integer, parameter :: status_open = 0
@@ -64,17 +68,27 @@ module dem_contacts
         real(wp), allocatable :: gap(:)
         !> Lever arms (c1, c2) of the rotations in u_t [m].
         real(wp), allocatable :: lever(:, :)
-        !> Delassus block (W_nn, W_nt, W_tt) (3, n).
+        !> Delassus block (W_nn, W_nt, W_tt, W_nm, W_tm, W_mm) (6, n).
         real(wp), allocatable :: w(:, :)
         !> Constant velocity terms added to H^T v in the solver (wall motion, restitution
         !> target) (2, n).
         real(wp), allocatable :: shift(:, :)
-        !> Reaction impulse (r_n, r_t) (2, n) [N s/m].
+        !> Reaction impulse (r_n, r_t, M) (3, n) [N s/m, N s].
         real(wp), allocatable :: r(:, :)
-        !> End-of-step relative velocity (u_n, u_t) (2, n) [m/s].
+        !> End-of-step relative velocity (u_n, u_t, w_r) (3, n) [m/s, rad/s].
         real(wp), allocatable :: u(:, :)
-        !> Friction coefficient.
+        !> Friction coefficient of the current law (mu of the materials, or mu_b of an intact
+        !> bond).
         real(wp), allocatable :: mu(:)
+        !> Moment length of the current law [m] (rolling length e_r, or e_b of an intact bond);
+        !> 0: the contact transmits no moment.
+        real(wp), allocatable :: erol(:)
+        !> Mean radius of the pair [m] (the length that scales moments in the solver's norm).
+        real(wp), allocatable :: amoy(:)
+        !> Projection case of the last local solve (dem_bipotential case_*).
+        integer, allocatable :: pcase(:)
+        !> Rupture mode of a bond that broke at this step (dem_bonds break_*), else break_none.
+        integer, allocatable :: break_mode(:)
         !> Cohesive impulse r_cohe h of intact bonds (0 otherwise) [N s/m].
         real(wp), allocatable :: coh(:)
         !> Contact takes part in the solve this step.
@@ -120,7 +134,7 @@ contains
         call grow_int(cs%i1, cs%capacity, 0)
         call grow_int(cs%i2, cs%capacity, 0)
         call grow_int(cs%status, cs%capacity, 0)
-        call grow_real2(cs%r, 2, cs%capacity, 0)
+        call grow_real2(cs%r, 3, cs%capacity, 0)
         ! the new list is usually about as long as the previous one
         call ensure_capacity(cs, cs%n_prev + cs%n_prev/8)
     end subroutine contacts_begin_detection
@@ -180,6 +194,13 @@ contains
         cs%nrm(1, k) = nx
         cs%nrm(2, k) = ny
         cs%gap(k) = gap
+        ! the law is set by contacts_set_laws; until then: none
+        cs%mu(k) = 0.0_wp
+        cs%erol(k) = 0.0_wp
+        cs%coh(k) = 0.0_wp
+        cs%amoy(k) = 0.0_wp
+        cs%pcase(k) = case_separation
+        cs%break_mode(k) = break_none
         ! skip the previous pairs that come before this one
         key = pair_key(i1, i2)
         p = cs%merge_pos
@@ -190,15 +211,13 @@ contains
         cs%merge_pos = p
         if (p <= cs%n_prev) then
             if (cs%prev_i1(p) == i1 .and. cs%prev_i2(p) == i2) then
-                cs%r(1, k) = cs%prev_r(1, p)
-                cs%r(2, k) = cs%prev_r(2, p)
+                cs%r(:, k) = cs%prev_r(:, p)
                 cs%status(k) = cs%prev_status(p)
                 cs%merge_pos = p + 1
                 return
             end if
         end if
-        cs%r(1, k) = 0.0_wp
-        cs%r(2, k) = 0.0_wp
+        cs%r(:, k) = 0.0_wp
         cs%status(k) = status_open
     end subroutine append_one
 
@@ -214,12 +233,16 @@ contains
         call grow_real2(cs%nrm, 2, cap, cs%n)
         call grow_real1(cs%gap, cap, cs%n)
         call grow_real2(cs%lever, 2, cap, cs%n)
-        call grow_real2(cs%w, 3, cap, cs%n)
+        call grow_real2(cs%w, 6, cap, cs%n)
         call grow_real2(cs%shift, 2, cap, cs%n)
-        call grow_real2(cs%r, 2, cap, cs%n)
-        call grow_real2(cs%u, 2, cap, cs%n)
+        call grow_real2(cs%r, 3, cap, cs%n)
+        call grow_real2(cs%u, 3, cap, cs%n)
         call grow_real1(cs%mu, cap, cs%n)
+        call grow_real1(cs%erol, cap, cs%n)
+        call grow_real1(cs%amoy, cap, cs%n)
         call grow_real1(cs%coh, cap, cs%n)
+        call grow_int(cs%pcase, cap, cs%n)
+        call grow_int(cs%break_mode, cap, cs%n)
         call grow_int(cs%status, cap, cs%n)
         call grow_logical(cs%active, cap, cs%n)
         cs%capacity = cap
@@ -254,25 +277,30 @@ contains
             tx = -ny
             ty = nx
             cs%lever(2, k) = -radius(b)
-            cs%w(:, k) = block(im(:, b), cs%lever(2, k))
+            cs%w(:, k) = block(im(:, b), cs%lever(2, k), 1.0_wp)
             cs%lever(1, k) = 0.0_wp
             if (a > 0) then
                 cs%lever(1, k) = -radius(a)
-                cs%w(:, k) = cs%w(:, k) + block(im(:, a), cs%lever(1, k))
+                cs%w(:, k) = cs%w(:, k) + block(im(:, a), cs%lever(1, k), -1.0_wp)
             end if
         end do
     contains
-        pure function block(imb, c) result(w)
-            real(wp), intent(in) :: imb(3), c
-            real(wp) :: w(3)
+        ! block of one body: its generalised directions are s (n, 0), s (t, 0) + (0, c) and
+        ! (0, s) for r_n, r_t and M (s = +1 on i2, -1 on i1)
+        pure function block(imb, c, s) result(w)
+            real(wp), intent(in) :: imb(3), c, s
+            real(wp) :: w(6)
             w(1) = nx*nx*imb(1) + ny*ny*imb(2)
             w(2) = nx*tx*imb(1) + ny*ty*imb(2)
             w(3) = tx*tx*imb(1) + ty*ty*imb(2) + c*c*imb(3)
+            w(4) = 0.0_wp
+            w(5) = s*c*imb(3)
+            w(6) = imb(3)
         end function block
     end subroutine contacts_set_frames
 
-    !> Relative velocity (u_n, u_t) of contact k for body velocities vel (3, n_disks) and wall
-    !> velocities wall_vel (2, n_walls), without the solver shifts.
+    !> Relative velocity (u_n, u_t, w_r) of contact k for body velocities vel (3, n_disks) and
+    !> wall velocities wall_vel (2, n_walls), without the solver shifts.
     pure function contacts_local_velocity(cs, k, vel, wall_vel) result(u)
         !> Contacts.
         type(contact_set_t), intent(in) :: cs
@@ -282,7 +310,7 @@ contains
         real(wp), intent(in) :: vel(:, :)
         !> Wall velocities.
         real(wp), intent(in) :: wall_vel(:, :)
-        real(wp) :: u(2)
+        real(wp) :: u(3)
         real(wp) :: dv(2), nx, ny
         integer :: a, b
         a = cs%i1(k)
@@ -292,9 +320,11 @@ contains
         if (a > 0) then
             dv = vel(1:2, b) - vel(1:2, a)
             u(2) = cs%lever(1, k)*vel(3, a)
+            u(3) = vel(3, b) - vel(3, a)
         else
             dv = vel(1:2, b) - wall_vel(:, -a)
             u(2) = 0.0_wp
+            u(3) = vel(3, b)
         end if
         u(1) = nx*dv(1) + ny*dv(2)
         u(2) = u(2) - ny*dv(1) + nx*dv(2) + cs%lever(2, k)*vel(3, b)
@@ -338,7 +368,7 @@ contains
         !> Wall velocities at the start and at the end of the step (2, n_walls).
         real(wp), intent(in) :: wall_vel_begin(:, :), wall_vel_end(:, :)
         integer :: k, ma, mb
-        real(wp) :: ub(2), uf(2), uw(2), amoy, target, e, gp
+        real(wp) :: ub(3), uf(3), uw(2), amoy, target, e, gp
         do k = 1, cs%n
             mb = mat(cs%i2(k))
             if (cs%i1(k) > 0) then
@@ -348,12 +378,23 @@ contains
                 ma = wall_mat(-cs%i1(k))
                 amoy = radius(cs%i2(k))
             end if
-            cs%mu(k) = materials%mu(ma, mb)
+            cs%amoy(k) = amoy
             e = materials%restitution(ma, mb)
             if (law%make_bonds .and. materials%cohesion(ma, mb) > 0.0_wp .and. &
                 cs%gap(k) <= law%bond_ratio*amoy) cs%status(k) = status_cohesive
             cs%coh(k) = 0.0_wp
-            if (cs%status(k) == status_cohesive) cs%coh(k) = materials%cohesion(ma, mb)*amoy*law%h
+            cs%mu(k) = materials%mu(ma, mb)
+            cs%erol(k) = materials%rolling(ma, mb)
+            if (cs%status(k) == status_cohesive) then
+                cs%coh(k) = materials%cohesion(ma, mb)*amoy*law%h
+                cs%mu(k) = materials%bond_mu(ma, mb)
+                cs%erol(k) = materials%bond_e(ma, mb)
+                if (cs%erol(k) == bond_e_default) cs%erol(k) = 0.5_wp*amoy
+            end if
+            ! a law without moment: the warm start of a bond that broke carries none
+            if (cs%erol(k) <= 0.0_wp) cs%r(3, k) = 0.0_wp
+            cs%pcase(k) = case_separation
+            cs%break_mode(k) = break_none
             ub = contacts_local_velocity(cs, k, vel_begin, wall_vel_begin)
             uf = contacts_local_velocity(cs, k, vel_free, wall_vel_end)
             uw = 0.0_wp
@@ -381,14 +422,21 @@ contains
     end function wall_term
 
     !> After the solve: end-of-step relative velocities, statuses, broken bonds.
-    !> A bond breaks for good when the solution needs more tension than the cohesion holds:
-    !> its shifted reaction is at the apex of the cone (r_n + r_cohe h = 0, full tension, the
-    !> separation case of the law) and the contact opens (u_n > 0). This depends on the
-    !> converged forces, not on an opening of round-off size (which the solver tolerance
-    !> does not resolve). A bond left out of the solve (blocked: both bodies immobile along
-    !> the normal, see dem_nlgs) has no force to judge by: it breaks when its end-of-step gap
-    !> g + theta h u_n exceeds bond_ratio * mean radius.
-    pure subroutine contacts_finish(cs, law, radius, vel, wall_vel)
+    !> At a converged step, an intact bond breaks for good when its shifted reaction
+    !> (r_n + r_cohe h, r_t, M) reaches a bound of its cone (break_mode records which):
+    !>  - tension: the apex (full tension, the separation case of the law) and the contact
+    !>    opens (u_n > 0);
+    !>  - shear: the last local solve projected on the sliding face |r_t| = mu_b (r_n + r_cohe h);
+    !>  - moment: it projected on the rolling face |M| = e_b (r_n + r_cohe h);
+    !>  - shear and moment: on both (the edge of the cone).
+    !> A bound with a zero coefficient (mu_b = 0 or e_b = 0) locks nothing: that component is
+    !> free and does not break the bond. This depends on the converged forces, not on an
+    !> opening of round-off size (which the solver tolerance does not resolve). A step that
+    !> did not converge breaks no bond (it is reported by the solver statistics). A bond left
+    !> out of the solve (blocked: both bodies immobile along the normal, see dem_nlgs) has no
+    !> force to judge by: it breaks in tension when its end-of-step gap g + theta h u_n exceeds
+    !> bond_ratio * mean radius.
+    pure subroutine contacts_finish(cs, law, radius, vel, wall_vel, converged)
         !> Contacts.
         type(contact_set_t), intent(inout) :: cs
         !> Step parameters.
@@ -399,20 +447,26 @@ contains
         real(wp), intent(in) :: vel(:, :)
         !> End-of-step wall velocities (2, n_walls).
         real(wp), intent(in) :: wall_vel(:, :)
+        !> The solver converged at this step (default: yes).
+        logical, intent(in), optional :: converged
         integer :: k
         real(wp) :: amoy, rn
-        logical :: breaks
+        logical :: judge
+        judge = .true.
+        if (present(converged)) judge = converged
         do k = 1, cs%n
             cs%u(:, k) = contacts_local_velocity(cs, k, vel, wall_vel)
+            cs%break_mode(k) = break_none
             if (cs%status(k) == status_cohesive) then
                 if (cs%active(k)) then
-                    breaks = cs%r(1, k) + cs%coh(k) <= 0.0_wp .and. cs%u(1, k) > 0.0_wp
+                    if (judge) cs%break_mode(k) = bond_break_mode(cs, k)
                 else
                     amoy = radius(cs%i2(k))
                     if (cs%i1(k) > 0) amoy = 0.5_wp*(amoy + radius(cs%i1(k)))
-                    breaks = cs%gap(k) + law%theta*law%h*cs%u(1, k) > law%bond_ratio*amoy
+                    if (cs%gap(k) + law%theta*law%h*cs%u(1, k) > law%bond_ratio*amoy) &
+                        cs%break_mode(k) = break_tension
                 end if
-                if (breaks) cs%status(k) = status_broken
+                if (cs%break_mode(k) /= break_none) cs%status(k) = status_broken
             else if (cs%status(k) /= status_broken) then
                 rn = cs%r(1, k)
                 if (rn <= 0.0_wp) then
@@ -425,6 +479,35 @@ contains
             end if
         end do
     end subroutine contacts_finish
+
+    !> Rupture mode of the active intact bond k at the end of a converged solve (see
+    !> contacts_finish), break_none when it holds.
+    pure integer function bond_break_mode(cs, k) result(mode)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: k
+        logical :: shear, moment
+        mode = break_none
+        if (cs%r(1, k) + cs%coh(k) <= 0.0_wp) then
+            if (cs%u(1, k) > 0.0_wp) mode = break_tension
+            return
+        end if
+        shear = cs%mu(k) > 0.0_wp .and. (cs%pcase(k) == case_slip .or. cs%pcase(k) == case_slip_roll)
+        moment = cs%erol(k) > 0.0_wp .and. (cs%pcase(k) == case_roll .or. cs%pcase(k) == case_slip_roll)
+        if (shear .and. moment) then
+            mode = break_shear_moment
+        else if (shear) then
+            mode = break_shear
+        else if (moment) then
+            mode = break_moment
+        end if
+    end function bond_break_mode
+
+    !> Whether any contact of the list transmits moments (a moment length > 0).
+    pure logical function contacts_moments_active(cs) result(yes)
+        !> Contacts.
+        type(contact_set_t), intent(in) :: cs
+        yes = any(cs%erol(1:cs%n) > 0.0_wp)
+    end function contacts_moments_active
 
     !> Add the generalised contact impulses H r to p (3, n_disks).
     pure subroutine contacts_impulses(cs, p)
@@ -439,10 +522,10 @@ contains
             b = cs%i2(k)
             f = cs%r(1, k)*cs%nrm(:, k) + cs%r(2, k)*[-cs%nrm(2, k), cs%nrm(1, k)]
             p(1:2, b) = p(1:2, b) + f
-            p(3, b) = p(3, b) + cs%lever(2, k)*cs%r(2, k)
+            p(3, b) = p(3, b) + cs%lever(2, k)*cs%r(2, k) + cs%r(3, k)
             if (a > 0) then
                 p(1:2, a) = p(1:2, a) - f
-                p(3, a) = p(3, a) + cs%lever(1, k)*cs%r(2, k)
+                p(3, a) = p(3, a) + cs%lever(1, k)*cs%r(2, k) - cs%r(3, k)
             end if
         end do
     end subroutine contacts_impulses
@@ -464,8 +547,9 @@ contains
         if (allocated(cs%i1)) b = b + 4_i8*(size(cs%i1) + size(cs%i2))
         if (allocated(cs%nrm)) b = b + 8_i8*(size(cs%nrm) + size(cs%gap))
         if (allocated(cs%lever)) b = b + 8_i8*(size(cs%lever) + size(cs%w) + size(cs%shift) + size(cs%r) &
-                                               + size(cs%u) + size(cs%mu) + size(cs%coh))
-        if (allocated(cs%status)) b = b + 4_i8*(size(cs%status) + size(cs%active))
+                                               + size(cs%u) + size(cs%mu) + size(cs%coh) + size(cs%erol) + size(cs%amoy))
+        if (allocated(cs%status)) b = b + 4_i8*(size(cs%status) + size(cs%active) + size(cs%pcase) &
+                                                + size(cs%break_mode))
         if (allocated(cs%prev_i1)) b = b + 4_i8*(size(cs%prev_i1) + size(cs%prev_i2))
         if (allocated(cs%prev_r)) b = b + 8_i8*size(cs%prev_r)
         if (allocated(cs%prev_status)) b = b + 4_i8*size(cs%prev_status)

@@ -40,6 +40,7 @@ module dem_moreau_jean
                             contacts_bytes
     use dem_detection, only: detector_t, detect_contacts, detector_bytes
     use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_bilateral_t
+    use dem_bonds, only: rupture_log_t, break_none
     implicit none
     private
     public :: mj_config_t, energies_t, dem_system_t, mj_init, mj_step, energies_balance, dem_system_bytes
@@ -112,6 +113,8 @@ module dem_moreau_jean
         real(wp) :: time_detection = 0.0_wp, time_solver = 0.0_wp
         !> Bonds are still to be created (first step).
         logical :: bonds_pending = .true.
+        !> Bond ruptures since the start (pair, step, time, mode).
+        type(rupture_log_t) :: ruptures
         !> Work arrays (3, n): start and current velocities, inverse mass, loads, impulses.
         real(wp), allocatable :: vel0(:, :), vel(:, :), im(:, :), load(:, :), impulse(:, :)
         !> Work arrays: mid configuration of the disks and walls.
@@ -242,17 +245,26 @@ contains
         sys%time_solver = sys%time_solver + real(c1 - c0, wp)/real(rate, wp)
     end subroutine mj_solve
 
-    !> Part 4 of a step: statuses and broken bonds, energy audit (coupling_impulse included),
-    !> new configuration and velocities, time.
+    !> Part 4 of a step: statuses and broken bonds (logged in `ruptures`; bonds are judged
+    !> at converged steps only), energy audit (coupling_impulse included), new configuration
+    !> and velocities, time.
     subroutine mj_end_step(sys)
         !> System, after `mj_solve`.
         type(dem_system_t), intent(inout) :: sys
-        call contacts_finish(sys%contacts, step_law(sys), sys%particles%radius, sys%vel, sys%wall_v1)
+        integer :: k
+        call contacts_finish(sys%contacts, step_law(sys), sys%particles%radius, sys%vel, sys%wall_v1, &
+                             sys%stats%converged)
         call audit_energies(sys)
         call update_configuration(sys)
         sys%time = sys%time + sys%scheme%h
         sys%step = sys%step + 1
         sys%bonds_pending = .false.
+        associate (cs => sys%contacts)
+            do k = 1, cs%n
+                if (cs%break_mode(k) == break_none) cycle
+                call sys%ruptures%add(cs%i1(k), cs%i2(k), int(sys%step, i8), sys%time, cs%break_mode(k))
+            end do
+        end associate
     end subroutine mj_end_step
 
     !> vel0 = current velocities, im, theta-weighted loads, vel = free velocities, wall velocities.
@@ -341,11 +353,12 @@ contains
         end associate
     end subroutine audit_energies
 
-    !> Contact dissipation -sum r.u_theta and work of moving walls sum r.(n.vw, t.vw)_theta,
+    !> Contact dissipation -sum r.u_theta (r = (r_n, r_t, M), u = (u_n, u_t, w_r)) and work of
+    !> moving walls sum r.(n.vw, t.vw)_theta,
     !> over the contacts of the solve (inactive and blocked contacts have r = 0 and are skipped).
     subroutine contact_works(sys)
         type(dem_system_t), intent(inout) :: sys
-        real(wp) :: th, u(2), vw(2), nx, ny
+        real(wp) :: th, u(3), vw(2), nx, ny
         integer :: k, a
         th = sys%scheme%theta
         associate (cs => sys%contacts, e => sys%energies)

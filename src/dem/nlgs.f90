@@ -2,12 +2,26 @@
 !>
 !> Body velocities v (3, n) start at the free velocities; the solver adds M^-1 H r of the
 !> warm-started reactions, then sweeps: for each active contact, u = H^T v + shift,
-!> b = u - W r, local solve for r, v += M^-1 H dr. Cohesion: the unknown of the local solve
-!> is the shifted reaction r_n + r_cohe h (THEORY.md 1), the impulse applied is r.
+!> b = u - W r, local solve for r, v += M^-1 H dr. Each contact has the local unknowns
+!> (r_n, r_t, M); a contact whose law has no moment length (e = 0: M = 0) is solved with the
+!> two-component solver (bipotential_local_solve_scaled), the others with the
+!> three-component one (rolling_local_solve_scaled). Cohesion: the unknown of the local
+!> solve is the shifted reaction r_n + r_cohe h (doc/theory.md, "Cohesion"), the impulse
+!> applied is r.
 !> Convergence norm (LMGC90 'Quad'-like): after a sweep,
 !>     sqrt(sum |W_aa dr_a|^2) / sqrt(sum |W_aa r_a|^2) <= tol,
-!> i.e. the change of local velocities over the sweep relative to W r. The Signorini-Coulomb
-!> residual of the final state (scaled frame, bipotential_residual) is reported too.
+!> i.e. the change of local velocities over the sweep relative to W r, where r is the
+!> reaction actually applied (not shifted by the cohesion: the test is relative to the forces
+!> the contacts carry, not to the strength of the bonds); the rotation rows are multiplied
+!> by the mean radius of the pair so that all rows are velocities. Round-off bounds what a
+!> sweep can resolve: a relative velocity is known to about eps times the velocities of the
+!> two bodies, and the shifted unknown of a bond to about eps r_cohe h. Changes below that
+!> noise, floor = (64 eps)^2 sum (|W_aa (r_cohe h, 0, 0)|^2 + |v_i|^2 + |v_j|^2) over the
+!> contacts (v with rotations times the mean radius, taken when the solve starts), are not
+!> counted: the error reported is sqrt(max(num - floor, 0) / den), so that a structure that
+!> carries no force (rigid motion, unloaded bonds) converges instead of chasing round-off. The residual of the law in the final
+!> state (scaled frame, bipotential_residual / rolling_residual) is reported too, with the
+!> same normalisation.
 !> Sweeps alternate direction when `symmetric` (symmetric Gauss-Seidel).
 !> Blocked contacts (both bodies immobile along the normal: W_nn = 0) are taken out of the
 !> solve with r = 0 and counted in the statistics (`nlgs_stats_t%n_blocked`).
@@ -24,7 +38,8 @@ module dem_nlgs
     use core_kinds, only: wp, i8
     use dem_contacts, only: contact_set_t
     use dem_bipotential, only: bipotential_residual, bipotential_scaling, bipotential_local_solve_scaled, &
-                               bipotential_n_scaling
+                               bipotential_n_scaling, rolling_scaling, rolling_local_solve_scaled, rolling_residual, &
+                               rolling_n_scaling
     implicit none
     private
     public :: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_apply_reactions, nlgs_residual
@@ -33,6 +48,9 @@ module dem_nlgs
     !> A contact is blocked when W_nn <= blocked_ratio (W_nn + W_tt) (the floor of the scaled
     !> frame in dem_bipotential: below it the normal reaction would be unbounded).
     real(wp), parameter :: blocked_ratio = 1.0e-12_wp
+    !> Relative resolution of the shifted reactions of bonds (see the module header): 64
+    !> machine epsilons.
+    real(wp), parameter :: roundoff = 64.0_wp*epsilon(1.0_wp)
 
     !> Solver settings.
     type :: nlgs_config_t
@@ -121,21 +139,30 @@ contains
         integer(i8) :: nloc
         integer, allocatable :: list(:)
         ! per contact of the solve, constant over the solve: the scaled frame of its local
-        ! problem (bipotential_scaling)
+        ! problem (bipotential_scaling, or rolling_scaling for a law with moments)
         real(wp), allocatable :: sc(:, :)
+        real(wp) :: floor
         integer :: s, k
         stats%n_contacts = cs%n
         call skip_blocked(cs, stats%n_blocked)
         stats%n_active = count(cs%active(1:cs%n))
-        allocate (list(stats%n_active), sc(bipotential_n_scaling, stats%n_active))
+        allocate (list(stats%n_active), sc(rolling_n_scaling, stats%n_active))
         s = 0
+        floor = 0.0_wp
         do k = 1, cs%n
             if (.not. cs%active(k)) cycle
             s = s + 1
             list(s) = k
-            call bipotential_scaling(cs%w(1, k), cs%w(2, k), cs%w(3, k), cs%mu(k), sc(:, s))
+            if (cs%erol(k) > 0.0_wp) then
+                call rolling_scaling(cs%w(:, k), cs%mu(k), cs%erol(k), sc(:, s))
+            else
+                call bipotential_scaling(cs%w(1, k), cs%w(2, k), cs%w(3, k), cs%mu(k), sc(1:bipotential_n_scaling, s))
+            end if
         end do
         call nlgs_apply_reactions(cs, im, vel)
+        do s = 1, stats%n_active
+            floor = floor + roundoff_floor(cs, list(s), vel)
+        end do
         if (present(bilateral)) call bilateral%restore(vel)
         stats%converged = .true.
         stats%error = 0.0_wp
@@ -151,7 +178,7 @@ contains
                 end if
                 stats%sweeps = s
                 stats%local_iterations = stats%local_iterations + nloc
-                stats%error = relative(num, den)
+                stats%error = relative(max(num - floor, 0.0_wp), den)
                 if (stats%error <= config%tol) then
                     stats%converged = .true.
                     exit
@@ -161,6 +188,20 @@ contains
         stats%updates = int(stats%n_active, i8)*stats%sweeps
         stats%residual = nlgs_residual(cs, vel)
     end subroutine nlgs_solve
+
+    !> Round-off floor of the convergence norm's denominator for contact k (module header).
+    pure real(wp) function roundoff_floor(cs, k, vel) result(f)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: k
+        real(wp), intent(in) :: vel(:, :)
+        integer :: a, b
+        a = cs%i1(k)
+        b = cs%i2(k)
+        f = (cs%coh(k)*cs%w(1, k))**2 + (cs%coh(k)*cs%w(2, k))**2 + vel(1, b)**2 + vel(2, b)**2 &
+            + (cs%amoy(k)*vel(3, b))**2
+        if (a > 0) f = f + vel(1, a)**2 + vel(2, a)**2 + (cs%amoy(k)*vel(3, a))**2
+        f = roundoff**2*f
+    end function roundoff_floor
 
     !> sqrt(num/den), 0 for 0/0, huge for x/0.
     pure real(wp) function relative(num, den) result(q)
@@ -205,17 +246,17 @@ contains
         integer :: k
         do k = 1, cs%n
             if (.not. cs%active(k)) cycle
-            call apply(cs, k, im, vel, cs%r(1, k), cs%r(2, k))
+            call apply(cs, k, im, vel, cs%r(1, k), cs%r(2, k), cs%r(3, k))
         end do
     end subroutine nlgs_apply_reactions
 
-    !> vel += M^-1 H (drn, drt) for contact k.
-    pure subroutine apply(cs, k, im, vel, drn, drt)
+    !> vel += M^-1 H (drn, drt, drm) for contact k.
+    pure subroutine apply(cs, k, im, vel, drn, drt, drm)
         type(contact_set_t), intent(in) :: cs
         integer, intent(in) :: k
         real(wp), intent(in) :: im(:, :)
         real(wp), intent(inout) :: vel(:, :)
-        real(wp), intent(in) :: drn, drt
+        real(wp), intent(in) :: drn, drt, drm
         real(wp) :: px, py
         integer :: a, b
         a = cs%i1(k)
@@ -224,39 +265,59 @@ contains
         py = drn*cs%nrm(2, k) + drt*cs%nrm(1, k)
         vel(1, b) = vel(1, b) + im(1, b)*px
         vel(2, b) = vel(2, b) + im(2, b)*py
-        vel(3, b) = vel(3, b) + im(3, b)*cs%lever(2, k)*drt
+        vel(3, b) = vel(3, b) + im(3, b)*(cs%lever(2, k)*drt + drm)
         if (a > 0) then
             vel(1, a) = vel(1, a) - im(1, a)*px
             vel(2, a) = vel(2, a) - im(2, a)*py
-            vel(3, a) = vel(3, a) + im(3, a)*cs%lever(1, k)*drt
+            vel(3, a) = vel(3, a) + im(3, a)*(cs%lever(1, k)*drt - drm)
         end if
     end subroutine apply
 
-    !> Relative velocity H^T v + shift of contact k.
-    pure subroutine local_velocity(cs, k, vel, un, ut)
+    !> Relative velocity H^T v + shift of contact k: (u_n, u_t, w_r).
+    pure subroutine local_velocity(cs, k, vel, u)
         type(contact_set_t), intent(in) :: cs
         integer, intent(in) :: k
         real(wp), intent(in) :: vel(:, :)
-        real(wp), intent(out) :: un, ut
-        real(wp) :: dvx, dvy
+        real(wp), intent(out) :: u(3)
+        real(wp) :: dvx, dvy, ut
         integer :: a, b
         a = cs%i1(k)
         b = cs%i2(k)
         dvx = vel(1, b)
         dvy = vel(2, b)
         ut = cs%lever(2, k)*vel(3, b) + cs%shift(2, k)
+        u(3) = vel(3, b)
         if (a > 0) then
             dvx = dvx - vel(1, a)
             dvy = dvy - vel(2, a)
             ut = ut + cs%lever(1, k)*vel(3, a)
+            u(3) = u(3) - vel(3, a)
         end if
-        un = cs%nrm(1, k)*dvx + cs%nrm(2, k)*dvy + cs%shift(1, k)
-        ut = ut - cs%nrm(2, k)*dvx + cs%nrm(1, k)*dvy
+        u(1) = cs%nrm(1, k)*dvx + cs%nrm(2, k)*dvy + cs%shift(1, k)
+        u(2) = ut - cs%nrm(2, k)*dvx + cs%nrm(1, k)*dvy
     end subroutine local_velocity
 
+    !> W r for the 3x3 block w = (nn, nt, tt, nm, tm, mm).
+    pure function wmul(w, r) result(v)
+        real(wp), intent(in) :: w(6), r(3)
+        real(wp) :: v(3)
+        v(1) = w(1)*r(1) + w(2)*r(2) + w(4)*r(3)
+        v(2) = w(2)*r(1) + w(3)*r(2) + w(5)*r(3)
+        v(3) = w(4)*r(1) + w(5)*r(2) + w(6)*r(3)
+    end function wmul
+
+    !> |W r|^2 with the rotation row scaled by the length len (a velocity norm).
+    pure real(wp) function wnorm2(w, r, len) result(q)
+        real(wp), intent(in) :: w(6), r(3), len
+        real(wp) :: v(3)
+        v = wmul(w, r)
+        q = v(1)**2 + v(2)**2 + (len*v(3))**2
+    end function wnorm2
+
     !> One Gauss-Seidel sweep over the active contacts list(first), list(first + step), ...,
-    !> list(last). num = sum |W dr|^2, den = sum |W r~|^2, nloc = local iterations.
-    !> With bilateral constraints, they are restored after each contact update.
+    !> list(last). num = sum |W dr|^2, den = sum |W r|^2 (r applied, not shifted), nloc =
+    !> local iterations. With bilateral constraints, they are restored after each contact
+    !> update.
     subroutine sweep(config, cs, im, vel, list, sc, first, last, step, num, den, nloc, bilateral)
         type(nlgs_config_t), intent(in) :: config
         type(contact_set_t), intent(inout) :: cs
@@ -267,54 +328,66 @@ contains
         real(wp), intent(out) :: num, den
         integer(i8), intent(out) :: nloc
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
-        real(wp) :: un, ut, wnn, wnt, wtt, rn0, rt0, rn, rt, drn, drt
+        real(wp) :: u(3), r0(3), r(3), dr(3), wk(6)
         integer :: a, k, it, pcase
         num = 0.0_wp
         den = 0.0_wp
         nloc = 0_i8
         do a = first, last, step
             k = list(a)
-            call local_velocity(cs, k, vel, un, ut)
-            wnn = cs%w(1, k)
-            wnt = cs%w(2, k)
-            wtt = cs%w(3, k)
-            rn0 = cs%r(1, k) + cs%coh(k)
-            rt0 = cs%r(2, k)
-            rn = rn0
-            rt = rt0
-            call bipotential_local_solve_scaled(sc(:, a), un - wnn*rn0 - wnt*rt0, ut - wnt*rn0 - wtt*rt0, &
-                                                config%local_tol, config%local_max_iter, rn, rt, it, pcase)
+            call local_velocity(cs, k, vel, u)
+            wk = cs%w(:, k)
+            r0 = [cs%r(1, k) + cs%coh(k), cs%r(2, k), cs%r(3, k)]
+            r = r0
+            if (cs%erol(k) > 0.0_wp) then
+                call rolling_local_solve_scaled(sc(:, a), u - wmul(wk, r0), config%local_tol, config%local_max_iter, &
+                                                r, it, pcase)
+            else
+                ! no moment (r0(3) = 0, see contacts_set_laws): the two-component law
+                call bipotential_local_solve_scaled(sc(1:bipotential_n_scaling, a), u(1) - wk(1)*r0(1) - wk(2)*r0(2), &
+                                                    u(2) - wk(2)*r0(1) - wk(3)*r0(2), config%local_tol, &
+                                                    config%local_max_iter, r(1), r(2), it, pcase)
+            end if
             nloc = nloc + it
-            drn = rn - rn0
-            drt = rt - rt0
-            cs%r(1, k) = rn - cs%coh(k)
-            cs%r(2, k) = rt
-            call apply(cs, k, im, vel, drn, drt)
+            cs%pcase(k) = pcase
+            dr = r - r0
+            cs%r(1, k) = r(1) - cs%coh(k)
+            cs%r(2:3, k) = r(2:3)
+            call apply(cs, k, im, vel, dr(1), dr(2), dr(3))
             if (present(bilateral)) call bilateral%update(cs%i1(k), cs%i2(k), vel)
-            num = num + (wnn*drn + wnt*drt)**2 + (wnt*drn + wtt*drt)**2
-            den = den + (wnn*rn + wnt*rt)**2 + (wnt*rn + wtt*rt)**2
+            num = num + wnorm2(wk, dr, cs%amoy(k))
+            den = den + wnorm2(wk, cs%r(:, k), cs%amoy(k))
         end do
     end subroutine sweep
 
-    !> Relative Signorini-Coulomb residual of the current state:
-    !> sqrt(sum res_a^2) / sqrt(sum |r~'_a|^2) over active contacts, with res_a from
-    !> bipotential_residual and r~' the shifted reaction in the scaled frame (0 if no reaction).
+    !> Relative residual of the contact laws in the current state:
+    !> sqrt(sum res_a^2) / sqrt(sum |r'_a|^2) over active contacts, with res_a from
+    !> bipotential_residual or rolling_residual (scaled frame, shifted reaction) and r' the
+    !> applied reaction in the scaled frame (W_nn r_n^2 + W_tt r_t^2 + W_mm M^2); as for the
+    !> sweeps, the round-off noise (the floor of the module header divided by W_nn, in the
+    !> units of the scaled frame) is taken off the numerator.
     pure real(wp) function nlgs_residual(cs, vel) result(res)
         !> Contacts.
         type(contact_set_t), intent(in) :: cs
         !> Velocities (3, n_disks).
         real(wp), intent(in) :: vel(:, :)
-        real(wp) :: un, ut, rn, num, den
+        real(wp) :: u(3), r(3), num, den, noise
         integer :: k
         num = 0.0_wp
         den = 0.0_wp
+        noise = 0.0_wp
         do k = 1, cs%n
             if (.not. cs%active(k)) cycle
-            call local_velocity(cs, k, vel, un, ut)
-            rn = cs%r(1, k) + cs%coh(k)
-            num = num + bipotential_residual(cs%w(1, k), cs%w(2, k), cs%w(3, k), un, ut, cs%mu(k), rn, cs%r(2, k))**2
-            den = den + cs%w(1, k)*rn**2 + cs%w(3, k)*cs%r(2, k)**2
+            call local_velocity(cs, k, vel, u)
+            r = [cs%r(1, k) + cs%coh(k), cs%r(2, k), cs%r(3, k)]
+            if (cs%erol(k) > 0.0_wp) then
+                num = num + rolling_residual(cs%w(:, k), u, cs%mu(k), cs%erol(k), r)**2
+            else
+                num = num + bipotential_residual(cs%w(1, k), cs%w(2, k), cs%w(3, k), u(1), u(2), cs%mu(k), r(1), r(2))**2
+            end if
+            den = den + cs%w(1, k)*cs%r(1, k)**2 + cs%w(3, k)*cs%r(2, k)**2 + cs%w(6, k)*cs%r(3, k)**2
+            if (cs%w(1, k) > 0.0_wp) noise = noise + roundoff_floor(cs, k, vel)/cs%w(1, k)
         end do
-        res = relative(num, den)
+        res = relative(max(num - noise, 0.0_wp), den)
     end function nlgs_residual
 end module dem_nlgs

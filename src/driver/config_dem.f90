@@ -24,7 +24,7 @@ module driver_config_dem
     use dem_generators, only: generate_row, generate_square_lattice, generate_hex_lattice, &
                               generate_random_deposit
     use dem_walls, only: walls_add
-    use dem_materials, only: materials_init, materials_set_pair
+    use dem_materials, only: materials_init, materials_set_pair, materials_set_bond, bond_e_default
     use dem_contacts, only: contact_set_t
     use dem_detection, only: detector_t, detect_contacts
     use dem_moreau_jean, only: dem_system_t
@@ -634,8 +634,13 @@ contains
                 end if
                 law_line(a, b) = e%line
                 law_line(b, a) = e%line
-                call materials_set_pair(cfg%system%materials, a, b, e%real(3), e%real(4), &
-                                        e%real(5), error)
+                if (e%n_values() >= 6) then
+                    call materials_set_pair(cfg%system%materials, a, b, e%real(3), e%real(4), &
+                                            e%real(5), error, rolling=e%real(6))
+                else
+                    call materials_set_pair(cfg%system%materials, a, b, e%real(3), e%real(4), &
+                                            e%real(5), error)
+                end if
                 if (allocated(error)) then
                     message = error%message
                     call make_input_error(error, deck%file, e%line, 'law', message)
@@ -643,7 +648,66 @@ contains
                 end if
             end associate
         end do
+        call build_bonds(deck, cfg, law_line, error)
     end subroutine build_laws
+
+    !> Bond bounds: a cohesive law for the pair, one bond record per pair.
+    subroutine build_bonds(deck, cfg, law_line, error)
+        type(deck_t), intent(in) :: deck
+        type(dem_config_t), intent(inout) :: cfg
+        integer, intent(in) :: law_line(:, :)
+        type(error_t), allocatable, intent(out) :: error
+        type(deck_entry_t), allocatable :: list(:)
+        integer, allocatable :: bond_line(:, :)
+        character(len=:), allocatable :: message
+        real(wp) :: e_b
+        integer :: i, k, a, b
+        allocate (list, source=deck%records('contacts', 'bond'))
+        allocate (bond_line(size(cfg%material_id), size(cfg%material_id)))
+        bond_line = 0
+        do i = 1, size(list)
+            associate (e => list(i))
+                do k = 1, 2
+                    if (find_id(cfg%material_id, e%int(k)) == 0) then
+                        call make_input_error(error, deck%file, e%line, 'bond', 'material '// &
+                                              e%word(k)//' is not defined (no [particles] material record with '// &
+                                              'this id)')
+                        return
+                    end if
+                end do
+                a = find_id(cfg%material_id, e%int(1))
+                b = find_id(cfg%material_id, e%int(2))
+                if (bond_line(a, b) > 0) then
+                    call make_input_error(error, deck%file, e%line, 'bond', 'the bond between '// &
+                                          'materials '//e%word(1)//' and '//e%word(2)//' is already given on '// &
+                                          'line '//to_str(bond_line(a, b)))
+                    return
+                end if
+                if (law_line(a, b) == 0) then
+                    call make_input_error(error, deck%file, e%line, 'bond', 'materials '//e%word(1)// &
+                                          ' and '//e%word(2)//' have no law: give them a [contacts] law with '// &
+                                          'cohesion > 0, or the bond would never form')
+                    return
+                end if
+                if (.not. cfg%system%materials%cohesion(a, b) > 0.0_wp) then
+                    call make_input_error(error, deck%file, e%line, 'bond', 'the law of materials '// &
+                                          e%word(1)//' and '//e%word(2)//' (line '//to_str(law_line(a, b))// &
+                                          ') has no cohesion: bonds form only between cohesive materials')
+                    return
+                end if
+                bond_line(a, b) = e%line
+                bond_line(b, a) = e%line
+                e_b = bond_e_default
+                if (e%n_values() >= 4) e_b = e%real(4)
+                call materials_set_bond(cfg%system%materials, a, b, e%real(3), e_b, error)
+                if (allocated(error)) then
+                    message = error%message
+                    call make_input_error(error, deck%file, e%line, 'bond', message)
+                    return
+                end if
+            end associate
+        end do
+    end subroutine build_bonds
 
     !> Time stepping, detection, solver and output settings.
     subroutine build_settings(deck, run, cfg)

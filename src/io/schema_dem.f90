@@ -111,8 +111,19 @@ contains
                            'Law of the contacts between two materials (either order): friction coefficient, '// &
                            'restitution coefficient, cohesion stress sigma_cohe (the bond holds a tension '// &
                            'sigma_cohe times the mean radius of the pair per unit thickness; bonds form '// &
-                           'between touching disks at t = 0 and break for good once they open).', &
-                           repeatable=.true.)
+                           'between touching disks at t = 0 and break for good once a bound of their law is '// &
+                           'reached), and optionally the rolling resistance length e_r (default 0: none; '// &
+                           '|M| <= e_r r_n). Without a `bond` record the bonds of the pair keep mu and e_r: '// &
+                           'with both 0 they hold opening only (a hinge).', &
+                           tails=[tail([real_field('rolling', 'm', lower=0.0_wp)], 0, 1)], repeatable=.true.)
+        call s%add_keyword('contacts', 'bond', [int_field('material1', lower=1), &
+                                                int_field('material2', lower=1), real_field('mu_b', '', lower=0.0_wp)], &
+                           'Bounds of the bonds between two materials (either order; the pair needs a law '// &
+                           'with cohesion): an intact bond holds |r_t| <= mu_b (r_n + r_cohe) and |M| <= e_b '// &
+                           '(r_n + r_cohe), e_b in m (default: half the mean radius of the pair, the moment '// &
+                           'capacity of a rigid-plastic bond section, doc/theory.md). A bond that reaches a '// &
+                           'bound breaks for good (tension, shear or moment) and the contact follows `law`.', &
+                           tails=[tail([real_field('e_b', 'm', lower=0.0_wp)], 0, 1)], repeatable=.true.)
         call s%add_keyword('contacts', 'alert', [real_field('alert', 'm', lower=0.0_wp)], &
                            'Alert distance: pairs closer than this are candidate contacts of the step '// &
                            '(default 0.25 times the mean disk radius); it must exceed the distance a disk '// &
