@@ -177,6 +177,8 @@ contains
             call real_series('/dem/contacts/rn', [integer ::], 'N/m', error)
             if (allocated(error)) return
             call real_series('/dem/contacts/rt', [integer ::], 'N/m', error)
+            if (allocated(error)) return
+            call real_series('/dem/contacts/m', [integer ::], 'N.m/m', error)
         end subroutine series
 
         subroutine dataset(path, values, units, error)
@@ -294,6 +296,8 @@ contains
                 if (allocated(error)) return
                 call file%append_chunk('/dem/contacts/rt', cs%r(2, 1:m)/sys%scheme%h, error)
                 if (allocated(error)) return
+                call file%append_chunk('/dem/contacts/m', cs%r(3, 1:m)/sys%scheme%h, error)
+                if (allocated(error)) return
             end associate
         end if
         self%n_contacts_stored = self%n_contacts_stored + m
@@ -378,5 +382,20 @@ contains
         call file%write_attribute('/dem/solver', 'detection_seconds', sys%time_detection, error)
         if (allocated(error)) return
         call file%write_attribute('/dem/solver', 'solver_seconds', sys%time_solver, error)
+        if (allocated(error)) return
+        call file%write_attribute('/dem/solver', 'bond_ruptures', sys%ruptures%n, error)
+        if (allocated(error) .or. sys%ruptures%n == 0) return
+        associate (rl => sys%ruptures, n => sys%ruptures%n)
+            ! as the contacts: i is the second body (a disk), j the first (a disk, or -wall)
+            call file%write_dataset('/dem/bonds/i', rl%i2(1:n), error)
+            if (allocated(error)) return
+            call file%write_dataset('/dem/bonds/j', rl%i1(1:n), error)
+            if (allocated(error)) return
+            call file%write_dataset('/dem/bonds/step', int(rl%step(1:n)), error)
+            if (allocated(error)) return
+            call file%write_dataset('/dem/bonds/time', rl%time(1:n), error)
+            if (allocated(error)) return
+            call file%write_dataset('/dem/bonds/mode', rl%mode(1:n), error)
+        end associate
     end subroutine writer_finish
 end module driver_results_dem
