@@ -44,6 +44,7 @@ class Contacts:
     rn: np.ndarray        # (n_c,) [N/m], > 0 compression, < 0 cohesive tension
     rt: np.ndarray        # (n_c,) [N/m]
     status: np.ndarray    # (n_c,) int, STATUS_NAMES
+    m: Optional[np.ndarray] = None  # (n_c,) [N.m/m] contact moment on i (files before it: None)
 
     def at(self, k: int) -> slice:
         """Entries of output ``k``."""
@@ -166,7 +167,8 @@ def load_dem(path) -> DemResults:
                                     normal=get("dem/contacts/normal", (m, 2)),
                                     rn=get("dem/contacts/rn", (m,)),
                                     rt=get("dem/contacts/rt", (m,)),
-                                    status=get("dem/contacts/status", (m,)).astype(int))
+                                    status=get("dem/contacts/status", (m,)).astype(int),
+                                    m=get("dem/contacts/m", (m,)) if "dem/contacts/m" in f else None)
     return res
 
 
@@ -230,7 +232,9 @@ def plot_configuration(res: DemResults, k: Optional[int] = None) -> Figure:
     """Disks at output ``k`` (default: the last), coloured by material, the walls, and the
     contact forces: black lines for compression, red for cohesive tension, width
     proportional to |r_n| (MAX_FORCE_WIDTH for the largest force of the snapshot; forces
-    below NOISE times the largest of the run are left out)."""
+    below NOISE times the largest of the run are left out); intact bonds as thin blue lines,
+    broken bonds as grey crosses at the contact point, and contact moments as orange rings
+    at the contact point, their area proportional to |m|."""
     if k is None:
         k = res.time.size - 1
     pos = res.position[k]
@@ -244,6 +248,7 @@ def plot_configuration(res: DemResults, k: Optional[int] = None) -> Figure:
                               facecolors=colors, edgecolors="0.35" if res.n <= 500 else "0.6",
                               linewidths=0.4 if res.n <= 500 else 0.15)
     ax.add_collection(disks)
+    handles = []
     lo = (pos[:, :2] - res.radius[:, None]).min(axis=0)
     hi = (pos[:, :2] + res.radius[:, None]).max(axis=0)
     if res.n <= SMALL_SYSTEM:
@@ -256,9 +261,26 @@ def plot_configuration(res: DemResults, k: Optional[int] = None) -> Figure:
         lo = np.minimum(lo, np.minimum(w[:, :2], w[:, 2:]).min(axis=0))
         hi = np.maximum(hi, np.maximum(w[:, :2], w[:, 2:]).max(axis=0))
     segments, rn, status = force_segments(res, k)
+    bonded = status == COHESIVE
+    if np.any(bonded):
+        ax.add_collection(LineCollection(segments[bonded], colors="tab:blue", linewidths=0.6, zorder=1))
+        handles.append(Line2D([], [], color="tab:blue", lw=0.6, label="intact bonds"))
+    broken = status == BROKEN
+    if np.any(broken):
+        mid = segments[broken].mean(axis=1)
+        ax.plot(mid[:, 0], mid[:, 1], "x", color="0.4", ms=5, zorder=3)
+        handles.append(Line2D([], [], color="0.4", marker="x", ls="", label="broken bonds"))
+    if res.contacts is not None and res.contacts.m is not None:
+        mom = np.abs(res.contacts.m[res.contacts.at(k)])
+        big = mom > NOISE * max(float(np.max(np.abs(res.contacts.m))), 0.0) if mom.size else mom > 0
+        if np.any(big):
+            mid = segments[big].mean(axis=1)
+            ax.scatter(mid[:, 0], mid[:, 1], s=80.0 * mom[big] / mom[big].max(), facecolors="none",
+                       edgecolors="tab:orange", linewidths=1.0, zorder=4)
+            handles.append(Line2D([], [], color="tab:orange", marker="o", mfc="none", ls="",
+                                  label=f"moment, area ∝ |m|; largest {mom[big].max():.3g} N.m/m"))
     # Forces below NOISE times the largest of the run are round-off of the solver: not drawn.
     carrying = np.abs(rn) > NOISE * force_scale(res)
-    handles = []
     scale = float(np.max(np.abs(rn[carrying]))) if np.any(carrying) else 0.0
     # The thickest line is at most 70 % of a mean disk diameter as drawn (the axes span
     # about 4.8 inches = 345 points along the longer side of the data).
