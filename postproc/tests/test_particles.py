@@ -58,9 +58,11 @@ def test_configuration_draws_disks_forces_and_walls(tmp_path):
     res = load_dem(write_dem(tmp_path / "col.h5"))
     fig = plot_configuration(res, 2)
     ax = fig.axes[0]
-    disks, marks, walls, forces = ax.collections
+    disks, marks, walls, bonds, forces = ax.collections
     assert len(disks.get_offsets()) == N_DISKS + 2
     assert len(walls.get_segments()) == 1
+    # the one intact bond (status 3) is drawn under the force network
+    assert len(bonds.get_segments()) == 1
     widths = np.asarray(forces.get_linewidths())
     # widths follow |r_n| (floor 3 m g, then 2, 1, and the bond 1 m g)
     np.testing.assert_allclose(widths / widths[0], [1.0, 2 / 3, 1 / 3, 1 / 3], rtol=1e-12)
