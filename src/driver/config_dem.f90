@@ -610,30 +610,14 @@ contains
         type(deck_entry_t), allocatable :: list(:)
         integer, allocatable :: law_line(:, :)
         character(len=:), allocatable :: message
-        integer :: i, k, a, b
+        integer :: i, a, b
         allocate (list, source=deck%records('contacts', 'law'))
         allocate (law_line(size(cfg%material_id), size(cfg%material_id)))
         law_line = 0
         do i = 1, size(list)
             associate (e => list(i))
-                do k = 1, 2
-                    if (find_id(cfg%material_id, e%int(k)) == 0) then
-                        call make_input_error(error, deck%file, e%line, 'law', 'material '// &
-                                              e%word(k)//' is not defined (no [particles] material record with '// &
-                                              'this id)')
-                        return
-                    end if
-                end do
-                a = find_id(cfg%material_id, e%int(1))
-                b = find_id(cfg%material_id, e%int(2))
-                if (law_line(a, b) > 0) then
-                    call make_input_error(error, deck%file, e%line, 'law', 'the law between '// &
-                                          'materials '//e%word(1)//' and '//e%word(2)//' is already given on '// &
-                                          'line '//to_str(law_line(a, b)))
-                    return
-                end if
-                law_line(a, b) = e%line
-                law_line(b, a) = e%line
+                call material_pair(deck, cfg, e, 'law', law_line, a, b, error)
+                if (allocated(error)) return
                 if (e%n_values() >= 6) then
                     call materials_set_pair(cfg%system%materials, a, b, e%real(3), e%real(4), &
                                             e%real(5), error, rolling=e%real(6))
@@ -651,6 +635,39 @@ contains
         call build_bonds(deck, cfg, law_line, error)
     end subroutine build_laws
 
+    !> Materials (a, b) of a `law` or `bond` record: both defined, the pair given once (its
+    !> line is recorded in `seen`).
+    subroutine material_pair(deck, cfg, e, keyword, seen, a, b, error)
+        type(deck_t), intent(in) :: deck
+        type(dem_config_t), intent(in) :: cfg
+        type(deck_entry_t), intent(in) :: e
+        character(len=*), intent(in) :: keyword
+        integer, intent(inout) :: seen(:, :)
+        integer, intent(out) :: a, b
+        type(error_t), allocatable, intent(out) :: error
+        integer :: k
+        a = 0
+        b = 0
+        do k = 1, 2
+            if (find_id(cfg%material_id, e%int(k)) == 0) then
+                call make_input_error(error, deck%file, e%line, keyword, 'material '// &
+                                      e%word(k)//' is not defined (no [particles] material record with '// &
+                                      'this id)')
+                return
+            end if
+        end do
+        a = find_id(cfg%material_id, e%int(1))
+        b = find_id(cfg%material_id, e%int(2))
+        if (seen(a, b) > 0) then
+            call make_input_error(error, deck%file, e%line, keyword, 'the '//keyword//' between '// &
+                                  'materials '//e%word(1)//' and '//e%word(2)//' is already given on '// &
+                                  'line '//to_str(seen(a, b)))
+            return
+        end if
+        seen(a, b) = e%line
+        seen(b, a) = e%line
+    end subroutine material_pair
+
     !> Bond bounds: a cohesive law for the pair, one bond record per pair.
     subroutine build_bonds(deck, cfg, law_line, error)
         type(deck_t), intent(in) :: deck
@@ -661,28 +678,14 @@ contains
         integer, allocatable :: bond_line(:, :)
         character(len=:), allocatable :: message
         real(wp) :: e_b
-        integer :: i, k, a, b
+        integer :: i, a, b
         allocate (list, source=deck%records('contacts', 'bond'))
         allocate (bond_line(size(cfg%material_id), size(cfg%material_id)))
         bond_line = 0
         do i = 1, size(list)
             associate (e => list(i))
-                do k = 1, 2
-                    if (find_id(cfg%material_id, e%int(k)) == 0) then
-                        call make_input_error(error, deck%file, e%line, 'bond', 'material '// &
-                                              e%word(k)//' is not defined (no [particles] material record with '// &
-                                              'this id)')
-                        return
-                    end if
-                end do
-                a = find_id(cfg%material_id, e%int(1))
-                b = find_id(cfg%material_id, e%int(2))
-                if (bond_line(a, b) > 0) then
-                    call make_input_error(error, deck%file, e%line, 'bond', 'the bond between '// &
-                                          'materials '//e%word(1)//' and '//e%word(2)//' is already given on '// &
-                                          'line '//to_str(bond_line(a, b)))
-                    return
-                end if
+                call material_pair(deck, cfg, e, 'bond', bond_line, a, b, error)
+                if (allocated(error)) return
                 if (law_line(a, b) == 0) then
                     call make_input_error(error, deck%file, e%line, 'bond', 'materials '//e%word(1)// &
                                           ' and '//e%word(2)//' have no law: give them a [contacts] law with '// &
@@ -695,8 +698,6 @@ contains
                                           ') has no cohesion: bonds form only between cohesive materials')
                     return
                 end if
-                bond_line(a, b) = e%line
-                bond_line(b, a) = e%line
                 e_b = bond_e_default
                 if (e%n_values() >= 4) e_b = e%real(4)
                 call materials_set_bond(cfg%system%materials, a, b, e%real(3), e_b, error)
