@@ -61,7 +61,7 @@ contains
         end select
     end function break_mode_name
 
-    !> Append one rupture (the arrays grow by half when full).
+    !> Append one rupture (ruptures are rare events: the arrays grow by one).
     pure subroutine rupture_log_add(self, i1, i2, step, time, mode)
         !> The log.
         class(rupture_log_t), intent(inout) :: self
@@ -73,49 +73,12 @@ contains
         real(wp), intent(in) :: time
         !> Mode of the rupture.
         integer, intent(in) :: mode
-        integer :: cap
-        if (.not. allocated(self%i1)) then
-            allocate (self%i1(16), self%i2(16), self%step(16), self%time(16), self%mode(16))
-        else if (self%n == size(self%i1)) then
-            cap = self%n + self%n/2 + 1
-            call grow_i(self%i1, cap)
-            call grow_i(self%i2, cap)
-            call grow_i(self%mode, cap)
-            call grow_i8(self%step, cap)
-            call grow_r(self%time, cap)
-        end if
+        if (.not. allocated(self%i1)) allocate (self%i1(0), self%i2(0), self%step(0), self%time(0), self%mode(0))
+        self%i1 = [self%i1, i1]
+        self%i2 = [self%i2, i2]
+        self%step = [self%step, step]
+        self%time = [self%time, time]
+        self%mode = [self%mode, mode]
         self%n = self%n + 1
-        self%i1(self%n) = i1
-        self%i2(self%n) = i2
-        self%step(self%n) = step
-        self%time(self%n) = time
-        self%mode(self%n) = mode
-    contains
-        pure subroutine grow_i(a, m)
-            integer, allocatable, intent(inout) :: a(:)
-            integer, intent(in) :: m
-            integer, allocatable :: t(:)
-            allocate (t(m))
-            t(1:size(a)) = a
-            call move_alloc(t, a)
-        end subroutine grow_i
-
-        pure subroutine grow_i8(a, m)
-            integer(i8), allocatable, intent(inout) :: a(:)
-            integer, intent(in) :: m
-            integer(i8), allocatable :: t(:)
-            allocate (t(m))
-            t(1:size(a)) = a
-            call move_alloc(t, a)
-        end subroutine grow_i8
-
-        pure subroutine grow_r(a, m)
-            real(wp), allocatable, intent(inout) :: a(:)
-            integer, intent(in) :: m
-            real(wp), allocatable :: t(:)
-            allocate (t(m))
-            t(1:size(a)) = a
-            call move_alloc(t, a)
-        end subroutine grow_r
     end subroutine rupture_log_add
 end module dem_bonds
