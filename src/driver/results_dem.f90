@@ -39,6 +39,8 @@ module driver_results_dem
         integer :: n_contacts_stored = 0
         !> Time steps whose statistics are buffered, and steps recorded in all.
         integer :: n_buffered = 0, n_steps = 0
+        !> Bond ruptures written so far.
+        integer :: n_ruptures = 0
         !> Buffered statistics per step: sweeps, contacts in the list, active contacts,
         !> converged (1) or not (0).
         integer, allocatable :: sweeps(:), contacts(:), active(:), blocked(:), converged(:)
@@ -81,6 +83,7 @@ contains
         self%n_contacts_stored = 0
         self%n_buffered = 0
         self%n_steps = 0
+        self%n_ruptures = 0
         allocate (self%sweeps(stats_buffer), self%contacts(stats_buffer), &
                   self%active(stats_buffer), self%blocked(stats_buffer), self%converged(stats_buffer), &
                   self%norm(stats_buffer), &
@@ -134,6 +137,7 @@ contains
                 'potential', 'external_work', 'drive_work', 'dissipated', 'numerical', 'balance']
             character(len=*), parameter :: stats_int(5) = [character(len=9) :: 'sweeps', &
                 'contacts', 'active', 'blocked', 'converged']
+            character(len=*), parameter :: bond_ints(4) = [character(len=4) :: 'i', 'j', 'step', 'mode']
             !&>
             integer :: k
             call real_series('/dem/time', [integer ::], 's', error)
@@ -159,6 +163,12 @@ contains
             call real_series('/dem/solver/error', [integer ::], '', error)
             if (allocated(error)) return
             call real_series('/dem/solver/residual', [integer ::], '', error)
+            if (allocated(error)) return
+            do k = 1, size(bond_ints)
+                call file%create_int_series('/dem/bonds/'//trim(bond_ints(k)), error)
+                if (allocated(error)) return
+            end do
+            call real_series('/dem/bonds/time', [integer ::], 's', error)
             if (allocated(error) .or. .not. self%store_contacts) return
             call file%create_int_series('/dem/contacts/offset', error)
             if (allocated(error)) return
@@ -241,6 +251,8 @@ contains
         call store_energies(file, sys, error)
         if (allocated(error)) return
         if (self%store_contacts) call store_contacts(self, file, sys, error)
+        if (allocated(error)) return
+        call store_ruptures(self, file, sys, error)
         if (allocated(error)) return
         self%n_out = self%n_out + 1
     end subroutine writer_store
@@ -383,19 +395,36 @@ contains
         if (allocated(error)) return
         call file%write_attribute('/dem/solver', 'solver_seconds', sys%time_solver, error)
         if (allocated(error)) return
+        call store_ruptures(self, file, sys, error)
+        if (allocated(error)) return
         call file%write_attribute('/dem/solver', 'bond_ruptures', sys%ruptures%n, error)
-        if (allocated(error) .or. sys%ruptures%n == 0) return
-        associate (rl => sys%ruptures, n => sys%ruptures%n)
-            ! as the contacts: i is the second body (a disk), j the first (a disk, or -wall)
-            call file%write_dataset('/dem/bonds/i', rl%i2(1:n), error)
-            if (allocated(error)) return
-            call file%write_dataset('/dem/bonds/j', rl%i1(1:n), error)
-            if (allocated(error)) return
-            call file%write_dataset('/dem/bonds/step', int(rl%step(1:n)), error)
-            if (allocated(error)) return
-            call file%write_dataset('/dem/bonds/time', rl%time(1:n), error)
-            if (allocated(error)) return
-            call file%write_dataset('/dem/bonds/mode', rl%mode(1:n), error)
-        end associate
     end subroutine writer_finish
+
+    !> Append the bond ruptures logged since the last call to /dem/bonds, so that a run
+    !> stopped early (signal, guard, kill after a flush) keeps the ruptures of its outputs.
+    subroutine store_ruptures(self, file, sys, error)
+        type(dem_writer_t), intent(inout) :: self
+        type(h5_file_t), intent(inout) :: file
+        type(dem_system_t), intent(in) :: sys
+        type(error_t), allocatable, intent(out) :: error
+        integer :: a, b
+        a = self%n_ruptures + 1
+        b = sys%ruptures%n
+        if (b < a) return
+        associate (rl => sys%ruptures)
+            ! as the contacts: i is the second body (a disk), j the first (a disk, or -wall)
+            call file%append_chunk('/dem/bonds/i', rl%i2(a:b), error)
+            if (allocated(error)) return
+            call file%append_chunk('/dem/bonds/j', rl%i1(a:b), error)
+            if (allocated(error)) return
+            ! steps <= huge(0) (driver_config caps the step count)
+            call file%append_chunk('/dem/bonds/step', int(rl%step(a:b)), error)
+            if (allocated(error)) return
+            call file%append_chunk('/dem/bonds/time', rl%time(a:b), error)
+            if (allocated(error)) return
+            call file%append_chunk('/dem/bonds/mode', rl%mode(a:b), error)
+            if (allocated(error)) return
+        end associate
+        self%n_ruptures = b
+    end subroutine store_ruptures
 end module driver_results_dem

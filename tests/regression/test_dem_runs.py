@@ -140,6 +140,8 @@ def cohesive_row(exe, src, work):
         m = f["dem/particles/mass"][0]
         h = f["dem"].attrs["time_step"]
         rows = [contacts_at(f, k) for k in range(len(t))]
+        log = {name: f[f"dem/bonds/{name}"][...] for name in ("i", "j", "step", "time", "mode")}
+        n_log = int(f["dem/solver"].attrs["bond_ruptures"])
     r_cohe = 2.0e4 * 0.01
     t_top = (r_cohe - 9 * m * G) / 1500.0
     t_bottom = 225.0 / 1500.0
@@ -152,6 +154,19 @@ def cohesive_row(exe, src, work):
                  for c, tk in zip(rows[1:], t[1:]) if abs(tk - t_top) > h and bond(c, 1)[0])
     check("cohesive row: top bond breaks at (r_cohe - 9 m g) / 1500 N/m/s", ok_top,
           f"t_break = {t_top:.5f} s; statuses {[bond(c, 1)[0] for c in rows[1:]]}")
+    # The rupture log: the top bond (disks 1-2) first, in tension, then the bottom one
+    # (9-10). A bond is judged at the end of a step, so the logged time is the end of the
+    # first step whose load exceeds the closed-form threshold: within one step h after it.
+    # The load of a step is F(t - h/2) (theta = 1/2), hence the half step.
+    first_two = [(int(log["j"][k]), int(log["i"][k]), int(log["mode"][k])) for k in range(min(2, n_log))]
+    check("cohesive row: rupture log names the top then the bottom bond, in tension",
+          n_log == len(log["time"]) >= 2 and first_two == [(1, 2, 1), (9, 10, 1)],
+          f"{n_log} ruptures: {first_two}")
+    if len(log["time"]) >= 2:
+        lag = log["time"][:2] - np.array([t_top, t_bottom])
+        check("cohesive row: logged rupture times within one step after the closed form",
+              bool(np.all((lag >= 0.5 * h - 1e-12) & (lag <= 1.5 * h + 1e-12))),
+              f"times {log['time'][:2]} s, closed form {t_top:.5f} {t_bottom:.5f} s, h = {h}")
     ok_bottom = all(bond(c, 9)[0] == 3 for c, tk in zip(rows[1:], t[1:]) if tk < t_bottom - h) \
         and all(bond(c, 9)[0] in (4, None) for c, tk in zip(rows[1:], t[1:]) if tk > t_bottom + h)
     check("cohesive row: bottom bond breaks when 8 F / 9 = r_cohe", ok_bottom,
