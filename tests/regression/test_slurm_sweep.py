@@ -8,7 +8,8 @@ a = g (sin phi - mu cos phi); with mu = 0.4 it rolls, a = (2/3) g sin phi (the d
 derives both). The sweep is submitted as a job array plus the collect job that depends on
 it; the table they write (results.csv) must hold the four points, finished, with the final
 velocity of disk 2 equal to the closed form, and the same values as the same sweep run
-locally (`run -j 2`). scripts/multicor.slurm runs one deck as a job. Keys that the deck does not contain are refused, naming them.
+locally (`run -j 2`). scripts/multicor.slurm runs one deck as a job. (test_sweep.py tests
+the tool without Slurm: keys refused, decks written, failures.)
 Skips (exit 77, reason printed) when not root or when slurm-wlm / munge are missing.
 Usage (ctest does this): test_slurm_sweep.py --exe multicor --work DIR --source REPO
 """
@@ -70,29 +71,6 @@ def check_table(name, rows):
               f"finished={r['summary.finished']} vx={vx!r} closed form {ref!r}")
 
 
-def refused_keys(src, exe, work):
-    """Keys the deck does not contain: exit 1, the key named, no sweep folder left."""
-    deck = src / "input" / "incline.dat"
-    cases = [("contacts.law[3].mu=0.2", "has 2 'law' record(s) in [contacts]"),
-             ("solver.tolerance=1e-5", "does not give 'tolerance' in [solver]"),
-             ("contacts.law[1].friction=0.2", "'law' has no value 'friction'"),
-             ("contacts.law[1].rolling=1e-3", "does not give 'rolling'"),
-             ("time.stepp=1e-4", "section [time] has no keyword 'stepp'")]
-    for key, expected in cases:
-        folder = work / "refused"
-        proc = sweep_tool(src, ["create", deck, "--exe", exe, "--set", key, "--dir", folder],
-                          expect=None)
-        k = key.split("=")[0]
-        check(f"refuses {k}", proc.returncode == 1 and f"'{k}'" in proc.stderr
-              and expected in proc.stderr and not folder.exists(), proc.stderr.strip())
-    # a value that the deck check refuses (mu < 0): the message of multicor, naming the line
-    proc = sweep_tool(src, ["create", deck, "--exe", exe, "--set", "contacts.law[2].mu=0.1,-1",
-                            "--dir", work / "bad_value"], expect=None)
-    check("refuses a point that fails multicor --check", proc.returncode == 1
-          and "p002 (contacts.law[2].mu=-1)" in proc.stderr and "p002.dat:" in proc.stderr,
-          proc.stderr.strip())
-
-
 def create(src, exe, folder):
     return sweep_tool(src, ["create", src / "input" / "incline.dat", "--exe", exe,
                             "--set", "contacts.law[2].mu=0.1,0.4",
@@ -140,11 +118,8 @@ def on_slurm(src, exe, work):
                                str(src / "input" / "incline.dat"), str(single)],
                               capture_output=True, text=True, env=env, cwd=src)
         check("scripts/multicor.slurm submitted", proc.returncode == 0, proc.stderr.strip())
-        jobs = cluster.query(["squeue", "-h", "-r", "-o", "%i %j %T"])
-        print(jobs.strip())
-        check("submitted: 4 array tasks and the collect job",
-              len([j for j in jobs.splitlines() if "multicor-sweep" in j]) == 4
-              and "multicor-collect" in jobs, "")
+        # (a task may have ended already: the logs and the table are checked below)
+        print(cluster.query(["squeue", "-h", "-r", "-o", "%i %j %T"]).strip())
         done = wait_idle(cluster, 120)
         print(f"array and collect job done in {time.monotonic() - t1:.1f} s")
         check("all jobs ended within 120 s", done, cluster.query(["squeue"]))
@@ -201,7 +176,6 @@ def main():
     shutil.rmtree(work, ignore_errors=True)
     work.mkdir(parents=True)
     t0 = time.monotonic()
-    refused_keys(src, exe, work)
     local_rows = locally(src, exe, work)
     slurm_rows = on_slurm(src, exe, work)
     if isinstance(slurm_rows, list):
