@@ -17,6 +17,7 @@ import pathlib
 import shutil
 import socket
 import subprocess
+import tempfile
 import time
 
 BINARIES = ("munged", "slurmctld", "slurmd", "slurmstepd", "sbatch", "srun", "squeue",
@@ -54,6 +55,7 @@ class LocalSlurm:
         self.cred_expire = cred_expire
         self.conf = self.dir / "slurm.conf"
         self.procs = {}
+        self.run_dir = None
         self.env = dict(os.environ, SLURM_CONF=str(self.conf))
         for var in list(self.env):
             # a surrounding Slurm job (CI inside a cluster) must not leak into ours
@@ -76,9 +78,10 @@ class LocalSlurm:
 
     def _write_conf(self):
         host = socket.gethostname().split(".")[0]
-        d = self.dir
-        for sub in ("state", "spool", "log"):
-            (d / sub).mkdir(parents=True, exist_ok=True)
+        d, r = self.dir, self.run_dir
+        (d / "log").mkdir(parents=True, exist_ok=True)
+        for sub in ("state", "spool"):
+            (r / sub).mkdir(parents=True, exist_ok=True)
         cpus = os.cpu_count() or 1
         self.conf.write_text(f"""\
 # Minimal single-node Slurm for the MULTICOR sweep tests (tests/regression/slurm_local.py)
@@ -90,9 +93,9 @@ SlurmctldPort={_free_port()}
 SlurmdPort={_free_port()}
 AuthType=auth/munge
 CredType=cred/munge
-AuthInfo=socket={d / 'munge.socket'},cred_expire={self.cred_expire}
-StateSaveLocation={d / 'state'}
-SlurmdSpoolDir={d / 'spool'}
+AuthInfo=socket={r / 'munge.socket'},cred_expire={self.cred_expire}
+StateSaveLocation={r / 'state'}
+SlurmdSpoolDir={r / 'spool'}
 SlurmctldPidFile={d / 'slurmctld.pid'}
 SlurmdPidFile={d / 'slurmd.pid'}
 SlurmctldLogFile={d / 'log' / 'slurmctld.log'}
@@ -142,13 +145,28 @@ PartitionName={self.PARTITION} Nodes={self.NODE} Default=YES MaxTime={self.max_t
         return "\n".join(f"  {p.name}:\n{_tail(p)}" for p in sorted(log.glob("*")))
 
     def start(self, timeout=30):
+        """Start munged, slurmctld and slurmd; on failure, end what started and raise."""
+        try:
+            self._start_all(timeout)
+        except ClusterError:
+            self.stop()
+            raise
+        except (OSError, subprocess.SubprocessError) as e:
+            logs = self.logs()
+            self.stop()
+            raise ClusterError(f"{e}\n{logs}") from None
+
+    def _start_all(self, timeout):
         self.dir.mkdir(parents=True, exist_ok=True)
         os.chmod(self.dir, 0o700)
+        # sockets (munge, slurmstepd's in the spool) need a short path (108 bytes at most):
+        # they live in a folder under /tmp, removed by stop()
+        self.run_dir = pathlib.Path(tempfile.mkdtemp(prefix="mcslurm-", dir="/tmp"))
         self._write_conf()
         key = self.dir / "munge.key"
         key.write_bytes(os.urandom(1024))
         os.chmod(key, 0o400)
-        sock = self.dir / "munge.socket"
+        sock = self.run_dir / "munge.socket"
         self._start("munged", [self._which("munged"), "--foreground", "--force",
                                f"--key-file={key}", f"--socket={sock}",
                                f"--pid-file={self.dir / 'munged.pid'}",
@@ -186,6 +204,9 @@ PartitionName={self.PARTITION} Nodes={self.NODE} Default=YES MaxTime={self.max_t
             except subprocess.TimeoutExpired:
                 proc.kill()
                 proc.wait()
+        if self.run_dir is not None:
+            shutil.rmtree(self.run_dir, ignore_errors=True)
+            self.run_dir = None
 
     def __enter__(self):
         self.start()
