@@ -1,0 +1,187 @@
+#!/usr/bin/env python3
+"""A sweep point stopped before its time limit requeues itself on a real Slurm and completes
+from its checkpoint (scripts/multicor-sweep, tests/regression/slurm_local.py).
+
+A 2-point sweep of input/incline.dat over the time step (1e-3 s: 500 steps; 1e-5 s: 50000
+steps, a few seconds on the Debug build; outputs every 100 steps). While the long point runs, the test sends it
+SIGUSR1 with `scancel --signal=USR1 <job>_2`: the signal that `#SBATCH --signal=USR1@<s>`
+makes slurmctld send to the job steps <s> seconds before the time limit, by the same route
+(slurmctld -> slurmd -> the step's tasks), only sent now instead of at the clock's time (a
+real time limit is a minute at least, and slurmctld checks limits every 30 s). multicor
+writes its checkpoint and exits with 138; the job script requeues the task (`scontrol
+requeue`, allowed by `--requeue`), and Slurm starts it again, which continues with
+`--restart runs/p002/checkpoint.h5`. The test checks: two starts of the point in its log,
+the second with --restart; the point finished; its final velocity equals the closed form
+of the deck and, bit for bit, a local uninterrupted run of the same deck.
+
+Skips (exit 77, reason printed) when `multicor --help` does not list --restart (restart not
+built in), when not root, or when slurm-wlm / munge are missing.
+Usage (ctest does this): test_slurm_requeue.py --exe multicor --work DIR --source REPO
+"""
+import argparse
+import csv
+import math
+import re
+import pathlib
+import shutil
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from slurm_local import ClusterError, LocalSlurm  # noqa: E402
+
+FAILED = []
+SIN_PHI, COS_PHI, T_END, G, MU2 = 0.6, 0.8, 0.5, 9.81, 0.1     # input/incline.dat
+
+
+def check(name, ok, detail=""):
+    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
+    if not ok:
+        FAILED.append(name)
+
+
+def sweep_tool(src, args, env=None):
+    cmd = [sys.executable, str(src / "scripts" / "multicor-sweep")] + [str(a) for a in args]
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    if proc.returncode != 0:
+        print(proc.stdout, proc.stderr)
+        raise SystemExit(f"{' '.join(cmd)}: exit {proc.returncode}")
+    return proc
+
+
+def wait_for(what, test, timeout, cluster):
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < timeout:
+        if test():
+            return True
+        time.sleep(0.1)
+    print(f"timeout ({timeout} s) waiting for {what}\n{cluster.query(['squeue'])}")
+    return False
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--exe", required=True)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("--source", required=True)
+    ap.add_argument("--real-time-limit", action="store_true",
+                    help="not in ctest (2-3 min): no scancel; the long point (3e6 steps) "
+                    "gets --time=1 (minute) and --signal=USR1@50, so slurmctld's own "
+                    "time-limit warning stops it, once or several times")
+    args = ap.parse_args()
+    real = args.real_time_limit
+    steps = 3000000 if real else 50000
+    exe = pathlib.Path(args.exe).resolve()
+    src = pathlib.Path(args.source).resolve()
+    work = pathlib.Path(args.work).resolve()
+    shutil.rmtree(work, ignore_errors=True)
+    work.mkdir(parents=True)
+
+    usage = subprocess.run([str(exe), "--help"], capture_output=True, text=True).stdout
+    if "--restart" not in usage:
+        print(f"skipped: {exe} --help does not list --restart: checkpoint/restart is not in "
+              "this build yet, so a requeued point cannot continue")
+        return 77
+    cluster = LocalSlurm(work / "cluster")
+    reason = cluster.unavailable()
+    if reason:
+        print(f"skipped: {reason}")
+        return 77
+
+    folder = work / "sweep"
+    limits = ["--time", "1", "--signal-seconds", "50"] if real else ["--time", "00:05:00"]
+    sweep_tool(src, ["create", src / "input" / "incline.dat", "--exe", exe,
+                     "--set", f"time.step=1e-3,{0.5 / steps!r}", "--set", "output.interval=100",
+                     "--scalar", "v2x=dem/velocity[-1,1,0]", "--dir", folder] + limits)
+    t0 = time.monotonic()
+    try:
+        cluster.start()
+    except ClusterError as e:
+        print(f"skipped: the Slurm daemons did not start: {e}")
+        return 77
+    try:
+        print(f"cluster up in {time.monotonic() - t0:.1f} s ({cluster.dir})")
+        out = sweep_tool(src, ["submit", folder], env=cluster.env).stdout
+        job = out.strip().splitlines()[-1]
+        partial = folder / "runs" / "p002" / "p002.h5.partial"
+        # the long point runs (its results file is open): 1 s later, the "time-limit" signal
+        running = wait_for("point 2 to run", partial.exists, 30, cluster)
+        check("point 2 runs under Slurm", running, "")
+        time.sleep(0.5)
+        t_signal = time.monotonic()
+        if not real:
+            sent = subprocess.run(["scancel", "--signal=USR1", f"{job}_2"], env=cluster.env,
+                                  capture_output=True, text=True)
+            check("scancel --signal=USR1 reached the running point", sent.returncode == 0,
+                  sent.stderr.strip())
+            print(f"SIGUSR1 sent to {job}_2 {t_signal - t0:.1f} s after the cluster started")
+        log = folder / "runs" / "p002" / "job.log"
+        requeued = wait_for("the requeue", lambda: log.exists() and "requeue"
+                            in log.read_text(), 90 if real else 30, cluster)
+        check("point 2 stopped with exit 138 and requeued itself", requeued
+              and "exit 138" in log.read_text(), log.read_text() if log.exists() else "")
+        done = wait_for("the end of every job", lambda: not cluster.query(
+            ["squeue", "-h", "-o", "%i"]).strip(), 400 if real else 120, cluster)
+        print(f"requeued point finished {time.monotonic() - t_signal:.1f} s after the "
+              f"{'start' if real else 'signal'}")
+        check("every job ended", done, "")
+    finally:
+        cluster.stop()
+
+    stop = []
+    for out in sorted((folder / "logs").glob("*_2.out")):
+        stop += re.findall(r"^stopped: signal SIGUSR1 at step (\d+)", out.read_text(), flags=re.M)
+    stop = [int(s) for s in stop]
+    check("point 2 stopped mid-run", (len(stop) >= 1 if real else len(stop) == 1)
+          and all(0 < s < steps for s in stop) and stop == sorted(stop),
+          f"checkpoints at steps {stop} of {steps}")
+    text = log.read_text() if log.exists() else ""
+    print(text)
+    starts = [line for line in text.splitlines() if " start " in line]
+    exits = re.findall(r" exit (\d+)$", text, flags=re.M)
+    check("point 2 started again from its checkpoint after each stop (exit 138)",
+          len(starts) == len(stop) + 1 and "--restart" not in starts[0]
+          and all("--restart" in s and "checkpoint.h5" in s for s in starts[1:])
+          and exits == ["138"] * len(stop) + ["0"], f"{len(starts)} starts, exits {exits}")
+    table = folder / "results.csv"
+    if not table.exists():
+        check("the collect job wrote results.csv", False, "")
+        return 1
+    print(table.read_text())
+    rows = {r["point"]: r for r in csv.DictReader(open(table, newline=""))}
+    ref_vx = COS_PHI * G * (SIN_PHI - MU2 * COS_PHI) * T_END   # slipping disk 2
+    for name in ("p001", "p002"):
+        r = rows.get(name, {})
+        vx = float(r.get("v2x") or "nan")
+        # constant acceleration: exact up to round-off (<= 500000 steps: 1e-10 relative)
+        check(f"{name}: finished, closed-form velocity", r.get("summary.finished") == "1"
+              and math.isclose(vx, ref_vx, rel_tol=1e-10), f"vx={vx!r} closed form {ref_vx!r}")
+    check("the table counts the starts of p002", rows.get("p002", {}).get("starts")
+          == str(len(starts)), "")
+
+    # the same deck run without interruption: the same numbers, bit for bit
+    ref = work / "uninterrupted"
+    proc = subprocess.run([str(exe), "--quiet", str(folder / "decks" / "p002.dat"),
+                           "--output", str(ref)], capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise SystemExit(f"uninterrupted run failed: {proc.stdout}{proc.stderr}")
+    import h5py
+    import numpy as np
+    with h5py.File(ref / "p002.h5", "r") as a, \
+            h5py.File(folder / "runs" / "p002" / "p002.h5", "r") as b:
+        names = []
+        a["dem"].visititems(lambda k, o: names.append(k) if isinstance(o, h5py.Dataset) else None)
+        differ = [k for k in names if k not in b["dem"]
+                  or not np.array_equal(a["dem"][k][...], b["dem"][k][...])]
+    check("requeued point = uninterrupted run, bit for bit (every dataset of /dem)",
+          names and not differ, f"{len(names) - len(differ)} of {len(names)} equal; "
+          f"differ: {differ}")
+    if FAILED:
+        print(f"{len(FAILED)} check(s) failed: {', '.join(FAILED)}")
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

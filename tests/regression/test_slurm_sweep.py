@@ -1,0 +1,197 @@
+#!/usr/bin/env python3
+"""scripts/multicor-sweep against a real Slurm (slurmctld + slurmd + munged started here on
+localhost, tests/regression/slurm_local.py), and locally without Slurm.
+
+A 2 x 2 sweep of input/incline.dat: friction of the lower disk mu in {0.1, 0.4} times
+gravity gy in {-9.81, -4.905}. With mu = 0.1 < tan(phi)/3 = 0.25 the disk slips,
+a = g (sin phi - mu cos phi); with mu = 0.4 it rolls, a = (2/3) g sin phi (the deck's header
+derives both). The sweep is submitted as a job array plus the collect job that depends on
+it; the table they write (results.csv) must hold the four points, finished, with the final
+velocity of disk 2 equal to the closed form, and the same values as the same sweep run
+locally (`run -j 2`). scripts/multicor.slurm runs one deck as a job. (test_sweep.py tests
+the tool without Slurm: keys refused, decks written, failures.)
+Skips (exit 77, reason printed) when not root or when slurm-wlm / munge are missing.
+Usage (ctest does this): test_slurm_sweep.py --exe multicor --work DIR --source REPO
+"""
+import argparse
+import csv
+import math
+import pathlib
+import shutil
+import subprocess
+import sys
+import time
+
+import h5py
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from slurm_local import ClusterError, LocalSlurm  # noqa: E402
+
+FAILED = []
+SIN_PHI, COS_PHI, T_END = 0.6, 0.8, 0.5      # input/incline.dat
+
+
+def check(name, ok, detail=""):
+    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
+    if not ok:
+        FAILED.append(name)
+
+
+def sweep_tool(src, args, env=None, expect=0):
+    cmd = [sys.executable, str(src / "scripts" / "multicor-sweep")] + [str(a) for a in args]
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    if expect is not None and proc.returncode != expect:
+        print(proc.stdout, proc.stderr)
+        raise SystemExit(f"{' '.join(cmd)}: exit {proc.returncode}, expected {expect}")
+    return proc
+
+
+def closed_form_vx(mu, gy):
+    """x velocity of disk 2 at T_END: slipping (mu < tan(phi)/3) or rolling."""
+    g = -gy
+    a = g * (SIN_PHI - mu * COS_PHI) if mu < SIN_PHI / COS_PHI / 3 else 2 / 3 * g * SIN_PHI
+    return COS_PHI * a * T_END
+
+
+def read_table(path):
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def check_table(name, rows):
+    check(f"{name}: four points", len(rows) == 4, f"{len(rows)} rows")
+    for r in rows:
+        mu, gy = float(r["contacts.law[2].mu"]), float(r["particles.gravity.gy"])
+        vx, ref = float(r["v2x"] or "nan"), closed_form_vx(mu, gy)
+        # Constant acceleration from the first step on: Moreau-Jean integrates it exactly,
+        # up to round-off over 500 steps (1e-12 relative is ~5000 ulps).
+        check(f"{name}: {r['point']} mu={mu} gy={gy}",
+              r["summary.finished"] == "1" and r["exit_status"] == "0"
+              and math.isclose(vx, ref, rel_tol=1e-12),
+              f"finished={r['summary.finished']} vx={vx!r} closed form {ref!r}")
+
+
+def create(src, exe, folder):
+    return sweep_tool(src, ["create", src / "input" / "incline.dat", "--exe", exe,
+                            "--set", "contacts.law[2].mu=0.1,0.4",
+                            "--set", "particles.gravity.gy=-9.81,-4.905",
+                            "--scalar", "v2x=dem/velocity[-1,1,0]",
+                            "--scalar", "balance=absmax(dem/energy/balance)",
+                            "--time", "00:05:00", "--dir", folder])
+
+
+def wait_idle(cluster, timeout):
+    """Until no job is pending or running; False on timeout."""
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < timeout:
+        if not cluster.query(["squeue", "-h", "-o", "%i"]).strip():
+            return True
+        time.sleep(0.5)
+    return False
+
+
+def on_slurm(src, exe, work):
+    cluster = LocalSlurm(work / "cluster")
+    reason = cluster.unavailable()
+    if reason:
+        return reason
+    folder = work / "slurm"
+    create(src, exe, folder)
+    script = (folder / "sweep.slurm").read_text()
+    check("job script: array, USR1 before the limit, requeue",
+          "#SBATCH --array=1-4" in script and "#SBATCH --signal=USR1@120" in script
+          and "#SBATCH --requeue" in script and "--restart" in script, "")
+    t0 = time.monotonic()
+    try:
+        cluster.start()
+    except ClusterError as e:
+        return f"the Slurm daemons did not start: {e}"
+    try:
+        print(f"cluster up in {time.monotonic() - t0:.1f} s ({cluster.dir})")
+        t1 = time.monotonic()
+        proc = sweep_tool(src, ["submit", folder], env=cluster.env)
+        print(proc.stdout.strip())
+        single = work / "single"
+        env = dict(cluster.env, MULTICOR_EXE=str(exe))
+        proc = subprocess.run(["sbatch", "--parsable", "--time=5", f"--output={work / 'single.out'}",
+                               str(src / "scripts" / "multicor.slurm"),
+                               str(src / "input" / "incline.dat"), str(single)],
+                              capture_output=True, text=True, env=env, cwd=src)
+        check("scripts/multicor.slurm submitted", proc.returncode == 0, proc.stderr.strip())
+        # (a task may have ended already: the logs and the table are checked below)
+        print(cluster.query(["squeue", "-h", "-r", "-o", "%i %j %T"]).strip())
+        done = wait_idle(cluster, 120)
+        print(f"array and collect job done in {time.monotonic() - t1:.1f} s")
+        check("all jobs ended within 120 s", done, cluster.query(["squeue"]))
+    finally:
+        cluster.stop()
+    try:
+        with h5py.File(single / "incline.h5", "r") as f:
+            finished = int(f["summary"].attrs["finished"])
+    except OSError as e:
+        finished = str(e)
+    check("scripts/multicor.slurm ran input/incline.dat to its end", finished == 1,
+          f"finished={finished}; " + ((work / "single.out").read_text()[-400:]
+                                      if (work / "single.out").exists() else "no job output"))
+    logs = sorted((folder / "logs").glob("*"))
+    check("one Slurm log per task and the collect log", len(logs) == 5,
+          " ".join(p.name for p in logs))
+    table = folder / "results.csv"
+    if not table.exists():
+        check("the collect job wrote results.csv", False,
+              "; ".join(p.read_text()[-300:] for p in logs if "collect" in p.name))
+        return None
+    print(table.read_text())
+    rows = read_table(table)
+    check_table("Slurm", rows)
+    check("the collect job drew results.png", (folder / "results.png").stat().st_size > 1000
+          if (folder / "results.png").exists() else False, "")
+    return rows
+
+
+def locally(src, exe, work):
+    folder = work / "local"
+    create(src, exe, folder)
+    t0 = time.monotonic()
+    proc = sweep_tool(src, ["run", folder, "-j", "2"])
+    print(proc.stdout.strip())
+    print(f"local run -j 2: {time.monotonic() - t0:.1f} s")
+    rows = read_table(folder / "results.csv")
+    check_table("local", rows)
+    again = sweep_tool(src, ["run", folder, "-j", "2"])
+    check("a second local run has nothing to do", "4 points finished before, 0 to run"
+          in again.stdout, again.stdout.strip().splitlines()[0])
+    return rows
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--exe", required=True)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("--source", required=True)
+    args = ap.parse_args()
+    exe = pathlib.Path(args.exe).resolve()
+    src = pathlib.Path(args.source).resolve()
+    work = pathlib.Path(args.work).resolve()
+    shutil.rmtree(work, ignore_errors=True)
+    work.mkdir(parents=True)
+    t0 = time.monotonic()
+    local_rows = locally(src, exe, work)
+    slurm_rows = on_slurm(src, exe, work)
+    if isinstance(slurm_rows, list):
+        same = [(a["point"], a["v2x"], b["v2x"]) for a, b in zip(local_rows, slurm_rows)
+                if a["v2x"] != b["v2x"]]
+        check("Slurm and local tables: same values (same executable and decks)",
+              not same and len(slurm_rows) == 4, str(same))
+    print(f"total {time.monotonic() - t0:.1f} s")
+    if FAILED:
+        print(f"{len(FAILED)} check(s) failed: {', '.join(FAILED)}")
+        return 1
+    if isinstance(slurm_rows, str):
+        print(f"skipped: the Slurm part: {slurm_rows} (the local part passed)")
+        return 77
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,174 @@
+#!/usr/bin/env python3
+"""scripts/multicor-sweep without Slurm: keys, generated decks, local runs, the table.
+
+- Keys that the deck does not contain are refused with exit code 1, naming the key, and
+  leave no sweep folder; a value that fails `multicor --check` is reported with multicor's
+  message naming the generated deck and line.
+- A grid file selecting a record by its values (`contacts.law[material1=2 material2=3].mu`)
+  and a positional field: the generated decks differ from the deck only in the swept tokens
+  (comments and layout kept).
+- A sequential local run of input/incline.dat over mu of the slipping disk in {0.1, 0.2}:
+  the table gives the closed-form final velocity g (sin phi - mu cos phi) cos phi t of
+  disk 2, and reductions (absmax of the energy balance) next to indexed values.
+- A point that fails at run time (gravity 1e300: the run stops with exit code 1) is
+  reported as failed; the next `run` runs only that point again.
+Usage (ctest does this): test_sweep.py --exe multicor --work DIR --source REPO
+"""
+import argparse
+import csv
+import math
+import pathlib
+import shutil
+import subprocess
+import sys
+
+FAILED = []
+SIN_PHI, COS_PHI, T_END, G = 0.6, 0.8, 0.5, 9.81      # input/incline.dat
+
+
+def check(name, ok, detail=""):
+    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
+    if not ok:
+        FAILED.append(name)
+
+
+def sweep_tool(src, args, expect=0):
+    cmd = [sys.executable, str(src / "scripts" / "multicor-sweep")] + [str(a) for a in args]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    if expect is not None and proc.returncode != expect:
+        print(proc.stdout, proc.stderr)
+        raise SystemExit(f"{' '.join(cmd)}: exit {proc.returncode}, expected {expect}")
+    return proc
+
+
+def read_table(path):
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def refused_keys(src, exe, work):
+    """Keys the deck does not contain: exit 1, the key named, no sweep folder left."""
+    deck = src / "input" / "incline.dat"
+    cases = [("contacts.law[3].mu=0.2", "has 2 'law' record(s) in [contacts]"),
+             ("contacts.law.mu=0.2", "has 2 'law' records in [contacts] (lines 36, 37)"),
+             ("contacts.law[material1=2 material2=9].mu=0.2", "it matches 0"),
+             ("solver.tolerance=1e-5", "does not give 'tolerance' in [solver]"),
+             ("contacts.law[1].friction=0.2", "'law' has no value 'friction'"),
+             ("contacts.law[1].rolling=1e-3", "does not give 'rolling'"),
+             ("time.stepp=1e-4", "section [time] has no keyword 'stepp'"),
+             ("contact.law[1].mu=0.2", "there is no section [contact]"),
+             ("particles.gravity=1", "'gravity' has several values (gx gy)"),
+             ("run.title=x", "'title' is text")]
+    for key, expected in cases:
+        folder = work / "refused"
+        proc = sweep_tool(src, ["create", deck, "--exe", exe, "--set", key, "--dir", folder],
+                          expect=None)
+        k = key.rsplit("=", 1)[0]
+        check(f"refuses {k}", proc.returncode == 1 and f"'{k}'" in proc.stderr
+              and expected in proc.stderr and not folder.exists(), proc.stderr.strip())
+    proc = sweep_tool(src, ["create", deck, "--exe", exe, "--set", "time.end=1",
+                            "--set", "time.end=2", "--dir", work / "refused"], expect=None)
+    check("refuses a key given twice", proc.returncode == 1
+          and "key given twice: time.end" in proc.stderr, proc.stderr.strip())
+    proc = sweep_tool(src, ["create", deck, "--exe", exe, "--set", "contacts.law[2].mu=0.1",
+                            "--set", "contacts.law[material1=2].3=0.2", "--dir",
+                            work / "refused"], expect=None)
+    check("refuses two keys naming the same value", proc.returncode == 1
+          and "name the same value" in proc.stderr, proc.stderr.strip())
+    # a value that the deck check refuses (mu < 0): the message of multicor, naming the line
+    proc = sweep_tool(src, ["create", deck, "--exe", exe, "--set", "contacts.law[2].mu=0.1,-1",
+                            "--dir", work / "bad_value"], expect=None)
+    check("refuses a point that fails multicor --check", proc.returncode == 1
+          and "p002 (contacts.law[2].mu=-1)" in proc.stderr
+          and "bad_value/decks/p002.dat:" in proc.stderr and "mu" in proc.stderr,
+          proc.stderr.strip())
+
+
+def generated_decks(src, exe, work):
+    deck = src / "input" / "incline.dat"
+    grid = work / "grid.txt"
+    grid.write_text("# friction of the lower disk on its incline, chosen by materials\n"
+                    "contacts.law[material1=2 material2=3].mu = 0.1, 0.2\n"
+                    "particles.disk[2].3 = 0.05   # the radius, by position\n")
+    folder = work / "seq"
+    sweep_tool(src, ["create", deck, "--exe", exe, "--grid", grid, "--dir", folder,
+                     "--scalar", "v2x=dem/velocity[-1,1,0]",
+                     "--scalar", "balance=absmax(dem/energy/balance)",
+                     "--scalar", "vmax=max(dem/velocity[:,1,0])"])
+    original = deck.read_text().splitlines()
+    for name, mu in (("p001", "0.1"), ("p002", "0.2")):
+        lines = (folder / "decks" / f"{name}.dat").read_text().splitlines()
+        # the header: '# multicor-sweep point ...' and one line per key
+        check(f"{name}: header names the point", lines[0].startswith(
+            f"# multicor-sweep point {name} of 2") and lines[1].startswith("#   contacts.law"),
+            lines[0])
+        body = lines[3:]
+        changed = [(a, b) for a, b in zip(original, body) if a != b]
+        expected_line = "law      = 2          3          " + mu.ljust(3) \
+            + "  0            0"
+        check(f"{name}: only the swept token changed", len(body) == len(original)
+              and len(changed) == (0 if mu == "0.1" else 1)
+              and all(b == expected_line for _, b in changed), str(changed))
+    return folder
+
+
+def sequential_run(src, folder):
+    proc = sweep_tool(src, ["run", folder])
+    print(proc.stdout.strip())
+    rows = read_table(folder / "results.csv")
+    check("table: two rows", len(rows) == 2, str(len(rows)))
+    for r in rows:
+        mu = float(r["contacts.law[material1=2 material2=3].mu"])
+        ref = COS_PHI * G * (SIN_PHI - mu * COS_PHI) * T_END
+        # constant acceleration from the first step: exact to round-off (1e-12 relative)
+        check(f"{r['point']} mu={mu}: closed-form velocity", r["summary.finished"] == "1"
+              and math.isclose(float(r["v2x"]), ref, rel_tol=1e-12)
+              and float(r["vmax"]) == float(r["v2x"]),
+              f"v2x={r['v2x']} (max over outputs {r['vmax']}) closed form {ref!r}")
+        # the energy audit closes to round-off: |balance| <= 1e-9 J/m on ~20 J/m moved
+        check(f"{r['point']}: energy balance collected", 0 <= float(r["balance"]) < 1e-9,
+              r["balance"])
+    check("results.png drawn", (folder / "results.png").exists(), "")
+
+
+def failing_point(src, exe, work):
+    folder = work / "fail"
+    sweep_tool(src, ["create", src / "input" / "incline.dat", "--exe", exe,
+                     "--set", "particles.gravity.gy=-9.81,-1e300", "--dir", folder])
+    proc = sweep_tool(src, ["run", folder, "-j", "2"], expect=1)
+    print(proc.stdout.strip())
+    rows = {r["point"]: r for r in read_table(folder / "results.csv")}
+    check("a failing point: exit 1 in the table, the other finished",
+          rows["p002"]["exit_status"] == "1" and rows["p002"].get("summary.finished") != "1"
+          and rows["p001"]["summary.finished"] == "1", str(rows["p002"]))
+    status = sweep_tool(src, ["status", folder]).stdout
+    check("status: 1 finished, 1 failed", "p002 failed" in status
+          and "1 finished, 1 failed" in status, status.strip())
+    again = sweep_tool(src, ["run", folder, "--no-collect"], expect=1)
+    check("the next run retries the failed point only",
+          "1 points finished before, 1 to run" in again.stdout, again.stdout.strip())
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--exe", required=True)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("--source", required=True)
+    args = ap.parse_args()
+    exe = pathlib.Path(args.exe).resolve()
+    src = pathlib.Path(args.source).resolve()
+    work = pathlib.Path(args.work).resolve()
+    shutil.rmtree(work, ignore_errors=True)
+    work.mkdir(parents=True)
+    refused_keys(src, exe, work)
+    folder = generated_decks(src, exe, work)
+    sequential_run(src, folder)
+    failing_point(src, exe, work)
+    if FAILED:
+        print(f"{len(FAILED)} check(s) failed: {', '.join(FAILED)}")
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
