@@ -113,8 +113,8 @@ module dem_nlgs
         procedure(bilateral_restore), deferred :: restore
         !> Restore the constraints after a contact update changed the velocities of two bodies.
         procedure(bilateral_update), deferred :: update
-        !> The constraints' share of the mobility (default: none; see bilateral_no_mobility).
-        procedure :: mobility => bilateral_no_mobility
+        !> The constraints' share of the disks' mobility (used by a block solve).
+        procedure(bilateral_mobility), deferred :: mobility
     end type nlgs_bilateral_t
 
     abstract interface
@@ -137,6 +137,20 @@ module dem_nlgs
             !> Disk velocities (3, n_disks).
             real(wp), intent(inout) :: vel(:, :)
         end subroutine bilateral_update
+
+        !> Mobility of the constrained disks: an impulse p (3, n_disks) applied to the disks
+        !> and followed by `restore` changes the velocities by M^-1 p - P^T D C D P p, with P
+        !> picking the DOFs (dof(r), owner(r)) of the rows, D = diag(inverse mass of those
+        !> DOFs) and C symmetric positive semi-definite (empty arrays: no share).
+        subroutine bilateral_mobility(self, owner, dof, c)
+            import :: nlgs_bilateral_t, wp
+            !> The constraints.
+            class(nlgs_bilateral_t), intent(in) :: self
+            !> Disk and DOF (1 = x, 2 = y, 3 = rotation) of each row.
+            integer, allocatable, intent(out) :: owner(:), dof(:)
+            !> The matrix C (rows x rows).
+            real(wp), allocatable, intent(out) :: c(:, :)
+        end subroutine bilateral_mobility
     end interface
 
     !> Contacts solved exactly as one block inside the sweeps (see the module header).
@@ -201,21 +215,6 @@ module dem_nlgs
     end interface
 
 contains
-
-    !> Mobility of the constrained disks: an impulse p (3, n_disks) applied to the disks and
-    !> followed by `restore` changes the velocities by M^-1 p - P^T D C D P p, with P picking
-    !> the DOFs (dof(r), owner(r)) of the rows, D = diag(im of those DOFs) and C symmetric
-    !> positive semi-definite. This default is for constraints that never move a disk
-    !> (no rows: owner, dof and c empty); extensions with rows override it.
-    subroutine bilateral_no_mobility(self, owner, dof, c)
-        !> The constraints.
-        class(nlgs_bilateral_t), intent(in) :: self
-        !> Disk and DOF (1 = x, 2 = y, 3 = rotation) of each row.
-        integer, allocatable, intent(out) :: owner(:), dof(:)
-        !> The matrix C (rows x rows) [m s/kg per unit multiplier scaled by the masses].
-        real(wp), allocatable, intent(out) :: c(:, :)
-        allocate (owner(0), dof(0), c(0, 0))
-    end subroutine bilateral_no_mobility
 
     !> Solve the contact problem of one step. On entry vel holds the free velocities, on
     !> exit the end-of-step velocities; cs%r holds the warm start on entry, the reactions on exit.
