@@ -74,6 +74,8 @@ module coupling_bilateral
         procedure :: condense
         !> G v: the velocities of the coupled DOFs.
         procedure :: gather
+        !> See `nlgs_bilateral_t%mobility`: C = (h gamma / t) A^-1 (or B).
+        procedure :: mobility
     end type coupling_rows_t
 
 contains
@@ -179,6 +181,21 @@ contains
         end do
         self%corrections = self%corrections + 1
     end subroutine correct
+
+    !> The rows' share of the disks' mobility (nlgs_bilateral_t): an impulse p followed by
+    !> `restore` changes the velocities by M^-1 p - P^T D C D P p with C = (h gamma / t) A^-1
+    !> (B with the mediator space), the matrix of `condense`.
+    subroutine mobility(self, owner, dof, c)
+        !> The rows.
+        class(coupling_rows_t), intent(in) :: self
+        !> Disk and DOF of each row.
+        integer, allocatable, intent(out) :: owner(:), dof(:)
+        !> C (n_rows, n_rows).
+        real(wp), allocatable, intent(out) :: c(:, :)
+        owner = self%owner(1:self%n_rows)
+        dof = self%dof(1:self%n_rows)
+        c = self%scale*self%ainv
+    end subroutine mobility
 
     !> Replace the Delassus block (W_nn, W_nt, W_tt, W_nm, W_tm, W_mm) of every contact that
     !> touches a coupled particle by the condensed one W - (h gamma/t) U^T A^-1 U (module

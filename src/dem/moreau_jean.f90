@@ -39,7 +39,8 @@ module dem_moreau_jean
                             contacts_set_laws, contacts_finish, contacts_impulses, contacts_local_velocity, &
                             contacts_bytes
     use dem_detection, only: detector_t, detect_contacts, detector_bytes
-    use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_bilateral_t
+    use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_bilateral_t, nlgs_method_block
+    use dem_bonded_block, only: bonded_block_t, bonded_block_solve
     use dem_bonds, only: rupture_log_t, break_none
     implicit none
     private
@@ -97,6 +98,10 @@ module dem_moreau_jean
         type(mj_config_t) :: scheme
         !> Solver settings.
         type(nlgs_config_t) :: solver
+        !> Intact bonds solved directly (solver%method = nlgs_method_block): the factor is
+        !> kept from step to step. Allocated at the first block solve (so that copies of a
+        !> system that has not run yet carry no CHOLMOD object).
+        type(bonded_block_t), allocatable :: block
         !> Contact list.
         type(contact_set_t) :: contacts
         !> Detection workspace.
@@ -232,7 +237,9 @@ contains
         sys%time_solver = sys%time_solver + real(c2 - c1, wp)/real(rate, wp)
     end subroutine mj_detect
 
-    !> Part 3 of a step: NLGS from the velocities in `vel`; end-of-step velocities in `vel`.
+    !> Part 3 of a step: the contact solve (NLGS, or with solver%method = nlgs_method_block
+    !> the intact bonds as a direct block, dem_bonded_block) from the velocities in `vel`;
+    !> end-of-step velocities in `vel`.
     subroutine mj_solve(sys, bilateral)
         !> System, after `mj_detect`.
         type(dem_system_t), intent(inout) :: sys
@@ -240,7 +247,12 @@ contains
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         integer(i8) :: c0, c1, rate
         call system_clock(c0, rate)
-        call nlgs_solve(sys%solver, sys%contacts, sys%im, sys%vel, sys%stats, bilateral)
+        if (sys%solver%method == nlgs_method_block) then
+            if (.not. allocated(sys%block)) allocate (sys%block)
+            call bonded_block_solve(sys%solver, sys%block, sys%contacts, sys%im, sys%vel, sys%stats, bilateral)
+        else
+            call nlgs_solve(sys%solver, sys%contacts, sys%im, sys%vel, sys%stats, bilateral)
+        end if
         call system_clock(c1)
         sys%time_solver = sys%time_solver + real(c1 - c0, wp)/real(rate, wp)
     end subroutine mj_solve

@@ -34,6 +34,14 @@
 !> (`restore`) and after every contact update that moved disks (`update`), and corrects the
 !> velocities of its disks there. The contacts then solve the problem with the constraints
 !> eliminated (give them the condensed Delassus blocks in cs%w for exact local solves).
+!>
+!> Block (optional, e.g. the intact bonds of dem_bonded_block): an extension of
+!> `nlgs_block_t` takes some active contacts out of the sweeps and solves them exactly as one
+!> block (block Gauss-Seidel). `prepare` chooses its members after the blocked contacts are
+!> taken out; `solve` is called once after the warm start and after every sweep that did not
+!> converge; after each sweep `measure` gives the block's share of the convergence norm (the
+!> change of the members' local velocities the next solve would make, and their |W r|), so
+!> that `sweeps` counts block iterations.
 module dem_nlgs
     use core_kinds, only: wp, i8
     use dem_contacts, only: contact_set_t
@@ -43,7 +51,14 @@ module dem_nlgs
     implicit none
     private
     public :: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_apply_reactions, nlgs_residual
-    public :: nlgs_bilateral_t
+    public :: nlgs_bilateral_t, nlgs_block_t
+    public :: nlgs_method_nlgs, nlgs_method_block
+
+    !> Global strategy: Gauss-Seidel sweeps over every contact.
+    integer, parameter :: nlgs_method_nlgs = 1
+    !> Global strategy: intact bonds solved directly as one block, sweeps over the others
+    !> (dem_bonded_block).
+    integer, parameter :: nlgs_method_block = 2
 
     !> A contact is blocked when W_nn <= blocked_ratio (W_nn + W_tt) (the floor of the scaled
     !> frame in dem_bipotential: below it the normal reaction would be unbounded).
@@ -64,6 +79,8 @@ module dem_nlgs
         integer :: local_max_iter = 8
         !> Alternate the sweep direction.
         logical :: symmetric = .true.
+        !> Global strategy (nlgs_method_nlgs or nlgs_method_block), chosen by the caller.
+        integer :: method = nlgs_method_nlgs
     end type nlgs_config_t
 
     !> Statistics of one solve.
@@ -85,6 +102,8 @@ module dem_nlgs
         real(wp) :: residual = 0.0_wp
         !> error <= tol reached.
         logical :: converged = .true.
+        !> Active contacts solved as a block (nlgs_block_t members), not swept.
+        integer :: n_block = 0
     end type nlgs_stats_t
 
     !> Linear velocity constraints kept satisfied during the sweeps (see the module header).
@@ -94,6 +113,8 @@ module dem_nlgs
         procedure(bilateral_restore), deferred :: restore
         !> Restore the constraints after a contact update changed the velocities of two bodies.
         procedure(bilateral_update), deferred :: update
+        !> The constraints' share of the disks' mobility (used by a block solve).
+        procedure(bilateral_mobility), deferred :: mobility
     end type nlgs_bilateral_t
 
     abstract interface
@@ -116,13 +137,88 @@ module dem_nlgs
             !> Disk velocities (3, n_disks).
             real(wp), intent(inout) :: vel(:, :)
         end subroutine bilateral_update
+
+        !> Mobility of the constrained disks: an impulse p (3, n_disks) applied to the disks
+        !> and followed by `restore` changes the velocities by M^-1 p - P^T D C D P p, with P
+        !> picking the DOFs (dof(r), owner(r)) of the rows, D = diag(inverse mass of those
+        !> DOFs) and C symmetric positive semi-definite (empty arrays: no share).
+        subroutine bilateral_mobility(self, owner, dof, c)
+            import :: nlgs_bilateral_t, wp
+            !> The constraints.
+            class(nlgs_bilateral_t), intent(in) :: self
+            !> Disk and DOF (1 = x, 2 = y, 3 = rotation) of each row.
+            integer, allocatable, intent(out) :: owner(:), dof(:)
+            !> The matrix C (rows x rows).
+            real(wp), allocatable, intent(out) :: c(:, :)
+        end subroutine bilateral_mobility
+    end interface
+
+    !> Contacts solved exactly as one block inside the sweeps (see the module header).
+    type, abstract :: nlgs_block_t
+        !> Contact k is a member of the block in the current solve (size >= cs%n), set by
+        !> `prepare`.
+        logical, allocatable :: member(:)
+    contains
+        !> Choose the members among the active contacts and set the block up.
+        procedure(block_prepare), deferred :: prepare
+        !> Solve the members exactly for the current velocities of the other contacts.
+        procedure(block_solve), deferred :: solve
+        !> The members' share of the convergence norm.
+        procedure(block_measure), deferred :: measure
+    end type nlgs_block_t
+
+    abstract interface
+        !> Choose the members (active contacts only) and set up their solve; reactions of the
+        !> members may be changed (they are applied afterwards).
+        subroutine block_prepare(self, cs, im, bilateral)
+            import :: nlgs_block_t, contact_set_t, nlgs_bilateral_t, wp
+            !> The block.
+            class(nlgs_block_t), intent(inout) :: self
+            !> Contacts (blocked ones already inactive).
+            type(contact_set_t), intent(inout) :: cs
+            !> Inverse mass per DOF (3, n_disks).
+            real(wp), intent(in) :: im(:, :)
+            !> Bilateral constraints of the solve, if any.
+            class(nlgs_bilateral_t), intent(inout), optional :: bilateral
+        end subroutine block_prepare
+
+        !> Solve the members for the current velocities: update their reactions and vel
+        !> (restoring the bilateral constraints if any).
+        subroutine block_solve(self, cs, im, vel, bilateral)
+            import :: nlgs_block_t, contact_set_t, nlgs_bilateral_t, wp
+            !> The block.
+            class(nlgs_block_t), intent(inout) :: self
+            !> Contacts.
+            type(contact_set_t), intent(inout) :: cs
+            !> Inverse mass per DOF (3, n_disks).
+            real(wp), intent(in) :: im(:, :)
+            !> Velocities (3, n_disks).
+            real(wp), intent(inout) :: vel(:, :)
+            !> Bilateral constraints of the solve, if any.
+            class(nlgs_bilateral_t), intent(inout), optional :: bilateral
+        end subroutine block_solve
+
+        !> The members' share of the convergence norm in the current state: num = sum of
+        !> the squared change of their local velocities that `solve` would make, den = sum
+        !> |W_aa r_a|^2 (rotation rows times the mean radius, as in the sweeps).
+        subroutine block_measure(self, cs, vel, num, den)
+            import :: nlgs_block_t, contact_set_t, wp
+            !> The block.
+            class(nlgs_block_t), intent(in) :: self
+            !> Contacts.
+            type(contact_set_t), intent(in) :: cs
+            !> Velocities (3, n_disks).
+            real(wp), intent(in) :: vel(:, :)
+            !> Contributions to the convergence norm.
+            real(wp), intent(out) :: num, den
+        end subroutine block_measure
     end interface
 
 contains
 
     !> Solve the contact problem of one step. On entry vel holds the free velocities, on
     !> exit the end-of-step velocities; cs%r holds the warm start on entry, the reactions on exit.
-    subroutine nlgs_solve(config, cs, im, vel, stats, bilateral)
+    subroutine nlgs_solve(config, cs, im, vel, stats, bilateral, block)
         !> Settings.
         type(nlgs_config_t), intent(in) :: config
         !> Contacts (frames, laws and activity set).
@@ -135,22 +231,33 @@ contains
         type(nlgs_stats_t), intent(out) :: stats
         !> Bilateral constraints kept satisfied (default: none).
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
-        real(wp) :: num, den
+        !> Contacts solved as one block (default: none).
+        class(nlgs_block_t), intent(inout), optional :: block
+        real(wp) :: num, den, num_b, den_b
         integer(i8) :: nloc
         integer, allocatable :: list(:)
         ! per contact of the solve, constant over the solve: the scaled frame of its local
         ! problem (bipotential_scaling, or rolling_scaling for a law with moments)
         real(wp), allocatable :: sc(:, :)
         real(wp) :: floor
-        integer :: s, k
+        integer :: s, k, n_swept
         stats%n_contacts = cs%n
         call skip_blocked(cs, stats%n_blocked)
         stats%n_active = count(cs%active(1:cs%n))
-        allocate (list(stats%n_active), sc(rolling_n_scaling, stats%n_active))
+        stats%n_block = 0
+        if (present(block)) then
+            call block%prepare(cs, im, bilateral)
+            stats%n_block = count(block%member(1:cs%n))
+        end if
+        n_swept = stats%n_active - stats%n_block
+        allocate (list(n_swept), sc(rolling_n_scaling, n_swept))
         s = 0
         floor = 0.0_wp
         do k = 1, cs%n
             if (.not. cs%active(k)) cycle
+            if (present(block)) then
+                if (block%member(k)) cycle
+            end if
             s = s + 1
             list(s) = k
             if (cs%erol(k) > 0.0_wp) then
@@ -160,21 +267,25 @@ contains
             end if
         end do
         call nlgs_apply_reactions(cs, im, vel)
-        do s = 1, stats%n_active
-            floor = floor + roundoff_floor(cs, list(s), vel)
+        do k = 1, cs%n
+            if (cs%active(k)) floor = floor + roundoff_floor(cs, k, vel)
         end do
         if (present(bilateral)) call bilateral%restore(vel)
+        if (present(block)) call block%solve(cs, im, vel, bilateral)
         stats%converged = .true.
         stats%error = 0.0_wp
         if (stats%n_active > 0) then
             stats%converged = .false.
             do s = 1, config%max_sweeps
                 if (config%symmetric .and. mod(s, 2) == 0) then
-                    call sweep(config, cs, im, vel, list, sc, stats%n_active, 1, -1, num, den, nloc, &
-                               bilateral)
+                    call sweep(config, cs, im, vel, list, sc, n_swept, 1, -1, num, den, nloc, bilateral)
                 else
-                    call sweep(config, cs, im, vel, list, sc, 1, stats%n_active, 1, num, den, nloc, &
-                               bilateral)
+                    call sweep(config, cs, im, vel, list, sc, 1, n_swept, 1, num, den, nloc, bilateral)
+                end if
+                if (present(block)) then
+                    call block%measure(cs, vel, num_b, den_b)
+                    num = num + num_b
+                    den = den + den_b
                 end if
                 stats%sweeps = s
                 stats%local_iterations = stats%local_iterations + nloc
@@ -183,9 +294,10 @@ contains
                     stats%converged = .true.
                     exit
                 end if
+                if (present(block)) call block%solve(cs, im, vel, bilateral)
             end do
         end if
-        stats%updates = int(stats%n_active, i8)*stats%sweeps
+        stats%updates = int(n_swept, i8)*stats%sweeps
         stats%residual = nlgs_residual(cs, vel)
     end subroutine nlgs_solve
 

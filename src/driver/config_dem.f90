@@ -28,6 +28,7 @@ module driver_config_dem
     use dem_contacts, only: contact_set_t
     use dem_detection, only: detector_t, detect_contacts
     use dem_moreau_jean, only: dem_system_t
+    use dem_nlgs, only: nlgs_method_nlgs, nlgs_method_block
     use driver_config, only: run_config_t, find_id
     implicit none
     private
@@ -732,6 +733,8 @@ contains
             sys%solver%max_sweeps = deck%get_int('solver', 'max_sweeps')
             sys%solver%local_tol = deck%get_real('solver', 'local_tolerance')
             sys%solver%local_max_iter = deck%get_int('solver', 'local_iterations')
+            sys%solver%method = nlgs_method_nlgs
+            if (deck%get_word('solver', 'method') == 'block') sys%solver%method = nlgs_method_block
         end associate
         cfg%store_contacts = deck%get_word('output', 'contacts') == 'yes'
     end subroutine build_settings

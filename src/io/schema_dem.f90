@@ -135,13 +135,23 @@ contains
         !> Schema to extend.
         type(schema_t), intent(inout) :: s
         call s%add_section('solver', 'Contact solver of the particles: non-linear Gauss-Seidel '// &
-                           'sweeps over the contacts with the bi-potential local solver, at every time step.')
+                           'sweeps over the contacts with the bi-potential local solver, at every time step; '// &
+                           'with `method = block` the intact bonds are solved directly as one block.')
+        call s%add_keyword('solver', 'method', [word_field('method', 'block nlgs')], &
+                           'Global strategy. `nlgs`: Gauss-Seidel sweeps over every contact. `block`: the '// &
+                           'intact bonds (with the coupling rows) are solved exactly as one sparse block '// &
+                           '(CHOLMOD), alternating with sweeps over the other contacts (block Gauss-Seidel); a '// &
+                           'bond whose reaction leaves its cone is released and the step solved again, so the '// &
+                           'bonds break as with `nlgs`. Without bonds both are the same sweeps. Every '// &
+                           'unilateral or frictional contact uses the bi-potential local solver in both.', &
+                           default='block')
         call s%add_keyword('solver', 'tolerance', [positive('tolerance', '')], &
                            'Convergence of the sweeps: change of the local velocities over a sweep relative '// &
                            'to W r (quadratic mean over the active contacts).', default='1.666e-4')
         call s%add_keyword('solver', 'max_sweeps', [int_field('max_sweeps', lower=1)], &
-                           'Largest number of sweeps per step; a step that reaches it without converging is '// &
-                           'reported (warning) and counted.', default='1000')
+                           'Largest number of sweeps per step (with `method = block`: block iterations, each a '// &
+                           'direct solve of the bonds and a sweep over the other contacts); a step that reaches '// &
+                           'it without converging is reported (warning) and counted.', default='1000')
         call s%add_keyword('solver', 'local_tolerance', [positive('local_tolerance', '')], &
                            'Relative tolerance of the local prediction-correction iterations of one contact.', &
                            default='1e-10')

@@ -1,0 +1,736 @@
+!> The intact bonds of a step solved directly, as one block of bilateral constraints
+!> (block Gauss-Seidel with the NLGS sweeps over the other contacts; doc/theory.md,
+!> "Bonded block").
+!>
+!> B is the set of active intact bonds (status_cohesive, not blocked). While a bond holds,
+!> its reaction lies inside its cone and the law asks u = 0 for every locked component: the
+!> normal one always, the tangential one when mu_b > 0, the rotation when e_b > 0 (a bound
+!> with a zero coefficient locks nothing: that component carries no reaction, as in the
+!> sweeps). The cohesion shifts only the reaction (r_n + r_cohe h in the cone), not the
+!> velocity, so the equality u_B = H_B^T v + shift = 0 holds with the same solver shift as
+!> the sweeps use. With the other reactions fixed, the change of the bond reactions dr solves
+!>     (W_BB + eps I) dr = -u_B,   W_BB = H_B^T M_eff^-1 H_B,
+!> where M_eff^-1 is M^-1 minus the share of the bilateral constraints of the solve (the
+!> Arlequin coupling rows, `nlgs_bilateral_t%mobility`): the rows join the block exactly, and
+!> `restore` then applies their multipliers. W_BB is sparse (one 3x3 block per pair of bonds
+!> that share a disk; a dense corner among the bonds on coupled disks) and is factored by
+!> CHOLMOD (core_sparse) with L L^T.
+!>
+!> Regularisation: eps = 1e-12 max diag(W_BB). Redundant bonds (a closed loop, e.g. a
+!> triangle of a hexagonal stack) make W_BB singular: its kernel holds the self-stresses,
+!> which the velocities do not see. eps I makes the matrix definite and picks among them
+!> the reaction change of least norm. The factorisation of a semi-definite matrix in floating
+!> point meets pivots of the size of the rounding of its entries, about 1e-16 max diag, so
+!> 1e-12 keeps four orders of margin. The bias that eps adds (a relative error eps/lambda
+!> on an eigen-component lambda of W_BB) is removed by iterative refinement with the same
+!> factor, the residual being recomputed from the velocities themselves (-u_B after the
+!> impulses are applied, not W_BB x: the reactions of a long chain are poorly determined by
+!> W_BB, whose condition grows like N^4, and the velocity residual is the exact one): each
+!> pass contracts a component by eps/(lambda + eps) and, for a singular but consistent
+!> system, converges to a solution. It stops at the round-off of the velocities (64 eps
+!> |v|, as the NLGS's floor), when the residual no longer halves, or after max_passes.
+!>
+!> Reuse: the symbolic analysis is kept while the bond graph (the pairs of B and their
+!> locked components, in order) does not change. The values of W_BB change at every step in
+!> a moving structure (the frames turn with the disks), but only by the rotation of the
+!> frames over a step, so a factor of older values is a near-exact solver: the refinement
+!> with it contracts by about that relative change per pass. The factor is therefore kept
+!> while a refinement pass reduces the residual by at least stale_contraction (1e-2), and
+!> refactored with the current values as soon as one does not; with the same values
+!> (bitwise) it is always exact. On the reference stack (doc/performance.md, "Bonded
+!> block") 1000 steps need 2 numerical factorisations and about 3 refinement passes per
+!> step, against one factorisation per step for a refactor at every step, which cost 40 %
+!> of the block's time.
+!>
+!> Outer check (`bonded_block_solve`): after a converged solve every bond of B is checked
+!> against its cone, r_n + r_cohe h >= 0, |r_t| <= mu_b (r_n + r_cohe h), |M| <= e_b (r_n +
+!> r_cohe h). A bond outside it cannot hold as a bilateral constraint: it leaves B for the
+!> rest of the step, joins the sweeps with its own (cohesive) law, and the step is solved
+!> again from the current reactions. This is the problem the plain NLGS solves, so the
+!> judgement of dem_contacts (contacts_finish) then breaks it exactly as after the NLGS.
+module dem_bonded_block
+    use core_kinds, only: wp, i8
+    use core_error, only: error_t
+    use core_sparse, only: sparse_matrix_t, sparse_solver_t, sparse_cholesky
+    use dem_contacts, only: contact_set_t, status_cohesive
+    use dem_bipotential, only: case_stick
+    use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_apply_reactions, nlgs_block_t, &
+                        nlgs_bilateral_t
+    implicit none
+    private
+    public :: bonded_block_t, bonded_block_counts_t, bonded_block_solve, bonded_block_eps_ratio
+
+    !> Regularisation eps relative to the largest diagonal entry of W_BB (module header).
+    real(wp), parameter :: bonded_block_eps_ratio = 1.0e-12_wp
+    !> Largest number of passes (solve and refinements) per block solve.
+    integer, parameter :: max_passes = 6
+    !> A kept factor of older values is refactored when a pass reduces the residual by less
+    !> than this factor.
+    real(wp), parameter :: stale_contraction = 1.0e-2_wp
+    !> Relative resolution of a relative velocity (64 machine epsilons of the velocities of
+    !> the two bodies, as in dem_nlgs): the refinement stops below it.
+    real(wp), parameter :: roundoff = 64.0_wp*epsilon(1.0_wp)
+
+    !> Counts since the block was created (for statistics and benchmarks).
+    type :: bonded_block_counts_t
+        !> Symbolic analyses (bond graph changed).
+        integer(i8) :: analyses = 0
+        !> Numerical factorisations.
+        integer(i8) :: factorisations = 0
+        !> Set-ups that kept the previous factor (graph unchanged; values unchanged, or the
+        !> factor still contracts the refinement well).
+        integer(i8) :: reuses = 0
+        !> Block solves (each with its refinement passes).
+        integer(i8) :: solves = 0
+        !> Refinement passes.
+        integer(i8) :: refinements = 0
+        !> Bonds moved out of the block by the outer check.
+        integer(i8) :: releases = 0
+        !> Steps solved again after a release.
+        integer(i8) :: resolves = 0
+        !> Set-ups whose factorisation failed (the bonds were then swept as by the NLGS).
+        integer(i8) :: failures = 0
+    end type bonded_block_counts_t
+
+    !> The bonded block and its factor (kept from step to step: see the module header).
+    type, extends(nlgs_block_t) :: bonded_block_t
+        !> Counts.
+        type(bonded_block_counts_t) :: counts
+        !> Contact k left the block at this step (outer check); set by bonded_block_solve.
+        logical, allocatable :: excluded(:)
+        !> Number of bonds in the block and of unknowns.
+        integer :: nb = 0, nu = 0
+        !> Contact index of each bond of the block (nb).
+        integer, allocatable :: bond(:)
+        !> First unknown of each bond (nb + 1).
+        integer, allocatable :: first(:)
+        !> Component (1 = r_n, 2 = r_t, 3 = M) of each unknown (nu).
+        integer, allocatable :: comp(:)
+        !> Bond graph of the analysed pattern: pairs and locked components (bitmask).
+        integer, allocatable :: key_i1(:), key_i2(:), key_rows(:)
+        !> A pattern is analysed.
+        logical :: analysed = .false.
+        !> A factor of the current pattern is held.
+        logical :: factored = .false.
+        !> The factor is of older values than the current ones (kept while it contracts).
+        logical :: stale = .false.
+        !> A refactorisation failed during this solve: the block is not solved.
+        logical :: lost = .false.
+        !> W_BB + eps I (lower triangle).
+        type(sparse_matrix_t) :: mat
+        !> Its factorisation.
+        type(sparse_solver_t) :: solver
+        !> Position of each diagonal entry in mat%values (nu).
+        integer(i8), allocatable :: diag(:)
+        !> Entries of the assembly (row, column, value) in assembly order, their number, and
+        !> the position of each in mat%values (the order depends on the graph only, so the
+        !> positions found once per pattern refill the values at the next steps).
+        integer, allocatable :: ti(:), tj(:)
+        real(wp), allocatable :: tv(:)
+        integer :: nt = 0
+        integer(i8), allocatable :: pos(:)
+        !> Values of the last factorisation.
+        real(wp), allocatable :: values_factored(:)
+        !> Regularisation of the current factor.
+        real(wp) :: eps = 0.0_wp
+        !> Work arrays (nu).
+        real(wp), allocatable :: rhs(:), x(:)
+    contains
+        !> See `nlgs_block_t%prepare`.
+        procedure :: prepare
+        !> See `nlgs_block_t%solve`.
+        procedure :: solve
+        !> See `nlgs_block_t%measure`.
+        procedure :: measure
+    end type bonded_block_t
+
+contains
+
+    !> Solve the contact problem of one step with the intact bonds as a direct block and
+    !> the NLGS sweeps over the other contacts (block Gauss-Seidel), then the outer check of
+    !> the bonds' cones (module header). Arguments as nlgs_solve; stats%sweeps counts the
+    !> block iterations of every pass, and the sweep limit applies to each pass.
+    subroutine bonded_block_solve(config, block, cs, im, vel, stats, bilateral)
+        !> Settings.
+        type(nlgs_config_t), intent(in) :: config
+        !> The block (kept between steps).
+        type(bonded_block_t), intent(inout) :: block
+        !> Contacts (frames, laws and activity set).
+        type(contact_set_t), intent(inout) :: cs
+        !> Inverse mass per DOF (3, n_disks).
+        real(wp), intent(in) :: im(:, :)
+        !> Velocities (3, n_disks): free velocities in, end-of-step velocities out.
+        real(wp), intent(inout) :: vel(:, :)
+        !> Statistics.
+        type(nlgs_stats_t), intent(out) :: stats
+        !> Bilateral constraints kept satisfied (default: none).
+        class(nlgs_bilateral_t), intent(inout), optional :: bilateral
+        type(nlgs_stats_t) :: pass
+        integer :: k, released, n_blocked, sweeps
+        integer(i8) :: updates, local
+        if (allocated(block%excluded)) then
+            if (size(block%excluded) < cs%n) deallocate (block%excluded)
+        end if
+        if (.not. allocated(block%excluded)) allocate (block%excluded(max(cs%n, 1)))
+        block%excluded = .false.
+        sweeps = 0
+        updates = 0_i8
+        local = 0_i8
+        n_blocked = -1
+        do
+            call nlgs_solve(config, cs, im, vel, pass, bilateral, block)
+            if (n_blocked < 0) n_blocked = pass%n_blocked
+            sweeps = sweeps + pass%sweeps
+            updates = updates + pass%updates
+            local = local + pass%local_iterations
+            if (.not. pass%converged) exit
+            released = 0
+            do k = 1, cs%n
+                if (.not. block%member(k)) cycle
+                if (outside_cone(cs, k)) then
+                    block%excluded(k) = .true.
+                    released = released + 1
+                end if
+            end do
+            if (released == 0) exit
+            block%counts%releases = block%counts%releases + released
+            block%counts%resolves = block%counts%resolves + 1
+            ! back to the velocities without the contact impulses (nlgs_solve applies the
+            ! current reactions again: the warm start of the next pass)
+            cs%r(:, 1:cs%n) = -cs%r(:, 1:cs%n)
+            call nlgs_apply_reactions(cs, im, vel)
+            cs%r(:, 1:cs%n) = -cs%r(:, 1:cs%n)
+        end do
+        stats = pass
+        stats%n_blocked = n_blocked
+        stats%sweeps = sweeps
+        stats%updates = updates
+        stats%local_iterations = local
+    end subroutine bonded_block_solve
+
+    !> The reaction of bond k lies outside its cone (a bound with a zero coefficient locks
+    !> nothing and is not checked).
+    pure logical function outside_cone(cs, k) result(out)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: k
+        real(wp) :: rn
+        rn = cs%r(1, k) + cs%coh(k)
+        out = rn < 0.0_wp
+        if (cs%mu(k) > 0.0_wp) out = out .or. abs(cs%r(2, k)) > cs%mu(k)*rn
+        if (cs%erol(k) > 0.0_wp) out = out .or. abs(cs%r(3, k)) > cs%erol(k)*rn
+    end function outside_cone
+
+    !> Choose B (active intact bonds not excluded), assemble W_BB + eps I, analyse when the
+    !> bond graph changed, factor when a value changed.
+    subroutine prepare(self, cs, im, bilateral)
+        !> The block.
+        class(bonded_block_t), intent(inout) :: self
+        !> Contacts (blocked ones already inactive).
+        type(contact_set_t), intent(inout) :: cs
+        !> Inverse mass per DOF (3, n_disks).
+        real(wp), intent(in) :: im(:, :)
+        !> Bilateral constraints of the solve, if any.
+        class(nlgs_bilateral_t), intent(inout), optional :: bilateral
+        type(error_t), allocatable :: error
+        integer :: k, b, u, mask, i
+        logical :: same, excl
+        if (allocated(self%member)) then
+            if (size(self%member) < cs%n) deallocate (self%member)
+        end if
+        if (.not. allocated(self%member)) allocate (self%member(max(cs%n, 1)))
+        self%member = .false.
+        self%lost = .false.
+        do k = 1, cs%n
+            excl = .false.
+            if (allocated(self%excluded)) then
+                if (k <= size(self%excluded)) excl = self%excluded(k)
+            end if
+            self%member(k) = cs%active(k) .and. cs%status(k) == status_cohesive .and. .not. excl
+        end do
+        self%nb = count(self%member(1:cs%n))
+        if (allocated(self%bond)) deallocate (self%bond, self%first)
+        allocate (self%bond(self%nb), self%first(self%nb + 1))
+        b = 0
+        u = 1
+        do k = 1, cs%n
+            if (.not. self%member(k)) cycle
+            b = b + 1
+            self%bond(b) = k
+            self%first(b) = u
+            u = u + popcnt(rows_mask(cs, k))
+            ! components that are not locked carry no reaction (see contacts_set_laws)
+            if (cs%mu(k) <= 0.0_wp) cs%r(2, k) = 0.0_wp
+            if (cs%erol(k) <= 0.0_wp) cs%r(3, k) = 0.0_wp
+        end do
+        self%first(self%nb + 1) = u
+        self%nu = u - 1
+        if (allocated(self%comp)) deallocate (self%comp)
+        allocate (self%comp(self%nu))
+        do b = 1, self%nb
+            mask = rows_mask(cs, self%bond(b))
+            u = self%first(b)
+            do k = 1, 3
+                if (.not. btest(mask, k - 1)) cycle
+                self%comp(u) = k
+                u = u + 1
+            end do
+        end do
+        if (self%nb == 0) return
+        ! same bond graph as the analysed pattern?
+        same = self%analysed
+        if (same) same = size(self%key_i1) == self%nb
+        if (same) then
+            do b = 1, self%nb
+                k = self%bond(b)
+                if (self%key_i1(b) /= cs%i1(k) .or. self%key_i2(b) /= cs%i2(k) .or. &
+                    self%key_rows(b) /= rows_mask(cs, k)) then
+                    same = .false.
+                    exit
+                end if
+            end do
+        end if
+        self%nt = 0
+        call assemble(self, cs, im, bilateral)
+        if (same) then
+            self%mat%values = 0.0_wp
+            do i = 1, self%nt
+                self%mat%values(self%pos(i)) = self%mat%values(self%pos(i)) + self%tv(i)
+            end do
+        else
+            self%analysed = .false.
+            self%factored = .false.
+            self%key_i1 = cs%i1(self%bond)
+            self%key_i2 = cs%i2(self%bond)
+            self%key_rows = [(rows_mask(cs, self%bond(b)), b=1, self%nb)]
+            call self%mat%init(self%nu, int(self%nt, i8))
+            do i = 1, self%nt
+                call self%mat%add(self%ti(i), self%tj(i), self%tv(i))
+            end do
+            call self%mat%finalize(error)
+            if (allocated(error)) then
+                call give_up(self)
+                return
+            end if
+            if (allocated(self%pos)) deallocate (self%pos, self%diag)
+            allocate (self%pos(self%nt), self%diag(self%nu))
+            do i = 1, self%nt
+                self%pos(i) = self%mat%position(self%ti(i), self%tj(i))
+            end do
+            do u = 1, self%nu
+                self%diag(u) = self%mat%position(u, u)
+            end do
+        end if
+        self%eps = bonded_block_eps_ratio*maxval(self%mat%values(self%diag))
+        if (self%eps <= 0.0_wp) then
+            call give_up(self)
+            return
+        end if
+        self%mat%values(self%diag) = self%mat%values(self%diag) + self%eps
+        if (.not. same) then
+            call self%solver%analyse(self%mat, error, kind=sparse_cholesky)
+            if (allocated(error)) then
+                call give_up(self)
+                return
+            end if
+            self%analysed = .true.
+            self%counts%analyses = self%counts%analyses + 1
+        end if
+        call size_work(self)
+        if (self%factored) then
+            ! keep the factor; `solve` refactors if it no longer contracts well
+            self%stale = any(self%mat%values /= self%values_factored)
+            self%counts%reuses = self%counts%reuses + 1
+            return
+        end if
+        call refactor(self)
+        if (.not. self%factored) call give_up(self)
+    end subroutine prepare
+
+    !> Numerical factorisation of the current values (factored = .false. on failure).
+    subroutine refactor(self)
+        type(bonded_block_t), intent(inout) :: self
+        type(error_t), allocatable :: error
+        self%factored = .false.
+        call self%solver%factor(self%mat, error)
+        if (allocated(error)) return
+        self%factored = .true.
+        self%stale = .false.
+        self%values_factored = self%mat%values
+        self%counts%factorisations = self%counts%factorisations + 1
+    end subroutine refactor
+
+    !> The factorisation failed (it should not with eps > 0): no block this solve, the bonds
+    !> are swept as by the plain NLGS, and the next set-up analyses again.
+    subroutine give_up(self)
+        type(bonded_block_t), intent(inout) :: self
+        self%member = .false.
+        self%nb = 0
+        self%nu = 0
+        self%analysed = .false.
+        self%factored = .false.
+        self%counts%failures = self%counts%failures + 1
+    end subroutine give_up
+
+    !> Work arrays of size nu.
+    subroutine size_work(self)
+        type(bonded_block_t), intent(inout) :: self
+        if (allocated(self%rhs)) then
+            if (size(self%rhs) == self%nu) return
+            deallocate (self%rhs, self%x)
+        end if
+        allocate (self%rhs(self%nu), self%x(self%nu))
+    end subroutine size_work
+
+    !> Locked components of bond k as a bitmask: bit 0 normal (always), bit 1 tangential
+    !> (mu_b > 0), bit 2 rotation (e_b > 0).
+    pure integer function rows_mask(cs, k) result(mask)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: k
+        mask = 1
+        if (cs%mu(k) > 0.0_wp) mask = ibset(mask, 1)
+        if (cs%erol(k) > 0.0_wp) mask = ibset(mask, 2)
+    end function rows_mask
+
+    !> Generalised directions of the reaction components of contact k on its body of side
+    !> s (1: i1, with sign -1; 2: i2, with sign +1): g(dof, component).
+    pure function directions(cs, k, s) result(g)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: k, s
+        real(wp) :: g(3, 3)
+        real(wp) :: sg, nx, ny
+        sg = merge(1.0_wp, -1.0_wp, s == 2)
+        nx = cs%nrm(1, k)
+        ny = cs%nrm(2, k)
+        g(:, 1) = [sg*nx, sg*ny, 0.0_wp]
+        g(:, 2) = [-sg*ny, sg*nx, cs%lever(s, k)]
+        g(:, 3) = [0.0_wp, 0.0_wp, sg]
+    end function directions
+
+    !> Assemble W_BB = H_B^T M_eff^-1 H_B as entries (push): one product per pair of
+    !> bonds that share a disk, then the bilateral constraints' share. Every entry of a block
+    !> is added, zero or not, so that the pattern depends on the graph only.
+    subroutine assemble(self, cs, im, bilateral)
+        type(bonded_block_t), intent(inout) :: self
+        type(contact_set_t), intent(in) :: cs
+        real(wp), intent(in) :: im(:, :)
+        class(nlgs_bilateral_t), intent(inout), optional :: bilateral
+        integer, allocatable :: start(:), inc_b(:), inc_s(:), fill(:)
+        integer :: nd, b, s, d, e1, e2, b1, b2, s1, s2, p, q
+        real(wp) :: g1(3, 3), g2(3, 3), v
+        nd = size(im, 2)
+        ! incidence: the (bond, side) pairs of each disk, by disk, bonds in order
+        allocate (start(nd + 1), fill(nd), inc_b(2*self%nb), inc_s(2*self%nb))
+        start = 0
+        do b = 1, self%nb
+            do s = 1, 2
+                d = body(cs, self%bond(b), s)
+                if (d > 0) start(d + 1) = start(d + 1) + 1
+            end do
+        end do
+        start(1) = 1
+        do d = 1, nd
+            start(d + 1) = start(d + 1) + start(d)
+        end do
+        fill = start(1:nd)
+        do b = 1, self%nb
+            do s = 1, 2
+                d = body(cs, self%bond(b), s)
+                if (d <= 0) cycle
+                inc_b(fill(d)) = b
+                inc_s(fill(d)) = s
+                fill(d) = fill(d) + 1
+            end do
+        end do
+        do d = 1, nd
+            do e1 = start(d), start(d + 1) - 1
+                b1 = inc_b(e1)
+                s1 = inc_s(e1)
+                g1 = directions(cs, self%bond(b1), s1)
+                do e2 = e1, start(d + 1) - 1
+                    b2 = inc_b(e2)
+                    s2 = inc_s(e2)
+                    g2 = directions(cs, self%bond(b2), s2)
+                    do p = self%first(b1), self%first(b1 + 1) - 1
+                        do q = self%first(b2), self%first(b2 + 1) - 1
+                            if (b1 == b2 .and. q > p) cycle
+                            v = sum(g1(:, self%comp(p))*im(:, d)*g2(:, self%comp(q)))
+                            call push(self, p, q, v)
+                        end do
+                    end do
+                end do
+            end do
+        end do
+        if (present(bilateral)) call add_mobility(self, cs, im, bilateral)
+    end subroutine assemble
+
+    !> Append the entry (i, j, v) to the assembly (either triangle, each pair once; every
+    !> unknown meets its diagonal entry, since every bond has a disk).
+    pure subroutine push(self, i, j, v)
+        type(bonded_block_t), intent(inout) :: self
+        integer, intent(in) :: i, j
+        real(wp), intent(in) :: v
+        integer, allocatable :: ti(:), tj(:)
+        real(wp), allocatable :: tv(:)
+        integer :: cap
+        if (.not. allocated(self%ti)) allocate (self%ti(64), self%tj(64), self%tv(64))
+        if (self%nt == size(self%ti)) then
+            cap = 2*size(self%ti)
+            allocate (ti(cap), tj(cap), tv(cap))
+            ti(1:self%nt) = self%ti(1:self%nt)
+            tj(1:self%nt) = self%tj(1:self%nt)
+            tv(1:self%nt) = self%tv(1:self%nt)
+            call move_alloc(ti, self%ti)
+            call move_alloc(tj, self%tj)
+            call move_alloc(tv, self%tv)
+        end if
+        self%nt = self%nt + 1
+        self%ti(self%nt) = i
+        self%tj(self%nt) = j
+        self%tv(self%nt) = v
+    end subroutine push
+
+    !> Add the bilateral constraints' share -U^T C U of W_BB, U = D P H_B (nlgs_bilateral_t
+    !> %mobility), on the unknowns of the bonds that touch a constrained disk.
+    subroutine add_mobility(self, cs, im, bilateral)
+        type(bonded_block_t), intent(inout) :: self
+        type(contact_set_t), intent(in) :: cs
+        real(wp), intent(in) :: im(:, :)
+        class(nlgs_bilateral_t), intent(inout) :: bilateral
+        integer, allocatable :: owner(:), dof(:), touched(:)
+        real(wp), allocatable :: c(:, :), um(:, :), cu(:, :)
+        integer :: nr, nt, b, s, d, r, p, i, j
+        real(wp) :: g(3, 3)
+        logical, allocatable :: constrained(:)
+        call bilateral%mobility(owner, dof, c)
+        nr = size(owner)
+        if (nr == 0) return
+        allocate (constrained(size(im, 2)))
+        constrained = .false.
+        constrained(owner) = .true.
+        ! unknowns of the bonds touching a constrained disk
+        allocate (touched(self%nu))
+        nt = 0
+        do b = 1, self%nb
+            if (.not. any([(touches(b, s), s=1, 2)])) cycle
+            do p = self%first(b), self%first(b + 1) - 1
+                nt = nt + 1
+                touched(nt) = p
+            end do
+        end do
+        if (nt == 0) return
+        allocate (um(nr, nt))
+        um = 0.0_wp
+        do i = 1, nt
+            p = touched(i)
+            b = bond_of(p)
+            do s = 1, 2
+                if (.not. touches(b, s)) cycle
+                d = body(cs, self%bond(b), s)
+                g = directions(cs, self%bond(b), s)
+                do r = 1, nr
+                    if (owner(r) /= d) cycle
+                    um(r, i) = um(r, i) + im(dof(r), d)*g(dof(r), self%comp(p))
+                end do
+            end do
+        end do
+        cu = matmul(c, um)
+        do j = 1, nt
+            do i = j, nt
+                call push(self, touched(i), touched(j), -dot_product(um(:, i), cu(:, j)))
+            end do
+        end do
+    contains
+        pure logical function touches(bb, ss)
+            integer, intent(in) :: bb, ss
+            integer :: dd
+            dd = body(cs, self%bond(bb), ss)
+            touches = .false.
+            if (dd > 0) touches = constrained(dd)
+        end function touches
+        pure integer function bond_of(pp)
+            integer, intent(in) :: pp
+            integer :: lo
+            do lo = 1, self%nb
+                if (self%first(lo + 1) > pp) exit
+            end do
+            bond_of = lo
+        end function bond_of
+    end subroutine add_mobility
+
+    !> Disk of side s (1: i1, 2: i2) of contact k, <= 0 for a wall.
+    pure integer function body(cs, k, s)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: k, s
+        if (s == 1) then
+            body = cs%i1(k)
+        else
+            body = cs%i2(k)
+        end if
+    end function body
+
+    !> The block's share of the convergence norm: num = |u_B|^2 over the locked components
+    !> (what the next solve changes in the bonds' local velocities; rotations times the mean
+    !> radius), den = sum |W_bb r_b|^2.
+    subroutine measure(self, cs, vel, num, den)
+        !> The block.
+        class(bonded_block_t), intent(in) :: self
+        !> Contacts.
+        type(contact_set_t), intent(in) :: cs
+        !> Velocities (3, n_disks).
+        real(wp), intent(in) :: vel(:, :)
+        !> Contributions to the convergence norm.
+        real(wp), intent(out) :: num, den
+        real(wp) :: u(3), wr(3)
+        integer :: b, k, p
+        num = 0.0_wp
+        den = 0.0_wp
+        if (self%lost) then
+            num = huge(1.0_wp)/4.0_wp
+            return
+        end if
+        do b = 1, self%nb
+            k = self%bond(b)
+            u = relative_velocity(cs, k, vel)
+            u(3) = cs%amoy(k)*u(3)
+            do p = self%first(b), self%first(b + 1) - 1
+                num = num + u(self%comp(p))**2
+            end do
+            wr = wmul(cs%w(:, k), cs%r(:, k))
+            den = den + wr(1)**2 + wr(2)**2 + (cs%amoy(k)*wr(3))**2
+        end do
+    end subroutine measure
+
+    !> Solve the block for the current velocities (module header): (W_BB + eps I) dr = -u_B
+    !> with iterative refinement, r += dr, vel += M_eff^-1 H_B dr.
+    subroutine solve(self, cs, im, vel, bilateral)
+        !> The block.
+        class(bonded_block_t), intent(inout) :: self
+        !> Contacts.
+        type(contact_set_t), intent(inout) :: cs
+        !> Inverse mass per DOF (3, n_disks).
+        real(wp), intent(in) :: im(:, :)
+        !> Velocities (3, n_disks).
+        real(wp), intent(inout) :: vel(:, :)
+        !> Bilateral constraints of the solve, if any.
+        class(nlgs_bilateral_t), intent(inout), optional :: bilateral
+        type(error_t), allocatable :: error
+        real(wp) :: u(3), rnorm, prev, noise
+        integer :: b, k, p, it
+        if (self%nb == 0 .or. self%lost) return
+        noise = 0.0_wp
+        do b = 1, self%nb
+            noise = noise + velocity_scale2(cs, self%bond(b), vel)
+        end do
+        noise = roundoff*sqrt(noise)
+        prev = huge(1.0_wp)
+        it = 0
+        do
+            ! the residual of the bonds, -u_B, from the velocities themselves
+            do b = 1, self%nb
+                k = self%bond(b)
+                u = relative_velocity(cs, k, vel)
+                do p = self%first(b), self%first(b + 1) - 1
+                    self%rhs(p) = -u(self%comp(p))
+                end do
+            end do
+            rnorm = norm2(self%rhs)
+            if (rnorm <= noise) exit
+            if (rnorm > stale_contraction*prev) then
+                if (self%stale) then
+                    ! the kept factor no longer contracts well: factor the current values
+                    call refactor(self)
+                    if (.not. self%factored) then
+                        ! cannot happen with eps > 0 short of a CHOLMOD failure; the step
+                        ! is then reported unconverged (measure) and the next set-up
+                        ! starts afresh
+                        self%lost = .true.
+                        self%analysed = .false.
+                        self%counts%failures = self%counts%failures + 1
+                        return
+                    end if
+                else if (rnorm > 0.5_wp*prev) then
+                    exit
+                end if
+            end if
+            if (it == max_passes) exit
+            it = it + 1
+            prev = rnorm
+            self%x = 0.0_wp
+            call self%solver%solve(self%rhs, self%x, error)
+            if (allocated(error)) return
+            if (it == 1) then
+                self%counts%solves = self%counts%solves + 1
+            else
+                self%counts%refinements = self%counts%refinements + 1
+            end if
+            do b = 1, self%nb
+                k = self%bond(b)
+                do p = self%first(b), self%first(b + 1) - 1
+                    cs%r(self%comp(p), k) = cs%r(self%comp(p), k) + self%x(p)
+                end do
+                call apply_change(cs, k, im, vel, b)
+                cs%pcase(k) = case_stick
+            end do
+            if (present(bilateral)) call bilateral%restore(vel)
+        end do
+    contains
+        ! vel += M^-1 H dr for the change x of bond b (contact k)
+        subroutine apply_change(cs, k, im, vel, b)
+            type(contact_set_t), intent(in) :: cs
+            integer, intent(in) :: k, b
+            real(wp), intent(in) :: im(:, :)
+            real(wp), intent(inout) :: vel(:, :)
+            real(wp) :: dr(3), g(3, 3)
+            integer :: s, d, pp
+            dr = 0.0_wp
+            do pp = self%first(b), self%first(b + 1) - 1
+                dr(self%comp(pp)) = self%x(pp)
+            end do
+            do s = 1, 2
+                d = body(cs, k, s)
+                if (d <= 0) cycle
+                g = directions(cs, k, s)
+                vel(:, d) = vel(:, d) + im(:, d)*matmul(g, dr)
+            end do
+        end subroutine apply_change
+    end subroutine solve
+
+    !> |v_1|^2 + |v_2|^2 of the bodies of contact k (rotations times the mean radius).
+    pure real(wp) function velocity_scale2(cs, k, vel) result(q)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: k
+        real(wp), intent(in) :: vel(:, :)
+        integer :: s, d
+        q = 0.0_wp
+        do s = 1, 2
+            d = body(cs, k, s)
+            if (d > 0) q = q + vel(1, d)**2 + vel(2, d)**2 + (cs%amoy(k)*vel(3, d))**2
+        end do
+    end function velocity_scale2
+
+    !> Relative velocity H^T v + shift of contact k: (u_n, u_t, w_r), as the sweeps see it.
+    pure function relative_velocity(cs, k, vel) result(u)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: k
+        real(wp), intent(in) :: vel(:, :)
+        real(wp) :: u(3)
+        real(wp) :: g(3, 3)
+        integer :: s, d
+        u = [cs%shift(1, k), cs%shift(2, k), 0.0_wp]
+        do s = 1, 2
+            d = body(cs, k, s)
+            if (d <= 0) cycle
+            g = directions(cs, k, s)
+            u = u + matmul(transpose(g), vel(:, d))
+        end do
+    end function relative_velocity
+
+    !> W r for the 3x3 block w = (nn, nt, tt, nm, tm, mm).
+    pure function wmul(w, r) result(v)
+        real(wp), intent(in) :: w(6), r(3)
+        real(wp) :: v(3)
+        v(1) = w(1)*r(1) + w(2)*r(2) + w(4)*r(3)
+        v(2) = w(2)*r(1) + w(3)*r(2) + w(5)*r(3)
+        v(3) = w(4)*r(1) + w(5)*r(2) + w(6)*r(3)
+    end function wmul
+end module dem_bonded_block
