@@ -16,4 +16,5 @@ set(MULTICOR_FEM_SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/mesh2d.f90
     ${CMAKE_CURRENT_LIST_DIR}/mesh_generator.f90
     ${CMAKE_CURRENT_LIST_DIR}/gmsh_reader.f90
-    ${CMAKE_CURRENT_LIST_DIR}/continuum_model.f90)
+    ${CMAKE_CURRENT_LIST_DIR}/continuum_model.f90
+    ${CMAKE_CURRENT_LIST_DIR}/continuum_dynamics.f90)
