@@ -1,6 +1,7 @@
 !> Which kind of run a deck asks for, from its sections: [beam] alone is a finite-element run,
 !> [particles] alone a discrete-element run, both a coupled (Arlequin) run that needs a
-!> [coupling] section; [coupling] without both models is an error.
+!> [coupling] section; [coupling] without both models is an error. [continuum] alone is a 2D
+!> continuum run (not yet coupled to the others).
 module driver_simulations
     use core_error, only: error_t, make_input_error
     use io_deck, only: deck_t
@@ -10,6 +11,7 @@ module driver_simulations
     use driver_simulation_beam, only: beam_simulation_t
     use driver_simulation_dem, only: dem_simulation_t
     use driver_simulation_coupled, only: coupled_simulation_t
+    use driver_simulation_continuum, only: continuum_simulation_t, deck_has_continuum
     implicit none
     private
     public :: select_simulation
@@ -28,6 +30,16 @@ contains
         integer :: k
         particles = deck_has_particles(deck)
         coupled = particles .and. deck_has_beam(deck)
+        if (deck_has_continuum(deck)) then
+            if (particles .or. deck_has_beam(deck) .or. deck_has_coupling(deck)) then
+                call make_input_error(error, deck%file, deck%line('run', 'analysis'), '', &
+                                      'a [continuum] deck cannot have [beam], [particles] or [coupling] yet: '// &
+                                      'run the continuum alone')
+                return
+            end if
+            allocate (continuum_simulation_t :: sim)
+            return
+        end if
         if (coupled .and. .not. deck_has_coupling(deck)) then
             call make_input_error(error, deck%file, deck%line('run', 'analysis'), '', &
                                   'this deck has both [beam] and [particles]: coupled runs need a '// &
