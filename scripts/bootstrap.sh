@@ -3,10 +3,11 @@
 # creates .venv from postproc/requirements.txt; configures and builds with CMake + Ninja.
 
 MULTICOR_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-# slurm-wlm and munge serve only the Slurm sweep tests (they skip without them): a user who
-# is not root and lacks only these gets a note, not an error.
-MULTICOR_APT_OPTIONAL="slurm-wlm munge"
-MULTICOR_APT_PACKAGES="gfortran cmake ninja-build libhdf5-dev hdf5-tools libopenblas-dev liblapack-dev libsuitesparse-dev gmsh python3 python3-venv python3-pip slurm-wlm munge"
+# slurm-wlm and munge serve only the Slurm sweep tests (they skip without them), paraview and
+# python3-paraview only the XDMF test of the continuum (meshio stands in without pvpython): a
+# user who is not root and lacks only these gets a note, not an error.
+MULTICOR_APT_OPTIONAL="slurm-wlm munge paraview python3-paraview"
+MULTICOR_APT_PACKAGES="gfortran cmake ninja-build libhdf5-dev hdf5-tools libopenblas-dev liblapack-dev libsuitesparse-dev gmsh python3 python3-venv python3-pip slurm-wlm munge paraview python3-paraview"
 
 say() { printf '[multicor] %s\n' "$*"; }
 die() { printf '[multicor] error: %s\n' "$*" >&2; exit 1; }

@@ -19,7 +19,7 @@ module driver_config
     use io_deck, only: deck_t, deck_entry_t
     implicit none
     private
-    public :: run_config_t, build_config, find_id, max_steps
+    public :: run_config_t, build_config, find_id, max_steps, build_run_settings
 
     !> Largest number of time steps of a run. The step counter is 64-bit; the bound is that of
     !> the 32-bit step counts stored in the results file (/summary steps, /dem/solver).
@@ -663,7 +663,24 @@ contains
         type(run_config_t), intent(inout) :: run
         !> Error, if any.
         type(error_t), allocatable, intent(out) :: error
-        integer :: n_free
+        call build_run_settings(deck, count(.not. beam%fixed), beam%lumped_mass, 'beam', run, error)
+    end subroutine build_run
+
+    !> Run settings ([run], [time], [modal], [output]) of a model with n_free free DOFs whose
+    !> mass matrix is lumped or not (`section` names where the mass is chosen, for messages).
+    subroutine build_run_settings(deck, n_free, lumped_mass, section, run, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Number of free DOFs of the model.
+        integer, intent(in) :: n_free
+        !> Whether the model's mass matrix is lumped.
+        logical, intent(in) :: lumped_mass
+        !> Section choosing the mass matrix ('beam', 'continuum').
+        character(len=*), intent(in) :: section
+        !> Run configuration.
+        type(run_config_t), intent(inout) :: run
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
         run%title = deck%get_text('run', 'title')
         run%analysis = deck%get_word('run', 'analysis')
         run%scheme = deck%get_word('time', 'scheme')
@@ -679,10 +696,10 @@ contains
             run%gamma = 0.5_wp
         end select
         if (run%analysis == 'dynamic' .and. run%scheme == 'central_difference' .and. &
-            .not. beam%lumped_mass) then
+            .not. lumped_mass) then
             call make_input_error(error, deck%file, deck%line('time', 'scheme'), 'scheme', &
-                                  'the central-difference scheme needs a lumped mass matrix: set [beam] '// &
-                                  'mass = lumped, or use scheme = average_acceleration')
+                                  'the central-difference scheme needs a lumped mass matrix: set ['//section// &
+                                  '] mass = lumped, or use scheme = average_acceleration')
             return
         end if
         run%h = deck%get_real('time', 'step')
@@ -699,7 +716,6 @@ contains
             if (allocated(error)) return
         end if
         run%n_modes = deck%get_int('modal', 'modes')
-        n_free = count(.not. beam%fixed)
         if (run%analysis == 'modal' .and. run%n_modes > n_free) then
             call make_input_error(error, deck%file, deck%line('modal', 'modes'), 'modes', &
                                   to_str(run%n_modes)//' modes asked but the model has only '// &
@@ -734,7 +750,7 @@ contains
             ceiling_real = aint(x)
             if (ceiling_real < x) ceiling_real = ceiling_real + 1.0_wp
         end function ceiling_real
-    end subroutine build_run
+    end subroutine build_run_settings
 
     !> Initial displacements and velocities on free DOFs.
     subroutine build_initial(deck, beam, fix_line, run, error)

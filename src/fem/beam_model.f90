@@ -13,10 +13,11 @@
 module fem_beam_model
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
-    use core_linalg, only: band_spd_t
+    use core_linalg, only: band_spd_t, largest_generalized_eigenvalue
     use core_sort, only: sort_in_place
     use core_timefunc, only: time_function_t
     use core_weight, only: weight_function_t
+    use fem_dynamic_operator, only: dynamic_operator_t, spd_factor_t
     use fem_beam_config, only: beam_config_t, beam_load_t, beam_section_t
     use fem_beam_element, only: element_stiffness, element_mass_consistent, &
                                 element_mass_lumped, to_global, hermite_shape
@@ -38,14 +39,13 @@ module fem_beam_model
                            0.4679139345726910473898703_wp, 0.4679139345726910473898703_wp, &
                            0.3607615730481386075698025_wp, 0.1713244923791703450402961_wp]
 
-    !> A planar Euler-Bernoulli frame ready for static, modal and transient analysis.
-    type :: beam_model_t
+    !> A planar Euler-Bernoulli frame ready for static, modal and transient analysis. From
+    !> `dynamic_operator_t`: n_free, lumped_mass (HRZ, diagonal: `m%kd` = 0), rayleigh_a0/a1.
+    type, extends(dynamic_operator_t) :: beam_model_t
         !> Number of nodes.
         integer :: n_nodes = 0
         !> Number of elements.
         integer :: n_elements = 0
-        !> Number of free DOFs (equations).
-        integer :: n_free = 0
         !> Equation number of each DOF (3, n_nodes), 0 if fixed.
         integer, allocatable :: eq(:, :)
         !> Node ids of the deck (for messages), size n_nodes.
@@ -58,16 +58,10 @@ module fem_beam_model
         real(wp), allocatable :: length(:), cosine(:), sine(:)
         !> Element rigidities E*A [N], E*I [N.m^2] and mass per length rho*A [kg/m].
         real(wp), allocatable :: ea(:), ei(:), rho_a(:)
-        !> Lumped (HRZ, diagonal: `m%kd` = 0) instead of consistent mass.
-        logical :: lumped_mass = .false.
         !> Stiffness matrix on the free DOFs (band).
         type(band_spd_t) :: k
         !> Mass matrix on the free DOFs (band; diagonal when lumped).
         type(band_spd_t) :: m
-        !> Rayleigh damping C = a0 M + a1 K: a0 [1/s], a1 [s].
-        real(wp) :: rayleigh_a0 = 0.0_wp
-        !> See `rayleigh_a0`.
-        real(wp) :: rayleigh_a1 = 0.0_wp
         !> Nodal loads (value times function).
         type(beam_load_t), allocatable :: loads(:)
         !> Time functions referenced by the loads.
@@ -109,7 +103,22 @@ module fem_beam_model
         procedure :: check_supports
         !> Curvilinear abscissa at reduced coordinate xi of an element.
         procedure :: abscissa_at
+        !> Band Cholesky factor of c_m M + c_k K.
+        procedure :: factor_combination
+        !> Diagonal of the (lumped) mass matrix.
+        procedure :: mass_diagonal
+        !> Largest eigenvalue of K phi = omega^2 M phi (band LAPACK).
+        procedure :: largest_eigenvalue
     end type beam_model_t
+
+    !> A band Cholesky factor as a `spd_factor_t`.
+    type, extends(spd_factor_t) :: band_factor_t
+        !> The factored band matrix.
+        type(band_spd_t) :: a
+    contains
+        procedure :: solve_vec => band_factor_solve_vec
+        procedure :: solve_mat => band_factor_solve_mat
+    end type band_factor_t
 
 contains
 
@@ -626,6 +635,67 @@ contains
         call self%m%matvec(v, mv)
         kinetic_energy = 0.5_wp*dot_product(v, mv)
     end function kinetic_energy
+
+    !> Band Cholesky factor of c_m M + c_k K; M alone (c_k = 0) keeps the band of M.
+    subroutine factor_combination(self, c_m, c_k, factor, error)
+        !> The model.
+        class(beam_model_t), intent(in) :: self
+        !> Coefficient of M.
+        real(wp), intent(in) :: c_m
+        !> Coefficient of K.
+        real(wp), intent(in) :: c_k
+        !> The factor.
+        class(spd_factor_t), allocatable, intent(out) :: factor
+        !> Set when the matrix is not positive definite.
+        type(error_t), allocatable, intent(out) :: error
+        type(band_factor_t), allocatable :: f
+        allocate (f)
+        if (c_k == 0 .and. c_m == 1) then
+            f%a = self%m
+        else
+            call f%a%init(self%n_free, self%k%kd)
+            call f%a%add_scaled(self%m, c_m)
+            call f%a%add_scaled(self%k, c_k)
+        end if
+        call f%a%factor(error)
+        call move_alloc(f, factor)
+    end subroutine factor_combination
+
+    !> x <- A^-1 x.
+    subroutine band_factor_solve_vec(self, x, error)
+        class(band_factor_t), intent(in) :: self
+        real(wp), contiguous, intent(inout) :: x(:)
+        type(error_t), allocatable, intent(out) :: error
+        call self%a%solve(x, error)
+    end subroutine band_factor_solve_vec
+
+    !> X <- A^-1 X.
+    subroutine band_factor_solve_mat(self, x, error)
+        class(band_factor_t), intent(in) :: self
+        real(wp), contiguous, intent(inout) :: x(:, :)
+        type(error_t), allocatable, intent(out) :: error
+        call self%a%solve(x, error)
+    end subroutine band_factor_solve_mat
+
+    !> Diagonal of the mass matrix (the whole matrix when lumped).
+    subroutine mass_diagonal(self, d)
+        !> The model.
+        class(beam_model_t), intent(in) :: self
+        !> M(i, i) (n_free).
+        real(wp), intent(out) :: d(:)
+        call self%m%diagonal(d)
+    end subroutine mass_diagonal
+
+    !> Largest eigenvalue of K phi = omega^2 M phi (dsbgvx).
+    subroutine largest_eigenvalue(self, lambda_max, error)
+        !> The model.
+        class(beam_model_t), intent(in) :: self
+        !> omega_max^2 [1/s^2].
+        real(wp), intent(out) :: lambda_max
+        !> Set on eigensolver failure.
+        type(error_t), allocatable, intent(out) :: error
+        call largest_generalized_eigenvalue(self%k, self%m, lambda_max, error)
+    end subroutine largest_eigenvalue
 
     !> Free-DOF vector to nodal array d(3, n_nodes), zeros on fixed DOFs.
     pure subroutine expand(self, u_free, d)

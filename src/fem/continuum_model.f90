@@ -77,6 +77,8 @@ module fem_continuum_model
         procedure :: expand => model_expand
         !> Stress (xx, yy, xy) at every element centre.
         procedure :: centre_stresses => model_centre_stresses
+        !> Whether the prescribed dofs stop the three rigid motions of the plane.
+        procedure :: stops_rigid_motions => model_stops_rigid_motions
     end type continuum_model_t
 
 contains
@@ -482,4 +484,29 @@ contains
             end associate
         end do
     end subroutine model_centre_stresses
+
+    !> Whether the prescribed dofs stop the rigid motions (two translations and the rotation)
+    !> of a connected body: the rows (1, 0, -y) of prescribed x dofs and (0, 1, x) of prescribed
+    !> y dofs (coordinates from the centroid, scaled by the size of the mesh) have rank 3,
+    !> judged by det(G^T G) > 1e-12 (trace/3)^3.
+    pure logical function model_stops_rigid_motions(self) result(stops)
+        !> The model.
+        class(continuum_model_t), intent(in) :: self
+        real(wp) :: g(3, 3), r(3), c(2), extent, det
+        integer :: a, k
+        c = sum(self%mesh%x, dim=2)/self%mesh%node_count()
+        extent = max(maxval(abs(self%mesh%x(1, :) - c(1))), maxval(abs(self%mesh%x(2, :) - c(2))), tiny(1.0_wp))
+        g = 0.0_wp
+        do a = 1, self%mesh%node_count()
+            do k = 1, 2
+                if (.not. self%prescribed(2*a - 2 + k)) cycle
+                if (k == 1) r = [1.0_wp, 0.0_wp, -(self%mesh%x(2, a) - c(2))/extent]
+                if (k == 2) r = [0.0_wp, 1.0_wp, (self%mesh%x(1, a) - c(1))/extent]
+                g = g + spread(r, 2, 3)*spread(r, 1, 3)
+            end do
+        end do
+        det = g(1, 1)*(g(2, 2)*g(3, 3) - g(2, 3)*g(3, 2)) - g(1, 2)*(g(2, 1)*g(3, 3) - g(2, 3)*g(3, 1)) &
+              + g(1, 3)*(g(2, 1)*g(3, 2) - g(2, 2)*g(3, 1))
+        stops = det > 1.0e-12_wp*((g(1, 1) + g(2, 2) + g(3, 3))/3)**3 .and. det > 0
+    end function model_stops_rigid_motions
 end module fem_continuum_model

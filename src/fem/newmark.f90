@@ -1,10 +1,11 @@
-!> Time integrators of M a + C v + K u = F(t) for the frame model (doc/theory.md, sections 5.4-5.5).
+!> Time integrators of M a + C v + K u = F(t) for any `dynamic_operator_t` (the frame model, the 2D
+!> continuum; doc/theory.md, sections 5.4-5.5).
 !>
 !> `time_integrator_t` holds the state (t, u, v, a) and the energy accounts, and defers
 !> `init` and `step` to the schemes:
 !> - `newmark_t`: implicit Newmark (beta, gamma) in acceleration form, default average
 !>   acceleration (1/4, 1/2); the effective matrix M + gamma h C + beta h^2 K is factored
-!>   once in `init` (band Cholesky).
+!>   once in `init` (by the model: band Cholesky for beams, CHOLMOD for the continuum).
 !> - `central_difference_t`: explicit (beta = 0, gamma = 1/2) with lumped mass; refuses a
 !>   step above the critical one.
 !>
@@ -22,8 +23,7 @@
 module fem_newmark
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
-    use core_linalg, only: band_spd_t, largest_generalized_eigenvalue
-    use fem_beam_model, only: beam_model_t
+    use fem_dynamic_operator, only: dynamic_operator_t, spd_factor_t
     implicit none
     private
     public :: time_integrator_t, newmark_t, central_difference_t, critical_time_step, newmark_critical_step
@@ -73,11 +73,11 @@ module fem_newmark
         !> Prepare the integrator: time step h from time t0 with displacements u0 and
         !> velocities v0 (n_free); computes a0 from M a0 = F(t0) - K u0 - C v0.
         subroutine integrator_init(self, model, h, t0, u0, v0, error)
-            import :: time_integrator_t, beam_model_t, wp, error_t
+            import :: time_integrator_t, dynamic_operator_t, wp, error_t
             !> The integrator.
             class(time_integrator_t), intent(inout) :: self
             !> The model.
-            type(beam_model_t), intent(in) :: model
+            class(dynamic_operator_t), intent(in) :: model
             !> Time step [s].
             real(wp), intent(in) :: h
             !> Initial time [s].
@@ -90,11 +90,11 @@ module fem_newmark
 
         !> Advance one time step.
         subroutine integrator_step(self, model, error)
-            import :: time_integrator_t, beam_model_t, error_t
+            import :: time_integrator_t, dynamic_operator_t, error_t
             !> The integrator.
             class(time_integrator_t), intent(inout) :: self
             !> The model (the same as at `init`).
-            type(beam_model_t), intent(in) :: model
+            class(dynamic_operator_t), intent(in) :: model
             !> Set on failure of the linear solve.
             type(error_t), allocatable, intent(out) :: error
         end subroutine integrator_step
@@ -111,7 +111,7 @@ module fem_newmark
         !> Newmark gamma.
         real(wp) :: gamma = 0.5_wp
         !> Factored effective matrix M + gamma h C + beta h^2 K.
-        type(band_spd_t) :: s
+        class(spd_factor_t), allocatable :: s
         !> True between `predict` and `correct`.
         logical :: predicted = .false.
         !> Coupling force of the previous step (n_free), for the coupling work.
@@ -164,7 +164,7 @@ contains
         !> The integrator.
         class(time_integrator_t), intent(inout) :: self
         !> The model.
-        type(beam_model_t), intent(in) :: model
+        class(dynamic_operator_t), intent(in) :: model
         !> Time step and initial time [s].
         real(wp), intent(in) :: h, t0
         !> Initial displacements and velocities (n_free).
@@ -211,7 +211,7 @@ contains
         !> The integrator.
         class(time_integrator_t), intent(inout) :: self
         !> The model.
-        type(beam_model_t), intent(in) :: model
+        class(dynamic_operator_t), intent(in) :: model
         call model%stiffness_times(self%u, self%work)
         self%a = self%f_old - self%work
         if (model%is_damped()) then
@@ -226,7 +226,7 @@ contains
         !> The integrator.
         class(time_integrator_t), intent(inout) :: self
         !> The model.
-        type(beam_model_t), intent(in) :: model
+        class(dynamic_operator_t), intent(in) :: model
         ! work = u_{n+1} - u_n
         self%work = self%u - self%u_old
         self%external_work = self%external_work + &
@@ -251,7 +251,7 @@ contains
         !> The integrator (beta and gamma set beforehand).
         class(newmark_t), intent(inout) :: self
         !> The model.
-        type(beam_model_t), intent(in) :: model
+        class(dynamic_operator_t), intent(in) :: model
         !> Time step [s].
         real(wp), intent(in) :: h
         !> Initial time [s].
@@ -260,7 +260,7 @@ contains
         real(wp), intent(in) :: u0(:), v0(:)
         !> Set on invalid parameters or a failed factorisation.
         type(error_t), allocatable, intent(out) :: error
-        type(band_spd_t) :: mf
+        class(spd_factor_t), allocatable :: mf
         real(wp) :: h_crit
         character(len=320) :: buf
         if (self%gamma < 0.5_wp .or. self%beta < 0.0_wp) then
@@ -286,15 +286,12 @@ contains
         if (allocated(error)) return
         self%predicted = .false.
         self%fc_old = 0*u0
-        mf = model%m
-        call mf%factor(error)
+        call model%factor_combination(1.0_wp, 0.0_wp, mf, error)
         if (allocated(error)) return
         call mf%solve(self%a, error)
         if (allocated(error)) return
-        call self%s%init(model%n_free, model%k%kd)
-        call self%s%add_scaled(model%m, 1.0_wp + self%gamma*h*model%rayleigh_a0)
-        call self%s%add_scaled(model%k, self%gamma*h*model%rayleigh_a1 + self%beta*h**2)
-        call self%s%factor(error)
+        call model%factor_combination(1.0_wp + self%gamma*h*model%rayleigh_a0, &
+                                      self%gamma*h*model%rayleigh_a1 + self%beta*h**2, self%s, error)
         if (allocated(error)) error%message = 'Newmark effective matrix M + gamma h C + '// &
                                               'beta h^2 K: '//error%message
     end subroutine newmark_init
@@ -304,7 +301,7 @@ contains
         !> The integrator.
         class(newmark_t), intent(inout) :: self
         !> The model.
-        type(beam_model_t), intent(in) :: model
+        class(dynamic_operator_t), intent(in) :: model
         !> Set on failure of the solve, or when a prediction awaits its correction.
         type(error_t), allocatable, intent(out) :: error
         if (self%predicted) then
@@ -321,7 +318,7 @@ contains
     !> and energies are not advanced.
     subroutine free_solve(self, model, error)
         class(newmark_t), intent(inout) :: self
-        type(beam_model_t), intent(in) :: model
+        class(dynamic_operator_t), intent(in) :: model
         type(error_t), allocatable, intent(out) :: error
         real(wp) :: h
         h = self%h
@@ -351,7 +348,7 @@ contains
         !> The integrator (initialised).
         class(newmark_t), intent(inout) :: self
         !> The model (the same as at `init`).
-        type(beam_model_t), intent(in) :: model
+        class(dynamic_operator_t), intent(in) :: model
         !> Set when the previous prediction was not corrected, or on failure of the solve.
         type(error_t), allocatable, intent(out) :: error
         if (self%predicted) then
@@ -370,7 +367,7 @@ contains
         !> The integrator, after `predict`.
         class(newmark_t), intent(inout) :: self
         !> The model (the same as at `init`).
-        type(beam_model_t), intent(in) :: model
+        class(dynamic_operator_t), intent(in) :: model
         !> Coupling force at t_{n+1} on the free DOFs (n_free) [N, N.m], e.g. -C^T lambda.
         real(wp), contiguous, intent(in) :: f_coupling(:)
         !> Set without a prediction, on a wrong size or failure of the solve.
@@ -439,13 +436,13 @@ contains
     !> omega_max^2 the largest eigenvalue of K phi = omega^2 M phi.
     real(wp) function critical_time_step(model, error) result(h_crit)
         !> The model.
-        type(beam_model_t), intent(in) :: model
+        class(dynamic_operator_t), intent(in) :: model
         !> Set on eigensolver failure (h_crit is then 0).
         type(error_t), allocatable, intent(out), optional :: error
         type(error_t), allocatable :: err
         real(wp) :: lambda_max
         h_crit = 0.0_wp
-        call largest_generalized_eigenvalue(model%k, model%m, lambda_max, err)
+        call model%largest_eigenvalue(lambda_max, err)
         if (allocated(err)) then
             if (present(error)) call move_alloc(err, error)
             return
@@ -460,7 +457,7 @@ contains
     !> K phi = omega^2 M phi.
     real(wp) function newmark_critical_step(model, beta, gamma, error) result(h_crit)
         !> The model.
-        type(beam_model_t), intent(in) :: model
+        class(dynamic_operator_t), intent(in) :: model
         !> Newmark beta (< gamma/2).
         real(wp), intent(in) :: beta
         !> Newmark gamma (>= 1/2).
@@ -477,7 +474,7 @@ contains
         !> The integrator.
         class(central_difference_t), intent(inout) :: self
         !> The model (lumped mass).
-        type(beam_model_t), intent(in) :: model
+        class(dynamic_operator_t), intent(in) :: model
         !> Time step [s].
         real(wp), intent(in) :: h
         !> Initial time [s].
@@ -486,7 +483,7 @@ contains
         real(wp), intent(in) :: u0(:), v0(:)
         !> Set when the mass is not lumped, h is too large, or on eigensolver failure.
         type(error_t), allocatable, intent(out) :: error
-        if (.not. model%lumped_mass .or. model%m%kd /= 0) then
+        if (.not. model%lumped_mass) then
             call make_error(error, 'the central-difference scheme needs a lumped mass matrix: '// &
                             'ask for lumped mass or use the Newmark scheme')
             return
@@ -496,7 +493,7 @@ contains
         call self%start_state(model, h, t0, u0, v0, error)
         if (allocated(error)) return
         self%inv_mass = self%a
-        call model%m%diagonal(self%inv_mass)
+        call model%mass_diagonal(self%inv_mass)
         self%a = self%a/self%inv_mass
         self%inv_mass = 1.0_wp/(self%inv_mass*(1.0_wp + 0.5_wp*h*model%rayleigh_a0))
     end subroutine central_difference_init
@@ -504,7 +501,7 @@ contains
     !> Store the critical step (reduced by stiffness damping) and refuse h above it.
     subroutine check_critical_step(self, model, h, error)
         class(central_difference_t), intent(inout) :: self
-        type(beam_model_t), intent(in) :: model
+        class(dynamic_operator_t), intent(in) :: model
         real(wp), intent(in) :: h
         type(error_t), allocatable, intent(out) :: error
         real(wp) :: xi
@@ -532,7 +529,7 @@ contains
         !> The integrator.
         class(central_difference_t), intent(inout) :: self
         !> The model.
-        type(beam_model_t), intent(in) :: model
+        class(dynamic_operator_t), intent(in) :: model
         !> Never set (kept for the common interface).
         type(error_t), allocatable, intent(out) :: error
         real(wp) :: h

@@ -2,6 +2,7 @@
 set(MULTICOR_FEM_SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/beam_config.f90
     ${CMAKE_CURRENT_LIST_DIR}/beam_element.f90
+    ${CMAKE_CURRENT_LIST_DIR}/dynamic_operator.f90
     ${CMAKE_CURRENT_LIST_DIR}/beam_model.f90
     ${CMAKE_CURRENT_LIST_DIR}/newmark.f90
     ${CMAKE_CURRENT_LIST_DIR}/modal.f90
@@ -15,4 +16,5 @@ set(MULTICOR_FEM_SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/mesh2d.f90
     ${CMAKE_CURRENT_LIST_DIR}/mesh_generator.f90
     ${CMAKE_CURRENT_LIST_DIR}/gmsh_reader.f90
-    ${CMAKE_CURRENT_LIST_DIR}/continuum_model.f90)
+    ${CMAKE_CURRENT_LIST_DIR}/continuum_model.f90
+    ${CMAKE_CURRENT_LIST_DIR}/continuum_dynamics.f90)

@@ -1,0 +1,364 @@
+!> The /continuum group of a results file (layout in doc/output.md) and the XDMF file next to it.
+!>
+!> /continuum/mesh: coordinates (2, n_nodes), connectivity (4, n_elements; 1-based, 0 beyond
+!> a triangle's 3 nodes), kind (1 = T3, 2 = Q4), topology (the 0-based XDMF connectivity:
+!> (3 or 4, n_elements) for one kind of element, a flat mixed list otherwise);
+!> /continuum/sets/{nodes,elements}/<name> (1-based indices) and /continuum/sets/edges/<name>
+!> (2, n_edges). A static run writes /continuum/static/{displacement (2, n_nodes), stress
+!> (3, n_elements: xx, yy, xy at element centres), strain_energy}; a modal run
+!> /continuum/modal/{omega, frequency, shapes (2, n_nodes, n_modes)}; a dynamic run the
+!> series /continuum/{time, displacement, velocity, stress} and /continuum/energy/{time,
+!> kinetic, strain, external_work, damping, balance} (h5py: one row per stored state).
+!>
+!> The XDMF file (`write_xdmf`) describes the mesh and its fields per stored state (a temporal
+!> collection) by reference into the HDF5 file, so that ParaView or meshio open them.
+module driver_results_continuum
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_error
+    use io_hdf5_file, only: h5_file_t
+    use fem_mesh2d, only: mesh2d_t, element_t3, nodes_per_element
+    implicit none
+    private
+    public :: continuum_writer_t
+
+    !> Writes the continuum's results into an open HDF5 file.
+    type :: continuum_writer_t
+        !> Number of nodes and elements.
+        integer :: n_nodes = 0, n_elements = 0
+        !> Number of stored states (dynamic) so far.
+        integer :: n_out = 0
+        !> Analysis ('static', 'modal', 'dynamic').
+        character(len=:), allocatable :: analysis
+        !> Number of modes (modal).
+        integer :: n_modes = 0
+        !> Stored times (dynamic).
+        real(wp), allocatable :: times(:)
+        !> XDMF topology: 'Triangle', 'Quadrilateral' or 'Mixed'; nodes per element (0: mixed).
+        character(len=:), allocatable :: topology
+        !> Number of values of the topology dataset.
+        integer :: topology_size = 0
+    contains
+        !> Write the mesh and the sets; create the series of the analysis.
+        procedure :: begin => writer_begin
+        !> Static solution.
+        procedure :: write_static => writer_write_static
+        !> Modes.
+        procedure :: write_modal => writer_write_modal
+        !> One stored state of a dynamic run.
+        procedure :: store => writer_store
+        !> One energy record.
+        procedure :: store_energy => writer_store_energy
+        !> Write the XDMF description of what was stored.
+        procedure :: write_xdmf => writer_write_xdmf
+    end type continuum_writer_t
+
+contains
+
+    !> Mesh, sets and the series of a dynamic run.
+    subroutine writer_begin(self, file, mesh, analysis, error)
+        !> The writer.
+        class(continuum_writer_t), intent(inout) :: self
+        !> The open results file.
+        type(h5_file_t), intent(inout) :: file
+        !> The mesh.
+        type(mesh2d_t), intent(in) :: mesh
+        !> 'static', 'modal' or 'dynamic'.
+        character(len=*), intent(in) :: analysis
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: topo(:), topo2(:, :)
+        integer :: e, k, n
+        self%n_nodes = mesh%node_count()
+        self%n_elements = mesh%element_count()
+        self%analysis = analysis
+        self%n_out = 0
+        allocate (self%times(0))
+        call file%create_group('/continuum', error)
+        if (allocated(error)) return
+        call file%create_group('/continuum/mesh', error)
+        if (allocated(error)) return
+        call file%write_dataset('/continuum/mesh/coordinates', mesh%x, error)
+        if (allocated(error)) return
+        call file%write_attribute('/continuum/mesh/coordinates', 'units', 'm', error)
+        if (allocated(error)) return
+        call file%write_dataset('/continuum/mesh/connectivity', mesh%connectivity, error)
+        if (allocated(error)) return
+        call file%write_dataset('/continuum/mesh/kind', mesh%kind, error)
+        if (allocated(error)) return
+        if (all(mesh%kind == mesh%kind(1))) then
+            n = nodes_per_element(mesh%kind(1))
+            self%topology = merge('Triangle     ', 'Quadrilateral', mesh%kind(1) == element_t3)
+            self%topology = trim(self%topology)
+            topo2 = mesh%connectivity(1:n, :) - 1
+            self%topology_size = size(topo2)
+            call file%write_dataset('/continuum/mesh/topology', topo2, error)
+        else
+            ! XDMF mixed topology: type code (4 triangle, 5 quadrilateral), then the nodes.
+            self%topology = 'Mixed'
+            allocate (topo(0))
+            do e = 1, self%n_elements
+                n = nodes_per_element(mesh%kind(e))
+                topo = [topo, merge(4, 5, mesh%kind(e) == element_t3), mesh%connectivity(1:n, e) - 1]
+            end do
+            self%topology_size = size(topo)
+            call file%write_dataset('/continuum/mesh/topology', topo, error)
+        end if
+        if (allocated(error)) return
+        call file%create_group('/continuum/sets', error)
+        if (.not. allocated(error)) call file%create_group('/continuum/sets/nodes', error)
+        if (.not. allocated(error)) call file%create_group('/continuum/sets/elements', error)
+        if (.not. allocated(error)) call file%create_group('/continuum/sets/edges', error)
+        if (allocated(error)) return
+        do k = 1, size(mesh%node_sets)
+            call file%write_dataset('/continuum/sets/nodes/'//mesh%node_sets(k)%name, mesh%node_sets(k)%ids, error)
+            if (allocated(error)) return
+        end do
+        do k = 1, size(mesh%element_sets)
+            call file%write_dataset('/continuum/sets/elements/'//mesh%element_sets(k)%name, &
+                                    mesh%element_sets(k)%ids, error)
+            if (allocated(error)) return
+        end do
+        do k = 1, size(mesh%edge_sets)
+            call file%write_dataset('/continuum/sets/edges/'//mesh%edge_sets(k)%name, mesh%edge_sets(k)%nodes, error)
+            if (allocated(error)) return
+        end do
+        if (analysis /= 'dynamic') return
+        call series('/continuum/time', [integer ::], 's', error)
+        if (.not. allocated(error)) call series('/continuum/displacement', [2, self%n_nodes], 'm', error)
+        if (.not. allocated(error)) call series('/continuum/velocity', [2, self%n_nodes], 'm/s', error)
+        if (.not. allocated(error)) call series('/continuum/stress', [3, self%n_elements], 'Pa', error)
+        if (.not. allocated(error)) call file%create_group('/continuum/energy', error)
+        if (.not. allocated(error)) call series('/continuum/energy/time', [integer ::], 's', error)
+        if (.not. allocated(error)) call series('/continuum/energy/kinetic', [integer ::], 'J', error)
+        if (.not. allocated(error)) call series('/continuum/energy/strain', [integer ::], 'J', error)
+        if (.not. allocated(error)) call series('/continuum/energy/external_work', [integer ::], 'J', error)
+        if (.not. allocated(error)) call series('/continuum/energy/damping', [integer ::], 'J', error)
+        if (.not. allocated(error)) call series('/continuum/energy/balance', [integer ::], 'J', error)
+    contains
+        subroutine series(path, record_shape, units, error)
+            character(len=*), intent(in) :: path, units
+            integer, intent(in) :: record_shape(:)
+            type(error_t), allocatable, intent(out) :: error
+            call file%create_series(path, record_shape, error)
+            if (allocated(error)) return
+            call file%write_attribute(path, 'units', units, error)
+        end subroutine series
+    end subroutine writer_begin
+
+    !> Static displacements (2, n_nodes), centre stresses (3, n_elements) and strain energy.
+    subroutine writer_write_static(self, file, d, stress, strain_energy, error)
+        !> The writer.
+        class(continuum_writer_t), intent(inout) :: self
+        !> The open results file.
+        type(h5_file_t), intent(inout) :: file
+        !> Displacements [m].
+        real(wp), intent(in) :: d(:, :)
+        !> Stresses [Pa].
+        real(wp), intent(in) :: stress(:, :)
+        !> Strain energy [J].
+        real(wp), intent(in) :: strain_energy
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call check_shapes(self, d, stress, error)
+        if (allocated(error)) return
+        call file%create_group('/continuum/static', error)
+        if (.not. allocated(error)) call file%write_dataset('/continuum/static/displacement', d, error)
+        if (.not. allocated(error)) call file%write_dataset('/continuum/static/stress', stress, error)
+        if (.not. allocated(error)) call file%write_attribute('/continuum/static', 'strain_energy', strain_energy, error)
+        if (allocated(error)) return
+        self%times = [0.0_wp]
+    end subroutine writer_write_static
+
+    !> Circular frequencies, frequencies and mode shapes (2, n_nodes, n_modes).
+    subroutine writer_write_modal(self, file, omega, shapes, error)
+        !> The writer.
+        class(continuum_writer_t), intent(inout) :: self
+        !> The open results file.
+        type(h5_file_t), intent(inout) :: file
+        !> Circular frequencies [rad/s].
+        real(wp), intent(in) :: omega(:)
+        !> Mode shapes (2, n_nodes, n_modes), mass-normalised.
+        real(wp), intent(in) :: shapes(:, :, :)
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), parameter :: two_pi = 6.283185307179586476925286766559_wp
+        call file%create_group('/continuum/modal', error)
+        if (.not. allocated(error)) call file%write_dataset('/continuum/modal/omega', omega, error)
+        if (.not. allocated(error)) call file%write_dataset('/continuum/modal/frequency', omega/two_pi, error)
+        if (.not. allocated(error)) call file%write_dataset('/continuum/modal/shapes', shapes, error)
+        self%n_modes = size(omega)
+    end subroutine writer_write_modal
+
+    !> Append one state: time, displacements, velocities (2, n_nodes), stresses (3, n_elements).
+    subroutine writer_store(self, file, t, d, v, stress, error)
+        !> The writer.
+        class(continuum_writer_t), intent(inout) :: self
+        !> The open results file.
+        type(h5_file_t), intent(inout) :: file
+        !> Time [s].
+        real(wp), intent(in) :: t
+        !> Displacements and velocities.
+        real(wp), intent(in) :: d(:, :), v(:, :)
+        !> Stresses.
+        real(wp), intent(in) :: stress(:, :)
+        !> Set on a size mismatch or a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call check_shapes(self, d, stress, error)
+        if (allocated(error)) return
+        call file%append('/continuum/time', t, error)
+        if (.not. allocated(error)) call file%append('/continuum/displacement', d, error)
+        if (.not. allocated(error)) call file%append('/continuum/velocity', v, error)
+        if (.not. allocated(error)) call file%append('/continuum/stress', stress, error)
+        if (allocated(error)) return
+        self%n_out = self%n_out + 1
+        self%times = [self%times, t]
+    end subroutine writer_store
+
+    !> Append one energy record [J]; balance = kinetic + strain + damping - external work - initial.
+    subroutine writer_store_energy(self, file, t, kinetic, strain, external_work, damping, balance, error)
+        !> The writer.
+        class(continuum_writer_t), intent(inout) :: self
+        !> The open results file.
+        type(h5_file_t), intent(inout) :: file
+        !> Time [s].
+        real(wp), intent(in) :: t
+        !> Energies [J].
+        real(wp), intent(in) :: kinetic, strain, external_work, damping, balance
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        if (self%n_nodes == 0) then
+            call make_error(error, 'results: continuum energy before begin')
+            return
+        end if
+        call file%append('/continuum/energy/time', t, error)
+        if (.not. allocated(error)) call file%append('/continuum/energy/kinetic', kinetic, error)
+        if (.not. allocated(error)) call file%append('/continuum/energy/strain', strain, error)
+        if (.not. allocated(error)) call file%append('/continuum/energy/external_work', external_work, error)
+        if (.not. allocated(error)) call file%append('/continuum/energy/damping', damping, error)
+        if (.not. allocated(error)) call file%append('/continuum/energy/balance', balance, error)
+    end subroutine writer_store_energy
+
+    !> Error unless d is (2, n_nodes) and stress (3, n_elements).
+    subroutine check_shapes(self, d, stress, error)
+        type(continuum_writer_t), intent(in) :: self
+        real(wp), intent(in) :: d(:, :), stress(:, :)
+        type(error_t), allocatable, intent(out) :: error
+        if (size(d, 1) /= 2 .or. size(d, 2) /= self%n_nodes .or. size(stress, 1) /= 3 .or. &
+            size(stress, 2) /= self%n_elements) &
+            call make_error(error, 'results: continuum fields do not match the mesh (begin first)')
+    end subroutine check_shapes
+
+    !> Write `path` (XDMF 3): the mesh with, per stored state, displacement and velocity at the
+    !> nodes and stress at the elements (static: one state; modal: one grid per mode shape).
+    subroutine writer_write_xdmf(self, path, h5_name, error)
+        !> The writer (after the run).
+        class(continuum_writer_t), intent(in) :: self
+        !> XDMF file to write.
+        character(len=*), intent(in) :: path
+        !> Name of the HDF5 file as seen from the XDMF file's folder.
+        character(len=*), intent(in) :: h5_name
+        !> Set when the file cannot be written.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: unit, ios, k
+        character(len=64) :: buf
+        open (newunit=unit, file=path, status='replace', action='write', iostat=ios)
+        if (ios /= 0) then
+            call make_error(error, "results: cannot write the XDMF file '"//path//"'")
+            return
+        end if
+        write (unit, '(a)') '<?xml version="1.0" ?>'
+        write (unit, '(a)') '<Xdmf Version="2.0">'
+        write (unit, '(a)') ' <Domain>'
+        select case (self%analysis)
+        case ('dynamic')
+            write (unit, '(a)') '  <Grid Name="continuum" GridType="Collection" CollectionType="Temporal">'
+            do k = 1, self%n_out
+                write (buf, '(es24.16e3)') self%times(k)
+                call grid('state '//itoa(k - 1), trim(adjustl(buf)), k)
+            end do
+            write (unit, '(a)') '  </Grid>'
+        case ('static')
+            call grid('static', '0', 0)
+        case ('modal')
+            write (unit, '(a)') '  <Grid Name="modes" GridType="Collection" CollectionType="Temporal">'
+            do k = 1, self%n_modes
+                call grid('mode '//itoa(k), itoa(k), k)
+            end do
+            write (unit, '(a)') '  </Grid>'
+        end select
+        write (unit, '(a)') ' </Domain>'
+        write (unit, '(a)') '</Xdmf>'
+        close (unit, iostat=ios)
+        if (ios /= 0) call make_error(error, "results: cannot write the XDMF file '"//path//"'")
+    contains
+        !> One uniform grid: the mesh and the fields of record k.
+        subroutine grid(name, time, k)
+            character(len=*), intent(in) :: name, time
+            integer, intent(in) :: k
+            character(len=:), allocatable :: nn, ne
+            nn = itoa(self%n_nodes)
+            ne = itoa(self%n_elements)
+            write (unit, '(a)') '   <Grid Name="'//name//'" GridType="Uniform">'
+            if (self%analysis /= 'static') write (unit, '(a)') '    <Time Value="'//time//'"/>'
+            if (self%topology == 'Mixed') then
+                write (unit, '(a)') '    <Topology TopologyType="Mixed" NumberOfElements="'//ne//'">'
+                write (unit, '(a)') '     <DataItem Dimensions="'//itoa(self%topology_size)// &
+                    '" NumberType="Int" Format="HDF">'//h5_name//':/continuum/mesh/topology</DataItem>'
+            else
+                write (unit, '(a)') '    <Topology TopologyType="'//self%topology//'" NumberOfElements="'//ne//'">'
+                write (unit, '(a)') '     <DataItem Dimensions="'//ne//' '//itoa(self%topology_size/self%n_elements)// &
+                    '" NumberType="Int" Format="HDF">'//h5_name//':/continuum/mesh/topology</DataItem>'
+            end if
+            write (unit, '(a)') '    </Topology>'
+            write (unit, '(a)') '    <Geometry GeometryType="XY">'
+            write (unit, '(a)') '     <DataItem Dimensions="'//nn//' 2" NumberType="Float" Precision="8" '// &
+                'Format="HDF">'//h5_name//':/continuum/mesh/coordinates</DataItem>'
+            write (unit, '(a)') '    </Geometry>'
+            select case (self%analysis)
+            case ('static')
+                call whole('displacement', 'Node', nn//' 2', '/continuum/static/displacement')
+                call whole('stress', 'Cell', ne//' 3', '/continuum/static/stress')
+            case ('modal')
+                call slab('mode_shape', 'Node', k, itoa(self%n_modes), nn, '2', '/continuum/modal/shapes')
+            case ('dynamic')
+                call slab('displacement', 'Node', k, itoa(self%n_out), nn, '2', '/continuum/displacement')
+                call slab('velocity', 'Node', k, itoa(self%n_out), nn, '2', '/continuum/velocity')
+                call slab('stress', 'Cell', k, itoa(self%n_out), ne, '3', '/continuum/stress')
+            end select
+            write (unit, '(a)') '   </Grid>'
+        end subroutine grid
+
+        !> An attribute that is a whole dataset.
+        subroutine whole(name, centre, dims, dataset)
+            character(len=*), intent(in) :: name, centre, dims, dataset
+            write (unit, '(a)') '    <Attribute Name="'//name//'" AttributeType="Vector" Center="'//centre//'">'
+            write (unit, '(a)') '     <DataItem Dimensions="'//dims//'" NumberType="Float" Precision="8" '// &
+                'Format="HDF">'//h5_name//':'//dataset//'</DataItem>'
+            write (unit, '(a)') '    </Attribute>'
+        end subroutine whole
+
+        !> An attribute that is record k of a (records, n, m) dataset.
+        subroutine slab(name, centre, k, records, n, m, dataset)
+            character(len=*), intent(in) :: name, centre, records, n, m, dataset
+            integer, intent(in) :: k
+            write (unit, '(a)') '    <Attribute Name="'//name//'" AttributeType="Vector" Center="'//centre//'">'
+            write (unit, '(a)') '     <DataItem ItemType="HyperSlab" Dimensions="1 '//n//' '//m// &
+                '" Type="HyperSlab" NumberType="Float" Precision="8">'
+            write (unit, '(a)') '      <DataItem Dimensions="3 3" Format="XML">'//itoa(k - 1)//' 0 0 1 1 1 1 '// &
+                n//' '//m//'</DataItem>'
+            write (unit, '(a)') '      <DataItem Dimensions="'//records//' '//n//' '//m//'" NumberType="Float" '// &
+                'Precision="8" Format="HDF">'//h5_name//':'//dataset//'</DataItem>'
+            write (unit, '(a)') '     </DataItem>'
+            write (unit, '(a)') '    </Attribute>'
+        end subroutine slab
+    end subroutine writer_write_xdmf
+
+    !> Integer as text.
+    pure function itoa(i) result(text)
+        integer, intent(in) :: i
+        character(len=:), allocatable :: text
+        character(len=16) :: buf
+        write (buf, '(i0)') i
+        text = trim(buf)
+    end function itoa
+end module driver_results_continuum

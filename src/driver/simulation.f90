@@ -1,0 +1,75 @@
+!> One kind of run (beam, particles, coupled, continuum) as an extension of one abstract type.
+!>
+!> `driver_run` reads the deck, lets `driver_simulations` pick the extension from the deck's
+!> sections, then calls, in order: `init` (build the configuration and the model from the
+!> deck; everything that can fail because of the input fails here, before the results folder
+!> is touched), `describe` (the line of a `--check` run), and `run` (static solve, modes or
+!> time steps, writing every output into the open results file). Adding a kind of model adds
+!> an extension in its own file and one line in `driver_simulations`.
+module driver_simulation
+    use core_error, only: error_t
+    use io_deck, only: deck_t
+    use driver_results, only: results_writer_t
+    implicit none
+    private
+    public :: simulation_t, report_iface
+
+    abstract interface
+        !> Receives one line of progress or summary text.
+        subroutine report_iface(line)
+            !> The line.
+            character(len=*), intent(in) :: line
+        end subroutine report_iface
+    end interface
+
+    !> A run of one kind of model.
+    type, abstract :: simulation_t
+    contains
+        !> Build the configuration and the model from the deck; check everything that depends
+        !> on the input.
+        procedure(simulation_init), deferred :: init
+        !> What a `--check` run says about the valid deck.
+        procedure(simulation_describe), deferred :: describe
+        !> Run the analysis and write its results.
+        procedure(simulation_run), deferred :: run
+    end type simulation_t
+
+    abstract interface
+        !> Build the model from the deck (errors name file, line and keyword).
+        subroutine simulation_init(self, deck, report, error)
+            import :: simulation_t, deck_t, error_t, report_iface
+            !> The simulation.
+            class(simulation_t), intent(inout) :: self
+            !> The validated deck.
+            type(deck_t), intent(in) :: deck
+            !> Where warnings go.
+            procedure(report_iface) :: report
+            !> Set on any input error.
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine simulation_init
+
+        !> Summary of the valid deck, e.g. 'dynamic analysis, 40 disks, 2 walls'.
+        function simulation_describe(self) result(text)
+            import :: simulation_t
+            !> The simulation (after `init`).
+            class(simulation_t), intent(in) :: self
+            !> Text after 'deck is valid ('.
+            character(len=:), allocatable :: text
+        end function simulation_describe
+
+        !> Run the analysis; results into `out` (open).
+        subroutine simulation_run(self, out, quiet, report, error)
+            import :: simulation_t, results_writer_t, error_t, report_iface
+            !> The simulation (after `init`).
+            class(simulation_t), intent(inout) :: self
+            !> The results file.
+            type(results_writer_t), intent(inout) :: out
+            !> No progress lines.
+            logical, intent(in) :: quiet
+            !> Where progress and summary lines go.
+            procedure(report_iface) :: report
+            !> Set on a run or write failure (without the deck file name).
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine simulation_run
+    end interface
+end module driver_simulation

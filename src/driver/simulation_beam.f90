@@ -1,0 +1,259 @@
+!> Beam (finite-element frame) runs: static, modal or dynamic analysis of a [beam] deck
+!> without [particles].
+module driver_simulation_beam
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use core_kinds, only: wp, i8
+    use core_error, only: error_t, make_error, make_input_error
+    use core_signals, only: caught_signal, signal_name
+    use io_deck, only: deck_t
+    use io_progress, only: progress_t
+    use fem_beam_config, only: beam_config_t
+    use fem_beam_model, only: beam_model_t, build_beam_model
+    use fem_static, only: solve_static
+    use fem_modal, only: solve_modal
+    use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
+    use driver_config, only: run_config_t, build_config
+    use driver_config_dem, only: check_particle_keywords_unused
+    use driver_results, only: results_writer_t
+    use driver_guards, only: check_beam_state
+    use driver_simulation, only: simulation_t, report_iface
+    implicit none
+    private
+    public :: beam_simulation_t
+
+    !> A planar frame run.
+    type, extends(simulation_t) :: beam_simulation_t
+        !> Run settings.
+        type(run_config_t) :: settings
+        !> Frame description from the deck.
+        type(beam_config_t) :: beam
+        !> Assembled model.
+        type(beam_model_t) :: model
+        !> Time integrator (dynamic analysis).
+        class(time_integrator_t), allocatable :: integ
+    contains
+        !> See `simulation_t%init`.
+        procedure :: init => beam_init
+        !> See `simulation_t%describe`.
+        procedure :: describe => beam_describe
+        !> See `simulation_t%run`.
+        procedure :: run => beam_run
+    end type beam_simulation_t
+
+contains
+
+    !> Configuration, model and integrator; everything that can fail because of the input.
+    subroutine beam_init(self, deck, report, error)
+        !> The simulation.
+        class(beam_simulation_t), intent(inout) :: self
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        !> Where warnings go (none for beams).
+        procedure(report_iface) :: report
+        !> Set on any input error.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: message
+        call check_particle_keywords_unused(deck, error)
+        if (allocated(error)) return
+        call build_config(deck, self%settings, self%beam, error)
+        if (allocated(error)) return
+        call build_beam_model(self%beam, self%model, error)
+        ! A static solve needs supports that stop every rigid-body motion.
+        if (.not. allocated(error) .and. self%settings%analysis == 'static') &
+            call self%model%check_supports(error)
+        if (allocated(error)) then
+            error%message = deck%file//': '//error%message
+            return
+        end if
+        if (self%settings%analysis == 'dynamic') then
+            call make_integrator(self%settings, self%model, self%integ, error)
+            if (allocated(error)) then
+                ! The integrator only refuses a time step (stability limit).
+                message = error%message
+                call make_input_error(error, deck%file, deck%line('time', 'step'), 'step', &
+                                      message)
+            end if
+        end if
+    end subroutine beam_init
+
+    !> 'static analysis'.
+    function beam_describe(self) result(text)
+        !> The simulation.
+        class(beam_simulation_t), intent(in) :: self
+        !> Summary.
+        character(len=:), allocatable :: text
+        text = self%settings%analysis//' analysis'
+    end function beam_describe
+
+    !> The finite-element analysis, results into `out`.
+    subroutine beam_run(self, out, quiet, report, error)
+        !> The simulation.
+        class(beam_simulation_t), intent(inout) :: self
+        !> The results file.
+        type(results_writer_t), intent(inout) :: out
+        !> No progress lines.
+        logical, intent(in) :: quiet
+        !> Where progress and summary lines go.
+        procedure(report_iface) :: report
+        !> Set on a run or write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call out%write_mesh(self%beam%node_id, self%beam%x, self%beam%y, self%beam%conn, error)
+        if (allocated(error)) return
+        select case (self%settings%analysis)
+        case ('static')
+            call run_static(self%model, out, report, error)
+        case ('modal')
+            call run_modal(self%settings, self%model, out, report, error)
+        case ('dynamic')
+            call run_dynamic(self%settings, self%model, self%beam%node_id, self%integ, out, quiet, report, error)
+        end select
+    end subroutine beam_run
+
+    !> Build the time integrator the deck asks for (refuses an unstable explicit step).
+    subroutine make_integrator(run, model, integ, error)
+        type(run_config_t), intent(in) :: run
+        type(beam_model_t), intent(in) :: model
+        class(time_integrator_t), allocatable, intent(out) :: integ
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: u0(:), v0(:)
+        select case (run%scheme)
+        case ('central_difference')
+            allocate (central_difference_t :: integ)
+        case default
+            allocate (newmark_t :: integ)
+            select type (integ)
+            type is (newmark_t)
+                integ%beta = run%beta
+                integ%gamma = run%gamma
+            end select
+        end select
+        call model%restrict(run%u0, u0)
+        call model%restrict(run%v0, v0)
+        call integ%init(model, run%h, 0.0_wp, u0, v0, error)
+    end subroutine make_integrator
+
+    subroutine run_static(model, out, report, error)
+        type(beam_model_t), intent(in) :: model
+        type(results_writer_t), intent(inout) :: out
+        procedure(report_iface) :: report
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: u(:), d(:, :), r(:, :)
+        character(len=120) :: buf
+        call solve_static(model, 0.0_wp, u, error)
+        if (allocated(error)) return
+        allocate (d(3, model%n_nodes), r(3, model%n_nodes))
+        call model%expand(u, d)
+        call model%reactions(u, 0.0_wp, r)
+        if (.not. (all(ieee_is_finite(d)) .and. all(ieee_is_finite(r)))) then
+            call make_error(error, 'static solution: a displacement or a reaction is not finite; '// &
+                            'likely cause: a load or a stiffness far too large or too small (check the '// &
+                            'magnitudes in [beam])')
+            return
+        end if
+        call out%write_static(d, r, error)
+        if (allocated(error)) return
+        write (buf, '(a,es13.5e3,a)') 'static solution: max |displacement| = ', &
+            maxval(abs(d(1:2, :))), ' m'
+        call report(trim(buf))
+    end subroutine run_static
+
+    subroutine run_modal(run, model, out, report, error)
+        type(run_config_t), intent(in) :: run
+        type(beam_model_t), intent(in) :: model
+        type(results_writer_t), intent(inout) :: out
+        procedure(report_iface) :: report
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: omega(:), shapes(:, :), full(:, :, :)
+        real(wp), parameter :: two_pi = 6.283185307179586476925286766559_wp
+        character(len=120) :: buf
+        integer :: k
+        call solve_modal(model, run%n_modes, omega, shapes, error)
+        if (allocated(error)) return
+        if (.not. (all(ieee_is_finite(omega)) .and. all(ieee_is_finite(shapes)))) then
+            call make_error(error, 'modal analysis: a frequency or a mode shape is not finite; '// &
+                            'likely cause: a stiffness, density or section far too large or too small '// &
+                            '(check the magnitudes in [beam])')
+            return
+        end if
+        allocate (full(3, model%n_nodes, run%n_modes))
+        do k = 1, run%n_modes
+            call model%expand(shapes(:, k), full(:, :, k))
+            write (buf, '(a,i3,a,es15.7e3,a,es15.7e3,a)') 'mode ', k, ': omega = ', omega(k), &
+                ' rad/s, f = ', omega(k)/two_pi, ' Hz'
+            call report(trim(buf))
+        end do
+        call out%write_modal(omega, full, error)
+    end subroutine run_modal
+
+    subroutine run_dynamic(run, model, node_id, integ, out, quiet, report, error)
+        type(run_config_t), intent(in) :: run
+        type(beam_model_t), intent(in) :: model
+        integer, intent(in) :: node_id(:)
+        class(time_integrator_t), intent(inout) :: integ
+        type(results_writer_t), intent(inout) :: out
+        logical, intent(in) :: quiet
+        procedure(report_iface) :: report
+        type(error_t), allocatable, intent(out) :: error
+        type(progress_t) :: progress
+        real(wp), allocatable :: d(:, :), v(:, :), a(:, :)
+        integer(i8) :: n_steps, k
+        character(len=160) :: buf
+
+        n_steps = run%n_steps
+        allocate (d(3, model%n_nodes), v(3, model%n_nodes), a(3, model%n_nodes))
+        call progress%start(n_steps, run%t_end, run%progress_seconds)
+        call check(0_i8, error)
+        if (allocated(error)) return
+        call store(error)
+        if (allocated(error)) return
+        do k = 1, n_steps
+            call integ%step(model, error)
+            if (allocated(error)) return
+            call check(k, error)
+            if (allocated(error)) return
+            if (mod(k, int(run%output_interval, i8)) == 0 .or. k == n_steps) then
+                call store(error)
+                if (allocated(error)) return
+            end if
+            if (k < n_steps .and. caught_signal() /= 0) then
+                ! Stop request: the step just done is the last output.
+                if (mod(k, int(run%output_interval, i8)) /= 0) call store(error)
+                if (allocated(error)) return
+                call out%stop_at(signal_name(caught_signal()), k, integ%t)
+                n_steps = k
+                exit
+            end if
+            if (.not. quiet .and. progress%due()) call report(progress%line(k, integ%t))
+        end do
+        write (buf, '(a,i0,a,es13.5e3,a,es11.3e3)') 'dynamic run: ', n_steps, ' steps to t = ', &
+            integ%t, ' s; energy balance residual ', integ%energy_balance()
+        call report(trim(buf))
+        call report(progress%summary_line(n_steps))
+        ! n_steps <= max_steps = huge(0) (driver_config)
+        call out%write_summary(int(n_steps), progress%elapsed(), error)
+    contains
+        !> Guard after step k (0: the initial state).
+        subroutine check(k, error)
+            integer(i8), intent(in) :: k
+            type(error_t), allocatable, intent(out) :: error
+            call model%expand(integ%u, d)
+            call model%expand(integ%v, v)
+            call model%expand(integ%a, a)
+            call check_beam_state(k, integ%t, node_id, d, v, a, [integ%kinetic, integ%strain, &
+                                                                 integ%external_work, integ%damping_dissipation], error)
+        end subroutine check
+
+        subroutine store(error)
+            type(error_t), allocatable, intent(out) :: error
+            call model%expand(integ%u, d)
+            call model%expand(integ%v, v)
+            call model%expand(integ%a, a)
+            call out%append_state(integ%t, d, v, a, error)
+            if (allocated(error)) return
+            call out%append_energy(integ%t, integ%kinetic, integ%strain, integ%external_work, &
+                                   integ%damping_dissipation, error)
+            if (allocated(error)) return
+            call out%flush(error)
+        end subroutine store
+    end subroutine run_dynamic
+end module driver_simulation_beam

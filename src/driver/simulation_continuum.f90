@@ -1,0 +1,531 @@
+!> 2D continuum runs: a [continuum] deck (no [beam], no [particles]); static, modal or dynamic.
+!>
+!> The mesh comes from the rectangle generator or a Gmsh file; the deck's named sets are the
+!> mesh's (a Gmsh mesh gets the sets 'all' of its nodes and elements as well). Static: K_ff
+!> u_f = f_f - K_fp u_p by CHOLMOD. Modal: band LAPACK (dsbgvx) on the reduced K and M. Dynamic:
+!> the integrators of fem_newmark on the continuum as a `dynamic_operator_t`.
+module driver_simulation_continuum
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use core_kinds, only: wp, i8
+    use core_error, only: error_t, make_error, make_input_error
+    use core_strings, only: to_str
+    use core_signals, only: caught_signal, signal_name
+    use io_deck, only: deck_t, deck_entry_t
+    use io_paths, only: basename, stem
+    use io_progress, only: progress_t
+    use fem_mesh2d, only: mesh2d_t
+    use fem_mesh_generator, only: rectangle_mesh
+    use fem_gmsh_reader, only: read_gmsh
+    use fem_elastic2d, only: elastic2d_t, make_elastic2d
+    use fem_continuum_model, only: continuum_model_t
+    use fem_continuum_dynamics, only: continuum_dynamics_t
+    use fem_dynamic_operator, only: spd_factor_t
+    use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
+    use driver_config, only: run_config_t, build_run_settings
+    use driver_config_dem, only: check_particle_keywords_unused
+    use driver_results, only: results_writer_t
+    use driver_results_continuum, only: continuum_writer_t
+    use driver_simulation, only: simulation_t, report_iface
+    implicit none
+    private
+    public :: continuum_simulation_t, deck_has_continuum
+
+    !> A 2D continuum run.
+    type, extends(simulation_t) :: continuum_simulation_t
+        !> Run settings.
+        type(run_config_t) :: settings
+        !> The continuum (mesh, materials, loads, prescribed dofs).
+        type(continuum_model_t) :: model
+        !> K, M and loads on the free dofs.
+        type(continuum_dynamics_t) :: ops
+        !> Time integrator (dynamic).
+        class(time_integrator_t), allocatable :: integ
+        !> Factor of K_ff (static).
+        class(spd_factor_t), allocatable :: k_factor
+        !> Deck file (for the XDMF file's name).
+        character(len=:), allocatable :: deck_file
+    contains
+        !> See `simulation_t%init`.
+        procedure :: init => continuum_init
+        !> See `simulation_t%describe`.
+        procedure :: describe => continuum_describe
+        !> See `simulation_t%run`.
+        procedure :: run => continuum_run
+    end type continuum_simulation_t
+
+contains
+
+    !> Whether the deck has [continuum] entries.
+    pure logical function deck_has_continuum(deck)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        integer :: i
+        deck_has_continuum = .false.
+        do i = 1, size(deck%entries)
+            if (deck%entries(i)%section == 'continuum' .and. deck%entries(i)%line > 0) deck_has_continuum = .true.
+        end do
+    end function deck_has_continuum
+
+    !> Mesh, model, boundary conditions, loads, run settings and integrator from the deck.
+    subroutine continuum_init(self, deck, report, error)
+        !> The simulation.
+        class(continuum_simulation_t), intent(inout) :: self
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        !> Where warnings go.
+        procedure(report_iface) :: report
+        !> Set on any input error.
+        type(error_t), allocatable, intent(out) :: error
+        type(mesh2d_t) :: mesh
+        type(deck_entry_t) :: e
+        type(deck_entry_t), allocatable :: list(:)
+        character(len=:), allocatable :: message
+        logical :: lumped
+        integer :: k, line
+        self%deck_file = deck%file
+        call check_particle_keywords_unused(deck, error)
+        if (allocated(error)) return
+        do k = 1, size(deck%entries)
+            if (deck%entries(k)%section == 'initial' .and. deck%entries(k)%line > 0) then
+                call make_input_error(error, deck%file, deck%entries(k)%line, deck%entries(k)%keyword, &
+                                      '[initial] sets beam dofs; the continuum takes [continuum] initial_velocity')
+                return
+            end if
+        end do
+        call build_mesh(error)
+        if (allocated(error)) return
+        call self%model%init(mesh, error)
+        if (allocated(error)) call fail_at(error, deck%line('continuum', 'mesh'), 'mesh')
+        if (allocated(error)) return
+        call set_materials(error)
+        if (allocated(error)) return
+        call set_constraints(error)
+        if (allocated(error)) return
+        call set_loads(error)
+        if (allocated(error)) return
+        lumped = deck%get_word('continuum', 'mass') == 'lumped'
+        call self%ops%build(self%model, lumped, deck%get_real('continuum', 'rayleigh', 1), &
+                            deck%get_real('continuum', 'rayleigh', 2), error)
+        if (allocated(error)) call fail_at(error, deck%line('continuum', 'mesh'), 'mesh')
+        if (allocated(error)) return
+        call build_run_settings(deck, self%ops%n_free, lumped, 'continuum', self%settings, error)
+        if (allocated(error)) return
+        if (self%ops%n_free == 0) then
+            call make_input_error(error, deck%file, deck%line('continuum', 'fix'), 'fix', &
+                                  'every dof of the continuum is prescribed: nothing to solve')
+            return
+        end if
+        select case (self%settings%analysis)
+        case ('static')
+            if (self%model%stops_rigid_motions()) call self%ops%factor_combination(0.0_wp, 1.0_wp, self%k_factor, error)
+            if (allocated(error) .or. .not. self%model%stops_rigid_motions()) then
+                line = deck%line('continuum', 'fix')
+                if (line == 0) line = deck%line('continuum', 'mesh')
+                call make_input_error(error, deck%file, line, 'fix', 'the supports (fix, displacement) do not '// &
+                                      'stop every rigid motion (two translations and the rotation): the stiffness '// &
+                                      'on the free dofs is singular')
+                return
+            end if
+        case ('modal', 'dynamic')
+            call check_density(error)
+            if (allocated(error)) return
+            if (self%settings%analysis == 'dynamic') call make_integrator(error)
+        end select
+
+    contains
+
+        !> Input error at a line (keeps the library's message).
+        subroutine fail_at(error, at, keyword)
+            type(error_t), allocatable, intent(inout) :: error
+            integer, intent(in) :: at
+            character(len=*), intent(in) :: keyword
+            message = error%message
+            call make_input_error(error, deck%file, at, keyword, message)
+        end subroutine fail_at
+
+        !> The mesh: generated rectangle or Gmsh file (relative to the deck's folder).
+        subroutine build_mesh(error)
+            type(error_t), allocatable, intent(out) :: error
+            character(len=:), allocatable :: path
+            integer :: i
+            if (.not. deck%has('continuum', 'mesh')) then
+                call make_input_error(error, deck%file, first_line(), 'mesh', '[continuum] needs a mesh: '// &
+                                      'mesh = rectangle x0 y0 lx ly nx ny q4|t3, or mesh = file <name>.msh')
+                return
+            end if
+            e = deck%record('continuum', 'mesh', 1)
+            if (e%word(1) == 'rectangle') then
+                call rectangle_mesh(e%real(2), e%real(2) + e%real(4), e%real(3), e%real(3) + e%real(5), &
+                                    e%int(6), e%int(7), e%word(8) == 't3', mesh, error)
+            else
+                path = e%word(2)
+                if (path(1:1) /= '/') path = folder(deck%file)//path
+                call read_gmsh(path, mesh, error)
+                if (.not. allocated(error)) then
+                    if (.not. any([(mesh%element_sets(i)%name == 'all', i=1, size(mesh%element_sets))])) &
+                        call mesh%add_element_set('all', [(i, i=1, mesh%element_count())])
+                    if (.not. any([(mesh%node_sets(i)%name == 'all', i=1, size(mesh%node_sets))])) &
+                        call mesh%add_node_set('all', [(i, i=1, mesh%node_count())])
+                end if
+            end if
+            if (allocated(error)) call fail_at(error, e%line, 'mesh')
+        end subroutine build_mesh
+
+        !> Line of the first [continuum] entry.
+        integer function first_line()
+            integer :: i
+            first_line = 0
+            do i = 1, size(deck%entries)
+                if (deck%entries(i)%section /= 'continuum' .or. deck%entries(i)%line == 0) cycle
+                first_line = deck%entries(i)%line
+                return
+            end do
+        end function first_line
+
+        !> Materials of the element sets; every element must get one.
+        subroutine set_materials(error)
+            type(error_t), allocatable, intent(out) :: error
+            type(elastic2d_t) :: mat
+            character(len=:), allocatable :: set
+            integer :: i
+            list = deck%records('continuum', 'material')
+            if (size(list) == 0) then
+                call make_input_error(error, deck%file, first_line(), 'material', '[continuum] needs a material: '// &
+                                      'material = young poisson density thickness plane_stress|plane_strain [set]')
+                return
+            end if
+            do i = 1, size(list)
+                e = list(i)
+                call make_elastic2d(e%real(1), e%real(2), e%real(3), e%real(4), e%word(5) == 'plane_strain', mat, error)
+                if (allocated(error)) call fail_at(error, e%line, 'material')
+                if (allocated(error)) return
+                set = 'all'
+                if (e%n_values() >= 6) set = e%word(6)
+                call self%model%set_material(set, mat, error)
+                if (allocated(error)) call fail_at(error, e%line, 'material')
+                if (allocated(error)) return
+            end do
+            call self%model%check(error)
+            if (allocated(error)) call fail_at(error, list(1)%line, 'material')
+        end subroutine set_materials
+
+        !> Supports (fix) and prescribed displacements.
+        subroutine set_constraints(error)
+            type(error_t), allocatable, intent(out) :: error
+            integer :: i, j
+            list = deck%records('continuum', 'fix')
+            do i = 1, size(list)
+                e = list(i)
+                do j = 2, e%n_values()
+                    call self%model%prescribe_set(e%word(1), component(e%word(j)), 0.0_wp, error)
+                    if (allocated(error)) call fail_at(error, e%line, 'fix')
+                    if (allocated(error)) return
+                end do
+            end do
+            list = deck%records('continuum', 'displacement')
+            do i = 1, size(list)
+                e = list(i)
+                call self%model%prescribe_set(e%word(1), component(e%word(2)), e%real(3), error)
+                if (allocated(error)) call fail_at(error, e%line, 'displacement')
+                if (allocated(error)) return
+            end do
+        end subroutine set_constraints
+
+        !> Nodal loads, tractions and gravity.
+        subroutine set_loads(error)
+            type(error_t), allocatable, intent(out) :: error
+            integer, allocatable :: ids(:)
+            integer :: i, j
+            list = deck%records('continuum', 'load')
+            do i = 1, size(list)
+                e = list(i)
+                call self%model%mesh%node_set(e%word(1), ids, error)
+                if (allocated(error)) call fail_at(error, e%line, 'load')
+                if (allocated(error)) return
+                do j = 1, size(ids)
+                    call self%model%add_nodal_load(ids(j), component(e%word(2)), e%real(3))
+                end do
+            end do
+            list = deck%records('continuum', 'traction')
+            do i = 1, size(list)
+                e = list(i)
+                if (e%word(4) == 'parabolic') then
+                    call add_parabolic(self%model, e%word(1), [e%real(2), e%real(3)], error)
+                else
+                    call self%model%add_traction(e%word(1), [e%real(2), e%real(3)], error)
+                end if
+                if (allocated(error)) call fail_at(error, e%line, 'traction')
+                if (allocated(error)) return
+            end do
+            if (deck%get_real('continuum', 'gravity', 1) /= 0 .or. deck%get_real('continuum', 'gravity', 2) /= 0) then
+                call self%model%add_body_force([deck%get_real('continuum', 'gravity', 1), &
+                                                deck%get_real('continuum', 'gravity', 2)], error)
+                if (allocated(error)) call fail_at(error, deck%line('continuum', 'gravity'), 'gravity')
+                if (allocated(error)) return
+            end if
+        end subroutine set_loads
+
+        !> Modes and dynamics need a positive-definite mass: every density > 0.
+        subroutine check_density(error)
+            type(error_t), allocatable, intent(out) :: error
+            integer :: i
+            list = deck%records('continuum', 'material')
+            do i = 1, size(list)
+                if (list(i)%real(3) > 0) cycle
+                call make_input_error(error, deck%file, list(i)%line, 'material', 'a '// &
+                                      deck%get_word('run', 'analysis')//' analysis needs a density > 0 (the mass '// &
+                                      'matrix must be positive definite)')
+                return
+            end do
+        end subroutine check_density
+
+        !> Newmark or central difference from rest with the initial velocity field.
+        subroutine make_integrator(error)
+            type(error_t), allocatable, intent(out) :: error
+            real(wp), allocatable :: u0(:), v0(:), v_all(:)
+            integer, allocatable :: eq(:)
+            real(wp) :: vx, vy, omega, xc, yc
+            integer :: a, n, c
+            e = deck%record('continuum', 'initial_velocity', 1)
+            vx = deck%get_real('continuum', 'initial_velocity', 1)
+            vy = deck%get_real('continuum', 'initial_velocity', 2)
+            omega = 0.0_wp
+            xc = 0.0_wp
+            yc = 0.0_wp
+            if (e%n_values() >= 3) omega = e%real(3)
+            if (e%n_values() >= 4) xc = e%real(4)
+            if (e%n_values() >= 5) yc = e%real(5)
+            allocate (v_all(self%model%dof_count()))
+            do a = 1, self%model%mesh%node_count()
+                v_all(2*a - 1) = vx - omega*(self%model%mesh%x(2, a) - yc)
+                v_all(2*a) = vy + omega*(self%model%mesh%x(1, a) - xc)
+            end do
+            call self%model%equations(eq, n)
+            allocate (u0(n), v0(n))
+            u0 = 0.0_wp
+            do c = 1, size(eq)
+                if (eq(c) > 0) v0(eq(c)) = v_all(c)
+            end do
+            select case (self%settings%scheme)
+            case ('central_difference')
+                allocate (central_difference_t :: self%integ)
+            case default
+                allocate (newmark_t :: self%integ)
+                select type (integ => self%integ)
+                type is (newmark_t)
+                    integ%beta = self%settings%beta
+                    integ%gamma = self%settings%gamma
+                end select
+            end select
+            call self%integ%init(self%ops, self%settings%h, 0.0_wp, u0, v0, error)
+            if (allocated(error)) call fail_at(error, deck%line('time', 'step'), 'step')
+        end subroutine make_integrator
+    end subroutine continuum_init
+
+    !> Parabolic traction 1.5 t (1 - s^2) across an edge set (s = -1..1 along its longer
+    !> extent): the resultant of a uniform t.
+    subroutine add_parabolic(model, set, t, error)
+        !> The model.
+        type(continuum_model_t), intent(inout) :: model
+        !> Edge set.
+        character(len=*), intent(in) :: set
+        !> Mean traction [Pa].
+        real(wp), intent(in) :: t(2)
+        !> Set when the set is unknown.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: edges(:, :)
+        real(wp) :: lo(2), hi(2)
+        integer :: axis
+        call model%mesh%edge_set(set, edges, error)
+        if (allocated(error)) return
+        lo = minval(model%mesh%x(:, reshape(edges, [size(edges)])), dim=2)
+        hi = maxval(model%mesh%x(:, reshape(edges, [size(edges)])), dim=2)
+        axis = merge(1, 2, hi(1) - lo(1) >= hi(2) - lo(2))
+        call model%add_traction_field(set, profile, error)
+    contains
+        pure function profile(x) result(tr)
+            real(wp), intent(in) :: x(2)
+            real(wp) :: tr(2)
+            real(wp) :: s
+            s = (2*x(axis) - lo(axis) - hi(axis))/(hi(axis) - lo(axis))
+            tr = 1.5_wp*(1 - s**2)*t
+        end function profile
+    end subroutine add_parabolic
+
+    !> Folder of a path, with its trailing '/' ('' for a bare name).
+    pure function folder(path) result(dir)
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: dir
+        dir = path(1:index(path, '/', back=.true.))
+    end function folder
+
+    !> Component number of 'x' (1) or 'y' (2).
+    pure integer function component(word)
+        character(len=*), intent(in) :: word
+        component = merge(1, 2, word == 'x')
+    end function component
+
+    !> 'static analysis, 400 elements, 882 dofs (40 prescribed)'.
+    function continuum_describe(self) result(text)
+        !> The simulation.
+        class(continuum_simulation_t), intent(in) :: self
+        !> Summary.
+        character(len=:), allocatable :: text
+        text = self%settings%analysis//' analysis of a continuum, '//to_str(self%model%mesh%element_count())// &
+               ' elements, '//to_str(self%model%mesh%node_count())//' nodes, '//to_str(self%ops%n_free)//' free dofs'
+    end function continuum_describe
+
+    !> Static solve, modes or time integration; results into `out` and an XDMF file next to it.
+    subroutine continuum_run(self, out, quiet, report, error)
+        !> The simulation.
+        class(continuum_simulation_t), intent(inout) :: self
+        !> The results file.
+        type(results_writer_t), intent(inout) :: out
+        !> No progress lines.
+        logical, intent(in) :: quiet
+        !> Where progress and summary lines go.
+        procedure(report_iface) :: report
+        !> Set on a run or write failure.
+        type(error_t), allocatable, intent(out) :: error
+        type(continuum_writer_t) :: writer
+        character(len=:), allocatable :: xdmf
+        call writer%begin(out%file, self%model%mesh, self%settings%analysis, error)
+        if (allocated(error)) return
+        select case (self%settings%analysis)
+        case ('static')
+            call run_static(error)
+        case ('modal')
+            call run_modal(error)
+        case ('dynamic')
+            call run_dynamic(error)
+        end select
+        if (allocated(error)) return
+        ! The XDMF file names the HDF5 file as it is after a successful run.
+        if (out%stopped()) return
+        xdmf = out%final_path(1:len(out%final_path) - 3)//'.xdmf'
+        call writer%write_xdmf(xdmf, basename(out%final_path), error)
+
+    contains
+
+        !> K_ff u_f = f_f - K_fp u_p.
+        subroutine run_static(error)
+            type(error_t), allocatable, intent(out) :: error
+            real(wp), allocatable :: uf(:), u(:), stress(:, :)
+            character(len=160) :: buf
+            real(wp) :: energy
+            uf = self%ops%load
+            call self%k_factor%solve(uf, error)
+            if (allocated(error)) return
+            u = self%model%expand(uf)
+            call self%model%centre_stresses(u, stress, error)
+            if (allocated(error)) return
+            if (.not. (all(ieee_is_finite(u)) .and. all(ieee_is_finite(stress)))) then
+                call make_error(error, 'static solution of the continuum: a displacement or a stress is not '// &
+                                'finite; likely cause: loads or moduli far too large or too small')
+                return
+            end if
+            energy = self%ops%total_strain_energy(u)
+            if (.not. ieee_is_finite(energy)) then
+                call make_error(error, 'static solution of the continuum: the strain energy is not finite; likely '// &
+                                'cause: loads or moduli far too large or too small')
+                return
+            end if
+            call writer%write_static(out%file, reshape(u, [2, size(u)/2]), stress, energy, error)
+            if (allocated(error)) return
+            write (buf, '(a,es13.5e3,a,es13.5e3,a)') 'static solution: max |displacement| = ', maxval(abs(u)), &
+                ' m, strain energy = ', energy, ' J'
+            call report(trim(buf))
+        end subroutine run_static
+
+        !> Lowest modes.
+        subroutine run_modal(error)
+            type(error_t), allocatable, intent(out) :: error
+            real(wp), allocatable :: omega(:), shapes(:, :), full(:, :, :), u(:)
+            real(wp), parameter :: two_pi = 6.283185307179586476925286766559_wp
+            character(len=120) :: buf
+            integer :: k
+            call self%ops%solve_modes(self%settings%n_modes, omega, shapes, error)
+            if (allocated(error)) return
+            allocate (full(2, self%model%mesh%node_count(), size(omega)))
+            do k = 1, size(omega)
+                ! Mode shapes vanish on the prescribed dofs.
+                u = self%model%expand(shapes(:, k)) - self%model%prescribed_value
+                full(:, :, k) = reshape(u, [2, self%model%mesh%node_count()])
+                write (buf, '(a,i3,a,es15.7e3,a,es15.7e3,a)') 'mode ', k, ': omega = ', omega(k), &
+                    ' rad/s, f = ', omega(k)/two_pi, ' Hz'
+                call report(trim(buf))
+            end do
+            call writer%write_modal(out%file, omega, full, error)
+        end subroutine run_modal
+
+        !> Time steps with outputs every [output] interval.
+        subroutine run_dynamic(error)
+            type(error_t), allocatable, intent(out) :: error
+            type(progress_t) :: progress
+            integer(i8) :: n_steps, k
+            character(len=200) :: buf
+            n_steps = self%settings%n_steps
+            call progress%start(n_steps, self%settings%t_end, self%settings%progress_seconds)
+            call store(error)
+            if (allocated(error)) return
+            do k = 1, n_steps
+                call self%integ%step(self%ops, error)
+                if (allocated(error)) return
+                if (.not. (all(ieee_is_finite(self%integ%u)) .and. all(ieee_is_finite(self%integ%v)))) then
+                    write (buf, '(a,i0,a,es13.5e3,a)') 'continuum: the state is not finite after step ', k, &
+                        ' (t = ', self%integ%t, ' s); likely cause: a time step above the stability limit or '// &
+                        'loads far too large'
+                    call make_error(error, trim(buf))
+                    return
+                end if
+                if (mod(k, int(self%settings%output_interval, i8)) == 0 .or. k == n_steps) then
+                    call store(error)
+                    if (allocated(error)) return
+                end if
+                if (k < n_steps .and. caught_signal() /= 0) then
+                    if (mod(k, int(self%settings%output_interval, i8)) /= 0) call store(error)
+                    if (allocated(error)) return
+                    call out%stop_at(signal_name(caught_signal()), k, self%integ%t)
+                    n_steps = k
+                    exit
+                end if
+                if (.not. quiet .and. progress%due()) call report(progress%line(k, self%integ%t))
+            end do
+            write (buf, '(a,i0,a,es13.5e3,a,es11.3e3,a)') 'dynamic run: ', n_steps, ' steps to t = ', &
+                self%integ%t, ' s; energy balance residual ', self%integ%energy_balance(), ' J'
+            call report(trim(buf))
+            call report(progress%summary_line(n_steps))
+            call out%write_summary(int(n_steps), progress%elapsed(), error)
+        end subroutine run_dynamic
+
+        !> Store the current state and energies.
+        subroutine store(error)
+            type(error_t), allocatable, intent(out) :: error
+            real(wp), allocatable :: u(:), v(:), stress(:, :)
+            real(wp) :: energies(5)
+            character(len=200) :: buf
+            integer :: n
+            u = self%model%expand(self%integ%u)
+            v = self%model%expand(self%integ%v) - self%model%prescribed_value
+            n = self%model%mesh%node_count()
+            call self%model%centre_stresses(u, stress, error)
+            if (allocated(error)) return
+            associate (g => self%integ)
+                energies = [g%kinetic, self%ops%total_strain_energy(u), g%external_work, g%damping_dissipation, &
+                            g%energy_balance()]
+                if (.not. (all(ieee_is_finite(stress)) .and. all(ieee_is_finite(energies)))) then
+                    write (buf, '(a,es13.5e3,a)') 'continuum: a stress or an energy is not finite at t = ', g%t, &
+                        ' s; likely cause: loads or moduli far too large or too small'
+                    call make_error(error, trim(buf))
+                    return
+                end if
+                call writer%store(out%file, g%t, reshape(u, [2, n]), reshape(v, [2, n]), stress, error)
+                if (allocated(error)) return
+                call writer%store_energy(out%file, g%t, energies(1), energies(2), energies(3), energies(4), &
+                                         energies(5), error)
+            end associate
+            if (allocated(error)) return
+            call out%flush(error)
+        end subroutine store
+    end subroutine continuum_run
+end module driver_simulation_continuum

@@ -1,0 +1,406 @@
+!> The 2D continuum (fem_continuum_model) as a `dynamic_operator_t`: K, M and the loads reduced
+!> to the free dofs, in CHOLMOD sparse storage, for the time integrators of fem_newmark and
+!> for the static and modal solutions.
+!>
+!> Prescribed displacements u_p are constant in time and eliminated (fem_continuum_model
+!> `reduce`): the free dofs carry F = f_f - K_fp u_p, so that the integrator's energy accounts
+!> (on the free dofs) close; the strain energy of the whole body 1/2 u.K u over all dofs is
+!> `total_strain_energy`. Combinations c_m M + c_k K share the pattern of K (a lumped M is
+!> diagonal, inside it) and are factored by CHOLMOD (`sparse_cholesky`). The lowest modes come
+!> from a subspace iteration with that factor (`solve_modes`); the critical time step from the
+!> largest element eigenvalue (`largest_eigenvalue`).
+module fem_continuum_dynamics
+    use core_kinds, only: wp, i8
+    use core_error, only: error_t, make_error
+    use core_sparse, only: sparse_matrix_t, sparse_solver_t
+    use core_linalg, only: band_spd_t, band_generalized_eigen
+    use fem_dynamic_operator, only: dynamic_operator_t, spd_factor_t
+    use fem_continuum_model, only: continuum_model_t
+    use fem_triplets, only: fem_triplets_t
+    implicit none
+    private
+    public :: continuum_dynamics_t
+
+    !> The continuum on its free dofs.
+    type, extends(dynamic_operator_t) :: continuum_dynamics_t
+        !> Stiffness K_ff (finalized).
+        type(sparse_matrix_t) :: k
+        !> Mass M_ff (finalized; with the pattern of K).
+        type(sparse_matrix_t) :: m
+        !> K_ff and M_ff as triplets.
+        type(fem_triplets_t) :: k_triplets, m_triplets
+        !> Largest eigenvalue over the elements of K_e phi = lambda M_e phi [1/s^2].
+        real(wp) :: element_lambda_max = 0.0_wp
+        !> Constant load on the free dofs, f_f - K_fp u_p [N].
+        real(wp), allocatable :: load(:)
+        !> Stiffness over all dofs (for the strain energy of the whole body).
+        type(fem_triplets_t) :: k_all
+    contains
+        !> Assemble and reduce the model.
+        procedure :: build => dynamics_build
+        !> See `dynamic_operator_t`.
+        procedure :: external_force => dynamics_force
+        procedure :: stiffness_times => dynamics_stiffness_times
+        procedure :: mass_times => dynamics_mass_times
+        procedure :: damping_times => dynamics_damping_times
+        procedure :: is_damped => dynamics_is_damped
+        procedure :: strain_energy => dynamics_strain_energy
+        procedure :: kinetic_energy => dynamics_kinetic_energy
+        procedure :: factor_combination => dynamics_factor_combination
+        procedure :: mass_diagonal => dynamics_mass_diagonal
+        procedure :: largest_eigenvalue => dynamics_largest_eigenvalue
+        !> Lowest modes of K phi = omega^2 M phi.
+        procedure :: solve_modes => dynamics_solve_modes
+        !> 1/2 u.K u over all dofs [J].
+        procedure :: total_strain_energy => dynamics_total_strain_energy
+    end type continuum_dynamics_t
+
+    !> A CHOLMOD factor as a `spd_factor_t` (the solver is reached through a pointer because
+    !> CHOLMOD's solve updates its workspace).
+    type, extends(spd_factor_t) :: sparse_factor_t
+        !> The factored solver.
+        type(sparse_solver_t), pointer :: solver => null()
+    contains
+        procedure :: solve_vec => sparse_factor_solve_vec
+        procedure :: solve_mat => sparse_factor_solve_mat
+    end type sparse_factor_t
+
+contains
+
+    !> Assemble K and M of the model, reduce them and the loads to the free dofs.
+    subroutine dynamics_build(self, model, lumped, a0, a1, error)
+        !> The operator.
+        class(continuum_dynamics_t), intent(out) :: self
+        !> The continuum (materials, loads and prescribed dofs set).
+        type(continuum_model_t), intent(in) :: model
+        !> Row-sum lumped instead of consistent mass.
+        logical, intent(in) :: lumped
+        !> Rayleigh coefficients: C = a0 M + a1 K.
+        real(wp), intent(in) :: a0, a1
+        !> Set when an element has no material or CHOLMOD fails.
+        type(error_t), allocatable, intent(out) :: error
+        type(fem_triplets_t) :: m_all
+        real(wp), allocatable :: dummy(:)
+        integer :: p
+        call model%assemble_stiffness(self%k_all, error)
+        if (allocated(error)) return
+        call model%assemble_mass(lumped, m_all, error)
+        if (allocated(error)) return
+        call model%reduce(self%k_all, model%load, self%k_triplets, self%load)
+        ! M acts on accelerations: the prescribed dofs do not move, no right-hand side.
+        call model%reduce(m_all, 0*model%load, self%m_triplets, dummy)
+        self%n_free = self%k_triplets%n
+        self%lumped_mass = lumped
+        self%rayleigh_a0 = a0
+        self%rayleigh_a1 = a1
+        call self%k%init(self%n_free, int(self%k_triplets%nnz, i8))
+        call self%m%init(self%n_free, int(self%k_triplets%nnz, i8))
+        do p = 1, self%k_triplets%nnz
+            associate (i => self%k_triplets%i(p), j => self%k_triplets%j(p))
+                if (i >= j) call self%k%add(i, j, self%k_triplets%v(p))
+                ! M takes the pattern of K (zeros included) so that c_m M + c_k K adds values.
+                if (i >= j) call self%m%add(i, j, 0.0_wp)
+            end associate
+        end do
+        do p = 1, self%m_triplets%nnz
+            associate (i => self%m_triplets%i(p), j => self%m_triplets%j(p))
+                if (i >= j) call self%m%add(i, j, self%m_triplets%v(p))
+            end associate
+        end do
+        call self%k%finalize(error)
+        if (.not. allocated(error)) call self%m%finalize(error)
+        if (allocated(error)) return
+        call element_bound(error)
+        if (allocated(error)) return
+        if (self%m%nnz() == self%k%nnz()) then
+            if (all(self%m%rowind == self%k%rowind) .and. all(self%m%colptr == self%k%colptr)) return
+        end if
+        call make_error(error, 'continuum: the mass matrix has entries outside the stiffness pattern')
+    contains
+        !> Largest element eigenvalue (skipped when a density is zero: no dynamics then).
+        subroutine element_bound(error)
+            type(error_t), allocatable, intent(out) :: error
+            type(band_spd_t) :: ke, me
+            real(wp), allocatable :: k_e(:, :), m_e(:, :), lambda(:)
+            integer :: e, a, b, n
+            self%element_lambda_max = 0.0_wp
+            if (any(model%materials%density <= 0)) return
+            do e = 1, model%mesh%element_count()
+                associate (el => model%family(model%mesh%kind(e))%element, xe => model%mesh%element_coordinates(e), &
+                           mat => model%materials(model%element_material(e)))
+                    k_e = el%stiffness(xe, mat)
+                    if (lumped) then
+                        m_e = 0*k_e
+                        lambda = el%mass_lumped(xe, mat)
+                        do a = 1, size(lambda)
+                            m_e(a, a) = lambda(a)
+                        end do
+                    else
+                        m_e = el%mass_consistent(xe, mat)
+                    end if
+                end associate
+                n = size(k_e, 1)
+                call ke%init(n, n - 1)
+                call me%init(n, n - 1)
+                do b = 1, n
+                    do a = 1, b
+                        call ke%add(a, b, k_e(a, b))
+                        call me%add(a, b, m_e(a, b))
+                    end do
+                end do
+                call band_generalized_eigen(ke, me, n, n, lambda, error)
+                if (allocated(error)) return
+                self%element_lambda_max = max(self%element_lambda_max, lambda(1))
+            end do
+        end subroutine element_bound
+    end subroutine dynamics_build
+
+    !> Constant loads (f_f - K_fp u_p).
+    subroutine dynamics_force(self, t, f)
+        class(continuum_dynamics_t), intent(in) :: self
+        real(wp), intent(in) :: t
+        real(wp), intent(out) :: f(:)
+        f = self%load
+    end subroutine dynamics_force
+
+    !> ku = K u.
+    subroutine dynamics_stiffness_times(self, u, ku)
+        class(continuum_dynamics_t), intent(in) :: self
+        real(wp), contiguous, intent(in) :: u(:)
+        real(wp), contiguous, intent(out) :: ku(:)
+        type(error_t), allocatable :: error
+        call self%k%matvec(u, ku, error)
+    end subroutine dynamics_stiffness_times
+
+    !> mv = M v.
+    subroutine dynamics_mass_times(self, v, mv)
+        class(continuum_dynamics_t), intent(in) :: self
+        real(wp), contiguous, intent(in) :: v(:)
+        real(wp), contiguous, intent(out) :: mv(:)
+        type(error_t), allocatable :: error
+        call self%m%matvec(v, mv, error)
+    end subroutine dynamics_mass_times
+
+    !> cv = a0 M v + a1 K v.
+    subroutine dynamics_damping_times(self, v, cv)
+        class(continuum_dynamics_t), intent(in) :: self
+        real(wp), contiguous, intent(in) :: v(:)
+        real(wp), contiguous, intent(out) :: cv(:)
+        type(error_t), allocatable :: error
+        call self%k%matvec(v, cv, error, alpha=self%rayleigh_a1)
+        call self%m%matvec(v, cv, error, alpha=self%rayleigh_a0, beta=1.0_wp)
+    end subroutine dynamics_damping_times
+
+    !> True when C /= 0.
+    pure logical function dynamics_is_damped(self)
+        class(continuum_dynamics_t), intent(in) :: self
+        dynamics_is_damped = self%rayleigh_a0 /= 0 .or. self%rayleigh_a1 /= 0
+    end function dynamics_is_damped
+
+    !> 1/2 u.K_ff u [J].
+    real(wp) function dynamics_strain_energy(self, u)
+        class(continuum_dynamics_t), intent(in) :: self
+        real(wp), contiguous, intent(in) :: u(:)
+        real(wp) :: ku(size(u))
+        call self%stiffness_times(u, ku)
+        dynamics_strain_energy = 0.5_wp*dot_product(u, ku)
+    end function dynamics_strain_energy
+
+    !> 1/2 v.M v [J].
+    real(wp) function dynamics_kinetic_energy(self, v)
+        class(continuum_dynamics_t), intent(in) :: self
+        real(wp), contiguous, intent(in) :: v(:)
+        real(wp) :: mv(size(v))
+        call self%mass_times(v, mv)
+        dynamics_kinetic_energy = 0.5_wp*dot_product(v, mv)
+    end function dynamics_kinetic_energy
+
+    !> CHOLMOD factor of c_m M + c_k K.
+    subroutine dynamics_factor_combination(self, c_m, c_k, factor, error)
+        class(continuum_dynamics_t), intent(in) :: self
+        real(wp), intent(in) :: c_m
+        real(wp), intent(in) :: c_k
+        class(spd_factor_t), allocatable, intent(out) :: factor
+        type(error_t), allocatable, intent(out) :: error
+        type(sparse_matrix_t) :: a
+        type(sparse_factor_t), allocatable :: f
+        a = self%k
+        a%values = c_m*self%m%values + c_k*self%k%values
+        allocate (f)
+        allocate (f%solver)
+        call f%solver%factor(a, error)
+        call move_alloc(f, factor)
+    end subroutine dynamics_factor_combination
+
+    !> x <- A^-1 x.
+    subroutine sparse_factor_solve_vec(self, x, error)
+        class(sparse_factor_t), intent(in) :: self
+        real(wp), contiguous, intent(inout) :: x(:)
+        type(error_t), allocatable, intent(out) :: error
+        real(wp) :: b(size(x))
+        b = x
+        call self%solver%solve(b, x, error)
+    end subroutine sparse_factor_solve_vec
+
+    !> X <- A^-1 X.
+    subroutine sparse_factor_solve_mat(self, x, error)
+        class(sparse_factor_t), intent(in) :: self
+        real(wp), contiguous, intent(inout) :: x(:, :)
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: b(:, :)
+        b = x
+        call self%solver%solve(b, x, error)
+    end subroutine sparse_factor_solve_mat
+
+    !> Diagonal of M (lumped).
+    subroutine dynamics_mass_diagonal(self, d)
+        class(continuum_dynamics_t), intent(in) :: self
+        real(wp), intent(out) :: d(:)
+        integer :: p
+        d = 0.0_wp
+        do p = 1, self%m_triplets%nnz
+            if (self%m_triplets%i(p) == self%m_triplets%j(p)) &
+                d(self%m_triplets%i(p)) = d(self%m_triplets%i(p)) + self%m_triplets%v(p)
+        end do
+    end subroutine dynamics_mass_diagonal
+
+    !> Upper bound of the largest eigenvalue of K phi = omega^2 M phi: the largest element
+    !> eigenvalue (Irons and Treharne: the global one never exceeds it; prescribed dofs only
+    !> lower it), computed in `build`. Conservative for critical time steps.
+    subroutine dynamics_largest_eigenvalue(self, lambda_max, error)
+        class(continuum_dynamics_t), intent(in) :: self
+        real(wp), intent(out) :: lambda_max
+        type(error_t), allocatable, intent(out) :: error
+        lambda_max = self%element_lambda_max
+        if (.not. self%element_lambda_max > 0) &
+            call make_error(error, 'continuum: no element eigenvalue bound (a density is zero?)')
+    end subroutine dynamics_largest_eigenvalue
+
+    !> The n_modes lowest modes of K phi = omega^2 M phi on the free dofs, mass-normalised.
+    !>
+    !> Subspace iteration (Bathe, Finite Element Procedures, 11.6) with the CHOLMOD factor of
+    !> K - sigma M: p = max(2 n_modes, n_modes + 8) vectors (at most n_free),
+    !> Y = (K - sigma M)^-1 M X, Rayleigh-Ritz on span(Y) (M-orthonormalised by Gram-Schmidt, then
+    !> the p x p eigenproblem of the projected K by LAPACK), until the
+    !> wanted eigenvalues change by less than 1e-10 of the largest wanted one (at most 500
+    !> iterations; relative to the largest so that zero eigenvalues of rigid modes converge).
+    !> sigma = 0 when K_ff is positive definite; otherwise (rigid motions free) a small
+    !> negative shift, 1e-8 times the mean of K_ii/M_ii.
+    subroutine dynamics_solve_modes(self, n_modes, omega, shapes, error)
+        !> The operator.
+        class(continuum_dynamics_t), intent(in) :: self
+        !> Number of modes (1..n_free).
+        integer, intent(in) :: n_modes
+        !> Circular frequencies [rad/s], ascending.
+        real(wp), allocatable, intent(out) :: omega(:)
+        !> Mode shapes (n_free, n_modes), mass-normalised.
+        real(wp), allocatable, intent(out) :: shapes(:, :)
+        !> Set when n_modes is out of range, the iteration does not converge, or on failure.
+        type(error_t), allocatable, intent(out) :: error
+        integer, parameter :: max_iterations = 500
+        real(wp), parameter :: tolerance = 1.0e-10_wp
+        class(spd_factor_t), allocatable :: factor
+        real(wp), allocatable :: x(:, :), y(:, :), ky(:, :), my(:, :), lambda(:), previous(:), q(:, :), d(:)
+        type(band_spd_t) :: kr, mr
+        real(wp) :: sigma, norm
+        integer :: n, p, i, j, iteration
+        character(len=200) :: buf
+        n = self%n_free
+        if (n_modes < 1 .or. n_modes > n) then
+            write (buf, '(a,i0,a,i0,a)') 'modal analysis: ', n_modes, ' modes asked but the model has ', &
+                n, ' free dofs'
+            call make_error(error, trim(buf))
+            return
+        end if
+        p = min(max(2*n_modes, n_modes + 8), n)
+        sigma = 0.0_wp
+        call self%factor_combination(1.0_wp, 1.0_wp, factor, error)
+        if (allocated(error)) return
+        deallocate (factor)
+        call self%factor_combination(0.0_wp, 1.0_wp, factor, error)
+        if (allocated(error)) then
+            deallocate (error)
+            allocate (d(n))
+            call self%mass_diagonal(d)
+            sigma = -1.0e-8_wp*sum(diagonal(self%k)/d)/n
+            call self%factor_combination(-sigma, 1.0_wp, factor, error)
+            if (allocated(error)) return
+        end if
+        ! Start: smooth, independent vectors (sines of increasing frequency).
+        allocate (x(n, p), y(n, p), ky(n, p), my(n, p), previous(p))
+        do j = 1, p
+            do i = 1, n
+                x(i, j) = sin(real(i, wp)*real(j, wp)*3.14159265358979_wp/real(n + 1, wp)) + 1.0e-3_wp*j
+            end do
+        end do
+        previous = huge(1.0_wp)
+        do iteration = 1, max_iterations
+            call self%m%matvec(x, y, error)
+            if (allocated(error)) return
+            call factor%solve(y, error)
+            if (allocated(error)) return
+            ! M-orthonormal basis of span(Y) (Gram-Schmidt, twice), then K projected on it.
+            call self%m%matvec(y, my, error)
+            if (allocated(error)) return
+            do j = 1, p
+                do i = 1, 2
+                    y(:, j) = y(:, j) - matmul(y(:, 1:j - 1), matmul(transpose(my(:, 1:j - 1)), y(:, j)))
+                end do
+                call self%m%matvec(y(:, j), my(:, j), error)
+                if (allocated(error)) return
+                norm = sqrt(dot_product(y(:, j), my(:, j)))
+                if (.not. norm > 0) then
+                    call make_error(error, 'modal analysis of the continuum: the subspace lost its rank')
+                    return
+                end if
+                y(:, j) = y(:, j)/norm
+                my(:, j) = my(:, j)/norm
+            end do
+            call self%k%matvec(y, ky, error)
+            if (allocated(error)) return
+            call kr%init(p, p - 1)
+            call mr%init(p, 0)
+            do j = 1, p
+                call mr%add(j, j, 1.0_wp)
+                do i = 1, j
+                    call kr%add(i, j, 0.5_wp*(dot_product(y(:, i), ky(:, j)) + dot_product(y(:, j), ky(:, i))))
+                end do
+            end do
+            call band_generalized_eigen(kr, mr, 1, p, lambda, error, q)
+            if (allocated(error)) return
+            x = matmul(y, q)
+            if (all(abs(lambda(1:n_modes) - previous(1:n_modes)) <= tolerance*maxval(abs(lambda(1:n_modes))))) exit
+            previous = lambda
+        end do
+        if (iteration > max_iterations) then
+            call make_error(error, 'modal analysis of the continuum: the subspace iteration did not converge')
+            return
+        end if
+        shapes = x(:, 1:n_modes)
+        ! Rigid-body eigenvalues are zero up to rounding and may come out slightly negative.
+        omega = sqrt(max(lambda(1:n_modes), 0.0_wp))
+    end subroutine dynamics_solve_modes
+
+    !> Diagonal of a finalized sparse matrix.
+    function diagonal(a) result(d)
+        type(sparse_matrix_t), intent(in) :: a
+        real(wp) :: d(a%n)
+        integer :: j
+        ! Lower triangle, rows sorted within each column: the diagonal comes first.
+        do j = 1, a%n
+            d(j) = a%values(a%colptr(j) + 1)
+        end do
+    end function diagonal
+
+    !> 1/2 u.K u over all dofs [J].
+    real(wp) function dynamics_total_strain_energy(self, u) result(energy)
+        !> The operator.
+        class(continuum_dynamics_t), intent(in) :: self
+        !> Displacements of all dofs.
+        real(wp), intent(in) :: u(:)
+        real(wp), allocatable :: ku(:)
+        allocate (ku(size(u)))
+        call self%k_all%matvec(u, ku)
+        energy = 0.5_wp*dot_product(u, ku)
+    end function dynamics_total_strain_energy
+end module fem_continuum_dynamics

@@ -1,0 +1,67 @@
+!> Deck section of the 2D elastic continuum, declared as data: [continuum] (mesh, materials,
+!> supports, prescribed displacements, loads, damping, initial velocity). Machinery and field
+!> builders: io_deck_schema.
+module io_schema_continuum
+    use core_kinds, only: wp
+    use io_deck_schema, only: schema_t, tail_spec_t, int_field, real_field, positive, word_field, tail
+    implicit none
+    private
+    public :: add_continuum
+
+contains
+
+    !> [continuum]: plane strain or plane stress linear elasticity on a Q4/T3 mesh.
+    subroutine add_continuum(s)
+        !> Schema to extend.
+        type(schema_t), intent(inout) :: s
+        type(tail_spec_t), allocatable :: tails(:)
+        call s%add_section('continuum', &
+                           '2D linear-elastic continuum (plane strain or plane stress, Q4 and T3 elements); '// &
+                           'named node, element and edge sets come from the mesh.')
+        tails = [tail([real_field('x0', 'm'), real_field('y0', 'm'), positive('lx', 'm'), positive('ly', 'm'), &
+                       int_field('nx', lower=1), int_field('ny', lower=1), word_field('element', 'q4 t3')], &
+                      7, 7, selected_by='rectangle'), &
+                 tail([word_field('path', '')], 1, 1, selected_by='file')]
+        call s%add_keyword('continuum', 'mesh', [word_field('kind', 'rectangle file')], &
+                           'rectangle: [x0, x0 + lx] x [y0, y0 + ly] with nx x ny Q4 (or 2 nx ny T3), sets '// &
+                           'left, right, bottom, top (nodes and edges) and all (nodes and elements); file: a '// &
+                           'Gmsh 4.1 ASCII .msh (path relative to the deck), its physical groups as named sets.', &
+                           selector=1, tails=tails)
+        call s%add_keyword('continuum', 'material', [positive('young', 'Pa'), &
+                                                     real_field('poisson', '', lower=-1.0_wp, upper=0.5_wp, &
+                                                                lower_strict=.true., upper_strict=.true.), &
+                                                     real_field('density', 'kg/m^3', lower=0.0_wp), &
+                                                     positive('thickness', 'm'), &
+                                                     word_field('hypothesis', 'plane_stress plane_strain')], &
+                           'Isotropic elastic material of an element set (default all; later lines override '// &
+                           'earlier ones on shared elements).', &
+                           tails=[tail([word_field('element_set', '')], 0, 1)], repeatable=.true.)
+        call s%add_keyword('continuum', 'mass', [word_field('mass', 'consistent lumped')], &
+                           'Mass matrix: consistent, or row-sum lumped (diagonal).', default='consistent')
+        call s%add_keyword('continuum', 'fix', [word_field('node_set', '')], &
+                           'Zero displacement of the nodes of a set, components x and/or y.', &
+                           tails=[tail([word_field('component', 'x y')], 1, 2)], repeatable=.true.)
+        call s%add_keyword('continuum', 'displacement', [word_field('node_set', ''), &
+                                                         word_field('component', 'x y'), real_field('value', 'm')], &
+                           'Prescribed displacement (constant in time) of the nodes of a set.', repeatable=.true.)
+        call s%add_keyword('continuum', 'load', [word_field('node_set', ''), &
+                                                 word_field('component', 'x y'), real_field('value', 'N')], &
+                           'Force on every node of a set (constant in time).', repeatable=.true.)
+        call s%add_keyword('continuum', 'traction', [word_field('edge_set', ''), &
+                                                     real_field('tx', 'Pa'), real_field('ty', 'Pa')], &
+                           'Traction on the edges of a set (constant in time): uniform, or parabolic '// &
+                           '(1.5 t (1 - s^2) with s from -1 to 1 across the set along its longer extent, the '// &
+                           'same resultant as uniform t).', &
+                           tails=[tail([word_field('profile', 'uniform parabolic')], 0, 1)], repeatable=.true.)
+        call s%add_keyword('continuum', 'gravity', [real_field('gx', 'm/s^2'), real_field('gy', 'm/s^2')], &
+                           'Acceleration of gravity (body force rho g).', default='0 0')
+        call s%add_keyword('continuum', 'rayleigh', &
+                           [real_field('a0', '1/s', lower=0.0_wp), real_field('a1', 's', lower=0.0_wp)], &
+                           'Rayleigh damping C = a0 M + a1 K.', default='0 0')
+        call s%add_keyword('continuum', 'initial_velocity', [real_field('vx', 'm/s'), real_field('vy', 'm/s')], &
+                           'Initial velocity of the free nodes (dynamic analysis): (vx, vy) plus a rotation '// &
+                           'omega (rad/s) about (xc, yc) (m), v = (vx - omega (y - yc), vy + omega (x - xc)).', &
+                           tails=[tail([real_field('omega', 'rad/s'), real_field('xc', 'm'), real_field('yc', 'm')], &
+                                       0, 3)], default='0 0')
+    end subroutine add_continuum
+end module io_schema_continuum
