@@ -3,5 +3,6 @@ set(MULTICOR_COUPLING_SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/weights.f90
     ${CMAKE_CURRENT_LIST_DIR}/operator.f90
     ${CMAKE_CURRENT_LIST_DIR}/lambda.f90
+    ${CMAKE_CURRENT_LIST_DIR}/multiplier_space.f90
     ${CMAKE_CURRENT_LIST_DIR}/bilateral.f90
     ${CMAKE_CURRENT_LIST_DIR}/arlequin.f90)
