@@ -7,8 +7,9 @@
 !> coupled points (`multipliers_nodes`, a coarser mediator space, coupling_operator's
 !> `build_mediator`): the constraint is then Pi (q - C u) = 0, the disks receive Pi^T lambda
 !> and the FE -(Pi C)^T lambda, and A_m = Pi A Pi^T. A disk may move relative to the beam in
-!> the kernel of Pi (e.g. a zig-zag between the nodes). Both are handled by the same rows
-!> (coupling_bilateral with A^-1 replaced by B = Pi^T A_m^-1 Pi): `lambda` is always the force
+!> the kernel of Pi (e.g. a zig-zag between the nodes). Both are extensions of the abstract
+!> coupling_multiplier_space type (`space`), so the step does not branch on the choice; the
+!> rows (coupling_bilateral) use B = Pi^T A_m^-1 Pi in place of A^-1: `lambda` is always the force
 !> mu on the coupled DOFs (mu = Pi^T lambda_m), `multiplier` the multipliers themselves.
 !> The statistics' position/velocity/rotation residuals are those of the imposed constraint
 !> (Pi e with the mediator space), `particle_residual` the per-disk residual ||e||.
