@@ -13,16 +13,54 @@
 !> The constant shape needs no tags. Outside the region each side sees its own zone: the FE
 !> weight is 1 (`alpha_fe`), the disks' alpha is 0 (`alpha_disk`, weighted mass (1 - alpha) m).
 !> The boundary belongs to the region (a point within 1e-12 of the region's size of an edge).
+!>
+!> Several disjoint regions (e.g. the two bands of an interface between two blocks) form an
+!> `overlap_set_t`: a point takes the weight of the first region holding it, and 1 (FE) or
+!> 0 (disks) outside all of them. Both types extend the abstract `weight_field_t` that the
+!> weighted assembly takes.
 module coupling_overlap2d
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
     use coupling_weights, only: weight_config_t, overlap_weight_t, make_weight
     implicit none
     private
-    public :: overlap2d_t, make_box_overlap, make_polygon_overlap
+    public :: weight_field_t, overlap2d_t, overlap_set_t, make_box_overlap, make_polygon_overlap
+
+    !> A weight field alpha(x, y) of the 2D coupling.
+    type, abstract :: weight_field_t
+    contains
+        !> Weight of the FE side (1 outside the overlap).
+        procedure(weight_at_iface), deferred :: alpha_fe
+        !> Weight alpha of a disk (0 outside the overlap; its mass is (1 - alpha) m).
+        procedure(weight_at_iface), deferred :: alpha_disk
+        !> True when the box (xmin, xmax, ymin, ymax) misses the overlap (alpha_fe = 1 there).
+        procedure(weight_misses_iface), deferred :: misses
+        !> The disks to couple (alpha > 0: centre in the overlap) and every disk's alpha.
+        procedure :: select_disks => field_select_disks
+    end type weight_field_t
+
+    abstract interface
+        !> A weight at a point.
+        pure real(wp) function weight_at_iface(self, x, y) result(alpha)
+            import :: weight_field_t, wp
+            !> The weight field.
+            class(weight_field_t), intent(in) :: self
+            !> The point [m].
+            real(wp), intent(in) :: x, y
+        end function weight_at_iface
+
+        !> Whether a box misses the overlap.
+        pure logical function weight_misses_iface(self, box)
+            import :: weight_field_t, wp
+            !> The weight field.
+            class(weight_field_t), intent(in) :: self
+            !> The box (xmin, xmax, ymin, ymax) [m].
+            real(wp), intent(in) :: box(4)
+        end function weight_misses_iface
+    end interface
 
     !> A polygonal overlap region and its weight (see the module description).
-    type :: overlap2d_t
+    type, extends(weight_field_t) :: overlap2d_t
         !> Vertices (2, n_vertices), edge k from vertex k to vertex k + 1 (cyclic).
         real(wp), allocatable :: vertex(:, :)
         !> Edge on the FE side (n_vertices).
@@ -44,7 +82,22 @@ module coupling_overlap2d
         procedure :: alpha_fe => overlap_alpha_fe
         !> Weight alpha of a disk: alpha in the region, 0 outside (mass (1 - alpha) m).
         procedure :: alpha_disk => overlap_alpha_disk
+        !> True when a box misses the region's bounding box.
+        procedure :: misses => overlap_misses
     end type overlap2d_t
+
+    !> Disjoint overlap regions (see the module description).
+    type, extends(weight_field_t) :: overlap_set_t
+        !> The regions.
+        type(overlap2d_t), allocatable :: regions(:)
+    contains
+        !> Weight of the first region holding the point, 1 outside all.
+        procedure :: alpha_fe => set_alpha_fe
+        !> Disk weight of the first region holding the point, 0 outside all.
+        procedure :: alpha_disk => set_alpha_disk
+        !> True when a box misses every region.
+        procedure :: misses => set_misses
+    end type overlap_set_t
 
     !> Names of the edges of a box, in edge order.
     character(len=6), parameter :: box_sides(4) = ['bottom', 'right ', 'top   ', 'left  ']
@@ -257,4 +310,76 @@ contains
             alpha = 0.0_wp
         end if
     end function overlap_alpha_disk
+
+    !> Disk weights alpha_disk at the centres and the disks to couple: those with alpha > 0
+    !> (centre in the overlap), in increasing order.
+    pure subroutine field_select_disks(self, x, y, coupled, alpha)
+        !> The weight field.
+        class(weight_field_t), intent(in) :: self
+        !> Disk centres [m] (n_disks each).
+        real(wp), intent(in) :: x(:), y(:)
+        !> Indices of the coupled disks.
+        integer, allocatable, intent(out) :: coupled(:)
+        !> alpha of every disk (n_disks); its weighted mass is (1 - alpha) m.
+        real(wp), allocatable, intent(out) :: alpha(:)
+        integer :: i
+        allocate (alpha(size(x)))
+        do i = 1, size(x)
+            alpha(i) = self%alpha_disk(x(i), y(i))
+        end do
+        coupled = pack([(i, i=1, size(x))], alpha > 0)
+    end subroutine field_select_disks
+
+    !> True when the box misses the region's bounding box (up to the boundary tolerance).
+    pure logical function overlap_misses(self, box)
+        !> The region.
+        class(overlap2d_t), intent(in) :: self
+        !> The box (xmin, xmax, ymin, ymax) [m].
+        real(wp), intent(in) :: box(4)
+        overlap_misses = box(2) < self%box(1) - self%tol .or. box(1) > self%box(2) + self%tol .or. &
+                         box(4) < self%box(3) - self%tol .or. box(3) > self%box(4) + self%tol
+    end function overlap_misses
+
+    !> FE weight of the first region holding the point, 1 outside all.
+    pure real(wp) function set_alpha_fe(self, x, y) result(alpha)
+        !> The regions.
+        class(overlap_set_t), intent(in) :: self
+        !> The point [m].
+        real(wp), intent(in) :: x, y
+        integer :: k
+        alpha = 1.0_wp
+        do k = 1, size(self%regions)
+            if (.not. self%regions(k)%contains(x, y)) cycle
+            alpha = self%regions(k)%alpha_fe(x, y)
+            return
+        end do
+    end function set_alpha_fe
+
+    !> Disk weight of the first region holding the point, 0 outside all.
+    pure real(wp) function set_alpha_disk(self, x, y) result(alpha)
+        !> The regions.
+        class(overlap_set_t), intent(in) :: self
+        !> The point [m].
+        real(wp), intent(in) :: x, y
+        integer :: k
+        alpha = 0.0_wp
+        do k = 1, size(self%regions)
+            if (.not. self%regions(k)%contains(x, y)) cycle
+            alpha = self%regions(k)%alpha_disk(x, y)
+            return
+        end do
+    end function set_alpha_disk
+
+    !> True when the box misses every region.
+    pure logical function set_misses(self, box)
+        !> The regions.
+        class(overlap_set_t), intent(in) :: self
+        !> The box (xmin, xmax, ymin, ymax) [m].
+        real(wp), intent(in) :: box(4)
+        integer :: k
+        set_misses = .true.
+        do k = 1, size(self%regions)
+            if (.not. self%regions(k)%misses(box)) set_misses = .false.
+        end do
+    end function set_misses
 end module coupling_overlap2d

@@ -1,7 +1,8 @@
 !> alpha-weighted mass and stiffness of a 2D continuum in an Arlequin overlap (doc/continuum.md,
 !> "Arlequin coupling in 2D"; doc/theory.md section 6.9):
 !>   K_alpha = int alpha B^T D B t dA,   M_alpha = int alpha rho t N^T N dA,
-!> with alpha = coupling_overlap2d's FE weight (1 outside the region). Elements whose bounding
+!> with alpha = the FE weight of a coupling_overlap2d weight field (one region or a set of
+!> disjoint regions; 1 outside). Elements whose bounding
 !> box misses the region's are assembled with their own rule (alpha = 1, bitwise the
 !> unweighted model); the others by an n x n Gauss-Legendre rule (Q4) or its collapsed
 !> (Duffy) form on the triangle (T3), n = `order` (default 4). A polynomial alpha of degree d
@@ -16,7 +17,7 @@ module coupling_weighted2d
     use fem_element2d, only: element2d_t
     use fem_elastic2d, only: elastic2d_t
     use fem_triplets, only: fem_triplets_t
-    use coupling_overlap2d, only: overlap2d_t
+    use coupling_overlap2d, only: weight_field_t
     implicit none
     private
     public :: assemble_weighted, gauss_legendre
@@ -27,8 +28,8 @@ contains
     subroutine assemble_weighted(model, region, k, m, error, lumped, order)
         !> The continuum model (materials assigned).
         type(continuum_model_t), intent(in) :: model
-        !> The overlap region and its weight.
-        type(overlap2d_t), intent(in) :: region
+        !> The overlap weight (one region, or a set of regions).
+        class(weight_field_t), intent(in) :: region
         !> Weighted stiffness.
         type(fem_triplets_t), intent(out) :: k
         !> Weighted mass.
@@ -60,7 +61,7 @@ contains
             nodes = model%mesh%element_nodes(e)
             dofs = reshape(transpose(reshape([2*nodes - 1, 2*nodes], [size(nodes), 2])), [2*size(nodes)])
             associate (el => model%family(model%mesh%kind(e))%element, mat => model%materials(model%element_material(e)))
-                if (misses(region, xe)) then
+                if (region%misses([minval(xe(1, :)), maxval(xe(1, :)), minval(xe(2, :)), maxval(xe(2, :))])) then
                     ke = el%stiffness(xe, mat)
                     me = el%mass_consistent(xe, mat)
                 else
@@ -79,20 +80,12 @@ contains
         end do
     end subroutine assemble_weighted
 
-    !> True when the element's bounding box misses the region's.
-    pure logical function misses(region, xe)
-        type(overlap2d_t), intent(in) :: region
-        real(wp), intent(in) :: xe(:, :)
-        misses = maxval(xe(1, :)) < region%box(1) - region%tol .or. minval(xe(1, :)) > region%box(2) + region%tol .or. &
-                 maxval(xe(2, :)) < region%box(3) - region%tol .or. minval(xe(2, :)) > region%box(4) + region%tol
-    end function misses
-
     !> Element matrices with the weight at every quadrature point.
     subroutine weighted_element(el, xe, mat, region, pts, w, ke, me)
         class(element2d_t), intent(in) :: el
         real(wp), intent(in) :: xe(:, :)
         type(elastic2d_t), intent(in) :: mat
-        type(overlap2d_t), intent(in) :: region
+        class(weight_field_t), intent(in) :: region
         real(wp), intent(in) :: pts(:, :), w(:)
         real(wp), allocatable, intent(out) :: ke(:, :), me(:, :)
         real(wp), allocatable :: n(:), dndx(:, :), b(:, :)
