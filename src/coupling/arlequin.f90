@@ -7,8 +7,9 @@
 !> coupled points (`multipliers_nodes`, a coarser mediator space, coupling_operator's
 !> `build_mediator`): the constraint is then Pi (q - C u) = 0, the disks receive Pi^T lambda
 !> and the FE -(Pi C)^T lambda, and A_m = Pi A Pi^T. A disk may move relative to the beam in
-!> the kernel of Pi (e.g. a zig-zag between the nodes). Both are handled by the same rows
-!> (coupling_bilateral with A^-1 replaced by B = Pi^T A_m^-1 Pi): `lambda` is always the force
+!> the kernel of Pi (e.g. a zig-zag between the nodes). Both are extensions of the abstract
+!> coupling_multiplier_space type (`space`), so the step does not branch on the choice; the
+!> rows (coupling_bilateral) use B = Pi^T A_m^-1 Pi in place of A^-1: `lambda` is always the force
 !> mu on the coupled DOFs (mu = Pi^T lambda_m), `multiplier` the multipliers themselves.
 !> The statistics' position/velocity/rotation residuals are those of the imposed constraint
 !> (Pi e with the mediator space), `particle_residual` the per-disk residual ||e||.
@@ -74,6 +75,8 @@ module coupling_arlequin
                                  build_mediator
     use coupling_lambda, only: coupling_system_t, fe_coupling_force
     use coupling_bilateral, only: coupling_rows_t
+    use coupling_multiplier_space, only: multiplier_space_t, disk_space_t, mediator_space_t, &
+                                         make_mediator_space
     implicit none
     private
     public :: coupling_config_t, coupled_system_t, coupled_stats_t, coupled_energies_t
@@ -177,12 +180,12 @@ module coupling_arlequin
         type(coupling_system_t) :: multipliers
         !> Coupling rows as NLGS bilateral constraints (holds A^-1 or B).
         type(coupling_rows_t) :: rows
-        !> Multipliers on the FE nodes (mediator space) instead of the coupled DOFs.
+        !> The multiplier space (per coupled DOF, or the mediator space on the beam nodes).
+        class(multiplier_space_t), allocatable :: space
+        !> The space imposes only a projection Pi e (multipliers on the nodes); for messages.
         logical :: on_nodes = .false.
-        !> The mediator space (with on_nodes).
+        !> The beam nodes of the mediator space (with on_nodes; n_nodes = 0 otherwise).
         type(mediator_t) :: mediator
-        !> lambda_m = R mu, R = A_m^-1 Pi A (n_mult, n_rows) (with on_nodes).
-        real(wp), allocatable :: recover(:, :)
         !> Multipliers after a step: lambda (per DOF) or lambda_m (mediator) [N, N.m].
         real(wp), allocatable :: multiplier(:)
         !> Out-of-plane thickness of the particle domain [m].
@@ -240,7 +243,7 @@ contains
         real(wp), intent(in), optional :: fe_u0(:, :), fe_v0(:, :)
         real(wp), allocatable :: u0(:), v0(:), s(:), off(:), im(:, :), iw(:), alpha_pts(:)
         real(wp) :: h
-        integer :: n, r, i
+        integer :: n, r
         if (.not. (config%thickness > 0)) then
             call make_error(error, 'coupling: thickness (out-of-plane depth of the particle '// &
                             'domain, usually the width of the beam section) must be > 0')
@@ -300,50 +303,34 @@ contains
         end do
         call sys%multipliers%assemble(sys%op, sys%fe, error, inverse_mass=sys%fe%gamma*iw)
         if (allocated(error)) return
-        sys%on_nodes = config%multipliers == multipliers_nodes
-        if (sys%on_nodes) then
-            call mediator_inverse(sys, error)
-            if (allocated(error)) return
-        else
-            allocate (sys%rows%ainv(sys%op%n_rows, sys%op%n_rows), source=0.0_wp)
-            do i = 1, sys%op%n_rows
-                sys%rows%ainv(i, i) = 1.0_wp
-            end do
-            call sys%multipliers%a%solve(sys%rows%ainv, error)
-            if (allocated(error)) return
-        end if
+        call make_space(config, sys, error)
+        if (allocated(error)) return
+        call sys%space%inverse(sys%multipliers%a, sys%rows%ainv, error)
+        if (allocated(error)) return
+        sys%on_nodes = sys%space%projected()
         sys%rows%ainv = 0.5_wp*(sys%rows%ainv + transpose(sys%rows%ainv))
         sys%rows%response = h*sys%fe%gamma*iw
         sys%rows%scale = h*sys%fe%gamma/sys%thickness
         call init_state(sys)
     end subroutine build_coupled_system
 
-    !> Mediator space: Pi, A_m = Pi A Pi^T (factored: SPD when the rows of Pi are
-    !> independent, checked by build_mediator), B = Pi^T A_m^-1 Pi in the rows, R = A_m^-1 Pi A.
-    subroutine mediator_inverse(sys, error)
+    !> The multiplier space chosen by config%multipliers: per coupled DOF, or the mediator
+    !> space on the beam nodes carrying coupled points (Pi from build_mediator).
+    subroutine make_space(config, sys, error)
+        type(coupling_config_t), intent(in) :: config
         type(coupled_system_t), intent(inout) :: sys
         type(error_t), allocatable, intent(out) :: error
-        type(dense_spd_t) :: am
-        real(wp), allocatable :: p(:, :)
-        call build_mediator(sys%model, sys%op, sys%mediator, error)
-        if (allocated(error)) return
-        associate (pi => sys%mediator%pi, a => sys%multipliers%a%a)
-            call am%init(sys%mediator%n_mult)
-            am%a = matmul(pi, matmul(a, transpose(pi)))
-            am%a = 0.5_wp*(am%a + transpose(am%a))
-            call am%factor(error)
-            if (allocated(error)) then
-                error%message = 'coupling: multipliers = nodes: A_m = Pi A Pi^T is singular; '// &
-                                error%message
-                return
-            end if
-            p = pi
-            call am%solve(p, error)
+        type(mediator_space_t) :: med
+        if (config%multipliers == multipliers_nodes) then
+            call build_mediator(sys%model, sys%op, sys%mediator, error)
             if (allocated(error)) return
-            sys%rows%ainv = matmul(transpose(pi), p)
-            sys%recover = matmul(p, a)
-        end associate
-    end subroutine mediator_inverse
+            call make_mediator_space(sys%mediator%pi, sys%mediator%comp, med, error)
+            if (allocated(error)) return
+            allocate (sys%space, source=med)
+        else
+            allocate (sys%space, source=disk_space_t(sys%rows%dof))
+        end if
+    end subroutine make_space
 
     !> Error when an element lies wholly where alpha = 0 (beyond the overlap's particle end):
     !> it would have neither mass nor stiffness.
@@ -521,11 +508,7 @@ contains
         allocate (sys%lambda(nr), sys%lambda_old(nr), sys%g(nr), sys%q(nr), sys%drift(nr), &
                   sys%cv(nr), sys%gv(nr), sys%cu0(nr), sys%start(nr), source=0.0_wp)
         allocate (sys%fc(sys%op%n_free), source=0.0_wp)
-        if (sys%on_nodes) then
-            allocate (sys%multiplier(sys%mediator%n_mult), source=0.0_wp)
-        else
-            allocate (sys%multiplier(nr), source=0.0_wp)
-        end if
+        allocate (sys%multiplier(sys%space%n_mult), source=0.0_wp)
         call sys%op%apply(sys%fe%u, sys%cu0)
         associate (p => sys%dem%particles)
             do r = 1, nr
@@ -576,18 +559,13 @@ contains
         nrm = norm2(merge(v, 0.0_wp, (sys%rows%dof == dof_rot) .eqv. rotation))
     end function row_norm
 
-    !> Norm of the imposed part of a row vector v: row_norm(v), or the norm of Pi v over the
-    !> translation (or rotation) multipliers of the mediator space.
+    !> Norm of the imposed part of a row vector v (Pi v over the translation or rotation
+    !> multipliers; v itself per coupled DOF).
     pure real(wp) function constraint_norm(sys, v, rotation) result(nrm)
         type(coupled_system_t), intent(in) :: sys
         real(wp), intent(in) :: v(:)
         logical, intent(in) :: rotation
-        if (sys%on_nodes) then
-            nrm = norm2(merge(matmul(sys%mediator%pi, v), 0.0_wp, &
-                              (sys%mediator%comp == dof_rot) .eqv. rotation))
-        else
-            nrm = row_norm(sys, v, rotation)
-        end if
+        nrm = sys%space%constraint_norm(v, rotation)
     end function constraint_norm
 
     !> Advance the coupled system by one time step (see the module description).
@@ -661,11 +639,7 @@ contains
             st%position_residual = constraint_norm(sys, sys%drift, .false.)
             st%rotation_residual = constraint_norm(sys, sys%drift, .true.)
             st%particle_residual = row_norm(sys, sys%drift, .false.)
-            if (sys%on_nodes) then
-                sys%multiplier = matmul(sys%recover, sys%lambda)
-            else
-                sys%multiplier = sys%lambda
-            end if
+            call sys%space%recover(sys%lambda, sys%multiplier)
             st%lambda_norm = norm2(sys%multiplier)
         end associate
         sys%lambda_old = sys%lambda

@@ -17,7 +17,7 @@ module coupling_lambda
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_linalg, only: dense_spd_t
     use fem_newmark, only: newmark_t
-    use coupling_operator, only: coupling_operator_t
+    use coupling_map, only: coupling_map_t
     implicit none
     private
     public :: coupling_system_t, fe_coupling_force
@@ -31,21 +31,23 @@ module coupling_lambda
         !> A = h (W + gamma C S^-1 C^T) and its Cholesky factor.
         type(dense_spd_t) :: a
     contains
-        !> Build and factor A.
+        !> Build and factor A for a beam integrator (Newmark).
         procedure :: assemble
+        !> Build and factor A from the FE response S^-1 C^T of any FE model.
+        procedure :: assemble_response
         !> lambda = -A^-1 g.
         procedure :: solve
     end type coupling_system_t
 
 contains
 
-    !> Build A = h (W + gamma C S^-1 C^T) and factor it. W is diag(inverse_mass), plus
-    !> `mobility` if given (at least one of the two is needed).
+    !> Build A = h (W + gamma C S^-1 C^T) and factor it, with the beam integrator's factored S.
+    !> W is diag(inverse_mass), plus `mobility` if given (at least one of the two is needed).
     subroutine assemble(self, op, integ, error, inverse_mass, mobility)
         !> The multiplier system.
         class(coupling_system_t), intent(inout) :: self
         !> The coupling operator.
-        type(coupling_operator_t), intent(in) :: op
+        class(coupling_map_t), intent(in) :: op
         !> The FE time integrator, initialised (its factored S, h and gamma are used).
         type(newmark_t), intent(in) :: integ
         !> Set on inconsistent sizes, a negative inverse mass or a singular A.
@@ -57,9 +59,77 @@ contains
         !> multipliers (G M^-1 G^T of a rigid cluster), symmetric (n_rows, n_rows).
         real(wp), intent(in), optional :: mobility(:, :)
         real(wp), allocatable :: ct(:, :), x(:, :)
+        call check_particle_side(op%n_rows, error, inverse_mass, mobility)
+        if (allocated(error)) return
+        if (size(integ%u) /= op%n_free) then
+            call make_error(error, 'coupling multipliers: C and the FE integrator have '// &
+                            'different numbers of free DOFs')
+            return
+        end if
+        ! gamma C S^-1 C^T, column by column of C^T.
+        ct = transpose(op%to_dense())
+        allocate (x(op%n_free, op%n_rows))
+        call integ%solve_effective(ct, x, error)
+        if (allocated(error)) return
+        call self%assemble_response(op, x, integ%h, integ%gamma, error, inverse_mass, mobility)
+    end subroutine assemble
+
+    !> Build A = h (W + gamma C X) and factor it, X = S^-1 C^T the response of the FE model's
+    !> effective matrix S (any FE model: beam, 2D continuum) to the columns of C^T.
+    subroutine assemble_response(self, op, x, h, gamma, error, inverse_mass, mobility)
+        !> The multiplier system.
+        class(coupling_system_t), intent(inout) :: self
+        !> The coupling operator.
+        class(coupling_map_t), intent(in) :: op
+        !> S^-1 C^T (n_free, n_rows).
+        real(wp), intent(in) :: x(:, :)
+        !> Time step [s] and Newmark gamma.
+        real(wp), intent(in) :: h, gamma
+        !> Set on inconsistent sizes, a negative inverse mass or a singular A.
+        type(error_t), allocatable, intent(out) :: error
+        !> Particle side, independent DOFs (see `assemble`).
+        real(wp), intent(in), optional :: inverse_mass(:)
+        !> Particle side, coupled DOFs (see `assemble`).
+        real(wp), intent(in), optional :: mobility(:, :)
         integer :: n, j
-        character(len=200) :: buf
         n = op%n_rows
+        call check_particle_side(n, error, inverse_mass, mobility)
+        if (allocated(error)) return
+        if (any(shape(x) /= [op%n_free, n])) then
+            call make_error(error, 'coupling multipliers: the FE response S^-1 C^T must be (n_free, n_rows)')
+            return
+        end if
+        self%n = n
+        self%h = h
+        call self%a%init(n)
+        do j = 1, n
+            call op%apply(x(:, j), self%a%a(:, j))
+        end do
+        self%a%a = gamma*self%a%a
+        if (present(mobility)) self%a%a = self%a%a + mobility
+        if (present(inverse_mass)) then
+            do j = 1, n
+                self%a%a(j, j) = self%a%a(j, j) + inverse_mass(j)
+            end do
+        end if
+        ! Symmetric up to the rounding of the solves; keep it exactly symmetric.
+        self%a%a = self%h*0.5_wp*(self%a%a + transpose(self%a%a))
+        call self%a%factor(error)
+        if (allocated(error)) then
+            error%message = 'coupling multipliers: A = h (W + gamma C S^-1 C^T) is singular: '// &
+                            'a coupled DOF without weighted mass on the particle side (alpha = 1), '// &
+                            'or more multipliers than the FE can resolve (too many coupled points '// &
+                            'per element: couple fewer or use the mediator space); '//error%message
+        end if
+    end subroutine assemble_response
+
+    !> Checks of the particle side of A (sizes, signs, finiteness).
+    subroutine check_particle_side(n, error, inverse_mass, mobility)
+        integer, intent(in) :: n
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), intent(in), optional :: inverse_mass(:)
+        real(wp), intent(in), optional :: mobility(:, :)
+        character(len=200) :: buf
         if (.not. (present(inverse_mass) .or. present(mobility))) then
             call make_error(error, 'coupling multipliers: the particle side is missing (give '// &
                             'inverse_mass or mobility)')
@@ -90,39 +160,7 @@ contains
                 return
             end if
         end if
-        if (size(integ%u) /= op%n_free) then
-            call make_error(error, 'coupling multipliers: C and the FE integrator have '// &
-                            'different numbers of free DOFs')
-            return
-        end if
-        self%n = n
-        self%h = integ%h
-        call self%a%init(n)
-        ! gamma C S^-1 C^T, column by column of C^T.
-        ct = transpose(op%to_dense())
-        allocate (x(op%n_free, n))
-        call integ%solve_effective(ct, x, error)
-        if (allocated(error)) return
-        do j = 1, n
-            call op%apply(x(:, j), self%a%a(:, j))
-        end do
-        self%a%a = integ%gamma*self%a%a
-        if (present(mobility)) self%a%a = self%a%a + mobility
-        if (present(inverse_mass)) then
-            do j = 1, n
-                self%a%a(j, j) = self%a%a(j, j) + inverse_mass(j)
-            end do
-        end if
-        ! Symmetric up to the rounding of the solves; keep it exactly symmetric.
-        self%a%a = self%h*0.5_wp*(self%a%a + transpose(self%a%a))
-        call self%a%factor(error)
-        if (allocated(error)) then
-            error%message = 'coupling multipliers: A = h (W + gamma C S^-1 C^T) is singular: '// &
-                            'a coupled DOF without weighted mass on the particle side (alpha = 1), '// &
-                            'or more multipliers than the FE can resolve (too many coupled points '// &
-                            'per element: couple fewer or use the mediator space); '//error%message
-        end if
-    end subroutine assemble
+    end subroutine check_particle_side
 
     !> lambda = -A^-1 g: the multipliers that cancel the free velocity residual
     !> g = v_d,free - C v_c,free (see the module description).
@@ -147,7 +185,7 @@ contains
     !> FE coupling force f = -C^T lambda (n_free), to pass to `newmark_t%correct`.
     pure subroutine fe_coupling_force(op, lambda, f)
         !> The coupling operator.
-        type(coupling_operator_t), intent(in) :: op
+        class(coupling_map_t), intent(in) :: op
         !> Multipliers (n_rows).
         real(wp), intent(in) :: lambda(:)
         !> Force on the free DOFs (n_free).

@@ -23,6 +23,7 @@ module coupling_operator
     use core_weight, only: weight_function_t
     use fem_beam_model, only: beam_model_t
     use fem_beam_element, only: element_interpolation, rotation_matrix
+    use coupling_map, only: coupling_map_t
     implicit none
     private
     public :: coupling_operator_t, build_coupling_operator, row_x, row_y, row_phi
@@ -36,15 +37,7 @@ module coupling_operator
     integer, parameter :: row_phi = 3
 
     !> Sparse C (n_rows, n_free) and where each coupled point sits on the beam.
-    type :: coupling_operator_t
-        !> Number of coupled points.
-        integer :: n_points = 0
-        !> Rows per point: 2 (x, y) or 3 (x, y, phi).
-        integer :: rows_per_point = 2
-        !> Number of rows n_points*rows_per_point.
-        integer :: n_rows = 0
-        !> Number of columns (free DOFs of the model).
-        integer :: n_free = 0
+    type, extends(coupling_map_t) :: coupling_operator_t
         !> Element holding each point (n_points).
         integer, allocatable :: element(:)
         !> Reduced coordinate on that element, in [0, 1] (n_points).
@@ -62,8 +55,6 @@ module coupling_operator
         procedure :: apply
         !> f = C^T lambda.
         procedure :: apply_transpose
-        !> Row index of a component (row_x, row_y, row_phi) of a point.
-        procedure :: row_of
         !> C as a dense (n_rows, n_free) matrix (tests, small systems).
         procedure :: to_dense
         !> Weight alpha at each coupled point; error if one is outside the overlap.
@@ -296,33 +287,22 @@ contains
     end subroutine apply
 
     !> f = C^T lambda.
-    pure subroutine apply_transpose(self, lambda, f)
+    pure subroutine apply_transpose(self, u, cu)
         !> The operator.
         class(coupling_operator_t), intent(in) :: self
         !> One value per row (n_rows).
-        real(wp), intent(in) :: lambda(:)
+        real(wp), intent(in) :: u(:)
         !> Result on the free DOFs (n_free).
-        real(wp), intent(out) :: f(:)
+        real(wp), intent(out) :: cu(:)
         integer :: r, k
-        f = 0.0_wp
+        cu = 0.0_wp
         do r = 1, self%n_rows
             do k = 1, 6
-                if (self%col(k, r) > 0) f(self%col(k, r)) = f(self%col(k, r)) + &
-                                                            self%val(k, r)*lambda(r)
+                if (self%col(k, r) > 0) cu(self%col(k, r)) = cu(self%col(k, r)) + &
+                                                             self%val(k, r)*u(r)
             end do
         end do
     end subroutine apply_transpose
-
-    !> Row of component comp (row_x, row_y or row_phi) of point p.
-    pure integer function row_of(self, p, comp)
-        !> The operator.
-        class(coupling_operator_t), intent(in) :: self
-        !> Point (1..n_points).
-        integer, intent(in) :: p
-        !> Component.
-        integer, intent(in) :: comp
-        row_of = (p - 1)*self%rows_per_point + comp
-    end function row_of
 
     !> Dense copy of C (n_rows, n_free).
     pure function to_dense(self) result(c)

@@ -1,0 +1,385 @@
+!> Overlap regions of the 2D Arlequin coupling and their weight alpha(x, y) (doc/continuum.md,
+!> "Arlequin coupling in 2D"; doc/theory.md section 6.9).
+!>
+!> A region is a simple polygon (an axis-aligned box is the polygon of its four corners, edges
+!> bottom, right, top, left in that order). Each edge is tagged: on the FE side (the overlap
+!> meets the FE-only zone there), on the particle side (it meets the particle-only zone), or
+!> neither (a lateral edge, e.g. the ends of a band). Inside the region, with d_fe and d_p the
+!> distances to the nearest FE-side and particle-side edges,
+!>   xi = d_fe / (d_fe + d_p)  in [0, 1],   alpha = clip(r(xi), alpha_min, 1 - alpha_min),
+!> with the ramps r of coupling_weights (constant c, linear 1 - xi, cubic 1 - 3 xi^2 + 2 xi^3):
+!> alpha is 1 - alpha_min on the FE side, alpha_min on the particle side. For a band between
+!> two parallel edges xi is the reduced coordinate across the band, the 1D weight exactly.
+!> The constant shape needs no tags. Outside the region each side sees its own zone: the FE
+!> weight is 1 (`alpha_fe`), the disks' alpha is 0 (`alpha_disk`, weighted mass (1 - alpha) m).
+!> The boundary belongs to the region (a point within 1e-12 of the region's size of an edge).
+!>
+!> Several disjoint regions (e.g. the two bands of an interface between two blocks) form an
+!> `overlap_set_t`: a point takes the weight of the first region holding it, and 1 (FE) or
+!> 0 (disks) outside all of them. Both types extend the abstract `weight_field_t` that the
+!> weighted assembly takes.
+module coupling_overlap2d
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_error
+    use coupling_weights, only: weight_config_t, overlap_weight_t, make_weight
+    implicit none
+    private
+    public :: weight_field_t, overlap2d_t, overlap_set_t, make_box_overlap, make_polygon_overlap
+
+    !> A weight field alpha(x, y) of the 2D coupling.
+    type, abstract :: weight_field_t
+    contains
+        !> Weight of the FE side (1 outside the overlap).
+        procedure(weight_at_iface), deferred :: alpha_fe
+        !> Weight alpha of a disk (0 outside the overlap; its mass is (1 - alpha) m).
+        procedure(weight_at_iface), deferred :: alpha_disk
+        !> True when the box (xmin, xmax, ymin, ymax) misses the overlap (alpha_fe = 1 there).
+        procedure(weight_misses_iface), deferred :: misses
+        !> The disks to couple (alpha > 0: centre in the overlap) and every disk's alpha.
+        procedure :: select_disks => field_select_disks
+    end type weight_field_t
+
+    abstract interface
+        !> A weight at a point.
+        pure real(wp) function weight_at_iface(self, x, y) result(alpha)
+            import :: weight_field_t, wp
+            !> The weight field.
+            class(weight_field_t), intent(in) :: self
+            !> The point [m].
+            real(wp), intent(in) :: x, y
+        end function weight_at_iface
+
+        !> Whether a box misses the overlap.
+        pure logical function weight_misses_iface(self, box)
+            import :: weight_field_t, wp
+            !> The weight field.
+            class(weight_field_t), intent(in) :: self
+            !> The box (xmin, xmax, ymin, ymax) [m].
+            real(wp), intent(in) :: box(4)
+        end function weight_misses_iface
+    end interface
+
+    !> A polygonal overlap region and its weight (see the module description).
+    type, extends(weight_field_t) :: overlap2d_t
+        !> Vertices (2, n_vertices), edge k from vertex k to vertex k + 1 (cyclic).
+        real(wp), allocatable :: vertex(:, :)
+        !> Edge on the FE side (n_vertices).
+        logical, allocatable :: fe_edge(:)
+        !> Edge on the particle side (n_vertices).
+        logical, allocatable :: particle_edge(:)
+        !> Ramp r(xi) and floor, over xi in [0, 1] (s_fe = 0, s_particle = 1).
+        type(overlap_weight_t) :: weight
+        !> Bounding box (xmin, xmax, ymin, ymax) [m].
+        real(wp) :: box(4) = 0.0_wp
+        !> Distance under which a point is on the boundary [m].
+        real(wp) :: tol = 0.0_wp
+    contains
+        !> True when (x, y) lies in the region (boundary included).
+        procedure :: contains => overlap_contains
+        !> Reduced coordinate xi in [0, 1] of a point of the region.
+        procedure :: reduced => overlap_reduced
+        !> Weight of the FE side: alpha in the region, 1 outside.
+        procedure :: alpha_fe => overlap_alpha_fe
+        !> Weight alpha of a disk: alpha in the region, 0 outside (mass (1 - alpha) m).
+        procedure :: alpha_disk => overlap_alpha_disk
+        !> True when a box misses the region's bounding box.
+        procedure :: misses => overlap_misses
+    end type overlap2d_t
+
+    !> Disjoint overlap regions (see the module description).
+    type, extends(weight_field_t) :: overlap_set_t
+        !> The regions.
+        type(overlap2d_t), allocatable :: regions(:)
+    contains
+        !> Weight of the first region holding the point, 1 outside all.
+        procedure :: alpha_fe => set_alpha_fe
+        !> Disk weight of the first region holding the point, 0 outside all.
+        procedure :: alpha_disk => set_alpha_disk
+        !> True when a box misses every region.
+        procedure :: misses => set_misses
+    end type overlap_set_t
+
+    !> Names of the edges of a box, in edge order.
+    character(len=6), parameter :: box_sides(4) = ['bottom', 'right ', 'top   ', 'left  ']
+
+contains
+
+    !> An axis-aligned box [xmin, xmax] x [ymin, ymax]; fe_side and particle_side name its
+    !> edges ('bottom', 'right', 'top', 'left'; empty strings for the constant shape).
+    subroutine make_box_overlap(xmin, xmax, ymin, ymax, fe_side, particle_side, weight, region, error)
+        !> Extent of the box [m].
+        real(wp), intent(in) :: xmin, xmax, ymin, ymax
+        !> Side next to the FE-only zone.
+        character(len=*), intent(in) :: fe_side
+        !> Side next to the particle-only zone.
+        character(len=*), intent(in) :: particle_side
+        !> Shape, floor and constant value (s_fe and s_particle are ignored).
+        type(weight_config_t), intent(in) :: weight
+        !> The region.
+        type(overlap2d_t), intent(out) :: region
+        !> Set on an empty box, an unknown side name or an invalid weight.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: kf, kp
+        if (.not. (xmax > xmin .and. ymax > ymin)) then
+            call make_error(error, 'overlap box: empty (need xmin < xmax and ymin < ymax)')
+            return
+        end if
+        kf = side_index(fe_side)
+        kp = side_index(particle_side)
+        if (kf < 0) then
+            call make_error(error, "overlap box: unknown side '"//trim(fe_side)//"' (expected bottom, right, top or left)")
+            return
+        else if (kp < 0) then
+            call make_error(error, "overlap box: unknown side '"//trim(particle_side)// &
+                            "' (expected bottom, right, top or left)")
+            return
+        end if
+        call make_polygon_overlap(reshape([xmin, ymin, xmax, ymin, xmax, ymax, xmin, ymax], [2, 4]), &
+                                  pack([1, 2, 3, 4], [1, 2, 3, 4] == kf), pack([1, 2, 3, 4], [1, 2, 3, 4] == kp), &
+                                  weight, region, error)
+    end subroutine make_box_overlap
+
+    !> Index of a box side by name, 0 for an empty name, -1 when unknown.
+    pure integer function side_index(name) result(k)
+        character(len=*), intent(in) :: name
+        if (len_trim(name) == 0) then
+            k = 0
+        else
+            k = findloc(box_sides, trim(name), dim=1)
+            if (k == 0) k = -1
+        end if
+    end function side_index
+
+    !> A polygon (vertices in either orientation, not self-intersecting) with the indices of
+    !> its FE-side and particle-side edges (edge k joins vertices k and k + 1).
+    subroutine make_polygon_overlap(vertex, fe_edges, particle_edges, weight, region, error)
+        !> Vertices (2, n), n >= 3 [m].
+        real(wp), intent(in) :: vertex(:, :)
+        !> FE-side edges.
+        integer, intent(in) :: fe_edges(:)
+        !> Particle-side edges.
+        integer, intent(in) :: particle_edges(:)
+        !> Shape, floor and constant value (s_fe and s_particle are ignored).
+        type(weight_config_t), intent(in) :: weight
+        !> The region.
+        type(overlap2d_t), intent(out) :: region
+        !> Set on too few vertices, a zero area, an edge index out of range or tagged twice,
+        !> a ramp without edges on both sides, or an invalid weight.
+        type(error_t), allocatable, intent(out) :: error
+        type(weight_config_t) :: w
+        integer, allocatable :: tags(:)
+        integer :: n, k, e
+        real(wp) :: area
+        character(len=200) :: buf
+        n = size(vertex, 2)
+        if (n < 3 .or. size(vertex, 1) /= 2) then
+            call make_error(error, 'overlap polygon: needs at least 3 vertices (x, y)')
+            return
+        end if
+        area = 0.0_wp
+        do k = 1, n
+            area = area + cross(vertex(:, k), vertex(:, modulo(k, n) + 1))
+        end do
+        if (.not. abs(area) > 0) then
+            call make_error(error, 'overlap polygon: zero area')
+            return
+        end if
+        allocate (region%fe_edge(n), region%particle_edge(n), source=.false.)
+        tags = [fe_edges, particle_edges]
+        do k = 1, size(tags)
+            e = tags(k)
+            if (e < 1 .or. e > n) then
+                write (buf, '(a,i0,a,i0,a)') 'overlap polygon: edge ', e, ' does not exist (edges 1..', n, ')'
+            else if (region%fe_edge(e) .or. region%particle_edge(e)) then
+                write (buf, '(a,i0,a)') 'overlap polygon: edge ', e, ' is tagged twice'
+            else
+                if (k <= size(fe_edges)) then
+                    region%fe_edge(e) = .true.
+                else
+                    region%particle_edge(e) = .true.
+                end if
+                cycle
+            end if
+            call make_error(error, trim(buf))
+            return
+        end do
+        if (weight%shape /= 'constant' .and. .not. (any(region%fe_edge) .and. any(region%particle_edge))) then
+            call make_error(error, 'overlap: a '//trim(weight%shape)//' weight ramps from the FE side '// &
+                            'to the particle side: tag at least one edge of each')
+            return
+        end if
+        w = weight
+        w%s_fe = 0.0_wp
+        w%s_particle = 1.0_wp
+        call make_weight(w, region%weight, error)
+        if (allocated(error)) return
+        region%vertex = vertex
+        region%box = [minval(vertex(1, :)), maxval(vertex(1, :)), minval(vertex(2, :)), maxval(vertex(2, :))]
+        ! Rounding of coordinates at the scale of the region.
+        region%tol = 1.0e-12_wp*max(region%box(2) - region%box(1), region%box(4) - region%box(3))
+    end subroutine make_polygon_overlap
+
+    !> z component of a x b.
+    pure real(wp) function cross(a, b)
+        real(wp), intent(in) :: a(2), b(2)
+        cross = a(1)*b(2) - a(2)*b(1)
+    end function cross
+
+    !> Distance from p to the segment [a, b].
+    pure real(wp) function segment_distance(p, a, b) result(d)
+        real(wp), intent(in) :: p(2), a(2), b(2)
+        real(wp) :: t, ab(2)
+        ab = b - a
+        t = max(0.0_wp, min(1.0_wp, dot_product(p - a, ab)/dot_product(ab, ab)))
+        d = norm2(p - a - t*ab)
+    end function segment_distance
+
+    !> Inside test (crossing number), the boundary included.
+    pure logical function overlap_contains(self, x, y) result(inside)
+        !> The region.
+        class(overlap2d_t), intent(in) :: self
+        !> The point [m].
+        real(wp), intent(in) :: x, y
+        integer :: k, n
+        real(wp) :: a(2), b(2)
+        inside = .false.
+        if (x < self%box(1) - self%tol .or. x > self%box(2) + self%tol .or. &
+            y < self%box(3) - self%tol .or. y > self%box(4) + self%tol) return
+        n = size(self%vertex, 2)
+        do k = 1, n
+            a = self%vertex(:, k)
+            b = self%vertex(:, modulo(k, n) + 1)
+            if (segment_distance([x, y], a, b) <= self%tol) then
+                inside = .true.
+                return
+            end if
+            if ((a(2) > y) .neqv. (b(2) > y)) then
+                if (x < a(1) + (y - a(2))*(b(1) - a(1))/(b(2) - a(2))) inside = .not. inside
+            end if
+        end do
+    end function overlap_contains
+
+    !> xi = d_fe/(d_fe + d_p) of a point of the region (0 for the constant shape without tags).
+    pure real(wp) function overlap_reduced(self, x, y) result(xi)
+        !> The region.
+        class(overlap2d_t), intent(in) :: self
+        !> The point [m].
+        real(wp), intent(in) :: x, y
+        real(wp) :: dfe, dp, d
+        integer :: k, n
+        n = size(self%vertex, 2)
+        dfe = huge(1.0_wp)
+        dp = huge(1.0_wp)
+        do k = 1, n
+            if (.not. (self%fe_edge(k) .or. self%particle_edge(k))) cycle
+            d = segment_distance([x, y], self%vertex(:, k), self%vertex(:, modulo(k, n) + 1))
+            if (self%fe_edge(k)) dfe = min(dfe, d)
+            if (self%particle_edge(k)) dp = min(dp, d)
+        end do
+        if (dfe == huge(1.0_wp) .or. dp == huge(1.0_wp)) then
+            xi = 0.0_wp
+        else if (dfe + dp > 0) then
+            xi = dfe/(dfe + dp)
+        else
+            xi = 0.0_wp
+        end if
+    end function overlap_reduced
+
+    !> FE weight: the clipped ramp in the region, 1 outside (FE-only zone).
+    pure real(wp) function overlap_alpha_fe(self, x, y) result(alpha)
+        !> The region.
+        class(overlap2d_t), intent(in) :: self
+        !> The point [m].
+        real(wp), intent(in) :: x, y
+        if (self%contains(x, y)) then
+            alpha = self%weight%value(self%reduced(x, y))
+        else
+            alpha = 1.0_wp
+        end if
+    end function overlap_alpha_fe
+
+    !> Disk weight alpha: the clipped ramp in the region, 0 outside (particle-only zone).
+    pure real(wp) function overlap_alpha_disk(self, x, y) result(alpha)
+        !> The region.
+        class(overlap2d_t), intent(in) :: self
+        !> The point [m].
+        real(wp), intent(in) :: x, y
+        if (self%contains(x, y)) then
+            alpha = self%weight%value(self%reduced(x, y))
+        else
+            alpha = 0.0_wp
+        end if
+    end function overlap_alpha_disk
+
+    !> Disk weights alpha_disk at the centres and the disks to couple: those with alpha > 0
+    !> (centre in the overlap), in increasing order.
+    pure subroutine field_select_disks(self, x, y, coupled, alpha)
+        !> The weight field.
+        class(weight_field_t), intent(in) :: self
+        !> Disk centres [m] (n_disks each).
+        real(wp), intent(in) :: x(:), y(:)
+        !> Indices of the coupled disks.
+        integer, allocatable, intent(out) :: coupled(:)
+        !> alpha of every disk (n_disks); its weighted mass is (1 - alpha) m.
+        real(wp), allocatable, intent(out) :: alpha(:)
+        integer :: i
+        allocate (alpha(size(x)))
+        do i = 1, size(x)
+            alpha(i) = self%alpha_disk(x(i), y(i))
+        end do
+        coupled = pack([(i, i=1, size(x))], alpha > 0)
+    end subroutine field_select_disks
+
+    !> True when the box misses the region's bounding box (up to the boundary tolerance).
+    pure logical function overlap_misses(self, box)
+        !> The region.
+        class(overlap2d_t), intent(in) :: self
+        !> The box (xmin, xmax, ymin, ymax) [m].
+        real(wp), intent(in) :: box(4)
+        overlap_misses = box(2) < self%box(1) - self%tol .or. box(1) > self%box(2) + self%tol .or. &
+                         box(4) < self%box(3) - self%tol .or. box(3) > self%box(4) + self%tol
+    end function overlap_misses
+
+    !> FE weight of the first region holding the point, 1 outside all.
+    pure real(wp) function set_alpha_fe(self, x, y) result(alpha)
+        !> The regions.
+        class(overlap_set_t), intent(in) :: self
+        !> The point [m].
+        real(wp), intent(in) :: x, y
+        integer :: k
+        alpha = 1.0_wp
+        do k = 1, size(self%regions)
+            if (.not. self%regions(k)%contains(x, y)) cycle
+            alpha = self%regions(k)%alpha_fe(x, y)
+            return
+        end do
+    end function set_alpha_fe
+
+    !> Disk weight of the first region holding the point, 0 outside all.
+    pure real(wp) function set_alpha_disk(self, x, y) result(alpha)
+        !> The regions.
+        class(overlap_set_t), intent(in) :: self
+        !> The point [m].
+        real(wp), intent(in) :: x, y
+        integer :: k
+        alpha = 0.0_wp
+        do k = 1, size(self%regions)
+            if (.not. self%regions(k)%contains(x, y)) cycle
+            alpha = self%regions(k)%alpha_disk(x, y)
+            return
+        end do
+    end function set_alpha_disk
+
+    !> True when the box misses every region.
+    pure logical function set_misses(self, box)
+        !> The regions.
+        class(overlap_set_t), intent(in) :: self
+        !> The box (xmin, xmax, ymin, ymax) [m].
+        real(wp), intent(in) :: box(4)
+        integer :: k
+        set_misses = .true.
+        do k = 1, size(self%regions)
+            if (.not. self%regions(k)%misses(box)) set_misses = .false.
+        end do
+    end function set_misses
+end module coupling_overlap2d

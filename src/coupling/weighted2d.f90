@@ -1,0 +1,171 @@
+!> alpha-weighted mass and stiffness of a 2D continuum in an Arlequin overlap (doc/continuum.md,
+!> "Arlequin coupling in 2D"; doc/theory.md section 6.9):
+!>   K_alpha = int alpha B^T D B t dA,   M_alpha = int alpha rho t N^T N dA,
+!> with alpha = the FE weight of a coupling_overlap2d weight field (one region or a set of
+!> disjoint regions; 1 outside). Elements whose bounding
+!> box misses the region's are assembled with their own rule (alpha = 1, bitwise the
+!> unweighted model); the others by an n x n Gauss-Legendre rule (Q4) or its collapsed
+!> (Duffy) form on the triangle (T3), n = `order` (default 4). A polynomial alpha of degree d
+!> on an element lying in the region is integrated exactly when 2 n - 1 >= d + 2 (Q4 mass,
+!> per direction); across the region's boundary alpha has a kink and the rule is only
+!> convergent (refine the mesh or raise the order there).
+module coupling_weighted2d
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_error
+    use fem_continuum_model, only: continuum_model_t
+    use fem_mesh2d, only: element_t3
+    use fem_element2d, only: element2d_t
+    use fem_elastic2d, only: elastic2d_t
+    use fem_triplets, only: fem_triplets_t
+    use coupling_overlap2d, only: weight_field_t
+    implicit none
+    private
+    public :: assemble_weighted, gauss_legendre
+
+contains
+
+    !> Weighted stiffness and mass (consistent, or row-sum lumped) over all dofs, as triplets.
+    subroutine assemble_weighted(model, region, k, m, error, lumped, order)
+        !> The continuum model (materials assigned).
+        type(continuum_model_t), intent(in) :: model
+        !> The overlap weight (one region, or a set of regions).
+        class(weight_field_t), intent(in) :: region
+        !> Weighted stiffness.
+        type(fem_triplets_t), intent(out) :: k
+        !> Weighted mass.
+        type(fem_triplets_t), intent(out) :: m
+        !> Set when an element has no material or the order is out of 1..10.
+        type(error_t), allocatable, intent(out) :: error
+        !> Row-sum lumped mass (default: consistent).
+        logical, intent(in), optional :: lumped
+        !> Gauss points per direction in the elements touching the region (default 4).
+        integer, intent(in), optional :: order
+        real(wp), allocatable :: xe(:, :), ke(:, :), me(:, :), pts(:, :), w(:)
+        integer, allocatable :: dofs(:), nodes(:)
+        logical :: lump
+        integer :: e, a, nq
+        call model%check(error)
+        if (allocated(error)) return
+        nq = 4
+        if (present(order)) nq = order
+        if (nq < 1 .or. nq > 10) then
+            call make_error(error, 'weighted assembly: order must lie in 1..10 Gauss points per direction')
+            return
+        end if
+        lump = .false.
+        if (present(lumped)) lump = lumped
+        call k%init(model%dof_count(), 64*model%mesh%element_count())
+        call m%init(model%dof_count(), 64*model%mesh%element_count())
+        do e = 1, model%mesh%element_count()
+            xe = model%mesh%element_coordinates(e)
+            nodes = model%mesh%element_nodes(e)
+            dofs = reshape(transpose(reshape([2*nodes - 1, 2*nodes], [size(nodes), 2])), [2*size(nodes)])
+            associate (el => model%family(model%mesh%kind(e))%element, mat => model%materials(model%element_material(e)))
+                if (region%misses([minval(xe(1, :)), maxval(xe(1, :)), minval(xe(2, :)), maxval(xe(2, :))])) then
+                    ke = el%stiffness(xe, mat)
+                    me = el%mass_consistent(xe, mat)
+                else
+                    call element_rule(model%mesh%kind(e), nq, pts, w)
+                    call weighted_element(el, xe, mat, region, pts, w, ke, me)
+                end if
+            end associate
+            call k%add_block(dofs, ke)
+            if (lump) then
+                do a = 1, size(dofs)
+                    call m%add(dofs(a), dofs(a), sum(me(a, :)))
+                end do
+            else
+                call m%add_block(dofs, me)
+            end if
+        end do
+    end subroutine assemble_weighted
+
+    !> Element matrices with the weight at every quadrature point.
+    subroutine weighted_element(el, xe, mat, region, pts, w, ke, me)
+        class(element2d_t), intent(in) :: el
+        real(wp), intent(in) :: xe(:, :)
+        type(elastic2d_t), intent(in) :: mat
+        class(weight_field_t), intent(in) :: region
+        real(wp), intent(in) :: pts(:, :), w(:)
+        real(wp), allocatable, intent(out) :: ke(:, :), me(:, :)
+        real(wp), allocatable :: n(:), dndx(:, :), b(:, :)
+        real(wp) :: detj, alpha, xq(2), d(3, 3), dw
+        integer :: q, nn, a, c
+        nn = size(xe, 2)
+        allocate (n(nn), dndx(nn, 2), ke(2*nn, 2*nn), me(2*nn, 2*nn), source=0.0_wp)
+        d = mat%d_matrix()
+        do q = 1, size(w)
+            call el%geometry(xe, pts(:, q), n, dndx, detj)
+            xq = matmul(xe, n)
+            alpha = region%alpha_fe(xq(1), xq(2))
+            dw = alpha*w(q)*detj*mat%thickness
+            b = el%b_matrix(xe, pts(:, q))
+            ke = ke + dw*matmul(transpose(b), matmul(d, b))
+            do a = 1, nn
+                do c = 1, nn
+                    me(2*a - 1, 2*c - 1) = me(2*a - 1, 2*c - 1) + dw*mat%density*n(a)*n(c)
+                    me(2*a, 2*c) = me(2*a, 2*c) + dw*mat%density*n(a)*n(c)
+                end do
+            end do
+        end do
+    end subroutine weighted_element
+
+    !> n x n Gauss rule on the reference square [-1, 1]^2 (Q4) or its collapsed form on the
+    !> reference triangle (0,0), (1,0), (0,1) (T3).
+    pure subroutine element_rule(kind, n, pts, w)
+        integer, intent(in) :: kind, n
+        real(wp), allocatable, intent(out) :: pts(:, :), w(:)
+        real(wp) :: t(n), wt(n)
+        integer :: i, j, q
+        call gauss_legendre(n, t, wt)
+        allocate (pts(2, n*n), w(n*n))
+        q = 0
+        do j = 1, n
+            do i = 1, n
+                q = q + 1
+                if (kind == element_t3) then
+                    ! (u, v) in [0, 1]^2 -> (u, v (1 - u)), Jacobian (1 - u).
+                    associate (u => 0.5_wp*(1 + t(i)), v => 0.5_wp*(1 + t(j)))
+                        pts(:, q) = [u, v*(1 - u)]
+                        w(q) = 0.25_wp*wt(i)*wt(j)*(1 - u)
+                    end associate
+                else
+                    pts(:, q) = [t(i), t(j)]
+                    w(q) = wt(i)*wt(j)
+                end if
+            end do
+        end do
+    end subroutine element_rule
+
+    !> Gauss-Legendre points and weights on [-1, 1] (Newton on P_n from the Chebyshev guesses).
+    pure subroutine gauss_legendre(n, t, w)
+        !> Number of points.
+        integer, intent(in) :: n
+        !> Points (n), increasing.
+        real(wp), intent(out) :: t(n)
+        !> Weights (n), summing to 2.
+        real(wp), intent(out) :: w(n)
+        real(wp), parameter :: pi = acos(-1.0_wp)
+        real(wp) :: x, p0, p1, p2, dp, dx
+        integer :: i, k, it
+        do i = 1, n
+            x = -cos(pi*(i - 0.25_wp)/(n + 0.5_wp))
+            do it = 1, 100
+                p0 = 1.0_wp
+                p1 = x
+                do k = 2, n
+                    p2 = ((2*k - 1)*x*p1 - (k - 1)*p0)/k
+                    p0 = p1
+                    p1 = p2
+                end do
+                ! p1 = P_n(x), p0 = P_{n-1}(x).
+                dp = n*(x*p1 - p0)/(x*x - 1)
+                dx = p1/dp
+                x = x - dx
+                if (abs(dx) < 1.0e-16_wp) exit
+            end do
+            t(i) = x
+            w(i) = 2/((1 - x*x)*dp*dp)
+        end do
+    end subroutine gauss_legendre
+end module coupling_weighted2d
