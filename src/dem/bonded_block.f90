@@ -58,7 +58,8 @@ module dem_bonded_block
                         nlgs_bilateral_t
     implicit none
     private
-    public :: bonded_block_t, bonded_block_counts_t, bonded_block_solve, bonded_block_eps_ratio
+    public :: bonded_block_t, bonded_block_counts_t, bonded_block_solve, bonded_block_eps_ratio, &
+              bonded_block_restore
 
     !> Regularisation eps relative to the largest diagonal entry of W_BB (module header).
     real(wp), parameter :: bonded_block_eps_ratio = 1.0e-12_wp
@@ -135,6 +136,9 @@ module dem_bonded_block
         real(wp) :: eps = 0.0_wp
         !> Work arrays (nu).
         real(wp), allocatable :: rhs(:), x(:)
+        !> Restart (`bonded_block_restore`): values of the factor in use at the checkpoint,
+        !> factored at the next `prepare` when its bond graph is the restored key.
+        real(wp), allocatable :: restore_values(:)
     contains
         !> See `nlgs_block_t%prepare`.
         procedure :: prepare
@@ -145,6 +149,26 @@ module dem_bonded_block
     end type bonded_block_t
 
 contains
+
+    !> Restart from a checkpoint: the block had a factor of `values` (mat%values with eps,
+    !> values_factored) for the bond graph (key_i1, key_i2, key_rows). The next `prepare`
+    !> whose bond graph is that one factors these values instead of the current ones, so
+    !> that the same (possibly stale) factor is used as in the uninterrupted run and the
+    !> results stay bitwise the same; otherwise it proceeds as usual.
+    subroutine bonded_block_restore(block, key_i1, key_i2, key_rows, values)
+        !> The block (new).
+        type(bonded_block_t), intent(inout) :: block
+        !> Bond graph of the factor: pairs and locked components (bitmask) of each bond.
+        integer, intent(in) :: key_i1(:), key_i2(:), key_rows(:)
+        !> Values of the factor.
+        real(wp), intent(in) :: values(:)
+        block%key_i1 = key_i1
+        block%key_i2 = key_i2
+        block%key_rows = key_rows
+        block%restore_values = values
+        block%analysed = .false.
+        block%factored = .false.
+    end subroutine bonded_block_restore
 
     !> Solve the contact problem of one step with the intact bonds as a direct block and
     !> the NLGS sweeps over the other contacts (block Gauss-Seidel), then the outer check of
@@ -233,7 +257,8 @@ contains
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         type(error_t), allocatable :: error
         integer :: k, b, u, mask, i
-        logical :: same, excl
+        logical :: same, excl, restoring
+        real(wp), allocatable :: current(:)
         if (allocated(self%member)) then
             if (size(self%member) < cs%n) deallocate (self%member)
         end if
@@ -275,9 +300,13 @@ contains
                 u = u + 1
             end do
         end do
-        if (self%nb == 0) return
-        ! same bond graph as the analysed pattern?
-        same = self%analysed
+        if (self%nb == 0) then
+            if (allocated(self%restore_values)) deallocate (self%restore_values)
+            return
+        end if
+        ! same bond graph as the analysed pattern (or as the restored factor)?
+        restoring = allocated(self%restore_values)
+        same = self%analysed .or. restoring
         if (same) same = size(self%key_i1) == self%nb
         if (same) then
             do b = 1, self%nb
@@ -288,6 +317,10 @@ contains
                     exit
                 end if
             end do
+        end if
+        if (restoring) then
+            restoring = same
+            same = .false.
         end if
         self%nt = 0
         call assemble(self, cs, im, bilateral)
@@ -342,6 +375,21 @@ contains
             self%counts%reuses = self%counts%reuses + 1
             return
         end if
+        if (restoring) then
+            if (size(self%restore_values) == size(self%mat%values)) then
+                ! the factor of the checkpoint, then the current values as after a reuse
+                current = self%mat%values
+                self%mat%values = self%restore_values
+                call refactor(self)
+                self%mat%values = current
+                deallocate (self%restore_values)
+                if (.not. self%factored) call give_up(self)
+                if (.not. self%factored) return
+                self%stale = any(self%mat%values /= self%values_factored)
+                return
+            end if
+        end if
+        if (allocated(self%restore_values)) deallocate (self%restore_values)
         call refactor(self)
         if (.not. self%factored) call give_up(self)
     end subroutine prepare

@@ -19,7 +19,7 @@ module driver_config
     use io_deck, only: deck_t, deck_entry_t
     implicit none
     private
-    public :: run_config_t, build_config, find_id, max_steps, build_run_settings
+    public :: run_config_t, build_config, find_id, max_steps, build_run_settings, steps_to_end
 
     !> Largest number of time steps of a run. The step counter is 64-bit; the bound is that of
     !> the 32-bit step counts stored in the results file (/summary steps, /dem/solver).
@@ -50,6 +50,10 @@ module driver_config
         integer :: output_interval = 1
         !> Wall-clock seconds between progress lines (0 = none).
         real(wp) :: progress_seconds = 5.0_wp
+        !> Time steps between checkpoints (0 = none).
+        integer :: checkpoint_interval = 0
+        !> Wall-clock seconds between checkpoints (0 = none).
+        real(wp) :: checkpoint_seconds = 0.0_wp
         !> Initial displacements (3, n_nodes) [m, rad]; zero unless given in [initial].
         real(wp), allocatable :: u0(:, :)
         !> Initial velocities (3, n_nodes) [m/s, rad/s]; zero unless given in [initial].
@@ -724,6 +728,8 @@ contains
         end if
         run%output_interval = deck%get_int('output', 'interval')
         run%progress_seconds = deck%get_real('output', 'progress')
+        run%checkpoint_interval = deck%get_int('output', 'checkpoint_interval')
+        run%checkpoint_seconds = deck%get_real('output', 'checkpoint_seconds')
 
     contains
 
@@ -732,7 +738,7 @@ contains
         subroutine count_steps(error)
             type(error_t), allocatable, intent(out) :: error
             real(wp) :: steps
-            steps = ceiling_real(run%t_end/run%h*(1.0_wp - 1.0e-12_wp))
+            steps = steps_to_end(run%t_end, run%h)
             if (steps > real(max_steps, wp)) then
                 call make_input_error(error, deck%file, deck%line('time', 'end'), 'end', &
                                       'end time '//deck%get_word('time', 'end')//' with step '// &
@@ -744,13 +750,21 @@ contains
             run%n_steps = max(ceiling(steps, i8), 1_i8)
         end subroutine count_steps
 
-        !> ceiling(x) as a real (no integer conversion).
-        pure real(wp) function ceiling_real(x)
-            real(wp), intent(in) :: x
-            ceiling_real = aint(x)
-            if (ceiling_real < x) ceiling_real = ceiling_real + 1.0_wp
-        end function ceiling_real
     end subroutine build_run_settings
+
+    !> Number of time steps of length h up to the end time, as a real (no integer can
+    !> overflow; compare with max_steps before converting): whole steps, the last one may end
+    !> slightly after t_end.
+    pure real(wp) function steps_to_end(t_end, h) result(steps)
+        !> End time [s].
+        real(wp), intent(in) :: t_end
+        !> Time step [s].
+        real(wp), intent(in) :: h
+        real(wp) :: x
+        x = t_end/h*(1.0_wp - 1.0e-12_wp)
+        steps = aint(x)
+        if (steps < x) steps = steps + 1.0_wp
+    end function steps_to_end
 
     !> Initial displacements and velocities on free DOFs.
     subroutine build_initial(deck, beam, fix_line, run, error)

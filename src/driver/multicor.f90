@@ -1,6 +1,7 @@
 !> MULTICOR command-line driver: parses the command line and runs a deck.
 !>
 !>     multicor [--output DIR] [--quiet] deck.dat
+!>     multicor [--output DIR] deck.dat --restart DIR/checkpoint.h5 [--end T]
 !>     multicor --check deck.dat
 !>     multicor --help | --version | --schema-markdown
 !>
@@ -13,6 +14,7 @@ program multicor
     use, intrinsic :: ieee_exceptions, only: ieee_status_type, ieee_get_status, ieee_set_status
     use, intrinsic :: ieee_exceptions, only: ieee_set_halting_mode, ieee_overflow, ieee_invalid
     use, intrinsic :: ieee_exceptions, only: ieee_divide_by_zero
+    use core_kinds, only: wp
     use core_error, only: error_t
     use core_version, only: multicor_version
     use core_signals, only: signal_exit_code
@@ -24,13 +26,30 @@ program multicor
     type(ieee_status_type) :: fp_status
     type(error_t), allocatable :: error
     character(len=:), allocatable :: arg, text
-    integer :: i, n, stopped_by
-    logical :: take_output
+    integer :: i, n, stopped_by, ios
+    logical :: take_output, take_restart, take_end
 
     n = command_argument_count()
     take_output = .false.
+    take_restart = .false.
+    take_end = .false.
     do i = 1, n
         call get_arg(i, arg)
+        if (take_restart) then
+            if (len_trim(arg) == 0) call usage_error("--restart needs a checkpoint file, got ''")
+            opts%restart = arg
+            take_restart = .false.
+            cycle
+        end if
+        if (take_end) then
+            read (arg, *, iostat=ios) opts%end_time
+            if (ios /= 0 .or. verify(trim(arg), '0123456789.eEdD+-') /= 0) &
+                call usage_error("--end needs a time in seconds, got '"//arg(:min(len(arg), 40))//"'")
+            if (.not. (opts%end_time > 0.0_wp .and. opts%end_time <= huge(1.0_wp))) &
+                call usage_error("--end needs a positive time in seconds, got '"//arg(:min(len(arg), 40))//"'")
+            take_end = .false.
+            cycle
+        end if
         if (take_output) then
             ! '' would make the results path '/<name>.h5', at the filesystem root
             if (len_trim(arg) == 0) call usage_error("--output needs a folder name, got ''"// &
@@ -56,6 +75,10 @@ program multicor
             opts%quiet = .true.
         case ('-o', '--output')
             take_output = .true.
+        case ('--restart')
+            take_restart = .true.
+        case ('--end')
+            take_end = .true.
         case default
             if (arg(1:1) == '-') call usage_error("unknown option '"//arg//"'")
             if (allocated(opts%deck_path)) call usage_error("more than one deck given ('"// &
@@ -64,6 +87,9 @@ program multicor
         end select
     end do
     if (take_output) call usage_error('--output needs a folder name')
+    if (take_restart) call usage_error('--restart needs a checkpoint file')
+    if (take_end) call usage_error('--end needs a time in seconds')
+    if (opts%check_only .and. allocated(opts%restart)) call usage_error('--check and --restart exclude each other')
     if (.not. allocated(opts%deck_path)) call usage_error('no deck given')
 
     call ieee_get_status(fp_status)
@@ -119,6 +145,8 @@ contains
             '  -o, --output DIR     results folder (default: results/<deck name>)', &
             '  -q, --quiet          no progress lines', &
             '      --check          validate the deck only (nothing is written)', &
+            '      --restart FILE   continue the run from a checkpoint (DIR/checkpoint.h5)', &
+            '      --end T          end time T [s] instead of the deck''s [time] end', &
             '      --schema-markdown  print the reference of every deck keyword (doc/input.md)', &
             '  -V, --version        print the version', &
             '  -h, --help           print this help', &
@@ -126,6 +154,7 @@ contains
             'Results: DIR/<deck name>.h5 (HDF5, layout in doc/output.md).', &
             'Exit codes: 0 success, 1 error in the deck or the run, 2 bad command line,', &
             '128 + signal number when SIGTERM (143), SIGINT (130) or SIGUSR1 (138) stopped the', &
-            'run: the results so far are then in DIR/<deck name>.h5.partial.'
+            'run: the results so far are then in DIR/<deck name>.h5.partial, and the state in the', &
+            'checkpoint DIR/checkpoint.h5 (continue with --restart DIR/checkpoint.h5).'
     end subroutine print_help
 end program multicor

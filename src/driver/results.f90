@@ -15,7 +15,7 @@ module driver_results
     use core_error, only: error_t, make_error
     use core_version, only: multicor_version, multicor_name
     use io_hdf5_file, only: h5_file_t
-    use io_paths, only: rename_file, remove_file
+    use io_paths, only: rename_file, remove_file, copy_file, file_exists
     implicit none
     private
     public :: results_writer_t
@@ -43,8 +43,14 @@ module driver_results
         character(len=:), allocatable :: stop_reason
         !> Time of the last output stored before a stop [s] (set by `stop_at`).
         real(wp) :: stop_time = 0.0_wp
+        !> Root attribute 'run_id' of the file: start date-time and clock count of the run,
+        !> kept by its restarts.
+        character(len=:), allocatable :: run_id
+        !> Whether the file continues an earlier run (`resume`): a failed run then keeps it.
+        logical :: resumed = .false.
     contains
         procedure :: open => writer_open
+        procedure :: resume => writer_resume
         procedure :: write_mesh => writer_write_mesh
         procedure :: append_state => writer_append_state
         procedure :: append_energy => writer_append_energy
@@ -91,6 +97,8 @@ contains
         self%energy0 = 0.0_wp
         self%stop_reason = ''
         self%stop_time = 0.0_wp
+        self%run_id = new_run_id()
+        self%resumed = .false.
         call self%file%create(self%partial_path, error)
         if (allocated(error)) return
         call root_attributes(error)
@@ -116,8 +124,76 @@ contains
             call self%file%write_attribute('/', 'analysis', analysis, error)
             if (allocated(error)) return
             call self%file%write_attribute('/', 'created', iso_date_time(), error)
+            if (allocated(error)) return
+            call self%file%write_attribute('/', 'run_id', self%run_id, error)
         end subroutine root_attributes
     end subroutine writer_open
+
+    !> Open the results file of a run to continue it (restart): '<final_path>.partial' when
+    !> it exists and belongs to that run, else a copy of `final_path` made as the partial file
+    !> (the finished file stays as it is until the continued run ends normally). The run is
+    !> recognised by the root attribute 'run_id'. /summary is marked unfinished again.
+    subroutine writer_resume(self, final_path, run_id, error)
+        !> The writer; must not be open.
+        class(results_writer_t), intent(inout) :: self
+        !> Name of the results file on success.
+        character(len=*), intent(in) :: final_path
+        !> Root attribute 'run_id' of the run's file (from the checkpoint).
+        character(len=*), intent(in) :: run_id
+        !> Set when neither file belongs to the run, or it cannot be opened for writing.
+        type(error_t), allocatable, intent(out) :: error
+        if (self%is_open()) then
+            call make_error(error, "results: cannot resume '"//final_path//"': '" &
+                            //self%final_path//"' is still open")
+            return
+        end if
+        self%final_path = final_path
+        self%partial_path = final_path//'.partial'
+        self%stop_reason = ''
+        self%stop_time = 0.0_wp
+        self%run_id = run_id
+        self%resumed = .true.
+        if (.not. belongs(self%partial_path)) then
+            if (.not. belongs(final_path)) then
+                call make_error(error, "results: neither '"//self%partial_path//"' nor '"// &
+                                final_path//"' is the results file of the checkpoint's run (run_id "// &
+                                run_id//'): it was moved, deleted or replaced by another run')
+                return
+            end if
+            call copy_file(final_path, self%partial_path, error)
+            if (allocated(error)) then
+                error%message = 'results: '//error%message
+                return
+            end if
+        end if
+        call self%file%open(self%partial_path, error, writable=.true.)
+        if (allocated(error)) then
+            error%message = 'results: '//error%message
+            return
+        end if
+        call self%file%write_attribute('/summary', 'finished', 0, error)
+        if (.not. allocated(error)) call self%file%write_attribute('/summary', 'status', &
+                                                                   'running (or killed)', error)
+        if (allocated(error)) then
+            call self%abort()
+            error%message = 'results: '//error%message
+        end if
+    contains
+        !> Whether `path` is an HDF5 file whose 'run_id' attribute is `run_id`.
+        logical function belongs(path)
+            character(len=*), intent(in) :: path
+            type(h5_file_t) :: f
+            type(error_t), allocatable :: e
+            character(len=:), allocatable :: value
+            belongs = .false.
+            if (.not. file_exists(path)) return
+            call f%open(path, e)
+            if (allocated(e)) return
+            call f%read_attribute('/', 'run_id', value, e)
+            if (.not. allocated(e)) belongs = value == run_id
+            call f%close(e)
+        end function belongs
+    end subroutine writer_resume
 
     !> Write the FE mesh: /fem/mesh/{node_id, coordinates, connectivity}.
     subroutine writer_write_mesh(self, node_id, x, y, conn, error)
@@ -423,14 +499,16 @@ contains
     end subroutine writer_close_unfinished
 
     !> Close and delete the partial file after a failed run (an earlier result is untouched).
-    !> Does nothing when the writer is not open.
+    !> A resumed file is kept: it holds the outputs of the earlier part of the run, and a
+    !> restart from the checkpoint cuts what came after it. Does nothing when the writer is
+    !> not open.
     subroutine writer_abort(self)
         !> The writer; closed on return.
         class(results_writer_t), intent(inout) :: self
         type(error_t), allocatable :: ignored
         if (.not. self%file%is_open()) return
         call self%file%close(ignored)
-        call remove_file(self%partial_path)
+        if (.not. self%resumed) call remove_file(self%partial_path)
     end subroutine writer_abort
 
     !> Whether a results file is being written.
@@ -488,6 +566,16 @@ contains
             call make_error(error, 'results: '//what//': '//trim(buf))
         end if
     end subroutine check_nodes
+
+    !> Identifier of a new run: local date-time and the processor clock count.
+    function new_run_id() result(text)
+        character(len=:), allocatable :: text
+        character(len=24) :: buf
+        integer(int64) :: count
+        call system_clock(count)
+        write (buf, '(i0)') count
+        text = iso_date_time()//' '//trim(buf)
+    end function new_run_id
 
     !> Local date and time as ISO 8601, e.g. '2025-01-31T14:05:09+01:00'.
     function iso_date_time() result(text)

@@ -59,6 +59,10 @@ module driver_results_coupled
         procedure :: record_step => writer_record_step
         !> Write what is buffered and the closing attributes.
         procedure :: finish => writer_finish
+        !> Write the buffered per-step values now (before a checkpoint).
+        procedure :: flush_buffer => writer_flush_buffer
+        !> Take over a results file written by `begin` (restart; counters set by the caller).
+        procedure :: resume => writer_resume
     end type coupled_writer_t
 
 contains
@@ -241,6 +245,33 @@ contains
     end subroutine writer_record_step
 
     !> Write the buffered per-step values.
+    !> Write the buffered per-step values now (before a checkpoint: then nothing is buffered).
+    subroutine writer_flush_buffer(self, file, error)
+        !> The writer.
+        class(coupled_writer_t), intent(inout) :: self
+        !> The results file.
+        type(h5_file_t), intent(inout) :: file
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call flush_steps(self, file, error)
+    end subroutine writer_flush_buffer
+
+    !> Take over a results file that `begin` wrote for the same system (restart): sizes and
+    !> buffers as `begin`, nothing written; the counters are then restored by the caller.
+    subroutine writer_resume(self, sys)
+        !> The writer.
+        class(coupled_writer_t), intent(inout) :: self
+        !> The coupled system.
+        type(coupled_system_t), intent(in) :: sys
+        self%n_rows = sys%op%n_rows
+        self%n_out = 0
+        self%n_buffered = 0
+        self%n_steps = 0
+        if (allocated(self%values)) deallocate (self%values, self%sweeps, self%corrections)
+        allocate (self%values(stats_buffer, size(step_names)), self%sweeps(stats_buffer), &
+                  self%corrections(stats_buffer))
+    end subroutine writer_resume
+
     subroutine flush_steps(self, file, error)
         type(coupled_writer_t), intent(inout) :: self
         type(h5_file_t), intent(inout) :: file

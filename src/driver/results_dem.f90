@@ -55,6 +55,10 @@ module driver_results_dem
         procedure :: record_step => writer_record_step
         !> Write what is buffered and the closing attributes.
         procedure :: finish => writer_finish
+        !> Write the buffered statistics now (before a checkpoint).
+        procedure :: flush_buffer => writer_flush_buffer
+        !> Take over a results file written by `begin` (restart; counters set by the caller).
+        procedure :: resume => writer_resume
     end type dem_writer_t
 
 contains
@@ -345,6 +349,42 @@ contains
         self%n_buffered = k
         self%n_steps = self%n_steps + 1
     end subroutine writer_record_step
+
+    !> Write the buffered solver statistics now (before a checkpoint: then nothing is
+    !> buffered).
+    subroutine writer_flush_buffer(self, file, error)
+        !> The writer.
+        class(dem_writer_t), intent(inout) :: self
+        !> The results file.
+        type(h5_file_t), intent(inout) :: file
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call flush_stats(self, file, error)
+    end subroutine writer_flush_buffer
+
+    !> Take over a results file that `begin` wrote for the same system (restart): sizes and
+    !> buffers as `begin`, nothing written; the counters are then restored by the caller.
+    subroutine writer_resume(self, sys, store_contacts)
+        !> The writer.
+        class(dem_writer_t), intent(inout) :: self
+        !> The system.
+        type(dem_system_t), intent(in) :: sys
+        !> Store the contact network at the outputs.
+        logical, intent(in) :: store_contacts
+        self%n_particles = sys%particles%n
+        self%n_walls = sys%walls%n
+        self%store_contacts = store_contacts
+        self%n_out = 0
+        self%n_contacts_stored = 0
+        self%n_buffered = 0
+        self%n_steps = 0
+        self%n_ruptures = 0
+        if (allocated(self%sweeps)) deallocate (self%sweeps, self%contacts, self%active, self%blocked, &
+                                                self%converged, self%norm, self%residual)
+        allocate (self%sweeps(stats_buffer), self%contacts(stats_buffer), &
+                  self%active(stats_buffer), self%blocked(stats_buffer), self%converged(stats_buffer), &
+                  self%norm(stats_buffer), self%residual(stats_buffer))
+    end subroutine writer_resume
 
     !> Write the buffered solver statistics.
     subroutine flush_stats(self, file, error)

@@ -13,8 +13,14 @@
 !> represent; after every time step the state must be finite (and, for particles, no disk
 !> may tunnel through a wall or another disk). One run at a time writes a results folder: a
 !> lock file (io_lock) is held while writing and removed on every way out.
+!>
+!> Checkpoints (driver_checkpoint): the time loops of beam, particle and coupled runs write
+!> '<results folder>/checkpoint.h5' as the deck's [output] checkpoint_interval /
+!> checkpoint_seconds say, at a stop signal and at the end; `--restart` continues a run from
+!> one (same deck, same code version), into the same results file, with the option of a new
+!> end time (`--end`).
 module driver_run
-    use core_kinds, only: i8
+    use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
     use core_strings, only: to_str
     use io_lock, only: lock_t, lock_acquire, lock_release
@@ -27,6 +33,11 @@ module driver_run
     use driver_guards, only: check_memory
     use driver_simulation, only: simulation_t, report_iface
     use driver_simulations, only: select_simulation
+    use driver_simulation_beam, only: beam_simulation_t
+    use driver_simulation_dem, only: dem_simulation_t
+    use driver_simulation_coupled, only: coupled_simulation_t
+    use driver_config, only: steps_to_end, max_steps
+    use driver_checkpoint, only: checkpoint_run_t, checkpoint_name, checkpoint_open
     implicit none
     private
     public :: run_options_t, run_deck, report_iface
@@ -41,6 +52,10 @@ module driver_run
         logical :: check_only = .false.
         !> No progress lines.
         logical :: quiet = .false.
+        !> Checkpoint to continue from (unallocated: start at t = 0).
+        character(len=:), allocatable :: restart
+        !> End time replacing the deck's [time] end [s] (negative: the deck's).
+        real(wp) :: end_time = -1.0_wp
     end type run_options_t
 
 contains
@@ -64,7 +79,8 @@ contains
         class(simulation_t), allocatable :: sim
         type(results_writer_t) :: out
         type(lock_t) :: lock
-        character(len=:), allocatable :: dir, path, warning
+        type(checkpoint_run_t) :: ck
+        character(len=:), allocatable :: dir, path, warning, kind, run_id
         character(len=32) :: tbuf
 
         if (present(stopped_by)) stopped_by = 0
@@ -75,6 +91,17 @@ contains
         call check_model_size(error)
         if (allocated(error)) return
         call sim%init(deck, report, error)
+        if (allocated(error)) return
+        kind = ''
+        select type (sim)
+        type is (beam_simulation_t)
+            if (sim%settings%analysis == 'dynamic') kind = 'beam'
+        type is (dem_simulation_t)
+            kind = 'particles'
+        type is (coupled_simulation_t)
+            kind = 'coupled'
+        end select
+        call apply_end_time(error)
         if (allocated(error)) return
         if (opts%check_only) then
             call report(opts%deck_path//': deck is valid ('//sim%describe()//')')
@@ -89,12 +116,20 @@ contains
         call lock_acquire(lock, dir, warning, error)
         if (allocated(error)) return
         if (len(warning) > 0) call report(warning)
+        ck%path = dir//'/'//checkpoint_name
+        ck%deck_text = deck%text
+        ck%schedule%every = sim%settings%checkpoint_interval
+        ck%schedule%seconds = sim%settings%checkpoint_seconds
+        if (allocated(opts%restart)) call open_checkpoint(error)
         ! Until here a signal kills the program at once (nothing is written yet).
-        call install_signal_handlers(error)
+        if (.not. allocated(error)) call install_signal_handlers(error)
         if (.not. allocated(error)) call write_results(error)
         call lock_release(lock)
         if (allocated(error)) return
         call report('results written to '//path)
+        if (ck%last_step >= 0) call report('checkpoint: '//to_str(ck%last_step)//' steps, t = '// &
+                                           num(ck%last_time)//' s, in '//ck%path//' (to go on to a later end '// &
+                                           'time: '//continue_command()//' --end T)')
 
     contains
 
@@ -102,9 +137,15 @@ contains
         !> holds the folder's lock).
         subroutine write_results(error)
             type(error_t), allocatable, intent(out) :: error
-            call out%open(path, opts%deck_path, deck%text, sim_title(), sim_analysis(), error)
+            type(error_t), allocatable :: ignored
+            if (ck%restart) then
+                call out%resume(path, run_id, error)
+                if (allocated(error)) call ck%source%close(ignored)
+            else
+                call out%open(path, opts%deck_path, deck%text, sim_title(), sim_analysis(), error)
+            end if
             if (allocated(error)) return
-            call sim%run(out, opts%quiet, report, error)
+            call sim%run(out, opts%quiet, report, ck, error)
             if (allocated(error)) then
                 call out%abort()
                 error%message = deck%file//': '//error%message
@@ -119,14 +160,88 @@ contains
                 call report('saved: every output up to t = '//trim(adjustl(tbuf))//' s (the last one '// &
                             'at the stop) in '//out%partial_path//' (/summary finished = 0)')
                 if (file_exists(path)) call report('the earlier result '//path//' is left as it was')
-                call report('to continue: run the deck again (restart from a checkpoint is not '// &
-                            'available yet)')
+                if (ck%last_step >= 0) then
+                    call report('checkpoint: '//to_str(ck%last_step)//' steps, t = '//num(ck%last_time)// &
+                                ' s, in '//ck%path)
+                    call report('to continue: '//continue_command())
+                else
+                    call report('to continue: run the deck again (no checkpoint was written)')
+                end if
                 call make_error(error, deck%file//': run stopped by '//signal_name(caught_signal())// &
                                 '; results so far in '//out%partial_path)
                 return
             end if
             call out%close(error)
         end subroutine write_results
+
+        !> The command that continues this run from its checkpoint.
+        function continue_command() result(command)
+            character(len=:), allocatable :: command
+            command = 'multicor '//opts%deck_path
+            if (allocated(opts%output_dir)) command = command//' --output '//opts%output_dir
+            command = command//' --restart '//ck%path
+        end function continue_command
+
+        !> --end: a new end time (the models built by `init` do not depend on it, the step
+        !> count does).
+        subroutine apply_end_time(error)
+            type(error_t), allocatable, intent(out) :: error
+            real(wp) :: steps
+            if (opts%end_time < 0.0_wp) return
+            if (len(kind) == 0) then
+                call make_error(error, '--end: '//deck%file//' is not a beam, particle or coupled '// &
+                                'dynamic analysis (the runs that have checkpoints)')
+                return
+            end if
+            associate (run => sim%settings)
+                if (.not. (opts%end_time >= run%h)) then
+                    call make_error(error, '--end '//num(opts%end_time)//' s: shorter than the time step '// &
+                                    num(run%h)//' s')
+                    return
+                end if
+                steps = steps_to_end(opts%end_time, run%h)
+                if (steps > real(max_steps, wp)) then
+                    call make_error(error, '--end '//num(opts%end_time)//' s with step '//num(run%h)// &
+                                    ' s needs more time steps than a run can count ('//to_str(max_steps)//')')
+                    return
+                end if
+                run%t_end = opts%end_time
+                run%n_steps = max(int(steps, i8), 1_i8)
+            end associate
+        end subroutine apply_end_time
+
+        !> --restart: open the checkpoint and check it belongs to this deck, this code and this
+        !> kind of run, and that it leaves steps to do.
+        subroutine open_checkpoint(error)
+            type(error_t), allocatable, intent(out) :: error
+            type(error_t), allocatable :: ignored
+            if (len(kind) == 0) then
+                call make_error(error, '--restart: '//deck%file//' is not a beam, particle or coupled '// &
+                                'dynamic analysis (only those runs have checkpoints)')
+                return
+            end if
+            call checkpoint_open(ck%source, opts%restart, deck%file, deck%text, kind, ck%start, run_id, error)
+            if (allocated(error)) return
+            if (ck%start%step >= sim%settings%n_steps) then
+                call ck%source%close(ignored)
+                call make_error(error, "--restart: checkpoint '"//opts%restart//"' is at step "// &
+                                to_str(ck%start%step)//', the end time '//num(sim%settings%t_end)// &
+                                ' s is step '//to_str(sim%settings%n_steps)//': nothing to do (give a later '// &
+                                'end time: --end T)')
+                return
+            end if
+            ck%restart = .true.
+            call report('restart from '//opts%restart//' at step '//to_str(ck%start%step))
+        end subroutine open_checkpoint
+
+        !> A real with 4 significant digits.
+        function num(x) result(text)
+            real(wp), intent(in) :: x
+            character(len=:), allocatable :: text
+            character(len=24) :: buf
+            write (buf, '(es11.3e3)') x
+            text = trim(adjustl(buf))
+        end function num
 
         !> Refuse a model whose memory estimate exceeds the available memory, from the
         !> numbers of disks, nodes and elements the deck asks for (before allocating them).

@@ -28,6 +28,10 @@ module driver_run_coupled
     use driver_run_dem, only: max_warnings, report_line_iface, speed_warning, last_unconverged_warning
     use driver_guards, only: check_beam_state, check_disks_state, step_start_t, take_step_start, &
                              check_tunnelling
+    use io_hdf5_file, only: h5_file_t
+    use driver_checkpoint, only: checkpoint_run_t, loop_state_t, checkpoint_create, checkpoint_commit, &
+                                 checkpoint_discard, save_coupled, load_coupled, save_results, load_results, &
+                                 save_dem_writer, load_dem_writer, save_coupled_writer, load_coupled_writer
     implicit none
     private
     public :: build_coupled, run_coupled
@@ -59,8 +63,9 @@ contains
         end if
     end subroutine build_coupled
 
-    !> Integrate the coupled model from t = 0 to the end time and write its results.
-    subroutine run_coupled(run, beam, dem, sys, out, quiet, report, error)
+    !> Integrate the coupled model from t = 0 (or from a checkpoint) to the end time and write
+    !> its results; write checkpoints as `ck` says, at the end and at a stop signal.
+    subroutine run_coupled(run, beam, dem, sys, out, quiet, report, ck, error)
         !> Run settings (end time, output interval, progress).
         type(run_config_t), intent(in) :: run
         !> The beam (mesh for the results).
@@ -75,6 +80,8 @@ contains
         logical, intent(in) :: quiet
         !> Where progress, warning and summary lines go.
         procedure(report_line_iface) :: report
+        !> Checkpoints (and the one to restart from).
+        type(checkpoint_run_t), intent(inout) :: ck
         !> Set on a run or write failure.
         type(error_t), allocatable, intent(out) :: error
         type(dem_writer_t) :: dem_out
@@ -82,28 +89,35 @@ contains
         type(progress_t) :: progress
         real(wp), allocatable :: d(:, :), v(:, :), a(:, :)
         type(step_start_t) :: start
-        integer(i8) :: n_steps, k
+        integer(i8) :: n_steps, k, k0
         integer :: unconverged
-        logical :: speed_warned
+        logical :: speed_warned, regular, stop
         character(len=512) :: buf
 
         n_steps = run%n_steps
         allocate (d(3, sys%model%n_nodes), v(3, sys%model%n_nodes), a(3, sys%model%n_nodes))
-        call out%write_mesh(beam%node_id, beam%x, beam%y, beam%conn, error)
-        if (allocated(error)) return
-        call dem_out%begin(out%file, sys%dem, dem%material_id, dem%store_contacts, error)
-        if (allocated(error)) return
-        call cpl_out%begin(out%file, sys, error)
-        if (allocated(error)) return
-        k = 0
-        call check_step(error)
-        if (allocated(error)) return
-        call store(error)
-        if (allocated(error)) return
         unconverged = 0
         speed_warned = .false.
+        k0 = 0
+        if (ck%restart) then
+            call restore(error)
+            if (allocated(error)) return
+        else
+            call out%write_mesh(beam%node_id, beam%x, beam%y, beam%conn, error)
+            if (allocated(error)) return
+            call dem_out%begin(out%file, sys%dem, dem%material_id, dem%store_contacts, error)
+            if (allocated(error)) return
+            call cpl_out%begin(out%file, sys, error)
+            if (allocated(error)) return
+            k = 0
+            call check_step(error)
+            if (allocated(error)) return
+            call store(error)
+            if (allocated(error)) return
+        end if
         call progress%start(n_steps, run%t_end, run%progress_seconds)
-        do k = 1, n_steps
+        call ck%schedule%start()
+        do k = k0 + 1, n_steps
             call take_step_start(start, sys%dem%particles, sys%dem%walls)
             call arlequin_step(sys, error)
             if (allocated(error)) return
@@ -115,13 +129,19 @@ contains
             if (allocated(error)) return
             if (.not. sys%stats%converged) call warn_unconverged()
             if (.not. speed_warned) call check_speed()
-            if (mod(k, int(run%output_interval, i8)) == 0 .or. k == n_steps) then
-                call store(error)
-                if (allocated(error)) return
-            end if
-            if (k < n_steps .and. caught_signal() /= 0) then
+            ! The checkpoint holds the regular outputs up to step k, not the extra output of
+            ! the last step or of a stop (a restart with a later end time cuts them).
+            regular = mod(k, int(run%output_interval, i8)) == 0
+            if (regular) call store(error)
+            if (allocated(error)) return
+            stop = k < n_steps .and. caught_signal() /= 0
+            if (k == n_steps .or. stop .or. ck%schedule%due(k)) call checkpoint(error)
+            if (allocated(error)) return
+            if (k == n_steps .and. .not. regular) call store(error)
+            if (allocated(error)) return
+            if (stop) then
                 ! Stop request: the step just done is the last output.
-                if (mod(k, int(run%output_interval, i8)) /= 0) call store(error)
+                if (.not. regular) call store(error)
                 if (allocated(error)) return
                 call out%stop_at(signal_name(caught_signal()), k, sys%fe%t)
                 n_steps = k
@@ -139,6 +159,47 @@ contains
         call out%write_summary(int(n_steps), progress%elapsed(), error)
 
     contains
+
+        !> Restart: state, writer counters and results file from the checkpoint `ck%source`.
+        subroutine restore(error)
+            type(error_t), allocatable, intent(out) :: error
+            type(error_t), allocatable :: ignored
+            call dem_out%resume(sys%dem, dem%store_contacts)
+            call cpl_out%resume(sys)
+            call load_coupled(ck%source, sys, error)
+            if (.not. allocated(error)) call load_dem_writer(ck%source, dem_out, error)
+            if (.not. allocated(error)) call load_coupled_writer(ck%source, cpl_out, error)
+            if (.not. allocated(error)) call load_results(ck%source, out, error)
+            call ck%source%close(ignored)
+            if (allocated(error)) return
+            k0 = ck%start%step
+            unconverged = ck%start%unconverged
+            speed_warned = ck%start%speed_warned
+        end subroutine restore
+
+        !> Write a checkpoint after step k (the buffered per-step values are written first).
+        subroutine checkpoint(error)
+            type(error_t), allocatable, intent(out) :: error
+            type(h5_file_t) :: f
+            call dem_out%flush_buffer(out%file, error)
+            if (.not. allocated(error)) call cpl_out%flush_buffer(out%file, error)
+            if (allocated(error)) return
+            call checkpoint_create(f, ck%path, ck%deck_text, 'coupled', &
+                                   loop_state_t(k, unconverged, speed_warned, .false.), sys%fe%t, &
+                                   out%run_id, error)
+            if (.not. allocated(error)) call save_coupled(f, sys, error)
+            if (.not. allocated(error)) call save_dem_writer(f, dem_out, error)
+            if (.not. allocated(error)) call save_coupled_writer(f, cpl_out, error)
+            if (.not. allocated(error)) call save_results(f, out, error)
+            if (allocated(error)) then
+                call checkpoint_discard(f, ck%path)
+                return
+            end if
+            call checkpoint_commit(f, ck%path, error)
+            if (allocated(error)) return
+            ck%last_step = k
+            ck%last_time = sys%fe%t
+        end subroutine checkpoint
 
         !> Guards after a step: finite beam and disk states, disks in the box, no tunnelling.
         subroutine check_step(error)

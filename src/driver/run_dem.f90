@@ -20,6 +20,10 @@ module driver_run_dem
     use driver_results, only: results_writer_t
     use driver_results_dem, only: dem_writer_t
     use driver_guards, only: check_disks_state, step_start_t, take_step_start, check_tunnelling
+    use io_hdf5_file, only: h5_file_t
+    use driver_checkpoint, only: checkpoint_run_t, loop_state_t, checkpoint_create, checkpoint_commit, &
+                                 checkpoint_discard, &
+                                 save_dem, load_dem, save_results, load_results, save_dem_writer, load_dem_writer
     implicit none
     private
     public :: run_dem, max_warnings, report_line_iface, speed_warning, last_unconverged_warning
@@ -36,8 +40,9 @@ module driver_run_dem
 
 contains
 
-    !> Integrate the model from t = 0 to the end time and write its results into `out`.
-    subroutine run_dem(run, cfg, out, quiet, report, error)
+    !> Integrate the model from t = 0 (or from a checkpoint) to the end time and write its
+    !> results into `out`; write checkpoints as `ck` says, at the end and at a stop signal.
+    subroutine run_dem(run, cfg, out, quiet, report, ck, error)
         !> Run settings (time step, end time, output interval, progress).
         type(run_config_t), intent(in) :: run
         !> The model (its system advances).
@@ -48,15 +53,17 @@ contains
         logical, intent(in) :: quiet
         !> Where progress, warning and summary lines go.
         procedure(report_line_iface) :: report
+        !> Checkpoints (and the one to restart from).
+        type(checkpoint_run_t), intent(inout) :: ck
         !> Set on a run or write failure.
         type(error_t), allocatable, intent(out) :: error
         type(dem_writer_t) :: writer
         type(progress_t) :: progress
         type(step_start_t) :: start
-        integer(i8) :: n_steps, k
+        integer(i8) :: n_steps, k, k0
         integer :: unconverged
         logical :: blocked_warned
-        logical :: speed_warned
+        logical :: speed_warned, regular, stop
         character(len=:), allocatable :: message
         character(len=512) :: buf
 
@@ -67,17 +74,24 @@ contains
             return
         end if
         n_steps = run%n_steps
-        call writer%begin(out%file, cfg%system, cfg%material_id, cfg%store_contacts, error)
-        if (allocated(error)) return
-        call check_disks_state(0_i8, cfg%system%time, cfg%system%particles, cfg%system%energies, error)
-        if (allocated(error)) return
-        call store(error)
-        if (allocated(error)) return
         unconverged = 0
         speed_warned = .false.
         blocked_warned = .false.
+        k0 = 0
+        if (ck%restart) then
+            call restore(error)
+            if (allocated(error)) return
+        else
+            call writer%begin(out%file, cfg%system, cfg%material_id, cfg%store_contacts, error)
+            if (allocated(error)) return
+            call check_disks_state(0_i8, cfg%system%time, cfg%system%particles, cfg%system%energies, error)
+            if (allocated(error)) return
+            call store(error)
+            if (allocated(error)) return
+        end if
         call progress%start(n_steps, run%t_end, run%progress_seconds)
-        do k = 1, n_steps
+        call ck%schedule%start()
+        do k = k0 + 1, n_steps
             call take_step_start(start, cfg%system%particles, cfg%system%walls)
             call mj_step(cfg%system)
             call check_step(error)
@@ -91,13 +105,19 @@ contains
                 blocked_warned = .true.
             end if
             if (.not. speed_warned) call check_speed()
-            if (mod(k, int(run%output_interval, i8)) == 0 .or. k == n_steps) then
-                call store(error)
-                if (allocated(error)) return
-            end if
-            if (k < n_steps .and. caught_signal() /= 0) then
+            ! The checkpoint holds the regular outputs up to step k, not the extra output of
+            ! the last step or of a stop (a restart with a later end time cuts them).
+            regular = mod(k, int(run%output_interval, i8)) == 0
+            if (regular) call store(error)
+            if (allocated(error)) return
+            stop = k < n_steps .and. caught_signal() /= 0
+            if (k == n_steps .or. stop .or. ck%schedule%due(k)) call checkpoint(error)
+            if (allocated(error)) return
+            if (k == n_steps .and. .not. regular) call store(error)
+            if (allocated(error)) return
+            if (stop) then
                 ! Stop request: the step just done is the last output.
-                if (mod(k, int(run%output_interval, i8)) /= 0) call store(error)
+                if (.not. regular) call store(error)
                 if (allocated(error)) return
                 call out%stop_at(signal_name(caught_signal()), k, cfg%system%time)
                 n_steps = k
@@ -113,6 +133,44 @@ contains
         call out%write_summary(int(n_steps), progress%elapsed(), error)
 
     contains
+
+        !> Restart: state, writer counters and results file from the checkpoint `ck%source`.
+        subroutine restore(error)
+            type(error_t), allocatable, intent(out) :: error
+            type(error_t), allocatable :: ignored
+            call writer%resume(cfg%system, cfg%store_contacts)
+            call load_dem(ck%source, '/dem', cfg%system, error)
+            if (.not. allocated(error)) call load_dem_writer(ck%source, writer, error)
+            if (.not. allocated(error)) call load_results(ck%source, out, error)
+            call ck%source%close(ignored)
+            if (allocated(error)) return
+            k0 = ck%start%step
+            unconverged = ck%start%unconverged
+            speed_warned = ck%start%speed_warned
+            blocked_warned = ck%start%blocked_warned
+        end subroutine restore
+
+        !> Write a checkpoint after step k (the buffered statistics are written first).
+        subroutine checkpoint(error)
+            type(error_t), allocatable, intent(out) :: error
+            type(h5_file_t) :: f
+            call writer%flush_buffer(out%file, error)
+            if (allocated(error)) return
+            call checkpoint_create(f, ck%path, ck%deck_text, 'particles', &
+                                   loop_state_t(k, unconverged, speed_warned, blocked_warned), &
+                                   cfg%system%time, out%run_id, error)
+            if (.not. allocated(error)) call save_dem(f, '/dem', cfg%system, error)
+            if (.not. allocated(error)) call save_dem_writer(f, writer, error)
+            if (.not. allocated(error)) call save_results(f, out, error)
+            if (allocated(error)) then
+                call checkpoint_discard(f, ck%path)
+                return
+            end if
+            call checkpoint_commit(f, ck%path, error)
+            if (allocated(error)) return
+            ck%last_step = k
+            ck%last_time = cfg%system%time
+        end subroutine checkpoint
 
         !> Guards after a step: finite state in the box, no tunnelling.
         subroutine check_step(error)

@@ -10,6 +10,8 @@ module driver_simulation
     use core_error, only: error_t
     use io_deck, only: deck_t
     use driver_results, only: results_writer_t
+    use driver_config, only: run_config_t
+    use driver_checkpoint, only: checkpoint_run_t
     implicit none
     private
     public :: simulation_t, report_iface
@@ -24,6 +26,8 @@ module driver_simulation
 
     !> A run of one kind of model.
     type, abstract :: simulation_t
+        !> Run settings (analysis, time step, end time, outputs, checkpoints), from `init`.
+        type(run_config_t) :: settings
     contains
         !> Build the configuration and the model from the deck; check everything that depends
         !> on the input.
@@ -58,8 +62,8 @@ module driver_simulation
         end function simulation_describe
 
         !> Run the analysis; results into `out` (open).
-        subroutine simulation_run(self, out, quiet, report, error)
-            import :: simulation_t, results_writer_t, error_t, report_iface
+        subroutine simulation_run(self, out, quiet, report, ck, error)
+            import :: simulation_t, results_writer_t, error_t, report_iface, checkpoint_run_t
             !> The simulation (after `init`).
             class(simulation_t), intent(inout) :: self
             !> The results file.
@@ -68,6 +72,8 @@ module driver_simulation
             logical, intent(in) :: quiet
             !> Where progress and summary lines go.
             procedure(report_iface) :: report
+            !> Checkpoints of a time loop (and the one to restart from).
+            type(checkpoint_run_t), intent(inout) :: ck
             !> Set on a run or write failure (without the deck file name).
             type(error_t), allocatable, intent(out) :: error
         end subroutine simulation_run

@@ -15,6 +15,9 @@ module driver_simulation_beam
     use driver_config, only: run_config_t, build_config
     use driver_config_dem, only: check_particle_keywords_unused
     use driver_results, only: results_writer_t
+    use driver_checkpoint, only: checkpoint_run_t, loop_state_t, checkpoint_create, checkpoint_commit, &
+                                 checkpoint_discard, save_integrator, load_integrator, save_results, load_results
+    use io_hdf5_file, only: h5_file_t
     use driver_guards, only: check_beam_state
     use driver_simulation, only: simulation_t, report_iface
     implicit none
@@ -23,8 +26,6 @@ module driver_simulation_beam
 
     !> A planar frame run.
     type, extends(simulation_t) :: beam_simulation_t
-        !> Run settings.
-        type(run_config_t) :: settings
         !> Frame description from the deck.
         type(beam_config_t) :: beam
         !> Assembled model.
@@ -86,7 +87,7 @@ contains
     end function beam_describe
 
     !> The finite-element analysis, results into `out`.
-    subroutine beam_run(self, out, quiet, report, error)
+    subroutine beam_run(self, out, quiet, report, ck, error)
         !> The simulation.
         class(beam_simulation_t), intent(inout) :: self
         !> The results file.
@@ -95,9 +96,11 @@ contains
         logical, intent(in) :: quiet
         !> Where progress and summary lines go.
         procedure(report_iface) :: report
+        !> Checkpoints (and the one to restart from).
+        type(checkpoint_run_t), intent(inout) :: ck
         !> Set on a run or write failure.
         type(error_t), allocatable, intent(out) :: error
-        call out%write_mesh(self%beam%node_id, self%beam%x, self%beam%y, self%beam%conn, error)
+        if (.not. ck%restart) call out%write_mesh(self%beam%node_id, self%beam%x, self%beam%y, self%beam%conn, error)
         if (allocated(error)) return
         select case (self%settings%analysis)
         case ('static')
@@ -105,7 +108,8 @@ contains
         case ('modal')
             call run_modal(self%settings, self%model, out, report, error)
         case ('dynamic')
-            call run_dynamic(self%settings, self%model, self%beam%node_id, self%integ, out, quiet, report, error)
+            call run_dynamic(self%settings, self%model, self%beam%node_id, self%integ, out, quiet, report, ck, &
+                             error)
         end select
     end subroutine beam_run
 
@@ -185,7 +189,7 @@ contains
         call out%write_modal(omega, full, error)
     end subroutine run_modal
 
-    subroutine run_dynamic(run, model, node_id, integ, out, quiet, report, error)
+    subroutine run_dynamic(run, model, node_id, integ, out, quiet, report, ck, error)
         type(run_config_t), intent(in) :: run
         type(beam_model_t), intent(in) :: model
         integer, intent(in) :: node_id(:)
@@ -193,31 +197,46 @@ contains
         type(results_writer_t), intent(inout) :: out
         logical, intent(in) :: quiet
         procedure(report_iface) :: report
+        type(checkpoint_run_t), intent(inout) :: ck
         type(error_t), allocatable, intent(out) :: error
         type(progress_t) :: progress
         real(wp), allocatable :: d(:, :), v(:, :), a(:, :)
-        integer(i8) :: n_steps, k
+        integer(i8) :: n_steps, k, k0
+        logical :: regular, stop
         character(len=160) :: buf
 
         n_steps = run%n_steps
         allocate (d(3, model%n_nodes), v(3, model%n_nodes), a(3, model%n_nodes))
         call progress%start(n_steps, run%t_end, run%progress_seconds)
-        call check(0_i8, error)
-        if (allocated(error)) return
-        call store(error)
-        if (allocated(error)) return
-        do k = 1, n_steps
+        k0 = 0
+        if (ck%restart) then
+            call restore(error)
+            if (allocated(error)) return
+        else
+            call check(0_i8, error)
+            if (allocated(error)) return
+            call store(error)
+            if (allocated(error)) return
+        end if
+        call ck%schedule%start()
+        do k = k0 + 1, n_steps
             call integ%step(model, error)
             if (allocated(error)) return
             call check(k, error)
             if (allocated(error)) return
-            if (mod(k, int(run%output_interval, i8)) == 0 .or. k == n_steps) then
-                call store(error)
-                if (allocated(error)) return
-            end if
-            if (k < n_steps .and. caught_signal() /= 0) then
+            ! The checkpoint holds the regular outputs up to step k, not the extra output of
+            ! the last step or of a stop (a restart with a later end time cuts them).
+            regular = mod(k, int(run%output_interval, i8)) == 0
+            if (regular) call store(error)
+            if (allocated(error)) return
+            stop = k < n_steps .and. caught_signal() /= 0
+            if (k == n_steps .or. stop .or. ck%schedule%due(k)) call checkpoint(error)
+            if (allocated(error)) return
+            if (k == n_steps .and. .not. regular) call store(error)
+            if (allocated(error)) return
+            if (stop) then
                 ! Stop request: the step just done is the last output.
-                if (mod(k, int(run%output_interval, i8)) /= 0) call store(error)
+                if (.not. regular) call store(error)
                 if (allocated(error)) return
                 call out%stop_at(signal_name(caught_signal()), k, integ%t)
                 n_steps = k
@@ -232,6 +251,37 @@ contains
         ! n_steps <= max_steps = huge(0) (driver_config)
         call out%write_summary(int(n_steps), progress%elapsed(), error)
     contains
+        !> Restart: integrator state and results file from the checkpoint `ck%source`.
+        subroutine restore(error)
+            type(error_t), allocatable, intent(out) :: error
+            type(error_t), allocatable :: ignored
+            call load_integrator(ck%source, '/fe', integ, error)
+            if (.not. allocated(error)) call load_results(ck%source, out, error)
+            call ck%source%close(ignored)
+            if (allocated(error)) return
+            k0 = ck%start%step
+        end subroutine restore
+
+        !> Write a checkpoint after step k.
+        subroutine checkpoint(error)
+            type(error_t), allocatable, intent(out) :: error
+            type(h5_file_t) :: f
+            call out%flush(error)
+            if (allocated(error)) return
+            call checkpoint_create(f, ck%path, ck%deck_text, 'beam', loop_state_t(k, 0, .false., .false.), &
+                                   integ%t, out%run_id, error)
+            if (.not. allocated(error)) call save_integrator(f, '/fe', integ, error)
+            if (.not. allocated(error)) call save_results(f, out, error)
+            if (allocated(error)) then
+                call checkpoint_discard(f, ck%path)
+                return
+            end if
+            call checkpoint_commit(f, ck%path, error)
+            if (allocated(error)) return
+            ck%last_step = k
+            ck%last_time = integ%t
+        end subroutine checkpoint
+
         !> Guard after step k (0: the initial state).
         subroutine check(k, error)
             integer(i8), intent(in) :: k

@@ -24,6 +24,7 @@ module driver_simulation_continuum
     use driver_config, only: run_config_t, build_run_settings
     use driver_config_dem, only: check_particle_keywords_unused
     use driver_results, only: results_writer_t
+    use driver_checkpoint, only: checkpoint_run_t
     use driver_results_continuum, only: continuum_writer_t
     use driver_simulation, only: simulation_t, report_iface
     implicit none
@@ -32,8 +33,6 @@ module driver_simulation_continuum
 
     !> A 2D continuum run.
     type, extends(simulation_t) :: continuum_simulation_t
-        !> Run settings.
-        type(run_config_t) :: settings
         !> The continuum (mesh, materials, loads, prescribed dofs).
         type(continuum_model_t) :: model
         !> K, M and loads on the free dofs.
@@ -376,7 +375,7 @@ contains
     end function continuum_describe
 
     !> Static solve, modes or time integration; results into `out` and an XDMF file next to it.
-    subroutine continuum_run(self, out, quiet, report, error)
+    subroutine continuum_run(self, out, quiet, report, ck, error)
         !> The simulation.
         class(continuum_simulation_t), intent(inout) :: self
         !> The results file.
@@ -385,6 +384,8 @@ contains
         logical, intent(in) :: quiet
         !> Where progress and summary lines go.
         procedure(report_iface) :: report
+        !> Checkpoints: not written by continuum runs (run_deck refuses --restart for them).
+        type(checkpoint_run_t), intent(inout) :: ck
         !> Set on a run or write failure.
         type(error_t), allocatable, intent(out) :: error
         type(continuum_writer_t) :: writer

@@ -10,6 +10,7 @@ module driver_simulation_coupled
     use driver_run_coupled, only: build_coupled, run_coupled
     use coupling_arlequin, only: coupled_system_t
     use driver_results, only: results_writer_t
+    use driver_checkpoint, only: checkpoint_run_t
     use driver_simulation, only: simulation_t, report_iface
     use driver_simulation_dem, only: check_dem_coordinates
     implicit none
@@ -18,8 +19,6 @@ module driver_simulation_coupled
 
     !> A beam and particles glued in an overlap.
     type, extends(simulation_t) :: coupled_simulation_t
-        !> Run settings.
-        type(run_config_t) :: settings
         !> Frame description.
         type(beam_config_t) :: beam
         !> Particles, walls, contact laws and solver settings.
@@ -82,7 +81,7 @@ contains
     end function coupled_describe
 
     !> The coupled time integration; results into `out`.
-    subroutine coupled_run(self, out, quiet, report, error)
+    subroutine coupled_run(self, out, quiet, report, ck, error)
         !> The simulation.
         class(coupled_simulation_t), intent(inout) :: self
         !> The results file.
@@ -91,8 +90,10 @@ contains
         logical, intent(in) :: quiet
         !> Where progress and summary lines go.
         procedure(report_iface) :: report
+        !> Checkpoints (and the one to restart from).
+        type(checkpoint_run_t), intent(inout) :: ck
         !> Set on a run or write failure.
         type(error_t), allocatable, intent(out) :: error
-        call run_coupled(self%settings, self%beam, self%dem, self%sys, out, quiet, report, error)
+        call run_coupled(self%settings, self%beam, self%dem, self%sys, out, quiet, report, ck, error)
     end subroutine coupled_run
 end module driver_simulation_coupled

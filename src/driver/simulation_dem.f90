@@ -10,6 +10,7 @@ module driver_simulation_dem
     use driver_config_dem, only: dem_config_t, build_dem_config, check_beam_keywords_unused
     use driver_run_dem, only: run_dem
     use driver_results, only: results_writer_t
+    use driver_checkpoint, only: checkpoint_run_t
     use driver_simulation, only: simulation_t, report_iface
     implicit none
     private
@@ -17,8 +18,6 @@ module driver_simulation_dem
 
     !> A run of rigid disks and walls.
     type, extends(simulation_t) :: dem_simulation_t
-        !> Run settings.
-        type(run_config_t) :: settings
         !> Empty frame holding the time functions.
         type(beam_config_t) :: beam
         !> Particles, walls, contact laws and solver settings.
@@ -64,7 +63,7 @@ contains
     end function dem_describe
 
     !> Integrate the particles; results into `out`.
-    subroutine dem_run(self, out, quiet, report, error)
+    subroutine dem_run(self, out, quiet, report, ck, error)
         !> The simulation.
         class(dem_simulation_t), intent(inout) :: self
         !> The results file.
@@ -73,9 +72,11 @@ contains
         logical, intent(in) :: quiet
         !> Where progress and summary lines go.
         procedure(report_iface) :: report
+        !> Checkpoints (and the one to restart from).
+        type(checkpoint_run_t), intent(inout) :: ck
         !> Set on a run or write failure.
         type(error_t), allocatable, intent(out) :: error
-        call run_dem(self%settings, self%dem, out, quiet, report, error)
+        call run_dem(self%settings, self%dem, out, quiet, report, ck, error)
     end subroutine dem_run
 
     !> Disks and walls must lie in the box the contact detection can represent.

@@ -46,7 +46,9 @@ module io_hdf5_file
                     h5tset_strpad_f, h5tset_cset_f, h5tget_class_f, &
                     h5t_native_double, h5t_native_integer, h5t_ieee_f64le, h5t_std_i32le, &
                     h5t_str_nullterm_f, h5t_cset_utf8_f, h5t_float_f, h5t_integer_f, &
-                    h5t_string_f, h5t_c_s1, h5tis_variable_str_f, h5dvlen_reclaim_f, h5p_default_f
+                    h5t_string_f, h5t_c_s1, h5tis_variable_str_f, h5dvlen_reclaim_f, h5p_default_f, &
+                    h5f_acc_rdwr_f, h5gn_members_f, h5gget_obj_info_idx_f, h5g_group_f, h5g_dataset_f, &
+                    h5ldelete_f
     implicit none
     private
     public :: h5_file_t
@@ -119,6 +121,9 @@ module io_hdf5_file
         generic :: read_dataset => read_real_1d, read_real_2d, read_real_3d, read_int_1d, &
             read_int_2d
         procedure :: dataset_shape => file_dataset_shape
+        procedure :: list_datasets => file_list_datasets
+        procedure :: delete => file_delete
+        procedure :: resize_series => file_resize_series
         procedure :: create_series => file_create_series
         procedure :: create_int_series => file_create_int_series
         procedure, private :: append_0d, append_1d, append_2d
@@ -183,15 +188,18 @@ contains
         self%writable = .true.
     end subroutine file_create
 
-    !> Open an existing file for reading.
-    subroutine file_open(self, path, error)
+    !> Open an existing file for reading (or, with `writable`, for reading and writing).
+    subroutine file_open(self, path, error, writable)
         !> The file object; must not be open.
         class(h5_file_t), intent(inout) :: self
         !> File name.
         character(len=*), intent(in) :: path
         !> Set when the file is missing or is not an HDF5 file.
         type(error_t), allocatable, intent(out) :: error
+        !> Open for writing too (default: read only).
+        logical, intent(in), optional :: writable
         integer :: hdferr
+        logical :: rw
         if (self%is_open()) then
             call make_error(error, "HDF5: cannot open '"//path//"': this object still has '" &
                             //self%path//"' open")
@@ -200,14 +208,28 @@ contains
         call ensure_library(error)
         if (allocated(error)) return
         self%path = path
-        call h5fopen_f(path, h5f_acc_rdonly_f, self%id, hdferr)
+        rw = .false.
+        if (present(writable)) rw = writable
+        if (rw) then
+            call h5fopen_f(path, h5f_acc_rdwr_f, self%id, hdferr)
+        else
+            call h5fopen_f(path, h5f_acc_rdonly_f, self%id, hdferr)
+        end if
         if (hdferr < 0) then
             self%id = -1
-            call make_error(error, "HDF5: cannot open file '"//path// &
-                            "' for reading (missing, or not an HDF5 file)")
+            if (rw) then
+                ! HDF5 1.10 refuses a file whose writer was killed (its superblock still says
+                ! open for writing) until `h5clear -s` resets that mark.
+                call make_error(error, "HDF5: cannot open file '"//path//"' for writing "// &
+                                "(missing, not an HDF5 file, read-only, or left open by a killed "// &
+                                "writer: then run 'h5clear -s "//path//"' first)")
+            else
+                call make_error(error, "HDF5: cannot open file '"//path// &
+                                "' for reading (missing, or not an HDF5 file)")
+            end if
             return
         end if
-        self%writable = .false.
+        self%writable = rw
     end subroutine file_open
 
     !> Close the file (no-op when it is not open).
@@ -928,6 +950,119 @@ contains
         call release(dset)
         dims = int(hdims)
     end subroutine file_dataset_shape
+
+    !> Paths of every dataset in the file (groups visited recursively, in HDF5's name order),
+    !> with the extent of the last Fortran dimension of each (the number of records of a
+    !> series; 1 for a scalar dataset).
+    subroutine file_list_datasets(self, paths, last_dims, error)
+        !> An open file.
+        class(h5_file_t), intent(in) :: self
+        !> Absolute dataset paths.
+        character(len=256), allocatable, intent(out) :: paths(:)
+        !> Extent of the last dimension of each dataset.
+        integer, allocatable, intent(out) :: last_dims(:)
+        !> Set when the file cannot be read.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: n
+        allocate (paths(16), last_dims(16))
+        n = 0
+        if (.not. self%is_open()) then
+            call make_error(error, 'HDF5: list_datasets: no file is open')
+            return
+        end if
+        call visit('/', error)
+        if (allocated(error)) return
+        paths = paths(:n)
+        last_dims = last_dims(:n)
+    contains
+        recursive subroutine visit(group, error)
+            character(len=*), intent(in) :: group
+            type(error_t), allocatable, intent(out) :: error
+            character(len=256) :: name
+            character(len=:), allocatable :: child
+            integer :: members, k, obj_type, hdferr
+            integer, allocatable :: dims(:)
+            call h5gn_members_f(self%id, group, members, hdferr)
+            if (hdferr < 0) then
+                call make_error(error, "HDF5: cannot list group '"//group//"' in '"//self%path//"'")
+                return
+            end if
+            do k = 0, members - 1
+                call h5gget_obj_info_idx_f(self%id, group, k, name, obj_type, hdferr)
+                if (hdferr < 0) then
+                    call make_error(error, "HDF5: cannot list group '"//group//"' in '"//self%path//"'")
+                    return
+                end if
+                if (group == '/') then
+                    child = '/'//trim(name)
+                else
+                    child = group//'/'//trim(name)
+                end if
+                if (len(child) > len(paths)) then
+                    call make_error(error, "HDF5: path '"//child//"' longer than 256 characters")
+                    return
+                end if
+                if (obj_type == h5g_group_f) then
+                    call visit(child, error)
+                    if (allocated(error)) return
+                else if (obj_type == h5g_dataset_f) then
+                    call self%dataset_shape(child, dims, error)
+                    if (allocated(error)) return
+                    if (n == size(paths)) then
+                        paths = [paths, paths]
+                        last_dims = [last_dims, last_dims]
+                    end if
+                    n = n + 1
+                    paths(n) = child
+                    last_dims(n) = 1
+                    if (size(dims) > 0) last_dims(n) = dims(size(dims))
+                end if
+            end do
+        end subroutine visit
+    end subroutine file_list_datasets
+
+    !> Remove a dataset or group from the file (its space is not reused).
+    subroutine file_delete(self, path, error)
+        !> A file open for writing.
+        class(h5_file_t), intent(inout) :: self
+        !> Object path.
+        character(len=*), intent(in) :: path
+        !> Set when the object is missing or cannot be removed.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: hdferr
+        call require_writable(self, path, error)
+        if (allocated(error)) return
+        call h5ldelete_f(self%id, path, hdferr)
+        if (hdferr < 0) call make_error(error, "HDF5: cannot delete '"//path//"' in '"//self%path//"'")
+    end subroutine file_delete
+
+    !> Set the number of records of a series (fewer: the last records are dropped).
+    subroutine file_resize_series(self, path, n_records, error)
+        !> A file open for writing.
+        class(h5_file_t), intent(inout) :: self
+        !> Series path.
+        character(len=*), intent(in) :: path
+        !> New number of records.
+        integer, intent(in) :: n_records
+        !> Set when the dataset is missing or cannot be resized.
+        type(error_t), allocatable, intent(out) :: error
+        integer(hsize_t), allocatable :: dims(:)
+        integer(hid_t) :: dset
+        integer :: hdferr
+        call require_writable(self, path, error)
+        if (allocated(error)) return
+        call dataset_dims(self, path, dset, dims, error)
+        if (allocated(error)) return
+        if (size(dims) == 0) then
+            call release(dset)
+            call make_error(error, "HDF5: '"//path//"' is not a series")
+            return
+        end if
+        dims(size(dims)) = int(n_records, hsize_t)
+        call h5dset_extent_f(dset, dims, hdferr)
+        call release(dset)
+        if (hdferr < 0) call dataset_error(self, 'resize', path, error)
+    end subroutine file_resize_series
 
     !> Create a new dataset (with its parent groups) and return its id.
     subroutine new_dataset(self, path, file_type, dims, maxdims, dset, error, chunk)

@@ -1,10 +1,11 @@
-!> File-system helpers: file name parts, directory creation, file existence and removal.
+!> File-system helpers: file name parts, directory creation, file existence, copy and removal.
 module io_paths
     use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+    use, intrinsic :: iso_fortran_env, only: int64
     use core_error, only: error_t, make_error
     implicit none
     private
-    public :: basename, stem, mkdir_p, file_exists, remove_file, rename_file
+    public :: basename, stem, mkdir_p, file_exists, remove_file, rename_file, copy_file
 
     interface
         function c_mkdir(path, mode) bind(C, name='mkdir') result(rc)
@@ -93,4 +94,48 @@ contains
             call make_error(error, "cannot rename '"//old//"' to '"//new//"'")
         end if
     end subroutine rename_file
+    !> Copy a file byte for byte (the target is replaced; on failure it is removed).
+    subroutine copy_file(old, new, error)
+        !> File to copy.
+        character(len=*), intent(in) :: old
+        !> Name of the copy.
+        character(len=*), intent(in) :: new
+        !> Set if the file cannot be read or the copy written.
+        type(error_t), allocatable, intent(out) :: error
+        integer, parameter :: block = 1048576
+        character(len=block) :: buf
+        integer :: src, dst, ios, n
+        integer(int64) :: size_bytes, pos
+        open (newunit=src, file=old, access='stream', form='unformatted', status='old', &
+              action='read', iostat=ios)
+        if (ios /= 0) then
+            call make_error(error, "cannot read '"//old//"'")
+            return
+        end if
+        inquire (unit=src, size=size_bytes)
+        open (newunit=dst, file=new, access='stream', form='unformatted', status='replace', &
+              action='write', iostat=ios)
+        if (ios /= 0) then
+            close (src)
+            call make_error(error, "cannot create '"//new//"'")
+            return
+        end if
+        pos = 0
+        do while (pos < size_bytes .and. ios == 0)
+            n = int(min(int(block, int64), size_bytes - pos))
+            read (src, iostat=ios) buf(:n)
+            if (ios == 0) write (dst, iostat=ios) buf(:n)
+            pos = pos + n
+        end do
+        close (src)
+        if (ios == 0) then
+            close (dst, iostat=ios)
+        else
+            close (dst, status='delete')
+        end if
+        if (ios /= 0) then
+            call remove_file(new)
+            call make_error(error, "cannot copy '"//old//"' to '"//new//"' (disk full?)")
+        end if
+    end subroutine copy_file
 end module io_paths

@@ -82,5 +82,10 @@ contains
         call s%add_keyword('output', 'contacts', [word_field('contacts', 'yes no')], &
                            'Store the contact network (pairs, normals, forces, statuses) with every stored '// &
                            'state of the particles.', default='yes')
+        call s%add_keyword('output', 'checkpoint_interval', [int_field('checkpoint_interval', lower=0)], &
+                           'Time steps between checkpoints (0 = none); a dynamic run also writes one at its end '// &
+                           'and when a signal stops it (doc/output.md).', default='0')
+        call s%add_keyword('output', 'checkpoint_seconds', [real_field('checkpoint_seconds', 's', lower=0.0_wp)], &
+                           'Wall-clock seconds between checkpoints (0 = none).', default='0')
     end subroutine add_output
 end module io_schema_common

@@ -117,7 +117,9 @@ def main():
                   sent.stderr.strip())
             print(f"SIGUSR1 sent to {job}_2 {t_signal - t0:.1f} s after the cluster started")
         log = folder / "runs" / "p002" / "job.log"
-        requeued = wait_for("the requeue", lambda: log.exists() and "requeue"
+        # "requeued:" (the job script's line), not "requeue": the log's paths contain
+        # the test's folder name, test_slurm_requeue
+        requeued = wait_for("the requeue", lambda: log.exists() and "requeued:"
                             in log.read_text(), 90 if real else 30, cluster)
         check("point 2 stopped with exit 138 and requeued itself", requeued
               and "exit 138" in log.read_text(), log.read_text() if log.exists() else "")

@@ -1,0 +1,1048 @@
+!> Checkpoints of a time loop and restart from them (doc/output.md, "Checkpoints and restart").
+!>
+!> A checkpoint is an HDF5 file holding everything a time loop needs to go on as if it had
+!> never stopped: the mutable state of the models (Newmark state of a beam; Moreau-Jean state
+!> of the disks and walls, the contact list with its reactions and statuses for the warm
+!> start, bond states and the rupture log; multipliers and constraint state of a coupling),
+!> the counters of the results writers and the record count of every dataset of the results
+!> file, the loop's own counters, and a header: code version, a hash of the deck's text, the
+!> kind of run, the step. What the deck builds (meshes, matrices, materials, functions) is
+!> built again from the deck at restart and not stored. There is no random state in a time
+!> loop: the random deposit is generated from the deck's seed when the model is built.
+!>
+!> The file is written as '<path>.tmp' and renamed to `path` (atomic on POSIX): a kill
+!> during the write leaves the previous checkpoint intact.
+module driver_checkpoint
+    use core_kinds, only: wp, i8
+    use core_error, only: error_t, make_error
+    use core_version, only: multicor_version
+    use io_hdf5_file, only: h5_file_t
+    use io_paths, only: rename_file, remove_file, file_exists
+    use fem_newmark, only: time_integrator_t, newmark_t
+    use dem_moreau_jean, only: dem_system_t
+    use dem_nlgs, only: nlgs_stats_t
+    use dem_bonded_block, only: bonded_block_restore
+    use coupling_arlequin, only: coupled_system_t
+    use driver_results, only: results_writer_t
+    use driver_results_dem, only: dem_writer_t
+    use driver_results_coupled, only: coupled_writer_t
+    implicit none
+    private
+    public :: checkpoint_name, deck_hash, loop_state_t, checkpoint_schedule_t
+    public :: checkpoint_create, checkpoint_commit, checkpoint_open, checkpoint_discard
+    public :: save_integrator, load_integrator, save_dem, load_dem, save_coupled, load_coupled
+    public :: save_results, load_results, save_dem_writer, load_dem_writer
+    public :: save_coupled_writer, load_coupled_writer, save_loop, load_loop
+    public :: checkpoint_run_t
+
+    !> File name of the checkpoint in the results folder.
+    character(len=*), parameter :: checkpoint_name = 'checkpoint.h5'
+    !> Format tag written in every checkpoint.
+    character(len=*), parameter :: format_tag = 'MULTICOR checkpoint 1'
+
+    !> Counters of a time loop that the results depend on.
+    type :: loop_state_t
+        !> Steps done.
+        integer(i8) :: step = 0
+        !> Unconverged steps so far.
+        integer :: unconverged = 0
+        !> Warnings given once: disk faster than the alert distance, blocked contacts.
+        logical :: speed_warned = .false., blocked_warned = .false.
+    end type loop_state_t
+
+    !> When a time loop writes a checkpoint (besides signals and the end of the run).
+    type :: checkpoint_schedule_t
+        !> Every this many steps (0: never).
+        integer :: every = 0
+        !> Every this many seconds of wall time (0: never).
+        real(wp) :: seconds = 0.0_wp
+        !> Clock count of the last checkpoint (or of the start).
+        integer(i8), private :: last = 0
+        !> Clock rate.
+        integer(i8), private :: rate = 1
+    contains
+        !> Start the wall-time clock.
+        procedure :: start => schedule_start
+        !> Whether a checkpoint is due after step k (restarts the clock when it is).
+        procedure :: due => schedule_due
+    end type checkpoint_schedule_t
+
+    !> Checkpoints of one run: where and when to write them, and the checkpoint a restart
+    !> starts from.
+    type :: checkpoint_run_t
+        !> Where checkpoints are written ('<results folder>/checkpoint.h5').
+        character(len=:), allocatable :: path
+        !> The deck's text (hashed into every checkpoint).
+        character(len=:), allocatable :: deck_text
+        !> When to write them besides signals and the end.
+        type(checkpoint_schedule_t) :: schedule
+        !> Whether the run continues from `source`.
+        logical :: restart = .false.
+        !> The checkpoint a restart reads (open while the loop loads it).
+        type(h5_file_t) :: source
+        !> Loop counters at the checkpoint of a restart.
+        type(loop_state_t) :: start
+        !> Step and time of the last checkpoint written by this run (-1: none yet).
+        integer(i8) :: last_step = -1
+        !> Time of the state in the last checkpoint written [s].
+        real(wp) :: last_time = 0.0_wp
+    end type checkpoint_run_t
+
+contains
+
+    !> Start the wall-time clock of a schedule.
+    subroutine schedule_start(self)
+        !> The schedule.
+        class(checkpoint_schedule_t), intent(inout) :: self
+        call system_clock(self%last, self%rate)
+        if (self%rate <= 0) self%rate = 1
+    end subroutine schedule_start
+
+    !> Whether a checkpoint is due after step k: every `every` steps or once `seconds` of wall
+    !> time have passed since the last one.
+    logical function schedule_due(self, k)
+        !> The schedule.
+        class(checkpoint_schedule_t), intent(inout) :: self
+        !> Steps done.
+        integer(i8), intent(in) :: k
+        integer(i8) :: now
+        schedule_due = .false.
+        if (self%every > 0) schedule_due = mod(k, int(self%every, i8)) == 0
+        if (self%seconds > 0.0_wp .and. .not. schedule_due) then
+            call system_clock(now)
+            schedule_due = real(now - self%last, wp)/real(self%rate, wp) >= self%seconds
+        end if
+        if (schedule_due) call system_clock(self%last)
+    end function schedule_due
+
+    !> Hash of a deck's text: 16 hexadecimal digits (two polynomial hashes modulo primes below
+    !> 2**31, and the length); it tells decks apart, it is not a cryptographic digest.
+    pure function deck_hash(text) result(hex)
+        !> The deck's text.
+        character(len=*), intent(in) :: text
+        character(len=16) :: hex
+        integer(i8), parameter :: p1 = 2147483647_i8, p2 = 2147483629_i8
+        integer(i8) :: h1, h2
+        integer :: i
+        h1 = int(len(text), i8)
+        h2 = 7_i8
+        do i = 1, len(text)
+            h1 = mod(h1*257_i8 + int(ichar(text(i:i)), i8), p1)
+            h2 = mod(h2*263_i8 + int(ichar(text(i:i)), i8) + 1_i8, p2)
+        end do
+        write (hex, '(z8.8,z8.8)') h1, h2
+    end function deck_hash
+
+    !> Create '<path>.tmp' and write the header.
+    subroutine checkpoint_create(file, path, deck_text, kind, loop, time, run_id, error)
+        !> The checkpoint file (closed on entry).
+        type(h5_file_t), intent(inout) :: file
+        !> Final name of the checkpoint.
+        character(len=*), intent(in) :: path
+        !> The deck's text.
+        character(len=*), intent(in) :: deck_text
+        !> Kind of run: 'beam', 'particles' or 'coupled'.
+        character(len=*), intent(in) :: kind
+        !> The loop's counters.
+        type(loop_state_t), intent(in) :: loop
+        !> Time of the state [s].
+        real(wp), intent(in) :: time
+        !> Root attribute 'run_id' of the results file (identifies the run).
+        character(len=*), intent(in) :: run_id
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call file%create(path//'.tmp', error)
+        if (allocated(error)) return
+        call file%write_attribute('/', 'format', format_tag, error)
+        if (allocated(error)) return
+        call file%write_attribute('/', 'code_version', multicor_version, error)
+        if (allocated(error)) return
+        call file%write_attribute('/', 'deck_hash', deck_hash(deck_text), error)
+        if (allocated(error)) return
+        call file%write_attribute('/', 'kind', kind, error)
+        if (allocated(error)) return
+        call file%write_attribute('/', 'time', time, error)
+        if (allocated(error)) return
+        call file%write_attribute('/', 'run_id', run_id, error)
+        if (allocated(error)) return
+        call save_loop(file, loop, error)
+    end subroutine checkpoint_create
+
+    !> Close '<path>.tmp' and rename it to `path` (replacing the previous checkpoint).
+    subroutine checkpoint_commit(file, path, error)
+        !> The checkpoint file being written; closed on return.
+        type(h5_file_t), intent(inout) :: file
+        !> Final name of the checkpoint.
+        character(len=*), intent(in) :: path
+        !> Set when the file cannot be closed or renamed.
+        type(error_t), allocatable, intent(out) :: error
+        call file%close(error)
+        if (allocated(error)) then
+            call remove_file(path//'.tmp')
+            return
+        end if
+        call rename_file(path//'.tmp', path, error)
+    end subroutine checkpoint_commit
+
+    !> Close and delete '<path>.tmp' after a failed write (the previous checkpoint stays).
+    subroutine checkpoint_discard(file, path)
+        !> The checkpoint file being written; closed on return.
+        type(h5_file_t), intent(inout) :: file
+        !> Final name of the checkpoint.
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable :: ignored
+        call file%close(ignored)
+        call remove_file(path//'.tmp')
+    end subroutine checkpoint_discard
+
+    !> Open a checkpoint for reading and check it belongs to this deck, this code version and
+    !> this kind of run.
+    subroutine checkpoint_open(file, path, deck_file, deck_text, kind, loop, run_id, error)
+        !> The checkpoint file (closed on entry; open on success).
+        type(h5_file_t), intent(inout) :: file
+        !> Path of the checkpoint.
+        character(len=*), intent(in) :: path
+        !> Deck path (for messages).
+        character(len=*), intent(in) :: deck_file
+        !> The deck's text.
+        character(len=*), intent(in) :: deck_text
+        !> Kind of run of the deck: 'beam', 'particles' or 'coupled'.
+        character(len=*), intent(in) :: kind
+        !> The loop's counters at the checkpoint.
+        type(loop_state_t), intent(out) :: loop
+        !> Root attribute 'run_id' of the results file of the run.
+        character(len=:), allocatable, intent(out) :: run_id
+        !> Set when the file is not a checkpoint of this deck and code.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: tag, version, hash, ckind
+        type(error_t), allocatable :: ignored
+        if (.not. file_exists(path)) then
+            call make_error(error, "--restart: no checkpoint '"//path//"'")
+            return
+        end if
+        call file%open(path, error)
+        if (allocated(error)) then
+            call make_error(error, "--restart: '"//path//"' is not an HDF5 file")
+            return
+        end if
+        call file%read_attribute('/', 'format', tag, error)
+        if (allocated(error)) tag = ''
+        if (tag /= format_tag) then
+            call refuse("'"//path//"' is not a MULTICOR checkpoint")
+            return
+        end if
+        call file%read_attribute('/', 'code_version', version, error)
+        if (.not. allocated(error)) call file%read_attribute('/', 'deck_hash', hash, error)
+        if (.not. allocated(error)) call file%read_attribute('/', 'kind', ckind, error)
+        if (.not. allocated(error)) call file%read_attribute('/', 'run_id', run_id, error)
+        if (allocated(error)) then
+            call refuse("'"//path//"' is an incomplete checkpoint")
+            return
+        end if
+        if (version /= multicor_version) then
+            call refuse("checkpoint '"//path//"' was written by MULTICOR "//version// &
+                        ', this is MULTICOR '//multicor_version//': a restart needs the same code '// &
+                        'version (run the deck from the start, or use that version)')
+        else if (hash /= deck_hash(deck_text)) then
+            call refuse("checkpoint '"//path//"' was written for another deck (deck hash "// &
+                        hash//", '"//deck_file//"' has "//deck_hash(deck_text)//'): restart with '// &
+                        'the deck of that run, unchanged (a new end time goes on the command line: --end)')
+        else if (ckind /= kind) then
+            call refuse("checkpoint '"//path//"' holds a "//ckind//' run, the deck is a '//kind//' run')
+        else
+            call load_loop(file, loop, error)
+            if (allocated(error)) call file%close(ignored)
+        end if
+    contains
+        subroutine refuse(message)
+            character(len=*), intent(in) :: message
+            call file%close(ignored)
+            call make_error(error, '--restart: '//message)
+        end subroutine refuse
+    end subroutine checkpoint_open
+
+    ! ---------------------------------------------------------------------------------------
+    ! Loop counters
+    ! ---------------------------------------------------------------------------------------
+
+    !> Write the loop counters (attributes of /loop).
+    subroutine save_loop(file, loop, error)
+        !> Checkpoint being written.
+        type(h5_file_t), intent(inout) :: file
+        !> The counters.
+        type(loop_state_t), intent(in) :: loop
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call file%create_group('/loop', error)
+        if (allocated(error)) return
+        ! n_steps <= max_steps = huge(0) (driver_config)
+        call file%write_attribute('/loop', 'step', int(loop%step), error)
+        if (allocated(error)) return
+        call file%write_attribute('/loop', 'unconverged', loop%unconverged, error)
+        if (allocated(error)) return
+        call file%write_attribute('/loop', 'speed_warned', merge(1, 0, loop%speed_warned), error)
+        if (allocated(error)) return
+        call file%write_attribute('/loop', 'blocked_warned', merge(1, 0, loop%blocked_warned), error)
+    end subroutine save_loop
+
+    !> Read the loop counters.
+    subroutine load_loop(file, loop, error)
+        !> Checkpoint being read.
+        type(h5_file_t), intent(inout) :: file
+        !> The counters.
+        type(loop_state_t), intent(out) :: loop
+        !> Set on a read failure.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: k
+        call file%read_attribute('/loop', 'step', k, error)
+        if (allocated(error)) return
+        loop%step = int(k, i8)
+        call file%read_attribute('/loop', 'unconverged', loop%unconverged, error)
+        if (allocated(error)) return
+        call file%read_attribute('/loop', 'speed_warned', k, error)
+        if (allocated(error)) return
+        loop%speed_warned = k /= 0
+        call file%read_attribute('/loop', 'blocked_warned', k, error)
+        if (allocated(error)) return
+        loop%blocked_warned = k /= 0
+    end subroutine load_loop
+
+    ! ---------------------------------------------------------------------------------------
+    ! Beam: Newmark state
+    ! ---------------------------------------------------------------------------------------
+
+    !> Write the state of a time integrator under `group`.
+    subroutine save_integrator(file, group, integ, error)
+        !> Checkpoint being written.
+        type(h5_file_t), intent(inout) :: file
+        !> Group, e.g. '/fe'.
+        character(len=*), intent(in) :: group
+        !> The integrator.
+        class(time_integrator_t), intent(in) :: integ
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call file%create_group(group, error)
+        if (allocated(error)) return
+        call file%write_attribute(group, 'scalars', [integ%t, integ%h, integ%t0, integ%kinetic, &
+                                                     integ%strain, integ%external_work, integ%damping_dissipation, &
+                                                     integ%initial_energy, integ%coupling_work], error)
+        if (allocated(error)) return
+        call file%write_attribute(group, 'step_count', integ%step_count, error)
+        if (allocated(error)) return
+        call put_r1(file, group//'/u', integ%u, error)
+        if (allocated(error)) return
+        call put_r1(file, group//'/v', integ%v, error)
+        if (allocated(error)) return
+        call put_r1(file, group//'/a', integ%a, error)
+        if (allocated(error)) return
+        call put_r1(file, group//'/u_old', integ%u_old, error)
+        if (allocated(error)) return
+        call put_r1(file, group//'/v_old', integ%v_old, error)
+        if (allocated(error)) return
+        call put_r1(file, group//'/f_old', integ%f_old, error)
+        if (allocated(error)) return
+        call put_r1(file, group//'/f_new', integ%f_new, error)
+        if (allocated(error)) return
+        select type (integ)
+        type is (newmark_t)
+            call file%write_attribute(group, 'predicted', merge(1, 0, integ%predicted), error)
+            if (allocated(error)) return
+            call put_r1(file, group//'/fc_old', integ%fc_old, error)
+        end select
+    end subroutine save_integrator
+
+    !> Read the state of a time integrator (built from the deck) from `group`.
+    subroutine load_integrator(file, group, integ, error)
+        !> Checkpoint being read.
+        type(h5_file_t), intent(inout) :: file
+        !> Group, e.g. '/fe'.
+        character(len=*), intent(in) :: group
+        !> The integrator (init done).
+        class(time_integrator_t), intent(inout) :: integ
+        !> Set on a read failure or a size mismatch.
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: s(:)
+        integer :: k
+        call file%read_attribute(group, 'scalars', s, error)
+        if (allocated(error)) return
+        if (size(s) /= 9) then
+            call make_error(error, 'checkpoint: '//group//': wrong number of scalars')
+            return
+        end if
+        integ%t = s(1)
+        integ%h = s(2)
+        integ%t0 = s(3)
+        integ%kinetic = s(4)
+        integ%strain = s(5)
+        integ%external_work = s(6)
+        integ%damping_dissipation = s(7)
+        integ%initial_energy = s(8)
+        integ%coupling_work = s(9)
+        call file%read_attribute(group, 'step_count', integ%step_count, error)
+        if (allocated(error)) return
+        call get_r1(file, group//'/u', integ%u, error)
+        if (allocated(error)) return
+        call get_r1(file, group//'/v', integ%v, error)
+        if (allocated(error)) return
+        call get_r1(file, group//'/a', integ%a, error)
+        if (allocated(error)) return
+        call get_r1(file, group//'/u_old', integ%u_old, error)
+        if (allocated(error)) return
+        call get_r1(file, group//'/v_old', integ%v_old, error)
+        if (allocated(error)) return
+        call get_r1(file, group//'/f_old', integ%f_old, error)
+        if (allocated(error)) return
+        call get_r1(file, group//'/f_new', integ%f_new, error)
+        if (allocated(error)) return
+        select type (integ)
+        type is (newmark_t)
+            call file%read_attribute(group, 'predicted', k, error)
+            if (allocated(error)) return
+            integ%predicted = k /= 0
+            call get_r1(file, group//'/fc_old', integ%fc_old, error)
+        end select
+    end subroutine load_integrator
+
+    ! ---------------------------------------------------------------------------------------
+    ! Particles: Moreau-Jean state, contacts, bonds
+    ! ---------------------------------------------------------------------------------------
+
+    !> Write the mutable state of a particle system under `group`.
+    subroutine save_dem(file, group, sys, error)
+        !> Checkpoint being written.
+        type(h5_file_t), intent(inout) :: file
+        !> Group, e.g. '/dem'.
+        character(len=*), intent(in) :: group
+        !> The system.
+        type(dem_system_t), intent(in) :: sys
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: n
+        call file%create_group(group, error)
+        if (allocated(error)) return
+        associate (e => sys%energies, st => sys%stats)
+            call file%write_attribute(group, 'scalars', [sys%time, sys%time_detection, sys%time_solver, &
+                                                         e%kinetic, e%potential, e%external_work, e%drive_work, &
+                                                         e%contact_dissipation, e%numerical_dissipation, e%initial, &
+                                                         e%coupling_work, st%error, st%residual], error)
+            if (allocated(error)) return
+            call file%write_attribute(group, 'integers', real([sys%step, merge(1, 0, sys%bonds_pending), &
+                                                               st%sweeps, st%n_contacts, st%n_active, st%n_blocked, &
+                                                               merge(1, 0, st%converged), sys%particles%n, sys%walls%n], wp), error)
+            if (allocated(error)) return
+            call file%write_attribute(group, 'counts_i8', real([st%local_iterations, st%updates], wp), error)
+            if (allocated(error)) return
+        end associate
+        associate (p => sys%particles, w => sys%walls)
+            n = p%n
+            call put_part(file, group//'/x', p%x(1:n), error)
+            if (.not. allocated(error)) call put_part(file, group//'/y', p%y(1:n), error)
+            if (.not. allocated(error)) call put_part(file, group//'/rot', p%rot(1:n), error)
+            if (.not. allocated(error)) call put_part(file, group//'/vx', p%vx(1:n), error)
+            if (.not. allocated(error)) call put_part(file, group//'/vy', p%vy(1:n), error)
+            if (.not. allocated(error)) call put_part(file, group//'/w', p%w(1:n), error)
+            if (allocated(error)) return
+            n = w%n
+            if (n > 0) then
+                call put_part(file, group//'/walls/x1', w%x1(1:n), error)
+                if (.not. allocated(error)) call put_part(file, group//'/walls/y1', w%y1(1:n), error)
+                if (.not. allocated(error)) call put_part(file, group//'/walls/x2', w%x2(1:n), error)
+                if (.not. allocated(error)) call put_part(file, group//'/walls/y2', w%y2(1:n), error)
+                if (.not. allocated(error)) call put_part(file, group//'/walls/vx', w%vx(1:n), error)
+                if (.not. allocated(error)) call put_part(file, group//'/walls/vy', w%vy(1:n), error)
+                if (allocated(error)) return
+            end if
+        end associate
+        call save_contacts(error)
+        if (allocated(error)) return
+        call save_ruptures(error)
+        if (allocated(error)) return
+        call save_block(error)
+    contains
+        !> The factor of the bonded block in use (solver method = block): its bond graph and
+        !> values, factored again at the restart (dem_bonded_block::bonded_block_restore).
+        subroutine save_block(error)
+            type(error_t), allocatable, intent(out) :: error
+            character(len=:), allocatable :: g
+            if (.not. allocated(sys%block)) return
+            if (.not. (sys%block%factored .and. allocated(sys%block%values_factored))) return
+            if (size(sys%block%key_i1) == 0) return
+            g = group//'/block'
+            call file%write_dataset(g//'/key_i1', sys%block%key_i1, error)
+            if (.not. allocated(error)) call file%write_dataset(g//'/key_i2', sys%block%key_i2, error)
+            if (.not. allocated(error)) call file%write_dataset(g//'/key_rows', sys%block%key_rows, error)
+            if (.not. allocated(error)) call file%write_dataset(g//'/values', sys%block%values_factored, error)
+        end subroutine save_block
+
+        subroutine save_contacts(error)
+            type(error_t), allocatable, intent(out) :: error
+            character(len=:), allocatable :: g
+            integer :: m
+            g = group//'/contacts'
+            associate (cs => sys%contacts)
+                m = cs%n
+                call file%create_group(g, error)
+                if (allocated(error)) return
+                call file%write_attribute(g, 'n', m, error)
+                if (allocated(error) .or. m == 0) return
+                call file%write_dataset(g//'/i1', cs%i1(1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/i2', cs%i2(1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/nrm', cs%nrm(:, 1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/gap', cs%gap(1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/lever', cs%lever(:, 1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/w', cs%w(:, 1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/shift', cs%shift(:, 1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/r', cs%r(:, 1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/u', cs%u(:, 1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/mu', cs%mu(1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/erol', cs%erol(1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/amoy', cs%amoy(1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/coh', cs%coh(1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/pcase', cs%pcase(1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/break_mode', cs%break_mode(1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/status', cs%status(1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/active', &
+                                                                    merge(1, 0, cs%active(1:m)), error)
+            end associate
+        end subroutine save_contacts
+
+        subroutine save_ruptures(error)
+            type(error_t), allocatable, intent(out) :: error
+            character(len=:), allocatable :: g
+            integer :: m
+            g = group//'/ruptures'
+            associate (rl => sys%ruptures)
+                m = rl%n
+                call file%create_group(g, error)
+                if (allocated(error)) return
+                call file%write_attribute(g, 'n', m, error)
+                if (allocated(error) .or. m == 0) return
+                call file%write_dataset(g//'/i1', rl%i1(1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/i2', rl%i2(1:m), error)
+                ! steps <= max_steps = huge(0) (driver_config)
+                if (.not. allocated(error)) call file%write_dataset(g//'/step', int(rl%step(1:m)), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/time', rl%time(1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/mode', rl%mode(1:m), error)
+            end associate
+        end subroutine save_ruptures
+    end subroutine save_dem
+
+    !> Read the mutable state of a particle system (built from the deck, mj_init done).
+    subroutine load_dem(file, group, sys, error)
+        !> Checkpoint being read.
+        type(h5_file_t), intent(inout) :: file
+        !> Group, e.g. '/dem'.
+        character(len=*), intent(in) :: group
+        !> The system.
+        type(dem_system_t), intent(inout) :: sys
+        !> Set on a read failure or when the numbers of disks or walls differ.
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: s(:), c(:)
+        integer, allocatable :: iv(:)
+        integer :: n
+        call file%read_attribute(group, 'scalars', s, error)
+        if (allocated(error)) return
+        call read_int_attr_1d(file, group, 'integers', iv, error)
+        if (allocated(error)) return
+        call file%read_attribute(group, 'counts_i8', c, error)
+        if (allocated(error)) return
+        if (size(s) /= 13 .or. size(iv) /= 9 .or. size(c) /= 2) then
+            call make_error(error, 'checkpoint: '//group//': wrong number of values')
+            return
+        end if
+        if (iv(8) /= sys%particles%n .or. iv(9) /= sys%walls%n) then
+            call make_error(error, 'checkpoint: '//group//': numbers of disks or walls differ from the deck')
+            return
+        end if
+        sys%time = s(1)
+        sys%time_detection = s(2)
+        sys%time_solver = s(3)
+        associate (e => sys%energies, st => sys%stats)
+            e%kinetic = s(4)
+            e%potential = s(5)
+            e%external_work = s(6)
+            e%drive_work = s(7)
+            e%contact_dissipation = s(8)
+            e%numerical_dissipation = s(9)
+            e%initial = s(10)
+            e%coupling_work = s(11)
+            st%error = s(12)
+            st%residual = s(13)
+            sys%step = iv(1)
+            sys%bonds_pending = iv(2) /= 0
+            st%sweeps = iv(3)
+            st%n_contacts = iv(4)
+            st%n_active = iv(5)
+            st%n_blocked = iv(6)
+            st%converged = iv(7) /= 0
+            st%local_iterations = int(c(1), i8)
+            st%updates = int(c(2), i8)
+        end associate
+        associate (p => sys%particles, w => sys%walls)
+            n = p%n
+            call get_part(group//'/x', p%x, error)
+            if (.not. allocated(error)) call get_part(group//'/y', p%y, error)
+            if (.not. allocated(error)) call get_part(group//'/rot', p%rot, error)
+            if (.not. allocated(error)) call get_part(group//'/vx', p%vx, error)
+            if (.not. allocated(error)) call get_part(group//'/vy', p%vy, error)
+            if (.not. allocated(error)) call get_part(group//'/w', p%w, error)
+            if (allocated(error)) return
+            n = w%n
+            if (n > 0) then
+                call get_part(group//'/walls/x1', w%x1, error)
+                if (.not. allocated(error)) call get_part(group//'/walls/y1', w%y1, error)
+                if (.not. allocated(error)) call get_part(group//'/walls/x2', w%x2, error)
+                if (.not. allocated(error)) call get_part(group//'/walls/y2', w%y2, error)
+                if (.not. allocated(error)) call get_part(group//'/walls/vx', w%vx, error)
+                if (.not. allocated(error)) call get_part(group//'/walls/vy', w%vy, error)
+                if (allocated(error)) return
+            end if
+        end associate
+        call load_contacts(error)
+        if (allocated(error)) return
+        call load_ruptures(error)
+        if (allocated(error)) return
+        call load_block(error)
+    contains
+        subroutine load_block(error)
+            type(error_t), allocatable, intent(out) :: error
+            character(len=:), allocatable :: g
+            integer, allocatable :: k1(:), k2(:), kr(:)
+            real(wp), allocatable :: v(:)
+            if (allocated(sys%block)) deallocate (sys%block)
+            g = group//'/block'
+            if (.not. file%exists(g//'/values')) return
+            call file%read_dataset(g//'/key_i1', k1, error)
+            if (.not. allocated(error)) call file%read_dataset(g//'/key_i2', k2, error)
+            if (.not. allocated(error)) call file%read_dataset(g//'/key_rows', kr, error)
+            if (.not. allocated(error)) call file%read_dataset(g//'/values', v, error)
+            if (allocated(error)) return
+            allocate (sys%block)
+            call bonded_block_restore(sys%block, k1, k2, kr, v)
+        end subroutine load_block
+
+        !> Read the first n values of a per-body array (the array keeps its size).
+        subroutine get_part(path, x, error)
+            character(len=*), intent(in) :: path
+            real(wp), intent(inout) :: x(:)
+            type(error_t), allocatable, intent(out) :: error
+            real(wp), allocatable :: v(:)
+            if (n == 0) return
+            call file%read_dataset(path, v, error)
+            if (allocated(error)) return
+            if (size(v) /= n .or. size(x) < n) then
+                call make_error(error, 'checkpoint: '//path//': size differs from the deck')
+                return
+            end if
+            x(1:n) = v
+        end subroutine get_part
+
+        subroutine load_contacts(error)
+            type(error_t), allocatable, intent(out) :: error
+            character(len=:), allocatable :: g
+            integer, allocatable :: active(:)
+            integer :: m
+            g = group//'/contacts'
+            associate (cs => sys%contacts)
+                call file%read_attribute(g, 'n', m, error)
+                if (allocated(error)) return
+                if (allocated(cs%i1)) deallocate (cs%i1, cs%i2, cs%nrm, cs%gap, cs%lever, cs%w, cs%shift, &
+                                                  cs%r, cs%u, cs%mu, cs%erol, cs%amoy, cs%coh, cs%pcase, &
+                                                  cs%break_mode, cs%status, cs%active)
+                cs%n = m
+                cs%capacity = m
+                cs%n_prev = 0
+                cs%merge_pos = 1
+                if (m == 0) then
+                    allocate (cs%i1(0), cs%i2(0), cs%nrm(2, 0), cs%gap(0), cs%lever(2, 0), cs%w(6, 0), &
+                              cs%shift(2, 0), cs%r(3, 0), cs%u(3, 0), cs%mu(0), cs%erol(0), cs%amoy(0), &
+                              cs%coh(0), cs%pcase(0), cs%break_mode(0), cs%status(0), cs%active(0))
+                    return
+                end if
+                call file%read_dataset(g//'/i1', cs%i1, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/i2', cs%i2, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/nrm', cs%nrm, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/gap', cs%gap, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/lever', cs%lever, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/w', cs%w, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/shift', cs%shift, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/r', cs%r, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/u', cs%u, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/mu', cs%mu, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/erol', cs%erol, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/amoy', cs%amoy, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/coh', cs%coh, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/pcase', cs%pcase, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/break_mode', cs%break_mode, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/status', cs%status, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/active', active, error)
+                if (allocated(error)) return
+                cs%active = active /= 0
+            end associate
+        end subroutine load_contacts
+
+        subroutine load_ruptures(error)
+            type(error_t), allocatable, intent(out) :: error
+            character(len=:), allocatable :: g
+            integer, allocatable :: step(:)
+            integer :: m
+            g = group//'/ruptures'
+            associate (rl => sys%ruptures)
+                call file%read_attribute(g, 'n', m, error)
+                if (allocated(error)) return
+                rl%n = m
+                if (allocated(rl%i1)) deallocate (rl%i1, rl%i2, rl%step, rl%time, rl%mode)
+                if (m == 0) return
+                call file%read_dataset(g//'/i1', rl%i1, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/i2', rl%i2, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/step', step, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/time', rl%time, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/mode', rl%mode, error)
+                if (allocated(error)) return
+                rl%step = int(step, i8)
+            end associate
+        end subroutine load_ruptures
+    end subroutine load_dem
+
+    ! ---------------------------------------------------------------------------------------
+    ! Coupling: multipliers and constraint state
+    ! ---------------------------------------------------------------------------------------
+
+    !> Write the state of a coupled system: beam, particles and coupling.
+    subroutine save_coupled(file, sys, error)
+        !> Checkpoint being written.
+        type(h5_file_t), intent(inout) :: file
+        !> The coupled system.
+        type(coupled_system_t), intent(in) :: sys
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call save_integrator(file, '/fe', sys%fe, error)
+        if (allocated(error)) return
+        call save_dem(file, '/dem', sys%dem, error)
+        if (allocated(error)) return
+        call file%create_group('/coupling', error)
+        if (allocated(error)) return
+        associate (st => sys%stats)
+            call file%write_attribute('/coupling', 'integers', &
+                                      real([sys%step, st%sweeps, st%corrections, st%n_contacts, st%n_active, &
+                                            merge(1, 0, st%converged)], wp), error)
+            if (allocated(error)) return
+            call file%write_attribute('/coupling', 'scalars', [st%nlgs_error, st%free_residual, &
+                                                               st%velocity_residual, st%position_residual, st%particle_residual, &
+                                                               st%rotation_residual, st%lambda_norm], error)
+            if (allocated(error)) return
+        end associate
+        call put_r1(file, '/coupling/lambda', sys%lambda, error)
+        if (.not. allocated(error)) call put_r1(file, '/coupling/lambda_old', sys%lambda_old, error)
+        if (.not. allocated(error)) call put_r1(file, '/coupling/g', sys%g, error)
+        if (.not. allocated(error)) call put_r1(file, '/coupling/q', sys%q, error)
+        if (.not. allocated(error)) call put_r1(file, '/coupling/cu0', sys%cu0, error)
+        if (.not. allocated(error)) call put_r1(file, '/coupling/drift', sys%drift, error)
+        if (.not. allocated(error)) call put_r1(file, '/coupling/start', sys%start, error)
+        if (.not. allocated(error)) call put_r1(file, '/coupling/multiplier', sys%multiplier, error)
+        if (.not. allocated(error)) call put_r1(file, '/coupling/cv', sys%cv, error)
+        if (.not. allocated(error)) call put_r1(file, '/coupling/gv', sys%gv, error)
+        if (.not. allocated(error)) call put_r1(file, '/coupling/fc', sys%fc, error)
+    end subroutine save_coupled
+
+    !> Read the state of a coupled system (built from the deck).
+    subroutine load_coupled(file, sys, error)
+        !> Checkpoint being read.
+        type(h5_file_t), intent(inout) :: file
+        !> The coupled system.
+        type(coupled_system_t), intent(inout) :: sys
+        !> Set on a read failure.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: iv(:)
+        real(wp), allocatable :: s(:)
+        call load_integrator(file, '/fe', sys%fe, error)
+        if (allocated(error)) return
+        call load_dem(file, '/dem', sys%dem, error)
+        if (allocated(error)) return
+        call read_int_attr_1d(file, '/coupling', 'integers', iv, error)
+        if (allocated(error)) return
+        call file%read_attribute('/coupling', 'scalars', s, error)
+        if (allocated(error)) return
+        if (size(iv) /= 6 .or. size(s) /= 7) then
+            call make_error(error, 'checkpoint: /coupling: wrong number of values')
+            return
+        end if
+        associate (st => sys%stats)
+            sys%step = iv(1)
+            st%sweeps = iv(2)
+            st%corrections = iv(3)
+            st%n_contacts = iv(4)
+            st%n_active = iv(5)
+            st%converged = iv(6) /= 0
+            st%nlgs_error = s(1)
+            st%free_residual = s(2)
+            st%velocity_residual = s(3)
+            st%position_residual = s(4)
+            st%particle_residual = s(5)
+            st%rotation_residual = s(6)
+            st%lambda_norm = s(7)
+        end associate
+        call get_r1(file, '/coupling/lambda', sys%lambda, error)
+        if (.not. allocated(error)) call get_r1(file, '/coupling/lambda_old', sys%lambda_old, error)
+        if (.not. allocated(error)) call get_r1(file, '/coupling/g', sys%g, error)
+        if (.not. allocated(error)) call get_r1(file, '/coupling/q', sys%q, error)
+        if (.not. allocated(error)) call get_r1(file, '/coupling/cu0', sys%cu0, error)
+        if (.not. allocated(error)) call get_r1(file, '/coupling/drift', sys%drift, error)
+        if (.not. allocated(error)) call get_r1(file, '/coupling/start', sys%start, error)
+        if (.not. allocated(error)) call get_r1(file, '/coupling/multiplier', sys%multiplier, error)
+        if (.not. allocated(error)) call get_r1(file, '/coupling/cv', sys%cv, error)
+        if (.not. allocated(error)) call get_r1(file, '/coupling/gv', sys%gv, error)
+        if (.not. allocated(error)) call get_r1(file, '/coupling/fc', sys%fc, error)
+    end subroutine load_coupled
+
+    ! ---------------------------------------------------------------------------------------
+    ! Results writers and the results file
+    ! ---------------------------------------------------------------------------------------
+
+    !> Write the results writer's counters and the record count of every dataset of the
+    !> results file (flushed before).
+    subroutine save_results(file, out, error)
+        !> Checkpoint being written.
+        type(h5_file_t), intent(inout) :: file
+        !> The results writer (open).
+        type(results_writer_t), intent(in) :: out
+        !> Set on a read or write failure.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=256), allocatable :: paths(:)
+        integer, allocatable :: counts(:)
+        character(len=:), allocatable :: joined
+        integer :: k
+        call out%file%list_datasets(paths, counts, error)
+        if (allocated(error)) return
+        call file%create_group('/results', error)
+        if (allocated(error)) return
+        call file%write_attribute('/results', 'writer', real([out%n_nodes, merge(1, 0, out%have_state), &
+                                                              merge(1, 0, out%have_energy)], wp), error)
+        if (allocated(error)) return
+        call file%write_attribute('/results', 'energy0', out%energy0, error)
+        if (allocated(error)) return
+        joined = ''
+        do k = 1, size(paths)
+            joined = joined//trim(paths(k))//new_line('a')
+        end do
+        call file%write_attribute('/results', 'datasets', joined, error)
+        if (allocated(error) .or. size(paths) == 0) return
+        call file%write_dataset('/results/records', counts, error)
+    end subroutine save_results
+
+    !> Restore the results writer's counters, and bring its (open) results file back to the
+    !> checkpoint: datasets written after it are deleted, series cut to their record counts.
+    subroutine load_results(file, out, error)
+        !> Checkpoint being read.
+        type(h5_file_t), intent(inout) :: file
+        !> The results writer, its file open for writing.
+        type(results_writer_t), intent(inout) :: out
+        !> Set on a read or write failure, or when a dataset of the checkpoint is missing.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=256), allocatable :: paths(:)
+        integer, allocatable :: counts(:), saved(:), w(:)
+        character(len=:), allocatable :: joined
+        integer :: k, j, start, n_saved
+        call read_int_attr_1d(file, '/results', 'writer', w, error)
+        if (allocated(error)) return
+        out%n_nodes = w(1)
+        out%have_state = w(2) /= 0
+        out%have_energy = w(3) /= 0
+        call file%read_attribute('/results', 'energy0', out%energy0, error)
+        if (allocated(error)) return
+        call file%read_attribute('/results', 'datasets', joined, error)
+        if (allocated(error)) return
+        n_saved = count([(joined(k:k) == new_line('a'), k=1, len(joined))])
+        allocate (saved(0))
+        if (n_saved > 0) call file%read_dataset('/results/records', saved, error)
+        if (allocated(error)) return
+        call out%file%list_datasets(paths, counts, error)
+        if (allocated(error)) return
+        ! Every dataset of the file: kept (series cut to the checkpoint) or deleted.
+        do k = 1, size(paths)
+            j = find(trim(paths(k)))
+            if (j == 0) then
+                call out%file%delete(trim(paths(k)), error)
+            else if (counts(k) /= saved(j)) then
+                call out%file%resize_series(trim(paths(k)), saved(j), error)
+            end if
+            if (allocated(error)) return
+        end do
+        ! Every dataset of the checkpoint must be there.
+        start = 1
+        do k = 1, len(joined)
+            if (joined(k:k) /= new_line('a')) cycle
+            if (.not. any(paths == joined(start:k - 1))) then
+                call make_error(error, "checkpoint: the results file '"//out%file%path// &
+                                "' has no dataset '"//joined(start:k - 1)//"'")
+                return
+            end if
+            start = k + 1
+        end do
+    contains
+        !> Index of `path` in the checkpoint's list (0: not there).
+        integer function find(path)
+            character(len=*), intent(in) :: path
+            integer :: i, s0, idx
+            find = 0
+            s0 = 1
+            idx = 0
+            do i = 1, len(joined)
+                if (joined(i:i) /= new_line('a')) cycle
+                idx = idx + 1
+                if (joined(s0:i - 1) == path) then
+                    find = idx
+                    return
+                end if
+                s0 = i + 1
+            end do
+        end function find
+    end subroutine load_results
+
+    !> Write the counters of the particle writer (its buffered statistics written before).
+    subroutine save_dem_writer(file, writer, error)
+        !> Checkpoint being written.
+        type(h5_file_t), intent(inout) :: file
+        !> The writer, nothing buffered.
+        type(dem_writer_t), intent(in) :: writer
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call file%create_group('/writers', error)
+        if (allocated(error)) return
+        call file%write_attribute('/writers', 'dem', real([writer%n_out, writer%n_contacts_stored, &
+                                                           writer%n_steps, writer%n_buffered, writer%n_ruptures], wp), error)
+    end subroutine save_dem_writer
+
+    !> Read the counters of the particle writer (begun again: its buffers exist).
+    subroutine load_dem_writer(file, writer, error)
+        !> Checkpoint being read.
+        type(h5_file_t), intent(inout) :: file
+        !> The writer.
+        type(dem_writer_t), intent(inout) :: writer
+        !> Set on a read failure.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: c(:)
+        call read_int_attr_1d(file, '/writers', 'dem', c, error)
+        if (allocated(error)) return
+        if (size(c) /= 5) then
+            call make_error(error, 'checkpoint: /writers: wrong number of particle writer counters')
+            return
+        end if
+        if (c(4) /= 0) then
+            call make_error(error, 'checkpoint: the particle writer had unwritten statistics')
+            return
+        end if
+        writer%n_out = c(1)
+        writer%n_contacts_stored = c(2)
+        writer%n_steps = c(3)
+        writer%n_buffered = 0
+        writer%n_ruptures = c(5)
+    end subroutine load_dem_writer
+
+    !> Write the counters and running maxima of the coupling writer (nothing buffered).
+    subroutine save_coupled_writer(file, writer, error)
+        !> Checkpoint being written.
+        type(h5_file_t), intent(inout) :: file
+        !> The writer, nothing buffered.
+        type(coupled_writer_t), intent(in) :: writer
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call file%create_group('/writers', error)
+        if (allocated(error)) return
+        call file%write_attribute('/writers', 'coupled', real([writer%n_out, writer%n_steps, &
+                                                               writer%n_buffered], wp), error)
+        if (allocated(error)) return
+        call file%write_attribute('/writers', 'coupled_max', [writer%max_position, writer%max_velocity, &
+                                                              writer%max_coordinate, writer%max_balance], error)
+    end subroutine save_coupled_writer
+
+    !> Read the counters and running maxima of the coupling writer (begun again).
+    subroutine load_coupled_writer(file, writer, error)
+        !> Checkpoint being read.
+        type(h5_file_t), intent(inout) :: file
+        !> The writer.
+        type(coupled_writer_t), intent(inout) :: writer
+        !> Set on a read failure.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: c(:)
+        real(wp), allocatable :: m(:)
+        call read_int_attr_1d(file, '/writers', 'coupled', c, error)
+        if (allocated(error)) return
+        call file%read_attribute('/writers', 'coupled_max', m, error)
+        if (allocated(error)) return
+        if (c(3) /= 0) then
+            call make_error(error, 'checkpoint: the coupling writer had unwritten statistics')
+            return
+        end if
+        writer%n_out = c(1)
+        writer%n_steps = c(2)
+        writer%n_buffered = 0
+        writer%max_position = m(1)
+        writer%max_velocity = m(2)
+        writer%max_coordinate = m(3)
+        writer%max_balance = m(4)
+    end subroutine load_coupled_writer
+
+    ! ---------------------------------------------------------------------------------------
+    ! Helpers
+    ! ---------------------------------------------------------------------------------------
+
+    !> Write a real array if it is allocated and not empty.
+    subroutine put_r1(file, path, x, error)
+        type(h5_file_t), intent(inout) :: file
+        character(len=*), intent(in) :: path
+        real(wp), allocatable, intent(in) :: x(:)
+        type(error_t), allocatable, intent(out) :: error
+        if (.not. allocated(x)) return
+        if (size(x) == 0) return
+        call file%write_dataset(path, x, error)
+    end subroutine put_r1
+
+    !> Write a real array if it is not empty.
+    subroutine put_part(file, path, x, error)
+        type(h5_file_t), intent(inout) :: file
+        character(len=*), intent(in) :: path
+        real(wp), intent(in) :: x(:)
+        type(error_t), allocatable, intent(out) :: error
+        if (size(x) == 0) return
+        call file%write_dataset(path, x, error)
+    end subroutine put_part
+
+    !> Read a real array written by put_r1 (left as it is when absent; it must then be
+    !> unallocated or empty).
+    subroutine get_r1(file, path, x, error)
+        type(h5_file_t), intent(inout) :: file
+        character(len=*), intent(in) :: path
+        real(wp), allocatable, intent(inout) :: x(:)
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: v(:)
+        if (.not. file%exists(path)) then
+            if (allocated(x)) then
+                if (size(x) > 0) call make_error(error, 'checkpoint: no dataset '//path)
+            end if
+            return
+        end if
+        call file%read_dataset(path, v, error)
+        if (allocated(error)) return
+        if (allocated(x)) then
+            if (size(x) /= size(v)) then
+                call make_error(error, 'checkpoint: '//path//': size differs from the deck''s model')
+                return
+            end if
+        end if
+        call move_alloc(v, x)
+    end subroutine get_r1
+
+    !> Read an integer attribute array (the file API has 1-D attributes of reals only: the
+    !> integers are written as reals, exact below 2**53).
+    subroutine read_int_attr_1d(file, object, name, values, error)
+        type(h5_file_t), intent(inout) :: file
+        character(len=*), intent(in) :: object, name
+        integer, allocatable, intent(out) :: values(:)
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: r(:)
+        call file%read_attribute(object, name, r, error)
+        if (allocated(error)) return
+        values = nint(r)
+    end subroutine read_int_attr_1d
+end module driver_checkpoint

@@ -1,0 +1,344 @@
+#!/usr/bin/env python3
+"""Checkpoint and restart (doc/output.md, "Checkpoints and restart"): a run stopped and
+continued from its checkpoint gives BITWISE the results of the uninterrupted run.
+
+For a beam deck (input/cantilever.dat), a particle deck with contacts and bonds that break
+(input/cohesive_row.dat: bonded row, two ruptures, one before and one after the stop; also
+with [solver] method = block, whose factor is kept from step to step) and
+coupled decks (input/bending_stack.dat, tests/regression/decks/coupled_rigid_translation.dat),
+the run is stopped at step k in three
+ways: by a shorter end time (--end, the stop not on an output step: its extra last output
+must disappear at the restart), by a signal (SIGTERM / SIGUSR1: exit 128 + signal, then the
+exact command the program prints is run), and by kill -9 after a periodic checkpoint
+([output] checkpoint_interval). Every dataset of the continued file must be equal, byte for
+byte, to that of the uninterrupted run, and so must every attribute except the wall-clock
+ones (dates, wall and solver seconds). Refusals: a checkpoint of another deck, of another
+code version, a restart with nothing left to do. A new end time (--end) continues a finished
+run; the earlier finished result stays untouched when the continued run fails.
+Usage (ctest does this): test_restart.py --exe multicor --work DIR --source REPO
+"""
+import argparse
+import hashlib
+import pathlib
+import re
+import resource
+import shutil
+import signal
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+FAILED = []
+# Attributes that measure wall-clock time or dates: they differ between any two runs.
+CLOCK_ATTRIBUTES = {"created", "ended", "wall_seconds", "detection_seconds", "solver_seconds",
+                    "run_id"}
+
+
+def check(name, ok, detail=""):
+    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
+    if not ok:
+        FAILED.append(name)
+
+
+def edit_deck(src, dst, end=None, extra_output=None, progress=None):
+    """Copy a deck with another [time] end and extra [output] lines."""
+    text = src.read_text()
+    if end is not None:
+        text = re.sub(r"^end\s*=.*$", f"end = {end!r}", text, count=1, flags=re.M)
+    lines = list(extra_output or [])
+    if progress is not None:
+        text = re.sub(r"^progress\s*=.*$", "", text, flags=re.M)
+        lines.append(f"progress = {progress!r}")
+    if lines:
+        if re.search(r"^\[output\]\s*$", text, flags=re.M):
+            text = re.sub(r"^\[output\]\s*$", "[output]\n" + "\n".join(lines), text, count=1,
+                          flags=re.M)
+        else:
+            text += "\n[output]\n" + "\n".join(lines) + "\n"
+    dst.write_text(text)
+    return dst
+
+
+def run(exe, *args, **kw):
+    return subprocess.run([str(exe)] + [str(a) for a in args], capture_output=True, text=True,
+                          timeout=900, **kw)
+
+
+def digest(path):
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def contents(path):
+    """Every dataset (bytes, dtype, shape) and every attribute of a file."""
+    data, attrs = {}, {}
+
+    def visit(name, obj):
+        if isinstance(obj, h5py.Dataset):
+            a = obj[...]
+            data[name] = (a.dtype.str, a.shape, np.ascontiguousarray(a).tobytes())
+        for k, v in obj.attrs.items():
+            attrs[f"{name}@{k}"] = v
+
+    with h5py.File(path, "r") as f:
+        for k, v in f.attrs.items():
+            attrs[f"/@{k}"] = v
+        f.visititems(visit)
+    return data, attrs
+
+
+def compare(name, continued, reference):
+    """Bitwise comparison of every dataset; attributes equal except the clock ones."""
+    a, aa = contents(continued)
+    b, ba = contents(reference)
+    bad = [f"{k} missing in one file" for k in sorted(set(a) ^ set(b))]
+    bad += [f"{k} differs {a[k][1]} vs {b[k][1]}" for k in sorted(set(a) & set(b)) if a[k] != b[k]]
+    n_values = sum(int(np.prod(b[k][1])) for k in b)
+    check(f"{name}: every dataset bitwise equal to the uninterrupted run", not bad,
+          f"{len(b)} datasets, {n_values} values, {len(bad)} differ" if not bad
+          else "; ".join(bad[:5]))
+    abad = []
+    for k in sorted(set(aa) | set(ba)):
+        if k.rsplit("@", 1)[1] in CLOCK_ATTRIBUTES:
+            continue
+        x, y = aa.get(k), ba.get(k)
+        if x is None or y is None or not np.array_equal(np.asarray(x), np.asarray(y)):
+            abad.append(f"{k}: {x!r} vs {y!r}")
+    check(f"{name}: every attribute equal (but dates and wall times)", not abad,
+          f"{len(ba)} attributes" if not abad else "; ".join(abad[:4]))
+
+
+def reference(exe, deck, work, name):
+    folder = work / f"ref_{name}"
+    proc = run(exe, deck, "--output", folder, "--quiet")
+    if proc.returncode != 0:
+        raise SystemExit(f"reference run of {deck} failed: {proc.stdout}{proc.stderr}")
+    return folder / f"{deck.stem}.h5"
+
+
+def by_end_time(exe, deck, work, name, t_stop):
+    """Stop at t_stop (--end, not an output step), restart to the deck's end."""
+    ref = reference(exe, deck, work, name)
+    folder = work / name
+    first = run(exe, deck, "--output", folder, "--quiet", "--end", t_stop)
+    check(f"{name}: first part (--end {t_stop}) exit 0", first.returncode == 0,
+          (first.stdout + first.stderr)[-300:])
+    ckpt = folder / "checkpoint.h5"
+    check(f"{name}: checkpoint at {ckpt.relative_to(work)}", ckpt.is_file(), "")
+    if ckpt.is_file():
+        shutil.copy(ckpt, work / f"{name}_first_checkpoint.h5")
+    second = run(exe, deck, "--output", folder, "--restart", ckpt)
+    check(f"{name}: restart exit 0", second.returncode == 0, (second.stdout + second.stderr)[-300:])
+    if second.returncode == 0:
+        compare(name, folder / f"{deck.stem}.h5", ref)
+    return ref
+
+
+def start(exe, deck, folder):
+    return subprocess.Popen([str(exe), str(deck), "--output", str(folder)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def wait_for_step(proc, min_step, lines):
+    for line in proc.stdout:
+        lines.append(line)
+        m = re.match(r"step (\d+)/", line)
+        if m and int(m.group(1)) >= min_step:
+            return True
+    return False
+
+
+def by_signal(exe, deck_src, work, name, sig, end, min_step):
+    """A signal stops the run after step min_step; the command printed continues it."""
+    deck = edit_deck(deck_src, work / f"{name}.dat", end=end, progress=0.02)
+    ref = reference(exe, deck, work, name)
+    folder = work / name
+    proc = start(exe, deck, folder)
+    lines = []
+    if not wait_for_step(proc, min_step, lines):
+        check(f"{name}: run reached step {min_step}", False, proc.communicate()[1][-300:])
+        return
+    proc.send_signal(sig)
+    out, err = proc.communicate()
+    out = "".join(lines) + out
+    signame = signal.Signals(sig).name
+    check(f"{name}: {signame} gives exit 128 + {int(sig)}", proc.returncode == 128 + sig,
+          f"exit {proc.returncode}")
+    m = re.search(r"^checkpoint: (\d+) steps, t = \S+ s, in (\S+)$", out, flags=re.M)
+    check(f"{name}: says where the checkpoint is", m is not None and
+          pathlib.Path(m.group(2)) == folder / "checkpoint.h5", out.strip()[-300:])
+    c = re.search(r"^to continue: (multicor .*)$", out, flags=re.M)
+    check(f"{name}: prints the command to continue", c is not None, out.strip()[-300:])
+    if c is None or m is None:
+        return
+    command = c.group(1).split()
+    check(f"{name}: the command is the deck with --restart",
+          command[1:] == [str(deck), "--output", str(folder), "--restart",
+                          str(folder / "checkpoint.h5")], c.group(1))
+    stopped = int(m.group(1))
+    check(f"{name}: stopped before the end", min_step <= stopped, f"step {stopped}")
+    second = run(exe, *command[1:])
+    check(f"{name}: continued run exit 0", second.returncode == 0,
+          (second.stdout + second.stderr)[-300:])
+    check(f"{name}: continued from the step of the stop",
+          f"restart from {folder / 'checkpoint.h5'} at step {stopped}" in second.stdout,
+          second.stdout[:200])
+    if second.returncode == 0:
+        compare(name, folder / f"{deck.stem}.h5", ref)
+
+
+def by_kill_9(exe, deck_src, work, name, end, every, min_step, seconds=None):
+    """kill -9 after periodic checkpoints (every `every` steps, or every `seconds` of wall
+    time); restart from the last one."""
+    extra = [f"checkpoint_seconds = {seconds!r}"] if seconds else [f"checkpoint_interval = {every}"]
+    deck = edit_deck(deck_src, work / f"{name}.dat", end=end, progress=0.02, extra_output=extra)
+    ref = reference(exe, deck, work, name)
+    folder = work / name
+    proc = start(exe, deck, folder)
+    if not wait_for_step(proc, min_step, []):
+        check(f"{name}: run reached step {min_step}", False, proc.communicate()[1][-300:])
+        return
+    proc.send_signal(signal.SIGKILL)
+    proc.communicate()
+    with h5py.File(folder / "checkpoint.h5", "r") as f:
+        step = int(f["loop"].attrs["step"])
+    if seconds:
+        check(f"{name}: a checkpoint by wall time before the kill", 0 < step <= min_step + 1000,
+              f"step {step}")
+    else:
+        check(f"{name}: periodic checkpoint at a multiple of {every}",
+              step >= every and step % every == 0, f"step {step}")
+    second = run(exe, deck, "--output", folder, "--restart", folder / "checkpoint.h5")
+    check(f"{name}: restart after kill -9 exit 0", second.returncode == 0,
+          (second.stdout + second.stderr)[-300:])
+    if second.returncode == 0:
+        compare(name, folder / f"{deck.stem}.h5", ref)
+
+
+def refusals(exe, deck, work):
+    """Another deck, another code version, nothing left to do: exit 1 with a clear message,
+    nothing written."""
+    folder = work / "refuse"
+    first = run(exe, deck, "--output", folder, "--quiet", "--end", 0.05)
+    assert first.returncode == 0, first.stderr
+    ckpt = folder / "checkpoint.h5"
+    result = folder / f"{deck.stem}.h5"
+    before = digest(result)
+    other = work / f"other_{deck.name}"
+    other.write_text(deck.read_text().replace("-10.0", "-11.0"))
+    proc = run(exe, other, "--output", folder, "--restart", ckpt, "--end", 0.1)
+    check("another deck refused", proc.returncode == 1 and
+          "was written for another deck" in proc.stderr, proc.stderr.strip())
+    proc = run(exe, deck, "--output", folder, "--restart", ckpt, "--end", 0.05)
+    check("nothing left to do refused", proc.returncode == 1 and "nothing to do" in proc.stderr,
+          proc.stderr.strip())
+    proc = run(exe, deck, "--output", folder, "--restart", ckpt, "--end", 0.04)
+    check("an end time before the checkpoint refused", proc.returncode == 1 and
+          "nothing to do" in proc.stderr, proc.stderr.strip())
+    old = work / "old_version.h5"
+    shutil.copy(ckpt, old)
+    with h5py.File(old, "r+") as f:
+        f.attrs["code_version"] = "0.0.1"
+    proc = run(exe, deck, "--output", folder, "--restart", old, "--end", 0.1)
+    check("another code version refused", proc.returncode == 1 and
+          "written by MULTICOR 0.0.1" in proc.stderr, proc.stderr.strip())
+    beam_deck = work / "not_a_checkpoint.h5"
+    shutil.copy(result, beam_deck)
+    proc = run(exe, deck, "--output", folder, "--restart", beam_deck, "--end", 0.1)
+    check("a results file is not a checkpoint", proc.returncode == 1 and
+          "is not a MULTICOR checkpoint" in proc.stderr, proc.stderr.strip())
+    check("refusals leave the result untouched", digest(result) == before, "")
+    check("refusals leave no partial file", not (folder / f"{deck.stem}.h5.partial").exists(), "")
+
+
+def new_end_time(exe, deck, work):
+    """A finished run continued to a later end time equals the run to that end time; a
+    continuation that fails leaves the earlier finished result as it was."""
+    folder = work / "extend"
+    first = run(exe, deck, "--output", folder, "--quiet", "--end", 0.06)
+    assert first.returncode == 0, first.stderr
+    result = folder / f"{deck.stem}.h5"
+    before = digest(result)
+    ref_deck = edit_deck(deck, work / "extend_ref.dat", end=0.13)
+    ref = reference(exe, ref_deck, work, "extend")
+    # Fails at a write: a file size limit just above the finished file (its copy fits, the
+    # continued outputs do not).
+    limit = result.stat().st_size + 16384
+
+    def limit_file_size():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    proc = subprocess.run([str(exe), str(deck), "--output", str(folder), "--quiet", "--restart",
+                           str(folder / "checkpoint.h5"), "--end", "0.13"],
+                          capture_output=True, text=True, preexec_fn=limit_file_size, timeout=300)
+    check("failed continuation: exit 1", proc.returncode == 1, proc.stderr.strip()[-300:])
+    check("failed continuation: the finished result is untouched", digest(result) == before, "")
+    proc = run(exe, deck, "--output", folder, "--restart", folder / "checkpoint.h5", "--end", 0.13)
+    check("continued to a new end time: exit 0", proc.returncode == 0, proc.stderr.strip()[-300:])
+    if proc.returncode == 0:
+        # The deck text differs from the reference's (end time): the root attribute deck_text
+        # is compared apart.
+        with h5py.File(result, "r") as f:
+            same_deck = f.attrs["deck_text"] == deck.read_text()
+        check("new end time: the file keeps the deck of the run", same_deck, "")
+        a, _ = contents(result)
+        b, _ = contents(ref)
+        bad = [k for k in sorted(set(a) | set(b)) if a.get(k) != b.get(k)]
+        check("new end time: every dataset bitwise equal to the run to that end", not bad,
+              f"{len(b)} datasets" if not bad else ", ".join(bad[:5]))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--exe", required=True)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("--source", required=True)
+    a = ap.parse_args()
+    exe, src, work = pathlib.Path(a.exe), pathlib.Path(a.source), pathlib.Path(a.work)
+    shutil.rmtree(work, ignore_errors=True)
+    work.mkdir(parents=True)
+    decks = src / "tests" / "regression" / "decks"
+    beam = edit_deck(src / "input" / "cantilever.dat", work / "beam.dat", end=0.1)
+    # Stop at step 253 (outputs every 5 steps): the extra last output of the first part
+    # must be cut at the restart.
+    by_end_time(exe, beam, work, "beam_end", 0.0506)
+    # The row's first bond breaks at t = 0.0871 s, the second at 0.15 s: the stop at
+    # t = 0.1 s (step 500) lies between them.
+    ref = by_end_time(exe, src / "input" / "cohesive_row.dat", work, "bonds_end", 0.1)
+    with h5py.File(ref, "r") as f, \
+            h5py.File(work / "bonds_end_first_checkpoint.h5", "r") as c:
+        times = f["dem/bonds/time"][...]
+        in_checkpoint = int(c["dem/ruptures"].attrs["n"])
+        intact = int(np.sum(c["dem/contacts/status"][...] == 3))
+    check("bonds_end: one rupture before the stop, one after", len(times) == 2 and
+          times[0] < 0.1 < times[1] and in_checkpoint == 1,
+          f"ruptures at {times} s, {in_checkpoint} in the checkpoint")
+    check("bonds_end: the checkpoint holds intact bonds (status 3)", intact == 8,
+          f"{intact} intact bonds")
+    # The same row with the bonds solved as a direct block ([solver] method = block): the
+    # block's factor, kept from step to step, is restored from the checkpoint.
+    block = work / "cohesive_row_block.dat"
+    block.write_text(re.sub(r"^\[solver\]\s*$", "[solver]\nmethod = block",
+                            (src / "input" / "cohesive_row.dat").read_text(), count=1, flags=re.M))
+    by_end_time(exe, block, work, "block_end", 0.1)
+    stack = edit_deck(src / "input" / "bending_stack.dat", work / "coupled_stack.dat", end=3.0e-4)
+    by_end_time(exe, stack, work, "coupled_end", 1.3e-4)
+    by_signal(exe, src / "input" / "cantilever.dat", work, "beam_term", signal.SIGTERM, 3.0, 1000)
+    by_signal(exe, src / "input" / "incline.dat", work, "dem_usr1", signal.SIGUSR1, 20.0, 2000)
+    by_signal(exe, decks / "coupled_rigid_translation.dat", work, "coupled_term", signal.SIGTERM,
+              0.05, 1000)
+    by_kill_9(exe, src / "input" / "cantilever.dat", work, "beam_kill9", 3.0, 700, 2000)
+    # Every 0.05 s of wall time: several checkpoints before step 3000 (about 0.2 ms per step).
+    by_kill_9(exe, src / "input" / "incline.dat", work, "dem_kill9_wall", 20.0, 0, 3000,
+              seconds=0.05)
+    refusals(exe, beam, work)
+    new_end_time(exe, beam, work)
+    if FAILED:
+        print(f"{len(FAILED)} check(s) failed: {', '.join(FAILED)}")
+        sys.exit(1)
+    print("all checks passed")
+
+
+if __name__ == "__main__":
+    main()
