@@ -21,6 +21,12 @@
 !> With the argument `--convergence`, prints instead the sweeps one step needs to reach the
 !> tolerance from a cold start (no warm start, cap 50000) on packings of 250 to 16000 disks:
 !> what limits the solver on tall static packings.
+!> Options: --sizes N... (the packings to run), --anderson M (Anderson depth), --relaxation W,
+!> --check-every K (safeguard period of the over-relaxation), --criterion siconos,
+!> --max-sweeps C (cap of the timed steps), --forward (no alternating sweeps), --settle S (steps
+!> before timing, default 10), --settle-anderson M and --settle-sweeps C (solver of those
+!> steps, default the timed one), --verbose (sweeps, Siconos error, solver ms of every timed
+!> step). The Siconos error of every timed step is printed too (mean and max).
 !> Run: cmake --build <build> --target bench_dem && OMP_NUM_THREADS=1 <build>/bench/bench_dem
 program bench_dem
     use, intrinsic :: iso_fortran_env, only: output_unit, compiler_version, compiler_options
@@ -32,6 +38,7 @@ program bench_dem
     use dem_materials, only: materials_init, materials_set_pair
     use dem_detection, only: detect_contacts
     use dem_moreau_jean, only: dem_system_t, mj_init, mj_step, dem_system_bytes
+    use dem_nlgs, only: criterion_lmgc90, criterion_siconos
     use bench_packing, only: deposit_disks, deposit_width
     implicit none
 
@@ -54,26 +61,81 @@ program bench_dem
         real(wp) :: rate = 0.0_wp, rate_best = 0.0_wp
         !> Bytes per particle.
         real(wp) :: bytes = 0.0_wp
+        !> Siconos error at the end of the step: mean and max over the timed steps.
+        real(wp) :: sic_mean = 0.0_wp, sic_max = 0.0_wp
     end type case_t
 
-    integer, parameter :: sizes(3) = [1000, 10000, 100000]
+    integer, allocatable :: sizes(:)
     !> Steps before timing (the warm start fills up).
-    integer, parameter :: n_settle = 10
+    integer :: n_settle = 10
     real(wp), parameter :: radius_mean = 1.0e-3_wp, gravity = 9.81_wp, step = 1.0e-3_wp
     !> Rounds of the interleaved detection timing.
     integer, parameter :: n_rounds = 30
-    type(case_t) :: res(size(sizes))
+    type(case_t), allocatable :: res(:)
     type(dem_system_t), allocatable :: systems(:)
-    character(len=32) :: arg
+    character(len=32) :: arg, val
+    !> Solver options from the command line (see the header).
+    real(wp) :: relaxation = 1.0_wp
+    integer :: criterion = criterion_lmgc90, max_sweeps = 200, check_every = 10, settle_sweeps = 0, iarg
+    integer :: anderson = 0, settle_anderson = -1
+    logical :: convergence = .false., sizes_given = .false., verbose = .false., symmetric = .true.
     integer :: k
+    sizes = [1000, 10000, 100000]
+    iarg = 1
+    do while (iarg <= command_argument_count())
+        call get_command_argument(iarg, arg)
+        call get_command_argument(iarg + 1, val)
+        select case (arg)
+        case ('--convergence')
+            convergence = .true.
+            iarg = iarg - 1
+        case ('--relaxation')
+            read (val, *) relaxation
+        case ('--max-sweeps')
+            read (val, *) max_sweeps
+        case ('--forward')
+            symmetric = .false.
+            iarg = iarg - 1
+        case ('--verbose')
+            verbose = .true.
+            iarg = iarg - 1
+        case ('--anderson')
+            read (val, *) anderson
+        case ('--settle-anderson')
+            read (val, *) settle_anderson
+        case ('--settle')
+            read (val, *) n_settle
+        case ('--settle-sweeps')
+            read (val, *) settle_sweeps
+        case ('--check-every')
+            read (val, *) check_every
+        case ('--criterion')
+            if (val == 'siconos') criterion = criterion_siconos
+        case ('--sizes')
+            sizes = [integer ::]
+            sizes_given = .true.
+            do while (iarg + 1 <= command_argument_count())
+                call get_command_argument(iarg + 1, val)
+                if (val(1:1) == '-') exit
+                sizes = [sizes, 0]
+                read (val, *) sizes(size(sizes))
+                iarg = iarg + 1
+            end do
+            iarg = iarg - 1
+        case default
+            error stop 'bench_dem: unknown argument'
+        end select
+        iarg = iarg + 2
+    end do
     write (output_unit, '(a)') '# DEM kernel benchmark, 1 core: dense random packing in a box under gravity'
     write (output_unit, '(a)') '# compiler: '//compiler_version()
     write (output_unit, '(a)') '# options:  '//compiler_options()
-    call get_command_argument(1, arg)
-    if (arg == '--convergence') then
+    write (output_unit, '(a, f0.3, a, i0, a, i0, a)') '# solver: relaxation ', relaxation, &
+        ', criterion ', criterion, ' (1 lmgc90, 2 siconos), cap ', max_sweeps, ' sweeps'
+    if (convergence) then
         call cold_start_sweeps()
     else
-        allocate (systems(size(sizes)))
+        allocate (systems(size(sizes)), res(size(sizes)))
         do k = 1, size(sizes)
             call run_case(systems(k), sizes(k), res(k))
         end do
@@ -89,16 +151,21 @@ contains
         type(case_t), intent(out) :: c
         real(wp), allocatable :: t_det(:), t_sol(:), rate(:)
         integer :: s, n_steps, sweeps, n_conv
-        real(wp) :: before_det, before_sol
+        real(wp) :: before_det, before_sol, sic
         ! at least 8 steps, and ~2e5 disk-steps for the small cases
         n_steps = max(8, 200000/n)
         call build(sys, n, c)
+        if (settle_sweeps > 0) sys%solver%max_sweeps = settle_sweeps
+        if (settle_anderson >= 0) sys%solver%anderson = settle_anderson
         do s = 1, n_settle
             call mj_step(sys)
         end do
+        sys%solver%max_sweeps = max_sweeps
+        sys%solver%anderson = anderson
         allocate (t_det(n_steps), t_sol(n_steps), rate(n_steps))
         sweeps = 0
         n_conv = 0
+        sic = 0.0_wp
         do s = 1, n_steps
             before_det = sys%time_detection
             before_sol = sys%time_solver
@@ -109,7 +176,12 @@ contains
             sweeps = sweeps + sys%stats%sweeps
             c%sweeps_max = max(c%sweeps_max, sys%stats%sweeps)
             if (sys%stats%converged) n_conv = n_conv + 1
+            sic = sic + sys%stats%siconos_error
+            if (verbose) write (output_unit, '(a, i4, a, i6, l2, es11.3, f10.2)') '# step ', s, ' sweeps', &
+                sys%stats%sweeps, sys%stats%converged, sys%stats%siconos_error, 1.0e3_wp*t_sol(s)
+            c%sic_max = max(c%sic_max, sys%stats%siconos_error)
         end do
+        c%sic_mean = sic/n_steps
         c%contacts = sys%contacts%n
         c%active = sys%stats%n_active
         c%sweeps = real(sweeps, wp)/n_steps
@@ -165,10 +237,12 @@ contains
     !> Sweeps of the first step (reactions start at zero) until the tolerance, for packings of
     !> increasing height: the weight has to travel from the top layer to the floor.
     subroutine cold_start_sweeps()
-        integer, parameter :: cold_sizes(4) = [250, 1000, 4000, 16000]
+        integer, allocatable :: cold_sizes(:)
         type(dem_system_t) :: sys
         type(case_t) :: c
         integer :: k
+        cold_sizes = [250, 1000, 4000, 16000]
+        if (sizes_given) cold_sizes = sizes
         write (output_unit, '(a)') '# first step from rest, no warm start, tolerance 1.666e-4, ' &
             //'cap 50000 sweeps; height/d: deposit height in mean diameters'
         write (output_unit, '(a)') '#      N  height/d  active  sweeps  converged  solve[s]  updates/s' &
@@ -223,7 +297,12 @@ contains
         sys%scheme%h = step
         sys%scheme%alert = 0.05_wp*radius_mean
         sys%solver%tol = 1.666e-4_wp
-        sys%solver%max_sweeps = 200
+        sys%solver%max_sweeps = max_sweeps
+        sys%solver%relaxation = relaxation
+        sys%solver%check_every = check_every
+        sys%solver%anderson = anderson
+        sys%solver%symmetric = symmetric
+        sys%solver%criterion = criterion
         call mj_init(sys, error)
         if (allocated(error)) error stop 'bench_dem: invalid setup'
     end subroutine build
@@ -258,6 +337,11 @@ contains
                     1.0e3_wp*c%det_best, 1.0e3_wp*c%rep_med, 1.0e3_wp*c%rep_best, 1.0e3_wp*c%sol_med, &
                     1.0e3_wp*c%sol_best, c%rate, c%rate_best, c%bytes
             end associate
+        end do
+        write (output_unit, '(a)') '#'
+        write (output_unit, '(a)') '#      N  siconos error (mean, max over the timed steps)'
+        do k = 1, size(res)
+            write (output_unit, '(i8, 2es11.3)') res(k)%n, res(k)%sic_mean, res(k)%sic_max
         end do
         if (size(res) >= 3) then
             write (output_unit, '(a, 4(f6.2, a))') '# detection time 1e5 / 1e4: ', &

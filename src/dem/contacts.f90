@@ -260,7 +260,8 @@ contains
     end function pair_key
 
     !> Lever arms and Delassus blocks from radii and inverse masses per DOF (0 when fixed).
-    pure subroutine contacts_set_frames(cs, radius, im)
+    !> Contacts are independent: the loop runs over the OpenMP threads (same result).
+    subroutine contacts_set_frames(cs, radius, im)
         !> Contacts.
         type(contact_set_t), intent(inout) :: cs
         !> Disk radii [m].
@@ -268,28 +269,30 @@ contains
         !> Inverse masses (3, n_disks).
         real(wp), intent(in) :: im(:, :)
         integer :: k, a, b
-        real(wp) :: nx, ny, tx, ty
+        real(wp) :: nx, ny
+        !$omp parallel do schedule(static) private(k, a, b, nx, ny)
         do k = 1, cs%n
             a = cs%i1(k)
             b = cs%i2(k)
             nx = cs%nrm(1, k)
             ny = cs%nrm(2, k)
-            tx = -ny
-            ty = nx
             cs%lever(2, k) = -radius(b)
-            cs%w(:, k) = block(im(:, b), cs%lever(2, k), 1.0_wp)
+            cs%w(:, k) = block(im(:, b), cs%lever(2, k), 1.0_wp, nx, ny)
             cs%lever(1, k) = 0.0_wp
             if (a > 0) then
                 cs%lever(1, k) = -radius(a)
-                cs%w(:, k) = cs%w(:, k) + block(im(:, a), cs%lever(1, k), -1.0_wp)
+                cs%w(:, k) = cs%w(:, k) + block(im(:, a), cs%lever(1, k), -1.0_wp, nx, ny)
             end if
         end do
+        !$omp end parallel do
     contains
         ! block of one body: its generalised directions are s (n, 0), s (t, 0) + (0, c) and
-        ! (0, s) for r_n, r_t and M (s = +1 on i2, -1 on i1)
-        pure function block(imb, c, s) result(w)
-            real(wp), intent(in) :: imb(3), c, s
-            real(wp) :: w(6)
+        ! (0, s) for r_n, r_t and M (s = +1 on i2, -1 on i1), t = (-n_y, n_x)
+        pure function block(imb, c, s, nx, ny) result(w)
+            real(wp), intent(in) :: imb(3), c, s, nx, ny
+            real(wp) :: w(6), tx, ty
+            tx = -ny
+            ty = nx
             w(1) = nx*nx*imb(1) + ny*ny*imb(2)
             w(2) = nx*tx*imb(1) + ny*ty*imb(2)
             w(3) = tx*tx*imb(1) + ty*ty*imb(2) + c*c*imb(3)
@@ -351,8 +354,8 @@ contains
     !> contact never closes past its gap at the start of the step; with theta < 1 an impact
     !> may overlap by up to (1 - theta) h |u_n|, and the overlap is kept. (A full push-out
     !> -g/(theta h) of overlaps was tried and makes dense packings unstable.)
-    pure subroutine contacts_set_laws(cs, law, radius, mat, wall_mat, materials, vel_begin, vel_free, &
-                                      wall_vel_begin, wall_vel_end)
+    subroutine contacts_set_laws(cs, law, radius, mat, wall_mat, materials, vel_begin, vel_free, &
+                                 wall_vel_begin, wall_vel_end)
         !> Contacts.
         type(contact_set_t), intent(inout) :: cs
         !> Step parameters.
@@ -369,6 +372,8 @@ contains
         real(wp), intent(in) :: wall_vel_begin(:, :), wall_vel_end(:, :)
         integer :: k, ma, mb
         real(wp) :: ub(3), uf(3), uw(2), amoy, target, e, gp
+        ! contacts are independent: the loop runs over the OpenMP threads (same result)
+        !$omp parallel do schedule(static) private(k, ma, mb, ub, uf, uw, amoy, target, e, gp)
         do k = 1, cs%n
             mb = mat(cs%i2(k))
             if (cs%i1(k) > 0) then
@@ -411,6 +416,7 @@ contains
                            cs%r(1, k) > 0.0_wp
             if (.not. cs%active(k)) cs%r(:, k) = 0.0_wp
         end do
+        !$omp end parallel do
     end subroutine contacts_set_laws
 
     !> Local components (n.v, t.v) of a wall velocity v.

@@ -23,6 +23,13 @@
 !> state (scaled frame, bipotential_residual / rolling_residual) is reported too, with the
 !> same normalisation.
 !> Sweeps alternate direction when `symmetric` (symmetric Gauss-Seidel).
+!> Acceleration (doc/theory.md 4.4), off by default: over-relaxation (`relaxation` omega,
+!> each update P_K(r0 + omega (r_loc - r0)), back to omega = 1 when the error measured every
+!> `check_every` sweeps rose), and Anderson mixing of the last `anderson` sweeps (one sweep
+!> in the fixed contact order is the map; the history restarts when |G(x) - x| grows).
+!> The Siconos error (nlgs_siconos_error, doc/theory.md 4.5) of the final state is always
+!> computed, from u = H^T (v_free + M^-1 H r) + shift in full; `criterion` chooses which
+!> error stops the sweeps.
 !> Blocked contacts (both bodies immobile along the normal: W_nn = 0) are taken out of the
 !> solve with r = 0 and counted in the statistics (`nlgs_stats_t%n_blocked`).
 !> The constants of each contact's scaled frame (bipotential_scaling) are computed once per
@@ -45,9 +52,10 @@
 module dem_nlgs
     use core_kinds, only: wp, i8
     use dem_contacts, only: contact_set_t
+!$  use omp_lib, only: omp_get_max_threads
     use dem_bipotential, only: bipotential_residual, bipotential_scaling, bipotential_local_solve_scaled, &
                                bipotential_n_scaling, rolling_scaling, rolling_local_solve_scaled, rolling_residual, &
-                               rolling_n_scaling
+                               rolling_n_scaling, rolling_projection, coulomb_projection
     implicit none
     private
     public :: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_apply_reactions, nlgs_residual
@@ -59,6 +67,15 @@ module dem_nlgs
     !> Global strategy: intact bonds solved directly as one block, sweeps over the others
     !> (dem_bonded_block).
     integer, parameter :: nlgs_method_block = 2
+    public :: nlgs_siconos_error
+    public :: criterion_lmgc90, criterion_siconos, criterion_names
+
+    !> Stopping criterion: the LMGC90-like norm of the sweeps (module header).
+    integer, parameter :: criterion_lmgc90 = 1
+    !> Stopping criterion: the Siconos error (nlgs_siconos_error).
+    integer, parameter :: criterion_siconos = 2
+    !> Names of the criteria (deck keyword `[solver] criterion`), by code.
+    character(len=*), parameter :: criterion_names(2) = [character(len=7) :: 'lmgc90', 'siconos']
 
     !> A contact is blocked when W_nn <= blocked_ratio (W_nn + W_tt) (the floor of the scaled
     !> frame in dem_bipotential: below it the normal reaction would be unbounded).
@@ -81,6 +98,21 @@ module dem_nlgs
         logical :: symmetric = .true.
         !> Global strategy (nlgs_method_nlgs or nlgs_method_block), chosen by the caller.
         integer :: method = nlgs_method_nlgs
+        !> Over-relaxation factor omega in (0, 2): each contact update becomes
+        !> P_K(r0 + omega (r_loc - r0)) (module header); 1 is plain NLGS.
+        real(wp) :: relaxation = 1.0_wp
+        !> Safeguard of the over-relaxation: every check_every sweeps the error is compared
+        !> with the one check_every sweeps earlier, and omega falls back to 1 for the rest of
+        !> the solve when it rose.
+        integer :: check_every = 10
+        !> Stopping criterion: criterion_lmgc90 or criterion_siconos.
+        integer :: criterion = criterion_lmgc90
+        !> Anderson acceleration of the sweeps (module header): depth (number of previous
+        !> sweeps mixed); 0: none. Not used with bilateral constraints.
+        integer :: anderson = 0
+        !> Domain split of the sweeps over the OpenMP threads (split_build): fewest contacts
+        !> per block (smaller solves, and all solves on one thread, are serial).
+        integer :: split_min = 2000
     end type nlgs_config_t
 
     !> Statistics of one solve.
@@ -100,11 +132,36 @@ module dem_nlgs
         real(wp) :: error = 0.0_wp
         !> Relative Signorini-Coulomb residual of the final state.
         real(wp) :: residual = 0.0_wp
+        !> Siconos error of the final state (nlgs_siconos_error), whatever the criterion.
+        real(wp) :: siconos_error = 0.0_wp
+        !> Over-relaxation factor at the end of the solve (1 once the safeguard fell back).
+        real(wp) :: relaxation = 1.0_wp
         !> error <= tol reached.
         logical :: converged = .true.
         !> Active contacts solved as a block (nlgs_block_t members), not swept.
         integer :: n_block = 0
     end type nlgs_stats_t
+
+    !> History of the Anderson acceleration: differences of the sweep map's outputs g and
+    !> residuals f = g - x over the last sweeps (ring buffer of `depth` columns), in the
+    !> scaled reactions x = D r (D = sqrt of the diagonal of W, 3 per contact).
+    type :: anderson_t
+        integer :: depth = 0, used = 0, next = 1
+        real(wp), allocatable :: df(:, :), dg(:, :), gram(:, :)
+        real(wp), allocatable :: x(:), f(:), g(:), fprev(:), gprev(:), d(:)
+        real(wp) :: fnorm_prev = huge(1.0_wp)
+        logical :: started = .false.
+    end type anderson_t
+
+    !> Domain split of the sweeps (split_build): blocks of positions in the list of the
+    !> solve, swept in parallel, and the interface positions, swept after them.
+    type :: split_t
+        integer :: nb = 1
+        integer, allocatable :: start(:), pos(:), interface(:)
+    end type split_t
+
+    !> Chunk of the deterministic parallel dot products (pdot).
+    integer, parameter :: dot_chunk = 4096
 
     !> Linear velocity constraints kept satisfied during the sweeps (see the module header).
     type, abstract :: nlgs_bilateral_t
@@ -239,8 +296,13 @@ contains
         ! per contact of the solve, constant over the solve: the scaled frame of its local
         ! problem (bipotential_scaling, or rolling_scaling for a law with moments)
         real(wp), allocatable :: sc(:, :)
-        real(wp) :: floor
-        integer :: s, k, n_swept
+        ! free velocities (the Siconos error is computed from them in full) and a work copy
+        real(wp), allocatable :: vfree(:, :), vwork(:, :)
+        real(wp) :: floor, omega, checked
+        type(anderson_t) :: aa
+        type(split_t) :: split
+        logical :: accelerate
+        integer :: s, k, n_swept, nb
         stats%n_contacts = cs%n
         call skip_blocked(cs, stats%n_blocked)
         stats%n_active = count(cs%active(1:cs%n))
@@ -251,6 +313,8 @@ contains
         end if
         n_swept = stats%n_active - stats%n_block
         allocate (list(n_swept), sc(rolling_n_scaling, n_swept))
+        allocate (vfree, source=vel)
+        allocate (vwork, mold=vel)
         s = 0
         floor = 0.0_wp
         do k = 1, cs%n
@@ -274,13 +338,27 @@ contains
         if (present(block)) call block%solve(cs, im, vel, bilateral)
         stats%converged = .true.
         stats%error = 0.0_wp
+        omega = config%relaxation
+        checked = huge(1.0_wp)
+        ! the Anderson steps rebuild the velocities from the swept contacts: not with a block
+        ! or bilateral constraints, whose impulses are not among them
+        accelerate = config%anderson > 0 .and. .not. present(bilateral) .and. .not. present(block) .and. n_swept > 0
+        if (accelerate) call anderson_init(aa, config%anderson, cs, list)
+        nb = 1
+!$      nb = omp_get_max_threads()
+        if (present(bilateral) .or. present(block)) nb = 1
+        nb = max(1, min(nb, n_swept/max(config%split_min, 1)))
+        call split_build(split, cs, list, size(vel, 2), nb)
         if (stats%n_active > 0) then
             stats%converged = .false.
             do s = 1, config%max_sweeps
-                if (config%symmetric .and. mod(s, 2) == 0) then
-                    call sweep(config, cs, im, vel, list, sc, n_swept, 1, -1, num, den, nloc, bilateral)
+                if (accelerate) then
+                    ! the map accelerated is one sweep in the fixed (bottom-up) contact order
+                    call gather(cs, list, aa%d, aa%x)
+                    call split_sweep(config, omega, cs, im, vel, list, sc, split, .true., num, den, nloc)
                 else
-                    call sweep(config, cs, im, vel, list, sc, 1, n_swept, 1, num, den, nloc, bilateral)
+                    call split_sweep(config, omega, cs, im, vel, list, sc, split, &
+                                     .not. (config%symmetric .and. mod(s, 2) == 0), num, den, nloc, bilateral)
                 end if
                 if (present(block)) then
                     call block%measure(cs, vel, num_b, den_b)
@@ -289,17 +367,241 @@ contains
                 end if
                 stats%sweeps = s
                 stats%local_iterations = stats%local_iterations + nloc
-                stats%error = relative(max(num - floor, 0.0_wp), den)
+                if (config%criterion == criterion_siconos) then
+                    stats%error = siconos_error(cs, im, vfree, vel, vwork, present(bilateral))
+                else
+                    stats%error = relative(max(num - floor, 0.0_wp), den)
+                end if
                 if (stats%error <= config%tol) then
                     stats%converged = .true.
                     exit
                 end if
                 if (present(block)) call block%solve(cs, im, vel, bilateral)
+                ! safeguard of the over-relaxation
+                if (omega /= 1.0_wp .and. mod(s, config%check_every) == 0) then
+                    if (stats%error > checked) omega = 1.0_wp
+                    checked = stats%error
+                end if
+                if (accelerate) call anderson_mix(aa, cs, list, im, vfree, vel, split)
             end do
         end if
+        stats%relaxation = omega
         stats%updates = int(n_swept, i8)*stats%sweeps
         stats%residual = nlgs_residual(cs, vel)
+        stats%siconos_error = siconos_error(cs, im, vfree, vel, vwork, present(bilateral))
     end subroutine nlgs_solve
+
+    !> Size the history and the scaling D = sqrt(diag W) of the Anderson acceleration.
+    subroutine anderson_init(aa, depth, cs, list)
+        type(anderson_t), intent(inout) :: aa
+        integer, intent(in) :: depth
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: list(:)
+        integer :: n, a, k
+        n = 3*size(list)
+        aa%depth = depth
+        allocate (aa%df(n, depth), aa%dg(n, depth), aa%gram(depth, depth))
+        allocate (aa%x(n), aa%f(n), aa%g(n), aa%fprev(n), aa%gprev(n), aa%d(n))
+        do a = 1, size(list)
+            k = list(a)
+            aa%d(3*a - 2) = sqrt(cs%w(1, k))
+            aa%d(3*a - 1) = sqrt(max(cs%w(3, k), 0.0_wp))
+            ! no moment: the third component stays 0
+            aa%d(3*a) = merge(sqrt(max(cs%w(6, k), 0.0_wp)), 0.0_wp, cs%erol(k) > 0.0_wp)
+        end do
+    end subroutine anderson_init
+
+    !> Scaled shifted reactions x = D (r_n + r_cohe h, r_t, M) of the contacts of the solve.
+    subroutine gather(cs, list, d, x)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: list(:)
+        real(wp), intent(in) :: d(:)
+        real(wp), intent(out) :: x(:)
+        integer :: a, k
+        !$omp parallel do schedule(static) private(k)
+        do a = 1, size(list)
+            k = list(a)
+            x(3*a - 2) = d(3*a - 2)*(cs%r(1, k) + cs%coh(k))
+            x(3*a - 1) = d(3*a - 1)*cs%r(2, k)
+            x(3*a) = d(3*a)*cs%r(3, k)
+        end do
+        !$omp end parallel do
+    end subroutine gather
+
+    !> One Anderson step after a sweep: with x the reactions before the sweep and g after,
+    !> f = g - x; the new iterate is g - dG gamma, gamma minimising |f - dF gamma| over the
+    !> history, projected on the cones, and the velocities are recomputed from it. When |f|
+    !> rose since the last sweep the history is cleared and g is kept (plain NLGS step).
+    subroutine anderson_mix(aa, cs, list, im, vfree, vel, split)
+        type(anderson_t), intent(inout) :: aa
+        type(contact_set_t), intent(inout) :: cs
+        integer, intent(in) :: list(:)
+        real(wp), intent(in) :: im(:, :), vfree(:, :)
+        real(wp), intent(inout) :: vel(:, :)
+        type(split_t), intent(in) :: split
+        real(wp) :: gamma(aa%depth), rhs(aa%depth), fnorm, t(3), p(3)
+        integer :: a, k, j, pcase, slot, m, i
+        call gather(cs, list, aa%d, aa%g)
+        !$omp parallel do schedule(static)
+        do i = 1, size(aa%f)
+            aa%f(i) = aa%g(i) - aa%x(i)
+        end do
+        !$omp end parallel do
+        fnorm = sqrt(pdot(aa%f, aa%f))
+        if (aa%started) then
+            if (fnorm > aa%fnorm_prev) then
+                ! safeguard: the residual rose, restart from the plain sweep's result
+                aa%used = 0
+                aa%next = 1
+                call shift_history(-1)
+                aa%fnorm_prev = fnorm
+                return
+            end if
+            slot = aa%next
+            call shift_history(slot)
+            aa%used = min(aa%used + 1, aa%depth)
+            aa%next = mod(slot, aa%depth) + 1
+            do j = 1, aa%used
+                aa%gram(slot, j) = pdot(aa%df(:, slot), aa%df(:, j))
+                aa%gram(j, slot) = aa%gram(slot, j)
+            end do
+        else
+            call shift_history(-1)
+        end if
+        aa%started = .true.
+        aa%fnorm_prev = fnorm
+        m = aa%used
+        if (m == 0) return
+        do j = 1, m
+            rhs(j) = pdot(aa%df(:, j), aa%f)
+        end do
+        call solve_small(aa%gram(1:m, 1:m), rhs(1:m), gamma(1:m))
+        !$omp parallel do schedule(static) private(j)
+        do i = 1, size(aa%x)
+            aa%x(i) = aa%g(i)
+            do j = 1, m
+                aa%x(i) = aa%x(i) - gamma(j)*aa%dg(i, j)
+            end do
+        end do
+        !$omp end parallel do
+        ! back to reactions, on the cones
+        !$omp parallel do schedule(static) private(a, k, t, p, pcase)
+        do a = 1, size(list)
+            k = list(a)
+            t = 0.0_wp
+            if (aa%d(3*a - 2) > 0.0_wp) t(1) = aa%x(3*a - 2)/aa%d(3*a - 2)
+            if (aa%d(3*a - 1) > 0.0_wp) t(2) = aa%x(3*a - 1)/aa%d(3*a - 1)
+            if (aa%d(3*a) > 0.0_wp) t(3) = aa%x(3*a)/aa%d(3*a)
+            if (cs%erol(k) > 0.0_wp) then
+                call rolling_projection(t(1), t(2), t(3), cs%mu(k), cs%erol(k), p(1), p(2), p(3), pcase)
+            else
+                call coulomb_projection(t(1), t(2), cs%mu(k), p(1), p(2), pcase)
+                p(3) = 0.0_wp
+            end if
+            cs%r(1, k) = p(1) - cs%coh(k)
+            cs%r(2:3, k) = p(2:3)
+        end do
+        !$omp end parallel do
+        vel = vfree
+        call split_apply(cs, list, split, im, vel)
+    contains
+        ! new differences in column `slot` (none for slot < 0), then fprev = f, gprev = g
+        subroutine shift_history(slot)
+            integer, intent(in) :: slot
+            integer :: i
+            !$omp parallel do schedule(static)
+            do i = 1, size(aa%f)
+                if (slot > 0) then
+                    aa%df(i, slot) = aa%f(i) - aa%fprev(i)
+                    aa%dg(i, slot) = aa%g(i) - aa%gprev(i)
+                end if
+                aa%fprev(i) = aa%f(i)
+                aa%gprev(i) = aa%g(i)
+            end do
+            !$omp end parallel do
+        end subroutine shift_history
+    end subroutine anderson_mix
+
+    !> Dot product summed by fixed chunks of `dot_chunk` entries (in parallel), then over
+    !> the chunks in order: the same result for any number of threads.
+    real(wp) function pdot(x, y) result(s)
+        real(wp), intent(in) :: x(:), y(:)
+        real(wp), allocatable :: part(:)
+        integer :: c, nc
+        nc = (size(x) + dot_chunk - 1)/dot_chunk
+        allocate (part(nc))
+        !$omp parallel do schedule(static)
+        do c = 1, nc
+            part(c) = dot_product(x((c - 1)*dot_chunk + 1:min(c*dot_chunk, size(x))), &
+                                  y((c - 1)*dot_chunk + 1:min(c*dot_chunk, size(x))))
+        end do
+        !$omp end parallel do
+        s = 0.0_wp
+        do c = 1, nc
+            s = s + part(c)
+        end do
+    end function pdot
+
+    !> vel += M^-1 H r over the contacts of the solve, with the domain split: the blocks in
+    !> parallel, then the interface (serial order for one block).
+    subroutine split_apply(cs, list, split, im, vel)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: list(:)
+        type(split_t), intent(in) :: split
+        real(wp), intent(in) :: im(:, :)
+        real(wp), intent(inout) :: vel(:, :)
+        integer :: b, j, k
+        if (split%nb == 1) then
+            do j = 1, size(list)
+                k = list(j)
+                call apply(cs, k, im, vel, cs%r(1, k), cs%r(2, k), cs%r(3, k))
+            end do
+            return
+        end if
+        !$omp parallel do schedule(static, 1) num_threads(split%nb) private(j, k)
+        do b = 1, split%nb
+            do j = split%start(b), split%start(b + 1) - 1
+                k = list(split%pos(j))
+                call apply(cs, k, im, vel, cs%r(1, k), cs%r(2, k), cs%r(3, k))
+            end do
+        end do
+        !$omp end parallel do
+        do j = 1, size(split%interface)
+            k = list(split%interface(j))
+            call apply(cs, k, im, vel, cs%r(1, k), cs%r(2, k), cs%r(3, k))
+        end do
+    end subroutine split_apply
+
+    !> Solve the small symmetric system (a + lambda I) x = b by Gaussian elimination, with
+    !> lambda = 1e-12 trace(a) (the differences of the history may be nearly dependent).
+    pure subroutine solve_small(a, b, x)
+        real(wp), intent(in) :: a(:, :), b(:)
+        real(wp), intent(out) :: x(:)
+        real(wp) :: m(size(b), size(b) + 1), f, lambda
+        integer :: n, i, j, piv
+        n = size(b)
+        m(:, 1:n) = a
+        m(:, n + 1) = b
+        lambda = 1.0e-12_wp*sum([(a(i, i), i=1, n)])
+        do i = 1, n
+            m(i, i) = m(i, i) + lambda
+        end do
+        do i = 1, n
+            piv = i - 1 + maxloc(abs(m(i:n, i)), 1)
+            if (piv /= i) m([i, piv], :) = m([piv, i], :)
+            if (m(i, i) == 0.0_wp) then
+                x = 0.0_wp
+                return
+            end if
+            do j = i + 1, n
+                f = m(j, i)/m(i, i)
+                m(j, i:n + 1) = m(j, i:n + 1) - f*m(i, i:n + 1)
+            end do
+        end do
+        do i = n, 1, -1
+            x(i) = (m(i, n + 1) - dot_product(m(i, i + 1:n), x(i + 1:n)))/m(i, i)
+        end do
+    end subroutine solve_small
 
     !> Round-off floor of the convergence norm's denominator for contact k (module header).
     pure real(wp) function roundoff_floor(cs, k, vel) result(f)
@@ -430,8 +732,9 @@ contains
     !> list(last). num = sum |W dr|^2, den = sum |W r|^2 (r applied, not shifted), nloc =
     !> local iterations. With bilateral constraints, they are restored after each contact
     !> update.
-    subroutine sweep(config, cs, im, vel, list, sc, first, last, step, num, den, nloc, bilateral)
+    subroutine sweep(config, omega, cs, im, vel, list, sc, first, last, step, num, den, nloc, bilateral)
         type(nlgs_config_t), intent(in) :: config
+        real(wp), intent(in) :: omega
         type(contact_set_t), intent(inout) :: cs
         real(wp), intent(in) :: im(:, :)
         real(wp), intent(inout) :: vel(:, :)
@@ -440,37 +743,255 @@ contains
         real(wp), intent(out) :: num, den
         integer(i8), intent(out) :: nloc
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
-        real(wp) :: u(3), r0(3), r(3), dr(3), wk(6)
-        integer :: a, k, it, pcase
+        integer :: a
         num = 0.0_wp
         den = 0.0_wp
         nloc = 0_i8
         do a = first, last, step
-            k = list(a)
-            call local_velocity(cs, k, vel, u)
-            wk = cs%w(:, k)
-            r0 = [cs%r(1, k) + cs%coh(k), cs%r(2, k), cs%r(3, k)]
-            r = r0
-            if (cs%erol(k) > 0.0_wp) then
-                call rolling_local_solve_scaled(sc(:, a), u - wmul(wk, r0), config%local_tol, config%local_max_iter, &
-                                                r, it, pcase)
-            else
-                ! no moment (r0(3) = 0, see contacts_set_laws): the two-component law
-                call bipotential_local_solve_scaled(sc(1:bipotential_n_scaling, a), u(1) - wk(1)*r0(1) - wk(2)*r0(2), &
-                                                    u(2) - wk(2)*r0(1) - wk(3)*r0(2), config%local_tol, &
-                                                    config%local_max_iter, r(1), r(2), it, pcase)
-            end if
-            nloc = nloc + it
-            cs%pcase(k) = pcase
-            dr = r - r0
-            cs%r(1, k) = r(1) - cs%coh(k)
-            cs%r(2:3, k) = r(2:3)
-            call apply(cs, k, im, vel, dr(1), dr(2), dr(3))
-            if (present(bilateral)) call bilateral%update(cs%i1(k), cs%i2(k), vel)
-            num = num + wnorm2(wk, dr, cs%amoy(k))
-            den = den + wnorm2(wk, cs%r(:, k), cs%amoy(k))
+            call update(config, omega, cs, im, vel, list(a), sc(:, a), num, den, nloc)
+            if (present(bilateral)) call bilateral%update(cs%i1(list(a)), cs%i2(list(a)), vel)
         end do
     end subroutine sweep
+
+    !> One Gauss-Seidel update of contact k (scaled frame sck): local solve, relaxation,
+    !> impulse applied to the bodies; adds to num = sum |W dr|^2, den = sum |W r|^2 and nloc.
+    subroutine update(config, omega, cs, im, vel, k, sck, num, den, nloc)
+        type(nlgs_config_t), intent(in) :: config
+        real(wp), intent(in) :: omega
+        type(contact_set_t), intent(inout) :: cs
+        real(wp), intent(in) :: im(:, :)
+        real(wp), intent(inout) :: vel(:, :)
+        integer, intent(in) :: k
+        real(wp), intent(in) :: sck(:)
+        real(wp), intent(inout) :: num, den
+        integer(i8), intent(inout) :: nloc
+        real(wp) :: u(3), r0(3), r(3), dr(3), wk(6)
+        integer :: it, pcase
+        call local_velocity(cs, k, vel, u)
+        wk = cs%w(:, k)
+        r0 = [cs%r(1, k) + cs%coh(k), cs%r(2, k), cs%r(3, k)]
+        r = r0
+        if (cs%erol(k) > 0.0_wp) then
+            call rolling_local_solve_scaled(sck, u - wmul(wk, r0), config%local_tol, config%local_max_iter, &
+                                            r, it, pcase)
+        else
+            ! no moment (r0(3) = 0, see contacts_set_laws): the two-component law
+            call bipotential_local_solve_scaled(sck(1:bipotential_n_scaling), u(1) - wk(1)*r0(1) - wk(2)*r0(2), &
+                                                u(2) - wk(2)*r0(1) - wk(3)*r0(2), config%local_tol, &
+                                                config%local_max_iter, r(1), r(2), it, pcase)
+        end if
+        nloc = nloc + it
+        cs%pcase(k) = pcase
+        if (omega /= 1.0_wp) call relax(omega, cs%mu(k), cs%erol(k), r0, r)
+        dr = r - r0
+        cs%r(1, k) = r(1) - cs%coh(k)
+        cs%r(2:3, k) = r(2:3)
+        call apply(cs, k, im, vel, dr(1), dr(2), dr(3))
+        num = num + wnorm2(wk, dr, cs%amoy(k))
+        den = den + wnorm2(wk, cs%r(:, k), cs%amoy(k))
+    end subroutine update
+
+    !> The domain split of the sweeps (OpenMP): nb contiguous blocks of the contact list (in
+    !> contact order, i.e. bottom-up for disks numbered by height), swept at the same time,
+    !> each in its own order; the contacts that touch a disk of another block (the interface)
+    !> are swept after them, serially. nb = the number of OpenMP threads (1 without OpenMP or
+    !> below split_min contacts per block, or with bilateral constraints): with nb = 1 the
+    !> sweep is the serial one, and for a fixed nb the result does not depend on timing.
+    subroutine split_build(split, cs, list, n_disks, nb)
+        type(split_t), intent(out) :: split
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: list(:), n_disks, nb
+        integer, allocatable :: owner(:)
+        integer :: n, b, a, k, lo, hi, nint
+        logical, allocatable :: inter(:)
+        n = size(list)
+        split%nb = nb
+        allocate (split%start(nb + 1))
+        if (nb == 1) return
+        allocate (owner(n_disks), source=0)
+        allocate (inter(n), source=.false.)
+        do b = 1, nb
+            lo = 1 + int((int(b - 1, i8)*n)/nb)
+            hi = int((int(b, i8)*n)/nb)
+            do a = lo, hi
+                k = list(a)
+                call mark(cs%i2(k), b)
+                if (cs%i1(k) > 0) call mark(cs%i1(k), b)
+            end do
+        end do
+        do a = 1, n
+            k = list(a)
+            inter(a) = owner(cs%i2(k)) < 0
+            if (cs%i1(k) > 0) inter(a) = inter(a) .or. owner(cs%i1(k)) < 0
+        end do
+        nint = count(inter)
+        allocate (split%pos(n - nint), split%interface(nint))
+        split%interface = pack([(a, a=1, n)], inter)
+        split%start(1) = 1
+        do b = 1, nb
+            lo = 1 + int((int(b - 1, i8)*n)/nb)
+            hi = int((int(b, i8)*n)/nb)
+            split%start(b + 1) = split%start(b) + count(.not. inter(lo:hi))
+            split%pos(split%start(b):split%start(b + 1) - 1) = pack([(a, a=lo, hi)],.not. inter(lo:hi))
+        end do
+    contains
+        subroutine mark(d, b)
+            integer, intent(in) :: d, b
+            if (owner(d) == 0) then
+                owner(d) = b
+            else if (owner(d) /= b) then
+                owner(d) = -1
+            end if
+        end subroutine mark
+    end subroutine split_build
+
+    !> One sweep with the domain split (split_build), forward or backward.
+    subroutine split_sweep(config, omega, cs, im, vel, list, sc, split, forward, num, den, nloc, bilateral)
+        type(nlgs_config_t), intent(in) :: config
+        real(wp), intent(in) :: omega
+        type(contact_set_t), intent(inout) :: cs
+        real(wp), intent(in) :: im(:, :)
+        real(wp), intent(inout) :: vel(:, :)
+        integer, intent(in) :: list(:)
+        real(wp), intent(in), contiguous :: sc(:, :)
+        type(split_t), intent(in) :: split
+        logical, intent(in) :: forward
+        real(wp), intent(out) :: num, den
+        integer(i8), intent(out) :: nloc
+        class(nlgs_bilateral_t), intent(inout), optional :: bilateral
+        real(wp) :: nb_num(split%nb), nb_den(split%nb), inum, iden
+        integer(i8) :: nb_loc(split%nb), iloc
+        integer :: b
+        if (split%nb == 1) then
+            if (forward) then
+                call sweep(config, omega, cs, im, vel, list, sc, 1, size(list), 1, num, den, nloc, bilateral)
+            else
+                call sweep(config, omega, cs, im, vel, list, sc, size(list), 1, -1, num, den, nloc, bilateral)
+            end if
+            return
+        end if
+        if (.not. forward) call positions(split%interface, .false., inum, iden, iloc)
+        !$omp parallel do schedule(static, 1) num_threads(split%nb)
+        do b = 1, split%nb
+            call positions(split%pos(split%start(b):split%start(b + 1) - 1), forward, nb_num(b), nb_den(b), &
+                           nb_loc(b))
+        end do
+        !$omp end parallel do
+        if (forward) call positions(split%interface, .true., inum, iden, iloc)
+        num = 0.0_wp
+        den = 0.0_wp
+        nloc = iloc
+        do b = 1, split%nb
+            num = num + nb_num(b)
+            den = den + nb_den(b)
+            nloc = nloc + nb_loc(b)
+        end do
+        num = num + inum
+        den = den + iden
+    contains
+        subroutine positions(pos, fwd, pnum, pden, ploc)
+            integer, intent(in) :: pos(:)
+            logical, intent(in) :: fwd
+            real(wp), intent(out) :: pnum, pden
+            integer(i8), intent(out) :: ploc
+            integer :: j, a
+            pnum = 0.0_wp
+            pden = 0.0_wp
+            ploc = 0_i8
+            do j = 1, size(pos)
+                a = merge(pos(j), pos(size(pos) + 1 - j), fwd)
+                call update(config, omega, cs, im, vel, list(a), sc(:, a), pnum, pden, ploc)
+            end do
+        end subroutine positions
+    end subroutine split_sweep
+
+    !> Over-relaxed update: r = P_K(r0 + omega (r - r0)) (Euclidean projection on the cone of
+    !> the contact, shifted reactions), so that r stays admissible for omega > 1.
+    pure subroutine relax(omega, mu, e, r0, r)
+        real(wp), intent(in) :: omega, mu, e, r0(3)
+        real(wp), intent(inout) :: r(3)
+        real(wp) :: t(3)
+        integer :: pcase
+        t = r0 + omega*(r - r0)
+        if (e > 0.0_wp) then
+            call rolling_projection(t(1), t(2), t(3), mu, e, r(1), r(2), r(3), pcase)
+        else
+            call coulomb_projection(t(1), t(2), mu, r(1), r(2), pcase)
+        end if
+    end subroutine relax
+
+    !> Siconos error of the current reactions (doc/theory.md, "Siconos error"), u computed in
+    !> full from the free velocities: vwork = vfree + M^-1 H r (or vel itself when bilateral
+    !> constraints changed the velocities: their impulses are not contacts).
+    real(wp) function siconos_error(cs, im, vfree, vel, vwork, bilateral) result(err)
+        type(contact_set_t), intent(in) :: cs
+        real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :)
+        real(wp), intent(inout) :: vwork(:, :)
+        logical, intent(in) :: bilateral
+        if (bilateral) then
+            vwork = vel
+        else
+            vwork = vfree
+            call nlgs_apply_reactions(cs, im, vwork)
+        end if
+        err = nlgs_siconos_error(cs, im, vfree, vwork)
+    end function siconos_error
+
+    !> Siconos error of the contact problem u = W r + q over the active contacts:
+    !>     sqrt(sum_a |r_a - P_K(r_a - u_hat_a)|^2) / max(|q|, |r|, |u|),
+    !> with r the shifted reaction (r_n + r_cohe h, r_t, M), u_hat = (u_n + mu |u_t| + e |w_r|,
+    !> u_t, w_r) (e |w_r| and the third component only for a law with moments), q = u - W r
+    !> the free term in the shifted unknown (H^T v_free + shift - W (r_cohe h, 0, 0)) and u
+    !> the local velocities of `vel` (doc/theory.md, "Siconos error"). 0 without active
+    !> contacts.
+    function nlgs_siconos_error(cs, im, vfree, vel) result(err)
+        !> Contacts (reactions r).
+        type(contact_set_t), intent(in) :: cs
+        !> Inverse mass per DOF (3, n_disks).
+        real(wp), intent(in) :: im(:, :)
+        !> Free velocities (3, n_disks).
+        real(wp), intent(in) :: vfree(:, :)
+        !> Velocities (3, n_disks) of the reactions (vfree + M^-1 H r).
+        real(wp), intent(in) :: vel(:, :)
+        real(wp) :: err
+        real(wp), allocatable :: vq(:, :)
+        real(wp) :: u(3), q(3), r(3), t(3), p(3), num, nq, nr, nu, den
+        integer :: k, pcase
+        ! free term in the shifted unknown: velocities of the free motion minus the cohesion
+        allocate (vq, source=vfree)
+        do k = 1, cs%n
+            if (.not. cs%active(k)) cycle
+            if (cs%coh(k) /= 0.0_wp) call apply(cs, k, im, vq, -cs%coh(k), 0.0_wp, 0.0_wp)
+        end do
+        num = 0.0_wp
+        nq = 0.0_wp
+        nr = 0.0_wp
+        nu = 0.0_wp
+        do k = 1, cs%n
+            if (.not. cs%active(k)) cycle
+            call local_velocity(cs, k, vel, u)
+            call local_velocity(cs, k, vq, q)
+            r = [cs%r(1, k) + cs%coh(k), cs%r(2, k), cs%r(3, k)]
+            if (cs%erol(k) > 0.0_wp) then
+                t = r - [u(1) + cs%mu(k)*abs(u(2)) + cs%erol(k)*abs(u(3)), u(2), u(3)]
+                call rolling_projection(t(1), t(2), t(3), cs%mu(k), cs%erol(k), p(1), p(2), p(3), pcase)
+            else
+                u(3) = 0.0_wp
+                q(3) = 0.0_wp
+                r(3) = 0.0_wp
+                t = [r(1) - (u(1) + cs%mu(k)*abs(u(2))), r(2) - u(2), 0.0_wp]
+                call coulomb_projection(t(1), t(2), cs%mu(k), p(1), p(2), pcase)
+                p(3) = 0.0_wp
+            end if
+            num = num + sum((r - p)**2)
+            nq = nq + sum(q**2)
+            nr = nr + sum(r**2)
+            nu = nu + sum(u**2)
+        end do
+        den = sqrt(max(nq, nr, nu))
+        err = 0.0_wp
+        if (den > 0.0_wp) err = sqrt(num)/den
+    end function nlgs_siconos_error
 
     !> Relative residual of the contact laws in the current state:
     !> sqrt(sum res_a^2) / sqrt(sum |r'_a|^2) over active contacts, with res_a from

@@ -11,4 +11,5 @@ set(MULTICOR_DEM_SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/bonds.f90
     ${CMAKE_CURRENT_LIST_DIR}/nlgs.f90
     ${CMAKE_CURRENT_LIST_DIR}/bonded_block.f90
+    ${CMAKE_CURRENT_LIST_DIR}/local_problem.f90
     ${CMAKE_CURRENT_LIST_DIR}/moreau_jean.f90)

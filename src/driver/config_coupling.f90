@@ -92,6 +92,12 @@ contains
                                   'alike): set gravity = 0 0 and apply loads instead')
             return
         end if
+        if (deck%has('solver', 'fclib_step')) then
+            call make_input_error(error, deck%file, deck%line('solver', 'fclib_step'), 'fclib_step', &
+                                  'coupled runs do not export their contact problem yet (the coupling rows '// &
+                                  'are not contacts): remove fclib_step')
+            return
+        end if
         call require(deck, 'overlap', first_line, 's_fe s_particle [m]', error)
         if (allocated(error)) return
         call require(deck, 'thickness', first_line, 'depth of the disks [m], usually the '// &

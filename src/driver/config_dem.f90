@@ -28,7 +28,7 @@ module driver_config_dem
     use dem_contacts, only: contact_set_t
     use dem_detection, only: detector_t, detect_contacts
     use dem_moreau_jean, only: dem_system_t
-    use dem_nlgs, only: nlgs_method_nlgs, nlgs_method_block
+    use dem_nlgs, only: nlgs_method_nlgs, nlgs_method_block, criterion_lmgc90, criterion_siconos
     use driver_config, only: run_config_t, find_id
     implicit none
     private
@@ -63,6 +63,8 @@ module driver_config_dem
         logical :: store_contacts = .true.
         !> The alert distance is the default one (not given in the deck).
         logical :: default_alert = .true.
+        !> Step whose local contact problem is written in FCLIB's format (0: none).
+        integer :: fclib_step = 0
     end type dem_config_t
 
 contains
@@ -735,6 +737,12 @@ contains
             sys%solver%local_max_iter = deck%get_int('solver', 'local_iterations')
             sys%solver%method = nlgs_method_nlgs
             if (deck%get_word('solver', 'method') == 'block') sys%solver%method = nlgs_method_block
+            sys%solver%relaxation = deck%get_real('solver', 'relaxation')
+            sys%solver%check_every = deck%get_int('solver', 'check_every')
+            sys%solver%anderson = deck%get_int('solver', 'anderson')
+            sys%solver%criterion = criterion_lmgc90
+            if (deck%get_word('solver', 'criterion') == 'siconos') sys%solver%criterion = criterion_siconos
+            if (deck%has('solver', 'fclib_step')) cfg%fclib_step = deck%get_int('solver', 'fclib_step')
         end associate
         cfg%store_contacts = deck%get_word('output', 'contacts') == 'yes'
     end subroutine build_settings

@@ -14,11 +14,12 @@ module driver_results_dem
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
     use io_hdf5_file, only: h5_file_t
-    use dem_nlgs, only: nlgs_stats_t
+    use dem_nlgs, only: nlgs_stats_t, criterion_names
     use dem_moreau_jean, only: dem_system_t, energies_balance
+    use dem_local_problem, only: local_problem_t
     implicit none
     private
-    public :: dem_writer_t
+    public :: dem_writer_t, write_fclib_local
 
     !> Steps of solver statistics kept in memory before they are written.
     integer, parameter :: stats_buffer = 4096
@@ -46,6 +47,8 @@ module driver_results_dem
         integer, allocatable :: sweeps(:), contacts(:), active(:), blocked(:), converged(:)
         !> Buffered convergence norms and Signorini-Coulomb residuals per step.
         real(wp), allocatable :: norm(:), residual(:)
+        !> Buffered Siconos errors per step (dem_nlgs, nlgs_siconos_error).
+        real(wp), allocatable :: siconos(:)
     contains
         !> Write disk and wall properties, settings, and create every series.
         procedure :: begin => writer_begin
@@ -91,7 +94,7 @@ contains
         allocate (self%sweeps(stats_buffer), self%contacts(stats_buffer), &
                   self%active(stats_buffer), self%blocked(stats_buffer), self%converged(stats_buffer), &
                   self%norm(stats_buffer), &
-                  self%residual(stats_buffer))
+                  self%residual(stats_buffer), self%siconos(stats_buffer))
         call properties(error)
         if (allocated(error)) return
         call settings(error)
@@ -132,6 +135,10 @@ contains
             call file%write_attribute('/dem/solver', 'tolerance', sys%solver%tol, error)
             if (allocated(error)) return
             call file%write_attribute('/dem/solver', 'max_sweeps', sys%solver%max_sweeps, error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem/solver', 'relaxation', sys%solver%relaxation, error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem/solver', 'criterion', trim(criterion_names(sys%solver%criterion)), error)
         end subroutine settings
 
         subroutine series(error)
@@ -167,6 +174,8 @@ contains
             call real_series('/dem/solver/error', [integer ::], '', error)
             if (allocated(error)) return
             call real_series('/dem/solver/residual', [integer ::], '', error)
+            if (allocated(error)) return
+            call real_series('/dem/solver/siconos_error', [integer ::], '', error)
             if (allocated(error)) return
             do k = 1, size(bond_ints)
                 call file%create_int_series('/dem/bonds/'//trim(bond_ints(k)), error)
@@ -346,6 +355,7 @@ contains
         self%converged(k) = merge(1, 0, stats%converged)
         self%norm(k) = stats%error
         self%residual(k) = stats%residual
+        self%siconos(k) = stats%siconos_error
         self%n_buffered = k
         self%n_steps = self%n_steps + 1
     end subroutine writer_record_step
@@ -381,9 +391,10 @@ contains
         self%n_ruptures = 0
         if (allocated(self%sweeps)) deallocate (self%sweeps, self%contacts, self%active, self%blocked, &
                                                 self%converged, self%norm, self%residual)
+        if (allocated(self%siconos)) deallocate (self%siconos)
         allocate (self%sweeps(stats_buffer), self%contacts(stats_buffer), &
                   self%active(stats_buffer), self%blocked(stats_buffer), self%converged(stats_buffer), &
-                  self%norm(stats_buffer), self%residual(stats_buffer))
+                  self%norm(stats_buffer), self%residual(stats_buffer), self%siconos(stats_buffer))
     end subroutine writer_resume
 
     !> Write the buffered solver statistics.
@@ -406,6 +417,8 @@ contains
         call file%append_chunk('/dem/solver/error', self%norm(:k), error)
         if (allocated(error)) return
         call file%append_chunk('/dem/solver/residual', self%residual(:k), error)
+        if (allocated(error)) return
+        call file%append_chunk('/dem/solver/siconos_error', self%siconos(:k), error)
         if (allocated(error)) return
         self%n_buffered = 0
         ! Every batch of writes ends with a flush (a killed run keeps a readable file).
@@ -467,4 +480,93 @@ contains
         end associate
         self%n_ruptures = b
     end subroutine store_ruptures
+
+    !> Write a local contact problem to a new HDF5 file in FCLIB's layout (fclib.c,
+    !> fclib_write_local and fclib_write_solution): /fclib_local/spacedim, /fclib_local/W
+    !> (compressed sparse columns, nz = -1, 0-based: nzmax, m, n, nz, p, i, x),
+    !> /fclib_local/vectors/q and mu, /solution/r and u; MULTICOR's extra data, which FCLIB
+    !> readers ignore, in /multicor: cohesion (r_cohe h), rolling (moment lengths), i1 and i2
+    !> (bodies), and the attributes step, time and siconos_error (doc/theory.md, "Siconos
+    !> error").
+    subroutine write_fclib_local(path, lp, step, time, siconos_error, error)
+        !> File name (created, or truncated).
+        character(len=*), intent(in) :: path
+        !> The problem.
+        type(local_problem_t), intent(in) :: lp
+        !> Step number and time at its end [s].
+        integer, intent(in) :: step
+        real(wp), intent(in) :: time
+        !> Siconos error of the solution found by the solver.
+        real(wp), intent(in) :: siconos_error
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        type(h5_file_t) :: file
+        type(error_t), allocatable :: close_error
+        integer :: m
+        m = lp%dim*lp%n
+        call file%create(path, error)
+        if (allocated(error)) return
+        call body(error)
+        call file%close(close_error)
+        if (.not. allocated(error) .and. allocated(close_error)) call move_alloc(close_error, error)
+    contains
+        subroutine body(error)
+            type(error_t), allocatable, intent(out) :: error
+            call file%create_group('/fclib_local', error)
+            if (allocated(error)) return
+            call file%write_dataset('/fclib_local/spacedim', [lp%dim], error)
+            if (allocated(error)) return
+            call file%create_group('/fclib_local/W', error)
+            if (allocated(error)) return
+            call file%write_dataset('/fclib_local/W/nzmax', [size(lp%values)], error)
+            if (allocated(error)) return
+            call file%write_dataset('/fclib_local/W/m', [m], error)
+            if (allocated(error)) return
+            call file%write_dataset('/fclib_local/W/n', [m], error)
+            if (allocated(error)) return
+            call file%write_dataset('/fclib_local/W/nz', [-1], error)
+            if (allocated(error)) return
+            call file%write_dataset('/fclib_local/W/p', lp%colptr, error)
+            if (allocated(error)) return
+            call file%write_dataset('/fclib_local/W/i', lp%rowind, error)
+            if (allocated(error)) return
+            call file%write_dataset('/fclib_local/W/x', lp%values, error)
+            if (allocated(error)) return
+            call file%create_group('/fclib_local/vectors', error)
+            if (allocated(error)) return
+            call file%write_dataset('/fclib_local/vectors/q', lp%q, error)
+            if (allocated(error)) return
+            call file%write_dataset('/fclib_local/vectors/mu', lp%mu, error)
+            if (allocated(error)) return
+            call file%create_group('/solution', error)
+            if (allocated(error)) return
+            call file%write_dataset('/solution/r', lp%r, error)
+            if (allocated(error)) return
+            call file%write_dataset('/solution/u', lp%u, error)
+            if (allocated(error)) return
+            call file%create_group('/multicor', error)
+            if (allocated(error)) return
+            call file%write_dataset('/multicor/cohesion', lp%cohesion, error)
+            if (allocated(error)) return
+            call file%write_dataset('/multicor/rolling', lp%rolling, error)
+            if (allocated(error)) return
+            call file%write_dataset('/multicor/i1', lp%i1, error)
+            if (allocated(error)) return
+            call file%write_dataset('/multicor/i2', lp%i2, error)
+            if (allocated(error)) return
+            call file%write_attribute('/multicor', 'step', step, error)
+            if (allocated(error)) return
+            call file%write_attribute('/multicor', 'time', time, error)
+            if (allocated(error)) return
+            call file%write_attribute('/multicor', 'siconos_error', siconos_error, error)
+            if (allocated(error)) return
+            if (lp%dim == 3) then
+                call file%write_attribute('/multicor', 'unknowns', 'per contact (r_n + r_cohe h, r_t, M); cone '// &
+                                          '|r_t| <= mu r_n, |M| <= e r_n with e = rolling', error)
+            else
+                call file%write_attribute('/multicor', 'unknowns', 'per contact (r_n + r_cohe h, r_t); cone '// &
+                                          '|r_t| <= mu r_n', error)
+            end if
+        end subroutine body
+    end subroutine write_fclib_local
 end module driver_results_dem

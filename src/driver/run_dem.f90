@@ -14,11 +14,13 @@ module driver_run_dem
     use core_signals, only: caught_signal, signal_name
     use io_progress, only: progress_t
     use dem_particles, only: particles_t
-    use dem_moreau_jean, only: mj_init, mj_step, energies_balance
+    use dem_moreau_jean, only: mj_init, mj_step, energies_balance, mj_free_velocities, mj_detect, mj_solve, &
+                               mj_end_step
+    use dem_local_problem, only: local_problem_t, local_problem_build
     use driver_config, only: run_config_t
     use driver_config_dem, only: dem_config_t
     use driver_results, only: results_writer_t
-    use driver_results_dem, only: dem_writer_t
+    use driver_results_dem, only: dem_writer_t, write_fclib_local
     use driver_guards, only: check_disks_state, step_start_t, take_step_start, check_tunnelling
     use io_hdf5_file, only: h5_file_t
     use driver_checkpoint, only: checkpoint_run_t, loop_state_t, checkpoint_create, checkpoint_commit, &
@@ -93,7 +95,12 @@ contains
         call ck%schedule%start()
         do k = k0 + 1, n_steps
             call take_step_start(start, cfg%system%particles, cfg%system%walls)
-            call mj_step(cfg%system)
+            if (k == cfg%fclib_step) then
+                call step_with_export(error)
+                if (allocated(error)) return
+            else
+                call mj_step(cfg%system)
+            end if
             call check_step(error)
             if (allocated(error)) return
             call writer%record_step(out%file, cfg%system%stats, error)
@@ -171,6 +178,32 @@ contains
             ck%last_step = k
             ck%last_time = cfg%system%time
         end subroutine checkpoint
+
+        !> One step (as mj_step) that writes its local contact problem in FCLIB's format to
+        !> <results without .h5>_fclib_<step>.h5.
+        subroutine step_with_export(error)
+            type(error_t), allocatable, intent(out) :: error
+            type(local_problem_t) :: lp
+            real(wp), allocatable :: vfree(:, :)
+            character(len=:), allocatable :: path
+            character(len=32) :: tag
+            associate (sys => cfg%system)
+                call mj_free_velocities(sys)
+                call mj_detect(sys)
+                allocate (vfree, source=sys%vel)
+                call mj_solve(sys)
+                call local_problem_build(sys%contacts, sys%im, vfree, lp)
+                write (tag, '(a, i0, a)') '_fclib_', sys%step + 1, '.h5'
+                path = out%final_path
+                if (len(path) > 3) then
+                    if (path(len(path) - 2:) == '.h5') path = path(:len(path) - 3)
+                end if
+                call write_fclib_local(path//trim(tag), lp, sys%step + 1, sys%time + sys%scheme%h, &
+                                       sys%stats%siconos_error, error)
+                if (allocated(error)) return
+                call mj_end_step(sys)
+            end associate
+        end subroutine step_with_export
 
         !> Guards after a step: finite state in the box, no tunnelling.
         subroutine check_step(error)

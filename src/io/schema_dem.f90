@@ -158,5 +158,27 @@ contains
         call s%add_keyword('solver', 'local_iterations', [int_field('local_iterations', lower=1)], &
                            'Largest number of local prediction-correction iterations per contact visit.', &
                            default='8')
+        call s%add_keyword('solver', 'criterion', [word_field('criterion', 'lmgc90 siconos')], &
+                           'Which error stops the sweeps: lmgc90 (the change of W r over a sweep, see '// &
+                           'tolerance) or siconos (the norm of r - P_K(r - u_hat) over the largest norm of q, r and '// &
+                           'u, with u = W r + q computed in full, doc/theory.md 4.5). Both are stored per step in '// &
+                           'the results.', &
+                           default='lmgc90')
+        call s%add_keyword('solver', 'relaxation', [real_field('relaxation', '', lower=0.0_wp, upper=2.0_wp, &
+                                                               lower_strict=.true., upper_strict=.true.)], &
+                           'Over-relaxation factor omega of the sweeps: each contact takes P_K(r + omega '// &
+                           '(r_local - r)). Every `check_every` sweeps the error is compared with the one '// &
+                           'before; omega falls back to 1 for the rest of the step when it rose.', default='1')
+        call s%add_keyword('solver', 'anderson', [int_field('anderson', lower=0, upper=20)], &
+                           'Anderson acceleration of the sweeps: the number of previous sweeps mixed (5 is '// &
+                           'a good choice for tall packings, doc/performance.md); 0: plain sweeps. The '// &
+                           'accelerated sweeps run in the fixed contact order; the history restarts when the '// &
+                           'change over a sweep grows. Not used with the Arlequin coupling rows.', default='0')
+        call s%add_keyword('solver', 'check_every', [int_field('check_every', lower=1)], &
+                           'Period in sweeps of the safeguard of the over-relaxation.', default='10')
+        call s%add_keyword('solver', 'fclib_step', [int_field('fclib_step', lower=1)], &
+                           'Write the local contact problem of this step (W, q, mu, cohesion, rolling '// &
+                           'lengths and the solution found) in FCLIB''s HDF5 format to <output>_fclib_<step>.h5 '// &
+                           '(doc/theory.md, "Siconos error"). Default: none.')
     end subroutine add_solver
 end module io_schema_dem

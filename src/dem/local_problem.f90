@@ -1,0 +1,252 @@
+!> The local contact problem of one step, u = W r + q over the active contacts, assembled
+!> explicitly for export (FCLIB's 'local' problem, doc/theory.md, "Siconos error").
+!>
+!> Unknowns per contact, in list order: (r_n, r_t) when no active contact has a moment length
+!> (dim = 2), else (r_n, r_t, M) for every contact (dim = 3; M = 0 rows of contacts without
+!> moment have their W rows and columns but their cone holds M = 0). r is the shifted
+!> reaction (r_n + r_cohe h, r_t, M), so that the cone is the plain one; q is the free term
+!> in that unknown: q = H^T v_free + shift - W (r_cohe h, 0, 0). W = H^T M^-1 H is stored in
+!> compressed sparse columns, 0-based (FCLIB's nz = -1), rows sorted within each column.
+module dem_local_problem
+    use core_kinds, only: wp
+    use dem_contacts, only: contact_set_t
+    implicit none
+    private
+    public :: local_problem_t, local_problem_build
+
+    !> The assembled local problem.
+    type :: local_problem_t
+        !> Components per contact (2 or 3) and number of contacts.
+        integer :: dim = 2, n = 0
+        !> W in compressed sparse columns (0-based): column starts (dim n + 1), row indices
+        !> and values (nnz).
+        integer, allocatable :: colptr(:), rowind(:)
+        real(wp), allocatable :: values(:)
+        !> Free term (dim n), friction coefficients, cohesive impulses r_cohe h and moment
+        !> lengths (n).
+        real(wp), allocatable :: q(:), mu(:), cohesion(:), rolling(:)
+        !> The reactions of the contact set (shifted, dim n) and u = W r + q computed from the
+        !> velocities vfree + M^-1 H r (dim n).
+        real(wp), allocatable :: r(:), u(:)
+        !> Bodies of each contact (i1: disk or -wall, i2: disk) and index in the contact set.
+        integer, allocatable :: i1(:), i2(:), index(:)
+    end type local_problem_t
+
+contains
+
+    !> Assemble the local problem of the active contacts of cs.
+    subroutine local_problem_build(cs, im, vfree, lp)
+        !> Contacts after the solve (frames, laws, activity, reactions).
+        type(contact_set_t), intent(in) :: cs
+        !> Inverse mass per DOF (3, n_disks).
+        real(wp), intent(in) :: im(:, :)
+        !> Free velocities of the step (3, n_disks).
+        real(wp), intent(in) :: vfree(:, :)
+        !> The problem.
+        type(local_problem_t), intent(out) :: lp
+        integer, allocatable :: pos(:), adj_start(:), adj(:), rows(:)
+        real(wp), allocatable :: vq(:, :), vr(:, :), vals(:)
+        real(wp) :: ga(3, 3), gb(3, 3), s
+        integer :: nd, m, d, k, a, b, c, e, j, side, body, nnz, nrow, other, col
+        nd = size(im, 2)
+        m = count(cs%active(1:cs%n))
+        lp%n = m
+        lp%dim = 2
+        if (any(cs%active(1:cs%n) .and. cs%erol(1:cs%n) > 0.0_wp)) lp%dim = 3
+        d = lp%dim
+        allocate (lp%i1(m), lp%i2(m), lp%index(m), lp%mu(m), lp%cohesion(m), lp%rolling(m))
+        allocate (pos(cs%n), source=0)
+        j = 0
+        do k = 1, cs%n
+            if (.not. cs%active(k)) cycle
+            j = j + 1
+            pos(k) = j
+            lp%index(j) = k
+            lp%i1(j) = cs%i1(k)
+            lp%i2(j) = cs%i2(k)
+            lp%mu(j) = cs%mu(k)
+            lp%cohesion(j) = cs%coh(k)
+            lp%rolling(j) = cs%erol(k)
+        end do
+        ! contacts of each disk (CSR)
+        allocate (adj_start(nd + 1), source=0)
+        do j = 1, m
+            if (lp%i1(j) > 0) adj_start(lp%i1(j) + 1) = adj_start(lp%i1(j) + 1) + 1
+            adj_start(lp%i2(j) + 1) = adj_start(lp%i2(j) + 1) + 1
+        end do
+        adj_start(1) = 1
+        do body = 1, nd
+            adj_start(body + 1) = adj_start(body + 1) + adj_start(body)
+        end do
+        allocate (adj(adj_start(nd + 1) - 1), rows(nd))
+        rows(1:nd) = adj_start(1:nd)
+        do j = 1, m
+            if (lp%i1(j) > 0) then
+                adj(rows(lp%i1(j))) = j
+                rows(lp%i1(j)) = rows(lp%i1(j)) + 1
+            end if
+            adj(rows(lp%i2(j))) = j
+            rows(lp%i2(j)) = rows(lp%i2(j)) + 1
+        end do
+        ! W column by column: the block of contact b with itself is cs%w; with another
+        ! contact a it is the term of the one body they share
+        allocate (lp%colptr(d*m + 1))
+        allocate (lp%rowind(d*d*m*8), lp%values(d*d*m*8))
+        deallocate (rows)
+        allocate (rows(64), vals(64))
+        nnz = 0
+        lp%colptr(1) = 0
+        do b = 1, m
+            k = lp%index(b)
+            do c = 1, d
+                nrow = 0
+                call add_self(k, c)
+                do side = 1, 2
+                    body = merge(lp%i1(b), lp%i2(b), side == 1)
+                    if (body <= 0) cycle
+                    call directions(cs, lp%index(b), body, gb)
+                    do e = adj_start(body), adj_start(body + 1) - 1
+                        a = adj(e)
+                        if (a == b) cycle
+                        call directions(cs, lp%index(a), body, ga)
+                        do j = 1, d
+                            s = sum(ga(:, j)*im(:, body)*gb(:, c))
+                            call push(d*(a - 1) + j - 1, s)
+                        end do
+                    end do
+                end do
+                call sort_rows(rows(1:nrow), vals(1:nrow))
+                col = d*(b - 1) + c
+                if (nnz + nrow > size(lp%rowind)) call grow(nnz + nrow)
+                lp%rowind(nnz + 1:nnz + nrow) = rows(1:nrow)
+                lp%values(nnz + 1:nnz + nrow) = vals(1:nrow)
+                nnz = nnz + nrow
+                lp%colptr(col + 1) = nnz
+            end do
+        end do
+        lp%rowind = lp%rowind(1:nnz)
+        lp%values = lp%values(1:nnz)
+        ! q from the free velocities shifted by the cohesion, u from vfree + M^-1 H r
+        allocate (vq, source=vfree)
+        allocate (vr, source=vfree)
+        do j = 1, m
+            k = lp%index(j)
+            call impulse(cs, k, im, vq, [-cs%coh(k), 0.0_wp, 0.0_wp])
+            call impulse(cs, k, im, vr, cs%r(:, k))
+        end do
+        allocate (lp%q(d*m), lp%u(d*m), lp%r(d*m))
+        do j = 1, m
+            k = lp%index(j)
+            call velocity(cs, k, vq, lp%q(d*(j - 1) + 1:d*j))
+            call velocity(cs, k, vr, lp%u(d*(j - 1) + 1:d*j))
+            lp%r(d*(j - 1) + 1) = cs%r(1, k) + cs%coh(k)
+            lp%r(d*(j - 1) + 2) = cs%r(2, k)
+            if (d == 3) lp%r(d*j) = cs%r(3, k)
+        end do
+    contains
+        ! the diagonal block from cs%w (sum over both bodies)
+        subroutine add_self(k, c)
+            integer, intent(in) :: k, c
+            integer, parameter :: idx(3, 3) = reshape([1, 2, 4, 2, 3, 5, 4, 5, 6], [3, 3])
+            integer :: i
+            do i = 1, d
+                call push(d*(pos(k) - 1) + i - 1, cs%w(idx(i, c), k))
+            end do
+        end subroutine add_self
+
+        subroutine push(row, v)
+            integer, intent(in) :: row
+            real(wp), intent(in) :: v
+            if (nrow == size(rows)) then
+                rows = [rows, rows]
+                vals = [vals, vals]
+            end if
+            nrow = nrow + 1
+            rows(nrow) = row
+            vals(nrow) = v
+        end subroutine push
+
+        subroutine grow(need)
+            integer, intent(in) :: need
+            integer, allocatable :: ti(:)
+            real(wp), allocatable :: tv(:)
+            allocate (ti(max(need, 2*size(lp%rowind))), tv(max(need, 2*size(lp%rowind))))
+            ti(1:nnz) = lp%rowind(1:nnz)
+            tv(1:nnz) = lp%values(1:nnz)
+            call move_alloc(ti, lp%rowind)
+            call move_alloc(tv, lp%values)
+        end subroutine grow
+    end subroutine local_problem_build
+
+    !> Generalised directions (vx, vy, w) on disk `body` of the unit components r_n, r_t, M
+    !> of contact k (columns); the velocity components of the contact are their dot products
+    !> with the body's velocity (H^T is the transpose of the impulse map).
+    pure subroutine directions(cs, k, body, g)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: k, body
+        real(wp), intent(out) :: g(3, 3)
+        real(wp) :: s, lever
+        if (body == cs%i2(k)) then
+            s = 1.0_wp
+            lever = cs%lever(2, k)
+        else
+            s = -1.0_wp
+            lever = cs%lever(1, k)
+        end if
+        g(:, 1) = [s*cs%nrm(1, k), s*cs%nrm(2, k), 0.0_wp]
+        g(:, 2) = [-s*cs%nrm(2, k), s*cs%nrm(1, k), lever]
+        g(:, 3) = [0.0_wp, 0.0_wp, s]
+    end subroutine directions
+
+    !> vel += M^-1 H dr for contact k.
+    pure subroutine impulse(cs, k, im, vel, dr)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: k
+        real(wp), intent(in) :: im(:, :), dr(3)
+        real(wp), intent(inout) :: vel(:, :)
+        real(wp) :: g(3, 3)
+        call directions(cs, k, cs%i2(k), g)
+        vel(:, cs%i2(k)) = vel(:, cs%i2(k)) + im(:, cs%i2(k))*matmul(g, dr)
+        if (cs%i1(k) <= 0) return
+        call directions(cs, k, cs%i1(k), g)
+        vel(:, cs%i1(k)) = vel(:, cs%i1(k)) + im(:, cs%i1(k))*matmul(g, dr)
+    end subroutine impulse
+
+    !> Local velocity H^T v + shift of contact k, its first size(u) components.
+    pure subroutine velocity(cs, k, vel, u)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: k
+        real(wp), intent(in) :: vel(:, :)
+        real(wp), intent(out) :: u(:)
+        real(wp) :: g(3, 3), w(3)
+        call directions(cs, k, cs%i2(k), g)
+        w = matmul(vel(:, cs%i2(k)), g)
+        if (cs%i1(k) > 0) then
+            call directions(cs, k, cs%i1(k), g)
+            w = w + matmul(vel(:, cs%i1(k)), g)
+        end if
+        w(1:2) = w(1:2) + cs%shift(:, k)
+        u = w(1:size(u))
+    end subroutine velocity
+
+    !> Sort (rows, vals) by row (insertion sort: a column has a few entries).
+    pure subroutine sort_rows(rows, vals)
+        integer, intent(inout) :: rows(:)
+        real(wp), intent(inout) :: vals(:)
+        integer :: i, j, r
+        real(wp) :: v
+        do i = 2, size(rows)
+            r = rows(i)
+            v = vals(i)
+            j = i - 1
+            do while (j >= 1)
+                if (rows(j) <= r) exit
+                rows(j + 1) = rows(j)
+                vals(j + 1) = vals(j)
+                j = j - 1
+            end do
+            rows(j + 1) = r
+            vals(j + 1) = v
+        end do
+    end subroutine sort_rows
+end module dem_local_problem

@@ -1,0 +1,191 @@
+#!/usr/bin/env python3
+"""The Siconos error that multicor stores per step (/dem/solver/siconos_error) against an
+independent computation with numpy on the local problem of that step read back from the
+FCLIB export ([solver] fclib_step, doc/theory.md "Siconos error").
+
+The code computes the error from velocities (u = H^T (v_free + M^-1 H r) + shift); here W is
+the exported sparse matrix and u = W r + q. Two decks: a frictional deposit (2 components per
+contact, no cohesion) and the cohesive hanging row (bonds: cohesion and moments, 3 components).
+Usage (ctest does this): test_fclib_export.py --exe multicor --work DIR --source REPO
+"""
+import argparse
+import pathlib
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+FAILED = []
+
+
+def check(name, ok, detail=""):
+    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
+    if not ok:
+        FAILED.append(name)
+
+
+def with_export(deck, step, work, extra=(), replace=None, name=None):
+    """Copy of deck with [solver] fclib_step = step (and extra [solver] lines); replace =
+    (old line, new lines) edits one line of the deck."""
+    lines = deck.read_text().splitlines()
+    if replace:
+        stripped = [ln.strip() for ln in lines]
+        assert replace[0] in stripped, f"{deck}: no line {replace[0]!r}"
+        k = stripped.index(replace[0])
+        lines[k:k + 1] = replace[1]
+    add = [f"fclib_step = {step}", *extra]
+    if "[solver]" in [ln.strip() for ln in lines]:
+        k = [ln.strip() for ln in lines].index("[solver]")
+        lines[k + 1:k + 1] = add
+    else:
+        lines += ["[solver]", *add]
+    out = work / (name or deck.name)
+    out.write_text("\n".join(lines) + "\n")
+    return out
+
+
+def run(exe, deck, work):
+    out = work / deck.stem
+    proc = subprocess.run([str(exe), str(deck), "--output", str(out), "--quiet"],
+                          capture_output=True, text=True)
+    if proc.returncode != 0:
+        print(proc.stdout, proc.stderr)
+        raise SystemExit(f"multicor failed on {deck} (exit {proc.returncode})")
+    return out / f"{deck.stem}.h5"
+
+
+def proj_coulomb(t, mu):
+    """Euclidean projection of (t_n, t_t) on |r_t| <= mu r_n."""
+    n, s = t
+    if mu * abs(s) <= -n:
+        return np.zeros(2)
+    if abs(s) <= mu * n:
+        return np.array([n, s])
+    rn = (n + mu * abs(s)) / (1 + mu * mu)
+    return np.array([rn, np.copysign(mu * rn, s)])
+
+
+def proj_rolling(t, mu, e):
+    """Euclidean projection of (n, t, m) on |r_t| <= mu r_n, |M| <= e r_n (KKT active sets)."""
+    n, s, m = t
+    T, A = abs(s), abs(m)
+    if mu * T + e * A <= -n:
+        return np.zeros(3)
+    if T <= mu * n and A <= e * n:
+        return np.array([n, s, m])
+    n1 = (n + mu * T + e * A) / (1 + mu * mu + e * e)
+    if T > mu * n1 and A > e * n1:
+        return np.array([n1, np.copysign(mu * n1, s), np.copysign(e * n1, m)])
+    n2 = (n + mu * T) / (1 + mu * mu)
+    if A <= e * n2:
+        return np.array([n2, np.copysign(mu * n2, s), m])
+    n3 = (n + e * A) / (1 + e * e)
+    return np.array([n3, s, np.copysign(e * n3, m)])
+
+
+def siconos_error(W, q, r, mu, rolling, dim):
+    """||r - P_K(r - u_hat)|| / max(||q||, ||r||, ||u||), u = W r + q; components M of
+    contacts without a moment length are not part of their problem (M = 0)."""
+    u = W @ r + q
+    num = nq = nr = nu = 0.0
+    for j, (muj, ej) in enumerate(zip(mu, rolling)):
+        s = slice(dim * j, dim * j + (3 if ej > 0 else 2))
+        rj, uj, qj = r[s], u[s], q[s]
+        if ej > 0:
+            uh = np.array([uj[0] + muj * abs(uj[1]) + ej * abs(uj[2]), uj[1], uj[2]])
+            p = proj_rolling(rj - uh, muj, ej)
+        else:
+            uh = np.array([uj[0] + muj * abs(uj[1]), uj[1]])
+            p = proj_coulomb(rj - uh, muj)
+        num += np.sum((rj - p) ** 2)
+        nq += qj @ qj
+        nr += rj @ rj
+        nu += uj @ uj
+    return np.sqrt(num) / np.sqrt(max(nq, nr, nu)), u
+
+
+def case(exe, deck, step, work, expect_dim, extra=(), replace=None, name=None):
+    deck = with_export(deck, step, work, extra, replace, name)
+    results = run(exe, deck, work)
+    fclib = results.parent / f"{deck.stem}_fclib_{step}.h5"
+    with h5py.File(results, "r") as f:
+        stored = f["dem/solver/siconos_error"][step - 1]
+    with h5py.File(fclib, "r") as f:
+        dim = int(f["fclib_local/spacedim"][0])
+        g = f["fclib_local/W"]
+        m, n, nz = int(g["m"][0]), int(g["n"][0]), int(g["nz"][0])
+        p, i, x = g["p"][...], g["i"][...], g["x"][...]
+        q = f["fclib_local/vectors/q"][...]
+        mu = f["fclib_local/vectors/mu"][...]
+        r, u_code = f["solution/r"][...], f["solution/u"][...]
+        rolling = f["multicor/rolling"][...]
+        cohesion = f["multicor/cohesion"][...]
+        attr = float(f["multicor"].attrs["siconos_error"])
+    name = deck.stem
+    check(f"{name}: layout", nz == -1 and m == n == dim * len(mu) and len(p) == n + 1
+          and p[-1] == len(i) == len(x) and dim == expect_dim,
+          f"spacedim {dim}, {len(mu)} contacts, nnz {len(x)}")
+    W = np.zeros((m, n))
+    for col in range(n):
+        W[i[p[col]:p[col + 1]], col] = x[p[col]:p[col + 1]]
+    # W = H^T M^-1 H is symmetric positive semi-definite; 1e-12 relative: the entries of both
+    # triangles are the same products in another order.
+    sym = np.max(np.abs(W - W.T)) / np.max(np.abs(W))
+    eig = np.linalg.eigvalsh(0.5 * (W + W.T)).min() / np.max(np.abs(W))
+    check(f"{name}: W symmetric, positive semi-definite", sym < 1e-12 and eig > -1e-12,
+          f"asymmetry {sym:.1e}, smallest eigenvalue / max|W| {eig:.1e}")
+    err, u = siconos_error(W, q, r, mu, rolling, dim)
+    # u from W r + q against the code's u (from the body velocities): the same sum in another
+    # order; both are sums of terms of size |q|, so they agree to a few eps * |q|.
+    du = np.max(np.abs(u - u_code)) / np.linalg.norm(q)
+    check(f"{name}: W r + q = u of the code", du < 1e-12, f"max diff / |q| = {du:.1e}")
+    # The two errors differ by the round-off of u (a few eps |q|, above), which the error's
+    # numerator takes up to its sqrt(m) components: rtol 1e-8 leaves a margin of 1e4 over
+    # that for an error of 1e-6, and any mistake in the formula changes the error at O(1).
+    check(f"{name}: Siconos error, code against numpy", abs(err - stored) <= 1e-8 * err + 1e-14,
+          f"numpy {err:.10e}, stored {stored:.10e}, file attribute {attr:.10e}")
+    check(f"{name}: the file's attribute is the stored error", attr == stored, "")
+    return cohesion, rolling
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--exe", required=True)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("--source", required=True)
+    args = ap.parse_args()
+    exe, work, src = pathlib.Path(args.exe), pathlib.Path(args.work), pathlib.Path(args.source)
+    work.mkdir(parents=True, exist_ok=True)
+    decks = src / "tests" / "regression" / "decks"
+    # a loose tolerance, so that the error compared is well above round-off
+    case(exe, decks / "dem_small_deposit.dat", 276, work, 2, ("tolerance = 1e-3",))
+    # rolling resistance (e_r = 1 mm) on the pair 1-1, the one of every contact of that step
+    _, rolling = case(exe, decks / "dem_small_deposit.dat", 291, work, 3, ("tolerance = 1e-3",),
+                      ("law = 1 1 0.4 0.2 0", ["law = 1 1 0.4 0.2 0 0.001"]), "deposit_rolling.dat")
+    check("deposit_rolling: contacts with a moment", np.all(rolling == 0.001), f"{len(rolling)} contacts")
+    # bonds (cohesion) that carry moments (e_b = R/2)
+    cohesion, rolling = case(exe, src / "input" / "cohesive_row.dat", 100, work, 3, (),
+                             ("law      = 1          1          0.3  0            2.0e4",
+                              ["law = 1 1 0.3 0 2.0e4", "bond = 1 1 0.3 0.0025"]), "bonded_row.dat")
+    check("bonded_row: bonds exported with cohesion and moment length",
+          np.all(cohesion > 0) and np.all(rolling > 0), f"{len(cohesion)} contacts")
+    # The criterion chosen by the deck stops the sweeps: with criterion = siconos every
+    # converged step has a stored Siconos error at most the tolerance.
+    deck = with_export(src / "tests" / "regression" / "decks" / "dem_small_deposit.dat", 250, work,
+                       ("criterion = siconos", "tolerance = 1e-6", "max_sweeps = 100000"))
+    with h5py.File(run(exe, deck, work), "r") as f:
+        e = f["dem/solver/siconos_error"][...]
+        conv = f["dem/solver/converged"][...]
+        crit = f["dem/solver"].attrs["criterion"]
+    crit = crit.decode() if isinstance(crit, bytes) else str(crit)
+    check("criterion = siconos stops at the tolerance", crit == "siconos" and conv.all()
+          and e.max() <= 1e-6, f"{len(e)} steps, max error {e.max():.2e}")
+    if FAILED:
+        print("FAILED:", ", ".join(FAILED))
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
