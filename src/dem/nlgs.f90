@@ -340,13 +340,13 @@ contains
         stats%error = 0.0_wp
         omega = config%relaxation
         checked = huge(1.0_wp)
-        ! the Anderson steps rebuild the velocities from the swept contacts: not with a block
-        ! or bilateral constraints, whose impulses are not among them
-        accelerate = config%anderson > 0 .and. .not. present(bilateral) .and. .not. present(block) .and. n_swept > 0
+        ! the Anderson steps rebuild the velocities from the swept contacts: not with members
+        ! of a block or bilateral constraints, whose impulses are not among them
+        accelerate = config%anderson > 0 .and. .not. present(bilateral) .and. stats%n_block == 0 .and. n_swept > 0
         if (accelerate) call anderson_init(aa, config%anderson, cs, list)
         nb = 1
 !$      nb = omp_get_max_threads()
-        if (present(bilateral) .or. present(block)) nb = 1
+        if (present(bilateral) .or. stats%n_block > 0) nb = 1
         nb = max(1, min(nb, n_swept/max(config%split_min, 1)))
         call split_build(split, cs, list, size(vel, 2), nb)
         if (stats%n_active > 0) then

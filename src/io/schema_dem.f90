@@ -173,7 +173,8 @@ contains
                            'Anderson acceleration of the sweeps: the number of previous sweeps mixed (5 is '// &
                            'a good choice for tall packings, doc/performance.md); 0: plain sweeps. The '// &
                            'accelerated sweeps run in the fixed contact order; the history restarts when the '// &
-                           'change over a sweep grows. Not used with the Arlequin coupling rows.', default='0')
+                           'change over a sweep grows. Not used with the Arlequin coupling rows, nor in a step '// &
+                           'where method = block solves intact bonds directly.', default='0')
         call s%add_keyword('solver', 'check_every', [int_field('check_every', lower=1)], &
                            'Period in sweeps of the safeguard of the over-relaxation.', default='10')
         call s%add_keyword('solver', 'fclib_step', [int_field('fclib_step', lower=1)], &
