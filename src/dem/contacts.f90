@@ -15,6 +15,7 @@
 !> contacts are appended (warm start).
 module dem_contacts
     use core_kinds, only: wp, i8
+    use core_constants, only: relative_roundoff
     use dem_materials, only: materials_t, bond_e_default
     use dem_bipotential, only: case_separation, case_slip, case_roll, case_slip_roll
     use dem_bonds, only: break_none, break_tension, break_shear, break_moment, break_shear_moment
@@ -471,7 +472,7 @@ contains
                 rn = cs%r(1, k)
                 if (rn <= 0.0_wp) then
                     cs%status(k) = status_open
-                else if (abs(cs%r(2, k)) >= cs%mu(k)*rn*(1.0_wp - 1.0e-12_wp)) then
+                else if (abs(cs%r(2, k)) >= cs%mu(k)*rn*(1.0_wp - relative_roundoff)) then
                     cs%status(k) = status_slip
                 else
                     cs%status(k) = status_stick

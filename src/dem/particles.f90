@@ -7,6 +7,7 @@
 !> Time functions are referenced by index into `particles_t%functions` (0 = constant 1).
 module dem_particles
     use core_kinds, only: wp, i8
+    use core_constants, only: pi
     use core_error, only: error_t, make_error
     use core_timefunc, only: time_function_t
     implicit none
@@ -28,8 +29,6 @@ module dem_particles
     integer, parameter :: dof_fixed = 1
     !> Condition kind: velocity imposed as value times a time function.
     integer, parameter :: dof_imposed = 2
-
-    real(wp), parameter :: pi = 3.141592653589793238462643383279502884_wp
 
     !> A condition on one DOF of one disk.
     type :: dof_condition_t

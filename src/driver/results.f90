@@ -12,6 +12,7 @@
 module driver_results
     use, intrinsic :: iso_fortran_env, only: int64
     use core_kinds, only: wp
+    use core_constants, only: two_pi
     use core_error, only: error_t, make_error
     use core_version, only: multicor_version, multicor_name
     use io_hdf5_file, only: h5_file_t
@@ -19,9 +20,6 @@ module driver_results
     implicit none
     private
     public :: results_writer_t
-
-    !> 2 pi, for frequencies in Hz.
-    real(wp), parameter :: two_pi = 6.283185307179586476925286766559_wp
 
     !> Writes the results of one run into one HDF5 file.
     type :: results_writer_t

@@ -3,6 +3,7 @@
 module driver_simulation_beam
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp, i8
+    use core_constants, only: two_pi
     use core_error, only: error_t, make_error, make_input_error
     use core_signals, only: caught_signal, signal_name
     use io_deck, only: deck_t
@@ -168,7 +169,6 @@ contains
         procedure(report_iface) :: report
         type(error_t), allocatable, intent(out) :: error
         real(wp), allocatable :: omega(:), shapes(:, :), full(:, :, :)
-        real(wp), parameter :: two_pi = 6.283185307179586476925286766559_wp
         character(len=120) :: buf
         integer :: k
         call solve_modal(model, run%n_modes, omega, shapes, error)
