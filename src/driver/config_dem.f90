@@ -518,7 +518,7 @@ contains
                 do k = 2, e%n_values()
                     word = e%word(k)
                     do dof = 1, 3
-                        if (word /= 'all' .and. word /= trim(dof_names(dof))) cycle
+                        if (word /= 'all' .and. dof_index(word) /= dof) cycle
                         do j = first, last
                             if (state(dof, j) == imposed) then
                                 call conflict(e, j, dof, 'cannot be fixed')
@@ -807,14 +807,14 @@ contains
                               ' is not defined (no [functions] function record with this id)')
     end subroutine unknown_function
 
-    !> DOF index of a DOF word (x, y, rot).
+    !> DOF index of a DOF word: x, y, rot or their [beam] names u, w, theta.
     pure integer function dof_index(word)
-        !> 'x', 'y' or 'rot'.
+        !> 'x' or 'u', 'y' or 'w', 'rot' or 'theta'.
         character(len=*), intent(in) :: word
         select case (word)
-        case ('x')
+        case ('x', 'u')
             dof_index = dof_x
-        case ('y')
+        case ('y', 'w')
             dof_index = dof_y
         case default
             dof_index = dof_rot
