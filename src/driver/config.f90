@@ -905,8 +905,50 @@ contains
         call fill(deck%records('initial', 'displacement'), run%u0)
         if (allocated(error)) return
         call fill(deck%records('initial', 'velocity'), run%v0)
+        if (allocated(error)) return
+        call rigid(deck%records('initial', 'rigid'))
 
     contains
+
+        !> `rigid` records: node_a node_b vx vy omega xc yc gives the nodes with ids from node_a
+        !> to node_b the velocity of a rigid motion, (vx - omega (y - yc), vy + omega (x - xc))
+        !> and the rotation rate omega; a fixed DOF must get zero from it.
+        subroutine rigid(list)
+            type(deck_entry_t), intent(in) :: list(:)
+            integer :: i, node, dof, lo, hi, count_nodes
+            real(wp) :: v(3)
+            do i = 1, size(list)
+                associate (e => list(i))
+                    lo = min(e%int(1), e%int(2))
+                    hi = max(e%int(1), e%int(2))
+                    count_nodes = 0
+                    do node = 1, size(beam%x)
+                        if (beam%node_id(node) < lo .or. beam%node_id(node) > hi) cycle
+                        count_nodes = count_nodes + 1
+                        v = [e%real(3) - e%real(5)*(beam%y(node) - e%real(7)), &
+                             e%real(4) + e%real(5)*(beam%x(node) - e%real(6)), e%real(5)]
+                        do dof = 1, 3
+                            if (fix_line(dof, node) == 0) then
+                                run%v0(dof, node) = v(dof)
+                            else if (v(dof) /= 0.0_wp) then
+                                call make_input_error(error, deck%file, e%line, 'rigid', 'DOF '// &
+                                                      trim(dof_word(dof))//' of node '// &
+                                                      to_str(beam%node_id(node))//' is fixed (fix on line '// &
+                                                      to_str(fix_line(dof, node))//') but the rigid motion '// &
+                                                      'gives it '//to_str(v(dof))//'; an initial velocity '// &
+                                                      'applies only to a free DOF')
+                                return
+                            end if
+                        end do
+                    end do
+                    if (count_nodes == 0) then
+                        call make_input_error(error, deck%file, e%line, 'rigid', 'no node has an id '// &
+                                              'from '//e%word(1)//' to '//e%word(2))
+                        return
+                    end if
+                end associate
+            end do
+        end subroutine rigid
 
         !> Values of one kind of initial condition from its records.
         subroutine fill(list, values)
@@ -963,6 +1005,15 @@ contains
                               e%word(1)//' is fixed (fix on line '//to_str(fixed_on)// &
                               '); a '//keyword//' applies only to a free DOF')
     end subroutine on_fixed_dof
+
+    !> DOF word (u, w, theta) of a DOF index.
+    pure function dof_word(dof) result(word)
+        !> dof_u, dof_w or dof_theta.
+        integer, intent(in) :: dof
+        character(len=5) :: word
+        character(len=5), parameter :: words(3) = ['u    ', 'w    ', 'theta']
+        word = words(dof)
+    end function dof_word
 
     !> DOF index of a DOF word: u, w, theta or their [particles] names x, y, rot.
     pure integer function dof_index(word)

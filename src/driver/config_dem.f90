@@ -478,6 +478,8 @@ contains
                         if (pass == 1) call constrain(e)
                     case ('force', 'initial_velocity')
                         if (pass == 2) call load(e)
+                    case ('initial_rigid')
+                        if (pass == 2) call rigid(e)
                     end select
                     if (allocated(error)) return
                 end associate
@@ -582,6 +584,33 @@ contains
                 end if
             end do
         end subroutine load
+
+        !> An `initial_rigid` record: selection vx vy omega xc yc gives each selected disk the
+        !> velocity of a rigid motion, (vx - omega (y - yc), vy + omega (x - xc)) and the
+        !> rotation rate omega; a DOF that is not free must get zero from it.
+        subroutine rigid(e)
+            type(deck_entry_t), intent(in) :: e
+            integer :: first, last, j, dof
+            real(wp) :: v(3)
+            call select_disks(e, first, last)
+            if (allocated(error)) return
+            associate (p => cfg%system%particles)
+                do j = first, last
+                    v = [e%real(2) - e%real(4)*(p%y(j) - e%real(6)), &
+                         e%real(3) + e%real(4)*(p%x(j) - e%real(5)), e%real(4)]
+                    do dof = 1, 3
+                        if (state(dof, j) /= free .and. v(dof) /= 0.0_wp) then
+                            call conflict(e, j, dof, 'cannot take the rigid velocity '//to_str(v(dof))// &
+                                          ' (an initial velocity applies to free DOFs only)')
+                            return
+                        end if
+                    end do
+                    if (state(dof_x, j) == free) p%vx(j) = v(1)
+                    if (state(dof_y, j) == free) p%vy(j) = v(2)
+                    if (state(dof_rot, j) == free) p%w(j) = v(3)
+                end do
+            end associate
+        end subroutine rigid
 
         !> Error: DOF `dof` of disk j already has a condition.
         subroutine conflict(e, j, dof, what)

@@ -85,6 +85,15 @@ contains
                                                              word_field('dof', dof_words), real_field('value', 'm/s or rad/s')], &
                            'Velocity at t = 0 of one free DOF of the selected disks (the others start at '// &
                            'rest); a later record overrides an earlier one.', repeatable=.true.)
+        call s%add_keyword('particles', 'initial_rigid', [selection_field('particles'), &
+                                                          real_field('vx', 'm/s'), real_field('vy', 'm/s'), &
+                                                          real_field('omega', 'rad/s'), &
+                                                          real_field('xc', 'm'), real_field('yc', 'm')], &
+                           'Velocity at t = 0 of a rigid motion of the selected disks: translation (vx, vy) '// &
+                           'plus rotation omega about (xc, yc), so that a disk centred at (x, y) gets (vx - '// &
+                           'omega (y - yc), vy + omega (x - xc)) and the rotation rate omega; a DOF that is '// &
+                           'fixed or imposed must get zero from it. Records apply in deck order with '// &
+                           'initial_velocity.', repeatable=.true.)
     end subroutine add_particles
 
     !> [walls]: straight walls, fixed or driven.

@@ -98,5 +98,13 @@ contains
         call s%add_keyword('initial', 'displacement', [int_field('node', lower=1), &
                                                        word_field('dof', dof_words), real_field('value', 'm or rad')], &
                            'Initial displacement of one DOF of a node.', repeatable=.true.)
+        call s%add_keyword('initial', 'rigid', [int_field('node_a', lower=1), int_field('node_b', lower=1), &
+                                                real_field('vx', 'm/s'), real_field('vy', 'm/s'), &
+                                                real_field('omega', 'rad/s'), &
+                                                real_field('xc', 'm'), real_field('yc', 'm')], &
+                           'Initial velocity of a rigid motion of the nodes with ids from node_a to node_b: '// &
+                           'translation (vx, vy) plus rotation omega about (xc, yc), so that a node at (x, y) '// &
+                           'gets u = vx - omega (y - yc), w = vy + omega (x - xc), theta = omega; a fixed DOF '// &
+                           'must get zero from it. Records apply after the velocity records.', repeatable=.true.)
     end subroutine add_initial
 end module io_schema_fem

@@ -119,6 +119,22 @@ def static_self_weight(exe, decks, work):
     check("polar_line end", bool(np.all(np.abs(xy[-1, :2] - end) < 1e-12 * L)), f"{xy[-1]} vs {end}")
 
 
+def rigid_spin(exe, decks, work):
+    rho_a, L, vx, vy, om, xc, yc = 7800.0 * 1.0e-3, 2.0, 0.5, -0.3, 2.0, 0.7, 0.1
+    with run(exe, decks / "beam_rigid_spin.dat", work) as f:
+        v0 = f["fem/velocity"][0]
+        xy = f["fem/mesh/coordinates"][...]
+        kin0 = f["energy/kinetic"][0]
+    ref = np.stack([vx - om * (xy[:, 1] - yc), vy + om * (xy[:, 0] - xc), np.full(len(xy), om)], axis=1)
+    # Velocities copied from the rigid field: rounding of one product, 1e-14 m/s.
+    check("rigid spin: nodal velocities", bool(np.allclose(v0, ref, rtol=0, atol=1e-14)),
+          f"max dev {np.abs(v0 - ref).max():.2e}")
+    vg = np.array([vx - om * (0.0 - yc), vy + om * (1.0 - xc)])
+    k_ref = 0.5 * rho_a * L * vg @ vg + 0.5 * rho_a * L**3 / 12 * om**2
+    # Consistent mass: exact for rigid fields; round-off of v.M v, rel. 1e-12.
+    check("rigid spin: kinetic energy", abs(kin0 / k_ref - 1) < 1e-12, f"{kin0:.12e} vs {k_ref:.12e}")
+
+
 def modal_cantilever(exe, decks, work):
     E, rho, A, I, L = 1.1e11, 8900.0, 1.2e-4, 1.0e-9, 0.6
     with run(exe, decks / "cantilever_modal.dat", work) as f:
@@ -179,6 +195,7 @@ def main():
     static_lframe(exe, decks, work)
     static_distributed(exe, decks, work)
     static_self_weight(exe, decks, work)
+    rigid_spin(exe, decks, work)
     modal_cantilever(exe, decks, work)
     dynamic_cantilever(exe, src, work)
     print(f"{len(FAILED)} failed checks")
