@@ -54,6 +54,7 @@ module driver_results
         procedure :: append_energy => writer_append_energy
         procedure :: write_static => writer_write_static
         procedure :: write_modal => writer_write_modal
+        procedure :: write_modal_kinds => writer_write_modal_kinds
         procedure :: write_summary => writer_write_summary
         procedure :: flush => writer_flush
         procedure :: stop_at => writer_stop_at
@@ -386,6 +387,29 @@ contains
         call self%file%write_attribute('/modal/shapes', 'units', 'm, m, rad (arbitrary scale)', &
                                        error)
     end subroutine writer_write_modal
+
+    !> Write the kind of each mode: /modal/axial_fraction (axial share of the strain energy,
+    !> -1 for a rigid-body mode) with the attributes `kind` (one word per mode: axial,
+    !> bending, mixed or rigid) and `threshold` (the share that makes a mode axial or bending).
+    subroutine writer_write_modal_kinds(self, fraction, kinds, threshold, error)
+        !> An open writer.
+        class(results_writer_t), intent(inout) :: self
+        !> Axial strain-energy share of each mode (n_modes).
+        real(wp), intent(in) :: fraction(:)
+        !> Kinds of the modes, space-separated, in mode order.
+        character(len=*), intent(in) :: kinds
+        !> Share above which a mode is axial (or, of bending energy, bending).
+        real(wp), intent(in) :: threshold
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call require_open(self, 'write_modal_kinds', error)
+        if (allocated(error)) return
+        call self%file%write_dataset('/modal/axial_fraction', fraction, error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/modal/axial_fraction', 'kind', kinds, error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/modal/axial_fraction', 'threshold', threshold, error)
+    end subroutine writer_write_modal_kinds
 
     !> Write run statistics as attributes of /summary.
     subroutine writer_write_summary(self, steps, wall_seconds, error)

@@ -151,6 +151,26 @@ def modal_cantilever(exe, decks, work):
     check("modal shapes stored", shapes.shape == (4, 25, 3), f"shape {shapes.shape}")
 
 
+def modal_kinds(exe, decks, work):
+    E, rho, A, I, L = 1.1e11, 8900.0, 1.2e-4, 1.0e-9, 0.6
+    with run(exe, decks / "beam_modal_kinds.dat", work) as f:
+        omega = f["modal/omega"][...]
+        frac = f["modal/axial_fraction"][...]
+        kinds = f["modal/axial_fraction"].attrs["kind"]
+        kinds = (kinds.decode() if isinstance(kinds, bytes) else str(kinds)).split()
+    w_axial = math.pi / 2 * math.sqrt(E / rho) / L
+    # 24 linear axial elements, consistent mass: discretisation error ~ (k h)^2/24 ~ 2e-4.
+    check("modal kinds: mode 7 is the first axial mode", abs(omega[6] / w_axial - 1) < 1e-3,
+          f"{omega[6]:.6e} vs {w_axial:.6e}")
+    check("modal kinds: labels", kinds == ["bending"] * 6 + ["axial", "bending"], f"{kinds}")
+    # A straight beam's axial and bending motions decouple exactly: shares 0 and 1 up to the
+    # rounding of the eigenvectors (rel. 1e-10 of the energy).
+    check("modal kinds: axial share of mode 7 is 1", abs(frac[6] - 1) < 1e-10, f"{frac[6]:.3e}")
+    others = np.delete(frac, 6)
+    check("modal kinds: bending modes carry no axial energy", bool(np.all(np.abs(others) < 1e-10)),
+          f"max {np.abs(others).max():.3e}")
+
+
 def dynamic_cantilever(exe, src, work):
     E, rho, A, I, L, P = 2.1e11, 7800.0, 2.0e-4, 1.0 / 6.0e8, 1.0, 10.0
     with run(exe, src / "input" / "cantilever.dat", work) as f:
@@ -197,6 +217,7 @@ def main():
     static_self_weight(exe, decks, work)
     rigid_spin(exe, decks, work)
     modal_cantilever(exe, decks, work)
+    modal_kinds(exe, decks, work)
     dynamic_cantilever(exe, src, work)
     print(f"{len(FAILED)} failed checks")
     return 1 if FAILED else 0
