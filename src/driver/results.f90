@@ -13,7 +13,7 @@ module driver_results
     use, intrinsic :: iso_fortran_env, only: int64
     use core_kinds, only: wp
     use core_constants, only: two_pi
-    use core_error, only: error_t, make_error
+    use core_error, only: error_t, make_error, make_internal_error
     use core_version, only: multicor_version, multicor_name
     use io_hdf5_file, only: h5_file_t
     use io_paths, only: rename_file, remove_file, copy_file, file_exists
@@ -212,8 +212,8 @@ contains
         call require_open(self, 'write_mesh', error)
         if (allocated(error)) return
         if (size(x) /= size(node_id) .or. size(y) /= size(node_id) .or. size(conn, 1) /= 2) then
-            call make_error(error, 'results: write_mesh: node_id, x, y must have the same size ' &
-                            //'and conn must be (2, n_elements)')
+            call make_internal_error(error, 'results: write_mesh', 'node_id, x, y must have the same '// &
+                                     'size and conn must be (2, n_elements)')
             return
         end if
         call check_nodes(self, size(node_id), 'write_mesh', error)
@@ -341,7 +341,7 @@ contains
         call require_open(self, 'write_static', error)
         if (allocated(error)) return
         if (size(d, 1) /= 3 .or. any(shape(reactions) /= shape(d))) then
-            call make_error(error, 'results: write_static: d and reactions must be (3, n_nodes)')
+            call make_internal_error(error, 'results: write_static', 'd and reactions must be (3, n_nodes)')
             return
         end if
         call check_nodes(self, size(d, 2), 'write_static', error)
@@ -368,8 +368,8 @@ contains
         call require_open(self, 'write_modal', error)
         if (allocated(error)) return
         if (size(shapes, 1) /= 3 .or. size(shapes, 3) /= size(omega)) then
-            call make_error(error, 'results: write_modal: shapes must be (3, n_nodes, n_modes) ' &
-                            //'with n_modes = size(omega)')
+            call make_internal_error(error, 'results: write_modal', 'shapes must be (3, n_nodes, '// &
+                                     'n_modes) with n_modes = size(omega)')
             return
         end if
         call check_nodes(self, size(shapes, 2), 'write_modal', error)

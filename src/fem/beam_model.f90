@@ -13,7 +13,7 @@
 module fem_beam_model
     use core_kinds, only: wp
     use core_constants, only: relative_roundoff, singular_ratio
-    use core_error, only: error_t, make_error
+    use core_error, only: error_t, make_error, make_internal_error
     use core_linalg, only: band_spd_t, largest_generalized_eigenvalue
     use core_sort, only: sort_in_place
     use core_timefunc, only: time_function_t
@@ -539,7 +539,7 @@ contains
             end do
         end do
         if (model%k%out_of_band .or. model%m%out_of_band) &
-            call make_error(error, 'beam model: internal error, bandwidth too small')
+            call make_internal_error(error, 'beam model assembly', 'an entry fell outside the band (bandwidth computed too small)')
     end subroutine assemble
 
     !> Weighted element matrices in global axes: kg = int alpha B^T D B ds, mg = int alpha

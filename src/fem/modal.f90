@@ -5,7 +5,7 @@
 module fem_modal
     use core_kinds, only: wp
     use core_constants, only: relative_roundoff
-    use core_error, only: error_t, make_error
+    use core_error, only: error_t, make_error, make_internal_error
     use core_linalg, only: band_generalized_eigen
     use fem_beam_model, only: beam_model_t
     use fem_beam_element, only: element_stiffness, rotation_matrix
@@ -43,8 +43,8 @@ contains
         call band_generalized_eigen(model%k, model%m, 1, n_modes, lambda, error, shapes)
         if (allocated(error)) return
         if (size(lambda) /= n_modes) then
-            call make_error(error, 'modal analysis: the eigensolver returned fewer modes '// &
-                            'than asked')
+            call make_internal_error(error, 'modal analysis', 'the eigensolver returned fewer '// &
+                                     'modes than asked')
             return
         end if
         ! Rigid-body eigenvalues are zero up to rounding and may come out slightly negative.
