@@ -27,15 +27,15 @@ module dem_contacts
     public :: contacts_set_frames, contacts_set_laws, contacts_finish, contacts_impulses
     public :: contacts_local_velocity, contacts_count_status, contacts_bytes, contacts_moments_active
 
-    !> Status: no reaction (separated or not active this step).
+    !> Contact status, no reaction (separated or not active this step).
     integer, parameter :: status_open = 0
-    !> Status: reaction strictly inside the Coulomb cone.
+    !> Contact status, reaction strictly inside the Coulomb cone.
     integer, parameter :: status_stick = 1
-    !> Status: reaction on the boundary of the cone (sliding).
+    !> Contact status, reaction on the boundary of the cone (sliding).
     integer, parameter :: status_slip = 2
-    !> Status: cohesive bond, intact.
+    !> Contact status, cohesive bond, intact.
     integer, parameter :: status_cohesive = 3
-    !> Status: cohesive bond broken for good (now a plain frictional contact).
+    !> Contact status, cohesive bond broken for good (now a plain frictional contact).
     integer, parameter :: status_broken = 4
 
     !> Parameters of the step needed to set the contact laws.

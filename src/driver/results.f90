@@ -47,21 +47,37 @@ module driver_results
         !> Whether the file continues an earlier run (`resume`): a failed run then keeps it.
         logical :: resumed = .false.
     contains
+        !> Create the results file (written as .partial until `close`).
         procedure :: open => writer_open
+        !> Reopen the results file of a checkpointed run to continue it (restart).
         procedure :: resume => writer_resume
+        !> Write the mesh of the beam: node ids, coordinates, connectivity.
         procedure :: write_mesh => writer_write_mesh
+        !> Append one stored state: time, displacements, velocities, accelerations.
         procedure :: append_state => writer_append_state
+        !> Append one record of the energy audit.
         procedure :: append_energy => writer_append_energy
+        !> Write the static solution: displacements and support reactions.
         procedure :: write_static => writer_write_static
+        !> Write the modal results: frequencies and mode shapes.
         procedure :: write_modal => writer_write_modal
+        !> Write the kind of each mode (axial share of its strain energy).
         procedure :: write_modal_kinds => writer_write_modal_kinds
+        !> Write the run statistics as attributes of /summary.
         procedure :: write_summary => writer_write_summary
+        !> Flush the file so that a killed run leaves every stored output readable.
         procedure :: flush => writer_flush
+        !> Record why and when the run stops before its end (a signal).
         procedure :: stop_at => writer_stop_at
+        !> True when `stop_at` was called.
         procedure :: stopped => writer_stopped
+        !> Close the file and give it its final name (finished = 1).
         procedure :: close => writer_close
+        !> Close a stopped run: the file stays .partial with the reason in /summary.
         procedure :: close_unfinished => writer_close_unfinished
+        !> Close and delete the partial file after an error.
         procedure :: abort => writer_abort
+        !> True while the file is open.
         procedure :: is_open => writer_is_open
     end type results_writer_t
 

@@ -74,8 +74,8 @@ module io_hdf5_file
         end function c_h5pset_file_space_strategy
     end interface
 
-    !> H5F_FSPACE_STRATEGY_NONE: every allocation at the end of the file, freed space never
-    !> reused while the file is open (see file_create).
+    !> Value of H5F_FSPACE_STRATEGY_NONE (every allocation at the end of the file, freed space never
+    !> reused while the file is open; see file_create).
     integer(c_int), parameter :: fspace_strategy_none = 3
 
     !> Target size of one chunk of a time series [bytes].
@@ -95,12 +95,19 @@ module io_hdf5_file
         !> File name, for error messages.
         character(len=:), allocatable :: path
     contains
+        !> Create a file (an existing one is replaced).
         procedure :: create => file_create
+        !> Open an existing file, read-only or for writing.
         procedure :: open => file_open
+        !> Close the file (nothing when it is not open).
         procedure :: close => file_close
+        !> Flush every buffer of the file to the operating system.
         procedure :: flush => file_flush
+        !> True while a file is open.
         procedure :: is_open => file_is_open
+        !> True when a group, dataset or attribute path exists.
         procedure :: exists => file_exists
+        !> Create a group (and its missing parents).
         procedure :: create_group => file_create_group
         procedure, private :: write_attr_string, write_attr_real, write_attr_int, &
             write_attr_real_1d
@@ -120,11 +127,17 @@ module io_hdf5_file
         !> Read a whole dataset into an array allocated to its shape.
         generic :: read_dataset => read_real_1d, read_real_2d, read_real_3d, read_int_1d, &
             read_int_2d
+        !> Shape of a dataset, in Fortran order.
         procedure :: dataset_shape => file_dataset_shape
+        !> Paths of every dataset in the file and their number of records.
         procedure :: list_datasets => file_list_datasets
+        !> Delete a dataset or group.
         procedure :: delete => file_delete
+        !> Cut or extend a series to a number of records.
         procedure :: resize_series => file_resize_series
+        !> Create an extendible real series of scalar, 1-D or 2-D records.
         procedure :: create_series => file_create_series
+        !> Create an extendible integer series of scalar records.
         procedure :: create_int_series => file_create_int_series
         procedure, private :: append_0d, append_1d, append_2d
         !> Append one record (scalar, 1-D or 2-D) at the end of a series.
