@@ -268,7 +268,7 @@ contains
         call require_open(self, 'append_state', error)
         if (allocated(error)) return
         if (size(d, 1) /= 3 .or. any(shape(v) /= shape(d)) .or. any(shape(a) /= shape(d))) then
-            call make_error(error, 'results: append_state: d, v, a must all be (3, n_nodes)')
+            call make_internal_error(error, 'results: append_state', 'd, v, a must all be (3, n_nodes)')
             return
         end if
         call check_nodes(self, size(d, 2), 'append_state', error)
@@ -582,7 +582,7 @@ contains
         !> Set when the writer is not open.
         type(error_t), allocatable, intent(out) :: error
         if (.not. self%is_open()) then
-            call make_error(error, 'results: '//what//': no results file is open')
+            call make_internal_error(error, 'results: '//what, 'no results file is open')
         end if
     end subroutine require_open
 
@@ -601,7 +601,7 @@ contains
             self%n_nodes = n
         else if (n /= self%n_nodes) then
             write (buf, '(i0,a,i0)') n, ' nodes instead of ', self%n_nodes
-            call make_error(error, 'results: '//what//': '//trim(buf))
+            call make_internal_error(error, 'results: '//what, trim(buf))
         end if
     end subroutine check_nodes
 

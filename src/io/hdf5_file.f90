@@ -29,7 +29,7 @@ module io_hdf5_file
                                                                               c_loc, c_f_pointer, c_associated, &
                                                                               c_int, c_bool, c_int64_t, c_long_long
     use core_kinds, only: wp
-    use core_error, only: error_t, make_error
+    use core_error, only: error_t, make_error, make_internal_error
     use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5dont_atexit_f, h5eset_auto_f, h5iis_valid_f, &
                     h5iget_type_f, h5i_dataset_f, h5i_dataspace_f, h5i_datatype_f, h5i_attr_f, h5i_group_f, &
                     h5i_genprop_lst_f, h5i_file_f, h5fcreate_f, h5fopen_f, h5fclose_f, h5f_acc_trunc_f, &
@@ -1193,8 +1193,8 @@ contains
         integer :: r, n_per_record, hdferr
         r = size(record_shape)
         if (r > 2 .or. any(record_shape < 1)) then
-            call make_error(error, "HDF5: series '"//path//"': records must be scalars, 1-D or " &
-                            //"2-D with positive extents")
+            call make_internal_error(error, 'HDF5 create_series', "series '"//path//"': records must "// &
+                                     "be scalars, 1-D or 2-D with positive extents")
             return
         end if
         n_per_record = product(record_shape)
@@ -1349,7 +1349,7 @@ contains
         end if
         if (r == 1) then
             if (dims(1) /= int(record_size, hsize_t)) then
-                call make_error(error, "HDF5: series '"//path//"': record shape does not match")
+                call make_internal_error(error, 'HDF5 append', "series '"//path//"': record shape does not match")
                 call release(dset)
                 return
             end if
@@ -1460,7 +1460,7 @@ contains
             return
         end if
         if (any(dims(:r) /= int(record_shape, hsize_t))) then
-            call make_error(error, "HDF5: series '"//path//"': record shape does not match")
+            call make_internal_error(error, 'HDF5 append', "series '"//path//"': record shape does not match")
             call release(dset)
             return
         end if
