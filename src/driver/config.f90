@@ -712,9 +712,9 @@ contains
         type(beam_element_load_t), allocatable :: loads(:)
         integer :: i, el, k, a, b, lo, hi, n, direction, func
         real(wp) :: qa, qb, chord(2), t(2)
+        logical :: selected(size(beam%conn, 2))
         allocate (list, source=deck%records('beam', 'distributed'))
-        allocate (loads(size(list)*size(beam%conn, 2)))
-        n = 0
+        allocate (beam%element_loads(0))
         do i = 1, size(list)
             associate (e => list(i))
                 a = find_node(beam%node_id, e%int(1))
@@ -757,25 +757,31 @@ contains
                 end if
                 lo = min(e%int(1), e%int(2))
                 hi = max(e%int(1), e%int(2))
-                k = n
                 do el = 1, size(beam%conn, 2)
-                    if (any(beam%node_id(beam%conn(:, el)) < lo .or. &
-                            beam%node_id(beam%conn(:, el)) > hi)) cycle
-                    ! Position of the element ends on the chord: 0 at node_a, 1 at node_b.
-                    t = ((beam%x(beam%conn(:, el)) - beam%x(a))*chord(1) + &
-                         (beam%y(beam%conn(:, el)) - beam%y(a))*chord(2))/dot_product(chord, chord)
-                    n = n + 1
-                    loads(n) = beam_element_load_t(element=el, direction=direction, &
-                                                   q=qa + (qb - qa)*t, func=func)
+                    selected(el) = all(beam%node_id(beam%conn(:, el)) >= lo .and. &
+                                       beam%node_id(beam%conn(:, el)) <= hi)
                 end do
-                if (n == k) then
+                n = count(selected)
+                if (n == 0) then
                     call make_input_error(error, deck%file, e%line, 'distributed', 'no element '// &
                                           'has both nodes with ids from '//e%word(1)//' to '//e%word(2))
                     return
                 end if
+                if (allocated(loads)) deallocate (loads)
+                allocate (loads(n))
+                k = 0
+                do el = 1, size(beam%conn, 2)
+                    if (.not. selected(el)) cycle
+                    ! Position of the element ends on the chord: 0 at node_a, 1 at node_b.
+                    t = ((beam%x(beam%conn(:, el)) - beam%x(a))*chord(1) + &
+                         (beam%y(beam%conn(:, el)) - beam%y(a))*chord(2))/dot_product(chord, chord)
+                    k = k + 1
+                    loads(k) = beam_element_load_t(element=el, direction=direction, &
+                                                   q=qa + (qb - qa)*t, func=func)
+                end do
+                beam%element_loads = [beam%element_loads, loads]
             end associate
         end do
-        beam%element_loads = loads(:n)
     end subroutine build_distributed_loads
 
     !> Run settings: analysis, time integration, modes, output.
