@@ -14,6 +14,7 @@
 !> they are filled directly: `dem_config_t%system` is ready for `mj_init`.
 module driver_config_dem
     use core_kinds, only: wp, i8
+    use core_constants, only: deg_to_rad
     use core_error, only: error_t, make_input_error
     use core_strings, only: to_str
     use core_timefunc, only: time_function_t
@@ -310,7 +311,6 @@ contains
             type(deck_entry_t), intent(in) :: e
             real(wp), allocatable, intent(out) :: gx(:), gy(:), gr(:)
             type(error_t), allocatable, intent(out) :: error
-            real(wp), parameter :: degree = 3.141592653589793238462643383279502884_wp/180.0_wp
             real(wp) :: gap_ratio, pitch
             character(len=:), allocatable :: message
             select case (e%keyword)
@@ -320,7 +320,7 @@ contains
                 gr = [e%real(3)]
             case ('row')
                 call generate_row(e%int(1), e%real(2), e%real(3), e%real(4), e%real(6), &
-                                  e%real(7)*degree, gx, gy, gr, error)
+                                  e%real(7)*deg_to_rad, gx, gy, gr, error)
             case ('square_lattice')
                 call generate_square_lattice(e%int(1), e%int(2), e%real(3), e%real(4), &
                                              e%real(5), e%real(7), gx, gy, gr, error)
