@@ -11,6 +11,7 @@
 !> largest element eigenvalue (`largest_eigenvalue`).
 module fem_continuum_dynamics
     use core_kinds, only: wp, i8
+    use core_constants, only: pi
     use core_error, only: error_t, make_error
     use core_sparse, only: sparse_matrix_t, sparse_solver_t
     use core_linalg, only: band_spd_t, band_generalized_eigen
@@ -330,7 +331,7 @@ contains
         allocate (x(n, p), y(n, p), ky(n, p), my(n, p), previous(p))
         do j = 1, p
             do i = 1, n
-                x(i, j) = sin(real(i, wp)*real(j, wp)*3.14159265358979_wp/real(n + 1, wp)) + 1.0e-3_wp*j
+                x(i, j) = sin(real(i, wp)*real(j, wp)*pi/real(n + 1, wp)) + 1.0e-3_wp*j
             end do
         end do
         previous = huge(1.0_wp)
