@@ -41,14 +41,23 @@ module fem_continuum_dynamics
         procedure :: build => dynamics_build
         !> See `dynamic_operator_t`.
         procedure :: external_force => dynamics_force
+        !> ku = K u on the free DOFs.
         procedure :: stiffness_times => dynamics_stiffness_times
+        !> mv = M v on the free DOFs.
         procedure :: mass_times => dynamics_mass_times
+        !> cv = C v (Rayleigh).
         procedure :: damping_times => dynamics_damping_times
+        !> True when C /= 0.
         procedure :: is_damped => dynamics_is_damped
+        !> 1/2 u.K u.
         procedure :: strain_energy => dynamics_strain_energy
+        !> 1/2 v.M v.
         procedure :: kinetic_energy => dynamics_kinetic_energy
+        !> Cholesky factor of c_m M + c_k K.
         procedure :: factor_combination => dynamics_factor_combination
+        !> Diagonal of the (lumped) mass matrix.
         procedure :: mass_diagonal => dynamics_mass_diagonal
+        !> Largest eigenvalue of K x = lambda M x (stable step of explicit schemes).
         procedure :: largest_eigenvalue => dynamics_largest_eigenvalue
         !> Lowest modes of K phi = omega^2 M phi.
         procedure :: solve_modes => dynamics_solve_modes
