@@ -38,6 +38,17 @@ def where(entity):
     return f"{getattr(entity, 'filename', '?')}: {getattr(entity, 'obj', 'entity')} '{entity.name}'"
 
 
+def inherited_doc(dtype, name):
+    """True when a parent type of dtype documents the binding `name`."""
+    parent = getattr(dtype, "extends", None)
+    while parent is not None and not isinstance(parent, str):
+        for bound in getattr(parent, "boundprocs", []):
+            if bound.name.lower() == name.lower() and documented(bound):
+                return True
+        parent = getattr(parent, "extends", None)
+    return False
+
+
 def missing_docs(project):
     missing = []
 
@@ -60,6 +71,8 @@ def missing_docs(project):
             for comp in dtype.variables:
                 need(comp, f"{module.name}::{dtype.name} component")
             for bound in dtype.boundprocs:
+                if not documented(bound) and inherited_doc(dtype, bound.name):
+                    continue  # overrides a binding documented in the parent type
                 need(bound, f"{module.name}::{dtype.name} type-bound procedure")
         for var in module.pub_vars.values():
             need(var, module.name)
