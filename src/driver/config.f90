@@ -888,7 +888,7 @@ contains
         !> Time step [s].
         real(wp), intent(in) :: h
         real(wp) :: x
-        x = t_end/h*(1.0_wp - 1.0e-12_wp)
+        x = t_end/h*(1.0_wp - relative_roundoff)
         steps = aint(x)
         if (steps < x) steps = steps + 1.0_wp
     end function steps_to_end
