@@ -72,11 +72,13 @@ ensure_cmake_version() {
     fi
 }
 
-# Python virtual environment for postproc/ (numpy, h5py, matplotlib, pytest), pinned.
+# Python virtual environment for postproc/ (numpy, h5py, matplotlib, pytest) and the API
+# documentation (doc/requirements.txt: FORD), pinned.
 ensure_venv() {
     local req="$MULTICOR_ROOT/postproc/requirements.txt" venv="$MULTICOR_ROOT/.venv"
+    local doc_req="$MULTICOR_ROOT/doc/requirements.txt"
     local stamp="$venv/.requirements.sha256" sum
-    sum=$(sha256sum "$req" | awk '{print $1}')
+    sum=$(cat "$req" "$doc_req" | sha256sum | awk '{print $1}')
     if [ -x "$venv/bin/python" ] && [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$sum" ]; then
         return 0
     fi
@@ -84,6 +86,7 @@ ensure_venv() {
     python3 -m venv "$venv" || die "python3 -m venv failed (Debian: apt-get install python3-venv)"
     "$venv/bin/python" -m pip install -q --upgrade pip >/dev/null || die "pip upgrade failed"
     "$venv/bin/python" -m pip install -q -r "$req" || die "pip install -r postproc/requirements.txt failed"
+    "$venv/bin/python" -m pip install -q -r "$doc_req" || die "pip install -r doc/requirements.txt failed"
     echo "$sum" > "$stamp"
 }
 

@@ -3,14 +3,28 @@
 !> A fallible routine takes `type(error_t), allocatable, intent(out) :: error`; it allocates
 !> the error on failure and returns. Callers propagate with `if (allocated(error)) return`.
 !> Only the main program stops, with a non-zero exit code.
+!>
+!> Each error has a kind, as stdlib's linalg state does: `error_input` (the default) for what
+!> the user can fix (deck, model, data, disk space), worded as such; `error_internal` for a
+!> failed internal consistency check (a bug: sizes that the code itself computed disagree, a
+!> routine called out of order), built by `make_internal_error` and worded so that nobody
+!> looks for the cause in the deck.
 module core_error
     use core_strings, only: shorten
     implicit none
     private
-    public :: error_t, make_error, make_input_error
+    public :: error_t, make_error, make_input_error, make_internal_error
+    public :: error_input, error_internal
+
+    !> Kind of an error the user can fix: input, model, data, environment.
+    integer, parameter :: error_input = 1
+    !> Kind of an error that reveals a bug: an internal consistency check failed.
+    integer, parameter :: error_internal = 2
 
     !> A user-facing error: what went wrong and where (file, line, keyword when known).
     type :: error_t
+        !> error_input or error_internal.
+        integer :: kind = error_input
         !> Complete message, ready to print.
         character(len=:), allocatable :: message
         !> File the error refers to ('' when none).
@@ -34,6 +48,23 @@ contains
         error%file = ''
         error%keyword = ''
     end subroutine make_error
+
+    !> Build an internal error: `internal error in <where>: <message> (a bug in MULTICOR, not
+    !> a problem of the input: please report it with the deck)`.
+    subroutine make_internal_error(error, where, message)
+        !> The error to allocate.
+        type(error_t), allocatable, intent(out) :: error
+        !> Routine or component whose check failed.
+        character(len=*), intent(in) :: where
+        !> The consistency condition that does not hold.
+        character(len=*), intent(in) :: message
+        allocate (error)
+        error%kind = error_internal
+        error%message = 'internal error in '//where//': '//message//' (a bug in MULTICOR, '// &
+                        'not a problem of the input: please report it with the deck)'
+        error%file = ''
+        error%keyword = ''
+    end subroutine make_internal_error
 
     !> Build an input error that names file, line and keyword:
     !> `file:line: keyword 'kw': message`.

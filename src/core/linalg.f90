@@ -12,7 +12,7 @@
 !> what the value of info means.
 module core_linalg
     use core_kinds, only: wp
-    use core_error, only: error_t, make_error
+    use core_error, only: error_t, make_error, make_internal_error
     implicit none
     private
     public :: band_spd_t, dense_spd_t, band_generalized_eigen, largest_generalized_eigenvalue
@@ -233,8 +233,8 @@ contains
         self%factored = .false.
         self%failed_equation = 0
         if (self%out_of_band) then
-            call make_error(error, 'band matrix: an entry was added outside the band '// &
-                            '(internal error: bandwidth computed too small)')
+            call make_internal_error(error, 'band matrix', 'an entry was added outside the band '// &
+                                     '(bandwidth computed too small)')
             return
         end if
         self%fac = self%ab
@@ -278,7 +278,7 @@ contains
         call check_solve(self%factored, self%n, size(b), 'band', error)
         if (allocated(error)) return
         call dpbtrs('U', self%n, self%kd, 1, self%fac, self%kd + 1, b, self%n, info)
-        if (info /= 0) call make_error(error, 'band Cholesky solve (dpbtrs): invalid argument')
+        if (info /= 0) call make_internal_error(error, 'band Cholesky solve', 'dpbtrs: invalid argument')
     end subroutine band_solve_vec
 
     !> Solve A X = B for several right-hand sides (columns of b); b is overwritten by X.
@@ -293,7 +293,7 @@ contains
         call check_solve(self%factored, self%n, size(b, 1), 'band', error)
         if (allocated(error)) return
         call dpbtrs('U', self%n, self%kd, size(b, 2), self%fac, self%kd + 1, b, self%n, info)
-        if (info /= 0) call make_error(error, 'band Cholesky solve (dpbtrs): invalid argument')
+        if (info /= 0) call make_internal_error(error, 'band Cholesky solve', 'dpbtrs: invalid argument')
     end subroutine band_solve_mat
 
     !> y = alpha*A*x + beta*y with the unfactored matrix (dsbmv).
@@ -328,7 +328,7 @@ contains
             call make_error(error, what//' Cholesky solve: the matrix is not factored '// &
                             '(call factor first, and again after changing entries)')
         else if (nb /= n) then
-            call make_error(error, what//' Cholesky solve: right-hand side has the wrong size')
+            call make_internal_error(error, what//' Cholesky solve', 'right-hand side has the wrong size')
         end if
     end subroutine check_solve
 
@@ -393,7 +393,7 @@ contains
         call check_solve(self%factored, self%n, size(b), 'dense', error)
         if (allocated(error)) return
         call dpotrs('U', self%n, 1, self%fac, self%n, b, self%n, info)
-        if (info /= 0) call make_error(error, 'dense Cholesky solve (dpotrs): invalid argument')
+        if (info /= 0) call make_internal_error(error, 'dense Cholesky solve', 'dpotrs: invalid argument')
     end subroutine dense_solve_vec
 
     !> Solve A X = B for several right-hand sides (columns of b); b is overwritten by X.
@@ -408,7 +408,7 @@ contains
         call check_solve(self%factored, self%n, size(b, 1), 'dense', error)
         if (allocated(error)) return
         call dpotrs('U', self%n, size(b, 2), self%fac, self%n, b, self%n, info)
-        if (info /= 0) call make_error(error, 'dense Cholesky solve (dpotrs): invalid argument')
+        if (info /= 0) call make_internal_error(error, 'dense Cholesky solve', 'dpotrs: invalid argument')
     end subroutine dense_solve_mat
 
     !> Eigenvalues il..iu (ascending) of A x = lambda B x, A symmetric and B symmetric
@@ -432,7 +432,7 @@ contains
         character(len=1) :: jobz
         n = a%n
         if (b%n /= n .or. il < 1 .or. iu > n .or. il > iu) then
-            call make_error(error, 'generalized eigenproblem: invalid sizes or index range')
+            call make_internal_error(error, 'generalized eigenproblem', 'invalid sizes or index range')
             return
         end if
         ! dsbgvx needs ka >= kb: widen A's storage when B is wider.

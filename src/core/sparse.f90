@@ -24,7 +24,7 @@
 module core_sparse
     use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_associated, c_int, c_int64_t, c_double
     use core_kinds, only: wp, i8
-    use core_error, only: error_t, make_error
+    use core_error, only: error_t, make_error, make_internal_error
     implicit none
     private
     public :: sparse_matrix_t, sparse_solver_t, sparse_stats_t
@@ -326,7 +326,7 @@ contains
         integer(c_int64_t) :: nnz
         integer(c_int) :: status
         if (self%n < 1) then
-            call make_error(error, 'sparse matrix: finalize called before init')
+            call make_internal_error(error, 'sparse matrix', 'finalize called before init')
             return
         end if
         call check_bad_entry(self, error)
@@ -450,7 +450,7 @@ contains
             return
         end if
         if (nx /= self%n .or. ny /= self%n) then
-            call make_error(error, 'sparse matrix product: vector of the wrong size')
+            call make_internal_error(error, 'sparse matrix product', 'vector of the wrong size')
             return
         end if
         al = 1.0_wp
@@ -483,7 +483,7 @@ contains
         if (present(kind)) self%kind = kind
         if (present(ordering)) self%ordering = ordering
         if (self%kind /= sparse_cholesky .and. self%kind /= sparse_ldlt) then
-            call make_error(error, 'sparse solver: kind must be sparse_cholesky or sparse_ldlt')
+            call make_internal_error(error, 'sparse solver', 'kind must be sparse_cholesky or sparse_ldlt')
             return
         end if
         if (self%ordering < sparse_order_auto .or. self%ordering > sparse_order_natural) then
@@ -611,7 +611,7 @@ contains
             return
         end if
         if (nb /= self%n .or. nx /= self%n) then
-            call make_error(error, 'sparse solve: right-hand side or solution of the wrong size')
+            call make_internal_error(error, 'sparse solve', 'right-hand side or solution of the wrong size')
             return
         end if
         if (nrhs == 0) return
@@ -788,9 +788,9 @@ contains
         case (cholmod_too_large)
             call make_error(error, what//': problem too large (integer overflow in CHOLMOD)')
         case (cholmod_invalid)
-            call make_error(error, what//': invalid input (internal error)')
+            call make_internal_error(error, what, 'CHOLMOD refused its input as invalid')
         case (mc_no_handle)
-            call make_error(error, what//': the solver is not analysed (internal error)')
+            call make_internal_error(error, what, 'the solver is not analysed')
         case default
             write (code, '(i0)') status
             call make_error(error, what//': CHOLMOD status '//trim(code))

@@ -3,6 +3,7 @@
 !> is not in a hot loop (once per load per step).
 module core_timefunc
     use core_kinds, only: wp
+    use core_constants, only: two_pi
     implicit none
     private
     public :: time_function_t, tf_constant, tf_ramp, tf_step, tf_table, tf_harmonic
@@ -33,7 +34,6 @@ contains
         class(time_function_t), intent(in) :: self
         !> Time [s].
         real(wp), intent(in) :: t
-        real(wp), parameter :: two_pi = 6.283185307179586476925286766559_wp
         integer :: i, n
         select case (self%kind)
         case (tf_constant)

@@ -62,7 +62,7 @@
 !> like a plastic impact).
 module coupling_arlequin
     use core_kinds, only: wp
-    use core_error, only: error_t, make_error
+    use core_error, only: error_t, make_error, make_internal_error
     use core_linalg, only: dense_spd_t
     use fem_beam_config, only: beam_config_t
     use fem_beam_model, only: beam_model_t, build_beam_model
@@ -363,7 +363,7 @@ contains
         real(wp), intent(in), optional :: d(:, :)
         if (present(d)) then
             if (any(shape(d) /= [3, model%n_nodes])) then
-                call make_error(error, 'coupling: '//what//' must be given as (3, n_nodes)')
+                call make_internal_error(error, 'coupling', what//' must be given as (3, n_nodes)')
                 return
             end if
         end if

@@ -13,7 +13,7 @@
 !> coupled set, h and the weights do not change.
 module coupling_lambda
     use core_kinds, only: wp
-    use core_error, only: error_t, make_error
+    use core_error, only: error_t, make_error, make_internal_error
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_linalg, only: dense_spd_t
     use fem_newmark, only: newmark_t
@@ -152,7 +152,7 @@ contains
         end if
         if (present(mobility)) then
             if (any(shape(mobility) /= [n, n])) then
-                call make_error(error, 'coupling multipliers: mobility must be (n_rows, n_rows)')
+                call make_internal_error(error, 'coupling multipliers', 'mobility must be (n_rows, n_rows)')
                 return
             end if
             if (.not. all(ieee_is_finite(mobility))) then

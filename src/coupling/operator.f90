@@ -19,7 +19,7 @@
 !> of unity (a uniform residual is seen fully). Pi (n_mult, n_rows) is dense (small).
 module coupling_operator
     use core_kinds, only: wp
-    use core_error, only: error_t, make_error
+    use core_error, only: error_t, make_error, make_internal_error
     use core_weight, only: weight_function_t
     use fem_beam_model, only: beam_model_t
     use fem_beam_element, only: element_interpolation, rotation_matrix
@@ -173,8 +173,8 @@ contains
         real(wp) :: rows(3, 6)
         character(len=240) :: buf
         if (size(x) /= size(y)) then
-            call make_error(error, 'coupling operator: x and y of the coupled points differ '// &
-                            'in size')
+            call make_internal_error(error, 'coupling operator', 'x and y of the coupled points '// &
+                                     'differ in size')
             return
         end if
         op%n_points = size(x)

@@ -22,6 +22,7 @@
 !> thus pick the branch and each branch is then solved exactly: 1 to 3 iterations per solve.
 module dem_bipotential
     use core_kinds, only: wp
+    use core_constants, only: diagonal_floor, singular_ratio
     implicit none
     private
     public :: bipotential_predictor, coulomb_projection, bipotential_local_solve
@@ -46,10 +47,10 @@ module dem_bipotential
     integer, parameter :: rolling_n_scaling = 18
     !> Floor of a diagonal entry of W relative to its trace, so that a direction held by the
     !> fixities does not divide by zero (the floored direction then barely responds).
-    real(wp), parameter :: scaling_floor = 1.0e-12_wp
+    real(wp), parameter :: scaling_floor = diagonal_floor
     !> Determinant below which a scaled block (unit diagonal) is treated as singular and its
     !> branch is not solved directly (the iterations still converge, only slower).
-    real(wp), parameter :: singular_det = 1.0e-12_wp
+    real(wp), parameter :: singular_det = singular_ratio
 
 contains
 

@@ -127,8 +127,11 @@ module dem_bonded_block
         !> the position of each in mat%values (the order depends on the graph only, so the
         !> positions found once per pattern refill the values at the next steps).
         integer, allocatable :: ti(:), tj(:)
+        !> Values of the assembled triplets (see `ti`).
         real(wp), allocatable :: tv(:)
+        !> Number of triplets in use in ti, tj, tv.
         integer :: nt = 0
+        !> Position of each triplet in mat%values (see `ti`).
         integer(i8), allocatable :: pos(:)
         !> Values of the last factorisation.
         real(wp), allocatable :: values_factored(:)

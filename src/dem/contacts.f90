@@ -15,6 +15,7 @@
 !> contacts are appended (warm start).
 module dem_contacts
     use core_kinds, only: wp, i8
+    use core_constants, only: relative_roundoff
     use dem_materials, only: materials_t, bond_e_default
     use dem_bipotential, only: case_separation, case_slip, case_roll, case_slip_roll
     use dem_bonds, only: break_none, break_tension, break_shear, break_moment, break_shear_moment
@@ -26,15 +27,15 @@ module dem_contacts
     public :: contacts_set_frames, contacts_set_laws, contacts_finish, contacts_impulses
     public :: contacts_local_velocity, contacts_count_status, contacts_bytes, contacts_moments_active
 
-    !> Status: no reaction (separated or not active this step).
+    !> Contact status, no reaction (separated or not active this step).
     integer, parameter :: status_open = 0
-    !> Status: reaction strictly inside the Coulomb cone.
+    !> Contact status, reaction strictly inside the Coulomb cone.
     integer, parameter :: status_stick = 1
-    !> Status: reaction on the boundary of the cone (sliding).
+    !> Contact status, reaction on the boundary of the cone (sliding).
     integer, parameter :: status_slip = 2
-    !> Status: cohesive bond, intact.
+    !> Contact status, cohesive bond, intact.
     integer, parameter :: status_cohesive = 3
-    !> Status: cohesive bond broken for good (now a plain frictional contact).
+    !> Contact status, cohesive bond broken for good (now a plain frictional contact).
     integer, parameter :: status_broken = 4
 
     !> Parameters of the step needed to set the contact laws.
@@ -477,7 +478,7 @@ contains
                 rn = cs%r(1, k)
                 if (rn <= 0.0_wp) then
                     cs%status(k) = status_open
-                else if (abs(cs%r(2, k)) >= cs%mu(k)*rn*(1.0_wp - 1.0e-12_wp)) then
+                else if (abs(cs%r(2, k)) >= cs%mu(k)*rn*(1.0_wp - relative_roundoff)) then
                     cs%status(k) = status_slip
                 else
                     cs%status(k) = status_stick

@@ -56,9 +56,9 @@ module dem_moreau_jean
         real(wp) :: theta = 0.5_wp
         !> Alert distance of the detection [m].
         real(wp) :: alert = 0.0_wp
-        !> Bonds: created at the first step on contacts with cohesion and gap <= bond_ratio *
-        !> mean radius; broken for good once the solution needs more tension than the
-        !> cohesion (dem_contacts, contacts_finish).
+        !> Gap ratio of the bonds, which are created at the first step on contacts with cohesion
+        !> and gap <= bond_ratio * mean radius, and broken for good once the solution needs
+        !> more tension than the cohesion (dem_contacts, contacts_finish).
         real(wp) :: bond_ratio = 1.0e-6_wp
         !> Round-off allowance of the contact activation and of the detection, relative to the
         !> (mean) radius: contacts whose predicted gap is at most this are active

@@ -51,6 +51,7 @@
 !> that `sweeps` counts block iterations.
 module dem_nlgs
     use core_kinds, only: wp, i8
+    use core_constants, only: diagonal_floor
     use dem_contacts, only: contact_set_t
 !$  use omp_lib, only: omp_get_max_threads
     use dem_bipotential, only: bipotential_residual, bipotential_scaling, bipotential_local_solve_scaled, &
@@ -79,7 +80,7 @@ module dem_nlgs
 
     !> A contact is blocked when W_nn <= blocked_ratio (W_nn + W_tt) (the floor of the scaled
     !> frame in dem_bipotential: below it the normal reaction would be unbounded).
-    real(wp), parameter :: blocked_ratio = 1.0e-12_wp
+    real(wp), parameter :: blocked_ratio = diagonal_floor
     !> Relative resolution of the shifted reactions of bonds (see the module header): 64
     !> machine epsilons.
     real(wp), parameter :: roundoff = 64.0_wp*epsilon(1.0_wp)

@@ -7,7 +7,8 @@
 !> Time functions are referenced by index into `particles_t%functions` (0 = constant 1).
 module dem_particles
     use core_kinds, only: wp, i8
-    use core_error, only: error_t, make_error
+    use core_constants, only: pi
+    use core_error, only: error_t, make_error, make_internal_error
     use core_timefunc, only: time_function_t
     implicit none
     private
@@ -28,8 +29,6 @@ module dem_particles
     integer, parameter :: dof_fixed = 1
     !> Condition kind: velocity imposed as value times a time function.
     integer, parameter :: dof_imposed = 2
-
-    real(wp), parameter :: pi = 3.141592653589793238462643383279502884_wp
 
     !> A condition on one DOF of one disk.
     type :: dof_condition_t
@@ -111,7 +110,7 @@ contains
         real(wp), allocatable :: rho(:), mass(:)
         m = size(x)
         if (size(y) /= m .or. size(radius) /= m .or. (size(density) /= m .and. size(density) /= 1)) then
-            call make_error(error, 'particles_add_disks: x, y, radius, density sizes differ')
+            call make_internal_error(error, 'particles_add_disks', 'x, y, radius, density sizes differ')
             return
         end if
         if (any(radius <= 0.0_wp) .or. any(density <= 0.0_wp)) then

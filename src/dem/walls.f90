@@ -1,4 +1,4 @@
-!> Walls: straight segments, fixed or driven in translation (velocity = value * f(t)).
+!> Straight walls (segments), fixed or driven in translation (velocity = value * f(t)).
 !>
 !> A wall is an obstacle of infinite mass and zero thickness; a disk touches it on either side.
 !> The contact normal goes from the closest point of the segment into the disk. Time functions

@@ -12,10 +12,12 @@
 !> indices 1..n in increasing id order (`beam%node_id(i)` is the deck id of node i).
 module driver_config
     use core_kinds, only: wp, i8
+    use core_constants, only: relative_roundoff, deg_to_rad
     use core_error, only: error_t, make_input_error
     use core_strings, only: to_str
     use core_timefunc, only: tf_constant, tf_ramp, tf_step, tf_table, tf_harmonic
-    use fem_beam_config, only: beam_config_t, dof_u, dof_w, dof_theta
+    use fem_beam_config, only: beam_config_t, dof_u, dof_w, dof_theta, beam_element_load_t, &
+                               load_x, load_y, load_axial, load_transverse
     use io_deck, only: deck_t, deck_entry_t
     implicit none
     private
@@ -118,6 +120,9 @@ contains
         if (allocated(error)) return
         call build_loads(deck, function_ids, fix_line, beam, error)
         if (allocated(error)) return
+        call build_distributed_loads(deck, function_ids, beam, error)
+        if (allocated(error)) return
+        beam%gravity = [deck%get_real('beam', 'gravity', 1), deck%get_real('beam', 'gravity', 2)]
         beam%lumped_mass = deck%get_word('beam', 'mass') == 'lumped'
         beam%rayleigh_a0 = deck%get_real('beam', 'rayleigh', 1)
         beam%rayleigh_a1 = deck%get_real('beam', 'rayleigh', 2)
@@ -257,9 +262,9 @@ contains
                     total_nodes = total_nodes + 1
                 case ('element')
                     total_elements = total_elements + 1
-                case ('line')
+                case ('line', 'polar_line')
                     if (e%int(1) > huge(0) - e%int(6)) then
-                        call make_input_error(error, deck%file, e%line, 'line', 'node ids '// &
+                        call make_input_error(error, deck%file, e%line, e%keyword, 'node ids '// &
                                               e%word(1)//' + '//e%word(6)//' exceed the largest integer')
                         return
                     end if
@@ -292,16 +297,15 @@ contains
                     n_elements = n_elements + 1
                     elements(n_elements) = element_candidate_t(e%int(1), [e%int(2), e%int(3)], &
                                                                e%int(4), e%line, .false.)
-                case ('line')
+                case ('line', 'polar_line')
                     first = e%int(1)
                     x1 = e%real(2)
                     y1 = e%real(3)
-                    x2 = e%real(4)
-                    y2 = e%real(5)
+                    call line_end(e, x2, y2)
                     ne = e%int(6)
                     length = hypot(x2 - x1, y2 - y1)
                     if (length <= coincidence*size_model) then
-                        call make_input_error(error, deck%file, e%line, 'line', &
+                        call make_input_error(error, deck%file, e%line, e%keyword, &
                                               'zero-length line: (x1, y1) and (x2, y2) coincide')
                         return
                     end if
@@ -322,25 +326,60 @@ contains
         end do
     end subroutine collect_candidates
 
+    !> End (x2, y2) of a `line` record, or of a `polar_line` record (first_node x1 y1 length
+    !> angle_deg elements section): (x1, y1) + length (cos angle, sin angle).
+    subroutine line_end(e, x2, y2)
+        !> The record.
+        type(deck_entry_t), intent(in) :: e
+        !> End point [m].
+        real(wp), intent(out) :: x2, y2
+        real(wp) :: angle
+        if (e%keyword == 'polar_line') then
+            angle = e%real(5)*deg_to_rad
+            x2 = e%real(2) + e%real(4)*cos(angle)
+            y2 = e%real(3) + e%real(4)*sin(angle)
+        else
+            x2 = e%real(4)
+            y2 = e%real(5)
+        end if
+    end subroutine line_end
+
+    !> Keyword of the [beam] record on a deck line ('node' when none is found).
+    function beam_keyword_at(deck, line) result(keyword)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Deck line.
+        integer, intent(in) :: line
+        character(len=:), allocatable :: keyword
+        integer :: i
+        keyword = 'node'
+        do i = 1, size(deck%entries)
+            if (deck%entries(i)%section /= 'beam' .or. deck%entries(i)%line /= line) cycle
+            keyword = deck%entries(i)%keyword
+            return
+        end do
+    end function beam_keyword_at
+
     !> Size of the model: diagonal of the bounding box of all nodes and line ends [m].
     function model_size(deck) result(size_model)
         !> The deck.
         type(deck_t), intent(in) :: deck
         real(wp) :: size_model
-        real(wp) :: lo(2), hi(2)
+        real(wp) :: lo(2), hi(2), x2, y2
         integer :: i
         lo = huge(1.0_wp)
         hi = -huge(1.0_wp)
         do i = 1, size(deck%entries)
             associate (e => deck%entries(i))
                 if (e%section /= 'beam') cycle
-                if (e%keyword == 'node' .or. e%keyword == 'line') then
+                if (e%keyword == 'node' .or. e%keyword == 'line' .or. e%keyword == 'polar_line') then
                     lo = min(lo, [e%real(2), e%real(3)])
                     hi = max(hi, [e%real(2), e%real(3)])
                 end if
-                if (e%keyword == 'line') then
-                    lo = min(lo, [e%real(4), e%real(5)])
-                    hi = max(hi, [e%real(4), e%real(5)])
+                if (e%keyword == 'line' .or. e%keyword == 'polar_line') then
+                    call line_end(e, x2, y2)
+                    lo = min(lo, [x2, y2])
+                    hi = max(hi, [x2, y2])
                 end if
             end associate
         end do
@@ -401,7 +440,7 @@ contains
         subroutine check_same_node(first, again)
             type(node_candidate_t), intent(in) :: first, again
             character(len=:), allocatable :: keyword
-            keyword = merge('line', 'node', again%generated)
+            keyword = beam_keyword_at(deck, again%line)
             if (.not. again%generated) then
                 call make_input_error(error, deck%file, again%line, keyword, &
                                       'duplicate node id '// &
@@ -509,7 +548,7 @@ contains
         do i = 1, size(connected)
             if (.not. connected(i)) then
                 call make_input_error(error, deck%file, def_line(i), &
-                                      trim(merge('line', 'node', def_generated(i))), 'node '// &
+                                      beam_keyword_at(deck, def_line(i)), 'node '// &
                                       to_str(beam%node_id(i))//' is connected to no element')
                 return
             end if
@@ -657,6 +696,94 @@ contains
         end do
     end subroutine build_loads
 
+    !> Distributed loads: each `distributed` record loads every element whose two nodes have
+    !> ids from node_a to node_b, with the intensity linear in the projection of the point on
+    !> the chord from node_a to node_b (q_a at node_a, q_b at node_b).
+    subroutine build_distributed_loads(deck, function_ids, beam, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Deck id of each function.
+        integer, intent(in) :: function_ids(:)
+        !> Beam configuration (element_loads filled).
+        type(beam_config_t), intent(inout) :: beam
+        !> Error, if any.
+        type(error_t), allocatable, intent(out) :: error
+        type(deck_entry_t), allocatable :: list(:)
+        type(beam_element_load_t), allocatable :: loads(:)
+        integer :: i, el, k, a, b, lo, hi, n, direction, func
+        real(wp) :: qa, qb, chord(2), t(2)
+        logical :: selected(size(beam%conn, 2))
+        allocate (list, source=deck%records('beam', 'distributed'))
+        allocate (beam%element_loads(0))
+        do i = 1, size(list)
+            associate (e => list(i))
+                a = find_node(beam%node_id, e%int(1))
+                b = find_node(beam%node_id, e%int(2))
+                if (a == 0 .or. b == 0) then
+                    call make_input_error(error, deck%file, e%line, 'distributed', 'node '// &
+                                          e%word(merge(1, 2, a == 0))//' is not defined (no node '// &
+                                          'or line record creates it)')
+                    return
+                end if
+                chord = [beam%x(b) - beam%x(a), beam%y(b) - beam%y(a)]
+                if (a == b .or. all(chord == 0.0_wp)) then
+                    call make_input_error(error, deck%file, e%line, 'distributed', 'node_a and '// &
+                                          'node_b must be two nodes at different places (they give the '// &
+                                          'range of elements and the direction of the load variation)')
+                    return
+                end if
+                select case (e%word(3))
+                case ('x')
+                    direction = load_x
+                case ('y')
+                    direction = load_y
+                case ('axial')
+                    direction = load_axial
+                case default
+                    direction = load_transverse
+                end select
+                qa = e%real(4)
+                qb = qa
+                if (e%n_values() >= 5) qb = e%real(5)
+                func = 0
+                if (e%n_values() >= 6) then
+                    func = find_id(function_ids, e%int(6))
+                    if (func == 0) then
+                        call make_input_error(error, deck%file, e%line, 'distributed', 'function '// &
+                                              e%word(6)//' is not defined (no [functions] '// &
+                                              'function record with this id)')
+                        return
+                    end if
+                end if
+                lo = min(e%int(1), e%int(2))
+                hi = max(e%int(1), e%int(2))
+                do el = 1, size(beam%conn, 2)
+                    selected(el) = all(beam%node_id(beam%conn(:, el)) >= lo .and. &
+                                       beam%node_id(beam%conn(:, el)) <= hi)
+                end do
+                n = count(selected)
+                if (n == 0) then
+                    call make_input_error(error, deck%file, e%line, 'distributed', 'no element '// &
+                                          'has both nodes with ids from '//e%word(1)//' to '//e%word(2))
+                    return
+                end if
+                if (allocated(loads)) deallocate (loads)
+                allocate (loads(n))
+                k = 0
+                do el = 1, size(beam%conn, 2)
+                    if (.not. selected(el)) cycle
+                    ! Position of the element ends on the chord: 0 at node_a, 1 at node_b.
+                    t = ((beam%x(beam%conn(:, el)) - beam%x(a))*chord(1) + &
+                         (beam%y(beam%conn(:, el)) - beam%y(a))*chord(2))/dot_product(chord, chord)
+                    k = k + 1
+                    loads(k) = beam_element_load_t(element=el, direction=direction, &
+                                                   q=qa + (qb - qa)*t, func=func)
+                end do
+                beam%element_loads = [beam%element_loads, loads]
+            end associate
+        end do
+    end subroutine build_distributed_loads
+
     !> Run settings: analysis, time integration, modes, output.
     subroutine build_run(deck, beam, run, error)
         !> The deck.
@@ -761,7 +888,7 @@ contains
         !> Time step [s].
         real(wp), intent(in) :: h
         real(wp) :: x
-        x = t_end/h*(1.0_wp - 1.0e-12_wp)
+        x = t_end/h*(1.0_wp - relative_roundoff)
         steps = aint(x)
         if (steps < x) steps = steps + 1.0_wp
     end function steps_to_end
@@ -784,8 +911,50 @@ contains
         call fill(deck%records('initial', 'displacement'), run%u0)
         if (allocated(error)) return
         call fill(deck%records('initial', 'velocity'), run%v0)
+        if (allocated(error)) return
+        call rigid(deck%records('initial', 'rigid'))
 
     contains
+
+        !> `rigid` records: node_a node_b vx vy omega xc yc gives the nodes with ids from node_a
+        !> to node_b the velocity of a rigid motion, (vx - omega (y - yc), vy + omega (x - xc))
+        !> and the rotation rate omega; a fixed DOF must get zero from it.
+        subroutine rigid(list)
+            type(deck_entry_t), intent(in) :: list(:)
+            integer :: i, node, dof, lo, hi, count_nodes
+            real(wp) :: v(3)
+            do i = 1, size(list)
+                associate (e => list(i))
+                    lo = min(e%int(1), e%int(2))
+                    hi = max(e%int(1), e%int(2))
+                    count_nodes = 0
+                    do node = 1, size(beam%x)
+                        if (beam%node_id(node) < lo .or. beam%node_id(node) > hi) cycle
+                        count_nodes = count_nodes + 1
+                        v = [e%real(3) - e%real(5)*(beam%y(node) - e%real(7)), &
+                             e%real(4) + e%real(5)*(beam%x(node) - e%real(6)), e%real(5)]
+                        do dof = 1, 3
+                            if (fix_line(dof, node) == 0) then
+                                run%v0(dof, node) = v(dof)
+                            else if (v(dof) /= 0.0_wp) then
+                                call make_input_error(error, deck%file, e%line, 'rigid', 'DOF '// &
+                                                      trim(dof_word(dof))//' of node '// &
+                                                      to_str(beam%node_id(node))//' is fixed (fix on line '// &
+                                                      to_str(fix_line(dof, node))//') but the rigid motion '// &
+                                                      'gives it '//to_str(v(dof))//'; an initial velocity '// &
+                                                      'applies only to a free DOF')
+                                return
+                            end if
+                        end do
+                    end do
+                    if (count_nodes == 0) then
+                        call make_input_error(error, deck%file, e%line, 'rigid', 'no node has an id '// &
+                                              'from '//e%word(1)//' to '//e%word(2))
+                        return
+                    end if
+                end associate
+            end do
+        end subroutine rigid
 
         !> Values of one kind of initial condition from its records.
         subroutine fill(list, values)
@@ -843,14 +1012,23 @@ contains
                               '); a '//keyword//' applies only to a free DOF')
     end subroutine on_fixed_dof
 
-    !> DOF index of a DOF word (u, w, theta).
+    !> DOF word (u, w, theta) of a DOF index.
+    pure function dof_word(dof) result(word)
+        !> dof_u, dof_w or dof_theta.
+        integer, intent(in) :: dof
+        character(len=5) :: word
+        character(len=5), parameter :: words(3) = ['u    ', 'w    ', 'theta']
+        word = words(dof)
+    end function dof_word
+
+    !> DOF index of a DOF word: u, w, theta or their [particles] names x, y, rot.
     pure integer function dof_index(word)
-        !> 'u', 'w' or 'theta'.
+        !> 'u' or 'x', 'w' or 'y', 'theta' or 'rot'.
         character(len=*), intent(in) :: word
         select case (word)
-        case ('u')
+        case ('u', 'x')
             dof_index = dof_u
-        case ('w')
+        case ('w', 'y')
             dof_index = dof_w
         case default
             dof_index = dof_theta

@@ -20,6 +20,7 @@
 !> number and the line that created it.
 module driver_config_coupling
     use core_kinds, only: wp
+    use core_constants, only: relative_roundoff
     use core_error, only: error_t, make_input_error
     use core_strings, only: string_t, to_str
     use io_deck, only: deck_t, deck_entry_t
@@ -61,6 +62,19 @@ contains
         end do
     end function deck_has_coupling
 
+    !> Line of the first gravity record, [beam] or [particles] (0 when neither has one).
+    pure integer function first_gravity_line(deck) result(line)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        integer :: i
+        line = 0
+        do i = 1, size(deck%entries)
+            if (deck%entries(i)%keyword /= 'gravity') cycle
+            line = deck%entries(i)%line
+            return
+        end do
+    end function first_gravity_line
+
     !> Build and check the coupling of a deck with [beam], [particles] and [coupling].
     subroutine build_coupling_config(deck, run, beam, dem, setup, error)
         !> Deck read with the MULTICOR schema.
@@ -83,13 +97,15 @@ contains
         first_line = coupling_first_line(deck)
         call check_schemes(deck, run, setup, error)
         if (allocated(error)) return
-        ! The beam has no self-weight load: gravity on the disks alone would load one side of
-        ! the coupling only.
-        if (any(dem%system%particles%gravity /= 0.0_wp)) then
-            call make_input_error(error, deck%file, deck%line('particles', 'gravity'), 'gravity', &
-                                  'coupled runs do not support gravity yet (the beam carries no '// &
-                                  'self-weight, so the two sides of the overlap would not be loaded '// &
-                                  'alike): set gravity = 0 0 and apply loads instead')
+        ! Both sides of the overlap must carry the same self-weight (each weighted by its share
+        ! of the Arlequin partition), else the overlap is loaded on one side only.
+        if (any(dem%system%particles%gravity /= beam%gravity)) then
+            call make_input_error(error, deck%file, first_gravity_line(deck), 'gravity', &
+                                  'coupled runs need the same gravity in [beam] and [particles] (the '// &
+                                  'two models share the weight in the overlap): [beam] gravity = '// &
+                                  to_str(beam%gravity(1))//' '//to_str(beam%gravity(2))// &
+                                  ', [particles] gravity = '//to_str(dem%system%particles%gravity(1))// &
+                                  ' '//to_str(dem%system%particles%gravity(2)))
             return
         end if
         if (deck%has('solver', 'fclib_step')) then
@@ -214,7 +230,7 @@ contains
         length = maxval(model%abscissa)
         ends = [setup%config%weight%s_fe, setup%config%weight%s_particle]
         do k = 1, 2
-            if (ends(k) <= length*(1 + 1.0e-12_wp)) cycle
+            if (ends(k) <= length*(1 + relative_roundoff)) cycle
             call make_input_error(error, deck%file, setup%overlap_line, 'overlap', &
                                   trim(names(k))//' = '//to_str(ends(k))//' m lies beyond the end of the beam '// &
                                   '(abscissas along the beam run from 0 at its first node to '// &

@@ -14,6 +14,7 @@
 !> they are filled directly: `dem_config_t%system` is ready for `mj_init`.
 module driver_config_dem
     use core_kinds, only: wp, i8
+    use core_constants, only: deg_to_rad
     use core_error, only: error_t, make_input_error
     use core_strings, only: to_str
     use core_timefunc, only: time_function_t
@@ -312,7 +313,6 @@ contains
             type(deck_entry_t), intent(in) :: e
             real(wp), allocatable, intent(out) :: gx(:), gy(:), gr(:)
             type(error_t), allocatable, intent(out) :: error
-            real(wp), parameter :: degree = 3.141592653589793238462643383279502884_wp/180.0_wp
             real(wp) :: gap_ratio, pitch
             character(len=:), allocatable :: message
             select case (e%keyword)
@@ -322,7 +322,7 @@ contains
                 gr = [e%real(3)]
             case ('row')
                 call generate_row(e%int(1), e%real(2), e%real(3), e%real(4), e%real(6), &
-                                  e%real(7)*degree, gx, gy, gr, error)
+                                  e%real(7)*deg_to_rad, gx, gy, gr, error)
             case ('square_lattice')
                 call generate_square_lattice(e%int(1), e%int(2), e%real(3), e%real(4), &
                                              e%real(5), e%real(7), gx, gy, gr, error)
@@ -480,6 +480,8 @@ contains
                         if (pass == 1) call constrain(e)
                     case ('force', 'initial_velocity')
                         if (pass == 2) call load(e)
+                    case ('initial_rigid')
+                        if (pass == 2) call rigid(e)
                     end select
                     if (allocated(error)) return
                 end associate
@@ -520,7 +522,7 @@ contains
                 do k = 2, e%n_values()
                     word = e%word(k)
                     do dof = 1, 3
-                        if (word /= 'all' .and. word /= trim(dof_names(dof))) cycle
+                        if (word /= 'all' .and. dof_index(word) /= dof) cycle
                         do j = first, last
                             if (state(dof, j) == imposed) then
                                 call conflict(e, j, dof, 'cannot be fixed')
@@ -584,6 +586,33 @@ contains
                 end if
             end do
         end subroutine load
+
+        !> An `initial_rigid` record: selection vx vy omega xc yc gives each selected disk the
+        !> velocity of a rigid motion, (vx - omega (y - yc), vy + omega (x - xc)) and the
+        !> rotation rate omega; a DOF that is not free must get zero from it.
+        subroutine rigid(e)
+            type(deck_entry_t), intent(in) :: e
+            integer :: first, last, j, dof
+            real(wp) :: v(3)
+            call select_disks(e, first, last)
+            if (allocated(error)) return
+            associate (p => cfg%system%particles)
+                do j = first, last
+                    v = [e%real(2) - e%real(4)*(p%y(j) - e%real(6)), &
+                         e%real(3) + e%real(4)*(p%x(j) - e%real(5)), e%real(4)]
+                    do dof = 1, 3
+                        if (state(dof, j) /= free .and. v(dof) /= 0.0_wp) then
+                            call conflict(e, j, dof, 'cannot take the rigid velocity '//to_str(v(dof))// &
+                                          ' (an initial velocity applies to free DOFs only)')
+                            return
+                        end if
+                    end do
+                    if (state(dof_x, j) == free) p%vx(j) = v(1)
+                    if (state(dof_y, j) == free) p%vy(j) = v(2)
+                    if (state(dof_rot, j) == free) p%w(j) = v(3)
+                end do
+            end associate
+        end subroutine rigid
 
         !> Error: DOF `dof` of disk j already has a condition.
         subroutine conflict(e, j, dof, what)
@@ -815,14 +844,14 @@ contains
                               ' is not defined (no [functions] function record with this id)')
     end subroutine unknown_function
 
-    !> DOF index of a DOF word (x, y, rot).
+    !> DOF index of a DOF word: x, y, rot or their [beam] names u, w, theta.
     pure integer function dof_index(word)
-        !> 'x', 'y' or 'rot'.
+        !> 'x' or 'u', 'y' or 'w', 'rot' or 'theta'.
         character(len=*), intent(in) :: word
         select case (word)
-        case ('x')
+        case ('x', 'u')
             dof_index = dof_x
-        case ('y')
+        case ('y', 'w')
             dof_index = dof_y
         case default
             dof_index = dof_rot

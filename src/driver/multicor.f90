@@ -15,7 +15,7 @@ program multicor
     use, intrinsic :: ieee_exceptions, only: ieee_set_halting_mode, ieee_overflow, ieee_invalid
     use, intrinsic :: ieee_exceptions, only: ieee_divide_by_zero
     use core_kinds, only: wp
-    use core_error, only: error_t
+    use core_error, only: error_t, error_internal
     use core_version, only: multicor_version
     use core_signals, only: signal_exit_code
     use io_deck_schema, only: multicor_schema, schema_markdown
@@ -105,6 +105,11 @@ program multicor
         flush (error_unit)
         stop signal_exit_code(stopped_by), quiet = .true.
     else if (allocated(error)) then
+        if (error%kind == error_internal) then
+            write (error_unit, '(a)') 'multicor: '//error%message
+            flush (error_unit)
+            stop 3, quiet = .true.
+        end if
         write (error_unit, '(a)') 'multicor: error: '//error%message
         flush (error_unit)
         stop 1, quiet = .true.

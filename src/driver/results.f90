@@ -12,16 +12,14 @@
 module driver_results
     use, intrinsic :: iso_fortran_env, only: int64
     use core_kinds, only: wp
-    use core_error, only: error_t, make_error
+    use core_constants, only: two_pi
+    use core_error, only: error_t, make_error, make_internal_error
     use core_version, only: multicor_version, multicor_name
     use io_hdf5_file, only: h5_file_t
     use io_paths, only: rename_file, remove_file, copy_file, file_exists
     implicit none
     private
     public :: results_writer_t
-
-    !> 2 pi, for frequencies in Hz.
-    real(wp), parameter :: two_pi = 6.283185307179586476925286766559_wp
 
     !> Writes the results of one run into one HDF5 file.
     type :: results_writer_t
@@ -49,20 +47,37 @@ module driver_results
         !> Whether the file continues an earlier run (`resume`): a failed run then keeps it.
         logical :: resumed = .false.
     contains
+        !> Create the results file (written as .partial until `close`).
         procedure :: open => writer_open
+        !> Reopen the results file of a checkpointed run to continue it (restart).
         procedure :: resume => writer_resume
+        !> Write the mesh of the beam: node ids, coordinates, connectivity.
         procedure :: write_mesh => writer_write_mesh
+        !> Append one stored state: time, displacements, velocities, accelerations.
         procedure :: append_state => writer_append_state
+        !> Append one record of the energy audit.
         procedure :: append_energy => writer_append_energy
+        !> Write the static solution: displacements and support reactions.
         procedure :: write_static => writer_write_static
+        !> Write the modal results: frequencies and mode shapes.
         procedure :: write_modal => writer_write_modal
+        !> Write the kind of each mode (axial share of its strain energy).
+        procedure :: write_modal_kinds => writer_write_modal_kinds
+        !> Write the run statistics as attributes of /summary.
         procedure :: write_summary => writer_write_summary
+        !> Flush the file so that a killed run leaves every stored output readable.
         procedure :: flush => writer_flush
+        !> Record why and when the run stops before its end (a signal).
         procedure :: stop_at => writer_stop_at
+        !> True when `stop_at` was called.
         procedure :: stopped => writer_stopped
+        !> Close the file and give it its final name (finished = 1).
         procedure :: close => writer_close
+        !> Close a stopped run: the file stays .partial with the reason in /summary.
         procedure :: close_unfinished => writer_close_unfinished
+        !> Close and delete the partial file after an error.
         procedure :: abort => writer_abort
+        !> True while the file is open.
         procedure :: is_open => writer_is_open
     end type results_writer_t
 
@@ -213,8 +228,8 @@ contains
         call require_open(self, 'write_mesh', error)
         if (allocated(error)) return
         if (size(x) /= size(node_id) .or. size(y) /= size(node_id) .or. size(conn, 1) /= 2) then
-            call make_error(error, 'results: write_mesh: node_id, x, y must have the same size ' &
-                            //'and conn must be (2, n_elements)')
+            call make_internal_error(error, 'results: write_mesh', 'node_id, x, y must have the same '// &
+                                     'size and conn must be (2, n_elements)')
             return
         end if
         call check_nodes(self, size(node_id), 'write_mesh', error)
@@ -253,7 +268,7 @@ contains
         call require_open(self, 'append_state', error)
         if (allocated(error)) return
         if (size(d, 1) /= 3 .or. any(shape(v) /= shape(d)) .or. any(shape(a) /= shape(d))) then
-            call make_error(error, 'results: append_state: d, v, a must all be (3, n_nodes)')
+            call make_internal_error(error, 'results: append_state', 'd, v, a must all be (3, n_nodes)')
             return
         end if
         call check_nodes(self, size(d, 2), 'append_state', error)
@@ -342,7 +357,7 @@ contains
         call require_open(self, 'write_static', error)
         if (allocated(error)) return
         if (size(d, 1) /= 3 .or. any(shape(reactions) /= shape(d))) then
-            call make_error(error, 'results: write_static: d and reactions must be (3, n_nodes)')
+            call make_internal_error(error, 'results: write_static', 'd and reactions must be (3, n_nodes)')
             return
         end if
         call check_nodes(self, size(d, 2), 'write_static', error)
@@ -369,8 +384,8 @@ contains
         call require_open(self, 'write_modal', error)
         if (allocated(error)) return
         if (size(shapes, 1) /= 3 .or. size(shapes, 3) /= size(omega)) then
-            call make_error(error, 'results: write_modal: shapes must be (3, n_nodes, n_modes) ' &
-                            //'with n_modes = size(omega)')
+            call make_internal_error(error, 'results: write_modal', 'shapes must be (3, n_nodes, '// &
+                                     'n_modes) with n_modes = size(omega)')
             return
         end if
         call check_nodes(self, size(shapes, 2), 'write_modal', error)
@@ -388,6 +403,29 @@ contains
         call self%file%write_attribute('/modal/shapes', 'units', 'm, m, rad (arbitrary scale)', &
                                        error)
     end subroutine writer_write_modal
+
+    !> Write the kind of each mode: /modal/axial_fraction (axial share of the strain energy,
+    !> -1 for a rigid-body mode) with the attributes `kind` (one word per mode: axial,
+    !> bending, mixed or rigid) and `threshold` (the share that makes a mode axial or bending).
+    subroutine writer_write_modal_kinds(self, fraction, kinds, threshold, error)
+        !> An open writer.
+        class(results_writer_t), intent(inout) :: self
+        !> Axial strain-energy share of each mode (n_modes).
+        real(wp), intent(in) :: fraction(:)
+        !> Kinds of the modes, space-separated, in mode order.
+        character(len=*), intent(in) :: kinds
+        !> Share above which a mode is axial (or, of bending energy, bending).
+        real(wp), intent(in) :: threshold
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call require_open(self, 'write_modal_kinds', error)
+        if (allocated(error)) return
+        call self%file%write_dataset('/modal/axial_fraction', fraction, error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/modal/axial_fraction', 'kind', kinds, error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/modal/axial_fraction', 'threshold', threshold, error)
+    end subroutine writer_write_modal_kinds
 
     !> Write run statistics as attributes of /summary.
     subroutine writer_write_summary(self, steps, wall_seconds, error)
@@ -544,7 +582,7 @@ contains
         !> Set when the writer is not open.
         type(error_t), allocatable, intent(out) :: error
         if (.not. self%is_open()) then
-            call make_error(error, 'results: '//what//': no results file is open')
+            call make_internal_error(error, 'results: '//what, 'no results file is open')
         end if
     end subroutine require_open
 
@@ -563,7 +601,7 @@ contains
             self%n_nodes = n
         else if (n /= self%n_nodes) then
             write (buf, '(i0,a,i0)') n, ' nodes instead of ', self%n_nodes
-            call make_error(error, 'results: '//what//': '//trim(buf))
+            call make_internal_error(error, 'results: '//what, trim(buf))
         end if
     end subroutine check_nodes
 

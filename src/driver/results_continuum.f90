@@ -14,6 +14,7 @@
 !> collection) by reference into the HDF5 file, so that ParaView or meshio open them.
 module driver_results_continuum
     use core_kinds, only: wp
+    use core_constants, only: two_pi
     use core_error, only: error_t, make_error
     use io_hdf5_file, only: h5_file_t
     use fem_mesh2d, only: mesh2d_t, element_t3, nodes_per_element
@@ -181,7 +182,6 @@ contains
         real(wp), intent(in) :: shapes(:, :, :)
         !> Set on a write failure.
         type(error_t), allocatable, intent(out) :: error
-        real(wp), parameter :: two_pi = 6.283185307179586476925286766559_wp
         call file%create_group('/continuum/modal', error)
         if (.not. allocated(error)) call file%write_dataset('/continuum/modal/omega', omega, error)
         if (.not. allocated(error)) call file%write_dataset('/continuum/modal/frequency', omega/two_pi, error)

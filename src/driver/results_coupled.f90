@@ -9,7 +9,7 @@
 !> (N.m for rotation rows), the force the beam exerts on the disk through the glue.
 module driver_results_coupled
     use core_kinds, only: wp
-    use core_error, only: error_t, make_error
+    use core_error, only: error_t, make_error, make_internal_error
     use io_hdf5_file, only: h5_file_t
     use coupling_arlequin, only: coupled_system_t, coupled_energies_t, coupled_energies, &
                                  coordinate_residual
@@ -179,8 +179,8 @@ contains
         real(wp) :: values(size(energy_names))
         integer :: k
         if (.not. allocated(self%values) .or. sys%op%n_rows /= self%n_rows) then
-            call make_error(error, 'results: coupling store: begin was not called for this '// &
-                            'system')
+            call make_internal_error(error, 'results: coupling store', 'begin was not called for '// &
+                                     'this system')
             return
         end if
         call file%append('/coupling/time', sys%fe%t, error)
@@ -224,7 +224,7 @@ contains
         integer :: k
         real(wp) :: coord
         if (.not. allocated(self%values)) then
-            call make_error(error, 'results: coupling record_step: begin was not called')
+            call make_internal_error(error, 'results: coupling record_step', 'begin was not called')
             return
         end if
         if (self%n_buffered == stats_buffer) call flush_steps(self, file, error)

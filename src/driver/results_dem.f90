@@ -12,7 +12,7 @@
 !> thickness, in the frame (n, t = (-n_y, n_x)); j receives the opposite force.
 module driver_results_dem
     use core_kinds, only: wp
-    use core_error, only: error_t, make_error
+    use core_error, only: error_t, make_error, make_internal_error
     use io_hdf5_file, only: h5_file_t
     use dem_nlgs, only: nlgs_stats_t, criterion_names
     use dem_moreau_jean, only: dem_system_t, energies_balance
@@ -238,7 +238,7 @@ contains
         integer :: n
         n = sys%particles%n
         if (n /= self%n_particles .or. .not. allocated(self%sweeps)) then
-            call make_error(error, 'results: DEM store: begin was not called for this system')
+            call make_internal_error(error, 'results: DEM store', 'begin was not called for this system')
             return
         end if
         call file%append('/dem/time', sys%time, error)
@@ -342,7 +342,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         integer :: k
         if (.not. allocated(self%sweeps)) then
-            call make_error(error, 'results: DEM record_step: begin was not called')
+            call make_internal_error(error, 'results: DEM record_step', 'begin was not called')
             return
         end if
         if (self%n_buffered == stats_buffer) call flush_stats(self, file, error)

@@ -3,6 +3,7 @@
 module driver_simulation_beam
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp, i8
+    use core_constants, only: two_pi
     use core_error, only: error_t, make_error, make_input_error
     use core_signals, only: caught_signal, signal_name
     use io_deck, only: deck_t
@@ -10,7 +11,7 @@ module driver_simulation_beam
     use fem_beam_config, only: beam_config_t
     use fem_beam_model, only: beam_model_t, build_beam_model
     use fem_static, only: solve_static
-    use fem_modal, only: solve_modal
+    use fem_modal, only: solve_modal, mode_axial_fraction, mode_kind, dominant_fraction
     use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
     use driver_config, only: run_config_t, build_config
     use driver_config_dem, only: check_particle_keywords_unused
@@ -167,9 +168,10 @@ contains
         type(results_writer_t), intent(inout) :: out
         procedure(report_iface) :: report
         type(error_t), allocatable, intent(out) :: error
-        real(wp), allocatable :: omega(:), shapes(:, :), full(:, :, :)
-        real(wp), parameter :: two_pi = 6.283185307179586476925286766559_wp
-        character(len=120) :: buf
+        real(wp), allocatable :: omega(:), shapes(:, :), full(:, :, :), fraction(:)
+        character(len=160) :: buf
+        character(len=:), allocatable :: kinds
+        character(len=5) :: share
         integer :: k
         call solve_modal(model, run%n_modes, omega, shapes, error)
         if (allocated(error)) return
@@ -179,14 +181,23 @@ contains
                             '(check the magnitudes in [beam])')
             return
         end if
-        allocate (full(3, model%n_nodes, run%n_modes))
+        allocate (full(3, model%n_nodes, run%n_modes), fraction(run%n_modes))
+        kinds = ''
         do k = 1, run%n_modes
             call model%expand(shapes(:, k), full(:, :, k))
+            fraction(k) = mode_axial_fraction(model, shapes(:, k))
+            kinds = trim(kinds//' '//mode_kind(fraction(k)))
             write (buf, '(a,i3,a,es15.7e3,a,es15.7e3,a)') 'mode ', k, ': omega = ', omega(k), &
-                ' rad/s, f = ', omega(k)/two_pi, ' Hz'
+                ' rad/s, f = ', omega(k)/two_pi, ' Hz, '//mode_kind(fraction(k))
+            if (fraction(k) >= 0) then
+                write (share, '(f5.1)') 100*fraction(k)
+                buf = trim(buf)//' (axial strain energy '//trim(adjustl(share))//' %)'
+            end if
             call report(trim(buf))
         end do
         call out%write_modal(omega, full, error)
+        if (allocated(error)) return
+        call out%write_modal_kinds(fraction, adjustl(kinds), dominant_fraction, error)
     end subroutine run_modal
 
     subroutine run_dynamic(run, model, node_id, integ, out, quiet, report, ck, error)

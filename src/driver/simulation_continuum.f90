@@ -7,6 +7,7 @@
 module driver_simulation_continuum
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp, i8
+    use core_constants, only: two_pi
     use core_error, only: error_t, make_error, make_input_error
     use core_strings, only: to_str
     use core_signals, only: caught_signal, signal_name
@@ -442,7 +443,6 @@ contains
         subroutine run_modal(error)
             type(error_t), allocatable, intent(out) :: error
             real(wp), allocatable :: omega(:), shapes(:, :), full(:, :, :), u(:)
-            real(wp), parameter :: two_pi = 6.283185307179586476925286766559_wp
             character(len=120) :: buf
             integer :: k
             call self%ops%solve_modes(self%settings%n_modes, omega, shapes, error)

@@ -9,6 +9,7 @@ module fem_beam_config
     implicit none
     private
     public :: beam_section_t, beam_load_t, beam_config_t, dof_u, dof_w, dof_theta
+    public :: beam_element_load_t, load_x, load_y, load_axial, load_transverse
 
     !> Index of the x displacement DOF of a node.
     integer, parameter :: dof_u = 1
@@ -16,6 +17,16 @@ module fem_beam_config
     integer, parameter :: dof_w = 2
     !> Index of the rotation DOF of a node.
     integer, parameter :: dof_theta = 3
+
+    !> Direction of a distributed load: global x (per unit length of the element).
+    integer, parameter :: load_x = 1
+    !> Direction of a distributed load: global y (per unit length of the element).
+    integer, parameter :: load_y = 2
+    !> Direction of a distributed load: along the element axis, from its node 1 to its node 2.
+    integer, parameter :: load_axial = 3
+    !> Direction of a distributed load: across the element axis (the axis turned by +90 deg),
+    !> the direction of the local w.
+    integer, parameter :: load_transverse = 4
 
     !> Cross-section and material of a group of elements (SI units).
     type :: beam_section_t
@@ -41,6 +52,18 @@ module fem_beam_config
         integer :: func = 0
     end type beam_load_t
 
+    !> A distributed load on one element, linear between its two ends, times a time function.
+    type :: beam_element_load_t
+        !> Element index (1..n_elements).
+        integer :: element = 0
+        !> Direction: load_x, load_y, load_axial or load_transverse.
+        integer :: direction = 0
+        !> Intensity at the element's node 1 and node 2 [N/m].
+        real(wp) :: q(2) = 0.0_wp
+        !> Index into `beam_config_t%functions` (0 = constant 1).
+        integer :: func = 0
+    end type beam_element_load_t
+
     !> Everything needed to build a beam model.
     type :: beam_config_t
         !> Node coordinates [m], size n_nodes.
@@ -61,6 +84,10 @@ module fem_beam_config
         type(beam_load_t), allocatable :: loads(:)
         !> Time functions referenced by loads.
         type(time_function_t), allocatable :: functions(:)
+        !> Distributed loads on elements (consistent nodal forces and moments).
+        type(beam_element_load_t), allocatable :: element_loads(:)
+        !> Gravity acceleration (gx, gy) [m/s^2]: self-weight rho A g on every element.
+        real(wp) :: gravity(2) = 0.0_wp
         !> Rayleigh damping C = a0 M + a1 K: mass coefficient [1/s].
         real(wp) :: rayleigh_a0 = 0.0_wp
         !> Rayleigh damping stiffness coefficient [s].

@@ -12,15 +12,17 @@
 !> mass products) and nodal loads are multiplied by alpha at their node.
 module fem_beam_model
     use core_kinds, only: wp
-    use core_error, only: error_t, make_error
+    use core_constants, only: relative_roundoff, singular_ratio
+    use core_error, only: error_t, make_error, make_internal_error
     use core_linalg, only: band_spd_t, largest_generalized_eigenvalue
     use core_sort, only: sort_in_place
     use core_timefunc, only: time_function_t
     use core_weight, only: weight_function_t
     use fem_dynamic_operator, only: dynamic_operator_t, spd_factor_t
-    use fem_beam_config, only: beam_config_t, beam_load_t, beam_section_t
+    use fem_beam_config, only: beam_config_t, beam_load_t, beam_section_t, beam_element_load_t, &
+                               load_x, load_y, load_axial, load_transverse
     use fem_beam_element, only: element_stiffness, element_mass_consistent, &
-                                element_mass_lumped, to_global, hermite_shape
+                                element_mass_lumped, to_global, hermite_shape, rotation_matrix
     implicit none
     private
     public :: beam_model_t, build_beam_model
@@ -66,6 +68,14 @@ module fem_beam_model
         type(beam_load_t), allocatable :: loads(:)
         !> Time functions referenced by the loads.
         type(time_function_t), allocatable :: functions(:)
+        !> Distributed loads, self-weight included: element of each (size n_element_loads).
+        integer, allocatable :: eload_element(:)
+        !> Time function of each distributed load (0 = constant 1).
+        integer, allocatable :: eload_func(:)
+        !> Consistent nodal forces and moments of each distributed load in global axes
+        !> (6, n_element_loads), on all six DOFs of its element (fixed ones included, for the
+        !> reactions), weighted by the Arlequin weight like the mass.
+        real(wp), allocatable :: eload_vector(:, :)
         !> Curvilinear abscissa of each node [m]: distance from node 1 along the elements
         !> (from the lowest node of each connected part); size n_nodes.
         real(wp), allocatable :: abscissa(:)
@@ -145,6 +155,8 @@ contains
         if (allocated(error)) return
         call check_loads(config, error)
         if (allocated(error)) return
+        call check_element_loads(config, error)
+        if (allocated(error)) return
         call copy_geometry(config, model)
         call number_equations(config, model, error)
         if (allocated(error)) return
@@ -167,10 +179,124 @@ contains
                 end associate
             end do
             call assemble(model, error, weight)
+            call build_element_loads(config, model, weight)
         else
             call assemble(model, error)
+            call build_element_loads(config, model)
         end if
     end subroutine build_beam_model
+
+    !> Distributed loads refer to existing elements, directions and functions.
+    subroutine check_element_loads(config, error)
+        type(beam_config_t), intent(in) :: config
+        type(error_t), allocatable, intent(out) :: error
+        integer :: i, nf
+        character(len=200) :: buf
+        if (.not. allocated(config%element_loads)) return
+        nf = 0
+        if (allocated(config%functions)) nf = size(config%functions)
+        do i = 1, size(config%element_loads)
+            associate (ld => config%element_loads(i))
+                if (ld%element < 1 .or. ld%element > size(config%conn, 2)) then
+                    write (buf, '(a,i0,a,i0,a)') 'beam model: distributed load ', i, &
+                        ' is on element ', ld%element, ', which does not exist'
+                else if (ld%direction < load_x .or. ld%direction > load_transverse) then
+                    write (buf, '(a,i0,a)') 'beam model: distributed load ', i, ' has no direction'
+                else if (ld%func < 0 .or. ld%func > nf) then
+                    write (buf, '(a,i0,a,i0,a)') 'beam model: distributed load ', i, &
+                        ' uses time function ', ld%func, ', which is not defined'
+                else
+                    cycle
+                end if
+            end associate
+            call make_error(error, trim(buf))
+            return
+        end do
+    end subroutine check_element_loads
+
+    !> Consistent nodal forces of the distributed loads and of the self-weight rho A g:
+    !> f = int alpha N^T q ds over each element (Gauss, 6 points per piece between the
+    !> weight's breakpoints: exact for a linear q times a cubic Hermite N times a piecewise
+    !> cubic alpha), in global axes, on all six DOFs of the element.
+    subroutine build_element_loads(config, model, weight)
+        type(beam_config_t), intent(in) :: config
+        type(beam_model_t), intent(inout) :: model
+        class(weight_function_t), intent(in), optional :: weight
+        integer :: n_given, n, i, e
+        real(wp) :: qa(2), qt(2)
+        n_given = 0
+        if (allocated(config%element_loads)) n_given = size(config%element_loads)
+        n = n_given
+        if (any(config%gravity /= 0.0_wp)) n = n + model%n_elements
+        allocate (model%eload_element(n), model%eload_func(n), model%eload_vector(6, n))
+        do i = 1, n_given
+            associate (ld => config%element_loads(i))
+                e = ld%element
+                associate (c => model%cosine(e), s => model%sine(e))
+                    select case (ld%direction)
+                    case (load_x)
+                        qa = c*ld%q
+                        qt = -s*ld%q
+                    case (load_y)
+                        qa = s*ld%q
+                        qt = c*ld%q
+                    case (load_axial)
+                        qa = ld%q
+                        qt = 0.0_wp
+                    case default
+                        qa = 0.0_wp
+                        qt = ld%q
+                    end select
+                end associate
+                model%eload_element(i) = e
+                model%eload_func(i) = ld%func
+                model%eload_vector(:, i) = element_load_vector(model, e, qa, qt, weight)
+            end associate
+        end do
+        do e = 1, n - n_given
+            i = n_given + e
+            ! Self-weight rho A g per unit length, in local components of the element axis.
+            qa = model%rho_a(e)*(model%cosine(e)*config%gravity(1) + model%sine(e)*config%gravity(2))
+            qt = model%rho_a(e)*(-model%sine(e)*config%gravity(1) + model%cosine(e)*config%gravity(2))
+            model%eload_element(i) = e
+            model%eload_func(i) = 0
+            model%eload_vector(:, i) = element_load_vector(model, e, qa, qt, weight)
+        end do
+    end subroutine build_element_loads
+
+    !> Consistent nodal forces in global axes (6) of a load linear along element e, with axial
+    !> components qa and transverse components qt at its two ends [N/m]: the local vector is
+    !> int alpha [Na qa; Nh qt] ds (Na linear, Nh Hermite), turned to global axes by T^T.
+    function element_load_vector(model, e, qa, qt, weight) result(f)
+        type(beam_model_t), intent(in) :: model
+        integer, intent(in) :: e
+        real(wp), intent(in) :: qa(2), qt(2)
+        class(weight_function_t), intent(in), optional :: weight
+        real(wp) :: f(6)
+        real(wp), allocatable :: cuts(:)
+        real(wp) :: fl(6), xi, dxi, dw, l, na(2), nh(4)
+        integer :: p, g
+        l = model%length(e)
+        if (present(weight)) then
+            cuts = element_cuts(model, e, weight)
+        else
+            cuts = [0.0_wp, 1.0_wp]
+        end if
+        fl = 0.0_wp
+        do p = 1, size(cuts) - 1
+            dxi = cuts(p + 1) - cuts(p)
+            do g = 1, 6
+                xi = cuts(p) + dxi*gauss_t(g)
+                dw = gauss_w(g)*dxi*l
+                if (present(weight)) dw = dw*weight%value(model%abscissa_at(e, xi))
+                na = [1.0_wp - xi, xi]
+                nh = hermite_shape(xi, l)
+                fl([1, 4]) = fl([1, 4]) + dw*dot_product(na, qa)*na
+                fl([2, 3, 5, 6]) = fl([2, 3, 5, 6]) + dw*dot_product(na, qt)*nh
+            end do
+        end do
+        f = matmul(transpose(rotation_matrix(model%cosine(e), model%sine(e))), fl)
+    end function element_load_vector
 
     !> Node label for messages: 'node 3 (id 12)'.
     function node_label(config, i) result(label)
@@ -234,7 +360,7 @@ contains
             end if
             length = hypot(config%x(n2) - config%x(n1), config%y(n2) - config%y(n1))
             ! Zero up to rounding of the coordinates (relative to the size of the model).
-            if (length <= 1.0e-12_wp*span) then
+            if (length <= relative_roundoff*span) then
                 write (buf, '(a,i0,a)') 'beam model: element ', e, ' has zero length ('// &
                     node_label(config, n1)//' and '//node_label(config, n2)// &
                     ' are at the same place); remove it or move a node'
@@ -413,7 +539,7 @@ contains
             end do
         end do
         if (model%k%out_of_band .or. model%m%out_of_band) &
-            call make_error(error, 'beam model: internal error, bandwidth too small')
+            call make_internal_error(error, 'beam model assembly', 'an entry fell outside the band (bandwidth computed too small)')
     end subroutine assemble
 
     !> Weighted element matrices in global axes: kg = int alpha B^T D B ds, mg = int alpha
@@ -484,9 +610,9 @@ contains
         real(wp), allocatable :: bp(:)
         real(wp) :: s1, s2, xi
         integer :: i, j
-        ! Cuts closer than this to an end or to each other are dropped: pieces of relative
-        ! length 1e-12 carry nothing at double precision.
-        real(wp), parameter :: eps = 1.0e-12_wp
+        ! Cuts closer than this to an end or to each other are dropped: such pieces carry
+        ! nothing at double precision.
+        real(wp), parameter :: eps = relative_roundoff
         s1 = model%abscissa(model%conn(1, e))
         s2 = model%abscissa(model%conn(2, e))
         bp = weight%breakpoints()
@@ -561,7 +687,7 @@ contains
         real(wp), intent(in) :: t
         !> Forces (n_free) [N, N.m].
         real(wp), intent(out) :: f(:)
-        integer :: i, ieq
+        integer :: i, ieq, k, dofs(6)
         real(wp) :: scale
         f = 0.0_wp
         do i = 1, size(self%loads)
@@ -570,6 +696,14 @@ contains
             scale = 1.0_wp
             if (self%loads(i)%func > 0) scale = self%functions(self%loads(i)%func)%value(t)
             f(ieq) = f(ieq) + self%loads(i)%value*scale
+        end do
+        do i = 1, size(self%eload_element)
+            scale = 1.0_wp
+            if (self%eload_func(i) > 0) scale = self%functions(self%eload_func(i))%value(t)
+            dofs = element_dofs(self, self%eload_element(i))
+            do k = 1, 6
+                if (dofs(k) > 0) f(dofs(k)) = f(dofs(k)) + self%eload_vector(k, i)*scale
+            end do
         end do
     end subroutine external_force
 
@@ -769,6 +903,15 @@ contains
                 r(ld%dof, ld%node) = r(ld%dof, ld%node) - ld%value*scale
             end associate
         end do
+        ! Distributed loads: their consistent forces on fixed DOFs go to the supports.
+        do i = 1, size(self%eload_element)
+            scale = 1.0_wp
+            if (self%eload_func(i) > 0) scale = self%functions(self%eload_func(i))%value(t)
+            n1 = self%conn(1, self%eload_element(i))
+            n2 = self%conn(2, self%eload_element(i))
+            r(:, n1) = r(:, n1) - self%eload_vector(1:3, i)*scale
+            r(:, n2) = r(:, n2) - self%eload_vector(4:6, i)*scale
+        end do
         where (self%eq > 0) r = 0.0_wp
     end subroutine reactions
 
@@ -868,7 +1011,7 @@ contains
     end function rigid_row
 
     !> Rank 3 test of a 3x3 Gram matrix: det(G)/prod(diag G) is 1 for orthogonal rows, 0 for
-    !> rank < 3, and does not depend on the scale of each column; 1e-12 separates exact
+    !> rank < 3, and does not depend on the scale of each column; singular_ratio separates exact
     !> zero (rounding ~ 1e-16) from nearly aligned supports (e.g. a roller 1e-6 L from a pin).
     pure logical function full_rank(g)
         real(wp), intent(in) :: g(3, 3)
@@ -878,6 +1021,6 @@ contains
         det = g(1, 1)*(g(2, 2)*g(3, 3) - g(2, 3)*g(3, 2)) &
               - g(1, 2)*(g(2, 1)*g(3, 3) - g(2, 3)*g(3, 1)) &
               + g(1, 3)*(g(2, 1)*g(3, 2) - g(2, 2)*g(3, 1))
-        full_rank = det > 1.0e-12_wp*g(1, 1)*g(2, 2)*g(3, 3)
+        full_rank = det > singular_ratio*g(1, 1)*g(2, 2)*g(3, 3)
     end function full_rank
 end module fem_beam_model

@@ -11,6 +11,7 @@
 !> largest element eigenvalue (`largest_eigenvalue`).
 module fem_continuum_dynamics
     use core_kinds, only: wp, i8
+    use core_constants, only: pi
     use core_error, only: error_t, make_error
     use core_sparse, only: sparse_matrix_t, sparse_solver_t
     use core_linalg, only: band_spd_t, band_generalized_eigen
@@ -40,14 +41,23 @@ module fem_continuum_dynamics
         procedure :: build => dynamics_build
         !> See `dynamic_operator_t`.
         procedure :: external_force => dynamics_force
+        !> ku = K u on the free DOFs.
         procedure :: stiffness_times => dynamics_stiffness_times
+        !> mv = M v on the free DOFs.
         procedure :: mass_times => dynamics_mass_times
+        !> cv = C v (Rayleigh).
         procedure :: damping_times => dynamics_damping_times
+        !> True when C /= 0.
         procedure :: is_damped => dynamics_is_damped
+        !> 1/2 u.K u.
         procedure :: strain_energy => dynamics_strain_energy
+        !> 1/2 v.M v.
         procedure :: kinetic_energy => dynamics_kinetic_energy
+        !> Cholesky factor of c_m M + c_k K.
         procedure :: factor_combination => dynamics_factor_combination
+        !> Diagonal of the (lumped) mass matrix.
         procedure :: mass_diagonal => dynamics_mass_diagonal
+        !> Largest eigenvalue of K x = lambda M x (stable step of explicit schemes).
         procedure :: largest_eigenvalue => dynamics_largest_eigenvalue
         !> Lowest modes of K phi = omega^2 M phi.
         procedure :: solve_modes => dynamics_solve_modes
@@ -330,7 +340,7 @@ contains
         allocate (x(n, p), y(n, p), ky(n, p), my(n, p), previous(p))
         do j = 1, p
             do i = 1, n
-                x(i, j) = sin(real(i, wp)*real(j, wp)*3.14159265358979_wp/real(n + 1, wp)) + 1.0e-3_wp*j
+                x(i, j) = sin(real(i, wp)*real(j, wp)*pi/real(n + 1, wp)) + 1.0e-3_wp*j
             end do
         end do
         previous = huge(1.0_wp)

@@ -7,6 +7,7 @@
 !> prescribed dofs remove the rigid motions; `expand` puts u_f and u_p back together.
 module fem_continuum_model
     use core_kinds, only: wp
+    use core_constants, only: singular_ratio
     use core_error, only: error_t, make_error
     use fem_elastic2d, only: elastic2d_t
     use fem_element2d, only: element2d_t
@@ -507,6 +508,6 @@ contains
         end do
         det = g(1, 1)*(g(2, 2)*g(3, 3) - g(2, 3)*g(3, 2)) - g(1, 2)*(g(2, 1)*g(3, 3) - g(2, 3)*g(3, 1)) &
               + g(1, 3)*(g(2, 1)*g(3, 2) - g(2, 2)*g(3, 1))
-        stops = det > 1.0e-12_wp*((g(1, 1) + g(2, 2) + g(3, 3))/3)**3 .and. det > 0
+        stops = det > singular_ratio*((g(1, 1) + g(2, 2) + g(3, 3))/3)**3 .and. det > 0
     end function model_stops_rigid_motions
 end module fem_continuum_model

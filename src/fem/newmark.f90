@@ -22,7 +22,7 @@
 !> `predict` + `correct(0)` is bit-identical to `step`.
 module fem_newmark
     use core_kinds, only: wp
-    use core_error, only: error_t, make_error
+    use core_error, only: error_t, make_error, make_internal_error
     use fem_dynamic_operator, only: dynamic_operator_t, spd_factor_t
     implicit none
     private
@@ -407,7 +407,7 @@ contains
         !> Set when the integrator is not initialised or sizes disagree.
         type(error_t), allocatable, intent(out) :: error
         if (size(x) /= size(b)) then
-            call make_error(error, 'Newmark solve_effective: b and x differ in size')
+            call make_internal_error(error, 'Newmark solve_effective', 'b and x differ in size')
             return
         end if
         x = b
@@ -425,7 +425,7 @@ contains
         !> Set when the integrator is not initialised or sizes disagree.
         type(error_t), allocatable, intent(out) :: error
         if (any(shape(x) /= shape(b))) then
-            call make_error(error, 'Newmark solve_effective: b and x differ in shape')
+            call make_internal_error(error, 'Newmark solve_effective', 'b and x differ in shape')
             return
         end if
         x = b

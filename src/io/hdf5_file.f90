@@ -29,7 +29,7 @@ module io_hdf5_file
                                                                               c_loc, c_f_pointer, c_associated, &
                                                                               c_int, c_bool, c_int64_t, c_long_long
     use core_kinds, only: wp
-    use core_error, only: error_t, make_error
+    use core_error, only: error_t, make_error, make_internal_error
     use hdf5, only: hid_t, hsize_t, size_t, h5open_f, h5dont_atexit_f, h5eset_auto_f, h5iis_valid_f, &
                     h5iget_type_f, h5i_dataset_f, h5i_dataspace_f, h5i_datatype_f, h5i_attr_f, h5i_group_f, &
                     h5i_genprop_lst_f, h5i_file_f, h5fcreate_f, h5fopen_f, h5fclose_f, h5f_acc_trunc_f, &
@@ -74,8 +74,8 @@ module io_hdf5_file
         end function c_h5pset_file_space_strategy
     end interface
 
-    !> H5F_FSPACE_STRATEGY_NONE: every allocation at the end of the file, freed space never
-    !> reused while the file is open (see file_create).
+    !> Value of H5F_FSPACE_STRATEGY_NONE (every allocation at the end of the file, freed space never
+    !> reused while the file is open; see file_create).
     integer(c_int), parameter :: fspace_strategy_none = 3
 
     !> Target size of one chunk of a time series [bytes].
@@ -95,12 +95,19 @@ module io_hdf5_file
         !> File name, for error messages.
         character(len=:), allocatable :: path
     contains
+        !> Create a file (an existing one is replaced).
         procedure :: create => file_create
+        !> Open an existing file, read-only or for writing.
         procedure :: open => file_open
+        !> Close the file (nothing when it is not open).
         procedure :: close => file_close
+        !> Flush every buffer of the file to the operating system.
         procedure :: flush => file_flush
+        !> True while a file is open.
         procedure :: is_open => file_is_open
+        !> True when a group, dataset or attribute path exists.
         procedure :: exists => file_exists
+        !> Create a group (and its missing parents).
         procedure :: create_group => file_create_group
         procedure, private :: write_attr_string, write_attr_real, write_attr_int, &
             write_attr_real_1d
@@ -120,11 +127,17 @@ module io_hdf5_file
         !> Read a whole dataset into an array allocated to its shape.
         generic :: read_dataset => read_real_1d, read_real_2d, read_real_3d, read_int_1d, &
             read_int_2d
+        !> Shape of a dataset, in Fortran order.
         procedure :: dataset_shape => file_dataset_shape
+        !> Paths of every dataset in the file and their number of records.
         procedure :: list_datasets => file_list_datasets
+        !> Delete a dataset or group.
         procedure :: delete => file_delete
+        !> Cut or extend a series to a number of records.
         procedure :: resize_series => file_resize_series
+        !> Create an extendible real series of scalar, 1-D or 2-D records.
         procedure :: create_series => file_create_series
+        !> Create an extendible integer series of scalar records.
         procedure :: create_int_series => file_create_int_series
         procedure, private :: append_0d, append_1d, append_2d
         !> Append one record (scalar, 1-D or 2-D) at the end of a series.
@@ -1180,8 +1193,8 @@ contains
         integer :: r, n_per_record, hdferr
         r = size(record_shape)
         if (r > 2 .or. any(record_shape < 1)) then
-            call make_error(error, "HDF5: series '"//path//"': records must be scalars, 1-D or " &
-                            //"2-D with positive extents")
+            call make_internal_error(error, 'HDF5 create_series', "series '"//path//"': records must "// &
+                                     "be scalars, 1-D or 2-D with positive extents")
             return
         end if
         n_per_record = product(record_shape)
@@ -1336,7 +1349,7 @@ contains
         end if
         if (r == 1) then
             if (dims(1) /= int(record_size, hsize_t)) then
-                call make_error(error, "HDF5: series '"//path//"': record shape does not match")
+                call make_internal_error(error, 'HDF5 append', "series '"//path//"': record shape does not match")
                 call release(dset)
                 return
             end if
@@ -1447,7 +1460,7 @@ contains
             return
         end if
         if (any(dims(:r) /= int(record_shape, hsize_t))) then
-            call make_error(error, "HDF5: series '"//path//"': record shape does not match")
+            call make_internal_error(error, 'HDF5 append', "series '"//path//"': record shape does not match")
             call release(dset)
             return
         end if

@@ -25,10 +25,15 @@ module io_progress
         !> Clock counts per second.
         integer(i8) :: rate = 1
     contains
+        !> Start the clock for a run of n steps to t_end, reporting every interval seconds.
         procedure :: start => progress_start
+        !> True when a progress line is due (interval elapsed since the last one).
         procedure :: due => progress_due
+        !> Wall-clock seconds since `start`.
         procedure :: elapsed => progress_elapsed
+        !> Progress line at a step: step, time, fraction done, elapsed and remaining time.
         procedure :: line => progress_line
+        !> Closing line: steps done, wall time, time per step.
         procedure :: summary_line => progress_summary_line
     end type progress_t
 

@@ -9,6 +9,10 @@ module io_schema_dem
                               selection_field, tail
     implicit none
     private
+
+    !> Words naming a DOF: the [beam] and [particles] vocabularies are both accepted
+    !> (u = x, w = y, theta = rot).
+    character(len=*), parameter :: dof_words = 'x y rot u w theta'
     public :: add_particles, add_walls, add_contacts, add_solver
 
 contains
@@ -63,23 +67,33 @@ contains
                            'Gravity acceleration (the default is none; write gravity = 0 -9.81 for the usual '// &
                            'one).', default='0 0')
         call s%add_keyword('particles', 'fix', [selection_field('particles')], &
-                           'Hold DOFs of the selected disks at zero velocity: x, y, rot (rotation), or all.', &
-                           tails=[tail([word_field('dof', 'x y rot all')], 1, 3, cyclic=.true.)], &
+                           'Hold DOFs of the selected disks at zero velocity: x, y, rot (rotation), or all; u, w '// &
+                           'and theta are the same DOFs under the names [beam] uses.', &
+                           tails=[tail([word_field('dof', 'x y rot all u w theta')], 1, 3, cyclic=.true.)], &
                            repeatable=.true.)
         call s%add_keyword('particles', 'velocity', [selection_field('particles'), &
-                                                     word_field('dof', 'x y rot'), real_field('value', 'm/s or rad/s')], &
+                                                     word_field('dof', dof_words), real_field('value', 'm/s or rad/s')], &
                            'Impose the velocity of one DOF of the selected disks: value times a time '// &
                            'function (none: constant 1).', &
                            tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
         call s%add_keyword('particles', 'force', [selection_field('particles'), &
-                                                  word_field('dof', 'x y rot'), real_field('value', 'N/m or N')], &
+                                                  word_field('dof', dof_words), real_field('value', 'N/m or N')], &
                            'Force per unit thickness (x, y) or torque (rot) on each selected disk, times a '// &
                            'time function (none: constant 1); forces on the same DOF add up.', &
                            tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
         call s%add_keyword('particles', 'initial_velocity', [selection_field('particles'), &
-                                                             word_field('dof', 'x y rot'), real_field('value', 'm/s or rad/s')], &
+                                                             word_field('dof', dof_words), real_field('value', 'm/s or rad/s')], &
                            'Velocity at t = 0 of one free DOF of the selected disks (the others start at '// &
                            'rest); a later record overrides an earlier one.', repeatable=.true.)
+        call s%add_keyword('particles', 'initial_rigid', [selection_field('particles'), &
+                                                          real_field('vx', 'm/s'), real_field('vy', 'm/s'), &
+                                                          real_field('omega', 'rad/s'), &
+                                                          real_field('xc', 'm'), real_field('yc', 'm')], &
+                           'Velocity at t = 0 of a rigid motion of the selected disks: translation (vx, vy) '// &
+                           'plus rotation omega about (xc, yc), so that a disk centred at (x, y) gets (vx - '// &
+                           'omega (y - yc), vy + omega (x - xc)) and the rotation rate omega; a DOF that is '// &
+                           'fixed or imposed must get zero from it. Records apply in deck order with '// &
+                           'initial_velocity.', repeatable=.true.)
     end subroutine add_particles
 
     !> [walls]: straight walls, fixed or driven.

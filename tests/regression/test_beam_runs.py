@@ -64,6 +64,77 @@ def static_lframe(exe, decks, work):
     check("L-frame horizontal tip displacement", abs(tip[0] / u_ref - 1) < 1e-8, f"{tip[0]:.10e} vs {u_ref:.10e}")
 
 
+def static_distributed(exe, decks, work):
+    E, I, L, q, q0 = 2.1e11, 8.0e-8, 2.0, -1500.0, -3000.0
+    with run(exe, decks / "beam_distributed_static.dat", work) as f:
+        d = f["static/displacement"][...]
+        ids = list(f["fem/mesh/node_id"][...])
+        r = f["static/reactions"][...]
+
+    def at(node):
+        return d[ids.index(node)]
+
+    # Consistent nodal forces make Hermite elements nodally exact for any load: round-off of
+    # the banded Cholesky only, rel. 1e-8.
+    cases = [
+        ("cantilever uniform: tip w", at(9)[1], q * L**4 / (8 * E * I)),
+        ("cantilever uniform: tip theta", at(9)[2], q * L**3 / (6 * E * I)),
+        ("cantilever triangular: tip w", at(109)[1], 11 * q0 * L**4 / (120 * E * I)),
+        ("cantilever triangular: tip theta", at(109)[2], q0 * L**3 / (8 * E * I)),
+        ("simply supported uniform: mid w", at(205)[1], 5 * q * L**4 / (384 * E * I)),
+        ("simply supported uniform: theta A", at(201)[2], q * L**3 / (24 * E * I)),
+        ("simply supported uniform: theta B", at(209)[2], -q * L**3 / (24 * E * I)),
+        ("simply supported triangular: mid w", at(305)[1], 5 * q0 * L**4 / (768 * E * I)),
+        ("simply supported triangular: theta A", at(301)[2], 7 * q0 * L**3 / (360 * E * I)),
+        ("simply supported triangular: theta B", at(309)[2], -8 * q0 * L**3 / (360 * E * I)),
+    ]
+    for name, got, ref in cases:
+        check(name, abs(got / ref - 1) < 1e-8, f"{got:.10e} vs {ref:.10e}")
+    # Supports of the triangular simply supported beam carry q0 L/6 and q0 L/3 (rel. 1e-8).
+    check("triangular load: reaction A", abs(r[ids.index(301), 1] / (-q0 * L / 6) - 1) < 1e-8,
+          f"{r[ids.index(301), 1]:.8e} vs {-q0 * L / 6:.8e}")
+    check("triangular load: reaction B", abs(r[ids.index(309), 1] / (-q0 * L / 3) - 1) < 1e-8,
+          f"{r[ids.index(309), 1]:.8e} vs {-q0 * L / 3:.8e}")
+
+
+def static_self_weight(exe, decks, work):
+    E, rho, A, I, L, g, phi = 2.1e11, 7800.0, 1.0e-3, 8.0e-8, 3.0, 9.81, math.radians(30.0)
+    with run(exe, decks / "beam_gravity_static.dat", work) as f:
+        d = f["static/displacement"][...]
+        r = f["static/reactions"][...]
+        xy = f["fem/mesh/coordinates"][...]
+    p = rho * A * g
+    c, s = math.cos(phi), math.sin(phi)
+    qa, qt = -p * s, -p * c
+    ua, wt, th = qa * L**2 / (2 * E * A), qt * L**4 / (8 * E * I), qt * L**3 / (6 * E * I)
+    ref = [ua * c - wt * s, ua * s + wt * c, th]
+    # Nodally exact (consistent loads), round-off only: rel. 1e-8.
+    for k, name in enumerate(["x", "y", "theta"]):
+        check(f"self-weight: tip {name}", abs(d[-1, k] / ref[k] - 1) < 1e-8, f"{d[-1, k]:.10e} vs {ref[k]:.10e}")
+    check("self-weight: clamp carries the weight", abs(r[0, 1] / (p * L) - 1) < 1e-8, f"{r[0, 1]:.8e} vs {p * L:.8e}")
+    check("self-weight: clamp moment", abs(r[0, 2] / (p * L**2 * c / 2) - 1) < 1e-8,
+          f"{r[0, 2]:.8e} vs {p * L**2 * c / 2:.8e}")
+    # Polar line: the last node is at (x1, y1) + L (cos 30, sin 30); 1e-12 L: rounding of cos/sin.
+    end = [0.5 + L * c, 0.2 + L * s]
+    check("polar_line end", bool(np.all(np.abs(xy[-1, :2] - end) < 1e-12 * L)), f"{xy[-1]} vs {end}")
+
+
+def rigid_spin(exe, decks, work):
+    rho_a, L, vx, vy, om, xc, yc = 7800.0 * 1.0e-3, 2.0, 0.5, -0.3, 2.0, 0.7, 0.1
+    with run(exe, decks / "beam_rigid_spin.dat", work) as f:
+        v0 = f["fem/velocity"][0]
+        xy = f["fem/mesh/coordinates"][...]
+        kin0 = f["energy/kinetic"][0]
+    ref = np.stack([vx - om * (xy[:, 1] - yc), vy + om * (xy[:, 0] - xc), np.full(len(xy), om)], axis=1)
+    # Velocities copied from the rigid field: rounding of one product, 1e-14 m/s.
+    check("rigid spin: nodal velocities", bool(np.allclose(v0, ref, rtol=0, atol=1e-14)),
+          f"max dev {np.abs(v0 - ref).max():.2e}")
+    vg = np.array([vx - om * (0.0 - yc), vy + om * (1.0 - xc)])
+    k_ref = 0.5 * rho_a * L * vg @ vg + 0.5 * rho_a * L**3 / 12 * om**2
+    # Consistent mass: exact for rigid fields; round-off of v.M v, rel. 1e-12.
+    check("rigid spin: kinetic energy", abs(kin0 / k_ref - 1) < 1e-12, f"{kin0:.12e} vs {k_ref:.12e}")
+
+
 def modal_cantilever(exe, decks, work):
     E, rho, A, I, L = 1.1e11, 8900.0, 1.2e-4, 1.0e-9, 0.6
     with run(exe, decks / "cantilever_modal.dat", work) as f:
@@ -78,6 +149,26 @@ def modal_cantilever(exe, decks, work):
     check("modal frequencies", bool(np.all(err < 1e-4)), f"relative errors {err}")
     check("modal Hz = rad/s / 2pi", bool(np.allclose(freq, omega / (2 * math.pi), rtol=1e-14)), "")
     check("modal shapes stored", shapes.shape == (4, 25, 3), f"shape {shapes.shape}")
+
+
+def modal_kinds(exe, decks, work):
+    E, rho, A, I, L = 1.1e11, 8900.0, 1.2e-4, 1.0e-9, 0.6
+    with run(exe, decks / "beam_modal_kinds.dat", work) as f:
+        omega = f["modal/omega"][...]
+        frac = f["modal/axial_fraction"][...]
+        kinds = f["modal/axial_fraction"].attrs["kind"]
+        kinds = (kinds.decode() if isinstance(kinds, bytes) else str(kinds)).split()
+    w_axial = math.pi / 2 * math.sqrt(E / rho) / L
+    # 24 linear axial elements, consistent mass: discretisation error ~ (k h)^2/24 ~ 2e-4.
+    check("modal kinds: mode 7 is the first axial mode", abs(omega[6] / w_axial - 1) < 1e-3,
+          f"{omega[6]:.6e} vs {w_axial:.6e}")
+    check("modal kinds: labels", kinds == ["bending"] * 6 + ["axial", "bending"], f"{kinds}")
+    # A straight beam's axial and bending motions decouple exactly: shares 0 and 1 up to the
+    # rounding of the eigenvectors (rel. 1e-10 of the energy).
+    check("modal kinds: axial share of mode 7 is 1", abs(frac[6] - 1) < 1e-10, f"{frac[6]:.3e}")
+    others = np.delete(frac, 6)
+    check("modal kinds: bending modes carry no axial energy", bool(np.all(np.abs(others) < 1e-10)),
+          f"max {np.abs(others).max():.3e}")
 
 
 def dynamic_cantilever(exe, src, work):
@@ -122,7 +213,11 @@ def main():
     decks = src / "tests" / "regression" / "decks"
     static_cantilever(exe, decks, work)
     static_lframe(exe, decks, work)
+    static_distributed(exe, decks, work)
+    static_self_weight(exe, decks, work)
+    rigid_spin(exe, decks, work)
     modal_cantilever(exe, decks, work)
+    modal_kinds(exe, decks, work)
     dynamic_cantilever(exe, src, work)
     print(f"{len(FAILED)} failed checks")
     return 1 if FAILED else 0

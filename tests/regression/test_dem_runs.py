@@ -289,6 +289,23 @@ def unconverged(exe, decks, work):
     check("unconverged: contacts = no stores no network", not has_contacts, "")
 
 
+def rigid_spin(exe, decks, work):
+    rho, R, pitch, vx, vy, om, xc, yc = 2500.0, 0.01, 0.025, 0.5, -0.3, 2.0, 0.02, 0.01
+    f, _ = run(exe, decks / "dem_rigid_spin.dat", work)
+    with f:
+        v0 = f["dem/velocity"][0]
+        kin0 = f["dem/energy/kinetic"][0]
+    x = pitch * np.arange(5)
+    ref = np.stack([np.full(5, vx + om * yc), vy + om * (x - xc), np.full(5, om)], axis=1)
+    # Velocities from the rigid field: rounding of one product, 1e-14 m/s.
+    check("rigid spin: disk velocities", bool(np.allclose(v0, ref, rtol=0, atol=1e-14)),
+          f"max dev {np.abs(v0 - ref).max():.2e}")
+    m = rho * np.pi * R**2
+    k_ref = 0.5 * m * np.sum(ref[:, 0]**2 + ref[:, 1]**2) + 5 * 0.5 * (0.5 * m * R**2) * om**2
+    # Sum of five terms: round-off, rel. 1e-12.
+    check("rigid spin: kinetic energy", abs(kin0 / k_ref - 1) < 1e-12, f"{kin0:.12e} vs {k_ref:.12e}")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--exe", required=True)
@@ -305,6 +322,7 @@ def main():
     small_deposit(exe, decks, work)
     unconverged(exe, decks, work)
     strategies(exe, src, work)
+    rigid_spin(exe, decks, work)
     print(f"{len(FAILED)} failed checks")
     return 1 if FAILED else 0
 
