@@ -18,9 +18,10 @@ module dem_local_problem
     type :: local_problem_t
         !> Components per contact (2 or 3) and number of contacts.
         integer :: dim = 2, n = 0
-        !> W in compressed sparse columns (0-based): column starts (dim n + 1), row indices
-        !> and values (nnz).
+        !> W in compressed sparse columns (0-based): column starts (dim n + 1) and row indices
+        !> (nnz).
         integer, allocatable :: colptr(:), rowind(:)
+        !> W's nonzero values, in the order of rowind (nnz).
         real(wp), allocatable :: values(:)
         !> Free term (dim n), friction coefficients, cohesive impulses r_cohe h and moment
         !> lengths (n).

@@ -493,8 +493,9 @@ contains
         character(len=*), intent(in) :: path
         !> The problem.
         type(local_problem_t), intent(in) :: lp
-        !> Step number and time at its end [s].
+        !> Step number.
         integer, intent(in) :: step
+        !> Time at the end of the step [s].
         real(wp), intent(in) :: time
         !> Siconos error of the solution found by the solver.
         real(wp), intent(in) :: siconos_error

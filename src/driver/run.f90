@@ -182,7 +182,7 @@ contains
             command = command//' --restart '//ck%path
         end function continue_command
 
-        !> --end: a new end time (the models built by `init` do not depend on it, the step
+        !> Option `--end`: a new end time (the models built by `init` do not depend on it, the step
         !> count does).
         subroutine apply_end_time(error)
             type(error_t), allocatable, intent(out) :: error
@@ -210,7 +210,7 @@ contains
             end associate
         end subroutine apply_end_time
 
-        !> --restart: open the checkpoint and check it belongs to this deck, this code and this
+        !> Option `--restart`: open the checkpoint and check it belongs to this deck, this code and this
         !> kind of run, and that it leaves steps to do.
         subroutine open_checkpoint(error)
             type(error_t), allocatable, intent(out) :: error
