@@ -8,7 +8,8 @@ components and type-bound procedures, public variable and abstract interface mus
 (e.g. a comment that FORD reads as metadata and drops) fails too.
 Exit 0: documentation built, nothing missing; 1: something missing or FORD failed;
 77: FORD is not installed (ctest reports the test as skipped).
-Usage (ctest does this): check_api_doc.py --project doc/ford.md --output DIR
+Usage (ctest does this): check_api_doc.py --project doc/ford.md --output DIR [--fypp PROGRAM]
+(FORD reads the .fypp sources through fypp: --fypp names the one the build uses.)
 """
 import argparse
 import contextlib
@@ -85,11 +86,14 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--project", required=True, type=pathlib.Path)
     ap.add_argument("--output", required=True, type=pathlib.Path)
+    ap.add_argument("--fypp", help="fypp program (default: the project file's preprocessor)")
     args = ap.parse_args()
     project_file = args.project.resolve()
     text = project_file.read_text(encoding="utf-8")
     proj_docs, settings = ford.load_settings(text, project_file.parent, project_file.name)
     cli = {"output_dir": str(args.output.resolve()), "quiet": True, "warn": False}
+    if args.fypp:
+        cli["preprocessor"] = args.fypp
     settings, proj_docs = ford.parse_arguments(cli, proj_docs, settings, project_file.parent)
     log = io.StringIO()
     with contextlib.redirect_stdout(log), contextlib.redirect_stderr(log):

@@ -1,7 +1,10 @@
 # Fail when a Fortran source is not formatted as fprettify would format it (STYLE.md 5):
 # indent 4, 132 columns. Inputs: FPRETTIFY (the program), ROOT (the source tree).
-# To fix: fprettify -i 4 -l 132 -r src bench tests/pfunit_fallback
-file(GLOB_RECURSE sources ${ROOT}/src/*.f90 ${ROOT}/bench/*.f90 ${ROOT}/tests/pfunit_fallback/*.f90)
+# fypp sources (src/**/*.fypp) too: fprettify indents the body of each #:for / #:if block.
+# To fix: fprettify -i 4 -l 132 -r src bench tests/pfunit_fallback, and fprettify -i 4 -l 132
+# src/io/hdf5_file.fypp (-r picks Fortran extensions only).
+file(GLOB_RECURSE sources ${ROOT}/src/*.f90 ${ROOT}/src/*.fypp ${ROOT}/bench/*.f90
+    ${ROOT}/tests/pfunit_fallback/*.f90)
 set(bad "")
 foreach(f IN LISTS sources)
     execute_process(COMMAND ${FPRETTIFY} -i 4 -l 132 --diff ${f}
