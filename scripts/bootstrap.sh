@@ -91,8 +91,9 @@ ensure_venv() {
 }
 
 # configure_and_build <build dir> <build type> [extra cmake args...]
-# Configures <build dir> once, then builds every target, or only $MULTICOR_BUILD_TARGET when
-# that is set (e.g. MULTICOR_BUILD_TARGET=multicor for the executable alone).
+# Configures <build dir> once, then builds every target, or only the targets listed in
+# $MULTICOR_BUILD_TARGET when that is set (e.g. MULTICOR_BUILD_TARGET=multicor for the
+# executable alone).
 configure_and_build() {
     local dir="$1" type="$2"
     shift 2
@@ -105,7 +106,8 @@ configure_and_build() {
             || { cat "$dir/configure.log" >&2; die "CMake configuration failed (log: $dir/configure.log)"; }
     fi
     local target=()
-    [ -n "${MULTICOR_BUILD_TARGET:-}" ] && target=(--target "$MULTICOR_BUILD_TARGET")
+    # shellcheck disable=SC2206
+    [ -n "${MULTICOR_BUILD_TARGET:-}" ] && target=(--target $MULTICOR_BUILD_TARGET)
     say "building ($type${MULTICOR_BUILD_TARGET:+, target $MULTICOR_BUILD_TARGET})"
     cmake --build "$dir" -j "$(nproc)" "${target[@]}" >"$dir/build.log" 2>&1 \
         || { tail -n 60 "$dir/build.log" >&2; die "build failed (log: $dir/build.log)"; }

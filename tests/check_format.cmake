@@ -3,19 +3,18 @@
 # fypp sources (src/**/*.fypp) too: fprettify indents the body of each #:for / #:if block.
 # To fix: fprettify -i 4 -l 132 -r src bench tests/pfunit_fallback, and fprettify -i 4 -l 132
 # src/io/hdf5_file.fypp (-r picks Fortran extensions only).
+# One fprettify process for all files (not one Python start-up per file).
 file(GLOB_RECURSE sources ${ROOT}/src/*.f90 ${ROOT}/src/*.fypp ${ROOT}/bench/*.f90
     ${ROOT}/tests/pfunit_fallback/*.f90)
-set(bad "")
-foreach(f IN LISTS sources)
-    execute_process(COMMAND ${FPRETTIFY} -i 4 -l 132 --diff ${f}
-        OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
-    if(NOT rc EQUAL 0 OR NOT out STREQUAL "")
-        message("${out}${err}")
-        list(APPEND bad ${f})
-    endif()
-endforeach()
+execute_process(COMMAND ${FPRETTIFY} -i 4 -l 132 --diff ${sources}
+    OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
 list(LENGTH sources n)
-if(bad)
+# --diff prints a unified diff per file that would change ('--- <file>' header).
+string(REGEX MATCHALL "(^|\n)--- [^\n]*" bad "${out}")
+if(NOT rc EQUAL 0 OR NOT out STREQUAL "")
+    message("${out}${err}")
+    string(REPLACE "\n--- " "" bad "${bad}")
+    string(REPLACE "--- " "" bad "${bad}")
     string(REPLACE ";" "\n  " bad "${bad}")
     message(FATAL_ERROR "not formatted (run fprettify -i 4 -l 132 on them):\n  ${bad}")
 endif()
