@@ -122,8 +122,8 @@ contains
         setup%overlap_line = deck%line('coupling', 'overlap')
         associate (c => setup%config)
             c%weight = weight_config_t(shape=deck%get_word('coupling', 'weight'), &
-                                       s_fe=deck%get_real('coupling', 'overlap', 1), &
-                                       s_particle=deck%get_real('coupling', 'overlap', 2), &
+                                       s_fe=deck%get_real('coupling', 'overlap', 's_fe'), &
+                                       s_particle=deck%get_real('coupling', 'overlap', 's_particle'), &
                                        alpha_min=deck%get_real('coupling', 'alpha_min'), &
                                        constant=deck%get_real('coupling', 'constant'))
             c%thickness = deck%get_real('coupling', 'thickness')
@@ -272,6 +272,7 @@ contains
         real(wp), intent(in) :: s(:), off(:)
         type(error_t), allocatable, intent(out) :: error
         type(deck_entry_t) :: e
+        type(string_t), allocatable :: selections(:)
         integer, allocatable :: list(:)
         character(len=:), allocatable :: message
         real(wp) :: alpha, max_offset
@@ -282,7 +283,7 @@ contains
         e = deck%record('coupling', 'coupled', 1)
         line = e%line
         auto = e%n_values() == 0
-        if (.not. auto) auto = e%word(1) == 'auto'
+        if (.not. auto) auto = e%word('coupled') == 'auto'
         if (auto) then
             if (e%n_values() > 1) then
                 call make_input_error(error, deck%file, line, 'coupled', "'auto' stands alone:"// &
@@ -303,8 +304,9 @@ contains
             return
         end if
         allocate (list(0))
-        do k = 1, e%n_values()
-            call parse_selection(e%word(k), n, first, last, ok, message, 'disks')
+        selections = e%words_from('coupled')
+        do k = 1, size(selections)
+            call parse_selection(selections(k)%s, n, first, last, ok, message, 'disks')
             if (.not. ok) then
                 call make_input_error(error, deck%file, line, 'coupled', message// &
                                       " (or 'auto')")
