@@ -1,4 +1,4 @@
-!> Sorting: small real arrays in place (breakpoint lists, timing samples), and the
+!> Sorting of small real arrays in place (breakpoint lists, timing samples), and the
 !> permutation that sorts integer keys (deck ids, node pairs), stable, in O(n log n).
 module core_sort
     use core_kinds, only: wp, i8

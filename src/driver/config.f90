@@ -20,6 +20,7 @@ module driver_config
     use fem_beam_config, only: beam_config_t, dof_u, dof_w, dof_theta, beam_element_load_t, &
                                load_x, load_y, load_axial, load_transverse
     use io_deck, only: deck_t, deck_entry_t
+    use driver_run_kind, only: run_kind_of, run_particles
     implicit none
     private
     public :: run_config_t, build_config, max_steps, build_run_settings, steps_to_end
@@ -107,7 +108,7 @@ contains
         !> Error naming file, line and keyword, if any.
         type(error_t), allocatable, intent(out) :: error
         integer, allocatable :: section_ids(:), function_ids(:), fix_line(:, :)
-        if (particles_only(deck)) then
+        if (run_kind_of(deck) == run_particles) then
             call build_particles_only(deck, run, beam, error)
             return
         end if
@@ -131,21 +132,6 @@ contains
         if (allocated(error)) return
         call build_initial(deck, beam, fix_line, run, error)
     end subroutine build_config
-
-    !> Whether the deck has [particles] entries and no [beam] entry.
-    pure logical function particles_only(deck)
-        !> The deck.
-        type(deck_t), intent(in) :: deck
-        integer :: i
-        logical :: beam, particles
-        beam = .false.
-        particles = .false.
-        do i = 1, size(deck%entries)
-            beam = beam .or. deck%entries(i)%section == 'beam'
-            particles = particles .or. deck%entries(i)%section == 'particles'
-        end do
-        particles_only = particles .and. .not. beam
-    end function particles_only
 
     !> Configuration of a deck without [beam]: an empty frame, the time functions, the run
     !> settings (a time integration: particles have no static or modal analysis).

@@ -35,7 +35,7 @@ module driver_config_coupling
     use driver_config_dem, only: dem_config_t
     implicit none
     private
-    public :: coupled_setup_t, deck_has_coupling, build_coupling_config, disk_abscissa
+    public :: coupled_setup_t, build_coupling_config, disk_abscissa
 
     !> The coupling of a deck, with what the driver reports and stores about it.
     type :: coupled_setup_t
@@ -48,19 +48,6 @@ module driver_config_coupling
     end type coupled_setup_t
 
 contains
-
-    !> Whether the deck has [coupling] entries.
-    pure logical function deck_has_coupling(deck)
-        !> The deck.
-        type(deck_t), intent(in) :: deck
-        integer :: i
-        deck_has_coupling = .false.
-        do i = 1, size(deck%entries)
-            if (deck%entries(i)%section /= 'coupling') cycle
-            deck_has_coupling = .true.
-            return
-        end do
-    end function deck_has_coupling
 
     !> Line of the first gravity record, [beam] or [particles] (0 when neither has one).
     pure integer function first_gravity_line(deck) result(line)

@@ -33,8 +33,7 @@ module driver_config_dem
     use driver_config, only: run_config_t
     implicit none
     private
-    public :: dem_config_t, build_dem_config, deck_has_particles, deck_has_beam
-    public :: check_particle_keywords_unused, check_beam_keywords_unused
+    public :: dem_config_t, build_dem_config
     public :: default_alert_ratio, overlap_tolerance, default_gap_ratio
 
     !> Default alert distance as a fraction of the mean disk radius.
@@ -69,92 +68,6 @@ module driver_config_dem
     end type dem_config_t
 
 contains
-
-    !> Whether the deck has [particles] entries.
-    pure logical function deck_has_particles(deck)
-        !> The deck.
-        type(deck_t), intent(in) :: deck
-        deck_has_particles = has_section(deck, 'particles')
-    end function deck_has_particles
-
-    !> Whether the deck has [beam] entries.
-    pure logical function deck_has_beam(deck)
-        !> The deck.
-        type(deck_t), intent(in) :: deck
-        deck_has_beam = has_section(deck, 'beam')
-    end function deck_has_beam
-
-    !> Whether any entry of the deck belongs to `section`.
-    pure logical function has_section(deck, section)
-        type(deck_t), intent(in) :: deck
-        character(len=*), intent(in) :: section
-        integer :: i
-        has_section = .false.
-        do i = 1, size(deck%entries)
-            if (deck%entries(i)%section == section) then
-                has_section = .true.
-                return
-            end if
-        end do
-    end function has_section
-
-    !> Error for a deck without [particles] that sets particle-only keywords ([walls],
-    !> [contacts], [solver], [time] theta, [output] contacts): they would have no effect.
-    subroutine check_particle_keywords_unused(deck, error)
-        !> The deck.
-        type(deck_t), intent(in) :: deck
-        !> Error naming the first such keyword, if any.
-        type(error_t), allocatable, intent(out) :: error
-        integer :: i
-        do i = 1, size(deck%entries)
-            associate (e => deck%entries(i))
-                select case (e%section)
-                case ('walls', 'contacts', 'solver')
-                case ('time')
-                    if (e%keyword /= 'theta') cycle
-                case ('output')
-                    if (e%keyword /= 'contacts') cycle
-                case default
-                    cycle
-                end select
-                call make_input_error(error, deck%file, e%line, e%keyword, '['//e%section// &
-                                      '] '//e%keyword//' applies to particles, and this deck has no [particles]'// &
-                                      ': remove it or add particles')
-                return
-            end associate
-        end do
-    end subroutine check_particle_keywords_unused
-
-    !> Error for a deck of particles without [beam] that sets beam-only keywords ([time]
-    !> scheme, beta, gamma, [modal], [initial]): they would have no effect.
-    subroutine check_beam_keywords_unused(deck, error)
-        !> The deck.
-        type(deck_t), intent(in) :: deck
-        !> Error naming the first such keyword, if any.
-        type(error_t), allocatable, intent(out) :: error
-        integer :: i
-        do i = 1, size(deck%entries)
-            associate (e => deck%entries(i))
-                select case (e%section)
-                case ('modal')
-                case ('initial')
-                    call make_input_error(error, deck%file, e%line, e%keyword, '[initial] '// &
-                                          'sets beam nodes, and this deck has no [beam]; the initial velocities '// &
-                                          'of disks are [particles] initial_velocity records')
-                    return
-                case ('time')
-                    if (e%keyword /= 'scheme' .and. e%keyword /= 'beta' .and. &
-                        e%keyword /= 'gamma') cycle
-                case default
-                    cycle
-                end select
-                call make_input_error(error, deck%file, e%line, e%keyword, '['//e%section// &
-                                      '] '//e%keyword//' applies to the beam, and this deck has no [beam]: '// &
-                                      'remove it (particles use [time] theta)')
-                return
-            end associate
-        end do
-    end subroutine check_beam_keywords_unused
 
     !> Build the discrete-element system of a deck with [particles].
     subroutine build_dem_config(deck, run, functions, cfg, error)
@@ -818,8 +731,7 @@ contains
         text = trim(adjustl(buf))
     end function length_text
 
-    !> Error: a record refers (by its `function` value) to a time function id that is not
-    !> defined.
+    !> Error for a record whose `function` value is the id of no time function.
     subroutine unknown_function(deck, e, error)
         !> The deck.
         type(deck_t), intent(in) :: deck

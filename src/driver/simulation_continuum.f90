@@ -23,14 +23,13 @@ module driver_simulation_continuum
     use fem_dynamic_operator, only: spd_factor_t
     use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
     use driver_config, only: run_config_t, build_run_settings
-    use driver_config_dem, only: check_particle_keywords_unused
     use driver_results, only: results_writer_t
     use driver_checkpoint, only: checkpoint_run_t
     use driver_results_continuum, only: continuum_writer_t
     use driver_simulation, only: simulation_t, report_iface
     implicit none
     private
-    public :: continuum_simulation_t, deck_has_continuum
+    public :: continuum_simulation_t
 
     !> A 2D continuum run.
     type, extends(simulation_t) :: continuum_simulation_t
@@ -55,17 +54,6 @@ module driver_simulation_continuum
 
 contains
 
-    !> Whether the deck has [continuum] entries.
-    pure logical function deck_has_continuum(deck)
-        !> The deck.
-        type(deck_t), intent(in) :: deck
-        integer :: i
-        deck_has_continuum = .false.
-        do i = 1, size(deck%entries)
-            if (deck%entries(i)%section == 'continuum' .and. deck%entries(i)%line > 0) deck_has_continuum = .true.
-        end do
-    end function deck_has_continuum
-
     !> Mesh, model, boundary conditions, loads, run settings and integrator from the deck.
     subroutine continuum_init(self, deck, report, error)
         !> The simulation.
@@ -81,17 +69,8 @@ contains
         type(deck_entry_t), allocatable :: list(:)
         character(len=:), allocatable :: message
         logical :: lumped
-        integer :: k, line
+        integer :: line
         self%deck_file = deck%file
-        call check_particle_keywords_unused(deck, error)
-        if (allocated(error)) return
-        do k = 1, size(deck%entries)
-            if (deck%entries(k)%section == 'initial' .and. deck%entries(k)%line > 0) then
-                call make_input_error(error, deck%file, deck%entries(k)%line, deck%entries(k)%keyword, &
-                                      '[initial] sets beam dofs; the continuum takes [continuum] initial_velocity')
-                return
-            end if
-        end do
         call build_mesh(error)
         if (allocated(error)) return
         call self%model%init(mesh, error)
