@@ -14,14 +14,16 @@ module driver_config
     use core_kinds, only: wp, i8
     use core_constants, only: relative_roundoff, deg_to_rad
     use core_error, only: error_t, make_input_error
-    use core_strings, only: to_str
+    use core_strings, only: string_t, to_str
+    use core_sort, only: sort_index
     use core_timefunc, only: tf_constant, tf_ramp, tf_step, tf_table, tf_harmonic
     use fem_beam_config, only: beam_config_t, dof_u, dof_w, dof_theta, beam_element_load_t, &
                                load_x, load_y, load_axial, load_transverse
     use io_deck, only: deck_t, deck_entry_t
+    use driver_run_kind, only: run_kind_of, run_particles
     implicit none
     private
-    public :: run_config_t, build_config, find_id, max_steps, build_run_settings, steps_to_end
+    public :: run_config_t, build_config, max_steps, build_run_settings, steps_to_end
 
     !> Largest number of time steps of a run. The step counter is 64-bit; the bound is that of
     !> the 32-bit step counts stored in the results file (/summary steps, /dem/solver).
@@ -106,7 +108,7 @@ contains
         !> Error naming file, line and keyword, if any.
         type(error_t), allocatable, intent(out) :: error
         integer, allocatable :: section_ids(:), function_ids(:), fix_line(:, :)
-        if (particles_only(deck)) then
+        if (run_kind_of(deck) == run_particles) then
             call build_particles_only(deck, run, beam, error)
             return
         end if
@@ -122,29 +124,14 @@ contains
         if (allocated(error)) return
         call build_distributed_loads(deck, function_ids, beam, error)
         if (allocated(error)) return
-        beam%gravity = [deck%get_real('beam', 'gravity', 1), deck%get_real('beam', 'gravity', 2)]
+        beam%gravity = [deck%get_real('beam', 'gravity', 'gx'), deck%get_real('beam', 'gravity', 'gy')]
         beam%lumped_mass = deck%get_word('beam', 'mass') == 'lumped'
-        beam%rayleigh_a0 = deck%get_real('beam', 'rayleigh', 1)
-        beam%rayleigh_a1 = deck%get_real('beam', 'rayleigh', 2)
+        beam%rayleigh_a0 = deck%get_real('beam', 'rayleigh', 'a0')
+        beam%rayleigh_a1 = deck%get_real('beam', 'rayleigh', 'a1')
         call build_run(deck, beam, run, error)
         if (allocated(error)) return
         call build_initial(deck, beam, fix_line, run, error)
     end subroutine build_config
-
-    !> Whether the deck has [particles] entries and no [beam] entry.
-    pure logical function particles_only(deck)
-        !> The deck.
-        type(deck_t), intent(in) :: deck
-        integer :: i
-        logical :: beam, particles
-        beam = .false.
-        particles = .false.
-        do i = 1, size(deck%entries)
-            beam = beam .or. deck%entries(i)%section == 'beam'
-            particles = particles .or. deck%entries(i)%section == 'particles'
-        end do
-        particles_only = particles .and. .not. beam
-    end function particles_only
 
     !> Configuration of a deck without [beam]: an empty frame, the time functions, the run
     !> settings (a time integration: particles have no static or modal analysis).
@@ -191,18 +178,18 @@ contains
         allocate (beam%sections(n), ids(n))
         do i = 1, n
             e = list(i)
-            ids(i) = e%int(1)
-            j = find_id(ids(:i - 1), ids(i))
+            ids(i) = e%int('id')
+            j = findloc(ids(:i - 1), ids(i), dim=1)
             if (j > 0) then
                 call make_input_error(error, deck%file, e%line, 'section', &
                                       'duplicate section id '// &
                                       to_str(ids(i))//': already defined on line '//to_str(list(j)%line))
                 return
             end if
-            beam%sections(i)%young = e%real(2)
-            beam%sections(i)%density = e%real(3)
-            beam%sections(i)%area = e%real(4)
-            beam%sections(i)%inertia = e%real(5)
+            beam%sections(i)%young = e%real('young')
+            beam%sections(i)%density = e%real('density')
+            beam%sections(i)%area = e%real('area')
+            beam%sections(i)%inertia = e%real('inertia')
         end do
     end subroutine build_sections
 
@@ -263,13 +250,13 @@ contains
                 case ('element')
                     total_elements = total_elements + 1
                 case ('line', 'polar_line')
-                    if (e%int(1) > huge(0) - e%int(6)) then
+                    if (e%int('first_node') > huge(0) - e%int('elements')) then
                         call make_input_error(error, deck%file, e%line, e%keyword, 'node ids '// &
-                                              e%word(1)//' + '//e%word(6)//' exceed the largest integer')
+                                              e%word('first_node')//' + '//e%word('elements')//' exceed the largest integer')
                         return
                     end if
-                    total_nodes = total_nodes + e%int(6) + 1
-                    total_elements = total_elements + e%int(6)
+                    total_nodes = total_nodes + e%int('elements') + 1
+                    total_elements = total_elements + e%int('elements')
                 end select
             end associate
         end do
@@ -291,18 +278,18 @@ contains
                 select case (e%keyword)
                 case ('node')
                     n_nodes = n_nodes + 1
-                    nodes(n_nodes) = node_candidate_t(e%int(1), e%real(2), e%real(3), 0.0_wp, &
+                    nodes(n_nodes) = node_candidate_t(e%int('id'), e%real('x'), e%real('y'), 0.0_wp, &
                                                       e%line, .false.)
                 case ('element')
                     n_elements = n_elements + 1
-                    elements(n_elements) = element_candidate_t(e%int(1), [e%int(2), e%int(3)], &
-                                                               e%int(4), e%line, .false.)
+                    elements(n_elements) = element_candidate_t(e%int('id'), [e%int('node1'), e%int('node2')], &
+                                                               e%int('section'), e%line, .false.)
                 case ('line', 'polar_line')
-                    first = e%int(1)
-                    x1 = e%real(2)
-                    y1 = e%real(3)
+                    first = e%int('first_node')
+                    x1 = e%real('x1')
+                    y1 = e%real('y1')
                     call line_end(e, x2, y2)
-                    ne = e%int(6)
+                    ne = e%int('elements')
                     length = hypot(x2 - x1, y2 - y1)
                     if (length <= coincidence*size_model) then
                         call make_input_error(error, deck%file, e%line, e%keyword, &
@@ -319,7 +306,7 @@ contains
                     do j = 1, ne
                         n_elements = n_elements + 1
                         elements(n_elements) = element_candidate_t(0, [first + j - 1, first + j], &
-                                                                   e%int(7), e%line, .true.)
+                                                                   e%int('section'), e%line, .true.)
                     end do
                 end select
             end associate
@@ -335,12 +322,12 @@ contains
         real(wp), intent(out) :: x2, y2
         real(wp) :: angle
         if (e%keyword == 'polar_line') then
-            angle = e%real(5)*deg_to_rad
-            x2 = e%real(2) + e%real(4)*cos(angle)
-            y2 = e%real(3) + e%real(4)*sin(angle)
+            angle = e%real('angle_deg')*deg_to_rad
+            x2 = e%real('x1') + e%real('length')*cos(angle)
+            y2 = e%real('y1') + e%real('length')*sin(angle)
         else
-            x2 = e%real(4)
-            y2 = e%real(5)
+            x2 = e%real('x2')
+            y2 = e%real('y2')
         end if
     end subroutine line_end
 
@@ -372,15 +359,15 @@ contains
         do i = 1, size(deck%entries)
             associate (e => deck%entries(i))
                 if (e%section /= 'beam') cycle
-                if (e%keyword == 'node' .or. e%keyword == 'line' .or. e%keyword == 'polar_line') then
-                    lo = min(lo, [e%real(2), e%real(3)])
-                    hi = max(hi, [e%real(2), e%real(3)])
-                end if
-                if (e%keyword == 'line' .or. e%keyword == 'polar_line') then
+                select case (e%keyword)
+                case ('node')
+                    lo = min(lo, [e%real('x'), e%real('y')])
+                    hi = max(hi, [e%real('x'), e%real('y')])
+                case ('line', 'polar_line')
                     call line_end(e, x2, y2)
-                    lo = min(lo, [x2, y2])
-                    hi = max(hi, [x2, y2])
-                end if
+                    lo = min(lo, [e%real('x1'), e%real('y1')], [x2, y2])
+                    hi = max(hi, [e%real('x1'), e%real('y1')], [x2, y2])
+                end select
             end associate
         end do
         size_model = 0.0_wp
@@ -495,7 +482,7 @@ contains
                         return
                     end if
                 end do
-                beam%elem_section(i) = find_id(section_ids, c%section)
+                beam%elem_section(i) = findloc(section_ids, c%section, dim=1)
                 if (beam%elem_section(i) == 0) then
                     call make_input_error(error, deck%file, c%line, trim(kw), 'section '// &
                                           to_str(c%section)//' is not defined (no [beam] section '// &
@@ -567,50 +554,52 @@ contains
         type(error_t), allocatable, intent(out) :: error
         type(deck_entry_t), allocatable :: list(:)
         type(deck_entry_t) :: e
-        real(wp), allocatable :: tail(:)
+        type(string_t), allocatable :: times(:)
+        real(wp), allocatable :: pairs(:)
         integer :: i, j, n
         allocate (list, source=deck%records('functions', 'function'))
         n = size(list)
         allocate (beam%functions(n), ids(n))
         do i = 1, n
             e = list(i)
-            ids(i) = e%int(1)
-            j = find_id(ids(:i - 1), ids(i))
+            ids(i) = e%int('id')
+            j = findloc(ids(:i - 1), ids(i), dim=1)
             if (j > 0) then
                 call make_input_error(error, deck%file, e%line, 'function', &
                                       'duplicate function id '// &
                                       to_str(ids(i))//': already defined on line '//to_str(list(j)%line))
                 return
             end if
-            tail = e%reals_from(3)
             associate (f => beam%functions(i))
-                select case (e%word(2))
+                f%p = 0.0_wp
+                select case (e%word('kind'))
                 case ('constant')
                     f%kind = tf_constant
+                    f%p(1) = e%real('c')
                 case ('ramp')
                     f%kind = tf_ramp
+                    f%p(1) = e%real('t1')
                 case ('step')
                     f%kind = tf_step
+                    f%p(1) = e%real('t0')
                 case ('harmonic')
                     f%kind = tf_harmonic
+                    f%p(1:2) = [e%real('freq'), e%real('phase')]
                 case ('table')
                     f%kind = tf_table
-                end select
-                if (f%kind == tf_table) then
-                    f%t = tail(1::2)
-                    f%f = tail(2::2)
+                    pairs = e%reals_from('t')
+                    f%t = pairs(1::2)
+                    f%f = pairs(2::2)
+                    times = e%words_from('t')
                     do j = 2, size(f%t)
                         if (f%t(j) <= f%t(j - 1)) then
                             call make_input_error(error, deck%file, e%line, 'function', &
                                                   'table times must increase strictly: t = '// &
-                                                  e%word(2*j + 1)//' follows t = '//e%word(2*j - 1))
+                                                  times(2*j - 1)%s//' follows t = '//times(2*j - 3)%s)
                             return
                         end if
                     end do
-                else
-                    f%p = 0.0_wp
-                    f%p(:size(tail)) = tail
-                end if
+                end select
             end associate
         end do
     end subroutine build_functions
@@ -627,6 +616,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         type(deck_entry_t), allocatable :: list(:)
         type(deck_entry_t) :: e
+        type(string_t), allocatable :: dofs(:)
         integer :: i, k, node, dof
         allocate (beam%fixed(3, size(beam%x)), fix_line(3, size(beam%x)))
         beam%fixed = .false.
@@ -634,16 +624,17 @@ contains
         allocate (list, source=deck%records('beam', 'fix'))
         do i = 1, size(list)
             e = list(i)
-            node = find_node(beam%node_id, e%int(1))
+            node = find_node(beam%node_id, e%int('node'))
             if (node == 0) then
                 call unknown_node(deck, e, 'fix', error)
                 return
             end if
-            do k = 2, e%n_values()
-                if (e%word(k) == 'all') then
+            dofs = e%words_from('dof')
+            do k = 1, size(dofs)
+                if (dofs(k)%s == 'all') then
                     where (fix_line(:, node) == 0) fix_line(:, node) = e%line
                 else
-                    dof = dof_index(e%word(k))
+                    dof = dof_index(dofs(k)%s)
                     if (fix_line(dof, node) == 0) fix_line(dof, node) = e%line
                 end if
             end do
@@ -671,23 +662,23 @@ contains
         do i = 1, size(list)
             e = list(i)
             associate (load => beam%loads(i))
-                load%node = find_node(beam%node_id, e%int(1))
+                load%node = find_node(beam%node_id, e%int('node'))
                 if (load%node == 0) then
                     call unknown_node(deck, e, 'load', error)
                     return
                 end if
-                load%dof = dof_index(e%word(2))
+                load%dof = dof_index(e%word('dof'))
                 if (fix_line(load%dof, load%node) > 0) then
                     call on_fixed_dof(deck, e, 'load', fix_line(load%dof, load%node), error)
                     return
                 end if
-                load%value = e%real(3)
+                load%value = e%real('value')
                 load%func = 0
-                if (e%n_values() >= 4) then
-                    load%func = find_id(function_ids, e%int(4))
+                if (e%has('function')) then
+                    load%func = findloc(function_ids, e%int('function'), dim=1)
                     if (load%func == 0) then
                         call make_input_error(error, deck%file, e%line, 'load', 'function '// &
-                                              e%word(4)//' is not defined (no [functions] '// &
+                                              e%word('function')//' is not defined (no [functions] '// &
                                               'function record with this id)')
                         return
                     end if
@@ -717,11 +708,11 @@ contains
         allocate (beam%element_loads(0))
         do i = 1, size(list)
             associate (e => list(i))
-                a = find_node(beam%node_id, e%int(1))
-                b = find_node(beam%node_id, e%int(2))
+                a = find_node(beam%node_id, e%int('node_a'))
+                b = find_node(beam%node_id, e%int('node_b'))
                 if (a == 0 .or. b == 0) then
                     call make_input_error(error, deck%file, e%line, 'distributed', 'node '// &
-                                          e%word(merge(1, 2, a == 0))//' is not defined (no node '// &
+                                          e%word(merge('node_a', 'node_b', a == 0))//' is not defined (no node '// &
                                           'or line record creates it)')
                     return
                 end if
@@ -732,7 +723,7 @@ contains
                                           'range of elements and the direction of the load variation)')
                     return
                 end if
-                select case (e%word(3))
+                select case (e%word('direction'))
                 case ('x')
                     direction = load_x
                 case ('y')
@@ -742,21 +733,21 @@ contains
                 case default
                     direction = load_transverse
                 end select
-                qa = e%real(4)
+                qa = e%real('q_a')
                 qb = qa
-                if (e%n_values() >= 5) qb = e%real(5)
+                if (e%has('q_b')) qb = e%real('q_b')
                 func = 0
-                if (e%n_values() >= 6) then
-                    func = find_id(function_ids, e%int(6))
+                if (e%has('function')) then
+                    func = findloc(function_ids, e%int('function'), dim=1)
                     if (func == 0) then
                         call make_input_error(error, deck%file, e%line, 'distributed', 'function '// &
-                                              e%word(6)//' is not defined (no [functions] '// &
+                                              e%word('function')//' is not defined (no [functions] '// &
                                               'function record with this id)')
                         return
                     end if
                 end if
-                lo = min(e%int(1), e%int(2))
-                hi = max(e%int(1), e%int(2))
+                lo = min(e%int('node_a'), e%int('node_b'))
+                hi = max(e%int('node_a'), e%int('node_b'))
                 do el = 1, size(beam%conn, 2)
                     selected(el) = all(beam%node_id(beam%conn(:, el)) >= lo .and. &
                                        beam%node_id(beam%conn(:, el)) <= hi)
@@ -764,7 +755,7 @@ contains
                 n = count(selected)
                 if (n == 0) then
                     call make_input_error(error, deck%file, e%line, 'distributed', 'no element '// &
-                                          'has both nodes with ids from '//e%word(1)//' to '//e%word(2))
+                                          'has both nodes with ids from '//e%word('node_a')//' to '//e%word('node_b'))
                     return
                 end if
                 if (allocated(loads)) deallocate (loads)
@@ -925,14 +916,14 @@ contains
             real(wp) :: v(3)
             do i = 1, size(list)
                 associate (e => list(i))
-                    lo = min(e%int(1), e%int(2))
-                    hi = max(e%int(1), e%int(2))
+                    lo = min(e%int('node_a'), e%int('node_b'))
+                    hi = max(e%int('node_a'), e%int('node_b'))
                     count_nodes = 0
                     do node = 1, size(beam%x)
                         if (beam%node_id(node) < lo .or. beam%node_id(node) > hi) cycle
                         count_nodes = count_nodes + 1
-                        v = [e%real(3) - e%real(5)*(beam%y(node) - e%real(7)), &
-                             e%real(4) + e%real(5)*(beam%x(node) - e%real(6)), e%real(5)]
+                        v = [e%real('vx') - e%real('omega')*(beam%y(node) - e%real('yc')), &
+                             e%real('vy') + e%real('omega')*(beam%x(node) - e%real('xc')), e%real('omega')]
                         do dof = 1, 3
                             if (fix_line(dof, node) == 0) then
                                 run%v0(dof, node) = v(dof)
@@ -949,7 +940,7 @@ contains
                     end do
                     if (count_nodes == 0) then
                         call make_input_error(error, deck%file, e%line, 'rigid', 'no node has an id '// &
-                                              'from '//e%word(1)//' to '//e%word(2))
+                                              'from '//e%word('node_a')//' to '//e%word('node_b'))
                         return
                     end if
                 end associate
@@ -962,17 +953,17 @@ contains
             real(wp), intent(inout) :: values(:, :)
             integer :: i, node, dof
             do i = 1, size(list)
-                node = find_node(beam%node_id, list(i)%int(1))
+                node = find_node(beam%node_id, list(i)%int('node'))
                 if (node == 0) then
                     call unknown_node(deck, list(i), list(i)%keyword, error)
                     return
                 end if
-                dof = dof_index(list(i)%word(2))
+                dof = dof_index(list(i)%word('dof'))
                 if (fix_line(dof, node) > 0) then
                     call on_fixed_dof(deck, list(i), list(i)%keyword, fix_line(dof, node), error)
                     return
                 end if
-                values(dof, node) = list(i)%real(3)
+                values(dof, node) = list(i)%real('value')
             end do
         end subroutine fill
     end subroutine build_initial
@@ -991,7 +982,7 @@ contains
         character(len=*), intent(in) :: keyword
         !> The error.
         type(error_t), allocatable, intent(out) :: error
-        call make_input_error(error, deck%file, e%line, keyword, 'node '//e%word(1)// &
+        call make_input_error(error, deck%file, e%line, keyword, 'node '//e%word('node')// &
                               ' is not defined (no node or line record creates it)')
     end subroutine unknown_node
 
@@ -1007,8 +998,8 @@ contains
         integer, intent(in) :: fixed_on
         !> The error.
         type(error_t), allocatable, intent(out) :: error
-        call make_input_error(error, deck%file, e%line, keyword, 'DOF '//e%word(2)//' of node '// &
-                              e%word(1)//' is fixed (fix on line '//to_str(fixed_on)// &
+        call make_input_error(error, deck%file, e%line, keyword, 'DOF '//e%word('dof')//' of node '// &
+                              e%word('node')//' is fixed (fix on line '//to_str(fixed_on)// &
                               '); a '//keyword//' applies only to a free DOF')
     end subroutine on_fixed_dof
 
@@ -1035,18 +1026,6 @@ contains
         end select
     end function dof_index
 
-    !> Position of `id` in a short unsorted list (0 if absent).
-    pure integer function find_id(ids, id) result(k)
-        !> Ids.
-        integer, intent(in) :: ids(:)
-        !> Id wanted.
-        integer, intent(in) :: id
-        do k = 1, size(ids)
-            if (ids(k) == id) return
-        end do
-        k = 0
-    end function find_id
-
     !> Node index of a deck node id (binary search in the increasing ids; 0 if absent).
     pure integer function find_node(node_id, id) result(k)
         !> Deck ids of the nodes, increasing.
@@ -1067,38 +1046,4 @@ contains
         end do
         k = 0
     end function find_node
-
-    !> Permutation sorting `keys` in increasing order; stable (merge sort).
-    pure function sort_index(keys) result(order)
-        !> Keys.
-        integer(i8), intent(in) :: keys(:)
-        integer, allocatable :: order(:)
-        integer, allocatable :: buffer(:)
-        integer :: n, width, lo, mid, hi, i, j, k
-        n = size(keys)
-        order = [(i, i=1, n)]
-        allocate (buffer(n))
-        width = 1
-        do while (width < n)
-            do lo = 1, n, 2*width
-                mid = min(lo + width, n + 1)
-                hi = min(lo + 2*width, n + 1)
-                i = lo
-                j = mid
-                do k = lo, hi - 1
-                    ! min() keeps the indices valid: Fortran does not short-circuit .or.
-                    if (i < mid .and. (j >= hi .or. &
-                                       keys(order(min(i, n))) <= keys(order(min(j, n))))) then
-                        buffer(k) = order(i)
-                        i = i + 1
-                    else
-                        buffer(k) = order(j)
-                        j = j + 1
-                    end if
-                end do
-            end do
-            order = buffer
-            width = 2*width
-        end do
-    end function sort_index
 end module driver_config

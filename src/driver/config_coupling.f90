@@ -35,7 +35,7 @@ module driver_config_coupling
     use driver_config_dem, only: dem_config_t
     implicit none
     private
-    public :: coupled_setup_t, deck_has_coupling, build_coupling_config, disk_abscissa
+    public :: coupled_setup_t, build_coupling_config, disk_abscissa
 
     !> The coupling of a deck, with what the driver reports and stores about it.
     type :: coupled_setup_t
@@ -48,19 +48,6 @@ module driver_config_coupling
     end type coupled_setup_t
 
 contains
-
-    !> Whether the deck has [coupling] entries.
-    pure logical function deck_has_coupling(deck)
-        !> The deck.
-        type(deck_t), intent(in) :: deck
-        integer :: i
-        deck_has_coupling = .false.
-        do i = 1, size(deck%entries)
-            if (deck%entries(i)%section /= 'coupling') cycle
-            deck_has_coupling = .true.
-            return
-        end do
-    end function deck_has_coupling
 
     !> Line of the first gravity record, [beam] or [particles] (0 when neither has one).
     pure integer function first_gravity_line(deck) result(line)
@@ -122,8 +109,8 @@ contains
         setup%overlap_line = deck%line('coupling', 'overlap')
         associate (c => setup%config)
             c%weight = weight_config_t(shape=deck%get_word('coupling', 'weight'), &
-                                       s_fe=deck%get_real('coupling', 'overlap', 1), &
-                                       s_particle=deck%get_real('coupling', 'overlap', 2), &
+                                       s_fe=deck%get_real('coupling', 'overlap', 's_fe'), &
+                                       s_particle=deck%get_real('coupling', 'overlap', 's_particle'), &
                                        alpha_min=deck%get_real('coupling', 'alpha_min'), &
                                        constant=deck%get_real('coupling', 'constant'))
             c%thickness = deck%get_real('coupling', 'thickness')
@@ -272,6 +259,7 @@ contains
         real(wp), intent(in) :: s(:), off(:)
         type(error_t), allocatable, intent(out) :: error
         type(deck_entry_t) :: e
+        type(string_t), allocatable :: selections(:)
         integer, allocatable :: list(:)
         character(len=:), allocatable :: message
         real(wp) :: alpha, max_offset
@@ -282,7 +270,7 @@ contains
         e = deck%record('coupling', 'coupled', 1)
         line = e%line
         auto = e%n_values() == 0
-        if (.not. auto) auto = e%word(1) == 'auto'
+        if (.not. auto) auto = e%word('coupled') == 'auto'
         if (auto) then
             if (e%n_values() > 1) then
                 call make_input_error(error, deck%file, line, 'coupled', "'auto' stands alone:"// &
@@ -303,8 +291,9 @@ contains
             return
         end if
         allocate (list(0))
-        do k = 1, e%n_values()
-            call parse_selection(e%word(k), n, first, last, ok, message, 'disks')
+        selections = e%words_from('coupled')
+        do k = 1, size(selections)
+            call parse_selection(selections(k)%s, n, first, last, ok, message, 'disks')
             if (.not. ok) then
                 call make_input_error(error, deck%file, line, 'coupled', message// &
                                       " (or 'auto')")

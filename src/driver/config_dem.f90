@@ -16,7 +16,7 @@ module driver_config_dem
     use core_kinds, only: wp, i8
     use core_constants, only: deg_to_rad
     use core_error, only: error_t, make_input_error
-    use core_strings, only: to_str
+    use core_strings, only: string_t, to_str
     use core_timefunc, only: time_function_t
     use io_deck, only: deck_t, deck_entry_t
     use io_deck_schema, only: parse_selection
@@ -30,11 +30,10 @@ module driver_config_dem
     use dem_detection, only: detector_t, detect_contacts
     use dem_moreau_jean, only: dem_system_t
     use dem_nlgs, only: nlgs_method_nlgs, nlgs_method_block, criterion_lmgc90, criterion_siconos
-    use driver_config, only: run_config_t, find_id
+    use driver_config, only: run_config_t
     implicit none
     private
-    public :: dem_config_t, build_dem_config, deck_has_particles, deck_has_beam
-    public :: check_particle_keywords_unused, check_beam_keywords_unused
+    public :: dem_config_t, build_dem_config
     public :: default_alert_ratio, overlap_tolerance, default_gap_ratio
 
     !> Default alert distance as a fraction of the mean disk radius.
@@ -70,92 +69,6 @@ module driver_config_dem
 
 contains
 
-    !> Whether the deck has [particles] entries.
-    pure logical function deck_has_particles(deck)
-        !> The deck.
-        type(deck_t), intent(in) :: deck
-        deck_has_particles = has_section(deck, 'particles')
-    end function deck_has_particles
-
-    !> Whether the deck has [beam] entries.
-    pure logical function deck_has_beam(deck)
-        !> The deck.
-        type(deck_t), intent(in) :: deck
-        deck_has_beam = has_section(deck, 'beam')
-    end function deck_has_beam
-
-    !> Whether any entry of the deck belongs to `section`.
-    pure logical function has_section(deck, section)
-        type(deck_t), intent(in) :: deck
-        character(len=*), intent(in) :: section
-        integer :: i
-        has_section = .false.
-        do i = 1, size(deck%entries)
-            if (deck%entries(i)%section == section) then
-                has_section = .true.
-                return
-            end if
-        end do
-    end function has_section
-
-    !> Error for a deck without [particles] that sets particle-only keywords ([walls],
-    !> [contacts], [solver], [time] theta, [output] contacts): they would have no effect.
-    subroutine check_particle_keywords_unused(deck, error)
-        !> The deck.
-        type(deck_t), intent(in) :: deck
-        !> Error naming the first such keyword, if any.
-        type(error_t), allocatable, intent(out) :: error
-        integer :: i
-        do i = 1, size(deck%entries)
-            associate (e => deck%entries(i))
-                select case (e%section)
-                case ('walls', 'contacts', 'solver')
-                case ('time')
-                    if (e%keyword /= 'theta') cycle
-                case ('output')
-                    if (e%keyword /= 'contacts') cycle
-                case default
-                    cycle
-                end select
-                call make_input_error(error, deck%file, e%line, e%keyword, '['//e%section// &
-                                      '] '//e%keyword//' applies to particles, and this deck has no [particles]'// &
-                                      ': remove it or add particles')
-                return
-            end associate
-        end do
-    end subroutine check_particle_keywords_unused
-
-    !> Error for a deck of particles without [beam] that sets beam-only keywords ([time]
-    !> scheme, beta, gamma, [modal], [initial]): they would have no effect.
-    subroutine check_beam_keywords_unused(deck, error)
-        !> The deck.
-        type(deck_t), intent(in) :: deck
-        !> Error naming the first such keyword, if any.
-        type(error_t), allocatable, intent(out) :: error
-        integer :: i
-        do i = 1, size(deck%entries)
-            associate (e => deck%entries(i))
-                select case (e%section)
-                case ('modal')
-                case ('initial')
-                    call make_input_error(error, deck%file, e%line, e%keyword, '[initial] '// &
-                                          'sets beam nodes, and this deck has no [beam]; the initial velocities '// &
-                                          'of disks are [particles] initial_velocity records')
-                    return
-                case ('time')
-                    if (e%keyword /= 'scheme' .and. e%keyword /= 'beta' .and. &
-                        e%keyword /= 'gamma') cycle
-                case default
-                    cycle
-                end select
-                call make_input_error(error, deck%file, e%line, e%keyword, '['//e%section// &
-                                      '] '//e%keyword//' applies to the beam, and this deck has no [beam]: '// &
-                                      'remove it (particles use [time] theta)')
-                return
-            end associate
-        end do
-    end subroutine check_beam_keywords_unused
-
     !> Build the discrete-element system of a deck with [particles].
     subroutine build_dem_config(deck, run, functions, cfg, error)
         !> Deck read by io_deck::read_deck with the MULTICOR schema.
@@ -176,7 +89,7 @@ contains
         allocate (list, source=deck%records('functions', 'function'))
         allocate (function_ids(size(list)))
         do i = 1, size(list)
-            function_ids(i) = list(i)%int(1)
+            function_ids(i) = list(i)%int('id')
         end do
         call build_materials(deck, cfg, density, error)
         if (allocated(error)) return
@@ -184,8 +97,8 @@ contains
         if (allocated(error)) return
         cfg%system%particles%functions = functions
         cfg%system%walls%functions = functions
-        cfg%system%particles%gravity = [deck%get_real('particles', 'gravity', 1), &
-                                        deck%get_real('particles', 'gravity', 2)]
+        cfg%system%particles%gravity = [deck%get_real('particles', 'gravity', 'gx'), &
+                                        deck%get_real('particles', 'gravity', 'gy')]
         call build_walls(deck, function_ids, cfg, error)
         if (allocated(error)) return
         call build_conditions(deck, function_ids, cfg, error)
@@ -211,12 +124,12 @@ contains
         allocate (list, source=deck%records('particles', 'material'))
         allocate (cfg%material_id(size(list)), density(size(list)))
         do i = 1, size(list)
-            cfg%material_id(i) = list(i)%int(1)
-            density(i) = list(i)%real(2)
-            j = find_id(cfg%material_id(:i - 1), cfg%material_id(i))
+            cfg%material_id(i) = list(i)%int('id')
+            density(i) = list(i)%real('density')
+            j = findloc(cfg%material_id(:i - 1), cfg%material_id(i), dim=1)
             if (j > 0) then
                 call make_input_error(error, deck%file, list(i)%line, 'material', &
-                                      'duplicate material id '//list(i)%word(1)//': already defined on line '// &
+                                      'duplicate material id '//list(i)%word('id')//': already defined on line '// &
                                       to_str(list(j)%line))
                 return
             end if
@@ -249,9 +162,9 @@ contains
                 case ('disk')
                     total = total + 1
                 case ('row', 'deposit')
-                    total = total + e%int(1)
+                    total = total + e%int('n')
                 case ('square_lattice', 'hex_lattice')
-                    total = total + int(e%int(1), i8)*int(e%int(2), i8)
+                    total = total + int(e%int('nx'), i8)*int(e%int('ny'), i8)
                 end select
             end associate
         end do
@@ -279,10 +192,10 @@ contains
                 end select
                 call generate(e, gx, gy, gr, error)
                 if (allocated(error)) return
-                k = material_index(e%int(material_field(e%keyword)))
+                k = material_index(e%int('material'))
                 if (k == 0) then
                     call make_input_error(error, deck%file, e%line, e%keyword, 'material '// &
-                                          e%word(material_field(e%keyword))//' is not defined (no [particles] '// &
+                                          e%word('material')//' is not defined (no [particles] '// &
                                           'material record with this id)')
                     return
                 end if
@@ -305,7 +218,7 @@ contains
         !> Position of the material with deck id `id` (0 if none).
         integer function material_index(id)
             integer, intent(in) :: id
-            material_index = find_id(cfg%material_id, id)
+            material_index = findloc(cfg%material_id, id, dim=1)
         end function material_index
 
         !> Centres and radii of one record.
@@ -317,35 +230,35 @@ contains
             character(len=:), allocatable :: message
             select case (e%keyword)
             case ('disk')
-                gx = [e%real(1)]
-                gy = [e%real(2)]
-                gr = [e%real(3)]
+                gx = [e%real('x')]
+                gy = [e%real('y')]
+                gr = [e%real('radius')]
             case ('row')
-                call generate_row(e%int(1), e%real(2), e%real(3), e%real(4), e%real(6), &
-                                  e%real(7)*deg_to_rad, gx, gy, gr, error)
+                call generate_row(e%int('n'), e%real('x0'), e%real('y0'), e%real('radius'), e%real('gap'), &
+                                  e%real('angle_deg')*deg_to_rad, gx, gy, gr, error)
             case ('square_lattice')
-                call generate_square_lattice(e%int(1), e%int(2), e%real(3), e%real(4), &
-                                             e%real(5), e%real(7), gx, gy, gr, error)
+                call generate_square_lattice(e%int('nx'), e%int('ny'), e%real('x0'), e%real('y0'), &
+                                             e%real('radius'), e%real('gap'), gx, gy, gr, error)
             case ('hex_lattice')
-                call generate_hex_lattice(e%int(1), e%int(2), e%real(3), e%real(4), &
-                                          e%real(5), e%real(7), gx, gy, gr, error)
+                call generate_hex_lattice(e%int('nx'), e%int('ny'), e%real('x0'), e%real('y0'), &
+                                          e%real('radius'), e%real('gap'), gx, gy, gr, error)
             case ('deposit')
                 gap_ratio = default_gap_ratio
-                if (e%n_values() >= 9) gap_ratio = e%real(9)
-                if (e%real(6) < e%real(5)) then
+                if (e%has('gap_ratio')) gap_ratio = e%real('gap_ratio')
+                if (e%real('rmax') < e%real('rmin')) then
                     call make_input_error(error, deck%file, e%line, e%keyword, 'rmax '// &
-                                          e%word(6)//' is smaller than rmin '//e%word(5))
+                                          e%word('rmax')//' is smaller than rmin '//e%word('rmin'))
                     return
                 end if
-                pitch = 2.0_wp*e%real(6)*(1.0_wp + gap_ratio)
-                if (e%real(3) - e%real(2) < pitch) then
+                pitch = 2.0_wp*e%real('rmax')*(1.0_wp + gap_ratio)
+                if (e%real('xmax') - e%real('xmin') < pitch) then
                     call make_input_error(error, deck%file, e%line, e%keyword, 'the box from '// &
-                                          'xmin = '//e%word(2)//' to xmax = '//e%word(3)//' is narrower than one '// &
+                                          'xmin = '//e%word('xmin')//' to xmax = '//e%word('xmax')//' is narrower than one '// &
                                           'site 2 rmax (1 + gap_ratio) = '//to_str(pitch)//' m')
                     return
                 end if
-                call generate_random_deposit(e%int(1), e%real(2), e%real(3), e%real(4), &
-                                             e%real(5), e%real(6), gap_ratio, e%int(8), gx, gy, gr, error)
+                call generate_random_deposit(e%int('n'), e%real('xmin'), e%real('xmax'), e%real('ymin'), &
+                                             e%real('rmin'), e%real('rmax'), gap_ratio, e%int('seed'), gx, gy, gr, error)
             end select
             if (allocated(error)) then
                 message = error%message
@@ -353,22 +266,6 @@ contains
             end if
         end subroutine generate
     end subroutine build_disks
-
-    !> Position of the material field in a disk-creating record.
-    pure integer function material_field(keyword)
-        !> disk, row, square_lattice, hex_lattice or deposit.
-        character(len=*), intent(in) :: keyword
-        select case (keyword)
-        case ('disk')
-            material_field = 4
-        case ('row')
-            material_field = 5
-        case ('deposit')
-            material_field = 7
-        case default
-            material_field = 6
-        end select
-    end function material_field
 
     !> Walls: 4, 5, 7 or 8 values; known material and function; non-zero length.
     subroutine build_walls(deck, function_ids, cfg, error)
@@ -383,47 +280,46 @@ contains
         type(deck_entry_t), allocatable :: list(:)
         real(wp) :: vx, vy, length, size_model
         character(len=:), allocatable :: message
-        integer :: i, nv, mat, func
+        integer :: i, mat, func
         allocate (list, source=deck%records('walls', 'wall'))
         allocate (cfg%wall_line(size(list)))
         size_model = model_size(cfg, list)
         do i = 1, size(list)
             associate (e => list(i))
                 cfg%wall_line(i) = e%line
-                nv = e%n_values()
-                if (nv == 6) then
+                if (e%has('vx') .and. .not. e%has('vy')) then
                     call make_input_error(error, deck%file, e%line, 'wall', 'the wall velocity '// &
                                           "needs both vx and vy: expected 'x1 y1 x2 y2 [material] [vx vy "// &
                                           "[function]]', got 6 values")
                     return
                 end if
                 mat = 1
-                if (nv >= 5) then
-                    mat = find_id(cfg%material_id, e%int(5))
+                if (e%has('material')) then
+                    mat = findloc(cfg%material_id, e%int('material'), dim=1)
                     if (mat == 0) then
                         call make_input_error(error, deck%file, e%line, 'wall', 'material '// &
-                                              e%word(5)//' is not defined (no [particles] material record with '// &
+                                              e%word('material')//' is not defined (no [particles] material record with '// &
                                               'this id)')
                         return
                     end if
                 end if
-                vx = e%real(6)
-                vy = e%real(7)
+                vx = e%real('vx')
+                vy = e%real('vy')
                 func = 0
-                if (nv == 8) then
-                    func = find_id(function_ids, e%int(8))
+                if (e%has('function')) then
+                    func = findloc(function_ids, e%int('function'), dim=1)
                     if (func == 0) then
-                        call unknown_function(deck, e, 8, error)
+                        call unknown_function(deck, e, error)
                         return
                     end if
                 end if
-                length = hypot(e%real(3) - e%real(1), e%real(4) - e%real(2))
+                length = hypot(e%real('x2') - e%real('x1'), e%real('y2') - e%real('y1'))
                 if (length <= 1.0e-9_wp*size_model) then
                     call make_input_error(error, deck%file, e%line, 'wall', &
                                           'zero-length wall: (x1, y1) and (x2, y2) coincide')
                     return
                 end if
-                call walls_add(cfg%system%walls, e%real(1), e%real(2), e%real(3), e%real(4), &
+                call walls_add(cfg%system%walls, e%real('x1'), e%real('y1'), e%real('x2'), e%real('y2'), &
                                error, mat=mat, vx=vx, vy=vy, func=func)
                 if (allocated(error)) then
                     message = error%message
@@ -446,8 +342,10 @@ contains
             hi = [maxval(p%x(1:p%n) + p%radius(1:p%n)), maxval(p%y(1:p%n) + p%radius(1:p%n))]
         end associate
         do i = 1, size(walls)
-            lo = min(lo, [walls(i)%real(1), walls(i)%real(2)], [walls(i)%real(3), walls(i)%real(4)])
-            hi = max(hi, [walls(i)%real(1), walls(i)%real(2)], [walls(i)%real(3), walls(i)%real(4)])
+            associate (w => walls(i))
+                lo = min(lo, [w%real('x1'), w%real('y1')], [w%real('x2'), w%real('y2')])
+                hi = max(hi, [w%real('x1'), w%real('y1')], [w%real('x2'), w%real('y2')])
+            end associate
         end do
         size_model = hypot(hi(1) - lo(1), hi(2) - lo(2))
     end function model_size
@@ -496,31 +394,33 @@ contains
             integer, intent(out) :: first, last
             character(len=:), allocatable :: message
             logical :: ok
-            call parse_selection(e%word(1), cfg%system%particles%n, first, last, ok, message, &
+            call parse_selection(e%word('particles'), cfg%system%particles%n, first, last, ok, message, &
                                  'disks')
             if (.not. ok) call make_input_error(error, deck%file, e%line, e%keyword, message)
         end subroutine select_disks
 
-        !> Time function index of field k of a record (0 if absent); error if unknown.
-        integer function function_of(e, k)
+        !> Time function index of the `function` value of a record (0 if absent); error if
+        !> unknown.
+        integer function function_of(e)
             type(deck_entry_t), intent(in) :: e
-            integer, intent(in) :: k
             function_of = 0
-            if (e%n_values() < k) return
-            function_of = find_id(function_ids, e%int(k))
-            if (function_of == 0) call unknown_function(deck, e, k, error)
+            if (.not. e%has('function')) return
+            function_of = findloc(function_ids, e%int('function'), dim=1)
+            if (function_of == 0) call unknown_function(deck, e, error)
         end function function_of
 
         !> A `fix` or `velocity` record.
         subroutine constrain(e)
             type(deck_entry_t), intent(in) :: e
             integer :: first, last, j, k, dof, func
+            type(string_t), allocatable :: words(:)
             character(len=:), allocatable :: word
             call select_disks(e, first, last)
             if (allocated(error)) return
             if (e%keyword == 'fix') then
-                do k = 2, e%n_values()
-                    word = e%word(k)
+                words = e%words_from('dof')
+                do k = 1, size(words)
+                    word = words(k)%s
                     do dof = 1, 3
                         if (word /= 'all' .and. dof_index(word) /= dof) cycle
                         do j = first, last
@@ -537,15 +437,15 @@ contains
                     end do
                 end do
             else
-                dof = dof_index(e%word(2))
-                func = function_of(e, 4)
+                dof = dof_index(e%word('dof'))
+                func = function_of(e)
                 if (allocated(error)) return
                 do j = first, last
                     if (state(dof, j) /= free) then
                         call conflict(e, j, dof, 'cannot also have an imposed velocity')
                         return
                     end if
-                    call particles_impose_velocity(cfg%system%particles, j, dof, e%real(3), &
+                    call particles_impose_velocity(cfg%system%particles, j, dof, e%real('value'), &
                                                    error, func)
                     if (allocated(error)) return
                     state(dof, j) = imposed
@@ -560,9 +460,9 @@ contains
             integer :: first, last, j, dof, func
             call select_disks(e, first, last)
             if (allocated(error)) return
-            dof = dof_index(e%word(2))
+            dof = dof_index(e%word('dof'))
             func = 0
-            if (e%keyword == 'force') func = function_of(e, 4)
+            if (e%keyword == 'force') func = function_of(e)
             if (allocated(error)) return
             do j = first, last
                 if (state(dof, j) /= free) then
@@ -572,16 +472,16 @@ contains
                     return
                 end if
                 if (e%keyword == 'force') then
-                    call particles_add_load(cfg%system%particles, j, dof, e%real(3), error, func)
+                    call particles_add_load(cfg%system%particles, j, dof, e%real('value'), error, func)
                     if (allocated(error)) return
                 else
                     select case (dof)
                     case (dof_x)
-                        cfg%system%particles%vx(j) = e%real(3)
+                        cfg%system%particles%vx(j) = e%real('value')
                     case (dof_y)
-                        cfg%system%particles%vy(j) = e%real(3)
+                        cfg%system%particles%vy(j) = e%real('value')
                     case default
-                        cfg%system%particles%w(j) = e%real(3)
+                        cfg%system%particles%w(j) = e%real('value')
                     end select
                 end if
             end do
@@ -598,8 +498,8 @@ contains
             if (allocated(error)) return
             associate (p => cfg%system%particles)
                 do j = first, last
-                    v = [e%real(2) - e%real(4)*(p%y(j) - e%real(6)), &
-                         e%real(3) + e%real(4)*(p%x(j) - e%real(5)), e%real(4)]
+                    v = [e%real('vx') - e%real('omega')*(p%y(j) - e%real('yc')), &
+                         e%real('vy') + e%real('omega')*(p%x(j) - e%real('xc')), e%real('omega')]
                     do dof = 1, 3
                         if (state(dof, j) /= free .and. v(dof) /= 0.0_wp) then
                             call conflict(e, j, dof, 'cannot take the rigid velocity '//to_str(v(dof))// &
@@ -650,12 +550,12 @@ contains
             associate (e => list(i))
                 call material_pair(deck, cfg, e, 'law', law_line, a, b, error)
                 if (allocated(error)) return
-                if (e%n_values() >= 6) then
-                    call materials_set_pair(cfg%system%materials, a, b, e%real(3), e%real(4), &
-                                            e%real(5), error, rolling=e%real(6))
+                if (e%has('rolling')) then
+                    call materials_set_pair(cfg%system%materials, a, b, e%real('mu'), e%real('restitution'), &
+                                            e%real('cohesion'), error, rolling=e%real('rolling'))
                 else
-                    call materials_set_pair(cfg%system%materials, a, b, e%real(3), e%real(4), &
-                                            e%real(5), error)
+                    call materials_set_pair(cfg%system%materials, a, b, e%real('mu'), e%real('restitution'), &
+                                            e%real('cohesion'), error)
                 end if
                 if (allocated(error)) then
                     message = error%message
@@ -677,22 +577,23 @@ contains
         integer, intent(inout) :: seen(:, :)
         integer, intent(out) :: a, b
         type(error_t), allocatable, intent(out) :: error
+        character(len=*), parameter :: fields(2) = ['material1', 'material2']
         integer :: k
         a = 0
         b = 0
         do k = 1, 2
-            if (find_id(cfg%material_id, e%int(k)) == 0) then
+            if (findloc(cfg%material_id, e%int(fields(k)), dim=1) == 0) then
                 call make_input_error(error, deck%file, e%line, keyword, 'material '// &
-                                      e%word(k)//' is not defined (no [particles] material record with '// &
+                                      e%word(fields(k))//' is not defined (no [particles] material record with '// &
                                       'this id)')
                 return
             end if
         end do
-        a = find_id(cfg%material_id, e%int(1))
-        b = find_id(cfg%material_id, e%int(2))
+        a = findloc(cfg%material_id, e%int('material1'), dim=1)
+        b = findloc(cfg%material_id, e%int('material2'), dim=1)
         if (seen(a, b) > 0) then
             call make_input_error(error, deck%file, e%line, keyword, 'the '//keyword//' between '// &
-                                  'materials '//e%word(1)//' and '//e%word(2)//' is already given on '// &
+                                  'materials '//e%word('material1')//' and '//e%word('material2')//' is already given on '// &
                                   'line '//to_str(seen(a, b)))
             return
         end if
@@ -719,20 +620,20 @@ contains
                 call material_pair(deck, cfg, e, 'bond', bond_line, a, b, error)
                 if (allocated(error)) return
                 if (law_line(a, b) == 0) then
-                    call make_input_error(error, deck%file, e%line, 'bond', 'materials '//e%word(1)// &
-                                          ' and '//e%word(2)//' have no law: give them a [contacts] law with '// &
+                    call make_input_error(error, deck%file, e%line, 'bond', 'materials '//e%word('material1')// &
+                                          ' and '//e%word('material2')//' have no law: give them a [contacts] law with '// &
                                           'cohesion > 0, or the bond would never form')
                     return
                 end if
                 if (.not. cfg%system%materials%cohesion(a, b) > 0.0_wp) then
                     call make_input_error(error, deck%file, e%line, 'bond', 'the law of materials '// &
-                                          e%word(1)//' and '//e%word(2)//' (line '//to_str(law_line(a, b))// &
+                                          e%word('material1')//' and '//e%word('material2')//' (line '//to_str(law_line(a, b))// &
                                           ') has no cohesion: bonds form only between cohesive materials')
                     return
                 end if
                 e_b = bond_e_default
-                if (e%n_values() >= 4) e_b = e%real(4)
-                call materials_set_bond(cfg%system%materials, a, b, e%real(3), e_b, error)
+                if (e%has('e_b')) e_b = e%real('e_b')
+                call materials_set_bond(cfg%system%materials, a, b, e%real('mu_b'), e_b, error)
                 if (allocated(error)) then
                     message = error%message
                     call make_input_error(error, deck%file, e%line, 'bond', message)
@@ -830,17 +731,15 @@ contains
         text = trim(adjustl(buf))
     end function length_text
 
-    !> Error: a record refers to a time function id that is not defined.
-    subroutine unknown_function(deck, e, k, error)
+    !> Error for a record whose `function` value is the id of no time function.
+    subroutine unknown_function(deck, e, error)
         !> The deck.
         type(deck_t), intent(in) :: deck
         !> The record.
         type(deck_entry_t), intent(in) :: e
-        !> Field holding the function id.
-        integer, intent(in) :: k
         !> The error.
         type(error_t), allocatable, intent(out) :: error
-        call make_input_error(error, deck%file, e%line, e%keyword, 'function '//e%word(k)// &
+        call make_input_error(error, deck%file, e%line, e%keyword, 'function '//e%word('function')// &
                               ' is not defined (no [functions] function record with this id)')
     end subroutine unknown_function
 

@@ -257,18 +257,18 @@ contains
                 associate (e => deck%entries(k))
                     select case (e%section//' '//e%keyword)
                     case ('particles row', 'particles deposit')
-                        n_disks = n_disks + e%int(1)
+                        n_disks = n_disks + e%int('n')
                     case ('particles square_lattice', 'particles hex_lattice')
-                        n_disks = n_disks + int(e%int(1), i8)*int(e%int(2), i8)
+                        n_disks = n_disks + int(e%int('nx'), i8)*int(e%int('ny'), i8)
                     case ('beam line')
-                        m = e%int(6)
+                        m = e%int('elements')
                         n_nodes = n_nodes + m + 1
                         n_elements = n_elements + m
                     case ('continuum mesh')
                         ! A Q4 or T3 keeps ~6 kB (4 triplet copies of 64 entries, sparse K and M,
                         ! a CHOLMOD factor of ~100 nonzeros per dof): 32 beam elements' worth.
-                        if (e%word(1) == 'rectangle') n_elements = n_elements + 32_i8*int(e%int(6), i8)* &
-                                                                   int(e%int(7), i8)*merge(2, 1, e%word(8) == 't3')
+                        if (e%word('kind') == 'rectangle') n_elements = n_elements + 32_i8*int(e%int('nx'), i8)* &
+                                                                        int(e%int('ny'), i8)*merge(2, 1, e%word('element') == 't3')
                     end select
                 end associate
             end do

@@ -14,7 +14,6 @@ module driver_simulation_beam
     use fem_modal, only: solve_modal, mode_axial_fraction, mode_kind, dominant_fraction
     use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
     use driver_config, only: run_config_t, build_config
-    use driver_config_dem, only: check_particle_keywords_unused
     use driver_results, only: results_writer_t
     use driver_checkpoint, only: checkpoint_run_t, loop_state_t, checkpoint_create, checkpoint_commit, &
                                  checkpoint_discard, save_integrator, load_integrator, save_results, load_results
@@ -55,8 +54,6 @@ contains
         !> Set on any input error.
         type(error_t), allocatable, intent(out) :: error
         character(len=:), allocatable :: message
-        call check_particle_keywords_unused(deck, error)
-        if (allocated(error)) return
         call build_config(deck, self%settings, self%beam, error)
         if (allocated(error)) return
         call build_beam_model(self%beam, self%model, error)

@@ -9,7 +9,7 @@ module driver_simulation_continuum
     use core_kinds, only: wp, i8
     use core_constants, only: two_pi
     use core_error, only: error_t, make_error, make_input_error
-    use core_strings, only: to_str
+    use core_strings, only: string_t, to_str
     use core_signals, only: caught_signal, signal_name
     use io_deck, only: deck_t, deck_entry_t
     use io_paths, only: basename, stem
@@ -23,14 +23,13 @@ module driver_simulation_continuum
     use fem_dynamic_operator, only: spd_factor_t
     use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
     use driver_config, only: run_config_t, build_run_settings
-    use driver_config_dem, only: check_particle_keywords_unused
     use driver_results, only: results_writer_t
     use driver_checkpoint, only: checkpoint_run_t
     use driver_results_continuum, only: continuum_writer_t
     use driver_simulation, only: simulation_t, report_iface
     implicit none
     private
-    public :: continuum_simulation_t, deck_has_continuum
+    public :: continuum_simulation_t
 
     !> A 2D continuum run.
     type, extends(simulation_t) :: continuum_simulation_t
@@ -55,17 +54,6 @@ module driver_simulation_continuum
 
 contains
 
-    !> Whether the deck has [continuum] entries.
-    pure logical function deck_has_continuum(deck)
-        !> The deck.
-        type(deck_t), intent(in) :: deck
-        integer :: i
-        deck_has_continuum = .false.
-        do i = 1, size(deck%entries)
-            if (deck%entries(i)%section == 'continuum' .and. deck%entries(i)%line > 0) deck_has_continuum = .true.
-        end do
-    end function deck_has_continuum
-
     !> Mesh, model, boundary conditions, loads, run settings and integrator from the deck.
     subroutine continuum_init(self, deck, report, error)
         !> The simulation.
@@ -81,17 +69,8 @@ contains
         type(deck_entry_t), allocatable :: list(:)
         character(len=:), allocatable :: message
         logical :: lumped
-        integer :: k, line
+        integer :: line
         self%deck_file = deck%file
-        call check_particle_keywords_unused(deck, error)
-        if (allocated(error)) return
-        do k = 1, size(deck%entries)
-            if (deck%entries(k)%section == 'initial' .and. deck%entries(k)%line > 0) then
-                call make_input_error(error, deck%file, deck%entries(k)%line, deck%entries(k)%keyword, &
-                                      '[initial] sets beam dofs; the continuum takes [continuum] initial_velocity')
-                return
-            end if
-        end do
         call build_mesh(error)
         if (allocated(error)) return
         call self%model%init(mesh, error)
@@ -104,8 +83,8 @@ contains
         call set_loads(error)
         if (allocated(error)) return
         lumped = deck%get_word('continuum', 'mass') == 'lumped'
-        call self%ops%build(self%model, lumped, deck%get_real('continuum', 'rayleigh', 1), &
-                            deck%get_real('continuum', 'rayleigh', 2), error)
+        call self%ops%build(self%model, lumped, deck%get_real('continuum', 'rayleigh', 'a0'), &
+                            deck%get_real('continuum', 'rayleigh', 'a1'), error)
         if (allocated(error)) call fail_at(error, deck%line('continuum', 'mesh'), 'mesh')
         if (allocated(error)) return
         call build_run_settings(deck, self%ops%n_free, lumped, 'continuum', self%settings, error)
@@ -154,11 +133,11 @@ contains
                 return
             end if
             e = deck%record('continuum', 'mesh', 1)
-            if (e%word(1) == 'rectangle') then
-                call rectangle_mesh(e%real(2), e%real(2) + e%real(4), e%real(3), e%real(3) + e%real(5), &
-                                    e%int(6), e%int(7), e%word(8) == 't3', mesh, error)
+            if (e%word('kind') == 'rectangle') then
+                call rectangle_mesh(e%real('x0'), e%real('x0') + e%real('lx'), e%real('y0'), e%real('y0') + e%real('ly'), &
+                                    e%int('nx'), e%int('ny'), e%word('element') == 't3', mesh, error)
             else
-                path = e%word(2)
+                path = e%word('path')
                 if (path(1:1) /= '/') path = folder(deck%file)//path
                 call read_gmsh(path, mesh, error)
                 if (.not. allocated(error)) then
@@ -196,11 +175,12 @@ contains
             end if
             do i = 1, size(list)
                 e = list(i)
-                call make_elastic2d(e%real(1), e%real(2), e%real(3), e%real(4), e%word(5) == 'plane_strain', mat, error)
+                call make_elastic2d(e%real('young'), e%real('poisson'), e%real('density'), e%real('thickness'), &
+                                    e%word('hypothesis') == 'plane_strain', mat, error)
                 if (allocated(error)) call fail_at(error, e%line, 'material')
                 if (allocated(error)) return
                 set = 'all'
-                if (e%n_values() >= 6) set = e%word(6)
+                if (e%has('element_set')) set = e%word('element_set')
                 call self%model%set_material(set, mat, error)
                 if (allocated(error)) call fail_at(error, e%line, 'material')
                 if (allocated(error)) return
@@ -212,12 +192,14 @@ contains
         !> Supports (fix) and prescribed displacements.
         subroutine set_constraints(error)
             type(error_t), allocatable, intent(out) :: error
+            type(string_t), allocatable :: components(:)
             integer :: i, j
             list = deck%records('continuum', 'fix')
             do i = 1, size(list)
                 e = list(i)
-                do j = 2, e%n_values()
-                    call self%model%prescribe_set(e%word(1), component(e%word(j)), 0.0_wp, error)
+                components = e%words_from('component')
+                do j = 1, size(components)
+                    call self%model%prescribe_set(e%word('node_set'), component(components(j)%s), 0.0_wp, error)
                     if (allocated(error)) call fail_at(error, e%line, 'fix')
                     if (allocated(error)) return
                 end do
@@ -225,7 +207,7 @@ contains
             list = deck%records('continuum', 'displacement')
             do i = 1, size(list)
                 e = list(i)
-                call self%model%prescribe_set(e%word(1), component(e%word(2)), e%real(3), error)
+                call self%model%prescribe_set(e%word('node_set'), component(e%word('component')), e%real('value'), error)
                 if (allocated(error)) call fail_at(error, e%line, 'displacement')
                 if (allocated(error)) return
             end do
@@ -239,27 +221,27 @@ contains
             list = deck%records('continuum', 'load')
             do i = 1, size(list)
                 e = list(i)
-                call self%model%mesh%node_set(e%word(1), ids, error)
+                call self%model%mesh%node_set(e%word('node_set'), ids, error)
                 if (allocated(error)) call fail_at(error, e%line, 'load')
                 if (allocated(error)) return
                 do j = 1, size(ids)
-                    call self%model%add_nodal_load(ids(j), component(e%word(2)), e%real(3))
+                    call self%model%add_nodal_load(ids(j), component(e%word('component')), e%real('value'))
                 end do
             end do
             list = deck%records('continuum', 'traction')
             do i = 1, size(list)
                 e = list(i)
-                if (e%word(4) == 'parabolic') then
-                    call add_parabolic(self%model, e%word(1), [e%real(2), e%real(3)], error)
+                if (e%word('profile') == 'parabolic') then
+                    call add_parabolic(self%model, e%word('edge_set'), [e%real('tx'), e%real('ty')], error)
                 else
-                    call self%model%add_traction(e%word(1), [e%real(2), e%real(3)], error)
+                    call self%model%add_traction(e%word('edge_set'), [e%real('tx'), e%real('ty')], error)
                 end if
                 if (allocated(error)) call fail_at(error, e%line, 'traction')
                 if (allocated(error)) return
             end do
-            if (deck%get_real('continuum', 'gravity', 1) /= 0 .or. deck%get_real('continuum', 'gravity', 2) /= 0) then
-                call self%model%add_body_force([deck%get_real('continuum', 'gravity', 1), &
-                                                deck%get_real('continuum', 'gravity', 2)], error)
+            if (deck%get_real('continuum', 'gravity', 'gx') /= 0 .or. deck%get_real('continuum', 'gravity', 'gy') /= 0) then
+                call self%model%add_body_force([deck%get_real('continuum', 'gravity', 'gx'), &
+                                                deck%get_real('continuum', 'gravity', 'gy')], error)
                 if (allocated(error)) call fail_at(error, deck%line('continuum', 'gravity'), 'gravity')
                 if (allocated(error)) return
             end if
@@ -271,7 +253,7 @@ contains
             integer :: i
             list = deck%records('continuum', 'material')
             do i = 1, size(list)
-                if (list(i)%real(3) > 0) cycle
+                if (list(i)%real('density') > 0) cycle
                 call make_input_error(error, deck%file, list(i)%line, 'material', 'a '// &
                                       deck%get_word('run', 'analysis')//' analysis needs a density > 0 (the mass '// &
                                       'matrix must be positive definite)')
@@ -286,15 +268,13 @@ contains
             integer, allocatable :: eq(:)
             real(wp) :: vx, vy, omega, xc, yc
             integer :: a, n, c
+            ! The rotation about (xc, yc) is optional: an absent value reads as 0.
             e = deck%record('continuum', 'initial_velocity', 1)
-            vx = deck%get_real('continuum', 'initial_velocity', 1)
-            vy = deck%get_real('continuum', 'initial_velocity', 2)
-            omega = 0.0_wp
-            xc = 0.0_wp
-            yc = 0.0_wp
-            if (e%n_values() >= 3) omega = e%real(3)
-            if (e%n_values() >= 4) xc = e%real(4)
-            if (e%n_values() >= 5) yc = e%real(5)
+            vx = deck%get_real('continuum', 'initial_velocity', 'vx')
+            vy = deck%get_real('continuum', 'initial_velocity', 'vy')
+            omega = e%real('omega')
+            xc = e%real('xc')
+            yc = e%real('yc')
             allocate (v_all(self%model%dof_count()))
             do a = 1, self%model%mesh%node_count()
                 v_all(2*a - 1) = vx - omega*(self%model%mesh%x(2, a) - yc)

@@ -7,7 +7,7 @@ module driver_simulation_dem
     use fem_beam_config, only: beam_config_t
     use dem_detection, only: coordinate_limit
     use driver_config, only: run_config_t, build_config
-    use driver_config_dem, only: dem_config_t, build_dem_config, check_beam_keywords_unused
+    use driver_config_dem, only: dem_config_t, build_dem_config
     use driver_run_dem, only: run_dem
     use driver_results, only: results_writer_t
     use driver_checkpoint, only: checkpoint_run_t
@@ -43,8 +43,6 @@ contains
         procedure(report_iface) :: report
         !> Set on any input error.
         type(error_t), allocatable, intent(out) :: error
-        call check_beam_keywords_unused(deck, error)
-        if (allocated(error)) return
         call build_config(deck, self%settings, self%beam, error)
         if (allocated(error)) return
         call build_dem_config(deck, self%settings, self%beam%functions, self%dem, error)

@@ -1,17 +1,16 @@
-!> Which kind of run a deck asks for, from its sections: [beam] alone is a finite-element run,
-!> [particles] alone a discrete-element run, both a coupled (Arlequin) run that needs a
-!> [coupling] section; [coupling] without both models is an error. [continuum] alone is a 2D
-!> continuum run (not yet coupled to the others).
+!> The simulation extension of a deck's kind of run (driver_run_kind): [beam] alone is a
+!> finite-element run, [particles] alone a discrete-element run, both a coupled (Arlequin)
+!> run, [continuum] alone a 2D continuum run.
 module driver_simulations
-    use core_error, only: error_t, make_input_error
+    use core_error, only: error_t
     use io_deck, only: deck_t
-    use driver_config_dem, only: deck_has_particles, deck_has_beam
-    use driver_config_coupling, only: deck_has_coupling
+    use driver_run_kind, only: run_kind_of, check_run_kind, run_beam, run_particles, run_coupled, &
+                               run_continuum
     use driver_simulation, only: simulation_t
     use driver_simulation_beam, only: beam_simulation_t
     use driver_simulation_dem, only: dem_simulation_t
     use driver_simulation_coupled, only: coupled_simulation_t
-    use driver_simulation_continuum, only: continuum_simulation_t, deck_has_continuum
+    use driver_simulation_continuum, only: continuum_simulation_t
     implicit none
     private
     public :: select_simulation
@@ -24,44 +23,20 @@ contains
         type(deck_t), intent(in) :: deck
         !> The simulation of the deck's kind.
         class(simulation_t), allocatable, intent(out) :: sim
-        !> Set when the sections do not make a kind of run.
+        !> Set when the sections do not make a kind of run, or when the deck sets keywords
+        !> that its kind of run does not use.
         type(error_t), allocatable, intent(out) :: error
-        logical :: particles, coupled
-        integer :: k
-        particles = deck_has_particles(deck)
-        coupled = particles .and. deck_has_beam(deck)
-        if (deck_has_continuum(deck)) then
-            if (particles .or. deck_has_beam(deck) .or. deck_has_coupling(deck)) then
-                call make_input_error(error, deck%file, deck%line('run', 'analysis'), '', &
-                                      'a [continuum] deck cannot have [beam], [particles] or [coupling] yet: '// &
-                                      'run the continuum alone')
-                return
-            end if
+        call check_run_kind(deck, error)
+        if (allocated(error)) return
+        select case (run_kind_of(deck))
+        case (run_continuum)
             allocate (continuum_simulation_t :: sim)
-            return
-        end if
-        if (coupled .and. .not. deck_has_coupling(deck)) then
-            call make_input_error(error, deck%file, deck%line('run', 'analysis'), '', &
-                                  'this deck has both [beam] and [particles]: coupled runs need a '// &
-                                  '[coupling] section (at least overlap = s_fe s_particle and thickness; '// &
-                                  'doc/input.md), or run the beam and the particles apart')
-            return
-        else if (.not. coupled .and. deck_has_coupling(deck)) then
-            do k = 1, size(deck%entries)
-                if (deck%entries(k)%section == 'coupling') exit
-            end do
-            call make_input_error(error, deck%file, deck%entries(k)%line, &
-                                  deck%entries(k)%keyword, '[coupling] glues particles to a beam, and this '// &
-                                  'deck has no '//trim(merge('[particles]', '[beam]     ',.not. particles))// &
-                                  ': remove [coupling] or add the missing model')
-            return
-        end if
-        if (coupled) then
+        case (run_coupled)
             allocate (coupled_simulation_t :: sim)
-        else if (particles) then
+        case (run_particles)
             allocate (dem_simulation_t :: sim)
-        else
+        case (run_beam)
             allocate (beam_simulation_t :: sim)
-        end if
+        end select
     end subroutine select_simulation
 end module driver_simulations

@@ -15,10 +15,18 @@
 !>   default gives 0 or '' (check `has` first);
 !> - records: `e = deck%record(section, keyword, i)` (i-th occurrence in file order) or
 !>   `list = deck%records(section, keyword)` (all of them), then `e%line`, `e%n_values()`,
-!>   `e%int(k)`, `e%real(k)`, `e%word(k)`, `e%reals_from(k)`.
+!>   and the values by the schema's field names, as fpm reads its manifest by key:
+!>   `e%int('elements')`, `e%real('x0')`, `e%word('dof')`, `e%has('gap')` (an optional
+!>   value is given), `e%reals_from('t')` and `e%words_from('dof')` (that value and all
+!>   after it: a repeated tail). `deck%get_real(section, keyword, 'gy')` reads a field of a
+!>   scalar keyword by name likewise. The names of a line are those of its fixed fields and
+!>   of the tail its selector word chooses (`function = 1 ramp 2` has `id kind t1`). A name
+!>   that is not one of them is a bug in the calling code, not an input error: the program
+!>   stops with an internal error. The positional forms (`e%real(k)`, ...) remain for
+!>   generic code such as error messages that quote a value by its position.
 module io_deck
     use core_kinds, only: wp
-    use core_error, only: error_t, make_input_error
+    use core_error, only: error_t, make_input_error, make_internal_error
     use core_strings, only: string_t, strip, split_words, join_words, &
                             closest_match, parse_real, parse_int, to_str, shorten
     use io_deck_schema, only: schema_t, keyword_spec_t, field_spec_t, condition_t, field_text
@@ -36,17 +44,32 @@ module io_deck
         integer :: line = 0
         !> Values as written (for a text keyword: one token, the whole text).
         type(string_t), allocatable :: tokens(:)
+        !> Names of the values, from the schema, separated by single blanks: fixed fields, then
+        !> those of the tail that applies (one group of a repeated tail).
+        character(len=:), allocatable :: names
     contains
         !> Number of values.
         procedure :: n_values => entry_n_values
-        !> k-th value as an integer (0 if absent).
-        procedure :: int => entry_int
-        !> k-th value as a real (0 if absent).
-        procedure :: real => entry_real
-        !> k-th value as written ('' if absent).
-        procedure :: word => entry_word
-        !> Values k, k+1, ... as reals (the variable-length tail of a record).
-        procedure :: reals_from => entry_reals_from
+        !> Position of a named value (an internal error stops the program if the keyword
+        !> has no field of that name).
+        procedure :: position => entry_position
+        !> Whether the named value is given on the line (an optional tail value).
+        procedure :: has => entry_has
+        procedure, private :: entry_int, entry_int_named
+        procedure, private :: entry_real, entry_real_named
+        procedure, private :: entry_word, entry_word_named
+        procedure, private :: entry_reals_from, entry_reals_from_named
+        !> A value as an integer, by field name or position (0 if absent).
+        generic :: int => entry_int, entry_int_named
+        !> A value as a real, by field name or position (0 if absent).
+        generic :: real => entry_real, entry_real_named
+        !> A value as written, by field name or position ('' if absent).
+        generic :: word => entry_word, entry_word_named
+        !> A value and all after it as reals (a variable-length tail), by field name or
+        !> position.
+        generic :: reals_from => entry_reals_from, entry_reals_from_named
+        !> A value and all after it as written (a variable-length tail), by field name.
+        procedure :: words_from => entry_words_from
     end type deck_entry_t
 
     !> A validated deck.
@@ -70,12 +93,17 @@ module io_deck
         procedure :: record => deck_record
         !> All occurrences of a keyword, in file order (one pass: use it to loop over records).
         procedure :: records => deck_records
-        !> A real value, from the deck or the schema default.
-        procedure :: get_real => deck_get_real
-        !> An integer value, from the deck or the schema default.
-        procedure :: get_int => deck_get_int
-        !> A word value, from the deck or the schema default.
-        procedure :: get_word => deck_get_word
+        !> Whether any keyword of a section appears in the deck.
+        procedure :: has_section => deck_has_section
+        procedure, private :: deck_get_real, deck_get_real_named
+        procedure, private :: deck_get_int, deck_get_int_named
+        procedure, private :: deck_get_word, deck_get_word_named
+        !> A real value, from the deck or the schema default, by field name or position.
+        generic :: get_real => deck_get_real, deck_get_real_named
+        !> An integer value, from the deck or the schema default, by field name or position.
+        generic :: get_int => deck_get_int, deck_get_int_named
+        !> A word value, from the deck or the schema default, by field name or position.
+        generic :: get_word => deck_get_word, deck_get_word_named
         !> A text value, from the deck or the schema default.
         procedure :: get_text => deck_get_text
     end type deck_t
@@ -241,6 +269,7 @@ contains
             entries(n)%section = current
             entries(n)%keyword = key
             entries(n)%line = line_no
+            entries(n)%names = line_names(schema%keywords(k), tokens)
             call move_alloc(tokens, entries(n)%tokens)
         end subroutine parse_line
 
@@ -304,6 +333,21 @@ contains
             text(i:i) = achar(10)
         end do
     end function normalized_text
+
+    !> Names of the values of a line of keyword `spec` with values `tokens`: the fixed
+    !> fields and the tail chosen by the selector word.
+    pure function line_names(spec, tokens) result(names)
+        !> Keyword spec.
+        type(keyword_spec_t), intent(in) :: spec
+        !> Values as written.
+        type(string_t), intent(in) :: tokens(:)
+        character(len=:), allocatable :: names
+        if (spec%selector > 0 .and. spec%selector <= size(tokens)) then
+            names = spec%field_names(tokens(spec%selector)%s)
+        else
+            names = spec%field_names('')
+        end if
+    end function line_names
 
     !> Largest Levenshtein distance at which a name is suggested for a misspelt one.
     pure integer function tolerance(name)
@@ -566,6 +610,22 @@ contains
         idx = 0
     end function find_entry
 
+    !> Whether any keyword of a section appears in the deck.
+    pure logical function deck_has_section(self, section)
+        !> The deck.
+        class(deck_t), intent(in) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        integer :: idx
+        deck_has_section = .false.
+        do idx = 1, size(self%entries)
+            if (self%entries(idx)%section == section) then
+                deck_has_section = .true.
+                return
+            end if
+        end do
+    end function deck_has_section
+
     !> Whether a keyword appears in the deck.
     pure logical function deck_has(self, section, keyword)
         !> The deck.
@@ -619,7 +679,7 @@ contains
         !> Occurrence (1 = first).
         integer, intent(in) :: i
         type(deck_entry_t) :: entry
-        integer :: idx
+        integer :: idx, k
         idx = find_entry(self, section, keyword, i)
         if (idx > 0) then
             entry = self%entries(idx)
@@ -627,6 +687,9 @@ contains
             entry%section = section
             entry%keyword = keyword
             allocate (entry%tokens(0))
+            entry%names = ''
+            k = self%schema%find_keyword(section, keyword)
+            if (k > 0) entry%names = self%schema%keywords(k)%field_names()
         end if
     end function deck_record
 
@@ -674,6 +737,7 @@ contains
             else
                 call split_words(kw%default, entry%tokens)
             end if
+            entry%names = line_names(kw, entry%tokens)
         end associate
     end function value_entry
 
@@ -724,6 +788,54 @@ contains
         entry = value_entry(self, section, keyword)
         value = entry%word(field_or_1(field))
     end function deck_get_word
+
+    !> A real value, the field named `name`, from the deck or the schema default.
+    function deck_get_real_named(self, section, keyword, name) result(value)
+        !> The deck.
+        class(deck_t), intent(in) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        !> Keyword.
+        character(len=*), intent(in) :: keyword
+        !> Field name (from the schema).
+        character(len=*), intent(in) :: name
+        real(wp) :: value
+        type(deck_entry_t) :: entry
+        entry = value_entry(self, section, keyword)
+        value = entry%real(name)
+    end function deck_get_real_named
+
+    !> An integer value, the field named `name`, from the deck or the schema default.
+    function deck_get_int_named(self, section, keyword, name) result(value)
+        !> The deck.
+        class(deck_t), intent(in) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        !> Keyword.
+        character(len=*), intent(in) :: keyword
+        !> Field name (from the schema).
+        character(len=*), intent(in) :: name
+        integer :: value
+        type(deck_entry_t) :: entry
+        entry = value_entry(self, section, keyword)
+        value = entry%int(name)
+    end function deck_get_int_named
+
+    !> A word value, the field named `name`, from the deck or the schema default.
+    function deck_get_word_named(self, section, keyword, name) result(value)
+        !> The deck.
+        class(deck_t), intent(in) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        !> Keyword.
+        character(len=*), intent(in) :: keyword
+        !> Field name (from the schema).
+        character(len=*), intent(in) :: name
+        character(len=:), allocatable :: value
+        type(deck_entry_t) :: entry
+        entry = value_entry(self, section, keyword)
+        value = entry%word(name)
+    end function deck_get_word_named
 
     !> A text value from the deck or the schema default.
     function deck_get_text(self, section, keyword) result(value)
@@ -801,4 +913,91 @@ contains
             values(i) = self%real(k + i - 1)
         end do
     end function entry_reals_from
+
+    !> Position of the value named `name` among the values of the line (its first one for a
+    !> repeated group). The names come from the schema, so a name that is not among them is
+    !> a bug in the calling code: the program stops with an internal error.
+    integer function entry_position(self, name) result(k)
+        !> The entry.
+        class(deck_entry_t), intent(in) :: self
+        !> Field name.
+        character(len=*), intent(in) :: name
+        type(error_t), allocatable :: error
+        character(len=:), allocatable :: padded
+        integer :: at, i
+        padded = ' '
+        if (allocated(self%names)) padded = ' '//self%names//' '
+        at = index(padded, ' '//name//' ')
+        if (at == 0 .or. len(name) == 0) then
+            call make_internal_error(error, 'io_deck', '['//self%section//'] '//self%keyword// &
+                                     " has no value named '"//name//"' (its values: "// &
+                                     strip(padded)//')')
+            error stop error%message
+        end if
+        k = 0
+        do i = 1, at
+            if (padded(i:i) == ' ') k = k + 1
+        end do
+    end function entry_position
+
+    !> Whether the value named `name` is given on the line (false for an optional tail value
+    !> left out).
+    logical function entry_has(self, name)
+        !> The entry.
+        class(deck_entry_t), intent(in) :: self
+        !> Field name.
+        character(len=*), intent(in) :: name
+        entry_has = self%position(name) <= self%n_values()
+    end function entry_has
+
+    !> The value named `name` as an integer (0 if absent).
+    integer function entry_int_named(self, name) result(value)
+        !> The entry.
+        class(deck_entry_t), intent(in) :: self
+        !> Field name.
+        character(len=*), intent(in) :: name
+        value = self%int(self%position(name))
+    end function entry_int_named
+
+    !> The value named `name` as a real (0 if absent).
+    real(wp) function entry_real_named(self, name) result(value)
+        !> The entry.
+        class(deck_entry_t), intent(in) :: self
+        !> Field name.
+        character(len=*), intent(in) :: name
+        value = self%real(self%position(name))
+    end function entry_real_named
+
+    !> The value named `name` as written ('' if absent).
+    function entry_word_named(self, name) result(value)
+        !> The entry.
+        class(deck_entry_t), intent(in) :: self
+        !> Field name.
+        character(len=*), intent(in) :: name
+        character(len=:), allocatable :: value
+        value = self%word(self%position(name))
+    end function entry_word_named
+
+    !> The value named `name` and all after it, as reals (size 0 if absent).
+    function entry_reals_from_named(self, name) result(values)
+        !> The entry.
+        class(deck_entry_t), intent(in) :: self
+        !> Field name.
+        character(len=*), intent(in) :: name
+        real(wp), allocatable :: values(:)
+        values = self%reals_from(self%position(name))
+    end function entry_reals_from_named
+
+    !> The value named `name` and all after it, as written (size 0 if absent).
+    function entry_words_from(self, name) result(values)
+        !> The entry.
+        class(deck_entry_t), intent(in) :: self
+        !> Field name.
+        character(len=*), intent(in) :: name
+        type(string_t), allocatable :: values(:)
+        integer :: k
+        k = self%position(name)
+        allocate (values(max(self%n_values() - k + 1, 0)))
+        if (size(values) > 0) values = self%tokens(k:)
+    end function entry_words_from
 end module io_deck

@@ -134,6 +134,9 @@ module io_deck_schema
         procedure :: tail_index => keyword_tail_index
         !> Usage text, e.g. `id young density area inertia`.
         procedure :: usage => keyword_usage
+        !> Names of the values of a line, blank-separated: fixed fields, then the fields of the
+        !> tail for a selector word (of every tail when the word is absent).
+        procedure :: field_names => keyword_field_names
     end type keyword_spec_t
 
     !> One `[section]` of the deck.
@@ -712,6 +715,40 @@ contains
         k = self%tail_index(word)
         if (k > 0) text = text//' '//self%tails(k)%usage()
     end function keyword_usage
+
+    !> Names of the values of a line, separated by single blanks, in value order: the fixed
+    !> fields, then the fields of the tail that applies for the selector word `word` (one
+    !> group of a repeated tail); without `word`, the fields of every tail (for a keyword
+    !> absent from the deck, whose values are all absent anyway).
+    pure function keyword_field_names(self, word) result(names)
+        !> The keyword.
+        class(keyword_spec_t), intent(in) :: self
+        !> Selector word ('' when the keyword has no selector).
+        character(len=*), intent(in), optional :: word
+        character(len=:), allocatable :: names
+        integer :: i, k
+        names = ''
+        do i = 1, size(self%fields)
+            call append(self%fields(i)%name)
+        end do
+        do k = 1, size(self%tails)
+            if (present(word)) then
+                if (k /= self%tail_index(word)) cycle
+            end if
+            do i = 1, size(self%tails(k)%fields)
+                call append(self%tails(k)%fields(i)%name)
+            end do
+        end do
+
+    contains
+
+        !> Append one name.
+        pure subroutine append(name)
+            character(len=*), intent(in) :: name
+            if (len(names) > 0) names = names//' '
+            names = names//name
+        end subroutine append
+    end function keyword_field_names
 
     !> Text of a condition: `[run] analysis = dynamic`.
     function condition_text(self) result(text)
