@@ -26,7 +26,10 @@
 !> --max-sweeps C (cap of the timed steps), --forward (no alternating sweeps), --settle S (steps
 !> before timing, default 10), --settle-anderson M and --settle-sweeps C (solver of those
 !> steps, default the timed one), --verbose (sweeps, Siconos error, solver ms of every timed
-!> step). The Siconos error of every timed step is printed too (mean and max).
+!> step), --hydrostatic (cold start from the hydrostatic estimate, `[solver] cold_start`).
+!> The Siconos error of every timed step is printed too (mean and max).
+!> With `--siconos N` (200 or 2000), runs instead the deposit compared with Siconos
+!> (siconos_deposit); --csv FILE and --deck FILE write its layout as CSV and as a deck.
 !> Run: cmake --build <build> --target bench_dem && OMP_NUM_THREADS=1 <build>/bench/bench_dem
 program bench_dem
     use, intrinsic :: iso_fortran_env, only: output_unit, compiler_version, compiler_options

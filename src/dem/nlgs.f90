@@ -538,7 +538,7 @@ contains
             end do
         end do
     contains
-        ! generator q of disk u: 3 per support, (support, sigma) = (sup(ceil(q/3)), mod(q, 3) - 1)
+        ! generator q: 3 per support, support sup((q + 2)/3), sigma = mod(q + 2, 3) - 1 (0: the normal)
         pure function generator(q) result(v)
             integer, intent(in) :: q
             real(wp) :: v(2)
