@@ -26,7 +26,10 @@
 !> --max-sweeps C (cap of the timed steps), --forward (no alternating sweeps), --settle S (steps
 !> before timing, default 10), --settle-anderson M and --settle-sweeps C (solver of those
 !> steps, default the timed one), --verbose (sweeps, Siconos error, solver ms of every timed
-!> step). The Siconos error of every timed step is printed too (mean and max).
+!> step), --hydrostatic (cold start from the hydrostatic estimate, `[solver] cold_start`).
+!> The Siconos error of every timed step is printed too (mean and max).
+!> With `--siconos N` (200 or 2000), runs instead the deposit compared with Siconos
+!> (siconos_deposit); --csv FILE and --deck FILE write its layout as CSV and as a deck.
 !> Run: cmake --build <build> --target bench_dem && OMP_NUM_THREADS=1 <build>/bench/bench_dem
 program bench_dem
     use, intrinsic :: iso_fortran_env, only: output_unit, compiler_version, compiler_options
@@ -39,7 +42,7 @@ program bench_dem
     use dem_detection, only: detect_contacts
     use dem_moreau_jean, only: dem_system_t, mj_init, mj_step, dem_system_bytes
     use dem_nlgs, only: criterion_lmgc90, criterion_siconos
-    use bench_packing, only: deposit_disks, deposit_width
+    use bench_packing, only: deposit_disks, deposit_width, staggered_layout
     implicit none
 
     !> Figures of one N.
@@ -73,12 +76,16 @@ program bench_dem
     integer, parameter :: n_rounds = 30
     type(case_t), allocatable :: res(:)
     type(dem_system_t), allocatable :: systems(:)
-    character(len=32) :: arg, val
+    character(len=256) :: arg, val
     !> Solver options from the command line (see the header).
     real(wp) :: relaxation = 1.0_wp
     integer :: criterion = criterion_lmgc90, max_sweeps = 200, check_every = 10, settle_sweeps = 0, iarg
     integer :: anderson = 0, settle_anderson = -1
     logical :: convergence = .false., sizes_given = .false., verbose = .false., symmetric = .true.
+    logical :: hydrostatic = .false., criterion_given = .false.
+    !> Siconos deposit (--siconos N): disks, and the files of the layout (empty: not written).
+    integer :: siconos_n = 0
+    character(len=256) :: csv_path = '', deck_path = ''
     integer :: k
     sizes = [1000, 10000, 100000]
     iarg = 1
@@ -101,6 +108,15 @@ program bench_dem
             iarg = iarg - 1
         case ('--anderson')
             read (val, *) anderson
+        case ('--siconos')
+            read (val, *) siconos_n
+        case ('--csv')
+            csv_path = val
+        case ('--deck')
+            deck_path = val
+        case ('--hydrostatic')
+            hydrostatic = .true.
+            iarg = iarg - 1
         case ('--settle-anderson')
             read (val, *) settle_anderson
         case ('--settle')
@@ -110,7 +126,9 @@ program bench_dem
         case ('--check-every')
             read (val, *) check_every
         case ('--criterion')
+            criterion_given = .true.
             if (val == 'siconos') criterion = criterion_siconos
+            if (val == 'lmgc90') criterion = criterion_lmgc90
         case ('--sizes')
             sizes = [integer ::]
             sizes_given = .true.
@@ -127,6 +145,11 @@ program bench_dem
         end select
         iarg = iarg + 2
     end do
+    if (siconos_n > 0) then
+        write (output_unit, '(a)') '# compiler: '//compiler_version()
+        call siconos_deposit(siconos_n)
+        stop
+    end if
     write (output_unit, '(a)') '# DEM kernel benchmark, 1 core: dense random packing in a box under gravity'
     write (output_unit, '(a)') '# compiler: '//compiler_version()
     write (output_unit, '(a)') '# options:  '//compiler_options()
@@ -261,6 +284,184 @@ contains
         end do
     end subroutine cold_start_sweeps
 
+    !> The gravity deposit compared with Siconos 4.4 NSGS (doc/performance.md, "Deposit
+    !> against Siconos"): N = 200 (10 x 20) or 2000 (40 x 50) disks on the staggered lattice
+    !> of staggered_layout (mean radius 1 cm, seed 8, density 2500 kg/m^3), box with a floor
+    !> and two side walls, mu = 0.3, e = 0, theta = 1/2, h = 2 ms, alert 5 mm, tolerance 1e-4
+    !> on the Siconos error (--criterion lmgc90 for the other norm), cap 10^4 sweeps, 1 s
+    !> (500 steps) from rest. Writes the layout
+    !> to --csv and --deck when given, then prints per step (with --verbose) and in total:
+    !> time per step (whole step, and the solver), sweeps, Siconos error, converged steps,
+    !> and the final pile: highest disk top max(y + r), centre-of-mass height, mean speed.
+    subroutine siconos_deposit(n)
+        integer, intent(in) :: n
+        real(wp), parameter :: rmean = 0.01_wp, rho = 2500.0_wp, mu = 0.3_wp, h = 2.0e-3_wp
+        real(wp), parameter :: t_end = 1.0_wp, alert = 5.0e-3_wp, tol = 1.0e-4_wp
+        integer, parameter :: seed = 8, cap = 10000
+        type(dem_system_t) :: sys
+        type(error_t), allocatable :: error
+        real(wp), allocatable :: x(:), y(:), radius(:), t_step(:), t_sol(:)
+        real(wp) :: width, top, sic, sic_max, before_sol
+        integer(i8) :: c0, c1, rate
+        integer :: n_row, n_rows, n_steps, s, sweeps, sweeps_max, n_conv
+        select case (n)
+        case (200)
+            n_row = 10
+            n_rows = 20
+        case (2000)
+            n_row = 40
+            n_rows = 50
+        case default
+            error stop 'bench_dem: --siconos takes 200 or 2000'
+        end select
+        call staggered_layout(n_row, n_rows, rmean, seed, x, y, radius, width)
+        top = maxval(y + radius) + 5.0_wp*rmean
+        if (len_trim(csv_path) > 0) call write_csv(trim(csv_path), x, y, radius, width)
+        if (len_trim(deck_path) > 0) call write_deck(trim(deck_path), n_row, n_rows, x, y, radius, width, top)
+        call particles_add_disks(sys%particles, x, y, radius, [rho], error)
+        if (allocated(error)) error stop 'bench_dem: invalid disks'
+        call walls_add(sys%walls, 0.0_wp, 0.0_wp, width, 0.0_wp, error)
+        call walls_add(sys%walls, 0.0_wp, 0.0_wp, 0.0_wp, top, error)
+        call walls_add(sys%walls, width, 0.0_wp, width, top, error)
+        if (allocated(error)) error stop 'bench_dem: invalid walls'
+        call materials_init(sys%materials, 1, error)
+        if (.not. allocated(error)) call materials_set_pair(sys%materials, 1, 1, mu, 0.0_wp, 0.0_wp, error)
+        if (allocated(error)) error stop 'bench_dem: invalid material'
+        sys%particles%gravity = [0.0_wp, -gravity]
+        sys%scheme%h = h
+        sys%scheme%alert = alert
+        sys%solver%tol = tol
+        sys%solver%max_sweeps = cap
+        sys%solver%criterion = criterion_siconos
+        if (criterion_given) sys%solver%criterion = criterion
+        sys%solver%relaxation = relaxation
+        sys%solver%anderson = anderson
+        sys%solver%hydrostatic = hydrostatic
+        sys%solver%symmetric = symmetric
+        call mj_init(sys, error)
+        if (allocated(error)) error stop 'bench_dem: invalid setup'
+        n_steps = nint(t_end/h)
+        allocate (t_step(n_steps), t_sol(n_steps))
+        sweeps = 0
+        sweeps_max = 0
+        n_conv = 0
+        sic = 0.0_wp
+        sic_max = 0.0_wp
+        write (output_unit, '(a, i0, a, i0, a, i0, a, f0.4, a)') '# deposit against Siconos: N = ', n, ' (', n_row, &
+            ' x ', n_rows, '), box width ', width, ' m, mean radius 1 cm, seed 8, mu 0.3, e 0, h 2 ms, 500 steps'
+        write (output_unit, '(a, i0, a, es9.2, a, i0, a, i0, a, l1)') '# criterion ', sys%solver%criterion, &
+            ' (1 lmgc90, 2 siconos), tolerance ', tol, ', cap ', cap, ' sweeps, anderson ', anderson, &
+            ', hydrostatic ', hydrostatic
+        if (verbose) write (output_unit, '(a)') '# step  active  sweeps  conv  siconos_error  step[ms]  top[m]'
+        do s = 1, n_steps
+            before_sol = sys%time_solver
+            call system_clock(c0, rate)
+            call mj_step(sys)
+            call system_clock(c1)
+            t_step(s) = real(c1 - c0, wp)/real(rate, wp)
+            t_sol(s) = sys%time_solver - before_sol
+            sweeps = sweeps + sys%stats%sweeps
+            sweeps_max = max(sweeps_max, sys%stats%sweeps)
+            if (sys%stats%converged) n_conv = n_conv + 1
+            sic = sic + sys%stats%siconos_error
+            sic_max = max(sic_max, sys%stats%siconos_error)
+            if (verbose) write (output_unit, '(i6, i8, i8, l6, es15.3, f10.3, f9.5)') s, sys%stats%n_active, &
+                sys%stats%sweeps, sys%stats%converged, sys%stats%siconos_error, 1.0e3_wp*t_step(s), &
+                maxval(sys%particles%y(1:n) + sys%particles%radius(1:n))
+        end do
+        write (output_unit, '(a)') '#      N  steps  step[ms](mean,median,best)  solver[ms](mean)  ' &
+            //'sweeps(mean,max)  conv  siconos(mean,max)  top[m]  y_centre_of_mass[m]  v_mean[m/s]'
+        associate (p => sys%particles)
+            write (output_unit, '(i8, i7, 3f9.3, f10.3, f10.1, i7, f7.3, 2es10.2, f9.5, f12.6, es12.3)') n, n_steps, &
+                1.0e3_wp*sum(t_step)/n_steps, 1.0e3_wp*median(t_step), 1.0e3_wp*minval(t_step), &
+                1.0e3_wp*sum(t_sol)/n_steps, real(sweeps, wp)/n_steps, sweeps_max, real(n_conv, wp)/n_steps, &
+                sic/n_steps, sic_max, maxval(p%y(1:n) + p%radius(1:n)), sum(p%mass(1:n)*p%y(1:n))/sum(p%mass(1:n)), &
+                sum(hypot(p%vx(1:n), p%vy(1:n)))/n
+        end associate
+    end subroutine siconos_deposit
+
+    !> The layout as CSV: a header of comment lines (box, material), then x, y, radius,
+    !> mass and moment of inertia per unit thickness of each disk.
+    subroutine write_csv(path, x, y, radius, width)
+        character(len=*), intent(in) :: path
+        real(wp), intent(in) :: x(:), y(:), radius(:), width
+        real(wp), parameter :: pi = 3.141592653589793238462643383279502884_wp, rho = 2500.0_wp
+        integer :: n
+        integer :: u, k
+        n = size(x)
+        open (newunit=u, file=path, status='replace', action='write')
+        write (u, '(a, i0, a, es24.16e2, a)') '# MULTICOR deposit against Siconos: ', n, &
+            ' disks; box: floor y = 0, side walls x = 0 and x = ', width, ' m'
+        write (u, '(a)') '# density 2500 kg/m^3 per unit thickness, mu = 0.3, e = 0, gravity 9.81 m/s^2, ' &
+            //'h = 2 ms, theta = 1/2, 500 steps; mass = 2500 pi r^2, inertia = mass r^2 / 2'
+        write (u, '(a)') 'x,y,radius,mass,inertia'
+        do k = 1, n
+            write (u, '(es24.16e2, 4(",", es24.16e2))') x(k), y(k), radius(k), rho*pi*radius(k)**2, &
+                0.5_wp*rho*pi*radius(k)**4
+        end do
+        close (u)
+    end subroutine write_csv
+
+    !> The same problem as a MULTICOR deck (explicit disk records, so that it does not
+    !> depend on a generator).
+    subroutine write_deck(path, n_row, n_rows, x, y, radius, width, top)
+        character(len=*), intent(in) :: path
+        integer, intent(in) :: n_row, n_rows
+        real(wp), intent(in) :: x(:), y(:), radius(:), width, top
+        integer :: n
+        integer :: u, k
+        n = size(x)
+        open (newunit=u, file=path, status='replace', action='write')
+        write (u, '(a, i0, a)') '# MULTICOR deck: gravity deposit of ', n, ' disks, the layout compared with' &
+            //' Siconos 4.4 NSGS'
+        write (u, '(a)') '# (doc/performance.md, "Deposit against Siconos"). Written by'
+        write (u, '(a, i0, a)') '#   build-release/bench/bench_dem --siconos ', n, ' --deck <this file>'
+        write (u, '(a, i0, a, i0, a)') '# Staggered lattice of ', n_row, ' x ', n_rows, &
+            ' disks, pitch 2.5 R (R = 1 cm), every other row shifted by'
+        write (u, '(a)') '# half a pitch, radii uniform in [0.8 R, 1.2 R] (seed 8 of dem_random); the disks' &
+            //' start at rest,'
+        write (u, '(a)') '# apart, and fall under gravity into a pile. mu = 0.3, e = 0, h = 2 ms, tolerance ' &
+            //'1e-4 on the'
+        write (u, '(a)') '# Siconos error. Coordinates with 17 significant digits: read back, they are the ' &
+            //'doubles of the'
+        write (u, '(a)') '# benchmark. Per unit thickness, SI units.'
+        write (u, '(a)') ''
+        write (u, '(a)') '[run]'
+        write (u, '(a, i0, a)') 'title    = Gravity deposit of ', n, ' disks (layout compared with Siconos)'
+        write (u, '(a)') 'analysis = dynamic'
+        write (u, '(a)') ''
+        write (u, '(a)') '[particles]'
+        write (u, '(a)') 'material = 1 2500'
+        write (u, '(a)') 'gravity  = 0 -9.81'
+        write (u, '(a)') '#          x  y  radius  material'
+        do k = 1, n
+            write (u, '(a, 3(es24.16e2, 1x), a)') 'disk     = ', x(k), y(k), radius(k), '1'
+        end do
+        write (u, '(a)') ''
+        write (u, '(a)') '[walls]'
+        write (u, '(a, es24.16e2, a)') 'wall     = 0 0 ', width, ' 0  # floor'
+        write (u, '(a, es24.16e2, a)') 'wall     = 0 0 0 ', top, '  # left side'
+        write (u, '(a, 3(es24.16e2, 1x), es24.16e2, a)') 'wall     = ', width, 0.0_wp, width, top, &
+            '  # right side'
+        write (u, '(a)') ''
+        write (u, '(a)') '[contacts]'
+        write (u, '(a)') 'law      = 1 1 0.3 0 0'
+        write (u, '(a)') 'alert    = 5e-3'
+        write (u, '(a)') ''
+        write (u, '(a)') '[solver]'
+        write (u, '(a)') 'tolerance  = 1e-4'
+        write (u, '(a)') 'criterion  = siconos'
+        write (u, '(a)') 'max_sweeps = 10000'
+        write (u, '(a)') ''
+        write (u, '(a)') '[time]'
+        write (u, '(a)') 'step     = 2e-3'
+        write (u, '(a)') 'end      = 1.0'
+        write (u, '(a)') ''
+        write (u, '(a)') '[output]'
+        write (u, '(a)') 'interval = 50'
+        close (u)
+    end subroutine write_deck
+
     !> Random packing of n disks in a box, walls, law, scheme.
     subroutine build(sys, n, c)
         type(dem_system_t), intent(out) :: sys
@@ -301,6 +502,7 @@ contains
         sys%solver%relaxation = relaxation
         sys%solver%check_every = check_every
         sys%solver%anderson = anderson
+        sys%solver%hydrostatic = hydrostatic
         sys%solver%symmetric = symmetric
         sys%solver%criterion = criterion
         call mj_init(sys, error)

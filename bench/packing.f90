@@ -16,7 +16,7 @@ module bench_packing
     use dem_random, only: rng_t, rng_seed, rng_uniform_in
     implicit none
     private
-    public :: deposit_disks, deposit_width
+    public :: deposit_disks, deposit_width, staggered_layout
 
     real(wp), parameter :: pi = 3.141592653589793238462643383279502884_wp
     !> Expected packing fraction of the deposit (to size the box).
@@ -100,6 +100,43 @@ contains
         end do
         call order_by_cells(g, x, y, radius)
     end subroutine deposit_disks
+
+    !> Staggered lattice of n_row x n_rows disks with radii uniform in [0.8, 1.2] rmean, the
+    !> layout of the deposit compared with Siconos (doc/performance.md): pitch p = 2.5 rmean
+    !> along the rows, rows p sqrt(3)/2 apart, every odd row (the 2nd, 4th, ...) shifted by
+    !> p/2 to the right; disk k = j n_row + i + 1 (row j = 0, 1, ..., column i = 0, 1, ...)
+    !> at x = p (1/2 + i + mod(j, 2)/2), y = p/2 + j p sqrt(3)/2, its radius the k-th deviate
+    !> of the generator of dem_random seeded with `seed` (rmean (0.8 + 0.4 u)). Box x in
+    !> [0, (n_row + 1/2) p], floor y = 0. No two disks touch (centres at least p = 2.5 rmean
+    !> apart, radii at most 1.2 rmean) and every disk is at least 0.05 rmean from the walls.
+    pure subroutine staggered_layout(n_row, n_rows, rmean, seed, x, y, radius, width)
+        !> Disks per row and number of rows.
+        integer, intent(in) :: n_row, n_rows
+        !> Mean radius [m].
+        real(wp), intent(in) :: rmean
+        !> Seed of the radii.
+        integer, intent(in) :: seed
+        !> Centres and radii [m], row by row from the bottom left.
+        real(wp), allocatable, intent(out) :: x(:), y(:), radius(:)
+        !> Box width [m].
+        real(wp), intent(out) :: width
+        type(rng_t) :: rng
+        real(wp) :: p, rise
+        integer :: i, j, k
+        p = 2.5_wp*rmean
+        rise = p*sqrt(3.0_wp)/2.0_wp
+        width = (n_row + 0.5_wp)*p
+        allocate (x(n_row*n_rows), y(n_row*n_rows), radius(n_row*n_rows))
+        call rng_seed(rng, seed)
+        do j = 0, n_rows - 1
+            do i = 0, n_row - 1
+                k = j*n_row + i + 1
+                call rng_uniform_in(rng, 0.8_wp*rmean, 1.2_wp*rmean, radius(k))
+                x(k) = p*(0.5_wp + i + 0.5_wp*mod(j, 2))
+                y(k) = 0.5_wp*p + j*rise
+            end do
+        end do
+    end subroutine staggered_layout
 
     !> Move disk i from its drop abscissa x(i) to its resting place (x(i), y(i)).
     subroutine place(g, i, x, y, radius, ok)

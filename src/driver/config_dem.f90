@@ -670,6 +670,7 @@ contains
             sys%solver%relaxation = deck%get_real('solver', 'relaxation')
             sys%solver%check_every = deck%get_int('solver', 'check_every')
             sys%solver%anderson = deck%get_int('solver', 'anderson')
+            sys%solver%hydrostatic = deck%get_word('solver', 'cold_start') == 'hydrostatic'
             sys%solver%criterion = criterion_lmgc90
             if (deck%get_word('solver', 'criterion') == 'siconos') sys%solver%criterion = criterion_siconos
             if (deck%has('solver', 'fclib_step')) cfg%fclib_step = deck%get_int('solver', 'fclib_step')
