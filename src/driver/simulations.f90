@@ -1,7 +1,7 @@
 !> Which kind of run a deck asks for, from its sections: [beam] alone is a finite-element run,
 !> [particles] alone a discrete-element run, both a coupled (Arlequin) run that needs a
 !> [coupling] section; [coupling] without both models is an error. [continuum] alone is a 2D
-!> continuum run (not yet coupled to the others).
+!> continuum run; [continuum] with [particles] and [coupling] a coupled continuum-disk run.
 module driver_simulations
     use core_error, only: error_t, make_input_error
     use io_deck, only: deck_t
@@ -12,6 +12,7 @@ module driver_simulations
     use driver_simulation_dem, only: dem_simulation_t
     use driver_simulation_coupled, only: coupled_simulation_t
     use driver_simulation_continuum, only: continuum_simulation_t, deck_has_continuum
+    use driver_simulation_coupled2d, only: coupled2d_simulation_t
     implicit none
     private
     public :: select_simulation
@@ -31,13 +32,18 @@ contains
         particles = deck_has_particles(deck)
         coupled = particles .and. deck_has_beam(deck)
         if (deck_has_continuum(deck)) then
-            if (particles .or. deck_has_beam(deck) .or. deck_has_coupling(deck)) then
+            if (deck_has_beam(deck) .or. (particles .neqv. deck_has_coupling(deck))) then
                 call make_input_error(error, deck%file, deck%line('run', 'analysis'), '', &
-                                      'a [continuum] deck cannot have [beam], [particles] or [coupling] yet: '// &
-                                      'run the continuum alone')
+                                      'a [continuum] deck cannot have [beam], and couples [particles] only with '// &
+                                      'a [coupling] section (region lines): run the continuum alone, or give both '// &
+                                      '[particles] and [coupling]')
                 return
             end if
-            allocate (continuum_simulation_t :: sim)
+            if (particles) then
+                allocate (coupled2d_simulation_t :: sim)
+            else
+                allocate (continuum_simulation_t :: sim)
+            end if
             return
         end if
         if (coupled .and. .not. deck_has_coupling(deck)) then
