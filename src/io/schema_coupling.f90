@@ -18,10 +18,11 @@ contains
         !> Schema to extend.
         type(schema_t), intent(inout) :: s
         type(tail_spec_t), allocatable :: tails(:)
-        call s%add_section('coupling', 'Arlequin coupling of a deck with both [beam] and '// &
-                           '[particles]: in the overlap the energies of both models are weighted by alpha '// &
-                           '(beam) and 1 - alpha (disks), and one Lagrange multiplier per coupled DOF glues '// &
-                           'each coupled disk centre to the beam (doc/input.md, section Coupled runs). '// &
+        call s%add_section('coupling', 'Arlequin coupling of a deck with [particles] and a [beam] or a '// &
+                           '[continuum]: in the overlap the energies of both models are weighted by alpha '// &
+                           '(FE) and 1 - alpha (disks), and Lagrange multipliers glue each coupled disk centre '// &
+                           'to the FE model (doc/input.md, sections Coupled runs and Coupled continuum and disk '// &
+                           'runs). '// &
                            'Coupled runs are dynamic, with [time] scheme = average_acceleration and '// &
                            'theta = 0.5.')
         call s%add_keyword('coupling', 'overlap', [real_field('s_fe', 'm', lower=0.0_wp), &
@@ -29,7 +30,7 @@ contains
                            'Overlap interval, as abscissas along the beam from its first node: s_fe is the '// &
                            'end next to the FE-only zone (alpha = 1 before it), s_particle the end next to '// &
                            'the particle-only zone (alpha = 0 beyond it; the beam must end there). Required '// &
-                           'in a coupled deck.')
+                           'in a beam coupled deck (a [continuum] takes region lines).')
         call s%add_keyword('coupling', 'weight', [word_field('weight', 'constant linear cubic')], &
                            'Shape of alpha across the overlap (xi = 0 at s_fe, 1 at s_particle): constant, '// &
                            'linear 1 - xi, or cubic 1 - 3 xi^2 + 2 xi^3 (zero slope at both ends).', &
