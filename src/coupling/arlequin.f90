@@ -1,18 +1,13 @@
-!> Arlequin DEM-FEM coupled system and its time step (doc/theory.md section 6): a weighted beam
-!> model (Newmark) and weighted disks (Moreau-Jean, contacts) glued in the overlap by one
-!> multiplier per coupled DOF, explicitly in the coupling, at velocity level.
+!> Arlequin coupling of a planar beam and disks (doc/theory.md section 6): the beam builder of
+!> the coupled system. The coupled time step, the energy audit and the generic parts of the
+!> build are in coupling_coupled_step (shared with the 2D continuum, coupling_arlequin2d);
+!> this module re-exports them, so that callers keep using coupling_arlequin.
 !>
 !> Multiplier space (`multipliers`): one multiplier per coupled DOF (`multipliers_particles`,
-!> the reference work: every coupled disk centre follows C u), or on the FE nodes that carry
+!> the reference work: every coupled disk centre follows C u), or on the beam nodes that carry
 !> coupled points (`multipliers_nodes`, a coarser mediator space, coupling_operator's
-!> `build_mediator`): the constraint is then Pi (q - C u) = 0, the disks receive Pi^T lambda
-!> and the FE -(Pi C)^T lambda, and A_m = Pi A Pi^T. A disk may move relative to the beam in
-!> the kernel of Pi (e.g. a zig-zag between the nodes). Both are extensions of the abstract
-!> coupling_multiplier_space type (`space`), so the step does not branch on the choice; the
-!> rows (coupling_bilateral) use B = Pi^T A_m^-1 Pi in place of A^-1: `lambda` is always the force
-!> mu on the coupled DOFs (mu = Pi^T lambda_m), `multiplier` the multipliers themselves.
-!> The statistics' position/velocity/rotation residuals are those of the imposed constraint
-!> (Pi e with the mediator space), `particle_residual` the per-disk residual ||e||.
+!> `build_mediator`). A disk may then move relative to the beam in the kernel of Pi (e.g. a
+!> zig-zag between the nodes).
 !>
 !> Build (`build_coupled_system`): the beam is assembled with the weight alpha(s) (mass,
 !> stiffness and loads integrated with alpha); every disk gets the weight alpha at the
@@ -21,72 +16,28 @@
 !> unchanged; a disk in the FE-only zone, alpha = 1, is an error). The coupled disks are those
 !> whose centre lies in the overlap (optionally within `max_offset` of the axis, or an explicit
 !> list); C interpolates the beam at their centres (offset included, optional rotation row).
-!> Small displacements: C, the weights and h are constant (C is built on the reference
-!> configuration), so A = h gamma (W + C S^-1 C^T) is assembled, factored and inverted once.
-!> The DEM is per unit thickness: `thickness` t turns its masses and impulses into absolute
-!> ones (W = ((1 - alpha) m t)^-1); energies are reported in J (DEM energies times t).
-!>
-!> Time discretisation of the coupling force. The FE (Newmark) sees -C^T lambda_{n+1} as a
-!> force at t_{n+1}: it enters v_{n+1} with weight gamma h and v_{n+2} with (1 - gamma) h
-!> (through a_{n+1}). The particles receive the same impulse in the same steps:
-!> h [(1 - gamma) lambda_n + gamma lambda_{n+1}] in step n+1. Momentum is thus exchanged
-!> exactly, and with gamma = theta = 1/2, beta = 1/4 (both schemes trapezoidal in position)
-!> the coupling works of the two sides cancel up to the drift term (below): the energy
-!> balance of the coupled system closes to round-off. (Giving the whole impulse h lambda_{n+1}
-!> to the particles instead leaves a net coupling work (lambda_{n+1} - lambda_n)/2 . C du per
-!> step, first order in h.)
-!>
-!> Step (`arlequin_step`):
-!> 1. FE Newmark prediction (no coupling force): v_c,free; DEM free velocities (loads,
-!>    gravity) plus the share (1 - gamma) h lambda_n of the previous multipliers;
-!> 2. free residual g = G v_free - C v_c,free + e_n/h, e_n = q_n - C (u_n - u_0) the position
-!>    residual at the start of the step (drift term: the constraint imposed at t_{n+1} is
-!>    G v - C v_c = -e_n/h, which pulls q - C u back instead of letting it drift);
-!> 3. lambda = -A^-1 g applied to the disks (an estimate used to activate the contacts);
-!> 4. contacts (detection, laws) and the joint solve: NLGS over the contacts with lambda
-!>    eliminated exactly at every contact update (coupling_bilateral, where the choice is
-!>    justified); contacts touching coupled disks get condensed Delassus blocks;
-!> 5. DEM update; FE correction with -C^T lambda; residuals and statistics.
-!> The velocity constraint holds to round-off after every step whatever the NLGS tolerance
-!> (lambda is re-solved after each contact update); with theta = 1/2 and average
-!> acceleration, e_{n+1} = (e_n - e_{n-1})/2: round-off errors of q - C u decay (|z| = 0.71).
-!> The particle displacements q of the coupled DOFs are accumulated with the DEM's own update
-!> rule, at the scale of the displacements (the coordinates carry a rounding of ulp(x) per
-!> step that would otherwise enter e).
-!>
-!> Energy audit (`coupled_energies`): FE kinetic + strain (weighted), DEM kinetic + potential
-!> (weighted, times t), external works of both, Rayleigh, contact and numerical dissipation,
-!> coupling works of both sides; `balance` = total energy + dissipation - works - initial, which
-!> equals the net coupling work (zero up to the drift term and round-off with the schemes
-!> above; a first-step impulse that removes inconsistent initial velocities dissipates energy
-!> like a plastic impact).
+!> `coupled_beam` and `coupled_beam_operator` give back the beam and its C from a system built
+!> here.
 module coupling_arlequin
     use core_kinds, only: wp
     use core_error, only: error_t, make_error, make_internal_error
-    use core_linalg, only: dense_spd_t
     use fem_beam_config, only: beam_config_t
     use fem_beam_model, only: beam_model_t, build_beam_model
-    use fem_newmark, only: newmark_t
-    use dem_particles, only: particles_inverse_mass, dof_x, dof_y, dof_rot
-    use dem_moreau_jean, only: dem_system_t, mj_init, mj_free_velocities, mj_detect, mj_solve, &
-                               mj_end_step, energies_balance
-    use coupling_weights, only: weight_config_t, overlap_weight_t, make_weight
+    use dem_moreau_jean, only: dem_system_t
+    use coupling_weights, only: weight_config_t, make_weight
     use coupling_operator, only: coupling_operator_t, build_coupling_operator, mediator_t, &
                                  build_mediator
-    use coupling_lambda, only: coupling_system_t, fe_coupling_force
-    use coupling_bilateral, only: coupling_rows_t
-    use coupling_multiplier_space, only: multiplier_space_t, disk_space_t, mediator_space_t, &
-                                         make_mediator_space
+    use coupling_multiplier_space, only: multiplier_space_t, mediator_space_t, make_mediator_space
+    use coupling_coupled_step, only: coupled_system_t, coupled_stats_t, coupled_energies_t, &
+                                     complete_coupled_system, disk_space, arlequin_step, &
+                                     coupled_energies, coordinate_residual, multipliers_particles, &
+                                     multipliers_nodes
     implicit none
     private
     public :: coupling_config_t, coupled_system_t, coupled_stats_t, coupled_energies_t
     public :: build_coupled_system, arlequin_step, coupled_energies, coordinate_residual
     public :: multipliers_particles, multipliers_nodes, nearest_abscissa
-
-    !> One multiplier per coupled DOF (the reference work).
-    integer, parameter :: multipliers_particles = 1
-    !> Multipliers on the FE nodes carrying coupled points (mediator space).
-    integer, parameter :: multipliers_nodes = 2
+    public :: coupled_beam, coupled_beam_operator
 
     !> Description of the coupling, as read from the deck ([coupling] section).
     type :: coupling_config_t
@@ -109,113 +60,6 @@ module coupling_arlequin
         !> Multiplier space: multipliers_particles or multipliers_nodes.
         integer :: multipliers = multipliers_particles
     end type coupling_config_t
-
-    !> Statistics of the last coupled step (norms over the translation rows unless said).
-    type :: coupled_stats_t
-        !> NLGS sweeps of the joint contact/multiplier solve.
-        integer :: sweeps = 0
-        !> Multiplier corrections made during the solve (restores and contact updates on
-        !> coupled disks).
-        integer :: corrections = 0
-        !> Contacts in the list and active contacts.
-        integer :: n_contacts = 0, n_active = 0
-        !> The NLGS reached its tolerance.
-        logical :: converged = .true.
-        !> NLGS convergence norm after the last sweep.
-        real(wp) :: nlgs_error = 0.0_wp
-        !> ||g||: free velocity residual before the multipliers [m/s].
-        real(wp) :: free_residual = 0.0_wp
-        !> ||G v - C v_c + e_n/h|| after the step [m/s] (round-off); ||Pi (...)|| with the
-        !> mediator space.
-        real(wp) :: velocity_residual = 0.0_wp
-        !> ||q - C (u - u_0)|| after the step [m] (round-off); ||Pi (...)|| with the mediator
-        !> space.
-        real(wp) :: position_residual = 0.0_wp
-        !> ||q - C (u - u_0)|| per disk [m]: the position residual with multipliers on the
-        !> particles, free in the kernel of Pi with the mediator space.
-        real(wp) :: particle_residual = 0.0_wp
-        !> Same for the rotation rows [rad] (0 without rotation rows).
-        real(wp) :: rotation_residual = 0.0_wp
-        !> ||lambda|| over all multipliers (mediator ones with multipliers_nodes) [N, N.m].
-        real(wp) :: lambda_norm = 0.0_wp
-    end type coupled_stats_t
-
-    !> Energy audit of the coupled system [J] (DEM terms already multiplied by the thickness).
-    type :: coupled_energies_t
-        !> FE kinetic and strain energy (weighted).
-        real(wp) :: fe_kinetic = 0.0_wp, fe_strain = 0.0_wp
-        !> FE external work (weighted loads) and Rayleigh dissipation.
-        real(wp) :: fe_external_work = 0.0_wp, fe_damping = 0.0_wp
-        !> Work of the coupling forces -C^T lambda on the FE.
-        real(wp) :: fe_coupling_work = 0.0_wp
-        !> DEM kinetic and gravity potential energy (weighted).
-        real(wp) :: dem_kinetic = 0.0_wp, dem_potential = 0.0_wp
-        !> DEM work of loads, and of imposed velocities and moving walls.
-        real(wp) :: dem_external_work = 0.0_wp, dem_drive_work = 0.0_wp
-        !> DEM contact and numerical (theta > 1/2) dissipation.
-        real(wp) :: dem_contact_dissipation = 0.0_wp, dem_numerical_dissipation = 0.0_wp
-        !> Work of the multipliers on the disks.
-        real(wp) :: dem_coupling_work = 0.0_wp
-        !> Total energy at the start.
-        real(wp) :: initial = 0.0_wp
-        !> Net coupling work fe_coupling_work + dem_coupling_work (ideally zero).
-        real(wp) :: coupling_work = 0.0_wp
-        !> Balance residual: energies + dissipations - external works - initial.
-        real(wp) :: balance = 0.0_wp
-    end type coupled_energies_t
-
-    !> A coupled simulation: both domains, the coupling and its state.
-    type :: coupled_system_t
-        !> Weighted beam model.
-        type(beam_model_t) :: model
-        !> FE time integrator (Newmark, split predict/correct).
-        type(newmark_t) :: fe
-        !> Discrete domain, masses and loads weighted by (1 - alpha).
-        type(dem_system_t) :: dem
-        !> Weight alpha(s).
-        type(overlap_weight_t) :: weight
-        !> Coupling operator C at the coupled disks.
-        type(coupling_operator_t) :: op
-        !> Factored A.
-        type(coupling_system_t) :: multipliers
-        !> Coupling rows as NLGS bilateral constraints (holds A^-1 or B).
-        type(coupling_rows_t) :: rows
-        !> The multiplier space (per coupled DOF, or the mediator space on the beam nodes).
-        class(multiplier_space_t), allocatable :: space
-        !> The space imposes only a projection Pi e (multipliers on the nodes); for messages.
-        logical :: on_nodes = .false.
-        !> The beam nodes of the mediator space (with on_nodes; n_nodes = 0 otherwise).
-        type(mediator_t) :: mediator
-        !> Multipliers after a step: lambda (per DOF) or lambda_m (mediator) [N, N.m].
-        real(wp), allocatable :: multiplier(:)
-        !> Out-of-plane thickness of the particle domain [m].
-        real(wp) :: thickness = 0.0_wp
-        !> Contacts on coupled disks use the condensed Delassus blocks.
-        logical :: condensed = .true.
-        !> Disk of each coupled point (n_points).
-        integer, allocatable :: coupled(:)
-        !> Weight alpha of every disk (n_disks): its mass is (1 - alpha) times the physical one.
-        real(wp), allocatable :: alpha(:)
-        !> Forces of the multipliers on the coupled DOFs (lambda, or Pi^T lambda_m) at t_{n+1}
-        !> (after a step) and t_n [N, N.m] (n_rows).
-        real(wp), allocatable :: lambda(:), lambda_old(:)
-        !> Free residual g of the last step [m/s, rad/s] (n_rows).
-        real(wp), allocatable :: g(:)
-        !> Displacement of the coupled DOFs since the start, accumulated [m, rad] (n_rows).
-        real(wp), allocatable :: q(:)
-        !> C u at the start [m, rad] (n_rows).
-        real(wp), allocatable :: cu0(:)
-        !> Position residual e = q - C (u - u_0) at the current time [m, rad] (n_rows).
-        real(wp), allocatable :: drift(:)
-        !> Coordinates of the coupled DOFs at the start (x, y or rotation) (n_rows).
-        real(wp), allocatable :: start(:)
-        !> Statistics of the last step (after the build: the initial residuals).
-        type(coupled_stats_t) :: stats
-        !> Steps done.
-        integer :: step = 0
-        !> Work arrays (n_rows): C v, G v; (n_free): FE coupling force.
-        real(wp), allocatable :: cv(:), gv(:), fc(:)
-    end type coupled_system_t
 
 contains
 
@@ -241,9 +85,10 @@ contains
         real(wp), intent(in), optional :: beta, gamma
         !> FE initial displacements and velocities per node (3, n_nodes) (default 0).
         real(wp), intent(in), optional :: fe_u0(:, :), fe_v0(:, :)
-        real(wp), allocatable :: u0(:), v0(:), s(:), off(:), im(:, :), iw(:), alpha_pts(:)
-        real(wp) :: h
-        integer :: n, r
+        type(beam_model_t) :: model
+        type(coupling_operator_t) :: op
+        class(multiplier_space_t), allocatable :: space
+        real(wp), allocatable :: u0(:), v0(:), s(:), off(:), alpha_pts(:)
         if (.not. (config%thickness > 0)) then
             call make_error(error, 'coupling: thickness (out-of-plane depth of the particle '// &
                             'domain, usually the width of the beam section) must be > 0')
@@ -251,101 +96,107 @@ contains
         end if
         call make_weight(config%weight, sys%weight, error)
         if (allocated(error)) return
-        call build_beam_model(beam, sys%model, error, sys%weight)
+        call build_beam_model(beam, model, error, sys%weight)
         if (allocated(error)) return
-        call check_beam_weight(sys, error)
+        call check_beam_weight(sys, model, error)
         if (allocated(error)) return
         sys%dem = dem
         sys%thickness = config%thickness
         sys%condensed = config%condensed_contacts
-        n = sys%dem%particles%n
-        if (n == 0) then
+        if (sys%dem%particles%n == 0) then
             call make_error(error, 'coupling: the particle domain has no disk')
             return
         end if
-        call disk_weights(sys, s, off, error)
+        call disk_weights(sys, model, s, off, error)
         if (allocated(error)) return
         call select_coupled(config, sys, off, error)
         if (allocated(error)) return
         if (config%max_offset > 0) then
-            call build_coupling_operator(sys%model, sys%dem%particles%x(sys%coupled), &
-                                         sys%dem%particles%y(sys%coupled), sys%op, error, &
+            call build_coupling_operator(model, sys%dem%particles%x(sys%coupled), &
+                                         sys%dem%particles%y(sys%coupled), op, error, &
                                          with_rotation=config%rotation_row, &
                                          max_offset=config%max_offset)
         else
-            call build_coupling_operator(sys%model, sys%dem%particles%x(sys%coupled), &
-                                         sys%dem%particles%y(sys%coupled), sys%op, error, &
+            call build_coupling_operator(model, sys%dem%particles%x(sys%coupled), &
+                                         sys%dem%particles%y(sys%coupled), op, error, &
                                          with_rotation=config%rotation_row)
         end if
         if (allocated(error)) return
-        call sys%op%point_weights(sys%weight, alpha_pts, error)
+        call op%point_weights(sys%weight, alpha_pts, error)
         if (allocated(error)) return
-        call scale_disks(sys)
-        call mj_init(sys%dem, error)
+        call nodal_to_free(model, 'fe_u0', u0, error, fe_u0)
         if (allocated(error)) return
-        ! FE integrator on the common step.
-        h = sys%dem%scheme%h
-        if (present(beta)) sys%fe%beta = beta
-        if (present(gamma)) sys%fe%gamma = gamma
-        call nodal_to_free(sys%model, 'fe_u0', u0, error, fe_u0)
+        call nodal_to_free(model, 'fe_v0', v0, error, fe_v0)
         if (allocated(error)) return
-        call nodal_to_free(sys%model, 'fe_v0', v0, error, fe_v0)
+        call make_space(config, model, op, sys, space, error)
         if (allocated(error)) return
-        call sys%fe%init(sys%model, h, sys%dem%time, u0, v0, error)
-        if (allocated(error)) return
-        ! Rows: owner disk and DOF, weighted inverse masses per unit thickness.
-        call init_rows(sys)
-        allocate (im(3, n))
-        call particles_inverse_mass(sys%dem%particles, im)
-        allocate (iw(sys%op%n_rows))
-        do r = 1, sys%op%n_rows
-            iw(r) = im(sys%rows%dof(r), sys%rows%owner(r))/sys%thickness
-        end do
-        call sys%multipliers%assemble(sys%op, sys%fe, error, inverse_mass=sys%fe%gamma*iw)
-        if (allocated(error)) return
-        call make_space(config, sys, error)
-        if (allocated(error)) return
-        call sys%space%inverse(sys%multipliers%a, sys%rows%ainv, error)
-        if (allocated(error)) return
-        sys%on_nodes = sys%space%projected()
-        sys%rows%ainv = 0.5_wp*(sys%rows%ainv + transpose(sys%rows%ainv))
-        sys%rows%response = h*sys%fe%gamma*iw
-        sys%rows%scale = h*sys%fe%gamma/sys%thickness
-        call init_state(sys)
+        allocate (sys%model, source=model)
+        allocate (sys%op, source=op)
+        call complete_coupled_system(sys, space, u0, v0, error, beta, gamma)
     end subroutine build_coupled_system
 
     !> The multiplier space chosen by config%multipliers: per coupled DOF, or the mediator
     !> space on the beam nodes carrying coupled points (Pi from build_mediator).
-    subroutine make_space(config, sys, error)
+    subroutine make_space(config, model, op, sys, space, error)
         type(coupling_config_t), intent(in) :: config
+        type(beam_model_t), intent(in) :: model
+        type(coupling_operator_t), intent(in) :: op
         type(coupled_system_t), intent(inout) :: sys
+        class(multiplier_space_t), allocatable, intent(out) :: space
         type(error_t), allocatable, intent(out) :: error
         type(mediator_space_t) :: med
+        type(mediator_t) :: mediator
         if (config%multipliers == multipliers_nodes) then
-            call build_mediator(sys%model, sys%op, sys%mediator, error)
+            call build_mediator(model, op, mediator, error)
             if (allocated(error)) return
-            call make_mediator_space(sys%mediator%pi, sys%mediator%comp, med, error)
+            call make_mediator_space(mediator%pi, mediator%comp, med, error)
             if (allocated(error)) return
-            allocate (sys%space, source=med)
+            allocate (space, source=med)
+            sys%mediator_nodes = mediator%node
         else
-            allocate (sys%space, source=disk_space_t(sys%rows%dof))
+            call disk_space(op, space)
         end if
     end subroutine make_space
 
+    !> The weighted beam of a system built by `build_coupled_system` (a copy).
+    function coupled_beam(sys) result(model)
+        !> The coupled system (beam and disks).
+        type(coupled_system_t), intent(in) :: sys
+        !> Its beam model.
+        type(beam_model_t) :: model
+        select type (m => sys%model)
+        type is (beam_model_t)
+            model = m
+        end select
+    end function coupled_beam
+
+    !> The coupling operator of a system built by `build_coupled_system` (a copy).
+    function coupled_beam_operator(sys) result(op)
+        !> The coupled system (beam and disks).
+        type(coupled_system_t), intent(in) :: sys
+        !> Its C.
+        type(coupling_operator_t) :: op
+        select type (o => sys%op)
+        type is (coupling_operator_t)
+            op = o
+        end select
+    end function coupled_beam_operator
+
     !> Error when an element lies wholly where alpha = 0 (beyond the overlap's particle end):
     !> it would have neither mass nor stiffness.
-    subroutine check_beam_weight(sys, error)
+    subroutine check_beam_weight(sys, model, error)
         type(coupled_system_t), intent(in) :: sys
+        type(beam_model_t), intent(in) :: model
         type(error_t), allocatable, intent(out) :: error
         integer :: e
         character(len=300) :: buf
-        do e = 1, sys%model%n_elements
-            if (sys%weight%value(sys%model%abscissa_at(e, 1.0e-6_wp)) > 0 .or. &
-                sys%weight%value(sys%model%abscissa_at(e, 0.5_wp)) > 0 .or. &
-                sys%weight%value(sys%model%abscissa_at(e, 1 - 1.0e-6_wp)) > 0) cycle
+        do e = 1, model%n_elements
+            if (sys%weight%value(model%abscissa_at(e, 1.0e-6_wp)) > 0 .or. &
+                sys%weight%value(model%abscissa_at(e, 0.5_wp)) > 0 .or. &
+                sys%weight%value(model%abscissa_at(e, 1 - 1.0e-6_wp)) > 0) cycle
             write (buf, '(a,i0,a,es13.5e3,a,es13.5e3,a,es13.5e3,a)') 'coupling: beam element ', e, &
-                ' (abscissa ', sys%model%abscissa_at(e, 0.0_wp), ' to ', &
-                sys%model%abscissa_at(e, 1.0_wp), ' m) lies beyond the overlap, where '// &
+                ' (abscissa ', model%abscissa_at(e, 0.0_wp), ' to ', &
+                model%abscissa_at(e, 1.0_wp), ' m) lies beyond the overlap, where '// &
                 'alpha = 0: it would have neither mass nor stiffness; end the beam at '// &
                 's_particle = ', &
                 sys%weight%s_particle, ' m'
@@ -373,8 +224,9 @@ contains
     !> Weight alpha of every disk at the abscissa of its centre (projection on the nearest
     !> element, extended linearly past the beam's ends) and its signed offset from the axis;
     !> a disk in the FE-only zone (alpha = 1) is an error.
-    subroutine disk_weights(sys, s, off, error)
+    subroutine disk_weights(sys, model, s, off, error)
         type(coupled_system_t), intent(inout) :: sys
+        type(beam_model_t), intent(in) :: model
         real(wp), allocatable, intent(out) :: s(:), off(:)
         type(error_t), allocatable, intent(out) :: error
         integer :: i, n
@@ -382,7 +234,7 @@ contains
         n = sys%dem%particles%n
         allocate (s(n), off(n), sys%alpha(n))
         do i = 1, n
-            call nearest_abscissa(sys%model, sys%dem%particles%x(i), sys%dem%particles%y(i), &
+            call nearest_abscissa(model, sys%dem%particles%x(i), sys%dem%particles%y(i), &
                                   s(i), off(i))
             sys%alpha(i) = sys%weight%value(s(i))
             if (sys%alpha(i) < 1) cycle
@@ -462,239 +314,4 @@ contains
                             'interval against the positions of the disks')
         end if
     end subroutine select_coupled
-
-    !> Masses, inertias and loads of the disks times (1 - alpha).
-    subroutine scale_disks(sys)
-        type(coupled_system_t), intent(inout) :: sys
-        integer :: i, k
-        associate (p => sys%dem%particles)
-            do i = 1, p%n
-                p%mass(i) = (1 - sys%alpha(i))*p%mass(i)
-                p%inertia(i) = (1 - sys%alpha(i))*p%inertia(i)
-            end do
-            do k = 1, p%n_loads
-                p%loads(k)%value = (1 - sys%alpha(p%loads(k)%particle))*p%loads(k)%value
-            end do
-        end associate
-    end subroutine scale_disks
-
-    !> Owner disk and DOF of every row, point of every disk.
-    subroutine init_rows(sys)
-        type(coupled_system_t), intent(inout) :: sys
-        integer :: p, k, r
-        associate (rows => sys%rows, op => sys%op)
-            rows%n_rows = op%n_rows
-            rows%rows_per_point = op%rows_per_point
-            allocate (rows%point_of(sys%dem%particles%n), source=0)
-            allocate (rows%owner(op%n_rows), rows%dof(op%n_rows))
-            do p = 1, op%n_points
-                rows%point_of(sys%coupled(p)) = p
-                do k = 1, op%rows_per_point
-                    r = op%row_of(p, k)
-                    rows%owner(r) = sys%coupled(p)
-                    rows%dof(r) = k
-                end do
-            end do
-            allocate (rows%lambda(op%n_rows), rows%target(op%n_rows), rows%delta(op%n_rows), &
-                      source=0.0_wp)
-        end associate
-    end subroutine init_rows
-
-    !> Multipliers, references of the constraint, initial residuals.
-    subroutine init_state(sys)
-        type(coupled_system_t), intent(inout) :: sys
-        integer :: nr, r
-        nr = sys%op%n_rows
-        allocate (sys%lambda(nr), sys%lambda_old(nr), sys%g(nr), sys%q(nr), sys%drift(nr), &
-                  sys%cv(nr), sys%gv(nr), sys%cu0(nr), sys%start(nr), source=0.0_wp)
-        allocate (sys%fc(sys%op%n_free), source=0.0_wp)
-        allocate (sys%multiplier(sys%space%n_mult), source=0.0_wp)
-        call sys%op%apply(sys%fe%u, sys%cu0)
-        associate (p => sys%dem%particles)
-            do r = 1, nr
-                select case (sys%rows%dof(r))
-                case (dof_x)
-                    sys%start(r) = p%x(sys%rows%owner(r))
-                case (dof_y)
-                    sys%start(r) = p%y(sys%rows%owner(r))
-                case default
-                    sys%start(r) = p%rot(sys%rows%owner(r))
-                end select
-            end do
-        end associate
-        call disk_velocities(sys, sys%gv)
-        call sys%op%apply(sys%fe%v, sys%cv)
-        sys%g = sys%gv - sys%cv
-        sys%stats = coupled_stats_t()
-        sys%stats%free_residual = constraint_norm(sys, sys%g, .false.)
-        sys%stats%velocity_residual = sys%stats%free_residual
-        sys%step = 0
-    end subroutine init_state
-
-    !> Velocities of the coupled DOFs from the disks' state (n_rows).
-    pure subroutine disk_velocities(sys, gv)
-        type(coupled_system_t), intent(in) :: sys
-        real(wp), intent(out) :: gv(:)
-        integer :: r, i
-        associate (p => sys%dem%particles)
-            do r = 1, sys%op%n_rows
-                i = sys%rows%owner(r)
-                select case (sys%rows%dof(r))
-                case (dof_x)
-                    gv(r) = p%vx(i)
-                case (dof_y)
-                    gv(r) = p%vy(i)
-                case default
-                    gv(r) = p%w(i)
-                end select
-            end do
-        end associate
-    end subroutine disk_velocities
-
-    !> Euclidean norm of v over the translation rows, or over the rotation rows.
-    pure real(wp) function row_norm(sys, v, rotation) result(nrm)
-        type(coupled_system_t), intent(in) :: sys
-        real(wp), intent(in) :: v(:)
-        logical, intent(in) :: rotation
-        nrm = norm2(merge(v, 0.0_wp, (sys%rows%dof == dof_rot) .eqv. rotation))
-    end function row_norm
-
-    !> Norm of the imposed part of a row vector v (Pi v over the translation or rotation
-    !> multipliers; v itself per coupled DOF).
-    pure real(wp) function constraint_norm(sys, v, rotation) result(nrm)
-        type(coupled_system_t), intent(in) :: sys
-        real(wp), intent(in) :: v(:)
-        logical, intent(in) :: rotation
-        nrm = sys%space%constraint_norm(v, rotation)
-    end function constraint_norm
-
-    !> Advance the coupled system by one time step (see the module description).
-    subroutine arlequin_step(sys, error)
-        !> The coupled system (built).
-        type(coupled_system_t), intent(inout) :: sys
-        !> Set on failure of the FE solves.
-        type(error_t), allocatable, intent(out) :: error
-        real(wp) :: h, gam, th, imp
-        integer :: r, i, d
-        h = sys%fe%h
-        gam = sys%fe%gamma
-        th = sys%dem%scheme%theta
-        call sys%fe%predict(sys%model, error)
-        if (allocated(error)) return
-        call mj_free_velocities(sys%dem)
-        ! The share (1 - gamma) h lambda_n of the previous multipliers acts in this step (on
-        ! the FE through a_n in the prediction), per unit thickness on the disks.
-        do r = 1, sys%op%n_rows
-            i = sys%rows%owner(r)
-            d = sys%rows%dof(r)
-            imp = h*(1 - gam)*sys%lambda_old(r)/sys%thickness
-            sys%dem%vel(d, i) = sys%dem%vel(d, i) + sys%dem%im(d, i)*imp
-            sys%dem%coupling_impulse(d, i) = sys%dem%coupling_impulse(d, i) + imp
-        end do
-        ! Free residual with the drift term, first multipliers (contacts are activated on the
-        ! velocities they give), contacts and the joint solve.
-        call sys%op%apply(sys%fe%v, sys%cv)
-        call sys%rows%gather(sys%dem%vel, sys%gv)
-        sys%g = sys%gv - sys%cv + sys%drift/h
-        call sys%rows%begin(sys%dem%vel, sys%g)
-        call sys%rows%restore(sys%dem%vel)
-        call mj_detect(sys%dem)
-        if (sys%condensed) call sys%rows%condense(sys%dem%contacts, sys%dem%im)
-        call mj_solve(sys%dem, sys%rows)
-        sys%lambda = sys%rows%lambda
-        do r = 1, sys%op%n_rows
-            i = sys%rows%owner(r)
-            d = sys%rows%dof(r)
-            sys%dem%coupling_impulse(d, i) = sys%dem%coupling_impulse(d, i) + &
-                                             h*gam*sys%lambda(r)/sys%thickness
-            ! Displacement of the coupled DOF, by the DEM's own update rule.
-            sys%q(r) = sys%q(r) + h*((1 - th)*sys%dem%vel0(d, i) + th*sys%dem%vel(d, i))
-        end do
-        call mj_end_step(sys%dem)
-        call fe_coupling_force(sys%op, sys%lambda, sys%fc)
-        call sys%fe%correct(sys%model, sys%fc, error)
-        if (allocated(error)) return
-        call finish_step(sys)
-    end subroutine arlequin_step
-
-    !> Residuals and statistics after a step; lambda_old = lambda.
-    subroutine finish_step(sys)
-        type(coupled_system_t), intent(inout) :: sys
-        associate (st => sys%stats)
-            st%sweeps = sys%dem%stats%sweeps
-            st%corrections = sys%rows%corrections
-            st%n_contacts = sys%dem%stats%n_contacts
-            st%n_active = sys%dem%stats%n_active
-            st%converged = sys%dem%stats%converged
-            st%nlgs_error = sys%dem%stats%error
-            st%free_residual = constraint_norm(sys, sys%g, .false.)
-            ! Velocity constraint at t_{n+1} with the drift term of the step.
-            call disk_velocities(sys, sys%gv)
-            call sys%op%apply(sys%fe%v, sys%cv)
-            sys%gv = sys%gv - sys%cv + sys%drift/sys%fe%h
-            st%velocity_residual = constraint_norm(sys, sys%gv, .false.)
-            ! New position residual.
-            call sys%op%apply(sys%fe%u, sys%cv)
-            sys%drift = sys%q - (sys%cv - sys%cu0)
-            st%position_residual = constraint_norm(sys, sys%drift, .false.)
-            st%rotation_residual = constraint_norm(sys, sys%drift, .true.)
-            st%particle_residual = row_norm(sys, sys%drift, .false.)
-            call sys%space%recover(sys%lambda, sys%multiplier)
-            st%lambda_norm = norm2(sys%multiplier)
-        end associate
-        sys%lambda_old = sys%lambda
-        sys%step = sys%step + 1
-    end subroutine finish_step
-
-    !> Largest |(x - x_0) - C (u - u_0)| over the translation rows, from the disks' actual
-    !> coordinates [m]: the position residual including the rounding of the coordinates
-    !> (about ulp(x) per step, a random walk).
-    real(wp) function coordinate_residual(sys) result(res)
-        !> The coupled system.
-        type(coupled_system_t), intent(in) :: sys
-        real(wp) :: cu(sys%op%n_rows), xr
-        integer :: r, i
-        call sys%op%apply(sys%fe%u, cu)
-        res = 0.0_wp
-        do r = 1, sys%op%n_rows
-            i = sys%rows%owner(r)
-            select case (sys%rows%dof(r))
-            case (dof_x)
-                xr = sys%dem%particles%x(i)
-            case (dof_y)
-                xr = sys%dem%particles%y(i)
-            case default
-                cycle
-            end select
-            res = max(res, abs((xr - sys%start(r)) - (cu(r) - sys%cu0(r))))
-        end do
-    end function coordinate_residual
-
-    !> Energy audit of the coupled system [J] (see the module description).
-    pure function coupled_energies(sys) result(e)
-        !> The coupled system.
-        type(coupled_system_t), intent(in) :: sys
-        type(coupled_energies_t) :: e
-        real(wp) :: t
-        t = sys%thickness
-        e%fe_kinetic = sys%fe%kinetic
-        e%fe_strain = sys%fe%strain
-        e%fe_external_work = sys%fe%external_work
-        e%fe_damping = sys%fe%damping_dissipation
-        e%fe_coupling_work = sys%fe%coupling_work
-        associate (d => sys%dem%energies)
-            e%dem_kinetic = t*d%kinetic
-            e%dem_potential = t*d%potential
-            e%dem_external_work = t*d%external_work
-            e%dem_drive_work = t*d%drive_work
-            e%dem_contact_dissipation = t*d%contact_dissipation
-            e%dem_numerical_dissipation = t*d%numerical_dissipation
-            e%dem_coupling_work = t*d%coupling_work
-            e%initial = sys%fe%initial_energy + t*d%initial
-            e%coupling_work = e%fe_coupling_work + e%dem_coupling_work
-            ! Each side's own audit (its coupling work included) closes to round-off; their
-            ! sum without the coupling works is the balance of the coupled system.
-            e%balance = sys%fe%energy_balance() + t*energies_balance(d) + e%coupling_work
-        end associate
-    end function coupled_energies
 end module coupling_arlequin

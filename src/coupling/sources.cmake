@@ -10,4 +10,6 @@ set(MULTICOR_COUPLING_SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/operator2d.f90
     ${CMAKE_CURRENT_LIST_DIR}/weighted2d.f90
     ${CMAKE_CURRENT_LIST_DIR}/bilateral.f90
-    ${CMAKE_CURRENT_LIST_DIR}/arlequin.f90)
+    ${CMAKE_CURRENT_LIST_DIR}/coupled_step.f90
+    ${CMAKE_CURRENT_LIST_DIR}/arlequin.f90
+    ${CMAKE_CURRENT_LIST_DIR}/arlequin2d.f90)

@@ -101,6 +101,12 @@ contains
                                   'are not contacts): remove fclib_step')
             return
         end if
+        if (deck%has('coupling', 'region')) then
+            call make_input_error(error, deck%file, deck%line('coupling', 'region'), 'region', &
+                                  'region lines define the overlap of a [continuum]; a beam takes overlap = '// &
+                                  's_fe s_particle')
+            return
+        end if
         call require(deck, 'overlap', first_line, 's_fe s_particle [m]', error)
         if (allocated(error)) return
         call require(deck, 'thickness', first_line, 'depth of the disks [m], usually the '// &

@@ -12,10 +12,11 @@ module driver_results_coupled
     use core_error, only: error_t, make_error, make_internal_error
     use io_hdf5_file, only: h5_file_t
     use coupling_arlequin, only: coupled_system_t, coupled_energies_t, coupled_energies, &
-                                 coordinate_residual
+                                 coordinate_residual, coupled_beam_operator
+    use coupling_operator, only: coupling_operator_t
     implicit none
     private
-    public :: coupled_writer_t, energy_names
+    public :: coupled_writer_t, energy_names, write_beam_overlap
 
     !> Steps of statistics kept in memory before they are written.
     integer, parameter :: stats_buffer = 4096
@@ -67,8 +68,8 @@ module driver_results_coupled
 
 contains
 
-    !> Write /coupling/{overlap, particles, alpha, abscissa, offset, alpha_disks, rows}, the
-    !> settings as attributes of /coupling, and create the series.
+    !> Write /coupling/{particles, alpha, alpha_disks, rows}, the settings as attributes of
+    !> /coupling, and create the series (any FE model; a beam adds `write_beam_overlap`).
     subroutine writer_begin(self, file, sys, error)
         !> The writer.
         class(coupled_writer_t), intent(inout) :: self
@@ -89,16 +90,9 @@ contains
         self%max_balance = 0.0_wp
         allocate (self%values(stats_buffer, size(step_names)), self%sweeps(stats_buffer), &
                   self%corrections(stats_buffer))
-        call real_dataset('/coupling/overlap', [sys%weight%s_fe, sys%weight%s_particle], 'm', &
-                          error)
-        if (allocated(error)) return
         call file%write_dataset('/coupling/particles', sys%coupled, error)
         if (allocated(error)) return
         call real_dataset('/coupling/alpha', sys%alpha(sys%coupled), '', error)
-        if (allocated(error)) return
-        call real_dataset('/coupling/abscissa', sys%op%abscissa, 'm', error)
-        if (allocated(error)) return
-        call real_dataset('/coupling/offset', sys%op%offset, 'm', error)
         if (allocated(error)) return
         call real_dataset('/coupling/alpha_disks', sys%alpha, '', error)
         if (allocated(error)) return
@@ -164,6 +158,33 @@ contains
             call file%write_attribute(path, 'units', units, error)
         end subroutine real_series
     end subroutine writer_begin
+
+    !> The beam's overlap interval and the coupled disks' abscissas and offsets:
+    !> /coupling/{overlap, abscissa, offset} (a system built by coupling_arlequin).
+    subroutine write_beam_overlap(file, sys, error)
+        !> A results file open for writing (`begin` done).
+        type(h5_file_t), intent(inout) :: file
+        !> The coupled system of a beam (built).
+        type(coupled_system_t), intent(in) :: sys
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        type(coupling_operator_t) :: op
+        op = coupled_beam_operator(sys)
+        call put('/coupling/overlap', [sys%weight%s_fe, sys%weight%s_particle], error)
+        if (allocated(error)) return
+        call put('/coupling/abscissa', op%abscissa, error)
+        if (allocated(error)) return
+        call put('/coupling/offset', op%offset, error)
+    contains
+        subroutine put(path, values, error)
+            character(len=*), intent(in) :: path
+            real(wp), intent(in) :: values(:)
+            type(error_t), allocatable, intent(out) :: error
+            call file%write_dataset(path, values, error)
+            if (allocated(error)) return
+            call file%write_attribute(path, 'units', 'm', error)
+        end subroutine put
+    end subroutine write_beam_overlap
 
     !> Store the current multipliers and energy audit as one output.
     subroutine writer_store(self, file, sys, error)

@@ -189,7 +189,7 @@ contains
             real(wp) :: steps
             if (opts%end_time < 0.0_wp) return
             if (len(kind) == 0) then
-                call make_error(error, '--end: '//deck%file//' is not a beam, particle or coupled '// &
+                call make_error(error, '--end: '//deck%file//' is not a beam, particle or beam-particle coupled '// &
                                 'dynamic analysis (the runs that have checkpoints)')
                 return
             end if
@@ -216,7 +216,7 @@ contains
             type(error_t), allocatable, intent(out) :: error
             type(error_t), allocatable :: ignored
             if (len(kind) == 0) then
-                call make_error(error, '--restart: '//deck%file//' is not a beam, particle or coupled '// &
+                call make_error(error, '--restart: '//deck%file//' is not a beam, particle or beam-particle coupled '// &
                                 'dynamic analysis (only those runs have checkpoints)')
                 return
             end if

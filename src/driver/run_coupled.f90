@@ -17,14 +17,15 @@ module driver_run_coupled
     use core_signals, only: caught_signal, signal_name
     use io_progress, only: progress_t
     use fem_beam_config, only: beam_config_t
+    use fem_beam_model, only: beam_model_t
     use coupling_arlequin, only: coupled_system_t, coupled_energies_t, build_coupled_system, &
-                                 arlequin_step, coupled_energies
+                                 arlequin_step, coupled_energies, coupled_beam
     use driver_config, only: run_config_t
     use driver_config_dem, only: dem_config_t
     use driver_config_coupling, only: coupled_setup_t
     use driver_results, only: results_writer_t
     use driver_results_dem, only: dem_writer_t
-    use driver_results_coupled, only: coupled_writer_t
+    use driver_results_coupled, only: coupled_writer_t, write_beam_overlap
     use driver_run_dem, only: max_warnings, report_line_iface, speed_warning, last_unconverged_warning
     use driver_guards, only: check_beam_state, check_disks_state, step_start_t, take_step_start, &
                              check_tunnelling
@@ -89,13 +90,16 @@ contains
         type(progress_t) :: progress
         real(wp), allocatable :: d(:, :), v(:, :), a(:, :)
         type(step_start_t) :: start
+        type(beam_model_t) :: model
         integer(i8) :: n_steps, k, k0
         integer :: unconverged
         logical :: speed_warned, regular, stop
         character(len=512) :: buf
 
         n_steps = run%n_steps
-        allocate (d(3, sys%model%n_nodes), v(3, sys%model%n_nodes), a(3, sys%model%n_nodes))
+        ! The weighted beam (constant), to expand the free DOFs to the nodes.
+        model = coupled_beam(sys)
+        allocate (d(3, model%n_nodes), v(3, model%n_nodes), a(3, model%n_nodes))
         unconverged = 0
         speed_warned = .false.
         k0 = 0
@@ -108,6 +112,8 @@ contains
             call dem_out%begin(out%file, sys%dem, dem%material_id, dem%store_contacts, error)
             if (allocated(error)) return
             call cpl_out%begin(out%file, sys, error)
+            if (allocated(error)) return
+            call write_beam_overlap(out%file, sys, error)
             if (allocated(error)) return
             k = 0
             call check_step(error)
@@ -204,9 +210,9 @@ contains
         !> Guards after a step: finite beam and disk states, disks in the box, no tunnelling.
         subroutine check_step(error)
             type(error_t), allocatable, intent(out) :: error
-            call sys%model%expand(sys%fe%u, d)
-            call sys%model%expand(sys%fe%v, v)
-            call sys%model%expand(sys%fe%a, a)
+            call model%expand(sys%fe%u, d)
+            call model%expand(sys%fe%v, v)
+            call model%expand(sys%fe%a, a)
             call check_beam_state(k, sys%fe%t, beam%node_id, d, v, a, [sys%fe%kinetic, sys%fe%strain, &
                                                                        sys%fe%external_work, sys%fe%damping_dissipation], error)
             if (allocated(error)) return
@@ -220,9 +226,9 @@ contains
         !> One stored output of the three parts.
         subroutine store(error)
             type(error_t), allocatable, intent(out) :: error
-            call sys%model%expand(sys%fe%u, d)
-            call sys%model%expand(sys%fe%v, v)
-            call sys%model%expand(sys%fe%a, a)
+            call model%expand(sys%fe%u, d)
+            call model%expand(sys%fe%v, v)
+            call model%expand(sys%fe%a, a)
             call out%append_state(sys%fe%t, d, v, a, error)
             if (allocated(error)) return
             call dem_out%store(out%file, sys%dem, error)
@@ -258,7 +264,7 @@ contains
             type(coupled_energies_t) :: en
             en = coupled_energies(sys)
             write (buf, '(a,i0,a,i0,a,i0,a,i0,a,es13.5e3,a)') 'coupled run: ', &
-                sys%model%n_nodes, ' beam nodes, ', sys%dem%particles%n, ' disks (', &
+                model%n_nodes, ' beam nodes, ', sys%dem%particles%n, ' disks (', &
                 sys%op%n_points, ' coupled), ', n_steps, ' steps to t = ', sys%fe%t, ' s'
             call report(trim(buf))
             if (sys%on_nodes) then

@@ -1,13 +1,15 @@
 !> The kind of run a deck asks for, decided in one place from the sections that hold
 !> keywords (a `[section]` header alone counts for nothing):
-!> - [continuum]: a 2D continuum run (alone: not yet coupled to the other models);
+!> - [continuum] alone: a 2D continuum run;
+!> - [continuum], [particles] and [coupling] (region lines): a coupled continuum-disk run;
 !> - [beam] and [particles]: a coupled (Arlequin) run, which needs a [coupling] section;
 !> - [particles] alone: a discrete-element run;
 !> - otherwise a beam (finite-element) run; without [beam] keywords building it reports that
 !>   the model has no element.
 !>
 !> `run_kind_of` gives the kind; `check_run_kind` refuses the sections that make no kind of
-!> run ([coupling] without both models, [continuum] with another model) and the keywords that
+!> run ([coupling] without both models, [continuum] with [beam], or with only one of
+!> [particles] and [coupling]) and the keywords that
 !> the kind of run would ignore (particle settings in a deck without particles, beam
 !> settings and [initial] in a deck without a beam), each error naming file, line and
 !> keyword.
@@ -16,7 +18,7 @@ module driver_run_kind
     use io_deck, only: deck_t
     implicit none
     private
-    public :: run_beam, run_particles, run_coupled, run_continuum
+    public :: run_beam, run_particles, run_coupled, run_continuum, run_coupled2d
     public :: run_kind_of, check_run_kind
 
     !> Kind of run: beam finite elements ([beam] alone).
@@ -27,15 +29,20 @@ module driver_run_kind
     integer, parameter :: run_coupled = 3
     !> Kind of run: 2D elastic continuum ([continuum] alone).
     integer, parameter :: run_continuum = 4
+    !> Kind of run: 2D continuum and particles coupled by Arlequin ([continuum], [particles],
+    !> [coupling] with region lines).
+    integer, parameter :: run_coupled2d = 5
 
 contains
 
-    !> Kind of run of a deck, from its sections (run_beam, run_particles, run_coupled or
-    !> run_continuum); `check_run_kind` says whether the sections go together.
+    !> Kind of run of a deck, from its sections (run_beam, run_particles, run_coupled,
+    !> run_continuum or run_coupled2d); `check_run_kind` says whether the sections go together.
     pure integer function run_kind_of(deck) result(kind)
         !> The validated deck.
         type(deck_t), intent(in) :: deck
-        if (deck%has_section('continuum')) then
+        if (deck%has_section('continuum') .and. deck%has_section('particles')) then
+            kind = run_coupled2d
+        else if (deck%has_section('continuum')) then
             kind = run_continuum
         else if (deck%has_section('particles') .and. deck%has_section('beam')) then
             kind = run_coupled
@@ -59,10 +66,11 @@ contains
         beam = deck%has_section('beam')
         coupling = deck%has_section('coupling')
         if (deck%has_section('continuum')) then
-            if (particles .or. beam .or. coupling) then
+            if (beam .or. (particles .neqv. coupling)) then
                 call make_input_error(error, deck%file, deck%line('run', 'analysis'), '', &
-                                      'a [continuum] deck cannot have [beam], [particles] or [coupling] yet: '// &
-                                      'run the continuum alone')
+                                      'a [continuum] deck cannot have [beam], and couples [particles] only with '// &
+                                      'a [coupling] section (region lines): run the continuum alone, or give both '// &
+                                      '[particles] and [coupling]')
                 return
             end if
         else if (particles .and. beam .and. .not. coupling) then

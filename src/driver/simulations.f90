@@ -1,16 +1,18 @@
 !> The simulation extension of a deck's kind of run (driver_run_kind): [beam] alone is a
 !> finite-element run, [particles] alone a discrete-element run, both a coupled (Arlequin)
-!> run, [continuum] alone a 2D continuum run.
+!> run, [continuum] alone a 2D continuum run, [continuum] with [particles] and [coupling] a
+!> coupled continuum-disk run.
 module driver_simulations
     use core_error, only: error_t
     use io_deck, only: deck_t
     use driver_run_kind, only: run_kind_of, check_run_kind, run_beam, run_particles, run_coupled, &
-                               run_continuum
+                               run_continuum, run_coupled2d
     use driver_simulation, only: simulation_t
     use driver_simulation_beam, only: beam_simulation_t
     use driver_simulation_dem, only: dem_simulation_t
     use driver_simulation_coupled, only: coupled_simulation_t
     use driver_simulation_continuum, only: continuum_simulation_t
+    use driver_simulation_coupled2d, only: coupled2d_simulation_t
     implicit none
     private
     public :: select_simulation
@@ -31,6 +33,8 @@ contains
         select case (run_kind_of(deck))
         case (run_continuum)
             allocate (continuum_simulation_t :: sim)
+        case (run_coupled2d)
+            allocate (coupled2d_simulation_t :: sim)
         case (run_coupled)
             allocate (coupled_simulation_t :: sim)
         case (run_particles)

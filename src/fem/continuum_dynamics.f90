@@ -39,6 +39,8 @@ module fem_continuum_dynamics
     contains
         !> Assemble and reduce the model.
         procedure :: build => dynamics_build
+        !> Reduce given matrices and loads (e.g. alpha-weighted ones).
+        procedure :: build_from => dynamics_build_from
         !> See `dynamic_operator_t`.
         procedure :: external_force => dynamics_force
         !> ku = K u on the free DOFs.
@@ -89,16 +91,41 @@ contains
         real(wp), intent(in) :: a0, a1
         !> Set when an element has no material or CHOLMOD fails.
         type(error_t), allocatable, intent(out) :: error
-        type(fem_triplets_t) :: m_all
-        real(wp), allocatable :: dummy(:)
-        integer :: p
-        call model%assemble_stiffness(self%k_all, error)
+        type(fem_triplets_t) :: k_all, m_all
+        call model%assemble_stiffness(k_all, error)
         if (allocated(error)) return
         call model%assemble_mass(lumped, m_all, error)
         if (allocated(error)) return
-        call model%reduce(self%k_all, model%load, self%k_triplets, self%load)
+        call self%build_from(model, k_all, m_all, model%load, lumped, a0, a1, error)
+    end subroutine dynamics_build
+
+    !> Reduce given K, M and loads over all dofs to the free dofs of the model (e.g. the
+    !> alpha-weighted K_alpha, M_alpha and loads of an Arlequin overlap, coupling_weighted2d).
+    !> The element bound of the critical step is that of the model's own element matrices: a
+    !> weight constant on an element scales K_e and M_e alike and leaves it unchanged.
+    subroutine dynamics_build_from(self, model, k_all, m_all, load, lumped, a0, a1, error)
+        !> The operator.
+        class(continuum_dynamics_t), intent(out) :: self
+        !> The continuum (materials and prescribed dofs set).
+        type(continuum_model_t), intent(in) :: model
+        !> Stiffness over all dofs.
+        type(fem_triplets_t), intent(in) :: k_all
+        !> Mass over all dofs (diagonal when lumped).
+        type(fem_triplets_t), intent(in) :: m_all
+        !> Loads over all dofs [N].
+        real(wp), intent(in) :: load(:)
+        !> The mass is lumped.
+        logical, intent(in) :: lumped
+        !> Rayleigh coefficients: C = a0 M + a1 K.
+        real(wp), intent(in) :: a0, a1
+        !> Set when CHOLMOD fails or the element bound cannot be computed.
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: dummy(:)
+        integer :: p
+        self%k_all = k_all
+        call model%reduce(self%k_all, load, self%k_triplets, self%load)
         ! M acts on accelerations: the prescribed dofs do not move, no right-hand side.
-        call model%reduce(m_all, 0*model%load, self%m_triplets, dummy)
+        call model%reduce(m_all, 0*load, self%m_triplets, dummy)
         self%n_free = self%k_triplets%n
         self%lumped_mass = lumped
         self%rayleigh_a0 = a0
@@ -163,7 +190,7 @@ contains
                 self%element_lambda_max = max(self%element_lambda_max, lambda(1))
             end do
         end subroutine element_bound
-    end subroutine dynamics_build
+    end subroutine dynamics_build_from
 
     !> Constant loads (f_f - K_fp u_p).
     subroutine dynamics_force(self, t, f)

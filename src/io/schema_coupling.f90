@@ -6,7 +6,7 @@
 module io_schema_coupling
     use core_kinds, only: wp
     use io_deck_schema, only: schema_t, real_field, positive, word_field, selection_field, &
-                              tail, when
+                              tail, when, tail_spec_t
     implicit none
     private
     public :: add_coupling
@@ -17,10 +17,12 @@ contains
     subroutine add_coupling(s)
         !> Schema to extend.
         type(schema_t), intent(inout) :: s
-        call s%add_section('coupling', 'Arlequin coupling of a deck with both [beam] and '// &
-                           '[particles]: in the overlap the energies of both models are weighted by alpha '// &
-                           '(beam) and 1 - alpha (disks), and one Lagrange multiplier per coupled DOF glues '// &
-                           'each coupled disk centre to the beam (doc/input.md, section Coupled runs). '// &
+        type(tail_spec_t), allocatable :: tails(:)
+        call s%add_section('coupling', 'Arlequin coupling of a deck with [particles] and a [beam] or a '// &
+                           '[continuum]: in the overlap the energies of both models are weighted by alpha '// &
+                           '(FE) and 1 - alpha (disks), and Lagrange multipliers glue each coupled disk centre '// &
+                           'to the FE model (doc/input.md, sections Coupled runs and Coupled continuum and disk '// &
+                           'runs). '// &
                            'Coupled runs are dynamic, with [time] scheme = average_acceleration and '// &
                            'theta = 0.5.')
         call s%add_keyword('coupling', 'overlap', [real_field('s_fe', 'm', lower=0.0_wp), &
@@ -28,7 +30,7 @@ contains
                            'Overlap interval, as abscissas along the beam from its first node: s_fe is the '// &
                            'end next to the FE-only zone (alpha = 1 before it), s_particle the end next to '// &
                            'the particle-only zone (alpha = 0 beyond it; the beam must end there). Required '// &
-                           'in a coupled deck.')
+                           'in a beam coupled deck (a [continuum] takes region lines).')
         call s%add_keyword('coupling', 'weight', [word_field('weight', 'constant linear cubic')], &
                            'Shape of alpha across the overlap (xi = 0 at s_fe, 1 at s_particle): constant, '// &
                            'linear 1 - xi, or cubic 1 - 3 xi^2 + 2 xi^3 (zero slope at both ends).', &
@@ -65,5 +67,27 @@ contains
                            'coupled disks, x and y: only the projection of the disks'' residual on the '// &
                            'beam''s linear hat functions vanishes; a coarser mediator space).', &
                            default='particles')
+        ! A 2D continuum coupled to disks ([continuum] with [particles]).
+        tails = [tail([real_field('xmin', 'm'), real_field('xmax', 'm'), real_field('ymin', 'm'), &
+                       real_field('ymax', 'm'), word_field('fe_side', 'bottom right top left none'), &
+                       word_field('particle_side', 'bottom right top left none')], 6, 6, selected_by='box'), &
+                 tail([real_field('a', ''), real_field('b', '')], 8, -1, cyclic=.true., selected_by='polygon')]
+        call s%add_keyword('coupling', 'region', [word_field('kind', 'box polygon')], &
+                           'Overlap region of a [continuum] coupled to [particles] (one line per disjoint '// &
+                           'region; required there, not allowed with [beam]). box: [xmin, xmax] x [ymin, ymax], '// &
+                           'the side next to the FE-only zone and the side next to the particle-only zone '// &
+                           '(none with weight = constant). polygon: fe_edge particle_edge x1 y1 x2 y2 x3 y3 ...: '// &
+                           'the numbers of the FE-side and particle-side edges (edge k joins vertex k to k + 1, '// &
+                           'the last to the first; 0: none), then at least 3 vertices. alpha ramps from 1 - '// &
+                           'alpha_min on the FE side to alpha_min on the particle side (weight, alpha_min).', &
+                           repeatable=.true., selector=1, tails=tails)
+        call s%add_keyword('coupling', 'pairing', [word_field('pairing', 'l2 h1')], &
+                           'Pairing of the mediator space of a [continuum] coupling (multipliers = nodes): l2 '// &
+                           '(shape functions of the overlap nodes tested at the disk centres) or h1 (adds '// &
+                           'h1_length^2 times the gradients; same constraint and motion, smoother multipliers).', &
+                           default='l2', allowed_when=when('coupling', 'multipliers', 'nodes'))
+        call s%add_keyword('coupling', 'h1_length', [real_field('h1_length', 'm', lower=0.0_wp)], &
+                           'Length l of the H1 pairing (pairing = h1).', default='0', &
+                           allowed_when=when('coupling', 'pairing', 'h1'))
     end subroutine add_coupling
 end module io_schema_coupling

@@ -10,11 +10,12 @@ module arlequin_fixtures
     use dem_materials, only: materials_init, materials_set_pair
     use dem_moreau_jean, only: dem_system_t
     use coupling_weights, only: weight_config_t
-    use coupling_arlequin, only: coupling_config_t, coupled_system_t, multipliers_nodes
+    use coupling_arlequin, only: coupling_config_t, coupled_system_t, multipliers_nodes, coupled_beam
+    use fem_beam_model, only: beam_model_t
     implicit none
     private
     public :: young, rho, area, inertia, thick, radius, pi, s0, s1, pitch, m_disk
-    public :: mesh, beam_of, disk_row, coupling_of, mediator_of, fe_momentum
+    public :: mesh, beam_of, disk_row, coupling_of, mediator_of, fe_momentum, beam_k_max, beam_eq
 
     ! Steel beam 1 cm x 1 cm; steel disks of the section's depth, as thick as the section.
     real(wp), parameter :: young = 210.0e9_wp, rho = 7800.0_wp, area = 1.0e-4_wp
@@ -100,13 +101,33 @@ contains
         type(coupled_system_t), intent(in) :: sys
         real(wp) :: p(2)
         real(wp) :: mv(sys%model%n_free)
+        type(beam_model_t) :: model
         integer :: i, d
+        model = coupled_beam(sys)
         call sys%model%mass_times(sys%fe%v, mv)
         p = 0.0_wp
-        do i = 1, sys%model%n_nodes
+        do i = 1, model%n_nodes
             do d = 1, 2
-                if (sys%model%eq(d, i) > 0) p(d) = p(d) + mv(sys%model%eq(d, i))
+                if (model%eq(d, i) > 0) p(d) = p(d) + mv(model%eq(d, i))
             end do
         end do
     end function fe_momentum
+
+    !> Largest stiffness entry of the coupled system's weighted beam [N/m].
+    function beam_k_max(sys) result(k_max)
+        type(coupled_system_t), intent(in) :: sys
+        real(wp) :: k_max
+        type(beam_model_t) :: model
+        model = coupled_beam(sys)
+        k_max = maxval(abs(model%k%ab))
+    end function beam_k_max
+
+    !> Equation number of DOF d of beam node i in the coupled system.
+    integer function beam_eq(sys, d, i)
+        type(coupled_system_t), intent(in) :: sys
+        integer, intent(in) :: d, i
+        type(beam_model_t) :: model
+        model = coupled_beam(sys)
+        beam_eq = model%eq(d, i)
+    end function beam_eq
 end module arlequin_fixtures

@@ -1,0 +1,196 @@
+!> From a validated deck with [continuum], [particles] and [coupling] to the description of the
+!> 2D Arlequin coupling (`coupling_arlequin2d::coupling2d_config_t`), read by keyword name, with
+!> the checks across sections:
+!> - a coupled run is a time integration (analysis = dynamic) with average acceleration
+!>   (beta = 1/4, gamma = 1/2) and theta = 1/2 (another theta: a warning), as for the beam;
+!> - the overlap is given by `region` lines (box or polygon, at least one); the beam's
+!>   `overlap`, `max_offset` and `coupled` have no meaning here and are refused;
+!> - [continuum] gravity and [particles] gravity agree (both sides carry their weighted share
+!>   of the weight in the overlap);
+!> - a polygon's edge numbers are integers within its edges.
+!> Errors name the deck file, the line and the keyword.
+module driver_config_coupling2d
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_input_error
+    use core_strings, only: string_t, to_str
+    use io_deck, only: deck_t, deck_entry_t
+    use coupling_weights, only: weight_config_t
+    use coupling_overlap2d, only: overlap2d_t, overlap_set_t, make_box_overlap, make_polygon_overlap
+    use coupling_operator2d, only: pairing_l2, pairing_h1
+    use coupling_coupled_step, only: multipliers_particles, multipliers_nodes
+    use coupling_arlequin2d, only: coupling2d_config_t
+    use driver_config, only: run_config_t
+    implicit none
+    private
+    public :: coupled2d_setup_t, build_coupling2d_config
+
+    !> The 2D coupling of a deck, with what the driver reports about it.
+    type :: coupled2d_setup_t
+        !> Description handed to coupling_arlequin2d::build_coupled2d.
+        type(coupling2d_config_t) :: config
+        !> Deck line of the first region (messages of the library are attached to it).
+        integer :: region_line = 0
+        !> Warnings to report before the run (e.g. theta > 1/2).
+        type(string_t), allocatable :: warnings(:)
+    end type coupled2d_setup_t
+
+contains
+
+    !> Build and check the coupling of a deck with [continuum], [particles] and [coupling].
+    subroutine build_coupling2d_config(deck, run, particle_gravity, setup, error)
+        !> Deck read with the MULTICOR schema.
+        type(deck_t), intent(in) :: deck
+        !> Run settings of the continuum (analysis, scheme, beta, gamma).
+        type(run_config_t), intent(in) :: run
+        !> Gravity of [particles] [m/s^2].
+        real(wp), intent(in) :: particle_gravity(2)
+        !> The coupling.
+        type(coupled2d_setup_t), intent(out) :: setup
+        !> Error naming file, line and keyword, if any.
+        type(error_t), allocatable, intent(out) :: error
+        type(deck_entry_t), allocatable :: regions(:)
+        type(overlap2d_t), allocatable :: parts(:)
+        type(weight_config_t) :: weight
+        character(len=*), parameter :: beam_only(3) = [character(len=10) :: 'overlap', 'max_offset', 'coupled']
+        real(wp) :: gravity(2), theta
+        character(len=:), allocatable :: message
+        integer :: k
+        allocate (setup%warnings(0))
+        call check_schemes(error)
+        if (allocated(error)) return
+        do k = 1, size(beam_only)
+            if (.not. deck%has('coupling', trim(beam_only(k)))) cycle
+            call make_input_error(error, deck%file, deck%line('coupling', trim(beam_only(k))), trim(beam_only(k)), &
+                                  'applies to a beam coupled to particles; a [continuum] coupling takes its overlap '// &
+                                  'from region lines and couples every disk whose centre lies in a region')
+            return
+        end do
+        gravity = [deck%get_real('continuum', 'gravity', 'gx'), deck%get_real('continuum', 'gravity', 'gy')]
+        if (any(gravity /= particle_gravity)) then
+            k = deck%line('continuum', 'gravity')
+            if (k == 0) k = deck%line('particles', 'gravity')
+            call make_input_error(error, deck%file, k, 'gravity', 'coupled runs need the same gravity in '// &
+                                  '[continuum] and [particles] (the two models share the weight in the overlap): '// &
+                                  '[continuum] gravity = '//to_str(gravity(1))//' '//to_str(gravity(2))// &
+                                  ', [particles] gravity = '//to_str(particle_gravity(1))//' '// &
+                                  to_str(particle_gravity(2)))
+            return
+        end if
+        if (.not. deck%has('coupling', 'thickness')) then
+            call make_input_error(error, deck%file, first_line(), 'thickness', '[coupling] needs thickness = '// &
+                                  'the out-of-plane depth of the disks [m] (usually the continuum''s thickness)')
+            return
+        end if
+        regions = deck%records('coupling', 'region')
+        if (size(regions) == 0) then
+            call make_input_error(error, deck%file, first_line(), 'region', '[coupling] of a [continuum] needs '// &
+                                  'at least one region = box xmin xmax ymin ymax fe_side particle_side (or polygon ...)')
+            return
+        end if
+        setup%region_line = regions(1)%line
+        weight%shape = deck%get_word('coupling', 'weight')
+        weight%alpha_min = deck%get_real('coupling', 'alpha_min')
+        weight%constant = deck%get_real('coupling', 'constant')
+        allocate (parts(size(regions)))
+        do k = 1, size(regions)
+            call make_region(regions(k), parts(k), error)
+            if (allocated(error)) return
+        end do
+        if (size(parts) == 1) then
+            allocate (setup%config%region, source=parts(1))
+        else
+            allocate (setup%config%region, source=overlap_set_t(parts))
+        end if
+        associate (c => setup%config)
+            c%thickness = deck%get_real('coupling', 'thickness')
+            c%rotation_row = deck%get_word('coupling', 'rotation') == 'on'
+            c%multipliers = merge(multipliers_nodes, multipliers_particles, &
+                                  deck%get_word('coupling', 'multipliers') == 'nodes')
+            c%pairing = merge(pairing_h1, pairing_l2, deck%get_word('coupling', 'pairing') == 'h1')
+            c%h1_length = deck%get_real('coupling', 'h1_length')
+            c%lumped = deck%get_word('continuum', 'mass') == 'lumped'
+            c%rayleigh = [deck%get_real('continuum', 'rayleigh', 'a0'), deck%get_real('continuum', 'rayleigh', 'a1')]
+            c%gravity = gravity
+        end associate
+
+    contains
+
+        !> Analysis, Newmark and Moreau-Jean parameters.
+        subroutine check_schemes(error)
+            type(error_t), allocatable, intent(out) :: error
+            character(len=*), parameter :: why = 'the coupling exchanges the impulse h ((1 - gamma) lambda_n + '// &
+                                           'gamma lambda_{n+1}) between the continuum and the disks, which conserves '// &
+                                           'momentum and energy only with beta = 1/4, gamma = 1/2 and theta = 1/2'
+            if (run%analysis /= 'dynamic') then
+                call make_input_error(error, deck%file, deck%line('run', 'analysis'), 'analysis', &
+                                      'a coupled run (continuum, particles and [coupling]) is a time integration: '// &
+                                      'set analysis = dynamic')
+                return
+            end if
+            if (run%scheme == 'central_difference' .or. abs(run%beta - 0.25_wp) > 0 .or. &
+                abs(run%gamma - 0.5_wp) > 0) then
+                call make_input_error(error, deck%file, deck%line('time', 'scheme'), 'scheme', &
+                                      'coupled runs need scheme = average_acceleration (beta = 0.25, gamma = 0.5); '// &
+                                      why)
+                return
+            end if
+            theta = deck%get_real('time', 'theta')
+            if (abs(theta - 0.5_wp) > 0) then
+                message = 'warning: '//deck%file//':'//to_str(deck%line('time', 'theta'))//': [time] theta = '// &
+                          to_str(theta)//' in a coupled run: the energy balance does not close; '//why
+                setup%warnings = [setup%warnings, string_t(message)]
+            end if
+        end subroutine check_schemes
+
+        !> One region line.
+        subroutine make_region(e, region, error)
+            type(deck_entry_t), intent(in) :: e
+            type(overlap2d_t), intent(out) :: region
+            type(error_t), allocatable, intent(out) :: error
+            character(len=:), allocatable :: message
+            real(wp), allocatable :: v(:)
+            integer :: i, nv, tags(2)
+            if (e%word('kind') == 'box') then
+                call make_box_overlap(e%real('xmin'), e%real('xmax'), e%real('ymin'), e%real('ymax'), &
+                                      side(e%word('fe_side')), side(e%word('particle_side')), weight, region, error)
+            else
+                v = e%reals_from('a')
+                nv = size(v)/2 - 1
+                do i = 1, 2
+                    tags(i) = nint(v(i))
+                    if (v(i) == tags(i) .and. tags(i) >= 0 .and. tags(i) <= nv) cycle
+                    call make_input_error(error, deck%file, e%line, 'region', 'polygon: the '// &
+                                          trim(merge('FE-side      ', 'particle-side', i == 1))//' edge number '// &
+                                          to_str(v(i))//' must be an integer in 0..'//to_str(nv)// &
+                                          ' (edge k joins vertex k to k + 1; 0: none)')
+                    return
+                end do
+                call make_polygon_overlap(reshape(v(3:), [2, nv]), pack([tags(1)], tags(1) > 0), &
+                                          pack([tags(2)], tags(2) > 0), weight, region, error)
+            end if
+            if (allocated(error)) then
+                message = error%message
+                call make_input_error(error, deck%file, e%line, 'region', message)
+            end if
+        end subroutine make_region
+
+        !> Side name for the library ('' for none).
+        pure function side(word) result(name)
+            character(len=*), intent(in) :: word
+            character(len=:), allocatable :: name
+            name = trim(word)
+            if (name == 'none') name = ''
+        end function side
+
+        !> Line of the first [coupling] entry.
+        integer function first_line()
+            integer :: i
+            first_line = 0
+            do i = 1, size(deck%entries)
+                if (deck%entries(i)%section /= 'coupling' .or. deck%entries(i)%line == 0) cycle
+                first_line = deck%entries(i)%line
+                return
+            end do
+        end function first_line
+    end subroutine build_coupling2d_config
+end module driver_config_coupling2d
