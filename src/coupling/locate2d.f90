@@ -13,6 +13,7 @@
 !> search in element order (`locate_brute`, kept for the tests).
 module coupling_locate2d
     use core_kinds, only: wp
+    use core_constants, only: relative_roundoff
     use fem_mesh2d, only: mesh2d_t, element_t3, element_q4
     use fem_element_q4, only: element_q4_t
     implicit none
@@ -65,7 +66,7 @@ contains
         ly = maxval(grid%bbox(4, :)) - grid%y0
         ! Mean element size; at least a tiny positive cell for degenerate extents.
         h = sum(max(grid%bbox(2, :) - grid%bbox(1, :), grid%bbox(4, :) - grid%bbox(3, :)))/ne
-        h = max(h, 1.0e-12_wp*max(lx, ly, 1.0e-300_wp))
+        h = max(h, relative_roundoff*max(lx, ly, 1.0e-300_wp))
         grid%nx = max(1, min(ceiling(lx/h), 4*ne))
         grid%ny = max(1, min(ceiling(ly/h), 4*ne))
         grid%dx = max(lx, h)/grid%nx

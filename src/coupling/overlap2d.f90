@@ -20,6 +20,7 @@
 !> weighted assembly takes.
 module coupling_overlap2d
     use core_kinds, only: wp
+    use core_constants, only: relative_roundoff
     use core_error, only: error_t, make_error
     use coupling_weights, only: weight_config_t, overlap_weight_t, make_weight
     implicit none
@@ -216,7 +217,7 @@ contains
         region%vertex = vertex
         region%box = [minval(vertex(1, :)), maxval(vertex(1, :)), minval(vertex(2, :)), maxval(vertex(2, :))]
         ! Rounding of coordinates at the scale of the region.
-        region%tol = 1.0e-12_wp*max(region%box(2) - region%box(1), region%box(4) - region%box(3))
+        region%tol = relative_roundoff*max(region%box(2) - region%box(1), region%box(4) - region%box(3))
     end subroutine make_polygon_overlap
 
     !> z component of a x b.

@@ -55,6 +55,8 @@
 module dem_nlgs
     use core_kinds, only: wp, i8
     use core_constants, only: diagonal_floor
+    use core_error, only: error_t
+    use core_linalg, only: dense_spd_t
     use dem_contacts, only: contact_set_t
 !$  use omp_lib, only: omp_get_max_threads
     use dem_bipotential, only: bipotential_residual, bipotential_scaling, bipotential_local_solve_scaled, &
@@ -171,6 +173,9 @@ module dem_nlgs
 
     !> Chunk of the deterministic parallel dot products (pdot).
     integer, parameter :: dot_chunk = 4096
+    !> Tikhonov term of the Anderson least-squares system, relative to its trace: far above
+    !> the rounding of the Gram matrix (1e-16), far below its genuine eigenvalues.
+    real(wp), parameter :: anderson_regularisation = 1.0e-12_wp
 
     !> Linear velocity constraints kept satisfied during the sweeps (see the module header).
     type, abstract :: nlgs_bilateral_t
@@ -742,35 +747,26 @@ contains
         end do
     end subroutine split_apply
 
-    !> Solve the small symmetric system (a + lambda I) x = b by Gaussian elimination, with
-    !> lambda = 1e-12 trace(a) (the differences of the history may be nearly dependent).
-    pure subroutine solve_small(a, b, x)
+    !> Solve the small symmetric system (a + lambda I) x = b (Cholesky, core_linalg), with
+    !> lambda = anderson_regularisation trace(a): the differences of the history may be nearly
+    !> dependent. x = 0 (a plain sweep) if the regularised system is still not positive definite.
+    subroutine solve_small(a, b, x)
         real(wp), intent(in) :: a(:, :), b(:)
         real(wp), intent(out) :: x(:)
-        real(wp) :: m(size(b), size(b) + 1), f, lambda
-        integer :: n, i, j, piv
-        n = size(b)
-        m(:, 1:n) = a
-        m(:, n + 1) = b
-        lambda = 1.0e-12_wp*sum([(a(i, i), i=1, n)])
-        do i = 1, n
-            m(i, i) = m(i, i) + lambda
+        type(dense_spd_t) :: g
+        type(error_t), allocatable :: error
+        real(wp) :: lambda
+        integer :: i
+        lambda = anderson_regularisation*sum([(a(i, i), i=1, size(b))])
+        call g%init(size(b))
+        g%a = a
+        do i = 1, size(b)
+            g%a(i, i) = g%a(i, i) + lambda
         end do
-        do i = 1, n
-            piv = i - 1 + maxloc(abs(m(i:n, i)), 1)
-            if (piv /= i) m([i, piv], :) = m([piv, i], :)
-            if (m(i, i) == 0.0_wp) then
-                x = 0.0_wp
-                return
-            end if
-            do j = i + 1, n
-                f = m(j, i)/m(i, i)
-                m(j, i:n + 1) = m(j, i:n + 1) - f*m(i, i:n + 1)
-            end do
-        end do
-        do i = n, 1, -1
-            x(i) = (m(i, n + 1) - dot_product(m(i, i + 1:n), x(i + 1:n)))/m(i, i)
-        end do
+        call g%factor(error)
+        x = b
+        if (.not. allocated(error)) call g%solve(x, error)
+        if (allocated(error)) x = 0.0_wp
     end subroutine solve_small
 
     !> Round-off floor of the convergence norm's denominator for contact k (module header).
