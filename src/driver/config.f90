@@ -16,14 +16,14 @@ module driver_config
     use core_error, only: error_t, make_input_error
     use core_strings, only: string_t, to_str
     use core_sort, only: sort_index
-    use core_timefunc, only: tf_constant, tf_ramp, tf_step, tf_table, tf_harmonic
+    use core_timefunc, only: time_function_t, tf_constant, tf_ramp, tf_step, tf_table, tf_harmonic
     use fem_beam_config, only: beam_config_t, dof_u, dof_w, dof_theta, beam_element_load_t, &
                                load_x, load_y, load_axial, load_transverse
     use io_deck, only: deck_t, deck_entry_t
     use driver_run_kind, only: run_kind_of, run_particles
     implicit none
     private
-    public :: run_config_t, build_config, max_steps, build_run_settings, steps_to_end
+    public :: run_config_t, build_config, max_steps, build_run_settings, steps_to_end, build_time_functions
 
     !> Largest number of time steps of a run. The step counter is 64-bit; the bound is that of
     !> the 32-bit step counts stored in the results file (/summary steps, /dem/solver).
@@ -541,6 +541,23 @@ contains
             end if
         end do
     end subroutine resolve_elements
+
+    !> The deck's [functions] (for models other than the beam, e.g. the continuum): the
+    !> functions in file order and their deck ids, checked as for the beam's loads.
+    subroutine build_time_functions(deck, functions, ids, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Time functions, in the order of the `function` records.
+        type(time_function_t), allocatable, intent(out) :: functions(:)
+        !> Deck id of each function.
+        integer, allocatable, intent(out) :: ids(:)
+        !> Error (duplicate id, table times not increasing), if any.
+        type(error_t), allocatable, intent(out) :: error
+        type(beam_config_t) :: holder
+        call build_functions(deck, holder, ids, error)
+        if (allocated(error)) return
+        call move_alloc(holder%functions, functions)
+    end subroutine build_time_functions
 
     !> Time functions, with unique ids and increasing table times.
     subroutine build_functions(deck, beam, ids, error)

@@ -22,7 +22,7 @@ module driver_simulation_continuum
     use fem_continuum_dynamics, only: continuum_dynamics_t
     use fem_dynamic_operator, only: spd_factor_t
     use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
-    use driver_config, only: run_config_t, build_run_settings
+    use driver_config, only: run_config_t, build_run_settings, build_time_functions
     use driver_results, only: results_writer_t
     use driver_checkpoint, only: checkpoint_run_t
     use driver_results_continuum, only: continuum_writer_t
@@ -68,6 +68,9 @@ contains
         type(deck_entry_t) :: e
         type(deck_entry_t), allocatable :: list(:)
         character(len=:), allocatable :: message
+        ! Deck ids of the time functions; constant loads set aside while a timed one is added.
+        integer, allocatable :: function_ids(:)
+        real(wp), allocatable :: constant(:)
         logical :: lumped
         integer :: line
         self%deck_file = deck%file
@@ -213,24 +216,33 @@ contains
             end do
         end subroutine set_constraints
 
-        !> Nodal loads, tractions and gravity.
+        !> Nodal loads and tractions (constant, or times a [functions] function), and gravity.
         subroutine set_loads(error)
             type(error_t), allocatable, intent(out) :: error
             integer, allocatable :: ids(:)
-            integer :: i, j
+            integer :: i, j, func
+            call build_time_functions(deck, self%model%functions, function_ids, error)
+            if (allocated(error)) return
+            deallocate (self%model%timed_load)
+            allocate (self%model%timed_load(self%model%dof_count(), size(function_ids)), source=0.0_wp)
             list = deck%records('continuum', 'load')
             do i = 1, size(list)
                 e = list(i)
+                call start_load('load', func, error)
+                if (allocated(error)) return
                 call self%model%mesh%node_set(e%word('node_set'), ids, error)
                 if (allocated(error)) call fail_at(error, e%line, 'load')
                 if (allocated(error)) return
                 do j = 1, size(ids)
                     call self%model%add_nodal_load(ids(j), component(e%word('component')), e%real('value'))
                 end do
+                call end_load(func)
             end do
             list = deck%records('continuum', 'traction')
             do i = 1, size(list)
                 e = list(i)
+                call start_load('traction', func, error)
+                if (allocated(error)) return
                 if (e%word('profile') == 'parabolic') then
                     call add_parabolic(self%model, e%word('edge_set'), [e%real('tx'), e%real('ty')], error)
                 else
@@ -238,6 +250,7 @@ contains
                 end if
                 if (allocated(error)) call fail_at(error, e%line, 'traction')
                 if (allocated(error)) return
+                call end_load(func)
             end do
             if (deck%get_real('continuum', 'gravity', 'gx') /= 0 .or. deck%get_real('continuum', 'gravity', 'gy') /= 0) then
                 call self%model%add_body_force([deck%get_real('continuum', 'gravity', 'gx'), &
@@ -246,6 +259,32 @@ contains
                 if (allocated(error)) return
             end if
         end subroutine set_loads
+
+        !> Before adding the load of record e: its function (0 = none, constant 1) and, for a
+        !> timed load, the constant loads set aside so that the model's `load` collects it alone.
+        subroutine start_load(keyword, func, error)
+            character(len=*), intent(in) :: keyword
+            integer, intent(out) :: func
+            type(error_t), allocatable, intent(out) :: error
+            func = 0
+            if (.not. e%has('function')) return
+            func = findloc(function_ids, e%int('function'), dim=1)
+            if (func == 0) then
+                call make_input_error(error, deck%file, e%line, keyword, 'function '//e%word('function')// &
+                                      ' is not defined (no [functions] function record with this id)')
+                return
+            end if
+            constant = self%model%load
+            self%model%load = 0.0_wp
+        end subroutine start_load
+
+        !> After adding the load of record e: a timed load moves to its function's column.
+        subroutine end_load(func)
+            integer, intent(in) :: func
+            if (func == 0) return
+            self%model%timed_load(:, func) = self%model%timed_load(:, func) + self%model%load
+            self%model%load = constant
+        end subroutine end_load
 
         !> Modes and dynamics need a positive-definite mass: every density > 0.
         subroutine check_density(error)
@@ -395,7 +434,9 @@ contains
             real(wp), allocatable :: uf(:), u(:), stress(:, :)
             character(len=160) :: buf
             real(wp) :: energy
-            uf = self%ops%load
+            ! Loads at t = 0 (their time functions' values there, as for the beam).
+            allocate (uf(self%ops%n_free))
+            call self%ops%external_force(0.0_wp, uf)
             call self%k_factor%solve(uf, error)
             if (allocated(error)) return
             u = self%model%expand(uf)

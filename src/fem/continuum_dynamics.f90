@@ -3,7 +3,8 @@
 !> for the static and modal solutions.
 !>
 !> Prescribed displacements u_p are constant in time and eliminated (fem_continuum_model
-!> `reduce`): the free dofs carry F = f_f - K_fp u_p, so that the integrator's energy accounts
+!> `reduce`): the free dofs carry F(t) = f_f - K_fp u_p + sum_k f_k(t) g_k,f (the model's loads
+!> times its time functions, `timed_load`), so that the integrator's energy accounts
 !> (on the free dofs) close; the strain energy of the whole body 1/2 u.K u over all dofs is
 !> `total_strain_energy`. Combinations c_m M + c_k K share the pattern of K (a lumped M is
 !> diagonal, inside it) and are factored by CHOLMOD (`sparse_cholesky`). The lowest modes come
@@ -16,6 +17,7 @@ module fem_continuum_dynamics
     use core_sparse, only: sparse_matrix_t, sparse_solver_t
     use core_linalg, only: band_spd_t, band_generalized_eigen
     use fem_dynamic_operator, only: dynamic_operator_t, spd_factor_t
+    use core_timefunc, only: time_function_t
     use fem_continuum_model, only: continuum_model_t
     use fem_triplets, only: fem_triplets_t
     implicit none
@@ -34,6 +36,10 @@ module fem_continuum_dynamics
         real(wp) :: element_lambda_max = 0.0_wp
         !> Constant load on the free dofs, f_f - K_fp u_p [N].
         real(wp), allocatable :: load(:)
+        !> Loads on the free dofs times a time function: column k times functions(k)(t) [N].
+        real(wp), allocatable :: timed_load(:, :)
+        !> The model's time functions (one per column of `timed_load`).
+        type(time_function_t), allocatable :: functions(:)
         !> Stiffness over all dofs (for the strain energy of the whole body).
         type(fem_triplets_t) :: k_all
     contains
@@ -121,9 +127,17 @@ contains
         !> Set when CHOLMOD fails or the element bound cannot be computed.
         type(error_t), allocatable, intent(out) :: error
         real(wp), allocatable :: dummy(:)
-        integer :: p
+        integer, allocatable :: eq(:)
+        integer :: p, c, n
         self%k_all = k_all
         call model%reduce(self%k_all, load, self%k_triplets, self%load)
+        ! Timed loads: their free rows (the prescribed dofs' reactions are constant, in `load`).
+        call model%equations(eq, n)
+        allocate (self%timed_load(n, size(model%functions)), source=0.0_wp)
+        self%functions = model%functions
+        do c = 1, size(eq)
+            if (eq(c) > 0) self%timed_load(eq(c), :) = model%timed_load(c, :)
+        end do
         ! M acts on accelerations: the prescribed dofs do not move, no right-hand side.
         call model%reduce(m_all, 0*load, self%m_triplets, dummy)
         self%n_free = self%k_triplets%n
@@ -192,12 +206,16 @@ contains
         end subroutine element_bound
     end subroutine dynamics_build_from
 
-    !> Constant loads (f_f - K_fp u_p).
+    !> Loads at time t: f_f - K_fp u_p + sum_k f_k(t) g_k,f.
     subroutine dynamics_force(self, t, f)
         class(continuum_dynamics_t), intent(in) :: self
         real(wp), intent(in) :: t
         real(wp), intent(out) :: f(:)
+        integer :: k
         f = self%load
+        do k = 1, size(self%functions)
+            f = f + self%functions(k)%value(t)*self%timed_load(:, k)
+        end do
     end subroutine dynamics_force
 
     !> ku = K u.

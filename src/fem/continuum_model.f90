@@ -9,6 +9,7 @@ module fem_continuum_model
     use core_kinds, only: wp
     use core_constants, only: singular_ratio
     use core_error, only: error_t, make_error
+    use core_timefunc, only: time_function_t
     use fem_elastic2d, only: elastic2d_t
     use fem_element2d, only: element2d_t
     use fem_element_q4, only: element_q4_t
@@ -41,8 +42,13 @@ module fem_continuum_model
         logical, allocatable :: prescribed(:)
         !> Prescribed value of each dof (m; 0 where free).
         real(wp), allocatable :: prescribed_value(:)
-        !> External nodal forces (N), size 2 * number of nodes.
+        !> External nodal forces (N), size 2 * number of nodes (constant in time).
         real(wp), allocatable :: load(:)
+        !> Time functions multiplying the columns of `timed_load` (none: every load constant).
+        type(time_function_t), allocatable :: functions(:)
+        !> Nodal forces (N) times a time function: column k (size 2 * number of nodes) is
+        !> multiplied by functions(k)(t); size (dof_count, size(functions)).
+        real(wp), allocatable :: timed_load(:, :)
     contains
         !> Take a mesh, check its elements, and start with no material, load or constraint.
         procedure :: init => model_init
@@ -119,6 +125,7 @@ contains
         allocate (self%element_material(mesh%element_count()), source=0)
         allocate (self%prescribed(self%dof_count()), source=.false.)
         allocate (self%prescribed_value(self%dof_count()), self%load(self%dof_count()), source=0.0_wp)
+        allocate (self%functions(0), self%timed_load(self%dof_count(), 0))
     end subroutine model_init
 
     !> Number of dofs.

@@ -46,13 +46,15 @@ contains
                            'Prescribed displacement (constant in time) of the nodes of a set.', repeatable=.true.)
         call s%add_keyword('continuum', 'load', [word_field('node_set', ''), &
                                                  word_field('component', 'x y'), real_field('value', 'N')], &
-                           'Force on every node of a set (constant in time).', repeatable=.true.)
+                           'Force on every node of a set, times a [functions] time function (none: constant 1).', &
+                           tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
         call s%add_keyword('continuum', 'traction', [word_field('edge_set', ''), &
                                                      real_field('tx', 'Pa'), real_field('ty', 'Pa')], &
-                           'Traction on the edges of a set (constant in time): uniform, or parabolic '// &
-                           '(1.5 t (1 - s^2) with s from -1 to 1 across the set along its longer extent, the '// &
-                           'same resultant as uniform t).', &
-                           tails=[tail([word_field('profile', 'uniform parabolic')], 0, 1)], repeatable=.true.)
+                           'Traction on the edges of a set: uniform, or parabolic (1.5 t (1 - s^2) with s from '// &
+                           '-1 to 1 across the set along its longer extent, the same resultant as uniform t), '// &
+                           'times a [functions] time function (none: constant 1; give the profile first).', &
+                           tails=[tail([word_field('profile', 'uniform parabolic'), int_field('function', lower=1)], &
+                                       0, 2)], repeatable=.true.)
         call s%add_keyword('continuum', 'gravity', [real_field('gx', 'm/s^2'), real_field('gy', 'm/s^2')], &
                            'Acceleration of gravity (body force rho g).', default='0 0')
         call s%add_keyword('continuum', 'rayleigh', &
