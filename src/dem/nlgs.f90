@@ -1055,19 +1055,28 @@ contains
         num = num + inum
         den = den + iden
     contains
+        !> Sweep of the positions pos. The sums are kept in locals of the thread and stored
+        !> once at the end: accumulating into pnum directly, the threads' nb_num(b) share a
+        !> cache line and every update would invalidate it on the other core (2 threads were
+        !> 2.3 times slower than 1 at 10^5 disks).
         subroutine positions(pos, fwd, pnum, pden, ploc)
             integer, intent(in) :: pos(:)
             logical, intent(in) :: fwd
             real(wp), intent(out) :: pnum, pden
             integer(i8), intent(out) :: ploc
+            real(wp) :: lnum, lden
+            integer(i8) :: lloc
             integer :: j, a
-            pnum = 0.0_wp
-            pden = 0.0_wp
-            ploc = 0_i8
+            lnum = 0.0_wp
+            lden = 0.0_wp
+            lloc = 0_i8
             do j = 1, size(pos)
                 a = merge(pos(j), pos(size(pos) + 1 - j), fwd)
-                call update(config, omega, cs, im, vel, list(a), sc(:, a), pnum, pden, ploc)
+                call update(config, omega, cs, im, vel, list(a), sc(:, a), lnum, lden, lloc)
             end do
+            pnum = lnum
+            pden = lden
+            ploc = lloc
         end subroutine positions
     end subroutine split_sweep
 
