@@ -16,6 +16,7 @@ module driver_checkpoint
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
     use core_version, only: multicor_version
+    use core_signals, only: caught_signal
     use io_hdf5_file, only: h5_file_t
     use io_paths, only: rename_file, remove_file, file_exists
     use fem_newmark, only: time_integrator_t, newmark_t
@@ -33,7 +34,7 @@ module driver_checkpoint
     public :: save_integrator, load_integrator, save_dem, load_dem, save_coupled, load_coupled
     public :: save_results, load_results, save_dem_writer, load_dem_writer
     public :: save_coupled_writer, load_coupled_writer, save_loop, load_loop
-    public :: checkpoint_run_t
+    public :: checkpoint_run_t, end_of_step
 
     !> File name of the checkpoint in the results folder.
     character(len=*), parameter :: checkpoint_name = 'checkpoint.h5'
@@ -87,6 +88,15 @@ module driver_checkpoint
         !> Time of the state in the last checkpoint written [s].
         real(wp) :: last_time = 0.0_wp
     end type checkpoint_run_t
+
+    abstract interface
+        !> An action of a time loop at the end of a step (store an output, write a checkpoint).
+        subroutine step_action(error)
+            import :: error_t
+            !> Set on a failure.
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine step_action
+    end interface
 
 contains
 
@@ -1045,4 +1055,35 @@ contains
         if (allocated(error)) return
         values = nint(r)
     end subroutine read_int_attr_1d
+
+    !> Outputs, checkpoint and stop test after step k of a time loop, in the one order that
+    !> makes a restart bitwise: the regular output of step k, then the checkpoint (last step,
+    !> stop request, or due by the schedule), then the extra output of the last step or of a
+    !> stop. The checkpoint thus holds the regular outputs up to step k and not the extra one
+    !> (a restart with a later end time cuts it).
+    subroutine end_of_step(k, n_steps, output_interval, schedule, store, checkpoint, stop, error)
+        !> Steps done, and steps of the run.
+        integer(i8), intent(in) :: k, n_steps
+        !> Steps between regular outputs.
+        integer, intent(in) :: output_interval
+        !> When checkpoints are due.
+        type(checkpoint_schedule_t), intent(inout) :: schedule
+        !> Store the output of the current step.
+        procedure(step_action) :: store
+        !> Write a checkpoint of the current state.
+        procedure(step_action) :: checkpoint
+        !> True when a stop signal came before the last step: the loop ends at step k.
+        logical, intent(out) :: stop
+        !> Set on a failure of either action.
+        type(error_t), allocatable, intent(out) :: error
+        logical :: regular
+        stop = .false.
+        regular = mod(k, int(output_interval, i8)) == 0
+        if (regular) call store(error)
+        if (allocated(error)) return
+        stop = k < n_steps .and. caught_signal() /= 0
+        if (k == n_steps .or. stop .or. schedule%due(k)) call checkpoint(error)
+        if (allocated(error)) return
+        if ((k == n_steps .or. stop) .and. .not. regular) call store(error)
+    end subroutine end_of_step
 end module driver_checkpoint

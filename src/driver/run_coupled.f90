@@ -30,7 +30,7 @@ module driver_run_coupled
     use driver_guards, only: check_beam_state, check_disks_state, step_start_t, take_step_start, &
                              check_tunnelling
     use io_hdf5_file, only: h5_file_t
-    use driver_checkpoint, only: checkpoint_run_t, loop_state_t, checkpoint_create, checkpoint_commit, &
+    use driver_checkpoint, only: end_of_step, checkpoint_run_t, loop_state_t, checkpoint_create, checkpoint_commit, &
                                  checkpoint_discard, save_coupled, load_coupled, save_results, load_results, &
                                  save_dem_writer, load_dem_writer, save_coupled_writer, load_coupled_writer
     implicit none
@@ -93,7 +93,7 @@ contains
         type(beam_model_t) :: model
         integer(i8) :: n_steps, k, k0
         integer :: unconverged
-        logical :: speed_warned, regular, stop
+        logical :: speed_warned, stop
         character(len=512) :: buf
 
         n_steps = run%n_steps
@@ -135,20 +135,10 @@ contains
             if (allocated(error)) return
             if (.not. sys%stats%converged) call warn_unconverged()
             if (.not. speed_warned) call check_speed()
-            ! The checkpoint holds the regular outputs up to step k, not the extra output of
-            ! the last step or of a stop (a restart with a later end time cuts them).
-            regular = mod(k, int(run%output_interval, i8)) == 0
-            if (regular) call store(error)
-            if (allocated(error)) return
-            stop = k < n_steps .and. caught_signal() /= 0
-            if (k == n_steps .or. stop .or. ck%schedule%due(k)) call checkpoint(error)
-            if (allocated(error)) return
-            if (k == n_steps .and. .not. regular) call store(error)
+            call end_of_step(k, n_steps, run%output_interval, ck%schedule, store, checkpoint, stop, error)
             if (allocated(error)) return
             if (stop) then
                 ! Stop request: the step just done is the last output.
-                if (.not. regular) call store(error)
-                if (allocated(error)) return
                 call out%stop_at(signal_name(caught_signal()), k, sys%fe%t)
                 n_steps = k
                 exit

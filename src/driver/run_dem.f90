@@ -23,7 +23,7 @@ module driver_run_dem
     use driver_results_dem, only: dem_writer_t, write_fclib_local
     use driver_guards, only: check_disks_state, step_start_t, take_step_start, check_tunnelling
     use io_hdf5_file, only: h5_file_t
-    use driver_checkpoint, only: checkpoint_run_t, loop_state_t, checkpoint_create, checkpoint_commit, &
+    use driver_checkpoint, only: end_of_step, checkpoint_run_t, loop_state_t, checkpoint_create, checkpoint_commit, &
                                  checkpoint_discard, &
                                  save_dem, load_dem, save_results, load_results, save_dem_writer, load_dem_writer
     implicit none
@@ -65,7 +65,7 @@ contains
         integer(i8) :: n_steps, k, k0
         integer :: unconverged
         logical :: blocked_warned
-        logical :: speed_warned, regular, stop
+        logical :: speed_warned, stop
         character(len=:), allocatable :: message
         character(len=512) :: buf
 
@@ -112,20 +112,10 @@ contains
                 blocked_warned = .true.
             end if
             if (.not. speed_warned) call check_speed()
-            ! The checkpoint holds the regular outputs up to step k, not the extra output of
-            ! the last step or of a stop (a restart with a later end time cuts them).
-            regular = mod(k, int(run%output_interval, i8)) == 0
-            if (regular) call store(error)
-            if (allocated(error)) return
-            stop = k < n_steps .and. caught_signal() /= 0
-            if (k == n_steps .or. stop .or. ck%schedule%due(k)) call checkpoint(error)
-            if (allocated(error)) return
-            if (k == n_steps .and. .not. regular) call store(error)
+            call end_of_step(k, n_steps, run%output_interval, ck%schedule, store, checkpoint, stop, error)
             if (allocated(error)) return
             if (stop) then
                 ! Stop request: the step just done is the last output.
-                if (.not. regular) call store(error)
-                if (allocated(error)) return
                 call out%stop_at(signal_name(caught_signal()), k, cfg%system%time)
                 n_steps = k
                 exit

@@ -15,7 +15,7 @@ module driver_simulation_beam
     use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
     use driver_config, only: run_config_t, build_config
     use driver_results, only: results_writer_t
-    use driver_checkpoint, only: checkpoint_run_t, loop_state_t, checkpoint_create, checkpoint_commit, &
+    use driver_checkpoint, only: end_of_step, checkpoint_run_t, loop_state_t, checkpoint_create, checkpoint_commit, &
                                  checkpoint_discard, save_integrator, load_integrator, save_results, load_results
     use io_hdf5_file, only: h5_file_t
     use driver_guards, only: check_beam_state
@@ -210,7 +210,7 @@ contains
         type(progress_t) :: progress
         real(wp), allocatable :: d(:, :), v(:, :), a(:, :)
         integer(i8) :: n_steps, k, k0
-        logical :: regular, stop
+        logical :: stop
         character(len=160) :: buf
 
         n_steps = run%n_steps
@@ -232,20 +232,10 @@ contains
             if (allocated(error)) return
             call check(k, error)
             if (allocated(error)) return
-            ! The checkpoint holds the regular outputs up to step k, not the extra output of
-            ! the last step or of a stop (a restart with a later end time cuts them).
-            regular = mod(k, int(run%output_interval, i8)) == 0
-            if (regular) call store(error)
-            if (allocated(error)) return
-            stop = k < n_steps .and. caught_signal() /= 0
-            if (k == n_steps .or. stop .or. ck%schedule%due(k)) call checkpoint(error)
-            if (allocated(error)) return
-            if (k == n_steps .and. .not. regular) call store(error)
+            call end_of_step(k, n_steps, run%output_interval, ck%schedule, store, checkpoint, stop, error)
             if (allocated(error)) return
             if (stop) then
                 ! Stop request: the step just done is the last output.
-                if (.not. regular) call store(error)
-                if (allocated(error)) return
                 call out%stop_at(signal_name(caught_signal()), k, integ%t)
                 n_steps = k
                 exit
