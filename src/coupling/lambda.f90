@@ -22,6 +22,10 @@ module coupling_lambda
     private
     public :: coupling_system_t, fe_coupling_force
 
+    !> Columns of C^T solved at once when A is assembled: bounds the work arrays to
+    !> 2 n_free response_block reals (about 50 MB at 10^5 free DOFs) whatever n_rows is.
+    integer, parameter :: response_block = 32
+
     !> The factored multiplier matrix A of one coupled set.
     type :: coupling_system_t
         !> Number of multipliers (rows of C).
@@ -58,7 +62,8 @@ contains
         !> Particle side, coupled DOFs: velocity response of the coupled DOFs to unit
         !> multipliers (G M^-1 G^T of a rigid cluster), symmetric (n_rows, n_rows).
         real(wp), intent(in), optional :: mobility(:, :)
-        real(wp), allocatable :: ct(:, :), x(:, :)
+        real(wp), allocatable :: b(:, :), x(:, :), e(:), cx(:, :)
+        integer :: j0, j, k
         call check_particle_side(op%n_rows, error, inverse_mass, mobility)
         if (allocated(error)) return
         if (size(integ%u) /= op%n_free) then
@@ -66,12 +71,25 @@ contains
                             'different numbers of free DOFs')
             return
         end if
-        ! gamma C S^-1 C^T, column by column of C^T.
-        ct = transpose(op%to_dense())
-        allocate (x(op%n_free, op%n_rows))
-        call integ%solve_effective(ct, x, error)
-        if (allocated(error)) return
-        call self%assemble_response(op, x, integ%h, integ%gamma, error, inverse_mass, mobility)
+        ! C S^-1 C^T, a block of columns of C^T at a time: only the n_rows x n_rows product is
+        ! kept, never C^T or S^-1 C^T in full (n_free x n_rows, dense, would not fit for a
+        ! large mesh).
+        k = min(response_block, op%n_rows)
+        allocate (b(op%n_free, k), x(op%n_free, k), e(op%n_rows), cx(op%n_rows, op%n_rows))
+        do j0 = 1, op%n_rows, response_block
+            k = min(response_block, op%n_rows - j0 + 1)
+            do j = 1, k
+                e = 0.0_wp
+                e(j0 + j - 1) = 1.0_wp
+                call op%apply_transpose(e, b(:, j))
+            end do
+            call integ%solve_effective(b(:, 1:k), x(:, 1:k), error)
+            if (allocated(error)) return
+            do j = 1, k
+                call op%apply(x(:, j), cx(:, j0 + j - 1))
+            end do
+        end do
+        call finish(self, cx, integ%h, integ%gamma, error, inverse_mass, mobility)
     end subroutine assemble
 
     !> Build A = h (W + gamma C X) and factor it, X = S^-1 C^T the response of the FE model's
@@ -91,21 +109,36 @@ contains
         real(wp), intent(in), optional :: inverse_mass(:)
         !> Particle side, coupled DOFs (see `assemble`).
         real(wp), intent(in), optional :: mobility(:, :)
-        integer :: n, j
-        n = op%n_rows
-        call check_particle_side(n, error, inverse_mass, mobility)
+        real(wp), allocatable :: cx(:, :)
+        integer :: j
+        call check_particle_side(op%n_rows, error, inverse_mass, mobility)
         if (allocated(error)) return
-        if (any(shape(x) /= [op%n_free, n])) then
+        if (any(shape(x) /= [op%n_free, op%n_rows])) then
             call make_error(error, 'coupling multipliers: the FE response S^-1 C^T must be (n_free, n_rows)')
             return
         end if
+        allocate (cx(op%n_rows, op%n_rows))
+        do j = 1, op%n_rows
+            call op%apply(x(:, j), cx(:, j))
+        end do
+        call finish(self, cx, h, gamma, error, inverse_mass, mobility)
+    end subroutine assemble_response
+
+    !> A = h (W + gamma C S^-1 C^T) from the product C S^-1 C^T, factored.
+    subroutine finish(self, cx, h, gamma, error, inverse_mass, mobility)
+        class(coupling_system_t), intent(inout) :: self
+        !> C S^-1 C^T (n_rows, n_rows).
+        real(wp), intent(in) :: cx(:, :)
+        real(wp), intent(in) :: h, gamma
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), intent(in), optional :: inverse_mass(:)
+        real(wp), intent(in), optional :: mobility(:, :)
+        integer :: n, j
+        n = size(cx, 1)
         self%n = n
         self%h = h
         call self%a%init(n)
-        do j = 1, n
-            call op%apply(x(:, j), self%a%a(:, j))
-        end do
-        self%a%a = gamma*self%a%a
+        self%a%a = gamma*cx
         if (present(mobility)) self%a%a = self%a%a + mobility
         if (present(inverse_mass)) then
             do j = 1, n
@@ -121,7 +154,7 @@ contains
                             'or more multipliers than the FE can resolve (too many coupled points '// &
                             'per element: couple fewer or use the mediator space); '//error%message
         end if
-    end subroutine assemble_response
+    end subroutine finish
 
     !> Checks of the particle side of A (sizes, signs, finiteness).
     subroutine check_particle_side(n, error, inverse_mass, mobility)
