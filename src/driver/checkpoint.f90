@@ -1,9 +1,10 @@
 !> Checkpoints of a time loop and restart from them (doc/output.md, "Checkpoints and restart").
 !>
 !> A checkpoint is an HDF5 file holding everything a time loop needs to go on as if it had
-!> never stopped: the mutable state of the models (Newmark state of a beam; Moreau-Jean state
-!> of the disks and walls, the contact list with its reactions and statuses for the warm
-!> start, bond states and the rupture log; multipliers and constraint state of a coupling),
+!> never stopped: the mutable state of the models (Newmark state of a beam or a 2D continuum;
+!> Moreau-Jean state of the disks and walls, the contact list with its reactions and statuses
+!> for the warm start, bond states and the rupture log; multipliers and constraint state of a
+!> coupling, with a beam or a continuum),
 !> the counters of the results writers and the record count of every dataset of the results
 !> file, the loop's own counters, and a header: code version, a hash of the deck's text, the
 !> kind of run, the step. What the deck builds (meshes, matrices, materials, functions) is
@@ -151,7 +152,7 @@ contains
         character(len=*), intent(in) :: path
         !> The deck's text.
         character(len=*), intent(in) :: deck_text
-        !> Kind of run: 'beam', 'particles' or 'coupled'.
+        !> Kind of run: 'beam', 'particles', 'coupled', 'continuum' or 'coupled2d'.
         character(len=*), intent(in) :: kind
         !> The loop's counters.
         type(loop_state_t), intent(in) :: loop
@@ -216,7 +217,7 @@ contains
         character(len=*), intent(in) :: deck_file
         !> The deck's text.
         character(len=*), intent(in) :: deck_text
-        !> Kind of run of the deck: 'beam', 'particles' or 'coupled'.
+        !> Kind of run of the deck: 'beam', 'particles', 'coupled', 'continuum' or 'coupled2d'.
         character(len=*), intent(in) :: kind
         !> The loop's counters at the checkpoint.
         type(loop_state_t), intent(out) :: loop

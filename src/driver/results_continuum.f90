@@ -41,6 +41,8 @@ module driver_results_continuum
     contains
         !> Write the mesh and the sets; create the series of the analysis.
         procedure :: begin => writer_begin
+        !> Take up a dynamic run's results file again at a restart (nothing written).
+        procedure :: resume => writer_resume
         !> Static solution.
         procedure :: write_static => writer_write_static
         !> Modes.
@@ -67,8 +69,8 @@ contains
         character(len=*), intent(in) :: analysis
         !> Set on a write failure.
         type(error_t), allocatable, intent(out) :: error
-        integer, allocatable :: topo(:), topo2(:, :)
-        integer :: e, k, n
+        integer, allocatable :: topo(:)
+        integer :: k, n
         self%n_nodes = mesh%node_count()
         self%n_elements = mesh%element_count()
         self%analysis = analysis
@@ -86,22 +88,11 @@ contains
         if (allocated(error)) return
         call file%write_dataset('/continuum/mesh/kind', mesh%kind, error)
         if (allocated(error)) return
-        if (all(mesh%kind == mesh%kind(1))) then
+        call set_topology(self, mesh, topo)
+        if (self%topology /= 'Mixed') then
             n = nodes_per_element(mesh%kind(1))
-            self%topology = merge('Triangle     ', 'Quadrilateral', mesh%kind(1) == element_t3)
-            self%topology = trim(self%topology)
-            topo2 = mesh%connectivity(1:n, :) - 1
-            self%topology_size = size(topo2)
-            call file%write_dataset('/continuum/mesh/topology', topo2, error)
+            call file%write_dataset('/continuum/mesh/topology', reshape(topo, [n, self%n_elements]), error)
         else
-            ! XDMF mixed topology: type code (4 triangle, 5 quadrilateral), then the nodes.
-            self%topology = 'Mixed'
-            allocate (topo(0))
-            do e = 1, self%n_elements
-                n = nodes_per_element(mesh%kind(e))
-                topo = [topo, merge(4, 5, mesh%kind(e) == element_t3), mesh%connectivity(1:n, e) - 1]
-            end do
-            self%topology_size = size(topo)
             call file%write_dataset('/continuum/mesh/topology', topo, error)
         end if
         if (allocated(error)) return
@@ -145,6 +136,52 @@ contains
             call file%write_attribute(path, 'units', units, error)
         end subroutine series
     end subroutine writer_begin
+
+    !> The XDMF topology of a mesh: its name and the 0-based connectivity, flat (one kind of
+    !> element: n nodes per element, element after element; mixed: type code 4 (triangle)
+    !> or 5 (quadrilateral), then the nodes).
+    subroutine set_topology(self, mesh, topo)
+        type(continuum_writer_t), intent(inout) :: self
+        type(mesh2d_t), intent(in) :: mesh
+        integer, allocatable, intent(out) :: topo(:)
+        integer :: e, n
+        if (all(mesh%kind == mesh%kind(1))) then
+            n = nodes_per_element(mesh%kind(1))
+            self%topology = merge('Triangle     ', 'Quadrilateral', mesh%kind(1) == element_t3)
+            self%topology = trim(self%topology)
+            topo = reshape(mesh%connectivity(1:n, :) - 1, [n*size(mesh%kind)])
+        else
+            self%topology = 'Mixed'
+            allocate (topo(0))
+            do e = 1, size(mesh%kind)
+                n = nodes_per_element(mesh%kind(e))
+                topo = [topo, merge(4, 5, mesh%kind(e) == element_t3), mesh%connectivity(1:n, e) - 1]
+            end do
+        end if
+        self%topology_size = size(topo)
+    end subroutine set_topology
+
+    !> Take up the results file of a dynamic run at a restart, its series already cut to the
+    !> checkpoint (driver_checkpoint::load_results): the stored times are read back from
+    !> /continuum/time.
+    subroutine writer_resume(self, file, mesh, error)
+        !> The writer.
+        class(continuum_writer_t), intent(inout) :: self
+        !> The open results file.
+        type(h5_file_t), intent(inout) :: file
+        !> The mesh (built from the deck).
+        type(mesh2d_t), intent(in) :: mesh
+        !> Set on a read failure.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: topo(:)
+        self%n_nodes = mesh%node_count()
+        self%n_elements = mesh%element_count()
+        self%analysis = 'dynamic'
+        call set_topology(self, mesh, topo)
+        call file%read_dataset('/continuum/time', self%times, error)
+        if (allocated(error)) return
+        self%n_out = size(self%times)
+    end subroutine writer_resume
 
     !> Static displacements (2, n_nodes), centre stresses (3, n_elements) and strain energy.
     subroutine writer_write_static(self, file, d, stress, strain_energy, error)

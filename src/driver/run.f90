@@ -14,7 +14,8 @@
 !> may tunnel through a wall or another disk). One run at a time writes a results folder: a
 !> lock file (io_lock) is held while writing and removed on every way out.
 !>
-!> Checkpoints (driver_checkpoint): the time loops of beam, particle and coupled runs write
+!> Checkpoints (driver_checkpoint): the time loops of every kind of run (beam, particles,
+!> beam-particle coupled, continuum, continuum-particle coupled) write
 !> '<results folder>/checkpoint.h5' as the deck's [output] checkpoint_interval /
 !> checkpoint_seconds say, at a stop signal and at the end; `--restart` continues a run from
 !> one (same deck, same code version), into the same results file, with the option of a new
@@ -33,9 +34,6 @@ module driver_run
     use driver_guards, only: check_memory
     use driver_simulation, only: simulation_t, report_iface
     use driver_simulations, only: select_simulation
-    use driver_simulation_beam, only: beam_simulation_t
-    use driver_simulation_dem, only: dem_simulation_t
-    use driver_simulation_coupled, only: coupled_simulation_t
     use driver_config, only: steps_to_end, max_steps
     use driver_checkpoint, only: checkpoint_run_t, checkpoint_name, checkpoint_open
     implicit none
@@ -92,15 +90,7 @@ contains
         if (allocated(error)) return
         call sim%init(deck, report, error)
         if (allocated(error)) return
-        kind = ''
-        select type (sim)
-        type is (beam_simulation_t)
-            if (sim%settings%analysis == 'dynamic') kind = 'beam'
-        type is (dem_simulation_t)
-            kind = 'particles'
-        type is (coupled_simulation_t)
-            kind = 'coupled'
-        end select
+        kind = sim%checkpoint_kind()
         call apply_end_time(error)
         if (allocated(error)) return
         if (opts%check_only) then
@@ -189,8 +179,8 @@ contains
             real(wp) :: steps
             if (opts%end_time < 0.0_wp) return
             if (len(kind) == 0) then
-                call make_error(error, '--end: '//deck%file//' is not a beam, particle or beam-particle coupled '// &
-                                'dynamic analysis (the runs that have checkpoints)')
+                call make_error(error, '--end: '//deck%file//' is not a dynamic analysis (static and modal '// &
+                                'analyses have no time steps to continue)')
                 return
             end if
             associate (run => sim%settings)
@@ -216,8 +206,8 @@ contains
             type(error_t), allocatable, intent(out) :: error
             type(error_t), allocatable :: ignored
             if (len(kind) == 0) then
-                call make_error(error, '--restart: '//deck%file//' is not a beam, particle or beam-particle coupled '// &
-                                'dynamic analysis (only those runs have checkpoints)')
+                call make_error(error, '--restart: '//deck%file//' is not a dynamic analysis (only time '// &
+                                'integrations have checkpoints)')
                 return
             end if
             call checkpoint_open(ck%source, opts%restart, deck%file, deck%text, kind, ck%start, run_id, error)

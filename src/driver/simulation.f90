@@ -4,8 +4,10 @@
 !> sections, then calls, in order: `init` (build the configuration and the model from the
 !> deck; everything that can fail because of the input fails here, before the results folder
 !> is touched), `describe` (the line of a `--check` run), and `run` (static solve, modes or
-!> time steps, writing every output into the open results file). Adding a kind of model adds
-!> an extension in its own file and one line in `driver_simulations`.
+!> time steps, writing every output into the open results file). A time loop that writes
+!> checkpoints (driver_checkpoint) names its kind of run with `checkpoint_kind`, which a
+!> restart checks. Adding a kind of model adds an extension in its own file and one line in
+!> `driver_simulations`.
 module driver_simulation
     use core_error, only: error_t
     use io_deck, only: deck_t
@@ -36,6 +38,10 @@ module driver_simulation
         procedure(simulation_describe), deferred :: describe
         !> Run the analysis and write its results.
         procedure(simulation_run), deferred :: run
+        !> Kind of run written in and checked against a checkpoint ('beam', 'particles',
+        !> 'coupled', 'continuum', 'coupled2d'); '' for a run without checkpoints (static and
+        !> modal analyses).
+        procedure(simulation_checkpoint_kind), deferred :: checkpoint_kind
     end type simulation_t
 
     abstract interface
@@ -77,5 +83,15 @@ module driver_simulation
             !> Set on a run or write failure (without the deck file name).
             type(error_t), allocatable, intent(out) :: error
         end subroutine simulation_run
+
+        !> Kind of run of the checkpoints of this simulation ('': it writes none).
+        function simulation_checkpoint_kind(self) result(kind)
+            import :: simulation_t
+            !> The simulation (after `init`).
+            class(simulation_t), intent(in) :: self
+            !> 'beam', 'particles', 'coupled', 'continuum', 'coupled2d' or ''.
+            character(len=:), allocatable :: kind
+        end function simulation_checkpoint_kind
     end interface
+
 end module driver_simulation

@@ -39,6 +39,8 @@ module driver_simulation_beam
         procedure :: describe => beam_describe
         !> See `simulation_t%run`.
         procedure :: run => beam_run
+        !> See `simulation_t%checkpoint_kind`.
+        procedure :: checkpoint_kind => beam_checkpoint_kind
     end type beam_simulation_t
 
 contains
@@ -304,4 +306,14 @@ contains
             call out%flush(error)
         end subroutine store
     end subroutine run_dynamic
+
+    !> 'beam' for a dynamic analysis (static and modal ones write no checkpoint).
+    function beam_checkpoint_kind(self) result(kind)
+        !> The simulation.
+        class(beam_simulation_t), intent(in) :: self
+        !> Kind of run of its checkpoints.
+        character(len=:), allocatable :: kind
+        kind = ''
+        if (self%settings%analysis == 'dynamic') kind = 'beam'
+    end function beam_checkpoint_kind
 end module driver_simulation_beam

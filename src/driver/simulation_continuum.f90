@@ -3,7 +3,9 @@
 !> The mesh comes from the rectangle generator or a Gmsh file; the deck's named sets are the
 !> mesh's (a Gmsh mesh gets the sets 'all' of its nodes and elements as well). Static: K_ff
 !> u_f = f_f - K_fp u_p by CHOLMOD. Modal: band LAPACK (dsbgvx) on the reduced K and M. Dynamic:
-!> the integrators of fem_newmark on the continuum as a `dynamic_operator_t`.
+!> the integrators of fem_newmark on the continuum as a `dynamic_operator_t`, with checkpoints
+!> and restart as the beam's (driver_checkpoint: the integrator's state and the results file's
+!> record counts).
 module driver_simulation_continuum
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp, i8
@@ -24,7 +26,9 @@ module driver_simulation_continuum
     use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
     use driver_config, only: run_config_t, build_run_settings, build_time_functions
     use driver_results, only: results_writer_t
-    use driver_checkpoint, only: checkpoint_run_t
+    use io_hdf5_file, only: h5_file_t
+    use driver_checkpoint, only: checkpoint_run_t, end_of_step, loop_state_t, checkpoint_create, checkpoint_commit, &
+                                 checkpoint_discard, save_integrator, load_integrator, save_results, load_results
     use driver_results_continuum, only: continuum_writer_t
     use driver_simulation, only: simulation_t, report_iface
     implicit none
@@ -50,6 +54,8 @@ module driver_simulation_continuum
         procedure :: describe => continuum_describe
         !> See `simulation_t%run`.
         procedure :: run => continuum_run
+        !> See `simulation_t%checkpoint_kind`.
+        procedure :: checkpoint_kind => continuum_checkpoint_kind
     end type continuum_simulation_t
 
 contains
@@ -276,6 +282,7 @@ contains
             end if
             constant = self%model%load
             self%model%load = 0.0_wp
+            self%model%load_column = func
         end subroutine start_load
 
         !> After adding the load of record e: a timed load moves to its function's column.
@@ -284,6 +291,7 @@ contains
             if (func == 0) return
             self%model%timed_load(:, func) = self%model%timed_load(:, func) + self%model%load
             self%model%load = constant
+            self%model%load_column = 0
         end subroutine end_load
 
         !> Modes and dynamics need a positive-definite mass: every density > 0.
@@ -404,13 +412,16 @@ contains
         logical, intent(in) :: quiet
         !> Where progress and summary lines go.
         procedure(report_iface) :: report
-        !> Checkpoints: not written by continuum runs (run_deck refuses --restart for them).
+        !> Checkpoints of a dynamic run (and the one to restart from).
         type(checkpoint_run_t), intent(inout) :: ck
         !> Set on a run or write failure.
         type(error_t), allocatable, intent(out) :: error
         type(continuum_writer_t) :: writer
         character(len=:), allocatable :: xdmf
-        call writer%begin(out%file, self%model%mesh, self%settings%analysis, error)
+        ! Steps done, and at the start of the loop (a checkpoint's at a restart).
+        integer(i8) :: k, k0
+        ! At a restart the file has the mesh and the series already (run_dynamic's restore).
+        if (.not. ck%restart) call writer%begin(out%file, self%model%mesh, self%settings%analysis, error)
         if (allocated(error)) return
         select case (self%settings%analysis)
         case ('static')
@@ -480,17 +491,25 @@ contains
             call writer%write_modal(out%file, omega, full, error)
         end subroutine run_modal
 
-        !> Time steps with outputs every [output] interval.
+        !> Time steps with outputs every [output] interval, checkpoints as `ck` says (from a
+        !> checkpoint's state at a restart).
         subroutine run_dynamic(error)
             type(error_t), allocatable, intent(out) :: error
             type(progress_t) :: progress
-            integer(i8) :: n_steps, k
+            integer(i8) :: n_steps
+            logical :: stop
             character(len=200) :: buf
             n_steps = self%settings%n_steps
             call progress%start(n_steps, self%settings%t_end, self%settings%progress_seconds)
-            call store(error)
+            k0 = 0
+            if (ck%restart) then
+                call restore(error)
+            else
+                call store(error)
+            end if
             if (allocated(error)) return
-            do k = 1, n_steps
+            call ck%schedule%start()
+            do k = k0 + 1, n_steps
                 call self%integ%step(self%ops, error)
                 if (allocated(error)) return
                 if (.not. (all(ieee_is_finite(self%integ%u)) .and. all(ieee_is_finite(self%integ%v)))) then
@@ -500,13 +519,10 @@ contains
                     call make_error(error, trim(buf))
                     return
                 end if
-                if (mod(k, int(self%settings%output_interval, i8)) == 0 .or. k == n_steps) then
-                    call store(error)
-                    if (allocated(error)) return
-                end if
-                if (k < n_steps .and. caught_signal() /= 0) then
-                    if (mod(k, int(self%settings%output_interval, i8)) /= 0) call store(error)
-                    if (allocated(error)) return
+                call end_of_step(k, n_steps, self%settings%output_interval, ck%schedule, store, checkpoint, stop, error)
+                if (allocated(error)) return
+                if (stop) then
+                    ! Stop request: the step just done is the last output.
                     call out%stop_at(signal_name(caught_signal()), k, self%integ%t)
                     n_steps = k
                     exit
@@ -519,6 +535,38 @@ contains
             call report(progress%summary_line(n_steps))
             call out%write_summary(int(n_steps), progress%elapsed(), error)
         end subroutine run_dynamic
+
+        !> Restart: integrator state, results file and writer from the checkpoint `ck%source`.
+        subroutine restore(error)
+            type(error_t), allocatable, intent(out) :: error
+            type(error_t), allocatable :: ignored
+            call load_integrator(ck%source, '/fe', self%integ, error)
+            if (.not. allocated(error)) call load_results(ck%source, out, error)
+            call ck%source%close(ignored)
+            if (allocated(error)) return
+            call writer%resume(out%file, self%model%mesh, error)
+            k0 = ck%start%step
+        end subroutine restore
+
+        !> Write a checkpoint after step k.
+        subroutine checkpoint(error)
+            type(error_t), allocatable, intent(out) :: error
+            type(h5_file_t) :: f
+            call out%flush(error)
+            if (allocated(error)) return
+            call checkpoint_create(f, ck%path, ck%deck_text, self%checkpoint_kind(), &
+                                   loop_state_t(k, 0, .false., .false.), self%integ%t, out%run_id, error)
+            if (.not. allocated(error)) call save_integrator(f, '/fe', self%integ, error)
+            if (.not. allocated(error)) call save_results(f, out, error)
+            if (allocated(error)) then
+                call checkpoint_discard(f, ck%path)
+                return
+            end if
+            call checkpoint_commit(f, ck%path, error)
+            if (allocated(error)) return
+            ck%last_step = k
+            ck%last_time = self%integ%t
+        end subroutine checkpoint
 
         !> Store the current state and energies.
         subroutine store(error)
@@ -550,4 +598,14 @@ contains
             call out%flush(error)
         end subroutine store
     end subroutine continuum_run
+
+    !> 'continuum' for a dynamic analysis (static and modal ones write no checkpoint).
+    function continuum_checkpoint_kind(self) result(kind)
+        !> The simulation.
+        class(continuum_simulation_t), intent(in) :: self
+        !> Kind of run of its checkpoints.
+        character(len=:), allocatable :: kind
+        kind = ''
+        if (self%settings%analysis == 'dynamic') kind = 'continuum'
+    end function continuum_checkpoint_kind
 end module driver_simulation_continuum

@@ -34,6 +34,8 @@ module driver_simulation_coupled
         procedure :: describe => coupled_describe
         !> See `simulation_t%run`.
         procedure :: run => coupled_run
+        !> See `simulation_t%checkpoint_kind`.
+        procedure :: checkpoint_kind => coupled_checkpoint_kind
     end type coupled_simulation_t
 
 contains
@@ -96,4 +98,13 @@ contains
         type(error_t), allocatable, intent(out) :: error
         call run_coupled(self%settings, self%beam, self%dem, self%sys, out, quiet, report, ck, error)
     end subroutine coupled_run
+
+    !> 'coupled'.
+    function coupled_checkpoint_kind(self) result(kind)
+        !> The simulation.
+        class(coupled_simulation_t), intent(in) :: self
+        !> Kind of run of its checkpoints.
+        character(len=:), allocatable :: kind
+        kind = 'coupled'
+    end function coupled_checkpoint_kind
 end module driver_simulation_coupled

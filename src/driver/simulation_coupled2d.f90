@@ -10,8 +10,10 @@
 !> Results: /continuum (mesh, sets, displacement, velocity, centre stresses, and the FE side's
 !> energies: kinetic and strain weighted by alpha), /dem and /coupling as in beam-coupled runs,
 !> and `<deck>.xdmf` next to the HDF5 file with the mesh's fields and the disks (points with
-!> their radius, grid "disks") per stored state. Checkpoints are not written (run_deck refuses
-!> --restart for these runs, as for continuum runs).
+!> their radius, grid "disks") per stored state. Checkpoints hold what a beam-particle coupled
+!> run's hold (driver_checkpoint::save_coupled: the Newmark state of the continuum, the disks,
+!> contacts and bonds, the multipliers and the constraint state) under the kind 'coupled2d';
+!> at a restart the continuum writer reads its stored times back from the results file.
 module driver_simulation_coupled2d
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp, i8
@@ -31,7 +33,10 @@ module driver_simulation_coupled2d
     use driver_results_coupled, only: coupled_writer_t
     use driver_run_dem, only: max_warnings, speed_warning, last_unconverged_warning
     use driver_guards, only: check_disks_state, step_start_t, take_step_start, check_tunnelling
-    use driver_checkpoint, only: checkpoint_run_t
+    use io_hdf5_file, only: h5_file_t
+    use driver_checkpoint, only: checkpoint_run_t, end_of_step, loop_state_t, checkpoint_create, checkpoint_commit, &
+                                 checkpoint_discard, save_coupled, load_coupled, save_results, load_results, &
+                                 save_dem_writer, load_dem_writer, save_coupled_writer, load_coupled_writer
     use driver_simulation, only: simulation_t, report_iface
     use driver_simulation_continuum, only: continuum_simulation_t
     use driver_simulation_dem, only: dem_simulation_t
@@ -56,6 +61,8 @@ module driver_simulation_coupled2d
         procedure :: describe => coupled2d_describe
         !> See `simulation_t%run`.
         procedure :: run => coupled2d_run
+        !> See `simulation_t%checkpoint_kind`.
+        procedure :: checkpoint_kind => coupled2d_checkpoint_kind
     end type coupled2d_simulation_t
 
 contains
@@ -144,7 +151,7 @@ contains
         logical, intent(in) :: quiet
         !> Where progress and summary lines go.
         procedure(report_iface) :: report
-        !> Checkpoints: not written by these runs (run_deck refuses --restart for them).
+        !> Checkpoints (and the one to restart from).
         type(checkpoint_run_t), intent(inout) :: ck
         !> Set on a run or write failure.
         type(error_t), allocatable, intent(out) :: error
@@ -155,28 +162,35 @@ contains
         type(step_start_t) :: start
         character(len=:), allocatable :: xdmf
         character(len=512) :: buf
-        integer(i8) :: n_steps, k
+        integer(i8) :: n_steps, k, k0
         integer :: unconverged
-        logical :: speed_warned
+        logical :: speed_warned, stop
         associate (sys => self%sys, model => self%continuum%model, run => self%settings)
             n_steps = run%n_steps
             unconverged = 0
             speed_warned = .false.
-            call fe_out%begin(out%file, model%mesh, 'dynamic', error)
-            if (allocated(error)) return
-            call dem_out%begin(out%file, sys%dem, self%particles%dem%material_id, self%particles%dem%store_contacts, &
-                               error)
-            if (allocated(error)) return
-            call cpl_out%begin(out%file, sys, error)
-            if (allocated(error)) return
-            if (size(sys%mediator_nodes) > 0) call out%file%write_dataset('/coupling/mediator_nodes', &
-                                                                          sys%mediator_nodes, error)
-            if (allocated(error)) return
-            k = 0
-            call store(error)
-            if (allocated(error)) return
+            k0 = 0
+            if (ck%restart) then
+                call restore(error)
+                if (allocated(error)) return
+            else
+                call fe_out%begin(out%file, model%mesh, 'dynamic', error)
+                if (allocated(error)) return
+                call dem_out%begin(out%file, sys%dem, self%particles%dem%material_id, &
+                                   self%particles%dem%store_contacts, error)
+                if (allocated(error)) return
+                call cpl_out%begin(out%file, sys, error)
+                if (allocated(error)) return
+                if (size(sys%mediator_nodes) > 0) call out%file%write_dataset('/coupling/mediator_nodes', &
+                                                                              sys%mediator_nodes, error)
+                if (allocated(error)) return
+                k = 0
+                call store(error)
+                if (allocated(error)) return
+            end if
             call progress%start(n_steps, run%t_end, run%progress_seconds)
-            do k = 1, n_steps
+            call ck%schedule%start()
+            do k = k0 + 1, n_steps
                 call take_step_start(start, sys%dem%particles, sys%dem%walls)
                 call arlequin_step(sys, error)
                 if (allocated(error)) return
@@ -188,13 +202,10 @@ contains
                 if (allocated(error)) return
                 if (.not. sys%stats%converged) call warn_unconverged()
                 if (.not. speed_warned) call check_speed()
-                if (mod(k, int(run%output_interval, i8)) == 0 .or. k == n_steps) then
-                    call store(error)
-                    if (allocated(error)) return
-                end if
-                if (k < n_steps .and. caught_signal() /= 0) then
-                    if (mod(k, int(run%output_interval, i8)) /= 0) call store(error)
-                    if (allocated(error)) return
+                call end_of_step(k, n_steps, run%output_interval, ck%schedule, store, checkpoint, stop, error)
+                if (allocated(error)) return
+                if (stop) then
+                    ! Stop request: the step just done is the last output.
                     call out%stop_at(signal_name(caught_signal()), k, sys%fe%t)
                     n_steps = k
                     exit
@@ -216,6 +227,49 @@ contains
         end associate
 
     contains
+
+        !> Restart: state, writer counters and results file from the checkpoint `ck%source`.
+        subroutine restore(error)
+            type(error_t), allocatable, intent(out) :: error
+            type(error_t), allocatable :: ignored
+            call dem_out%resume(self%sys%dem, self%particles%dem%store_contacts)
+            call cpl_out%resume(self%sys)
+            call load_coupled(ck%source, self%sys, error)
+            if (.not. allocated(error)) call load_dem_writer(ck%source, dem_out, error)
+            if (.not. allocated(error)) call load_coupled_writer(ck%source, cpl_out, error)
+            if (.not. allocated(error)) call load_results(ck%source, out, error)
+            call ck%source%close(ignored)
+            if (allocated(error)) return
+            call fe_out%resume(out%file, self%continuum%model%mesh, error)
+            if (allocated(error)) return
+            k0 = ck%start%step
+            unconverged = ck%start%unconverged
+            speed_warned = ck%start%speed_warned
+        end subroutine restore
+
+        !> Write a checkpoint after step k (the buffered per-step values are written first).
+        subroutine checkpoint(error)
+            type(error_t), allocatable, intent(out) :: error
+            type(h5_file_t) :: f
+            call dem_out%flush_buffer(out%file, error)
+            if (.not. allocated(error)) call cpl_out%flush_buffer(out%file, error)
+            if (allocated(error)) return
+            call checkpoint_create(f, ck%path, ck%deck_text, self%checkpoint_kind(), &
+                                   loop_state_t(k, unconverged, speed_warned, .false.), self%sys%fe%t, &
+                                   out%run_id, error)
+            if (.not. allocated(error)) call save_coupled(f, self%sys, error)
+            if (.not. allocated(error)) call save_dem_writer(f, dem_out, error)
+            if (.not. allocated(error)) call save_coupled_writer(f, cpl_out, error)
+            if (.not. allocated(error)) call save_results(f, out, error)
+            if (allocated(error)) then
+                call checkpoint_discard(f, ck%path)
+                return
+            end if
+            call checkpoint_commit(f, ck%path, error)
+            if (allocated(error)) return
+            ck%last_step = k
+            ck%last_time = self%sys%fe%t
+        end subroutine checkpoint
 
         !> One stored output of the three parts.
         subroutine store(error)
@@ -386,4 +440,13 @@ contains
                 '     </DataItem>'//new_line('a')
         end function slab
     end subroutine write_disks_xdmf
+
+    !> 'coupled2d'.
+    function coupled2d_checkpoint_kind(self) result(kind)
+        !> The simulation.
+        class(coupled2d_simulation_t), intent(in) :: self
+        !> Kind of run of its checkpoints.
+        character(len=:), allocatable :: kind
+        kind = 'coupled2d'
+    end function coupled2d_checkpoint_kind
 end module driver_simulation_coupled2d

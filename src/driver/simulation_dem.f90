@@ -29,6 +29,8 @@ module driver_simulation_dem
         procedure :: describe => dem_describe
         !> See `simulation_t%run`.
         procedure :: run => dem_run
+        !> See `simulation_t%checkpoint_kind`.
+        procedure :: checkpoint_kind => dem_checkpoint_kind
     end type dem_simulation_t
 
 contains
@@ -118,4 +120,13 @@ contains
         write (buf, '(es11.3e3)') x
         text = trim(adjustl(buf))
     end function num
+
+    !> 'particles'.
+    function dem_checkpoint_kind(self) result(kind)
+        !> The simulation.
+        class(dem_simulation_t), intent(in) :: self
+        !> Kind of run of its checkpoints.
+        character(len=:), allocatable :: kind
+        kind = 'particles'
+    end function dem_checkpoint_kind
 end module driver_simulation_dem

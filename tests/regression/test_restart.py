@@ -6,13 +6,16 @@ For a beam deck (input/cantilever.dat), a particle deck with contacts and bonds 
 (input/cohesive_row.dat: bonded row, two ruptures, one before and one after the stop; also
 with [solver] method = block, whose factor is kept from step to step) and
 coupled decks (input/bending_stack.dat, tests/regression/decks/coupled_rigid_translation.dat),
-the run is stopped at step k in three
+a 2D continuum deck (input/continuum_cantilever_dynamic.dat) and continuum-disk coupled decks
+(tests/regression/decks/coupled2d_pushed.dat with one multiplier per disk and with the
+mediator space), the run is stopped at step k in three
 ways: by a shorter end time (--end, the stop not on an output step: its extra last output
 must disappear at the restart), by a signal (SIGTERM / SIGUSR1: exit 128 + signal, then the
 exact command the program prints is run), and by kill -9 after a periodic checkpoint
 ([output] checkpoint_interval). Every dataset of the continued file must be equal, byte for
 byte, to that of the uninterrupted run, and so must every attribute except the wall-clock
-ones (dates, wall and solver seconds). Refusals: a checkpoint of another deck, of another
+ones (dates, wall and solver seconds); for the continuum runs the XDMF file next to the
+results is equal byte for byte as well. Refusals: a checkpoint of another deck, of another
 code version, a restart with nothing left to do. A new end time (--end) continues a finished
 run; the earlier finished result stays untouched when the continued run fails.
 Usage (ctest does this): test_restart.py --exe multicor --work DIR --source REPO
@@ -132,7 +135,16 @@ def by_end_time(exe, deck, work, name, t_stop):
     check(f"{name}: restart exit 0", second.returncode == 0, (second.stdout + second.stderr)[-300:])
     if second.returncode == 0:
         compare(name, folder / f"{deck.stem}.h5", ref)
+        compare_xdmf(name, folder / f"{deck.stem}.xdmf", ref.with_suffix(".xdmf"))
     return ref
+
+
+def compare_xdmf(name, continued, reference):
+    """The XDMF file of a continuum run (one grid per stored state) is the same text."""
+    if not reference.exists():
+        return
+    check(f"{name}: the XDMF file equals the uninterrupted run's", continued.exists() and
+          continued.read_bytes() == reference.read_bytes(), str(continued))
 
 
 def start(exe, deck, folder):
@@ -186,6 +198,7 @@ def by_signal(exe, deck_src, work, name, sig, end, min_step):
           second.stdout[:200])
     if second.returncode == 0:
         compare(name, folder / f"{deck.stem}.h5", ref)
+        compare_xdmf(name, folder / f"{deck.stem}.xdmf", ref.with_suffix(".xdmf"))
 
 
 def by_kill_9(exe, deck_src, work, name, end, every, min_step, seconds=None):
@@ -332,6 +345,19 @@ def main():
     # Every 0.05 s of wall time: several checkpoints before step 3000 (about 0.2 ms per step).
     by_kill_9(exe, src / "input" / "incline.dat", work, "dem_kill9_wall", 20.0, 0, 3000,
               seconds=0.05)
+    # 2D continuum: 500 steps, outputs every 5; the stop at step 204 is not an output step.
+    by_end_time(exe, src / "input" / "continuum_cantilever_dynamic.dat", work, "continuum_end", 0.2033)
+    by_signal(exe, src / "input" / "continuum_cantilever_dynamic.dat", work, "continuum_term",
+              signal.SIGTERM, 3.0, 1000)
+    # Continuum + disks: 100 steps, outputs every 10, stop at step 45; per-disk multipliers
+    # and the mediator space (multipliers on the FE nodes), whose multipliers are other rows.
+    pushed = decks / "coupled2d_pushed.dat"
+    by_end_time(exe, pushed, work, "coupled2d_end", 4.43e-4)
+    nodes = work / "coupled2d_nodes.dat"
+    nodes.write_text(re.sub(r"^\[coupling\]\s*$", "[coupling]\nmultipliers = nodes", pushed.read_text(),
+                            count=1, flags=re.M))
+    by_end_time(exe, nodes, work, "coupled2d_nodes_end", 6.17e-4)
+    by_signal(exe, pushed, work, "coupled2d_usr1", signal.SIGUSR1, 2.0e-3, 60)
     refusals(exe, beam, work)
     new_end_time(exe, beam, work)
     if FAILED:
