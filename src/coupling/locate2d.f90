@@ -234,7 +234,10 @@ contains
                 xi = xi + dxi
                 ! Far outside: Newton may wander; stop once clearly out.
                 if (maxval(abs(xi)) > 10) exit
-                if (maxval(abs(dxi)) < 1.0e-14_wp) then
+                ! Converged when the step is at the rounding of xi: the residual r carries the
+                ! rounding of the coordinates (eps |x|), which the step divides by the element
+                ! size, so small elements far from the origin need a step bound above eps.
+                if (maxval(abs(dxi)) < max(1.0e-14_wp, 64*epsilon(1.0_wp)*maxval(abs(xe))/sqrt(abs(det)))) then
                     converged = .true.
                     exit
                 end if
