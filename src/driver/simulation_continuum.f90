@@ -512,7 +512,10 @@ contains
             do k = k0 + 1, n_steps
                 call self%integ%step(self%ops, error)
                 if (allocated(error)) return
-                if (.not. (all(ieee_is_finite(self%integ%u)) .and. all(ieee_is_finite(self%integ%v)))) then
+                ! State and energy accounts (a checkpoint may follow: it must hold finite values).
+                if (.not. (all(ieee_is_finite(self%integ%u)) .and. all(ieee_is_finite(self%integ%v)) .and. &
+                           all(ieee_is_finite([self%integ%kinetic, self%integ%strain, self%integ%external_work, &
+                                               self%integ%damping_dissipation])))) then
                     write (buf, '(a,i0,a,es13.5e3,a)') 'continuum: the state is not finite after step ', k, &
                         ' (t = ', self%integ%t, ' s); likely cause: a time step above the stability limit or '// &
                         'loads far too large'

@@ -307,7 +307,10 @@ contains
         subroutine check_step(error)
             type(error_t), allocatable, intent(out) :: error
             associate (sys => self%sys)
-                if (.not. (all(ieee_is_finite(sys%fe%u)) .and. all(ieee_is_finite(sys%fe%v)))) then
+                ! State and energy accounts (a checkpoint may follow: it must hold finite values).
+                if (.not. (all(ieee_is_finite(sys%fe%u)) .and. all(ieee_is_finite(sys%fe%v)) .and. &
+                           all(ieee_is_finite([sys%fe%kinetic, sys%fe%strain, sys%fe%external_work, &
+                                               sys%fe%damping_dissipation, sys%fe%coupling_work])))) then
                     write (buf, '(a,i0,a,es13.5e3,a)') 'coupled continuum: the state is not finite after step ', k, &
                         ' (t = ', sys%fe%t, ' s); likely cause: loads or moduli far out of scale'
                     call make_error(error, trim(buf))
