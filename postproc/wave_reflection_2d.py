@@ -24,9 +24,9 @@ the band); the body's velocity (mean of the disks) against the closed form; the 
 disks' and band nodes' velocities about it (rigidity).
 
 Usage (one command; the Release build is faster):
-    .venv/bin/python postproc/wave_reflection_2d.py --exe build/src/multicor --work /tmp/wave2d
+    .venv/bin/python postproc/wave_reflection_2d.py --exe build/src/multicor --work /tmp/wave2d [--refine]
 prints the table of doc/verification.md (band widths 4, 8, 16 elements = 10, 20, 40 mm x
-weights constant, linear, cubic). tests/regression/test_wave_reflection_2d.py runs a subset and asserts against the
+weights constant, linear, cubic), and with --refine the 20 mm band at three resolutions. tests/regression/test_wave_reflection_2d.py runs a subset and asserts against the
 closed form.
 """
 import argparse
@@ -42,17 +42,30 @@ import numpy as np
 
 # Data set: steel strip H = 5 mm high, t = 1 cm thick, nu = 0; Q4 of 2.5 mm x 5 mm (one
 # element high); disks R = 1.25 mm (pitch 2.5 mm, one column per band node), 2 rows, bonded.
-E, NU, RHO, H, THICK = 2.1e11, 0.0, 7800.0, 0.005, 0.01
-DX, RADIUS = 0.0025, 0.00125
-S_FE = 0.25                   # end of the FE-only zone (100 elements)
+# `set_resolution` scales H, dx, R and h together (--refine).
+E, NU, RHO, THICK = 2.1e11, 0.0, 7800.0, 0.01
+S_FE = 0.25                   # end of the FE-only zone (100 elements of 2.5 mm)
 N_FREE = 4                    # disk columns beyond the band
 C_BAR = math.sqrt(E / RHO)
-Z = RHO * C_BAR * H * THICK
-M_DISK = RHO * math.pi * RADIUS**2 * THICK
-P0 = 50.0                     # end force amplitude [N]: traction P0 / (H t) = 1 MPa
-T_PULSE = 20.0e-6             # sin^2 pulse duration: c T = 0.104 m, 42 elements
-STEP = 2.5e-7                 # 80 steps per pulse, Courant number c h / dx = 0.52
+TRACTION = 1.0e6              # end traction amplitude [Pa]
+T_PULSE = 20.0e-6             # sin^2 pulse duration: c T = 0.104 m, 42 elements of 2.5 mm
 ALPHA_MIN = 1.0e-3
+
+
+def set_resolution(scale):
+    """Element size dx = 2.5 mm, step h = 0.25 us (80 steps per pulse, Courant number c h / dx
+    = 0.52), disk radius 1.25 mm and strip height 5 mm, all times `scale`; the traction and so
+    V = traction / (rho c) stay. The end mass changes with it (Z and the strip's share scale
+    as `scale`, the 4 free columns and the band's end columns of disks as `scale`^2), so each
+    resolution is compared with its own closed form."""
+    global H, DX, RADIUS, STEP, Z, M_DISK, P0
+    H, DX, RADIUS, STEP = 0.005 * scale, 0.0025 * scale, 0.00125 * scale, 2.5e-7 * scale
+    Z = RHO * C_BAR * H * THICK
+    M_DISK = RHO * math.pi * RADIUS**2 * THICK
+    P0 = TRACTION * H * THICK       # end force amplitude [N]
+
+
+set_resolution(1.0)
 
 
 def hann_table(duration, points=81):
@@ -77,7 +90,7 @@ function = 1 table {hann_table(T_PULSE)}
 [continuum]
 mesh = rectangle 0 0 {s_p:.6g} {H} {n_el} 1 q4
 material = {E} {NU} {RHO} {THICK} plane_stress
-traction = left {P0 / (H * THICK):.6g} 0 uniform 1
+traction = left {TRACTION:.6g} 0 uniform 1
 [particles]
 material = 1 {RHO}
 square_lattice = {n_band + 1 + N_FREE} 2 {S_FE} {RADIUS} {RADIUS} 1
@@ -249,10 +262,27 @@ def table(rows):
     return "\n".join(lines)
 
 
+def refine(exe, work):
+    """The 20 mm band (cubic) at dx = 5, 2.5, 1.25 mm with h = 0.5, 0.25, 0.125 us: the
+    departure from the closed form against the resolution."""
+    lines = ["| dx [mm] | h [us] | R(t_a + T) measured | closed form | difference | max abs(v - v_cf) / V |",
+             "|---|---|---|---|---|---|"]
+    for scale in (2.0, 1.0, 0.5):
+        set_resolution(scale)
+        n_band = round(0.02 / DX)
+        name = f"wave2d_refine_{DX * 1e3:g}mm"
+        m = measure(run(exe, deck(n_band, "cubic"), name, work), n_band, "cubic")
+        lines.append(f"| {DX * 1e3:g} | {STEP * 1e6:g} | {m['r_meas']:.5f} | {m['r_cf']:.5f} | "
+                     f"{m['r_meas'] - m['r_cf']:+.1e} | {m['v_err']:.1e} |")
+    set_resolution(1.0)
+    return "\n".join(lines)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--exe", required=True, help="the multicor executable")
     ap.add_argument("--work", required=True, help="folder for the decks and results")
+    ap.add_argument("--refine", action="store_true", help="also the 20 mm band at dx = 5, 2.5, 1.25 mm")
     args = ap.parse_args()
     start = time.perf_counter()
     rows = study(pathlib.Path(args.exe).resolve(), pathlib.Path(args.work).resolve())
@@ -261,6 +291,8 @@ def main():
     print(table(rows))
     worst = max(max(m["energy_check"], m["balance"]) for _, _, m in rows)
     print(f"Q4 energies against the stored ones before the band, and energy audit: worst {worst:.1e}")
+    if args.refine:
+        print(refine(pathlib.Path(args.exe).resolve(), pathlib.Path(args.work).resolve()))
     return 0
 
 

@@ -16,7 +16,7 @@ exact command the program prints is run), and by kill -9 after a periodic checkp
 byte, to that of the uninterrupted run, and so must every attribute except the wall-clock
 ones (dates, wall and solver seconds); for the continuum runs the XDMF file next to the
 results is equal byte for byte as well. Refusals: a checkpoint of another deck, of another
-code version, a restart with nothing left to do. A new end time (--end) continues a finished
+code version, of another kind of run, a restart with nothing left to do. A new end time (--end) continues a finished
 run; the earlier finished result stays untouched when the continued run fails.
 Usage (ctest does this): test_restart.py --exe multicor --work DIR --source REPO
 """
@@ -349,6 +349,16 @@ def main():
     by_end_time(exe, src / "input" / "continuum_cantilever_dynamic.dat", work, "continuum_end", 0.2033)
     by_signal(exe, src / "input" / "continuum_cantilever_dynamic.dat", work, "continuum_term",
               signal.SIGTERM, 3.0, 1000)
+    by_kill_9(exe, src / "input" / "continuum_cantilever_dynamic.dat", work, "continuum_kill9", 3.0, 700, 2000)
+    # A checkpoint whose kind of run is not the deck's (the header edited): refused.
+    other_kind = work / "other_kind.h5"
+    shutil.copy(work / "continuum_end" / "checkpoint.h5", other_kind)
+    with h5py.File(other_kind, "r+") as f:
+        f.attrs["kind"] = "coupled2d"
+    proc = run(exe, src / "input" / "continuum_cantilever_dynamic.dat", "--output", work / "continuum_end",
+               "--restart", other_kind, "--end", 0.6)
+    check("a checkpoint of another kind of run refused", proc.returncode == 1 and
+          "holds a coupled2d run, the deck is a continuum run" in proc.stderr, proc.stderr.strip())
     # Continuum + disks: 100 steps, outputs every 10, stop at step 45; per-disk multipliers
     # and the mediator space (multipliers on the FE nodes), whose multipliers are other rows.
     pushed = decks / "coupled2d_pushed.dat"
