@@ -16,8 +16,9 @@ exact command the program prints is run), and by kill -9 after a periodic checkp
 byte, to that of the uninterrupted run, and so must every attribute except the wall-clock
 ones (dates, wall and solver seconds); for the continuum runs the XDMF file next to the
 results is equal byte for byte as well. Refusals: a checkpoint of another deck, of another
-code version, of another kind of run, a restart with nothing left to do. A new end time (--end) continues a finished
-run; the earlier finished result stays untouched when the continued run fails.
+code version, of another kind of run, a restart with nothing left to do. A new end time
+(--end) continues a finished run; the earlier finished result stays untouched when the
+continued run fails.
 Usage (ctest does this): test_restart.py --exe multicor --work DIR --source REPO
 """
 import argparse
