@@ -5,8 +5,8 @@
 !>
 !> Build (`build_coupled2d`):
 !> - the continuum's K_alpha and M_alpha (coupling_weighted2d, alpha = the FE weight of the
-!>   overlap field, 1 outside it) and its loads: the model's nodal loads as they are, its
-!>   edge tractions weighted by alpha (`weight_tractions`: int alpha N_a t ds) plus the weighted body
+!>   overlap field, 1 outside it) and its loads: the model's own loads (nodal loads and
+!>   tractions, taken as they are: apply them outside the overlap) plus the weighted body
 !>   force int alpha rho t N g dA = M_alpha g_nodes (the rows of M_alpha, consistent or
 !>   lumped, sum to int alpha rho t N_a dA since the shape functions sum to 1), reduced to the
 !>   free dofs (fem_continuum_dynamics `build_from`);
@@ -26,7 +26,7 @@ module coupling_arlequin2d
     use dem_moreau_jean, only: dem_system_t
     use coupling_weights, only: overlap_weight_t
     use coupling_overlap2d, only: weight_field_t, overlap2d_t, overlap_set_t
-    use coupling_weighted2d, only: assemble_weighted, gauss_legendre
+    use coupling_weighted2d, only: assemble_weighted
     use coupling_locate2d, only: element_grid_t, build_element_grid
     use coupling_operator2d, only: continuum_operator_t, build_continuum_operator, build_mediator2d, &
                                    pairing_l2
@@ -35,7 +35,7 @@ module coupling_arlequin2d
                                      multipliers_particles, multipliers_nodes
     implicit none
     private
-    public :: coupling2d_config_t, build_coupled2d, weight_tractions
+    public :: coupling2d_config_t, build_coupled2d
 
     !> Description of a continuum-disk coupling.
     type :: coupling2d_config_t
@@ -89,7 +89,6 @@ contains
         type(mediator_space_t) :: med
         class(multiplier_space_t), allocatable :: space
         real(wp), allocatable :: load(:), g_nodes(:), mg(:), uf(:), vf(:)
-        type(continuum_model_t) :: weighted
         integer :: a
         if (.not. (config%thickness > 0)) then
             call make_error(error, 'coupling: thickness (out-of-plane depth of the particle domain) must be > 0')
@@ -111,12 +110,8 @@ contains
             g_nodes(2*a - 1:2*a) = config%gravity
         end do
         call m_all%matvec(g_nodes, mg)
-        ! Tractions weighted by alpha on the edges in the overlap (Gauss rule of the element
-        ! assembly's order; the constant tractions in `load`, the timed ones in their columns).
-        weighted = model
-        call weight_tractions(weighted, config%region, config%order)
-        load = weighted%load + mg
-        call ops%build_from(weighted, k_all, m_all, load, config%lumped, config%rayleigh(1), config%rayleigh(2), error)
+        load = model%load + mg
+        call ops%build_from(model, k_all, m_all, load, config%lumped, config%rayleigh(1), config%rayleigh(2), error)
         if (allocated(error)) return
         ! Disks: weights, coupled ones, none in the FE-only zone.
         sys%dem = dem
@@ -171,29 +166,6 @@ contains
             end do
         end subroutine check_fe_zone
     end subroutine build_coupled2d
-
-    !> Weight the model's edge tractions by the FE weight alpha of the field: f_a = int alpha
-    !> N_a t ds by an n-point Gauss-Legendre rule per edge, n = the element assembly's order
-    !> (default 4). alpha is a cubic polynomial along an edge that lies on one side of its
-    !> breakpoints (overlap ends, floor), so n = 4 integrates it exactly with a quadratic
-    !> traction (degree 3 + 3 = 6 <= 2 n - 1); across a breakpoint the rule is only convergent,
-    !> as for the mass and stiffness. Edges outside the overlap keep their forces bitwise.
-    subroutine weight_tractions(model, field, order)
-        !> The model (its loads change).
-        type(continuum_model_t), intent(inout) :: model
-        !> The overlap's weight field.
-        class(weight_field_t), intent(in) :: field
-        !> Gauss points per edge.
-        integer, intent(in) :: order
-        real(wp) :: t(order), w(order)
-        call gauss_legendre(order, t, w)
-        call model%weight_tractions(alpha_at, t, w)
-    contains
-        pure real(wp) function alpha_at(x) result(alpha)
-            real(wp), intent(in) :: x(2)
-            alpha = field%alpha_fe(x(1), x(2))
-        end function alpha_at
-    end subroutine weight_tractions
 
     !> The ramp (shape and floor) of a weight field: that of the region, or of the first
     !> region of a set (default ramp for another field).

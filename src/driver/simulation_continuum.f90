@@ -282,7 +282,6 @@ contains
             end if
             constant = self%model%load
             self%model%load = 0.0_wp
-            self%model%load_column = func
         end subroutine start_load
 
         !> After adding the load of record e: a timed load moves to its function's column.
@@ -291,7 +290,6 @@ contains
             if (func == 0) return
             self%model%timed_load(:, func) = self%model%timed_load(:, func) + self%model%load
             self%model%load = constant
-            self%model%load_column = 0
         end subroutine end_load
 
         !> Modes and dynamics need a positive-definite mass: every density > 0.

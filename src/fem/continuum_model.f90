@@ -15,26 +15,12 @@ module fem_continuum_model
     use fem_element_q4, only: element_q4_t
     use fem_element_t3, only: element_t3_t
     use fem_edge_load, only: edge_traction_linear, edge_traction_normal_tangential, &
-                             edge_traction_function, traction_field, edge_traction_weighted, edge_weight, edge_normal
+                             edge_traction_function, traction_field
     use fem_mesh2d, only: mesh2d_t, element_t3, element_q4, nodes_per_element
     use fem_triplets, only: fem_triplets_t
     implicit none
     private
     public :: continuum_model_t
-
-    !> The traction on one loaded edge, as added (kept so that a coupling can weight it).
-    type :: edge_load_t
-        !> The edge's nodes a, b.
-        integer :: nodes(2) = 0
-        !> Thickness of the element carrying it (m).
-        real(wp) :: thickness = 0.0_wp
-        !> Traction (tx, ty) at node a, at the midpoint and at node b (Pa).
-        real(wp) :: t(2, 3) = 0.0_wp
-        !> Nodal forces it added (f_ax, f_ay, f_bx, f_by) (N).
-        real(wp) :: f(4) = 0.0_wp
-        !> Where they went: 0 = `load`, k = column k of `timed_load`.
-        integer :: column = 0
-    end type edge_load_t
 
     !> One element type of the family, indexed by the mesh's element kind code.
     type :: element_slot_t
@@ -63,11 +49,6 @@ module fem_continuum_model
         !> Nodal forces (N) times a time function: column k (size 2 * number of nodes) is
         !> multiplied by functions(k)(t); size (dof_count, size(functions)).
         real(wp), allocatable :: timed_load(:, :)
-        !> Column of `timed_load` that the loads being added belong to (0: `load`), recorded
-        !> with every edge load. The caller that moves loads into a column sets it meanwhile.
-        integer :: load_column = 0
-        !> Every edge traction added, in order.
-        type(edge_load_t), allocatable :: edge_loads(:)
     contains
         !> Take a mesh, check its elements, and start with no material, load or constraint.
         procedure :: init => model_init
@@ -89,8 +70,6 @@ module fem_continuum_model
         procedure :: add_traction_nt => model_add_traction_nt
         !> Add a traction field t(x) on a named edge set.
         procedure :: add_traction_field => model_add_traction_field
-        !> Weight every edge traction by a field w(x) (its nodal forces become int w N_a t ds).
-        procedure :: weight_tractions => model_weight_tractions
         !> Check that every element has a material.
         procedure :: check => model_check
         !> Global stiffness (all dofs) as triplets.
@@ -147,7 +126,6 @@ contains
         allocate (self%prescribed(self%dof_count()), source=.false.)
         allocate (self%prescribed_value(self%dof_count()), self%load(self%dof_count()), source=0.0_wp)
         allocate (self%functions(0), self%timed_load(self%dof_count(), 0))
-        allocate (self%edge_loads(0))
     end subroutine model_init
 
     !> Number of dofs.
@@ -295,8 +273,7 @@ contains
             if (allocated(error)) return
             xa = self%mesh%x(:, edges(1, k))
             xb = self%mesh%x(:, edges(2, k))
-            call scatter_edge(self, edges(:, k), edge_traction_linear(xa, xb, traction, traction, t), t, &
-                              spread(traction, 2, 3))
+            call scatter_edge(self, edges(:, k), edge_traction_linear(xa, xb, traction, traction, t))
         end do
     end subroutine model_add_traction
 
@@ -314,7 +291,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         integer, allocatable :: edges(:, :), owner(:)
         integer :: k
-        real(wp) :: t, xa(2), xb(2), n(2), tr(2)
+        real(wp) :: t, xa(2), xb(2)
         call self%mesh%edge_set(set_name, edges, error, owner)
         if (allocated(error)) return
         do k = 1, size(edges, 2)
@@ -322,10 +299,7 @@ contains
             if (allocated(error)) return
             xa = self%mesh%x(:, edges(1, k))
             xb = self%mesh%x(:, edges(2, k))
-            n = edge_normal(xa, xb)
-            tr = normal*n + tangential*[-n(2), n(1)]
-            call scatter_edge(self, edges(:, k), edge_traction_normal_tangential(xa, xb, normal, tangential, t), t, &
-                              spread(tr, 2, 3))
+            call scatter_edge(self, edges(:, k), edge_traction_normal_tangential(xa, xb, normal, tangential, t))
         end do
     end subroutine model_add_traction_nt
 
@@ -349,69 +323,18 @@ contains
             if (allocated(error)) return
             xa = self%mesh%x(:, edges(1, k))
             xb = self%mesh%x(:, edges(2, k))
-            call scatter_edge(self, edges(:, k), edge_traction_function(xa, xb, traction, t), t, &
-                              reshape([traction(xa), traction(0.5_wp*(xa + xb)), traction(xb)], [2, 3]))
+            call scatter_edge(self, edges(:, k), edge_traction_function(xa, xb, traction, t))
         end do
     end subroutine model_add_traction_field
 
-    !> Add edge forces (f_ax, f_ay, f_bx, f_by) to the load vector and record the edge load.
-    subroutine scatter_edge(self, nodes, f, thickness, t)
+    !> Add edge forces (f_ax, f_ay, f_bx, f_by) to the load vector.
+    pure subroutine scatter_edge(self, nodes, f)
         class(continuum_model_t), intent(inout) :: self
         integer, intent(in) :: nodes(2)
         real(wp), intent(in) :: f(4)
-        real(wp), intent(in) :: thickness
-        real(wp), intent(in) :: t(2, 3)
-        call add_edge_forces(self%load, nodes, f)
-        if (.not. allocated(self%edge_loads)) allocate (self%edge_loads(0))
-        self%edge_loads = [self%edge_loads, edge_load_t(nodes, thickness, t, f, self%load_column)]
+        self%load(2*nodes(1) - 1:2*nodes(1)) = self%load(2*nodes(1) - 1:2*nodes(1)) + f(1:2)
+        self%load(2*nodes(2) - 1:2*nodes(2)) = self%load(2*nodes(2) - 1:2*nodes(2)) + f(3:4)
     end subroutine scatter_edge
-
-    !> load(dofs of a, b) += f.
-    pure subroutine add_edge_forces(load, nodes, f)
-        real(wp), intent(inout) :: load(:)
-        integer, intent(in) :: nodes(2)
-        real(wp), intent(in) :: f(4)
-        load(2*nodes(1) - 1:2*nodes(1)) = load(2*nodes(1) - 1:2*nodes(1)) + f(1:2)
-        load(2*nodes(2) - 1:2*nodes(2)) = load(2*nodes(2) - 1:2*nodes(2)) + f(3:4)
-    end subroutine add_edge_forces
-
-    !> Weight every recorded edge traction by w(x): its nodal forces f_a = int N_a t ds are
-    !> replaced, in `load` or in their column of `timed_load`, by int w N_a t ds (fem_edge_load
-    !> `edge_traction_weighted`, with the given rule). An edge where w = 1 at every point of
-    !> the rule keeps its forces bitwise. Used by an Arlequin coupling, whose FE side carries
-    !> the share alpha of the loads in the overlap (doc/continuum.md).
-    subroutine model_weight_tractions(self, weight, points, weights)
-        !> The model.
-        class(continuum_model_t), intent(inout) :: self
-        !> Weight field.
-        procedure(edge_weight) :: weight
-        !> Quadrature points on [-1, 1].
-        real(wp), intent(in) :: points(:)
-        !> Quadrature weights.
-        real(wp), intent(in) :: weights(:)
-        real(wp) :: xa(2), xb(2), fw(4)
-        integer :: k, p
-        logical :: unit
-        if (.not. allocated(self%edge_loads)) return
-        do k = 1, size(self%edge_loads)
-            associate (e => self%edge_loads(k))
-                xa = self%mesh%x(:, e%nodes(1))
-                xb = self%mesh%x(:, e%nodes(2))
-                unit = .true.
-                do p = 1, size(points)
-                    unit = unit .and. weight(0.5_wp*(1 - points(p))*xa + 0.5_wp*(1 + points(p))*xb) == 1.0_wp
-                end do
-                if (unit) cycle
-                fw = edge_traction_weighted(xa, xb, e%t, e%thickness, weight, points, weights)
-                if (e%column == 0) then
-                    call add_edge_forces(self%load, e%nodes, fw - e%f)
-                else
-                    call add_edge_forces(self%timed_load(:, e%column), e%nodes, fw - e%f)
-                end if
-                e%f = fw
-            end associate
-        end do
-    end subroutine model_weight_tractions
 
     !> Check that every element has a material.
     subroutine model_check(self, error)

@@ -10,7 +10,7 @@ module fem_edge_load
     implicit none
     private
     public :: edge_normal, edge_traction_linear, edge_traction_normal_tangential, &
-              edge_traction_function, traction_field, edge_traction_weighted, edge_weight
+              edge_traction_function, traction_field
 
     abstract interface
         !> A traction field t(x) (Pa) over the boundary.
@@ -21,15 +21,6 @@ module fem_edge_load
             !> Traction (tx, ty) (Pa).
             real(wp) :: t(2)
         end function traction_field
-
-        !> A weight w(x) (dimensionless) over the boundary, e.g. the Arlequin weight alpha.
-        pure function edge_weight(x) result(w)
-            import :: wp
-            !> Point on the boundary.
-            real(wp), intent(in) :: x(2)
-            !> Weight.
-            real(wp) :: w
-        end function edge_weight
     end interface
 
 contains
@@ -117,43 +108,4 @@ contains
             f(3:4) = f(3:4) + gw(p)*half*nb*t
         end do
     end function edge_traction_function
-
-    !> Nodal forces f_a = int w N_a t thickness ds of a traction given by its values at node
-    !> a, the edge's midpoint and node b (t is their quadratic interpolant along the edge: the
-    !> uniform and linear tractions and the parabolic profile exactly), weighted by w(x) and
-    !> integrated with the rule (points on [-1, 1], weights summing to 2). With n Gauss-Legendre
-    !> points the result is exact when w is a polynomial of degree <= 2 n - 4 along the edge
-    !> (N_a t has degree 3): n = 4 takes a cubic weight.
-    function edge_traction_weighted(xa, xb, t, thickness, weight, points, weights) result(f)
-        !> First node.
-        real(wp), intent(in) :: xa(2)
-        !> Second node.
-        real(wp), intent(in) :: xb(2)
-        !> Traction (tx, ty) at node a, at the midpoint and at node b (2, 3) (Pa).
-        real(wp), intent(in) :: t(2, 3)
-        !> Thickness (m).
-        real(wp), intent(in) :: thickness
-        !> Weight field.
-        procedure(edge_weight) :: weight
-        !> Quadrature points on [-1, 1].
-        real(wp), intent(in) :: points(:)
-        !> Quadrature weights.
-        real(wp), intent(in) :: weights(:)
-        !> Nodal forces (4) (N).
-        real(wp) :: f(4)
-        real(wp) :: na, nb, tq(2), half, r
-        integer :: p
-        half = 0.5_wp*norm2(xb - xa)*thickness
-        f = 0.0_wp
-        do p = 1, size(points)
-            r = points(p)
-            na = 0.5_wp*(1.0_wp - r)
-            nb = 0.5_wp*(1.0_wp + r)
-            ! Quadratic Lagrange interpolation through r = -1, 0, 1.
-            tq = 0.5_wp*r*(r - 1.0_wp)*t(:, 1) + (1.0_wp - r*r)*t(:, 2) + 0.5_wp*r*(r + 1.0_wp)*t(:, 3)
-            tq = weight(na*xa + nb*xb)*tq
-            f(1:2) = f(1:2) + weights(p)*half*na*tq
-            f(3:4) = f(3:4) + weights(p)*half*nb*tq
-        end do
-    end function edge_traction_weighted
 end module fem_edge_load
