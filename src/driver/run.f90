@@ -250,7 +250,7 @@ contains
                         n_disks = n_disks + e%int('n')
                     case ('particles square_lattice', 'particles hex_lattice')
                         n_disks = n_disks + int(e%int('nx'), i8)*int(e%int('ny'), i8)
-                    case ('beam line')
+                    case ('beam line', 'beam polar_line')
                         m = e%int('elements')
                         n_nodes = n_nodes + m + 1
                         n_elements = n_elements + m
