@@ -13,12 +13,12 @@
 !> Deterministic for a seed.
 module bench_packing
     use core_kinds, only: wp
+    use core_constants, only: pi
     use dem_random, only: rng_t, rng_seed, rng_uniform_in
     implicit none
     private
     public :: deposit_disks, deposit_width, staggered_layout
 
-    real(wp), parameter :: pi = 3.141592653589793238462643383279502884_wp
     !> Expected packing fraction of the deposit (to size the box).
     real(wp), parameter :: packing_fraction = 0.82_wp
     !> Smallest rolling angle counted as progress [rad] (the start point touches its supports).
