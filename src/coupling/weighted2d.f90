@@ -11,6 +11,7 @@
 !> convergent (refine the mesh or raise the order there).
 module coupling_weighted2d
     use core_kinds, only: wp
+    use core_constants, only: pi
     use core_error, only: error_t, make_error
     use fem_continuum_model, only: continuum_model_t
     use fem_mesh2d, only: element_t3
@@ -145,7 +146,6 @@ contains
         real(wp), intent(out) :: t(n)
         !> Weights (n), summing to 2.
         real(wp), intent(out) :: w(n)
-        real(wp), parameter :: pi = acos(-1.0_wp)
         real(wp) :: x, p0, p1, p2, dp, dx
         integer :: i, k, it
         do i = 1, n
