@@ -24,6 +24,11 @@ module core_timefunc
     contains
         !> Value at time t.
         procedure :: value => time_function_value
+        !> Rate df/dt at time t (right derivative at a kink).
+        procedure :: rate => time_function_rate
+        !> Second derivative d2f/dt2 at time t (zero on the linear pieces; the impulses at the
+        !> kinks of ramp, step and table are not represented).
+        procedure :: acceleration => time_function_acceleration
     end type time_function_t
 
 contains
@@ -60,4 +65,45 @@ contains
             f = 0.0_wp
         end select
     end function time_function_value
+
+    !> Rate df/dt [1/s] at time t: the right derivative (the slope of the piece that starts
+    !> at t) where f has a kink; 0 for constant and step (whose jump has no finite rate).
+    pure real(wp) function time_function_rate(self, t) result(df)
+        !> The function.
+        class(time_function_t), intent(in) :: self
+        !> Time [s].
+        real(wp), intent(in) :: t
+        integer :: i, n
+        select case (self%kind)
+        case (tf_ramp)
+            df = merge(1.0_wp/self%p(1), 0.0_wp, t >= 0 .and. t < self%p(1))
+        case (tf_table)
+            n = size(self%t)
+            df = 0.0_wp
+            if (t < self%t(1) .or. t >= self%t(n)) return
+            do i = 2, n
+                if (t < self%t(i)) exit
+            end do
+            df = (self%f(i) - self%f(i - 1))/(self%t(i) - self%t(i - 1))
+        case (tf_harmonic)
+            df = two_pi*self%p(1)*cos(two_pi*self%p(1)*t + self%p(2))
+        case default
+            df = 0.0_wp
+        end select
+    end function time_function_rate
+
+    !> Second derivative d2f/dt2 [1/s^2] at time t: zero on the linear pieces of ramp and
+    !> table, -(2 pi freq)^2 f for harmonic.
+    pure real(wp) function time_function_acceleration(self, t) result(d2f)
+        !> The function.
+        class(time_function_t), intent(in) :: self
+        !> Time [s].
+        real(wp), intent(in) :: t
+        select case (self%kind)
+        case (tf_harmonic)
+            d2f = -(two_pi*self%p(1))**2*sin(two_pi*self%p(1)*t + self%p(2))
+        case default
+            d2f = 0.0_wp
+        end select
+    end function time_function_acceleration
 end module core_timefunc
