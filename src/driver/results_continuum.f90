@@ -8,7 +8,9 @@
 !> (3, n_elements: xx, yy, xy at element centres), strain_energy}; a modal run
 !> /continuum/modal/{omega, frequency, shapes (2, n_nodes, n_modes)}; a dynamic run the
 !> series /continuum/{time, displacement, velocity, stress} and /continuum/energy/{time,
-!> kinetic, strain, external_work, damping, balance} (h5py: one row per stored state).
+!> kinetic, strain, external_work, damping, balance, reaction_work} (h5py: one row per stored
+!> state) with /continuum/energy/reaction (2: the x and y resultants of the reactions on the
+!> prescribed dofs, N) per record.
 !>
 !> The XDMF file (`write_xdmf`) describes the mesh and its fields per stored state (a temporal
 !> collection) by reference into the HDF5 file, so that ParaView or meshio open them.
@@ -126,6 +128,8 @@ contains
         if (.not. allocated(error)) call series('/continuum/energy/external_work', [integer ::], 'J', error)
         if (.not. allocated(error)) call series('/continuum/energy/damping', [integer ::], 'J', error)
         if (.not. allocated(error)) call series('/continuum/energy/balance', [integer ::], 'J', error)
+        if (.not. allocated(error)) call series('/continuum/energy/reaction_work', [integer ::], 'J', error)
+        if (.not. allocated(error)) call series('/continuum/energy/reaction', [2], 'N', error)
     contains
         subroutine series(path, record_shape, units, error)
             character(len=*), intent(in) :: path, units
@@ -251,8 +255,10 @@ contains
         self%times = [self%times, t]
     end subroutine writer_store
 
-    !> Append one energy record [J]; balance = kinetic + strain + damping - external work - initial.
-    subroutine writer_store_energy(self, file, t, kinetic, strain, external_work, damping, balance, error)
+    !> Append one energy record [J]; balance = kinetic + strain + damping - external work -
+    !> reaction work - initial (the reaction work and resultant are 0 when absent).
+    subroutine writer_store_energy(self, file, t, kinetic, strain, external_work, damping, balance, error, &
+                                   reaction_work, reaction)
         !> The writer.
         class(continuum_writer_t), intent(inout) :: self
         !> The open results file.
@@ -263,6 +269,15 @@ contains
         real(wp), intent(in) :: kinetic, strain, external_work, damping, balance
         !> Set on a write failure.
         type(error_t), allocatable, intent(out) :: error
+        !> Work of the reactions on the prescribed dofs since the start [J].
+        real(wp), intent(in), optional :: reaction_work
+        !> Resultant (x, y) of the reactions on the prescribed dofs [N].
+        real(wp), intent(in), optional :: reaction(2)
+        real(wp) :: w, r(2)
+        w = 0.0_wp
+        r = 0.0_wp
+        if (present(reaction_work)) w = reaction_work
+        if (present(reaction)) r = reaction
         if (self%n_nodes == 0) then
             call make_error(error, 'results: continuum energy before begin')
             return
@@ -273,6 +288,8 @@ contains
         if (.not. allocated(error)) call file%append('/continuum/energy/external_work', external_work, error)
         if (.not. allocated(error)) call file%append('/continuum/energy/damping', damping, error)
         if (.not. allocated(error)) call file%append('/continuum/energy/balance', balance, error)
+        if (.not. allocated(error)) call file%append('/continuum/energy/reaction_work', w, error)
+        if (.not. allocated(error)) call file%append('/continuum/energy/reaction', r, error)
     end subroutine writer_store_energy
 
     !> Error unless d is (2, n_nodes) and stress (3, n_elements).

@@ -21,7 +21,7 @@ module driver_simulation_continuum
     use fem_gmsh_reader, only: read_gmsh
     use fem_elastic2d, only: elastic2d_t, make_elastic2d
     use fem_continuum_model, only: continuum_model_t
-    use fem_continuum_dynamics, only: continuum_dynamics_t
+    use fem_continuum_dynamics, only: continuum_dynamics_t, continuum_audit_t
     use fem_dynamic_operator, only: spd_factor_t
     use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
     use driver_config, only: run_config_t, build_run_settings, build_time_functions
@@ -47,6 +47,8 @@ module driver_simulation_continuum
         class(spd_factor_t), allocatable :: k_factor
         !> Deck file (for the XDMF file's name).
         character(len=:), allocatable :: deck_file
+        !> Energy audit of the whole body (prescribed dofs and their reactions included).
+        type(continuum_audit_t) :: audit
     contains
         !> See `simulation_t%init`.
         procedure :: init => continuum_init
@@ -86,6 +88,8 @@ contains
         if (allocated(error)) call fail_at(error, deck%line('continuum', 'mesh'), 'mesh')
         if (allocated(error)) return
         call set_materials(error)
+        if (allocated(error)) return
+        call build_time_functions(deck, self%model%functions, function_ids, error)
         if (allocated(error)) return
         call set_constraints(error)
         if (allocated(error)) return
@@ -202,7 +206,7 @@ contains
         subroutine set_constraints(error)
             type(error_t), allocatable, intent(out) :: error
             type(string_t), allocatable :: components(:)
-            integer :: i, j
+            integer :: i, j, func
             list = deck%records('continuum', 'fix')
             do i = 1, size(list)
                 e = list(i)
@@ -216,7 +220,10 @@ contains
             list = deck%records('continuum', 'displacement')
             do i = 1, size(list)
                 e = list(i)
-                call self%model%prescribe_set(e%word('node_set'), component(e%word('component')), e%real('value'), error)
+                call find_function('displacement', func, error)
+                if (allocated(error)) return
+                call self%model%prescribe_set(e%word('node_set'), component(e%word('component')), e%real('value'), error, &
+                                              func)
                 if (allocated(error)) call fail_at(error, e%line, 'displacement')
                 if (allocated(error)) return
             end do
@@ -227,8 +234,6 @@ contains
             type(error_t), allocatable, intent(out) :: error
             integer, allocatable :: ids(:)
             integer :: i, j, func
-            call build_time_functions(deck, self%model%functions, function_ids, error)
-            if (allocated(error)) return
             deallocate (self%model%timed_load)
             allocate (self%model%timed_load(self%model%dof_count(), size(function_ids)), source=0.0_wp)
             list = deck%records('continuum', 'load')
@@ -272,17 +277,23 @@ contains
             character(len=*), intent(in) :: keyword
             integer, intent(out) :: func
             type(error_t), allocatable, intent(out) :: error
-            func = 0
-            if (.not. e%has('function')) return
-            func = findloc(function_ids, e%int('function'), dim=1)
-            if (func == 0) then
-                call make_input_error(error, deck%file, e%line, keyword, 'function '//e%word('function')// &
-                                      ' is not defined (no [functions] function record with this id)')
-                return
-            end if
+            call find_function(keyword, func, error)
+            if (allocated(error) .or. func == 0) return
             constant = self%model%load
             self%model%load = 0.0_wp
         end subroutine start_load
+
+        !> Index among the model's functions of the function of record e (0: none).
+        subroutine find_function(keyword, func, error)
+            character(len=*), intent(in) :: keyword
+            integer, intent(out) :: func
+            type(error_t), allocatable, intent(out) :: error
+            func = 0
+            if (.not. e%has('function')) return
+            func = findloc(function_ids, e%int('function'), dim=1)
+            if (func == 0) call make_input_error(error, deck%file, e%line, keyword, 'function '//e%word('function')// &
+                                                 ' is not defined (no [functions] function record with this id)')
+        end subroutine find_function
 
         !> After adding the load of record e: a timed load moves to its function's column.
         subroutine end_load(func)
@@ -445,7 +456,7 @@ contains
             real(wp) :: energy
             ! Loads at t = 0 (their time functions' values there, as for the beam).
             allocate (uf(self%ops%n_free))
-            call self%ops%external_force(0.0_wp, uf)
+            call self%ops%static_force(0.0_wp, uf)
             call self%k_factor%solve(uf, error)
             if (allocated(error)) return
             u = self%model%expand(uf)
@@ -480,7 +491,7 @@ contains
             allocate (full(2, self%model%mesh%node_count(), size(omega)))
             do k = 1, size(omega)
                 ! Mode shapes vanish on the prescribed dofs.
-                u = self%model%expand(shapes(:, k)) - self%model%prescribed_value
+                u = self%model%expand(shapes(:, k)) - self%model%prescribed_at(0.0_wp, 0)
                 full(:, :, k) = reshape(u, [2, self%model%mesh%node_count()])
                 write (buf, '(a,i3,a,es15.7e3,a,es15.7e3,a)') 'mode ', k, ': omega = ', omega(k), &
                     ' rad/s, f = ', omega(k)/two_pi, ' Hz'
@@ -503,6 +514,7 @@ contains
             if (ck%restart) then
                 call restore(error)
             else
+                call self%audit%start(self%ops, self%model, self%integ)
                 call store(error)
             end if
             if (allocated(error)) return
@@ -510,10 +522,11 @@ contains
             do k = k0 + 1, n_steps
                 call self%integ%step(self%ops, error)
                 if (allocated(error)) return
+                call self%audit%advance(self%ops, self%model, self%integ)
                 ! State and energy accounts (a checkpoint may follow: it must hold finite values).
                 if (.not. (all(ieee_is_finite(self%integ%u)) .and. all(ieee_is_finite(self%integ%v)) .and. &
                            all(ieee_is_finite([self%integ%kinetic, self%integ%strain, self%integ%external_work, &
-                                               self%integ%damping_dissipation])))) then
+                                               self%integ%damping_dissipation, self%audit%balance()])))) then
                     write (buf, '(a,i0,a,es13.5e3,a)') 'continuum: the state is not finite after step ', k, &
                         ' (t = ', self%integ%t, ' s); likely cause: a time step above the stability limit or '// &
                         'loads far too large'
@@ -531,7 +544,7 @@ contains
                 if (.not. quiet .and. progress%due()) call report(progress%line(k, self%integ%t))
             end do
             write (buf, '(a,i0,a,es13.5e3,a,es11.3e3,a)') 'dynamic run: ', n_steps, ' steps to t = ', &
-                self%integ%t, ' s; energy balance residual ', self%integ%energy_balance(), ' J'
+                self%integ%t, ' s; energy balance residual ', self%audit%balance(), ' J'
             call report(trim(buf))
             call report(progress%summary_line(n_steps))
             call out%write_summary(int(n_steps), progress%elapsed(), error)
@@ -541,7 +554,10 @@ contains
         subroutine restore(error)
             type(error_t), allocatable, intent(out) :: error
             type(error_t), allocatable :: ignored
+            real(wp), allocatable :: totals(:)
             call load_integrator(ck%source, '/fe', self%integ, error)
+            if (.not. allocated(error)) call ck%source%read_attribute('/fe', 'continuum_audit', totals, error)
+            if (.not. allocated(error)) call self%audit%resume(self%ops, self%model, self%integ, totals)
             if (.not. allocated(error)) call load_results(ck%source, out, error)
             call ck%source%close(ignored)
             if (allocated(error)) return
@@ -558,6 +574,7 @@ contains
             call checkpoint_create(f, ck%path, ck%deck_text, self%checkpoint_kind(), &
                                    loop_state_t(k, 0, .false., .false.), self%integ%t, out%run_id, error)
             if (.not. allocated(error)) call save_integrator(f, '/fe', self%integ, error)
+            if (.not. allocated(error)) call f%write_attribute('/fe', 'continuum_audit', self%audit%totals(), error)
             if (.not. allocated(error)) call save_results(f, out, error)
             if (allocated(error)) then
                 call checkpoint_discard(f, ck%path)
@@ -576,14 +593,13 @@ contains
             real(wp) :: energies(5)
             character(len=200) :: buf
             integer :: n
-            u = self%model%expand(self%integ%u)
-            v = self%model%expand(self%integ%v) - self%model%prescribed_value
+            u = self%model%expand(self%integ%u, self%integ%t)
+            v = self%model%expand(self%integ%v, self%integ%t, 1)
             n = self%model%mesh%node_count()
             call self%model%centre_stresses(u, stress, error)
             if (allocated(error)) return
-            associate (g => self%integ)
-                energies = [g%kinetic, self%ops%total_strain_energy(u), g%external_work, g%damping_dissipation, &
-                            g%energy_balance()]
+            associate (g => self%integ, au => self%audit)
+                energies = [au%kinetic, au%strain, au%load_work, au%damping, au%balance()]
                 if (.not. (all(ieee_is_finite(stress)) .and. all(ieee_is_finite(energies)))) then
                     write (buf, '(a,es13.5e3,a)') 'continuum: a stress or an energy is not finite at t = ', g%t, &
                         ' s; likely cause: loads or moduli far too large or too small'
@@ -593,7 +609,7 @@ contains
                 call writer%store(out%file, g%t, reshape(u, [2, n]), reshape(v, [2, n]), stress, error)
                 if (allocated(error)) return
                 call writer%store_energy(out%file, g%t, energies(1), energies(2), energies(3), energies(4), &
-                                         energies(5), error)
+                                         energies(5), error, au%reaction_work, au%reaction_resultant)
             end associate
             if (allocated(error)) return
             call out%flush(error)

@@ -185,6 +185,7 @@ contains
                                                                               sys%mediator_nodes, error)
                 if (allocated(error)) return
                 k = 0
+                call audit_step(.true.)
                 call store(error)
                 if (allocated(error)) return
             end if
@@ -194,6 +195,7 @@ contains
                 call take_step_start(start, sys%dem%particles, sys%dem%walls)
                 call arlequin_step(sys, error)
                 if (allocated(error)) return
+                call audit_step(.false.)
                 call check_step(error)
                 if (allocated(error)) return
                 call dem_out%record_step(out%file, sys%dem%stats, error)
@@ -232,9 +234,13 @@ contains
         subroutine restore(error)
             type(error_t), allocatable, intent(out) :: error
             type(error_t), allocatable :: ignored
+            real(wp), allocatable :: totals(:)
             call dem_out%resume(self%sys%dem, self%particles%dem%store_contacts)
             call cpl_out%resume(self%sys)
             call load_coupled(ck%source, self%sys, error)
+            ! The continuum's audit (its accumulated works; the rest follows from the state).
+            if (.not. allocated(error)) call ck%source%read_attribute('/coupling', 'continuum_audit', totals, error)
+            if (.not. allocated(error)) call audit_step(.true., totals(1:4))
             if (.not. allocated(error)) call load_dem_writer(ck%source, dem_out, error)
             if (.not. allocated(error)) call load_coupled_writer(ck%source, cpl_out, error)
             if (.not. allocated(error)) call load_results(ck%source, out, error)
@@ -258,6 +264,8 @@ contains
                                    loop_state_t(k, unconverged, speed_warned, .false.), self%sys%fe%t, &
                                    out%run_id, error)
             if (.not. allocated(error)) call save_coupled(f, self%sys, error)
+            if (.not. allocated(error)) call f%write_attribute('/coupling', 'continuum_audit', &
+                                                               self%continuum%audit%totals(), error)
             if (.not. allocated(error)) call save_dem_writer(f, dem_out, error)
             if (.not. allocated(error)) call save_coupled_writer(f, cpl_out, error)
             if (.not. allocated(error)) call save_results(f, out, error)
@@ -278,8 +286,8 @@ contains
             type(coupled_energies_t) :: en
             integer :: n
             associate (sys => self%sys, model => self%continuum%model)
-                u = model%expand(sys%fe%u)
-                v = model%expand(sys%fe%v) - model%prescribed_value
+                u = model%expand(sys%fe%u, sys%fe%t)
+                v = model%expand(sys%fe%v, sys%fe%t, 1)
                 n = model%mesh%node_count()
                 call model%centre_stresses(u, stress, error)
                 if (allocated(error)) return
@@ -292,8 +300,10 @@ contains
                 end if
                 call fe_out%store(out%file, sys%fe%t, reshape(u, [2, n]), reshape(v, [2, n]), stress, error)
                 if (allocated(error)) return
-                call fe_out%store_energy(out%file, sys%fe%t, en%fe_kinetic, en%fe_strain, en%fe_external_work, &
-                                         en%fe_damping, sys%fe%energy_balance(), error)
+                associate (au => self%continuum%audit)
+                    call fe_out%store_energy(out%file, sys%fe%t, au%kinetic, au%strain, au%load_work, au%damping, &
+                                             au%balance(), error, au%reaction_work, au%reaction_resultant)
+                end associate
                 if (allocated(error)) return
                 call dem_out%store(out%file, sys%dem, error)
                 if (allocated(error)) return
@@ -302,6 +312,24 @@ contains
             end associate
             call out%flush(error)
         end subroutine store
+
+        !> The continuum's audit of the whole body (prescribed dofs and reactions included) on
+        !> the weighted operator: started (resumed with the totals of a checkpoint), or advanced
+        !> by the step just made.
+        subroutine audit_step(first, totals)
+            logical, intent(in) :: first
+            real(wp), intent(in), optional :: totals(4)
+            select type (ops => self%sys%model)
+            type is (continuum_dynamics_t)
+                if (first .and. present(totals)) then
+                    call self%continuum%audit%resume(ops, self%continuum%model, self%sys%fe, totals)
+                else if (first) then
+                    call self%continuum%audit%start(ops, self%continuum%model, self%sys%fe)
+                else
+                    call self%continuum%audit%advance(ops, self%continuum%model, self%sys%fe)
+                end if
+            end select
+        end subroutine audit_step
 
         !> Guards after a step: finite continuum and disk states, disks in the box, no tunnelling.
         subroutine check_step(error)

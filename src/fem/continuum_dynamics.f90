@@ -2,11 +2,27 @@
 !> to the free dofs, in CHOLMOD sparse storage, for the time integrators of fem_newmark and
 !> for the static and modal solutions.
 !>
-!> Prescribed displacements u_p are constant in time and eliminated (fem_continuum_model
-!> `reduce`): the free dofs carry F(t) = f_f - K_fp u_p + sum_k f_k(t) g_k,f (the model's loads
-!> times its time functions, `timed_load`), so that the integrator's energy accounts
+!> Prescribed displacements u_p are eliminated (fem_continuum_model `reduce`): the free dofs
+!> carry F(t) = f_f - K_fp u_p(t) - C_fp v_p(t) - M_fp a_p(t) + sum_k f_k(t) g_k,f (the model's
+!> loads times its time functions, `timed_load`), so that the integrator's energy accounts
 !> (on the free dofs) close; the strain energy of the whole body 1/2 u.K u over all dofs is
-!> `total_strain_energy`. Combinations c_m M + c_k K share the pattern of K (a lumped M is
+!> `total_strain_energy`. A prescribed dof is constant, or u_p(t) = value f(t) with one of the
+!> model's time functions: its rate and acceleration are value f'(t) and value f''(t), the
+!> exact derivatives of the function (not finite differences of u_p: those of the trapezoidal
+!> rule, v_n+1 = 2 du/h - v_n, ring with an undamped period-2 oscillation after any kink of
+!> u_p). Within a step where u_p is linear in time (ramp and table functions between their
+!> kinks, whatever the step) they satisfy the scheme's own relations du_p = h (v_n + v_n+1)/2
+!> and dv_p = h (a_n + a_n+1)/2 exactly, which is what makes the energy audit of the whole body
+!> (`continuum_audit_t`) close to round-off. At a kink of f (the velocity of the support jumps)
+!> the rate is the one after the kink and the impulse of the kink is not represented: the
+!> audit's balance then moves once, by about 1/2 dv_p.M dv_p.
+!>
+!> Energy audit of the whole body (`continuum_audit_t`): kinetic 1/2 v.M v and strain
+!> 1/2 u.K u over all dofs, Rayleigh dissipation int du.C v, work of the loads int du.f, work of
+!> the reactions on the prescribed dofs int du_p.r with r = (K u + C v + M a - f)_p, and the
+!> integrator's coupling work; every integral by the trapezoidal rule of the scheme.
+!>
+!> Combinations c_m M + c_k K share the pattern of K (a lumped M is
 !> diagonal, inside it) and are factored by CHOLMOD (`sparse_cholesky`). The lowest modes come
 !> from a subspace iteration with that factor (`solve_modes`); the critical time step from the
 !> largest element eigenvalue (`largest_eigenvalue`).
@@ -20,9 +36,10 @@ module fem_continuum_dynamics
     use core_timefunc, only: time_function_t
     use fem_continuum_model, only: continuum_model_t
     use fem_triplets, only: fem_triplets_t
+    use fem_newmark, only: time_integrator_t
     implicit none
     private
-    public :: continuum_dynamics_t
+    public :: continuum_dynamics_t, continuum_audit_t
 
     !> The continuum on its free dofs.
     type, extends(dynamic_operator_t) :: continuum_dynamics_t
@@ -42,6 +59,16 @@ module fem_continuum_dynamics
         type(time_function_t), allocatable :: functions(:)
         !> Stiffness over all dofs (for the strain energy of the whole body).
         type(fem_triplets_t) :: k_all
+        !> Mass over all dofs (for the prescribed motion's inertia and the audit).
+        type(fem_triplets_t) :: m_all
+        !> Loads over all dofs: constant, and times the functions [N].
+        real(wp), allocatable :: load_all(:), timed_all(:, :)
+        !> Amplitude of every timed prescribed dof (0 elsewhere) [m].
+        real(wp), allocatable :: timed_value(:)
+        !> Time function of every prescribed dof (index into `functions`; 0: none).
+        integer, allocatable :: timed_function(:)
+        !> Equation number of every dof (0: prescribed).
+        integer, allocatable :: equation(:)
     contains
         !> Assemble and reduce the model.
         procedure :: build => dynamics_build
@@ -71,7 +98,42 @@ module fem_continuum_dynamics
         procedure :: solve_modes => dynamics_solve_modes
         !> 1/2 u.K u over all dofs [J].
         procedure :: total_strain_energy => dynamics_total_strain_energy
+        !> Loads over all dofs at time t [N].
+        procedure :: loads_at => dynamics_loads_at
+        !> Static loads at time t on the free dofs: f_f - K_fp u_p(t) (no rate terms).
+        procedure :: static_force => dynamics_static_force
+        !> Timed prescribed motion over all dofs at t: displacement, rate or acceleration.
+        procedure :: timed_motion => dynamics_timed_motion
+        !> Nodal reactions r = K u + C v + M a - f(t) over all dofs (meaningful on the
+        !> prescribed ones) [N].
+        procedure :: reactions => dynamics_reactions
     end type continuum_dynamics_t
+
+    !> Energy audit of the whole body, prescribed dofs included (see the module description).
+    type :: continuum_audit_t
+        !> Kinetic 1/2 v.M v and strain 1/2 u.K u over all dofs [J].
+        real(wp) :: kinetic = 0.0_wp, strain = 0.0_wp
+        !> Rayleigh dissipation, work of the loads, of the reactions on the prescribed dofs and
+        !> of the coupling forces, since the start [J].
+        real(wp) :: damping = 0.0_wp, load_work = 0.0_wp, reaction_work = 0.0_wp, coupling_work = 0.0_wp
+        !> Kinetic + strain energy at the start [J].
+        real(wp) :: initial = 0.0_wp
+        !> Resultant of the reactions on the prescribed dofs, (x, y), at the last time [N].
+        real(wp) :: reaction_resultant(2) = 0.0_wp
+        !> State over all dofs at the last time; reactions and loads there.
+        real(wp), allocatable :: u(:), v(:), r(:), f(:)
+    contains
+        !> Take the initial state.
+        procedure :: start => audit_start
+        !> Add one step (the integrator after it).
+        procedure :: advance => audit_advance
+        !> kinetic + strain + damping - works - initial [J].
+        procedure :: balance => audit_balance
+        !> The accumulated scalars (initial, damping, load work, reaction work), for checkpoints.
+        procedure :: totals => audit_totals
+        !> Start from the integrator's state with accumulated scalars of `totals` (restart).
+        procedure :: resume => audit_resume
+    end type continuum_audit_t
 
     !> A CHOLMOD factor as a `spd_factor_t` (the solver is reached through a pointer because
     !> CHOLMOD's solve updates its workspace).
@@ -130,9 +192,15 @@ contains
         integer, allocatable :: eq(:)
         integer :: p, c, n
         self%k_all = k_all
+        self%m_all = m_all
+        self%load_all = load
+        self%timed_all = model%timed_load
+        self%timed_value = merge(model%prescribed_value, 0.0_wp, model%prescribed .and. model%prescribed_function > 0)
+        self%timed_function = merge(model%prescribed_function, 0, model%prescribed)
         call model%reduce(self%k_all, load, self%k_triplets, self%load)
         ! Timed loads: their free rows (the prescribed dofs' reactions are constant, in `load`).
         call model%equations(eq, n)
+        self%equation = eq
         allocate (self%timed_load(n, size(model%functions)), source=0.0_wp)
         self%functions = model%functions
         do c = 1, size(eq)
@@ -206,17 +274,223 @@ contains
         end subroutine element_bound
     end subroutine dynamics_build_from
 
-    !> Loads at time t: f_f - K_fp u_p + sum_k f_k(t) g_k,f.
+    !> Loads at time t: f_f - K_fp u_p - C_fp v_p(t) - M_fp a_p(t) + sum_k f_k(t) g_k,f (the
+    !> constant u_p are in `load`; the timed ones are added here).
     subroutine dynamics_force(self, t, f)
         class(continuum_dynamics_t), intent(in) :: self
         real(wp), intent(in) :: t
         real(wp), intent(out) :: f(:)
-        integer :: k
+        real(wp), allocatable :: up(:), vp(:), ap(:), w(:), w2(:)
+        integer :: k, i
         f = self%load
         do k = 1, size(self%functions)
             f = f + self%functions(k)%value(t)*self%timed_load(:, k)
         end do
+        if (.not. any(self%timed_function > 0 .and. self%equation == 0)) return
+        up = self%timed_motion(t, 0)
+        vp = self%timed_motion(t, 1)
+        ap = self%timed_motion(t, 2)
+        allocate (w(size(up)), w2(size(up)))
+        ! K (u_p + a1 v_p) + M (a_p + a0 v_p) over all dofs; its free rows leave F.
+        call self%k_all%matvec(up + self%rayleigh_a1*vp, w)
+        call self%m_all%matvec(ap + self%rayleigh_a0*vp, w2)
+        w = w + w2
+        do i = 1, size(self%equation)
+            if (self%equation(i) > 0) f(self%equation(i)) = f(self%equation(i)) - w(i)
+        end do
     end subroutine dynamics_force
+
+    !> Static right-hand side at time t on the free dofs: f_f(t) - K_fp u_p(t) (the prescribed
+    !> displacements at t, without the damping and inertia of their motion).
+    subroutine dynamics_static_force(self, t, f)
+        !> The operator.
+        class(continuum_dynamics_t), intent(in) :: self
+        !> Time [s].
+        real(wp), intent(in) :: t
+        !> Right-hand side (n_free) [N].
+        real(wp), intent(out) :: f(:)
+        real(wp), allocatable :: w(:)
+        integer :: k, i
+        f = self%load
+        do k = 1, size(self%functions)
+            f = f + self%functions(k)%value(t)*self%timed_load(:, k)
+        end do
+        allocate (w(size(self%equation)))
+        call self%k_all%matvec(self%timed_motion(t, 0), w)
+        do i = 1, size(self%equation)
+            if (self%equation(i) > 0) f(self%equation(i)) = f(self%equation(i)) - w(i)
+        end do
+    end subroutine dynamics_static_force
+
+    !> Loads over all dofs at time t [N].
+    function dynamics_loads_at(self, t) result(f)
+        !> The operator.
+        class(continuum_dynamics_t), intent(in) :: self
+        !> Time [s].
+        real(wp), intent(in) :: t
+        !> Loads [N].
+        real(wp), allocatable :: f(:)
+        integer :: k
+        f = self%load_all
+        do k = 1, size(self%functions)
+            f = f + self%functions(k)%value(t)*self%timed_all(:, k)
+        end do
+    end function dynamics_loads_at
+
+    !> Timed prescribed dofs over all dofs (0 elsewhere) at time t: value f(t) (derivative 0),
+    !> value f'(t) (1) or value f''(t) (2).
+    function dynamics_timed_motion(self, t, derivative) result(x)
+        !> The operator.
+        class(continuum_dynamics_t), intent(in) :: self
+        !> Time [s].
+        real(wp), intent(in) :: t
+        !> 0, 1 or 2.
+        integer, intent(in) :: derivative
+        !> The motion [m, m/s, m/s^2].
+        real(wp), allocatable :: x(:)
+        integer :: i
+        allocate (x(size(self%timed_value)), source=0.0_wp)
+        do i = 1, size(x)
+            if (self%timed_function(i) == 0 .or. self%equation(i) /= 0) cycle
+            associate (fn => self%functions(self%timed_function(i)))
+                select case (derivative)
+                case (0)
+                    x(i) = self%timed_value(i)*fn%value(t)
+                case (1)
+                    x(i) = self%timed_value(i)*fn%rate(t)
+                case default
+                    x(i) = self%timed_value(i)*fn%acceleration(t)
+                end select
+            end associate
+        end do
+    end function dynamics_timed_motion
+
+    !> r = K u + a1 K v + M (a + a0 v) - f(t) over all dofs [N]: on the prescribed dofs, the
+    !> forces the supports apply; on the free dofs, the residual of the equation of motion
+    !> (minus the coupling force in a coupled run).
+    function dynamics_reactions(self, t, u, v, a) result(r)
+        !> The operator.
+        class(continuum_dynamics_t), intent(in) :: self
+        !> Time [s].
+        real(wp), intent(in) :: t
+        !> Displacements, velocities and accelerations over all dofs.
+        real(wp), intent(in) :: u(:), v(:), a(:)
+        !> Reactions [N].
+        real(wp), allocatable :: r(:)
+        real(wp), allocatable :: w(:)
+        allocate (r(size(u)), w(size(u)))
+        call self%k_all%matvec(u + self%rayleigh_a1*v, r)
+        call self%m_all%matvec(a + self%rayleigh_a0*v, w)
+        r = r + w - self%loads_at(t)
+    end function dynamics_reactions
+
+    !> Start the audit from the integrator's initial state.
+    subroutine audit_start(self, ops, model, integ)
+        !> The audit.
+        class(continuum_audit_t), intent(inout) :: self
+        !> The operator.
+        type(continuum_dynamics_t), intent(in) :: ops
+        !> The continuum (prescribed dofs).
+        type(continuum_model_t), intent(in) :: model
+        !> The integrator, initialised.
+        class(time_integrator_t), intent(in) :: integ
+        real(wp), allocatable :: a(:), w(:)
+        self%u = model%expand(integ%u, integ%t)
+        self%v = model%expand(integ%v, integ%t, 1)
+        a = model%expand(integ%a, integ%t, 2)
+        self%r = ops%reactions(integ%t, self%u, self%v, a)
+        self%f = ops%loads_at(integ%t)
+        allocate (w(size(self%u)))
+        call ops%m_all%matvec(self%v, w)
+        self%kinetic = 0.5_wp*dot_product(self%v, w)
+        self%strain = ops%total_strain_energy(self%u)
+        self%initial = self%kinetic + self%strain
+        self%damping = 0.0_wp
+        self%load_work = 0.0_wp
+        self%reaction_work = 0.0_wp
+        self%coupling_work = integ%coupling_work
+        call resultant(self, model)
+    end subroutine audit_start
+
+    !> Add the step the integrator just made (trapezoidal rule between the last time and now).
+    subroutine audit_advance(self, ops, model, integ)
+        !> The audit (started).
+        class(continuum_audit_t), intent(inout) :: self
+        !> The operator.
+        type(continuum_dynamics_t), intent(in) :: ops
+        !> The continuum (prescribed dofs).
+        type(continuum_model_t), intent(in) :: model
+        !> The integrator, after the step.
+        class(time_integrator_t), intent(in) :: integ
+        real(wp), allocatable :: u(:), v(:), a(:), r(:), f(:), du(:), w(:), w2(:)
+        u = model%expand(integ%u, integ%t)
+        v = model%expand(integ%v, integ%t, 1)
+        a = model%expand(integ%a, integ%t, 2)
+        r = ops%reactions(integ%t, u, v, a)
+        f = ops%loads_at(integ%t)
+        du = u - self%u
+        allocate (w(size(u)), w2(size(u)))
+        ! Rayleigh: du.C (v_n + v_n+1)/2.
+        call ops%k_all%matvec(ops%rayleigh_a1*(v + self%v), w)
+        call ops%m_all%matvec(ops%rayleigh_a0*(v + self%v), w2)
+        self%damping = self%damping + 0.5_wp*dot_product(du, w + w2)
+        self%load_work = self%load_work + 0.5_wp*dot_product(du, f + self%f)
+        self%reaction_work = self%reaction_work + 0.5_wp*dot_product(merge(du, 0.0_wp, model%prescribed), r + self%r)
+        self%coupling_work = integ%coupling_work
+        call ops%m_all%matvec(v, w)
+        self%kinetic = 0.5_wp*dot_product(v, w)
+        self%strain = ops%total_strain_energy(u)
+        call move_alloc(u, self%u)
+        call move_alloc(v, self%v)
+        call move_alloc(r, self%r)
+        call move_alloc(f, self%f)
+        call resultant(self, model)
+    end subroutine audit_advance
+
+    !> Resultant of the reactions on the prescribed dofs.
+    pure subroutine resultant(self, model)
+        type(continuum_audit_t), intent(inout) :: self
+        type(continuum_model_t), intent(in) :: model
+        self%reaction_resultant(1) = sum(self%r(1::2), mask=model%prescribed(1::2))
+        self%reaction_resultant(2) = sum(self%r(2::2), mask=model%prescribed(2::2))
+    end subroutine resultant
+
+    !> The accumulated scalars [J]: initial energy, damping, load work, reaction work.
+    pure function audit_totals(self) result(totals)
+        !> The audit.
+        class(continuum_audit_t), intent(in) :: self
+        !> (initial, damping, load_work, reaction_work).
+        real(wp) :: totals(4)
+        totals = [self%initial, self%damping, self%load_work, self%reaction_work]
+    end function audit_totals
+
+    !> Start from the integrator's state (restored from a checkpoint) and the accumulated
+    !> scalars saved there: the state-dependent terms are recomputed, bit for bit.
+    subroutine audit_resume(self, ops, model, integ, totals)
+        !> The audit.
+        class(continuum_audit_t), intent(inout) :: self
+        !> The operator.
+        type(continuum_dynamics_t), intent(in) :: ops
+        !> The continuum (prescribed dofs).
+        type(continuum_model_t), intent(in) :: model
+        !> The integrator, restored.
+        class(time_integrator_t), intent(in) :: integ
+        !> (initial, damping, load_work, reaction_work) from `totals` [J].
+        real(wp), intent(in) :: totals(4)
+        call self%start(ops, model, integ)
+        self%initial = totals(1)
+        self%damping = totals(2)
+        self%load_work = totals(3)
+        self%reaction_work = totals(4)
+    end subroutine audit_resume
+
+    !> kinetic + strain + damping - load, reaction and coupling works - initial [J].
+    pure real(wp) function audit_balance(self) result(b)
+        !> The audit.
+        class(continuum_audit_t), intent(in) :: self
+        b = self%kinetic + self%strain + self%damping - self%load_work - self%reaction_work - &
+            self%coupling_work - self%initial
+    end function audit_balance
 
     !> ku = K u.
     subroutine dynamics_stiffness_times(self, u, ku)

@@ -5,6 +5,11 @@
 !> imposed by elimination: the free dofs are numbered 1..n_equations (`equation`), and
 !> `reduce` returns K_ff and f_f - K_fp u_p, which stay symmetric positive definite when the
 !> prescribed dofs remove the rigid motions; `expand` puts u_f and u_p back together.
+!>
+!> A prescribed dof is constant (its value) or its value times one of the model's time
+!> functions, u_p(t) = value f(t) (`prescribed_function`). `reduce` moves only the constant
+!> ones to the right-hand side; the timed ones enter the loads of the free dofs at each time
+!> (fem_continuum_dynamics), and `prescribed_at` gives u_p(t), its rate and its acceleration.
 module fem_continuum_model
     use core_kinds, only: wp
     use core_constants, only: singular_ratio
@@ -40,8 +45,10 @@ module fem_continuum_model
         type(element_slot_t) :: family(2)
         !> Prescribed flag of each dof.
         logical, allocatable :: prescribed(:)
-        !> Prescribed value of each dof (m; 0 where free).
+        !> Prescribed value of each dof (m; 0 where free); for a timed dof, the amplitude.
         real(wp), allocatable :: prescribed_value(:)
+        !> Time function of each prescribed dof (index into `functions`; 0: constant value).
+        integer, allocatable :: prescribed_function(:)
         !> External nodal forces (N), size 2 * number of nodes (constant in time).
         real(wp), allocatable :: load(:)
         !> Time functions multiplying the columns of `timed_load` (none: every load constant).
@@ -82,6 +89,10 @@ module fem_continuum_model
         procedure :: reduce => model_reduce
         !> Full displacement vector from the free-dof solution and the prescribed values.
         procedure :: expand => model_expand
+        !> u_p(t), its rate or its acceleration over all dofs (0 on the free dofs).
+        procedure :: prescribed_at => model_prescribed_at
+        !> Whether some prescribed dof follows a time function.
+        procedure :: has_timed_prescribed => model_has_timed_prescribed
         !> Stress (xx, yy, xy) at every element centre.
         procedure :: centre_stresses => model_centre_stresses
         !> Whether the prescribed dofs stop the three rigid motions of the plane.
@@ -124,6 +135,7 @@ contains
         allocate (self%materials(0))
         allocate (self%element_material(mesh%element_count()), source=0)
         allocate (self%prescribed(self%dof_count()), source=.false.)
+        allocate (self%prescribed_function(self%dof_count()), source=0)
         allocate (self%prescribed_value(self%dof_count()), self%load(self%dof_count()), source=0.0_wp)
         allocate (self%functions(0), self%timed_load(self%dof_count(), 0))
     end subroutine model_init
@@ -165,7 +177,7 @@ contains
     end subroutine model_set_material
 
     !> Prescribe the displacement of one dof.
-    pure subroutine model_prescribe(self, node, component, value)
+    pure subroutine model_prescribe(self, node, component, value, function)
         !> The model.
         class(continuum_model_t), intent(inout) :: self
         !> Node index.
@@ -174,12 +186,16 @@ contains
         integer, intent(in) :: component
         !> Displacement (m).
         real(wp), intent(in) :: value
+        !> Index of the time function multiplying the value (absent or 0: constant).
+        integer, intent(in), optional :: function
         self%prescribed(2*node - 2 + component) = .true.
         self%prescribed_value(2*node - 2 + component) = value
+        self%prescribed_function(2*node - 2 + component) = 0
+        if (present(function)) self%prescribed_function(2*node - 2 + component) = function
     end subroutine model_prescribe
 
     !> Prescribe one displacement component on every node of a named node set.
-    subroutine model_prescribe_set(self, set_name, component, value, error)
+    subroutine model_prescribe_set(self, set_name, component, value, error, function)
         !> The model.
         class(continuum_model_t), intent(inout) :: self
         !> Node set name.
@@ -188,18 +204,27 @@ contains
         integer, intent(in) :: component
         !> Displacement (m).
         real(wp), intent(in) :: value
-        !> Set when the set is unknown or the component is not 1 or 2.
+        !> Set when the set is unknown, the component is not 1 or 2, or the function index is
+        !> not one of `functions`.
         type(error_t), allocatable, intent(out) :: error
+        !> Index of the time function multiplying the value (absent or 0: constant).
+        integer, intent(in), optional :: function
         integer, allocatable :: ids(:)
-        integer :: k
+        integer :: k, f
         if (component /= 1 .and. component /= 2) then
             call make_error(error, 'continuum model: displacement component must be 1 (x) or 2 (y)')
+            return
+        end if
+        f = 0
+        if (present(function)) f = function
+        if (f < 0 .or. f > size(self%functions)) then
+            call make_error(error, 'continuum model: the prescribed displacement names no time function of the model')
             return
         end if
         call self%mesh%node_set(set_name, ids, error)
         if (allocated(error)) return
         do k = 1, size(ids)
-            call self%prescribe(ids(k), component, value)
+            call self%prescribe(ids(k), component, value, f)
         end do
     end subroutine model_prescribe_set
 
@@ -423,7 +448,8 @@ contains
         end do
     end subroutine model_equations
 
-    !> Eliminate the prescribed dofs: kr = K_ff, fr = f_f - K_fp u_p.
+    !> Eliminate the prescribed dofs: kr = K_ff, fr = f_f - K_fp u_p over the constant
+    !> prescribed dofs (the timed ones are left to the caller, at each time).
     pure subroutine model_reduce(self, k, f, kr, fr)
         !> The model.
         class(continuum_model_t), intent(in) :: self
@@ -449,28 +475,77 @@ contains
             if (i == 0) cycle
             if (j > 0) then
                 call kr%add(i, j, k%v(p))
-            else
+            else if (self%prescribed_function(k%j(p)) == 0) then
                 fr(i) = fr(i) - k%v(p)*self%prescribed_value(k%j(p))
             end if
         end do
     end subroutine model_reduce
 
-    !> Full displacement vector: free dofs from the solution, prescribed dofs from their values.
-    pure function model_expand(self, ur) result(u)
+    !> Full displacement vector: free dofs from the solution, prescribed dofs from their values
+    !> at time t (default 0), or their rates (derivative 1) or accelerations (2).
+    pure function model_expand(self, ur, t, derivative) result(u)
         !> The model.
         class(continuum_model_t), intent(in) :: self
         !> Solution over the free dofs.
         real(wp), intent(in) :: ur(:)
+        !> Time [s] (default 0).
+        real(wp), intent(in), optional :: t
+        !> 0: displacements (default), 1: velocities, 2: accelerations of the prescribed dofs.
+        integer, intent(in), optional :: derivative
         !> Displacements over all dofs.
         real(wp), allocatable :: u(:)
         integer, allocatable :: eq(:)
-        integer :: n, i
+        integer :: n, i, order
+        real(wp) :: time
+        time = 0.0_wp
+        if (present(t)) time = t
+        order = 0
+        if (present(derivative)) order = derivative
         call self%equations(eq, n)
-        u = self%prescribed_value
+        u = self%prescribed_at(time, order)
         do i = 1, size(eq)
             if (eq(i) > 0) u(i) = ur(eq(i))
         end do
     end function model_expand
+
+    !> Prescribed displacements at time t over all dofs (0 on the free dofs): the value, or
+    !> value f(t) for a timed dof; derivative 1 and 2 give the rates value f'(t) and
+    !> accelerations value f''(t) (0 for the constant dofs).
+    pure function model_prescribed_at(self, t, derivative) result(up)
+        !> The model.
+        class(continuum_model_t), intent(in) :: self
+        !> Time [s].
+        real(wp), intent(in) :: t
+        !> 0: displacement, 1: rate, 2: acceleration.
+        integer, intent(in) :: derivative
+        !> u_p(t) or its derivative over all dofs.
+        real(wp), allocatable :: up(:)
+        real(wp), allocatable :: f(:)
+        integer :: i, k
+        allocate (f(0:size(self%functions)))
+        f(0) = merge(1.0_wp, 0.0_wp, derivative == 0)
+        do k = 1, size(self%functions)
+            select case (derivative)
+            case (0)
+                f(k) = self%functions(k)%value(t)
+            case (1)
+                f(k) = self%functions(k)%rate(t)
+            case default
+                f(k) = self%functions(k)%acceleration(t)
+            end select
+        end do
+        allocate (up(self%dof_count()), source=0.0_wp)
+        do i = 1, size(up)
+            if (self%prescribed(i)) up(i) = self%prescribed_value(i)*f(self%prescribed_function(i))
+        end do
+    end function model_prescribed_at
+
+    !> Whether some prescribed dof follows a time function.
+    pure logical function model_has_timed_prescribed(self) result(timed)
+        !> The model.
+        class(continuum_model_t), intent(in) :: self
+        timed = any(self%prescribed .and. self%prescribed_function > 0)
+    end function model_has_timed_prescribed
 
     !> Stress (xx, yy, xy) at the centre of every element for the displacements u.
     subroutine model_centre_stresses(self, u, stress, error)

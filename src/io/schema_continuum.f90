@@ -43,7 +43,9 @@ contains
                            tails=[tail([word_field('component', 'x y')], 1, 2)], repeatable=.true.)
         call s%add_keyword('continuum', 'displacement', [word_field('node_set', ''), &
                                                          word_field('component', 'x y'), real_field('value', 'm')], &
-                           'Prescribed displacement (constant in time) of the nodes of a set.', repeatable=.true.)
+                           'Prescribed displacement of the nodes of a set: the value, or the value times a '// &
+                           '[functions] time function (its rate and acceleration are the derivatives of the '// &
+                           'function).', tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
         call s%add_keyword('continuum', 'load', [word_field('node_set', ''), &
                                                  word_field('component', 'x y'), real_field('value', 'N')], &
                            'Force on every node of a set, times a [functions] time function (none: constant 1).', &
