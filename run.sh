@@ -5,8 +5,10 @@
 # Installs what is missing, builds a Release build in build/, runs the deck, writes
 # results/<deck name>/<deck name>.h5 and its plots, and prints where they are. With
 # --experiments: input/bending_case1.dat, bending_case2.dat and bending_stack.dat into
-# results/experiments/<case>/, then the figures (PNG and PDF) and a summary of the measured
-# figures in results/experiments/ (postproc/plot_experiments.py).
+# results/experiments/<case>/, the interface experiment (input/interface_shear.dat and its
+# variants of friction, cohesion and band width, postproc/run_interface_experiment.py) into
+# results/experiments/interface/, then the figures (PNG and PDF) and a summary of the
+# measured figures in results/experiments/ (postproc/plot_experiments.py).
 set -euo pipefail
 source "$(cd "$(dirname "$0")" && pwd)/scripts/bootstrap.sh"
 
@@ -36,6 +38,8 @@ if [ $experiments -eq 1 ]; then
         say "running input/$name.dat"
         build/src/multicor "input/$name.dat" --output "$out/$name"
     done
+    say "running the interface experiment (input/interface_shear.dat and its variants)"
+    .venv/bin/python postproc/run_interface_experiment.py --exe build/src/multicor --out "$out/interface"
     say "plotting the experiments"
     .venv/bin/python postproc/plot_experiments.py --results "$out"
     say "figures in $MULTICOR_ROOT/$out"

@@ -14,6 +14,14 @@ into --out (default DIR):
   (the same disk at the same abscissa) in case 1 and case 2 (default disks 7, 11 and 17);
 - stack_vs_row: displacement and velocity profiles of the stack against the single row;
 - experiments_summary.txt: constraint residuals, energy balance, wall times, rigid fits.
+With DIR/interface (postproc/run_interface_experiment.py; skipped when absent), the
+interface experiment (multicor_post.interface):
+- interface_friction_mu, interface_friction_cohesion, interface_friction_width: apparent
+  friction (top band T / N) against slip, one curve per local friction, per cohesion and per
+  band width, with the curve of disks sliding over disks for each mu;
+- interface_configuration: deformed mesh, disks and contact forces at the end of the base run;
+- interface_stress_xy, interface_stress_vm: sigma_xy and von Mises in the blocks at the end;
+- interface_summary.txt: peak and residual apparent friction, slip, energy balances per run.
 Prints the paths written. Exit code 1 with a message when a results file is missing.
 """
 import argparse
@@ -24,7 +32,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from multicor_post import coupled  # noqa: E402
+from multicor_post import coupled, interface  # noqa: E402
 from multicor_post.results import ResultsError  # noqa: E402
 
 CASES = ("bending_case1", "bending_case2", "bending_stack")
@@ -70,6 +78,51 @@ def summary_lines(runs, time):
     return lines
 
 
+def interface_runs(folder):
+    """{label: InterfaceRun} of the interface sweeps (run_interface_experiment.py)."""
+    def point(sweep, name):
+        return interface.InterfaceRun(os.path.join(folder, sweep, "runs", name, f"{name}.h5"))
+    return {"mu 0.1": point("mu", "p001"), "mu 0.3": point("mu", "p002"), "mu 0.5": point("mu", "p003"),
+            "cohesion 10 MPa": point("cohesion", "p001"), "bands 0.05 m": point("width", "p001")}
+
+
+def interface_figures(folder, out, written):
+    """Figures and summary lines of the interface experiment."""
+    runs = interface_runs(folder)
+    base = runs["mu 0.3"]
+    radius = float(base.radius.max())
+    save(interface.plot_friction([(k, runs[k]) for k in ("mu 0.1", "mu 0.3", "mu 0.5")],
+                                 "local friction mu (cohesion 0, bands 0.025 m)", (0.1, 0.3, 0.5), radius),
+         out, "interface_friction_mu", written)
+    save(interface.plot_friction([("cohesion 0", base), ("cohesion 10 MPa", runs["cohesion 10 MPa"])],
+                                 "cohesion (mu 0.3, bands 0.025 m)", (0.3,), radius),
+         out, "interface_friction_cohesion", written)
+    save(interface.plot_friction([("bands 0.025 m", base), ("bands 0.05 m", runs["bands 0.05 m"])],
+                                 "overlap band width (mu 0.3, cohesion 0)", (0.3,), radius),
+         out, "interface_friction_width", written)
+    last = len(base.time) - 1
+    save(interface.plot_configuration(base, last), out, "interface_configuration", written)
+    save(interface.plot_stress(base, last, "xy"), out, "interface_stress_xy", written)
+    save(interface.plot_stress(base, last, "vm"), out, "interface_stress_vm", written)
+    lines = [f"{'run':<16} {'max T/N':>8} {'T/N at 1 mm':>12} {'at 3 mm':>8} {'sliding 1 mm':>13} "
+             f"{'3 mm':>6} {'end':>7} {'slip [mm]':>10} {'max|bal| [J]':>13} {'FE audit [J]':>13} "
+             f"{'W_reaction [J]':>15}"]
+    mus = {"mu 0.1": 0.1, "mu 0.5": 0.5}
+    for name, r in runs.items():
+        s, mu = r.apparent_friction()
+        order = np.argsort(s)
+        at = np.interp([1e-3, 3e-3], s[order], mu[order])
+        theory = interface.sliding_over_disks(mus.get(name, 0.3), np.array([1e-3, 3e-3]), radius)
+        lines.append(f"{name:<16} {mu.max():>8.3f} {at[0]:>12.3f} {at[1]:>8.3f} {theory[0]:>13.3f} "
+                     f"{theory[1]:>6.3f} {mu[-1]:>7.3f} {r.slip()[-1] * 1e3:>10.3f} "
+                     f"{np.abs(r.balance).max():>13.3e} {np.abs(r.fe_balance).max():>13.3e} "
+                     f"{r.reaction_work[-1]:>15.4f}")
+    lines.append("max: over the run, rate-step transients included; sliding: tan(atan mu - asin(s/2R)) at "
+                 "1 and 3 mm; end: T/N at the last output; max|bal|: coupled audit; FE audit: the "
+                 "continuum's balance with the reactions' work (moves at the drive's rate steps)")
+    return lines
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="plot_experiments.py",
                                      description=__doc__.split("\n")[0])
@@ -82,6 +135,9 @@ def main(argv=None):
                         help="disks (1-based) whose histories are compared (default 7 11 17: "
                              "the last disk of the overlap of case 1, a disk of the particle "
                              "zone, the loaded disk)")
+    parser.add_argument("--interface", default=None,
+                        help="folder of the interface sweeps (default: <results>/interface; skipped "
+                             "when absent)")
     args = parser.parse_args(argv)
     out = args.out or args.results
     os.makedirs(out, exist_ok=True)
@@ -106,6 +162,18 @@ def main(argv=None):
         print(f"plot_experiments.py: error: {exc}", file=sys.stderr)
         return 1
     text = "\n".join(summary_lines(runs, args.time)) + "\n"
+    folder = args.interface or os.path.join(args.results, "interface")
+    if os.path.isdir(folder):
+        try:
+            lines = interface_figures(folder, out, written)
+        except ResultsError as exc:
+            print(f"plot_experiments.py: error: {exc}", file=sys.stderr)
+            return 1
+        path = os.path.join(out, "interface_summary.txt")
+        with open(path, "w") as f:
+            f.write("\n".join(lines) + "\n")
+        written.append(path)
+        text += "\ninterface experiment (apparent friction = top band T / N):\n" + "\n".join(lines) + "\n"
     path = os.path.join(out, "experiments_summary.txt")
     with open(path, "w") as f:
         f.write(text)
