@@ -1,0 +1,82 @@
+"""Tests of the interface-experiment reader (multicor_post.interface) on a synthetic file:
+two one-element blocks, one glued disk per band, multipliers that alternate from output to
+output about a known mean, and a known slip; and the sliding-over-disks curve."""
+import h5py
+import numpy as np
+import pytest
+
+from multicor_post import interface
+
+N_OUT = 6
+SLIP = np.linspace(0.0, 1.0e-3, N_OUT)
+T_MEAN, N_MEAN, ALT = 300.0, -1000.0, 50.0
+
+
+@pytest.fixture
+def interface_file(tmp_path):
+    path = tmp_path / "interface.h5"
+    x = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0, 2], [1, 2], [1, 3], [0, 3]], float)
+    u = np.zeros((N_OUT, 8, 2))
+    u[:, 4:, 0] = SLIP[:, None]                       # the top block moves in x as a whole
+    sign = (-1.0) ** np.arange(N_OUT)                 # the step-to-step alternation
+    lam = np.zeros((N_OUT, 4))
+    lam[:, 0] = -T_MEAN + ALT * sign                  # bottom disk, x
+    lam[:, 1] = -N_MEAN - ALT * sign                  # bottom disk, y
+    lam[:, 2] = T_MEAN - ALT * sign                   # top disk, x
+    lam[:, 3] = N_MEAN + ALT * sign                   # top disk, y
+    lam[0] = 0.0
+    with h5py.File(path, "w") as f:
+        f["coupling/time"] = np.arange(N_OUT) * 1e-4
+        f["coupling/lambda"] = lam
+        f["coupling/rows/dof"] = np.array([1, 2, 1, 2], np.int32)
+        f["coupling/rows/particle"] = np.array([1, 1, 2, 2], np.int32)
+        f["dem/position"] = np.tile(np.array([[0.5, 0.9, 0.0], [0.5, 2.1, 0.0]]), (N_OUT, 1, 1))
+        f["dem/particles/radius"] = np.array([0.1, 0.1])
+        f["continuum/mesh/coordinates"] = x
+        f["continuum/mesh/connectivity"] = np.array([[1, 2, 3, 4], [5, 6, 7, 8]], np.int32)
+        f["continuum/mesh/kind"] = np.array([2, 2], np.int32)
+        f["continuum/displacement"] = u
+        f["continuum/stress"] = np.zeros((N_OUT, 2, 3))
+        f["continuum/sets/nodes/bottom_block"] = np.array([1, 2, 3, 4], np.int32)
+        f["continuum/sets/nodes/top_block"] = np.array([5, 6, 7, 8], np.int32)
+        for name in ("coupling/energy/balance", "continuum/energy/balance", "continuum/energy/reaction_work"):
+            f[name] = np.zeros(N_OUT)
+    return path
+
+
+def test_pair_mean_removes_the_alternation_and_bands_are_split(interface_file):
+    run = interface.InterfaceRun(interface_file)
+    t_top, n_top, t_bot, n_bot = run.band_resultants()
+    # From output 2 on, each pair holds both phases: the mean is exact (sums of a few values
+    # of O(1e3) written as float64: a few ulps).
+    tol = 8 * np.spacing(1e3)
+    assert np.allclose(t_top[2:], T_MEAN, rtol=0, atol=tol)
+    assert np.allclose(n_top[2:], N_MEAN, rtol=0, atol=tol)
+    assert np.allclose(t_bot[2:], -T_MEAN, rtol=0, atol=tol)
+    assert np.allclose(n_bot[2:], -N_MEAN, rtol=0, atol=tol)
+
+
+def test_slip_and_apparent_friction(interface_file):
+    run = interface.InterfaceRun(interface_file)
+    assert np.array_equal(run.slip(), SLIP)
+    s, mu = run.apparent_friction()
+    # Output 0 carries no load and is left out (below 0.2 of the largest normal load); output
+    # 1 (about half the load: its pair holds output 0) is kept. From output 2 on T / N is
+    # the ratio of the means, to rounding.
+    assert s[0] == SLIP[1]
+    assert np.allclose(mu[s > SLIP[1]], T_MEAN / -N_MEAN, rtol=1e-14)
+
+
+def test_sliding_over_disks_starts_at_mu_and_vanishes_at_the_crest():
+    mu, r = 0.3, 0.0125
+    assert interface.sliding_over_disks(mu, 0.0, r) == pytest.approx(mu, rel=1e-15)
+    s0 = 2 * r * np.sin(np.arctan(mu))
+    assert interface.sliding_over_disks(mu, s0, r) == pytest.approx(0.0, abs=1e-15)
+
+
+def test_figures_are_drawn(interface_file):
+    run = interface.InterfaceRun(interface_file)
+    fig = interface.plot_friction([("synthetic", run)], "t", (0.3,), 0.1)
+    assert len(fig.axes[0].lines) == 3                # the run, the theory and its legend entry
+    assert interface.plot_configuration(run, N_OUT - 1) is not None
+    assert interface.plot_stress(run, N_OUT - 1, "vm") is not None
