@@ -131,8 +131,6 @@ contains
         call build_continuum_operator(model, grid, dem%particles%x(sys%coupled), dem%particles%y(sys%coupled), op, &
                                       error, with_rotation=config%rotation_row)
         if (allocated(error)) return
-        call check_timed_supports(error)
-        if (allocated(error)) return
         if (config%multipliers == multipliers_nodes) then
             call build_mediator2d(model, op, config%pairing, config%h1_length, med, sys%mediator_nodes, error)
             if (allocated(error)) return
@@ -148,25 +146,6 @@ contains
         call complete_coupled_system(sys, space, uf, vf, error, beta, gamma)
 
     contains
-
-        !> Error for a coupled centre in an element with a dof prescribed in time: C acts on the
-        !> free dofs, so the constraint q - q_0 = C (u - u_0) would miss u_p(t) - u_p(0) there.
-        subroutine check_timed_supports(error)
-            type(error_t), allocatable, intent(out) :: error
-            integer :: r, k
-            character(len=200) :: buf
-            do r = 1, op%n_rows
-                do k = 1, size(op%dof, 1)
-                    if (op%dof(k, r) == 0) cycle
-                    if (model%prescribed_function(op%dof(k, r)) == 0) cycle
-                    write (buf, '(a,i0,a)') 'coupling: coupled disk ', sys%coupled((r - 1)/op%rows_per_point + 1), &
-                        ' lies in an element with a displacement prescribed in time (not supported in the '// &
-                        'overlap): move the time-dependent displacement away from the overlap'
-                    call make_error(error, trim(buf))
-                    return
-                end do
-            end do
-        end subroutine check_timed_supports
 
         !> Error for a disk outside the overlap whose centre lies in an element.
         subroutine check_fe_zone(error)

@@ -21,6 +21,11 @@
 !>
 !> Small displacements: C, the weights and h are constant (C is built on the reference
 !> configuration), so A = h gamma (W + C S^-1 C^T) is assembled, factored and inverted once.
+!> FE dofs prescribed in time (u_p(t), a 2D continuum's `displacement` with a function) enter
+!> C u as C_p u_p(t) and C v as C_p v_p(t) (`coupling_map_t%add_prescribed`; none for a beam):
+!> they do not respond to the multipliers, so A is unchanged. The multipliers' force on them,
+!> -C_p^T lambda, is taken by the supports: its work is counted with the FE side's coupling
+!> work (`prescribed_coupling_work`), so that the audit still closes.
 !> The DEM is per unit thickness: `thickness` t turns its masses and impulses into absolute
 !> ones (W = ((1 - alpha) m t)^-1); energies are reported in J (DEM energies times t).
 !>
@@ -188,6 +193,13 @@ module coupling_coupled_step
         integer :: step = 0
         !> Work arrays (n_rows): C v, G v; (n_free): FE coupling force.
         real(wp), allocatable :: cv(:), gv(:), fc(:)
+        !> C_p u_p(t) at the current time: the coupled rows' share of FE dofs prescribed in time
+        !> [m, rad] (n_rows; zero without such dofs).
+        real(wp), allocatable :: cp(:)
+        !> Work of the multipliers through the prescribed FE dofs since the start,
+        !> sum of (lambda_n + lambda_n+1)/2 . (C_p u_p(t_n+1) - C_p u_p(t_n)) [J]: the FE side's
+        !> coupling work on those dofs is its negative.
+        real(wp) :: prescribed_coupling_work = 0.0_wp
     end type coupled_system_t
 
 contains
@@ -301,7 +313,11 @@ contains
                   sys%cv(nr), sys%gv(nr), sys%cu0(nr), sys%start(nr), source=0.0_wp)
         allocate (sys%fc(sys%op%n_free), source=0.0_wp)
         allocate (sys%multiplier(sys%space%n_mult), source=0.0_wp)
+        allocate (sys%cp(nr), source=0.0_wp)
+        call sys%op%add_prescribed(sys%fe%t, 0, sys%cp)
+        sys%prescribed_coupling_work = 0.0_wp
         call sys%op%apply(sys%fe%u, sys%cu0)
+        sys%cu0 = sys%cu0 + sys%cp
         associate (p => sys%dem%particles)
             do r = 1, nr
                 select case (sys%rows%dof(r))
@@ -316,6 +332,7 @@ contains
         end associate
         call disk_velocities(sys, sys%gv)
         call sys%op%apply(sys%fe%v, sys%cv)
+        call sys%op%add_prescribed(sys%fe%t, 1, sys%cv)
         sys%g = sys%gv - sys%cv
         sys%stats = coupled_stats_t()
         sys%stats%free_residual = constraint_norm(sys, sys%g, .false.)
@@ -386,6 +403,8 @@ contains
         ! Free residual with the drift term, first multipliers (contacts are activated on the
         ! velocities they give), contacts and the joint solve.
         call sys%op%apply(sys%fe%v, sys%cv)
+        ! (The FE time is still t_n after the prediction.)
+        call sys%op%add_prescribed(sys%fe%t + h, 1, sys%cv)
         call sys%rows%gather(sys%dem%vel, sys%gv)
         sys%g = sys%gv - sys%cv + sys%drift/h
         call sys%rows%begin(sys%dem%vel, sys%g)
@@ -423,11 +442,17 @@ contains
             ! Velocity constraint at t_{n+1} with the drift term of the step.
             call disk_velocities(sys, sys%gv)
             call sys%op%apply(sys%fe%v, sys%cv)
+            call sys%op%add_prescribed(sys%fe%t, 1, sys%cv)
             sys%gv = sys%gv - sys%cv + sys%drift/sys%fe%h
             st%velocity_residual = constraint_norm(sys, sys%gv, .false.)
-            ! New position residual.
+            ! Work through the prescribed dofs, then the new position residual.
+            sys%gv = 0.0_wp
+            call sys%op%add_prescribed(sys%fe%t, 0, sys%gv)
+            sys%prescribed_coupling_work = sys%prescribed_coupling_work + &
+                                           0.5_wp*dot_product(sys%lambda_old + sys%lambda, sys%gv - sys%cp)
+            sys%cp = sys%gv
             call sys%op%apply(sys%fe%u, sys%cv)
-            sys%drift = sys%q - (sys%cv - sys%cu0)
+            sys%drift = sys%q - (sys%cv + sys%cp - sys%cu0)
             st%position_residual = constraint_norm(sys, sys%drift, .false.)
             st%rotation_residual = constraint_norm(sys, sys%drift, .true.)
             st%particle_residual = row_norm(sys, sys%drift, .false.)
@@ -447,6 +472,7 @@ contains
         real(wp) :: cu(sys%op%n_rows), xr
         integer :: r, i
         call sys%op%apply(sys%fe%u, cu)
+        cu = cu + sys%cp
         res = 0.0_wp
         do r = 1, sys%op%n_rows
             i = sys%rows%owner(r)
@@ -473,7 +499,8 @@ contains
         e%fe_strain = sys%fe%strain
         e%fe_external_work = sys%fe%external_work
         e%fe_damping = sys%fe%damping_dissipation
-        e%fe_coupling_work = sys%fe%coupling_work
+        ! On the free dofs (the integrator's), and on the prescribed ones (FE dofs prescribed in time).
+        e%fe_coupling_work = sys%fe%coupling_work - sys%prescribed_coupling_work
         associate (d => sys%dem%energies)
             e%dem_kinetic = t*d%kinetic
             e%dem_potential = t*d%potential

@@ -2,7 +2,8 @@
 !> linear map from the FE free DOFs (n_free) to the coupled rows (n_rows, rows_per_point per
 !> coupled point: x, y and optionally the rotation). The beam (coupling_operator) and the 2D
 !> continuum (coupling_operator2d) extend it; the multiplier assembly (coupling_lambda) and
-!> the multiplier spaces only use this interface.
+!> the multiplier spaces only use this interface. `prescribed` adds the part of C u that comes
+!> from FE dofs prescribed in time, C_p u_p(t) (none by default).
 module coupling_map
     use core_kinds, only: wp
     implicit none
@@ -28,6 +29,8 @@ module coupling_map
         procedure(map_dense_iface), deferred :: to_dense
         !> Row index of a component (1 = x, 2 = y, 3 = rotation) of a point.
         procedure :: row_of => map_row_of
+        !> y += C_p u_p(t) (or its rate) over the FE dofs prescribed in time; none by default.
+        procedure :: add_prescribed => map_add_prescribed
     end type coupling_map_t
 
     abstract interface
@@ -64,4 +67,18 @@ contains
         integer, intent(in) :: comp
         map_row_of = (p - 1)*self%rows_per_point + comp
     end function map_row_of
+
+    !> y += C_p u_p(t), derivative 0, or C_p v_p(t), derivative 1: the coupled rows' share of
+    !> FE dofs prescribed in time. The default has none (y unchanged).
+    pure subroutine map_add_prescribed(self, t, derivative, y)
+        !> The operator.
+        class(coupling_map_t), intent(in) :: self
+        !> Time [s].
+        real(wp), intent(in) :: t
+        !> 0: displacement, 1: velocity.
+        integer, intent(in) :: derivative
+        !> Values at the coupled rows (n_rows), updated.
+        real(wp), intent(inout) :: y(:)
+        ! No prescribed dof in C: nothing to add.
+    end subroutine map_add_prescribed
 end module coupling_map

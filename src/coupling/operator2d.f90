@@ -8,7 +8,10 @@
 !> infinitesimal rotation, 1/2 curl u), glued to the disk's rotation. Rows are ordered point
 !> by point, (x, y[, omega]). Each row keeps up to 8 (dof, value) pairs: the global dof
 !> (2a - 1 for x, 2a for y) and its free column (equation number of the model; 0 for a
-!> prescribed dof, left out of `apply`, kept by `apply_all`).
+!> prescribed dof, left out of `apply`, kept by `apply_all`). The entries on dofs prescribed
+!> in time (u_p = value f(t)) give C_p u_p(t) and C_p v_p(t) (`add_prescribed`, with a copy of
+!> the model's time functions); constant prescribed dofs add nothing to the constraint
+!> q - q_0 = C (u - u_0) and its rate.
 !>
 !> Mediator space (`build_mediator2d`): one multiplier per component on every FE node whose
 !> shape function is non-zero at some coupled point (values below 1e-9 count as 0), with
@@ -26,6 +29,7 @@ module coupling_operator2d
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
     use core_linalg, only: dense_spd_t
+    use core_timefunc, only: time_function_t
     use fem_continuum_model, only: continuum_model_t
     use coupling_map, only: coupling_map_t
     use coupling_locate2d, only: element_grid_t
@@ -54,6 +58,13 @@ module coupling_operator2d
         integer, allocatable :: col(:, :)
         !> Value of each entry (width, n_rows).
         real(wp), allocatable :: val(:, :)
+        !> Value times the prescribed amplitude of each entry on a dof prescribed in time
+        !> (width, n_rows) [m]; 0 elsewhere.
+        real(wp), allocatable :: timed(:, :)
+        !> Time function of each entry on a dof prescribed in time (width, n_rows); 0 elsewhere.
+        integer, allocatable :: timed_function(:, :)
+        !> The model's time functions.
+        type(time_function_t), allocatable :: functions(:)
     contains
         !> y = C u (u over the free dofs).
         procedure :: apply => op2d_apply
@@ -63,6 +74,8 @@ module coupling_operator2d
         procedure :: to_dense => op2d_to_dense
         !> y = C u with u over all dofs (prescribed ones included).
         procedure :: apply_all => op2d_apply_all
+        !> y += C_p u_p(t) or C_p v_p(t) over the dofs prescribed in time.
+        procedure :: add_prescribed => op2d_add_prescribed
     end type continuum_operator_t
 
 contains
@@ -130,9 +143,16 @@ contains
             end if
             deallocate (n, dndx)
         end do
+        allocate (op%timed(width, op%n_rows), source=0.0_wp)
+        allocate (op%timed_function(width, op%n_rows), source=0)
+        op%functions = model%functions
         do r = 1, op%n_rows
             do a = 1, width
-                if (op%dof(a, r) > 0) op%col(a, r) = eq(op%dof(a, r))
+                if (op%dof(a, r) == 0) cycle
+                op%col(a, r) = eq(op%dof(a, r))
+                if (.not. model%prescribed(op%dof(a, r))) cycle
+                op%timed_function(a, r) = model%prescribed_function(op%dof(a, r))
+                if (op%timed_function(a, r) > 0) op%timed(a, r) = op%val(a, r)*model%prescribed_value(op%dof(a, r))
             end do
         end do
     end subroutine build_continuum_operator
@@ -194,6 +214,30 @@ contains
             end do
         end do
     end subroutine op2d_apply_all
+
+    !> y += sum over the entries on dofs prescribed in time of value amplitude f(t) (derivative
+    !> 0) or value amplitude f'(t) (derivative 1).
+    pure subroutine op2d_add_prescribed(self, t, derivative, y)
+        !> The operator.
+        class(continuum_operator_t), intent(in) :: self
+        !> Time [s].
+        real(wp), intent(in) :: t
+        !> 0: displacement, 1: velocity.
+        integer, intent(in) :: derivative
+        !> Values at the coupled rows (n_rows), updated.
+        real(wp), intent(inout) :: y(:)
+        integer :: r, k
+        if (.not. allocated(self%timed_function)) return
+        do r = 1, self%n_rows
+            do k = 1, width
+                if (self%timed_function(k, r) == 0) cycle
+                associate (fn => self%functions(self%timed_function(k, r)))
+                    if (derivative == 0) y(r) = y(r) + self%timed(k, r)*fn%value(t)
+                    if (derivative /= 0) y(r) = y(r) + self%timed(k, r)*fn%rate(t)
+                end associate
+            end do
+        end do
+    end subroutine op2d_add_prescribed
 
     !> The mediator space on the FE nodes carrying coupled points (see the module
     !> description), multipliers ordered node by node, (x, y[, omega]) per node.
