@@ -238,9 +238,15 @@ contains
             call dem_out%resume(self%sys%dem, self%particles%dem%store_contacts)
             call cpl_out%resume(self%sys)
             call load_coupled(ck%source, self%sys, error)
-            ! The continuum's audit (its accumulated works; the rest follows from the state).
+            ! The continuum's audit (its accumulated works; the rest follows from the state), the
+            ! multipliers' work through the prescribed dofs and C_p u_p at the restart time.
             if (.not. allocated(error)) call ck%source%read_attribute('/coupling', 'continuum_audit', totals, error)
-            if (.not. allocated(error)) call audit_step(.true., totals(1:4))
+            if (.not. allocated(error)) then
+                call audit_step(.true., totals(1:4))
+                self%sys%prescribed_coupling_work = totals(5)
+                self%sys%cp = 0.0_wp
+                call self%sys%op%add_prescribed(self%sys%fe%t, 0, self%sys%cp)
+            end if
             if (.not. allocated(error)) call load_dem_writer(ck%source, dem_out, error)
             if (.not. allocated(error)) call load_coupled_writer(ck%source, cpl_out, error)
             if (.not. allocated(error)) call load_results(ck%source, out, error)
@@ -265,7 +271,8 @@ contains
                                    out%run_id, error)
             if (.not. allocated(error)) call save_coupled(f, self%sys, error)
             if (.not. allocated(error)) call f%write_attribute('/coupling', 'continuum_audit', &
-                                                               self%continuum%audit%totals(), error)
+                                                               [self%continuum%audit%totals(), &
+                                                                self%sys%prescribed_coupling_work], error)
             if (.not. allocated(error)) call save_dem_writer(f, dem_out, error)
             if (.not. allocated(error)) call save_coupled_writer(f, cpl_out, error)
             if (.not. allocated(error)) call save_results(f, out, error)

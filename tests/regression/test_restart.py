@@ -8,7 +8,8 @@ with [solver] method = block, whose factor is kept from step to step) and
 coupled decks (input/bending_stack.dat, tests/regression/decks/coupled_rigid_translation.dat),
 a 2D continuum deck (input/continuum_cantilever_dynamic.dat) and continuum-disk coupled decks
 (tests/regression/decks/coupled2d_pushed.dat with one multiplier per disk and with the
-mediator space), the run is stopped at step k in three
+mediator space; coupled2d_driven_edge.dat, an edge driven in time inside the overlap), the
+run is stopped at step k in three
 ways: by a shorter end time (--end, the stop not on an output step: its extra last output
 must disappear at the restart), by a signal (SIGTERM / SIGUSR1: exit 128 + signal, then the
 exact command the program prints is run), and by kill -9 after a periodic checkpoint
@@ -369,6 +370,9 @@ def main():
                             count=1, flags=re.M))
     by_end_time(exe, nodes, work, "coupled2d_nodes_end", 6.17e-4)
     by_signal(exe, pushed, work, "coupled2d_usr1", signal.SIGUSR1, 2.0e-3, 60)
+    # A displacement prescribed in time inside the overlap: the continuum's audit and the
+    # multipliers' work through the prescribed dofs come back from the checkpoint.
+    by_end_time(exe, decks / "coupled2d_driven_edge.dat", work, "coupled2d_driven_end", 4.43e-4)
     refusals(exe, beam, work)
     new_end_time(exe, beam, work)
     if FAILED:
