@@ -26,7 +26,11 @@
 !> --max-sweeps C (cap of the timed steps), --forward (no alternating sweeps), --settle S (steps
 !> before timing, default 10), --settle-anderson M and --settle-sweeps C (solver of those
 !> steps, default the timed one), --verbose (sweeps, Siconos error, solver ms of every timed
-!> step), --hydrostatic (cold start from the hydrostatic estimate, `[solver] cold_start`).
+!> step), --hydrostatic (cold start from the hydrostatic estimate, `[solver] cold_start`),
+!> --method nlgs|block|active_set (`[solver] method`; default nlgs) and --active-every K
+!> (sweeps between two active-set corrections, `[solver] active_every`), --settle-method M
+!> (method of the settling steps, default the timed one). With --verbose the
+!> block solves (active-set corrections) of each step are printed after the solver time.
 !> The Siconos error of every timed step is printed too (mean and max).
 !> With `--siconos N` (200 or 2000), runs instead the deposit compared with Siconos
 !> (siconos_deposit); --csv FILE and --deck FILE write its layout as CSV and as a deck.
@@ -41,7 +45,8 @@ program bench_dem
     use dem_materials, only: materials_init, materials_set_pair
     use dem_detection, only: detect_contacts
     use dem_moreau_jean, only: dem_system_t, mj_init, mj_step, dem_system_bytes
-    use dem_nlgs, only: criterion_lmgc90, criterion_siconos
+    use dem_nlgs, only: criterion_lmgc90, criterion_siconos, nlgs_method_nlgs, nlgs_method_block, &
+                        nlgs_method_active_set, nlgs_method_coarse
     use bench_packing, only: deposit_disks, deposit_width, staggered_layout
     implicit none
 
@@ -83,6 +88,9 @@ program bench_dem
     integer :: anderson = 0, settle_anderson = -1
     logical :: convergence = .false., sizes_given = .false., verbose = .false., symmetric = .true.
     logical :: hydrostatic = .false., criterion_given = .false.
+    !> Global strategy (`[solver] method`) and sweeps between active-set corrections.
+    integer :: method = nlgs_method_nlgs, active_every = 10, settle_method = -1
+    integer :: coarse_every = 5, coarse_size = 200
     !> Siconos deposit (--siconos N): disks, and the files of the layout (empty: not written).
     integer :: siconos_n = 0
     character(len=256) :: csv_path = '', deck_path = ''
@@ -123,6 +131,16 @@ program bench_dem
             read (val, *) n_settle
         case ('--settle-sweeps')
             read (val, *) settle_sweeps
+        case ('--method')
+            method = method_code(val)
+        case ('--settle-method')
+            settle_method = method_code(val)
+        case ('--active-every')
+            read (val, *) active_every
+        case ('--coarse-every')
+            read (val, *) coarse_every
+        case ('--coarse-size')
+            read (val, *) coarse_size
         case ('--check-every')
             read (val, *) check_every
         case ('--criterion')
@@ -167,27 +185,47 @@ program bench_dem
     end if
 contains
 
+    !> Code of a `--method` value.
+    integer function method_code(word) result(code)
+        character(len=*), intent(in) :: word
+        select case (word)
+        case ('nlgs')
+            code = nlgs_method_nlgs
+        case ('block')
+            code = nlgs_method_block
+        case ('active_set')
+            code = nlgs_method_active_set
+        case ('coarse')
+            code = nlgs_method_coarse
+        case default
+            error stop 'bench_dem: --method nlgs|block|active_set'
+        end select
+    end function method_code
+
     !> Build, settle, time and measure one case (the system is kept for time_detection).
     subroutine run_case(sys, n, c)
         type(dem_system_t), intent(out) :: sys
         integer, intent(in) :: n
         type(case_t), intent(out) :: c
         real(wp), allocatable :: t_det(:), t_sol(:), rate(:)
-        integer :: s, n_steps, sweeps, n_conv
+        integer :: s, n_steps, sweeps, n_conv, block_solves
         real(wp) :: before_det, before_sol, sic
         ! at least 8 steps, and ~2e5 disk-steps for the small cases
         n_steps = max(8, 200000/n)
         call build(sys, n, c)
         if (settle_sweeps > 0) sys%solver%max_sweeps = settle_sweeps
         if (settle_anderson >= 0) sys%solver%anderson = settle_anderson
+        if (settle_method >= 0) sys%solver%method = settle_method
         do s = 1, n_settle
             call mj_step(sys)
         end do
         sys%solver%max_sweeps = max_sweeps
         sys%solver%anderson = anderson
+        sys%solver%method = method
         allocate (t_det(n_steps), t_sol(n_steps), rate(n_steps))
         sweeps = 0
         n_conv = 0
+        block_solves = 0
         sic = 0.0_wp
         do s = 1, n_steps
             before_det = sys%time_detection
@@ -200,8 +238,10 @@ contains
             c%sweeps_max = max(c%sweeps_max, sys%stats%sweeps)
             if (sys%stats%converged) n_conv = n_conv + 1
             sic = sic + sys%stats%siconos_error
-            if (verbose) write (output_unit, '(a, i4, a, i6, l2, es11.3, f10.2)') '# step ', s, ' sweeps', &
-                sys%stats%sweeps, sys%stats%converged, sys%stats%siconos_error, 1.0e3_wp*t_sol(s)
+            if (verbose) write (output_unit, '(a, i4, a, i6, l2, es11.3, f10.2, 2i5)') '# step ', s, ' sweeps', &
+                sys%stats%sweeps, sys%stats%converged, sys%stats%siconos_error, 1.0e3_wp*t_sol(s), &
+                sys%stats%block_solves, sys%stats%block_rejected
+            block_solves = block_solves + sys%stats%block_solves
             c%sic_max = max(c%sic_max, sys%stats%siconos_error)
         end do
         c%sic_mean = sic/n_steps
@@ -220,8 +260,9 @@ contains
             c%v_mean = sum(hypot(p%vx(1:p%n), p%vy(1:p%n)))/p%n/(gravity*step)
             c%v_max = maxval(hypot(p%vx(1:p%n), p%vy(1:p%n)))/(gravity*step)
         end associate
-        write (output_unit, '(a, i0, a, f0.1, a)') '# N = ', c%n, ' done (', sum(t_det) + sum(t_sol), &
-            ' s timed)'
+        write (output_unit, '(a, i0, a, f0.1, a, f0.2, a, f0.2, a, f0.3)') '# N = ', c%n, ' done (', &
+            sum(t_det) + sum(t_sol), ' s timed); sweeps/step ', c%sweeps, ', block solves/step ', &
+            real(block_solves, wp)/n_steps, ', converged ', c%converged
         flush (output_unit)
     end subroutine run_case
 
@@ -338,6 +379,10 @@ contains
         sys%solver%anderson = anderson
         sys%solver%hydrostatic = hydrostatic
         sys%solver%symmetric = symmetric
+        sys%solver%method = method
+        sys%solver%active_every = active_every
+        sys%solver%coarse_every = coarse_every
+        sys%solver%coarse_size = coarse_size
         call mj_init(sys, error)
         if (allocated(error)) error stop 'bench_dem: invalid setup'
         n_steps = nint(t_end/h)
@@ -504,6 +549,10 @@ contains
         sys%solver%anderson = anderson
         sys%solver%hydrostatic = hydrostatic
         sys%solver%symmetric = symmetric
+        sys%solver%method = method
+        sys%solver%active_every = active_every
+        sys%solver%coarse_every = coarse_every
+        sys%solver%coarse_size = coarse_size
         sys%solver%criterion = criterion
         call mj_init(sys, error)
         if (allocated(error)) error stop 'bench_dem: invalid setup'
