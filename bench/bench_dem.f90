@@ -27,10 +27,10 @@
 !> before timing, default 10), --settle-anderson M and --settle-sweeps C (solver of those
 !> steps, default the timed one), --verbose (sweeps, Siconos error, solver ms of every timed
 !> step), --hydrostatic (cold start from the hydrostatic estimate, `[solver] cold_start`),
-!> --method nlgs|block|active_set (`[solver] method`; default nlgs) and --active-every K
-!> (sweeps between two active-set corrections, `[solver] active_every`), --settle-method M
-!> (method of the settling steps, default the timed one). With --verbose the
-!> block solves (active-set corrections) of each step are printed after the solver time.
+!> --method nlgs|block|coarse (`[solver] method`; default nlgs), --coarse-every K and
+!> --coarse-size M (`[solver] coarse_every`, `coarse_size`), --settle-method M (method of the
+!> settling steps, default the timed one). With --verbose the coarse corrections of each
+!> step are printed after the solver time.
 !> The Siconos error of every timed step is printed too (mean and max).
 !> With `--siconos N` (200 or 2000), runs instead the deposit compared with Siconos
 !> (siconos_deposit); --csv FILE and --deck FILE write its layout as CSV and as a deck.
@@ -46,7 +46,7 @@ program bench_dem
     use dem_detection, only: detect_contacts
     use dem_moreau_jean, only: dem_system_t, mj_init, mj_step, dem_system_bytes
     use dem_nlgs, only: criterion_lmgc90, criterion_siconos, nlgs_method_nlgs, nlgs_method_block, &
-                        nlgs_method_active_set, nlgs_method_coarse
+                        nlgs_method_coarse
     use bench_packing, only: deposit_disks, deposit_width, staggered_layout
     implicit none
 
@@ -89,8 +89,8 @@ program bench_dem
     logical :: convergence = .false., sizes_given = .false., verbose = .false., symmetric = .true.
     logical :: hydrostatic = .false., criterion_given = .false.
     !> Global strategy (`[solver] method`) and sweeps between active-set corrections.
-    integer :: method = nlgs_method_nlgs, active_every = 10, settle_method = -1
-    integer :: coarse_every = 5, coarse_size = 200
+    integer :: method = nlgs_method_nlgs, settle_method = -1
+    integer :: coarse_every = 10, coarse_size = 400
     !> Siconos deposit (--siconos N): disks, and the files of the layout (empty: not written).
     integer :: siconos_n = 0
     character(len=256) :: csv_path = '', deck_path = ''
@@ -135,8 +135,6 @@ program bench_dem
             method = method_code(val)
         case ('--settle-method')
             settle_method = method_code(val)
-        case ('--active-every')
-            read (val, *) active_every
         case ('--coarse-every')
             read (val, *) coarse_every
         case ('--coarse-size')
@@ -193,12 +191,10 @@ contains
             code = nlgs_method_nlgs
         case ('block')
             code = nlgs_method_block
-        case ('active_set')
-            code = nlgs_method_active_set
         case ('coarse')
             code = nlgs_method_coarse
         case default
-            error stop 'bench_dem: --method nlgs|block|active_set'
+            error stop 'bench_dem: --method nlgs|block|coarse'
         end select
     end function method_code
 
@@ -208,7 +204,7 @@ contains
         integer, intent(in) :: n
         type(case_t), intent(out) :: c
         real(wp), allocatable :: t_det(:), t_sol(:), rate(:)
-        integer :: s, n_steps, sweeps, n_conv, block_solves
+        integer :: s, n_steps, sweeps, n_conv, corrections
         real(wp) :: before_det, before_sol, sic
         ! at least 8 steps, and ~2e5 disk-steps for the small cases
         n_steps = max(8, 200000/n)
@@ -225,7 +221,7 @@ contains
         allocate (t_det(n_steps), t_sol(n_steps), rate(n_steps))
         sweeps = 0
         n_conv = 0
-        block_solves = 0
+        corrections = 0
         sic = 0.0_wp
         do s = 1, n_steps
             before_det = sys%time_detection
@@ -238,10 +234,10 @@ contains
             c%sweeps_max = max(c%sweeps_max, sys%stats%sweeps)
             if (sys%stats%converged) n_conv = n_conv + 1
             sic = sic + sys%stats%siconos_error
-            if (verbose) write (output_unit, '(a, i4, a, i6, l2, es11.3, f10.2, 2i5)') '# step ', s, ' sweeps', &
+            if (verbose) write (output_unit, '(a, i4, a, i6, l2, es11.3, f10.2, i5)') '# step ', s, ' sweeps', &
                 sys%stats%sweeps, sys%stats%converged, sys%stats%siconos_error, 1.0e3_wp*t_sol(s), &
-                sys%stats%block_solves, sys%stats%block_rejected
-            block_solves = block_solves + sys%stats%block_solves
+                sys%stats%corrections
+            corrections = corrections + sys%stats%corrections
             c%sic_max = max(c%sic_max, sys%stats%siconos_error)
         end do
         c%sic_mean = sic/n_steps
@@ -261,8 +257,8 @@ contains
             c%v_max = maxval(hypot(p%vx(1:p%n), p%vy(1:p%n)))/(gravity*step)
         end associate
         write (output_unit, '(a, i0, a, f0.1, a, f0.2, a, f0.2, a, f0.3)') '# N = ', c%n, ' done (', &
-            sum(t_det) + sum(t_sol), ' s timed); sweeps/step ', c%sweeps, ', block solves/step ', &
-            real(block_solves, wp)/n_steps, ', converged ', c%converged
+            sum(t_det) + sum(t_sol), ' s timed); sweeps/step ', c%sweeps, ', coarse corrections/step ', &
+            real(corrections, wp)/n_steps, ', converged ', c%converged
         flush (output_unit)
     end subroutine run_case
 
@@ -380,7 +376,6 @@ contains
         sys%solver%hydrostatic = hydrostatic
         sys%solver%symmetric = symmetric
         sys%solver%method = method
-        sys%solver%active_every = active_every
         sys%solver%coarse_every = coarse_every
         sys%solver%coarse_size = coarse_size
         call mj_init(sys, error)
@@ -550,7 +545,6 @@ contains
         sys%solver%hydrostatic = hydrostatic
         sys%solver%symmetric = symmetric
         sys%solver%method = method
-        sys%solver%active_every = active_every
         sys%solver%coarse_every = coarse_every
         sys%solver%coarse_size = coarse_size
         sys%solver%criterion = criterion

@@ -48,23 +48,6 @@
 !> rest of the step, joins the sweeps with its own (cohesive) law, and the step is solved
 !> again from the current reactions. This is the problem the plain NLGS solves, so the
 !> judgement of dem_contacts (contacts_finish) then breaks it exactly as after the NLGS.
-!>
-!> Active set (`correction` set, `[solver] method = active_set`; doc/theory.md, "Active-set
-!> correction"): the same machinery as a correction of the sweeps over all the contacts of a
-!> packing. The pattern is that of every active contact (analysed once while the list of
-!> active pairs does not change); at each correction the contacts that are closed and
-!> sticking in the current iterate (r_n + r_cohe h > 0, and the last local solve found them
-!> sticking or their reaction is strictly inside the cone) form the set L, and
-!>     (W_LL + eps I) dr_L = -u_L,   dr = 0 on the other contacts,
-!> is solved with the other reactions fixed: L treated as bilateral, as the bonds above. The
-!> rows of the contacts outside L are made identity rows of the same pattern (their entries
-!> are set to zero), so the symbolic analysis is reused while the active list holds and only
-!> the numerical factorisation is redone when L or the values change. The sweeps over all
-!> the contacts (nlgs_block_t%correction) then restore Signorini and Coulomb with the
-!> bi-potential local solver: a contact that the correction pulled out of its cone is
-!> projected back by its next local solve. A packing carries its weight through the sticking
-!> contacts, so one correction transmits it through the whole height, where a sweep carries
-!> it down by one layer.
 module dem_bonded_block
     use core_kinds, only: wp, i8
     use core_error, only: error_t
@@ -156,15 +139,6 @@ module dem_bonded_block
         real(wp) :: eps = 0.0_wp
         !> Work arrays (nu).
         real(wp), allocatable :: rhs(:), x(:)
-        !> Active set (correction): bond b (contact bond(b)) is in L at this correction (nb);
-        !> all .true. for the bonded block.
-        logical, allocatable :: lock(:)
-        !> Active set: members in L at the last correction.
-        integer :: n_locked = 0
-        !> Active set: unknown u is solved at this correction (nu); all .true. otherwise.
-        logical, allocatable :: urow(:)
-        !> Active set: lock the normal components only (tangential reactions fixed).
-        logical :: normal_only = .false.
         !> Restart (`bonded_block_restore`): values of the factor in use at the checkpoint,
         !> factored at the next `prepare` when its bond graph is the restored key.
         real(wp), allocatable :: restore_values(:)
@@ -299,11 +273,7 @@ contains
             if (allocated(self%excluded)) then
                 if (k <= size(self%excluded)) excl = self%excluded(k)
             end if
-            if (self%correction) then
-                self%member(k) = cs%active(k)
-            else
-                self%member(k) = cs%active(k) .and. cs%status(k) == status_cohesive .and. .not. excl
-            end if
+            self%member(k) = cs%active(k) .and. cs%status(k) == status_cohesive .and. .not. excl
         end do
         self%nb = count(self%member(1:cs%n))
         if (allocated(self%bond)) deallocate (self%bond, self%first)
@@ -333,11 +303,6 @@ contains
                 u = u + 1
             end do
         end do
-        if (allocated(self%lock)) deallocate (self%lock)
-        allocate (self%lock(self%nb), source=.true.)
-        if (allocated(self%urow)) deallocate (self%urow)
-        allocate (self%urow(self%nu), source=.true.)
-        if (self%correction .and. allocated(self%restore_values)) deallocate (self%restore_values)
         if (self%nb == 0) then
             if (allocated(self%restore_values)) deallocate (self%restore_values)
             return
@@ -391,14 +356,12 @@ contains
                 self%diag(u) = self%mat%position(u, u)
             end do
         end if
-        if (.not. self%correction) then
-            self%eps = bonded_block_eps_ratio*maxval(self%mat%values(self%diag))
-            if (self%eps <= 0.0_wp) then
-                call give_up(self)
-                return
-            end if
-            self%mat%values(self%diag) = self%mat%values(self%diag) + self%eps
+        self%eps = bonded_block_eps_ratio*maxval(self%mat%values(self%diag))
+        if (self%eps <= 0.0_wp) then
+            call give_up(self)
+            return
         end if
+        self%mat%values(self%diag) = self%mat%values(self%diag) + self%eps
         if (.not. same) then
             call self%solver%analyse(self%mat, error, kind=sparse_cholesky)
             if (allocated(error)) then
@@ -409,8 +372,6 @@ contains
             self%counts%analyses = self%counts%analyses + 1
         end if
         call size_work(self)
-        ! active set: the values depend on L, set and factored by each correction (solve)
-        if (self%correction) return
         if (self%factored) then
             ! keep the factor; `solve` refactors if it no longer contracts well
             self%stale = any(self%mat%values /= self%values_factored)
@@ -707,13 +668,9 @@ contains
         real(wp) :: u(3), rnorm, prev, noise
         integer :: b, k, p, it
         if (self%nb == 0 .or. self%lost) return
-        if (self%correction) then
-            call set_active(self, cs)
-            if (self%n_locked == 0 .or. self%lost) return
-        end if
         noise = 0.0_wp
         do b = 1, self%nb
-            if (self%lock(b)) noise = noise + velocity_scale2(cs, self%bond(b), vel)
+            noise = noise + velocity_scale2(cs, self%bond(b), vel)
         end do
         noise = roundoff*sqrt(noise)
         prev = huge(1.0_wp)
@@ -722,18 +679,12 @@ contains
             ! the residual of the bonds, -u_B, from the velocities themselves
             do b = 1, self%nb
                 k = self%bond(b)
-                if (self%lock(b)) then
-                    u = relative_velocity(cs, k, vel)
-                else
-                    u = 0.0_wp
-                end if
+                u = relative_velocity(cs, k, vel)
                 do p = self%first(b), self%first(b + 1) - 1
-                    self%rhs(p) = merge(-u(self%comp(p)), 0.0_wp, self%urow(p))
+                    self%rhs(p) = -u(self%comp(p))
                 end do
             end do
             rnorm = norm2(self%rhs)
-            if (.false.) write (0, *) 'DBG pass', it, ' locked', self%n_locked, ' of', self%nb, &
-                ' rnorm', rnorm, ' noise', noise, ' |x|', norm2(self%x), ' max r', maxval(abs(cs%r(1, self%bond)))
             if (rnorm <= noise) exit
             if (rnorm > stale_contraction*prev) then
                 if (self%stale) then
@@ -764,10 +715,8 @@ contains
                 self%counts%refinements = self%counts%refinements + 1
             end if
             do b = 1, self%nb
-                if (.not. self%lock(b)) cycle
                 k = self%bond(b)
                 do p = self%first(b), self%first(b + 1) - 1
-                    if (.not. self%urow(p)) self%x(p) = 0.0_wp
                     cs%r(self%comp(p), k) = cs%r(self%comp(p), k) + self%x(p)
                 end do
                 call apply_change(cs, k, im, vel, b)
@@ -796,80 +745,6 @@ contains
             end do
         end subroutine apply_change
     end subroutine solve
-
-    !> Active set: choose L among the members (module header), set the values of W_LL + eps I
-    !> with identity rows for the other members, and factor them unless the factor in hand
-    !> is of exactly these values.
-    subroutine set_active(self, cs)
-        type(bonded_block_t), intent(inout) :: self
-        type(contact_set_t), intent(in) :: cs
-        integer :: b, i, u
-        real(wp) :: dmax
-        do b = 1, self%nb
-            if (self%normal_only) then
-                self%lock(b) = cs%r(1, self%bond(b)) + cs%coh(self%bond(b)) > 0.0_wp
-            else
-                self%lock(b) = sticking(cs, self%bond(b))
-            end if
-        end do
-        self%n_locked = count(self%lock)
-        if (self%n_locked == 0) return
-        associate (row_in => self%urow)
-        do b = 1, self%nb
-            row_in(self%first(b):self%first(b + 1) - 1) = self%lock(b)
-        end do
-        if (self%normal_only) row_in = row_in .and. self%comp(1:self%nu) == 1
-        self%mat%values = 0.0_wp
-        do i = 1, self%nt
-            if (row_in(self%ti(i)) .and. row_in(self%tj(i))) &
-                self%mat%values(self%pos(i)) = self%mat%values(self%pos(i)) + self%tv(i)
-        end do
-        dmax = 0.0_wp
-        do u = 1, self%nu
-            if (row_in(u)) dmax = max(dmax, self%mat%values(self%diag(u)))
-        end do
-        self%eps = bonded_block_eps_ratio*dmax
-        if (self%eps <= 0.0_wp) then
-            self%n_locked = 0
-            return
-        end if
-        do u = 1, self%nu
-            if (row_in(u)) then
-                self%mat%values(self%diag(u)) = self%mat%values(self%diag(u)) + self%eps
-            else
-                self%mat%values(self%diag(u)) = 1.0_wp
-            end if
-        end do
-        if (self%factored) then
-            if (size(self%values_factored) == size(self%mat%values)) then
-                if (all(self%mat%values == self%values_factored)) then
-                    self%counts%reuses = self%counts%reuses + 1
-                    return
-                end if
-            end if
-        end if
-        call refactor(self)
-        if (.not. self%factored) then
-            self%lost = .true.
-            self%analysed = .false.
-            self%counts%failures = self%counts%failures + 1
-        end if
-        end associate
-    end subroutine set_active
-
-    !> Contact k is closed and sticking in the current iterate: r_n + r_cohe h > 0, and its
-    !> last local solve found it sticking or its reaction lies strictly inside its cone.
-    pure logical function sticking(cs, k) result(yes)
-        type(contact_set_t), intent(in) :: cs
-        integer, intent(in) :: k
-        real(wp) :: rn
-        rn = cs%r(1, k) + cs%coh(k)
-        yes = rn > 0.0_wp .and. all(cs%shift(:, k) == 0.0_wp)
-        if (.not. yes) return
-        if (cs%pcase(k) == case_stick) return
-        if (cs%mu(k) > 0.0_wp) yes = abs(cs%r(2, k)) < cs%mu(k)*rn
-        if (cs%erol(k) > 0.0_wp) yes = yes .and. abs(cs%r(3, k)) < cs%erol(k)*rn
-    end function sticking
 
     !> |v_1|^2 + |v_2|^2 of the bodies of contact k (rotations times the mean radius).
     pure real(wp) function velocity_scale2(cs, k, vel) result(q)

@@ -39,8 +39,7 @@ module dem_moreau_jean
                             contacts_set_laws, contacts_finish, contacts_impulses, contacts_local_velocity, &
                             contacts_bytes
     use dem_detection, only: detector_t, detect_contacts, detector_bytes
-    use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_bilateral_t, nlgs_method_block, &
-                        nlgs_method_active_set
+    use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_bilateral_t, nlgs_method_block
     use dem_bonded_block, only: bonded_block_t, bonded_block_solve
     use dem_bonds, only: rupture_log_t, break_none
     implicit none
@@ -103,11 +102,6 @@ module dem_moreau_jean
         !> kept from step to step. Allocated at the first block solve (so that copies of a
         !> system that has not run yet carry no CHOLMOD object).
         type(bonded_block_t), allocatable :: block
-        !> Active-set corrections of the sweeps (solver%method = nlgs_method_active_set): the
-        !> symbolic analysis is kept from step to step while the active pairs do not change.
-        !> Allocated at the first solve; not checkpointed (every factor it uses is of the
-        !> current values, so a restart analyses again and gives the same results).
-        type(bonded_block_t), allocatable :: active
         !> Contact list.
         type(contact_set_t) :: contacts
         !> Detection workspace.
@@ -244,8 +238,7 @@ contains
     end subroutine mj_detect
 
     !> Part 3 of a step: the contact solve (NLGS, or with solver%method = nlgs_method_block
-    !> the intact bonds as a direct block, dem_bonded_block, or with nlgs_method_active_set
-    !> the sweeps corrected by direct solves of the sticking contacts) from the velocities in `vel`;
+    !> the intact bonds as a direct block, dem_bonded_block) from the velocities in `vel`;
     !> end-of-step velocities in `vel`.
     subroutine mj_solve(sys, bilateral)
         !> System, after `mj_detect`.
@@ -257,17 +250,6 @@ contains
         if (sys%solver%method == nlgs_method_block) then
             if (.not. allocated(sys%block)) allocate (sys%block)
             call bonded_block_solve(sys%solver, sys%block, sys%contacts, sys%im, sys%vel, sys%stats, bilateral)
-        else if (sys%solver%method == nlgs_method_active_set) then
-            if (.not. allocated(sys%active)) then
-                allocate (sys%active)
-                sys%active%correction = .true.
-                block
-                    integer :: lenv
-                    call get_environment_variable('AS_NORMAL', length=lenv)
-                    sys%active%normal_only = lenv > 0
-                end block
-            end if
-            call nlgs_solve(sys%solver, sys%contacts, sys%im, sys%vel, sys%stats, bilateral, sys%active)
         else
             call nlgs_solve(sys%solver, sys%contacts, sys%im, sys%vel, sys%stats, bilateral)
         end if

@@ -52,12 +52,12 @@
 !> converge; after each sweep `measure` gives the block's share of the convergence norm (the
 !> change of the members' local velocities the next solve would make, and their |W r|), so
 !> that `sweeps` counts block iterations.
-!> With `correction` set (the active set of dem_bonded_block, `method = active_set`), the
-!> members are not taken out of the sweeps: every active contact is swept with its local
-!> solver, and `solve` is a correction applied once after the warm start and then after
-!> every `active_every` sweeps (after the Anderson step, whose history then restarts). The
-!> sweeps alone decide convergence, so the converged state is a fixed point of the plain
-!> sweeps: the same problem as the NLGS solves.
+!>
+!> Coarse correction (`method = coarse`, coarse_correct): before the first sweep and after
+!> every `coarse_every` sweeps, the reactions of aggregates of consecutive contacts are
+!> scaled by the Galerkin solution of a small system (one unknown per aggregate), which
+!> moves the weight through the whole height of a packing at once. It does nothing at a
+!> solution of the sweeps, and the sweeps alone decide convergence.
 module dem_nlgs
     use core_kinds, only: wp, i8
     use core_constants, only: diagonal_floor
@@ -72,20 +72,16 @@ module dem_nlgs
     private
     public :: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_apply_reactions, nlgs_residual
     public :: nlgs_bilateral_t, nlgs_block_t
-    public :: nlgs_method_nlgs, nlgs_method_block, nlgs_method_active_set, nlgs_method_coarse
+    public :: nlgs_method_nlgs, nlgs_method_block, nlgs_method_coarse
 
     !> Global strategy: Gauss-Seidel sweeps over every contact.
     integer, parameter :: nlgs_method_nlgs = 1
     !> Global strategy: intact bonds solved directly as one block, sweeps over the others
     !> (dem_bonded_block).
     integer, parameter :: nlgs_method_block = 2
-    !> Global strategy: sweeps over every contact, corrected every `active_every` sweeps by a
-    !> direct solve of the contacts that are closed and sticking (dem_bonded_block, active
-    !> set).
-    integer, parameter :: nlgs_method_active_set = 3
-    !> Global strategy: sweeps over every contact with a coarse correction of the normal
-    !> reactions by aggregates of contacts every `coarse_every` sweeps (coarse_correct).
-    integer, parameter :: nlgs_method_coarse = 4
+    !> Global strategy: sweeps over every contact with a coarse correction of the reactions
+    !> by aggregates of contacts every `coarse_every` sweeps (coarse_correct).
+    integer, parameter :: nlgs_method_coarse = 3
     public :: nlgs_siconos_error
     public :: criterion_lmgc90, criterion_siconos, criterion_names
 
@@ -115,14 +111,12 @@ module dem_nlgs
         integer :: local_max_iter = 8
         !> Alternate the sweep direction.
         logical :: symmetric = .true.
-        !> Global strategy (nlgs_method_nlgs, nlgs_method_block or nlgs_method_active_set),
+        !> Global strategy (nlgs_method_nlgs, nlgs_method_block or nlgs_method_coarse),
         !> chosen by the caller.
         integer :: method = nlgs_method_nlgs
-        !> Sweeps between two corrections of a block with `correction` set (active set).
-        integer :: active_every = 10
         !> Coarse correction (nlgs_method_coarse): sweeps between two corrections, and
         !> contacts per aggregate (consecutive contacts of the solve).
-        integer :: coarse_every = 5, coarse_size = 200
+        integer :: coarse_every = 10, coarse_size = 400
         !> Over-relaxation factor omega in (0, 2): each contact update becomes
         !> P_K(r0 + omega (r_loc - r0)) (module header); 1 is plain NLGS.
         real(wp) :: relaxation = 1.0_wp
@@ -170,10 +164,8 @@ module dem_nlgs
         logical :: converged = .true.
         !> Active contacts solved as a block (nlgs_block_t members), not swept.
         integer :: n_block = 0
-        !> Calls of the block's `solve` (block solves, or corrections of an active set).
-        integer :: block_solves = 0
-        !> Corrections of an active set undone because they raised the residual of the laws.
-        integer :: block_rejected = 0
+        !> Coarse corrections done (nlgs_method_coarse).
+        integer :: corrections = 0
     end type nlgs_stats_t
 
     !> History of the Anderson acceleration: differences of the sweep map's outputs g and
@@ -252,9 +244,6 @@ module dem_nlgs
         !> Contact k is a member of the block in the current solve (size >= cs%n), set by
         !> `prepare`.
         logical, allocatable :: member(:)
-        !> The members are swept too and `solve` is a correction every `active_every` sweeps
-        !> (module header); otherwise they are solved only by the block.
-        logical :: correction = .false.
     contains
         !> Choose the members among the active contacts and set the block up.
         procedure(block_prepare), deferred :: prepare
@@ -341,7 +330,7 @@ contains
         real(wp) :: floor, omega, checked
         type(anderson_t) :: aa
         type(split_t) :: split
-        logical :: accelerate, correcting
+        logical :: accelerate, coarse
         integer :: s, k, n_swept, nb
         stats%n_contacts = cs%n
         call skip_blocked(cs, stats%n_blocked)
@@ -349,7 +338,7 @@ contains
         stats%n_block = 0
         if (present(block)) then
             call block%prepare(cs, im, bilateral)
-            if (.not. block%correction) stats%n_block = count(block%member(1:cs%n))
+            stats%n_block = count(block%member(1:cs%n))
         end if
         n_swept = stats%n_active - stats%n_block
         allocate (list(n_swept), sc(rolling_n_scaling, n_swept))
@@ -360,7 +349,7 @@ contains
         do k = 1, cs%n
             if (.not. cs%active(k)) cycle
             if (present(block)) then
-                if (block%member(k) .and. .not. block%correction) cycle
+                if (block%member(k)) cycle
             end if
             s = s + 1
             list(s) = k
@@ -378,16 +367,7 @@ contains
             if (cs%active(k)) floor = floor + roundoff_floor(cs, k, vel)
         end do
         if (present(bilateral)) call bilateral%restore(vel)
-        correcting = .false.
-        if (present(block)) then
-            correcting = block%correction
-            if (correcting) then
-                call correct(correcting)
-            else
-                call block%solve(cs, im, vel, bilateral)
-                stats%block_solves = 1
-            end if
-        end if
+        if (present(block)) call block%solve(cs, im, vel, bilateral)
         stats%converged = .true.
         stats%error = 0.0_wp
         omega = config%relaxation
@@ -396,9 +376,13 @@ contains
         ! of a block or bilateral constraints, whose impulses are not among them
         accelerate = config%anderson > 0 .and. .not. present(bilateral) .and. stats%n_block == 0 .and. n_swept > 0
         if (accelerate) call anderson_init(aa, config%anderson, cs, list)
-        if (config%method == nlgs_method_coarse .and. .not. present(bilateral) .and. stats%n_active > 0) then
+        ! the coarse correction scales swept contacts only: not with a block or bilateral rows
+        coarse = config%method == nlgs_method_coarse .and. .not. present(bilateral) .and. stats%n_block == 0 &
+                 .and. n_swept > 0
+        stats%corrections = 0
+        if (coarse) then
             call coarse_correct(cs, list, im, vel, config%coarse_size)
-            stats%block_solves = stats%block_solves + 1
+            stats%corrections = 1
         end if
         nb = 1
 !$      nb = omp_get_max_threads()
@@ -417,11 +401,9 @@ contains
                                      .not. (config%symmetric .and. mod(s, 2) == 0), num, den, nloc, bilateral)
                 end if
                 if (present(block)) then
-                    if (.not. block%correction) then
-                        call block%measure(cs, vel, num_b, den_b)
-                        num = num + num_b
-                        den = den + den_b
-                    end if
+                    call block%measure(cs, vel, num_b, den_b)
+                    num = num + num_b
+                    den = den + den_b
                 end if
                 stats%sweeps = s
                 stats%local_iterations = stats%local_iterations + nloc
@@ -434,26 +416,16 @@ contains
                     stats%converged = .true.
                     exit
                 end if
-                if (present(block)) then
-                    if (.not. block%correction) then
-                        call block%solve(cs, im, vel, bilateral)
-                        stats%block_solves = stats%block_solves + 1
-                    end if
-                end if
+                if (present(block)) call block%solve(cs, im, vel, bilateral)
                 ! safeguard of the over-relaxation
                 if (omega /= 1.0_wp .and. mod(s, config%check_every) == 0) then
                     if (stats%error > checked) omega = 1.0_wp
                     checked = stats%error
                 end if
                 if (accelerate) call anderson_mix(aa, cs, list, im, vfree, vel, split)
-                if (config%method == nlgs_method_coarse .and. .not. present(bilateral) .and. &
-                    mod(s, max(config%coarse_every, 1)) == 0) then
+                if (coarse .and. mod(s, config%coarse_every) == 0) then
                     call coarse_correct(cs, list, im, vel, config%coarse_size)
-                    stats%block_solves = stats%block_solves + 1
-                    if (accelerate) call anderson_restart(aa)
-                end if
-                if (correcting .and. mod(s, max(config%active_every, 1)) == 0) then
-                    call correct(correcting)
+                    stats%corrections = stats%corrections + 1
                     ! the correction is not a sweep: the history of the sweep map restarts
                     if (accelerate) call anderson_restart(aa)
                 end if
@@ -463,27 +435,6 @@ contains
         stats%updates = int(n_swept, i8)*stats%sweeps
         stats%residual = nlgs_residual(cs, vel)
         stats%siconos_error = siconos_error(cs, im, vfree, vel, vwork, present(bilateral))
-    contains
-        ! One correction of the block (active set), kept only when it lowers the residual of
-        ! the contact laws (nlgs_residual); a rejected correction is undone and ends the
-        ! corrections of this solve (keep = .false.).
-        subroutine correct(keep)
-            logical, intent(inout) :: keep
-            real(wp), allocatable :: r_saved(:, :), v_saved(:, :)
-            real(wp) :: before
-            before = nlgs_residual(cs, vel)
-            r_saved = cs%r(:, 1:cs%n)
-            v_saved = vel
-            call block%solve(cs, im, vel, bilateral)
-            stats%block_solves = stats%block_solves + 1
-            if (nlgs_residual(cs, vel) > before) then
-                cs%r(:, 1:cs%n) = r_saved
-                vel = v_saved
-                if (present(bilateral)) call bilateral%restore(vel)
-                stats%block_rejected = stats%block_rejected + 1
-                keep = .false.
-            end if
-        end subroutine correct
     end subroutine nlgs_solve
 
     !> Hydrostatic estimate of the reactions of a cold solve (config%hydrostatic): the
@@ -644,20 +595,21 @@ contains
         end subroutine set
     end subroutine hydrostatic_guess
 
-    !> Coarse correction of the normal reactions (nlgs_method_coarse; doc/theory.md, "Coarse
-    !> correction"). The contacts of the solve, in their order (bottom-up for a packing
-    !> numbered by rows), are cut into aggregates A of `size_agg` consecutive contacts. The
-    !> correction scales the normal reactions of each aggregate, r_n <- (1 + alpha_A) r_n
-    !> (contacts with cohesion are left out), with alpha the Galerkin solution of
-    !>     sum_{k in A} r_n,k u_n,k(alpha) = 0   for every A,
-    !> u_n the shifted normal velocity the sweeps see: C alpha = b with
-    !> C_AB = sum_{k in A, l in B} r_n,k r_n,l n_k^T H_k^T M^-1 H_l n_l (symmetric, sparse
-    !> between neighbouring aggregates; factored dense) and b_A = -sum_{k in A} r_n,k u_n,k.
-    !> At a solution of the sweeps every contact with r_n > 0 has u_n = 0, so b = 0 and the
-    !> correction does nothing: the fixed point is that of the plain sweeps. Away from it the
-    !> correction moves the weight between layers in one step, where a sweep moves it by one
-    !> layer. alpha_A is bounded below by -1/2 (the reactions keep their sign); the sweeps then
-    !> restore the laws exactly.
+    !> Coarse correction of the reactions (nlgs_method_coarse; doc/theory.md 4.6). The
+    !> contacts of the solve, in their order (bottom-up for a packing numbered by rows), are
+    !> cut into aggregates A of `size_agg` consecutive contacts. Each contact with r_n > 0 and
+    !> no cohesion has a pattern p: its reaction when strictly inside its cone (sticking),
+    !> (r_n, 0, 0) otherwise (sliding). The correction is r <- r + a_A p on the contacts of
+    !> each aggregate, with a the Galerkin solution of
+    !>     sum_{k in A} p_k . u_k(a) = 0   for every A,
+    !> u the shifted relative velocities the sweeps see: C a = b with
+    !> C_AB = (H P_A)^T M^-1 (H P_B) (symmetric, nonzero between aggregates that share a disk;
+    !> factored dense) and b_A = -sum_{k in A} p_k . u_k. At a solution of the sweeps a
+    !> sticking contact has u = 0 and a sliding one u_n = 0, so b = 0 and the correction does
+    !> nothing: the fixed point is that of the plain sweeps. Away from it the correction moves
+    !> the weight between layers in one step, where a sweep moves it by one layer. a_A is
+    !> bounded below by -1/2 (the reactions keep their sign); the next sweep projects any
+    !> reaction left outside its cone.
     subroutine coarse_correct(cs, list, im, vel, size_agg)
         type(contact_set_t), intent(inout) :: cs
         integer, intent(in) :: list(:)
@@ -669,10 +621,11 @@ contains
         integer, allocatable :: start(:), inc(:), fill(:)
         real(wp), allocatable :: b(:), pat(:, :)
         real(wp) :: u(3), dmax, dr, rn, ga_imp(3), gb_imp(3)
-        integer :: n, na, nd, a, k, e, f, d, ga, gb, af
+        integer :: n, na, nd, a, k, e, f, d, ga, gb, af, m
         n = size(list)
         if (n == 0) return
-        na = (n + max(size_agg, 1) - 1)/max(size_agg, 1)
+        m = max(size_agg, 1)
+        na = (n + m - 1)/m
         nd = size(vel, 2)
         ! pattern of each position (the reaction it scales) and the incidence of the disks
         allocate (pat(3, n), b(na), start(nd + 1), fill(nd), inc(2*n))
@@ -690,7 +643,7 @@ contains
                     (cs%erol(k) <= 0.0_wp .or. abs(cs%r(3, k)) < cs%erol(k)*rn)) pat(2:3, a) = cs%r(2:3, k)
             end if
             call local_velocity(cs, k, vel, u)
-            ga = (a - 1)/size_agg + 1
+            ga = (a - 1)/m + 1
             b(ga) = b(ga) - dot_product(pat(:, a), u)
             start(cs%i2(k) + 1) = start(cs%i2(k) + 1) + 1
             if (cs%i1(k) > 0) start(cs%i1(k) + 1) = start(cs%i1(k) + 1) + 1
@@ -714,12 +667,12 @@ contains
             do e = start(d), start(d + 1) - 1
                 a = abs(inc(e))
                 if (pat(1, a) == 0.0_wp) cycle
-                ga = (a - 1)/size_agg + 1
+                ga = (a - 1)/m + 1
                 ga_imp = impulse(a, inc(e) > 0)
                 do f = start(d), start(d + 1) - 1
                     af = abs(inc(f))
                     if (pat(1, af) == 0.0_wp) cycle
-                    gb = (af - 1)/size_agg + 1
+                    gb = (af - 1)/m + 1
                     if (gb < ga) cycle
                     ! the diagonal block (ga == gb) sums both orders of a pair
                     if (ga == gb .and. af < a) cycle
@@ -749,7 +702,7 @@ contains
         do a = 1, n
             if (pat(1, a) == 0.0_wp) cycle
             k = list(a)
-            dr = max(b((a - 1)/size_agg + 1), -0.5_wp)
+            dr = max(b((a - 1)/m + 1), -0.5_wp)
             cs%r(:, k) = cs%r(:, k) + dr*pat(:, a)
             call apply(cs, k, im, vel, dr*pat(1, a), dr*pat(2, a), dr*pat(3, a))
         end do

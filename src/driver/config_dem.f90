@@ -29,7 +29,7 @@ module driver_config_dem
     use dem_contacts, only: contact_set_t
     use dem_detection, only: detector_t, detect_contacts
     use dem_moreau_jean, only: dem_system_t
-    use dem_nlgs, only: nlgs_method_nlgs, nlgs_method_block, criterion_lmgc90, criterion_siconos
+    use dem_nlgs, only: nlgs_method_nlgs, nlgs_method_block, nlgs_method_coarse, criterion_lmgc90, criterion_siconos
     use driver_config, only: run_config_t
     implicit none
     private
@@ -667,6 +667,9 @@ contains
             sys%solver%local_max_iter = deck%get_int('solver', 'local_iterations')
             sys%solver%method = nlgs_method_nlgs
             if (deck%get_word('solver', 'method') == 'block') sys%solver%method = nlgs_method_block
+            if (deck%get_word('solver', 'method') == 'coarse') sys%solver%method = nlgs_method_coarse
+            sys%solver%coarse_every = deck%get_int('solver', 'coarse_every')
+            sys%solver%coarse_size = deck%get_int('solver', 'coarse_size')
             sys%solver%relaxation = deck%get_real('solver', 'relaxation')
             sys%solver%check_every = deck%get_int('solver', 'check_every')
             sys%solver%anderson = deck%get_int('solver', 'anderson')

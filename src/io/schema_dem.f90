@@ -151,13 +151,16 @@ contains
         call s%add_section('solver', 'Contact solver of the particles: non-linear Gauss-Seidel '// &
                            'sweeps over the contacts with the bi-potential local solver, at every time step; '// &
                            'with `method = block` the intact bonds are solved directly as one block.')
-        call s%add_keyword('solver', 'method', [word_field('method', 'block nlgs')], &
+        call s%add_keyword('solver', 'method', [word_field('method', 'block nlgs coarse')], &
                            'Global strategy. `nlgs`: Gauss-Seidel sweeps over every contact. `block`: the '// &
                            'intact bonds (with the coupling rows) are solved exactly as one sparse block '// &
                            '(CHOLMOD), alternating with sweeps over the other contacts (block Gauss-Seidel); a '// &
                            'bond whose reaction leaves its cone is released and the step solved again, so the '// &
-                           'bonds break as with `nlgs`. Without bonds both are the same sweeps. Every '// &
-                           'unilateral or frictional contact uses the bi-potential local solver in both.', &
+                           'bonds break as with `nlgs`. Without bonds both are the same sweeps. `coarse`: the '// &
+                           'sweeps of `nlgs` with a coarse correction every `coarse_every` sweeps, which scales '// &
+                           'the reactions of aggregates of `coarse_size` consecutive contacts at once (for tall '// &
+                           'packings away from rest, doc/performance.md; it changes nothing at a solution). Every '// &
+                           'unilateral or frictional contact uses the bi-potential local solver in all three.', &
                            default='block')
         call s%add_keyword('solver', 'tolerance', [positive('tolerance', '')], &
                            'Convergence of the sweeps: change of the local velocities over a sweep relative '// &
@@ -197,6 +200,12 @@ contains
                            'it cuts the sweeps of that step 2 to 6 times. Not used with the Arlequin '// &
                            'coupling rows, nor in a step where method = block solves intact bonds directly.', &
                            default='zero')
+        call s%add_keyword('solver', 'coarse_every', [int_field('coarse_every', lower=1)], &
+                           'With `method = coarse`: sweeps between two coarse corrections (one more before '// &
+                           'the first sweep).', default='10')
+        call s%add_keyword('solver', 'coarse_size', [int_field('coarse_size', lower=1)], &
+                           'With `method = coarse`: contacts per aggregate, consecutive in the contact list '// &
+                           '(ordered by disk: disks numbered by layers give horizontal slabs).', default='400')
         call s%add_keyword('solver', 'check_every', [int_field('check_every', lower=1)], &
                            'Period in sweeps of the safeguard of the over-relaxation.', default='10')
         call s%add_keyword('solver', 'fclib_step', [int_field('fclib_step', lower=1)], &
