@@ -186,6 +186,9 @@ module dem_nlgs
         integer, allocatable :: start(:), pos(:), interface(:)
     end type split_t
 
+    !> Largest number of aggregates of the coarse correction (its system is factored dense:
+    !> 2000^3/3 flops, about 1 s; larger aggregates are used beyond).
+    integer, parameter :: max_aggregates = 2000
     !> Chunk of the deterministic parallel dot products (pdot).
     integer, parameter :: dot_chunk = 4096
     !> Tikhonov term of the Anderson least-squares system, relative to its trace: far above
@@ -597,7 +600,8 @@ contains
 
     !> Coarse correction of the reactions (nlgs_method_coarse; doc/theory.md 4.6). The
     !> contacts of the solve, in their order (bottom-up for a packing numbered by rows), are
-    !> cut into aggregates A of `size_agg` consecutive contacts. Each contact with r_n > 0 and
+    !> cut into aggregates A of `size_agg` consecutive contacts (at most max_aggregates
+    !> aggregates). Each contact with r_n > 0 and
     !> no cohesion has a pattern p: its reaction when strictly inside its cone (sticking),
     !> (r_n, 0, 0) otherwise (sliding). The correction is r <- r + a_A p on the contacts of
     !> each aggregate, with a the Galerkin solution of
@@ -624,7 +628,8 @@ contains
         integer :: n, na, nd, a, k, e, f, d, ga, gb, af, m
         n = size(list)
         if (n == 0) return
-        m = max(size_agg, 1)
+        ! at most max_aggregates aggregates (the coarse system is dense)
+        m = max(size_agg, 1, (n + max_aggregates - 1)/max_aggregates)
         na = (n + m - 1)/m
         nd = size(vel, 2)
         ! pattern of each position (the reaction it scales) and the incidence of the disks

@@ -205,7 +205,8 @@ contains
                            'the first sweep).', default='10')
         call s%add_keyword('solver', 'coarse_size', [int_field('coarse_size', lower=1)], &
                            'With `method = coarse`: contacts per aggregate, consecutive in the contact list '// &
-                           '(ordered by disk: disks numbered by layers give horizontal slabs).', default='400')
+                           '(ordered by disk: disks numbered by layers give horizontal slabs); larger when '// &
+                           'there would be more than 2000 aggregates.', default='400')
         call s%add_keyword('solver', 'check_every', [int_field('check_every', lower=1)], &
                            'Period in sweeps of the safeguard of the over-relaxation.', default='10')
         call s%add_keyword('solver', 'fclib_step', [int_field('fclib_step', lower=1)], &
