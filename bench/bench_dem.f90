@@ -88,7 +88,8 @@ program bench_dem
     integer :: anderson = 0, settle_anderson = -1
     logical :: convergence = .false., sizes_given = .false., verbose = .false., symmetric = .true.
     logical :: hydrostatic = .false., criterion_given = .false.
-    !> Global strategy (`[solver] method`) and sweeps between active-set corrections.
+    !> Global strategy (`[solver] method`; of the settling steps, -1: the same) and the
+    !> coarse correction (`coarse_every`, `coarse_size`).
     integer :: method = nlgs_method_nlgs, settle_method = -1
     integer :: coarse_every = 10, coarse_size = 400
     !> Siconos deposit (--siconos N): disks, and the files of the layout (empty: not written).
