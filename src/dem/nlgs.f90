@@ -179,11 +179,13 @@ module dem_nlgs
         logical :: started = .false.
     end type anderson_t
 
-    !> Domain split of the sweeps (split_build): blocks of positions in the list of the
-    !> solve, swept in parallel, and the interface positions, swept after them.
+    !> Domain split of the sweeps (split_build): the contacts of the solve in block order,
+    !> order(start(b):start(b + 1) - 1) for block b (swept in parallel), then the interface,
+    !> order(start(nb + 1):), swept after them. The scaled frames of the solve are stored in the
+    !> same order, so that a block is swept over contiguous memory like the serial sweep.
     type :: split_t
         integer :: nb = 1
-        integer, allocatable :: start(:), pos(:), interface(:)
+        integer, allocatable :: start(:), order(:)
     end type split_t
 
     !> Largest number of aggregates of the coarse correction (its system is factored dense:
@@ -356,12 +358,23 @@ contains
             end if
             s = s + 1
             list(s) = k
+        end do
+        nb = 1
+!$      nb = omp_get_max_threads()
+        if (present(bilateral) .or. stats%n_block > 0) nb = 1
+        nb = max(1, min(nb, n_swept/max(config%split_min, 1)))
+        call split_build(split, cs, list, size(vel, 2), nb)
+        ! the scaled frames in the order of the sweeps (split%order)
+        !$omp parallel do schedule(static) private(k)
+        do s = 1, n_swept
+            k = split%order(s)
             if (cs%erol(k) > 0.0_wp) then
                 call rolling_scaling(cs%w(:, k), cs%mu(k), cs%erol(k), sc(:, s))
             else
                 call bipotential_scaling(cs%w(1, k), cs%w(2, k), cs%w(3, k), cs%mu(k), sc(1:bipotential_n_scaling, s))
             end if
         end do
+        !$omp end parallel do
         if (config%hydrostatic .and. .not. present(bilateral) .and. stats%n_block == 0) then
             if (all(cs%r(:, list) == 0.0_wp)) call hydrostatic_guess(cs, list, im, vfree)
         end if
@@ -387,20 +400,15 @@ contains
             call coarse_correct(cs, list, im, vel, config%coarse_size)
             stats%corrections = 1
         end if
-        nb = 1
-!$      nb = omp_get_max_threads()
-        if (present(bilateral) .or. stats%n_block > 0) nb = 1
-        nb = max(1, min(nb, n_swept/max(config%split_min, 1)))
-        call split_build(split, cs, list, size(vel, 2), nb)
         if (stats%n_active > 0) then
             stats%converged = .false.
             do s = 1, config%max_sweeps
                 if (accelerate) then
                     ! the map accelerated is one sweep in the fixed (bottom-up) contact order
                     call gather(cs, list, aa%d, aa%x)
-                    call split_sweep(config, omega, cs, im, vel, list, sc, split, .true., num, den, nloc)
+                    call split_sweep(config, omega, cs, im, vel, sc, split, .true., num, den, nloc)
                 else
-                    call split_sweep(config, omega, cs, im, vel, list, sc, split, &
+                    call split_sweep(config, omega, cs, im, vel, sc, split, &
                                      .not. (config%symmetric .and. mod(s, 2) == 0), num, den, nloc, bilateral)
                 end if
                 if (present(block)) then
@@ -851,7 +859,7 @@ contains
         end do
         !$omp end parallel do
         vel = vfree
-        call split_apply(cs, list, split, im, vel)
+        call split_apply(cs, split, im, vel)
     contains
         ! new differences in column `slot` (none for slot < 0), then fprev = f, gprev = g
         subroutine shift_history(slot)
@@ -892,16 +900,15 @@ contains
 
     !> vel += M^-1 H r over the contacts of the solve, with the domain split: the blocks in
     !> parallel, then the interface (serial order for one block).
-    subroutine split_apply(cs, list, split, im, vel)
+    subroutine split_apply(cs, split, im, vel)
         type(contact_set_t), intent(in) :: cs
-        integer, intent(in) :: list(:)
         type(split_t), intent(in) :: split
         real(wp), intent(in) :: im(:, :)
         real(wp), intent(inout) :: vel(:, :)
         integer :: b, j, k
         if (split%nb == 1) then
-            do j = 1, size(list)
-                k = list(j)
+            do j = 1, size(split%order)
+                k = split%order(j)
                 call apply(cs, k, im, vel, cs%r(1, k), cs%r(2, k), cs%r(3, k))
             end do
             return
@@ -909,13 +916,13 @@ contains
         !$omp parallel do schedule(static, 1) num_threads(split%nb) private(j, k)
         do b = 1, split%nb
             do j = split%start(b), split%start(b + 1) - 1
-                k = list(split%pos(j))
+                k = split%order(j)
                 call apply(cs, k, im, vel, cs%r(1, k), cs%r(2, k), cs%r(3, k))
             end do
         end do
         !$omp end parallel do
-        do j = 1, size(split%interface)
-            k = list(split%interface(j))
+        do j = split%start(split%nb + 1), size(split%order)
+            k = split%order(j)
             call apply(cs, k, im, vel, cs%r(1, k), cs%r(2, k), cs%r(3, k))
         end do
     end subroutine split_apply
@@ -1068,9 +1075,13 @@ contains
     end function wnorm2
 
     !> One Gauss-Seidel sweep over the active contacts list(first), list(first + step), ...,
-    !> list(last). num = sum |W dr|^2, den = sum |W r|^2 (r applied, not shifted), nloc =
-    !> local iterations. With bilateral constraints, they are restored after each contact
-    !> update.
+    !> list(last), with the scaled frames sc(:, first), sc(:, first + step), ... Per contact:
+    !> local solve, relaxation, impulse applied to the bodies. num = sum |W dr|^2, den = sum
+    !> |W r|^2 (r applied, not shifted), nloc = local iterations. With bilateral constraints,
+    !> they are restored after each contact update. The update is written out here rather than
+    !> in a procedure of its own: this loop is the hot path of the solver, and whether gfortran
+    !> inlined such a procedure depended on how many callers it had (one more caller made the
+    !> sweep 35 % slower at 10^5 disks).
     subroutine sweep(config, omega, cs, im, vel, list, sc, first, last, step, num, den, nloc, bilateral)
         type(nlgs_config_t), intent(in) :: config
         real(wp), intent(in) :: omega
@@ -1082,53 +1093,38 @@ contains
         real(wp), intent(out) :: num, den
         integer(i8), intent(out) :: nloc
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
-        integer :: a
+        real(wp) :: u(3), r0(3), r(3), dr(3), wk(6)
+        integer :: a, k, it, pcase
         num = 0.0_wp
         den = 0.0_wp
         nloc = 0_i8
         do a = first, last, step
-            call update(config, omega, cs, im, vel, list(a), sc(:, a), num, den, nloc)
-            if (present(bilateral)) call bilateral%update(cs%i1(list(a)), cs%i2(list(a)), vel)
+            k = list(a)
+            call local_velocity(cs, k, vel, u)
+            wk = cs%w(:, k)
+            r0 = [cs%r(1, k) + cs%coh(k), cs%r(2, k), cs%r(3, k)]
+            r = r0
+            if (cs%erol(k) > 0.0_wp) then
+                call rolling_local_solve_scaled(sc(:, a), u - wmul(wk, r0), config%local_tol, config%local_max_iter, &
+                                                r, it, pcase)
+            else
+                ! no moment (r0(3) = 0, see contacts_set_laws): the two-component law
+                call bipotential_local_solve_scaled(sc(1:bipotential_n_scaling, a), u(1) - wk(1)*r0(1) - wk(2)*r0(2), &
+                                                    u(2) - wk(2)*r0(1) - wk(3)*r0(2), config%local_tol, &
+                                                    config%local_max_iter, r(1), r(2), it, pcase)
+            end if
+            nloc = nloc + it
+            cs%pcase(k) = pcase
+            if (omega /= 1.0_wp) call relax(omega, cs%mu(k), cs%erol(k), r0, r)
+            dr = r - r0
+            cs%r(1, k) = r(1) - cs%coh(k)
+            cs%r(2:3, k) = r(2:3)
+            call apply(cs, k, im, vel, dr(1), dr(2), dr(3))
+            num = num + wnorm2(wk, dr, cs%amoy(k))
+            den = den + wnorm2(wk, cs%r(:, k), cs%amoy(k))
+            if (present(bilateral)) call bilateral%update(cs%i1(k), cs%i2(k), vel)
         end do
     end subroutine sweep
-
-    !> One Gauss-Seidel update of contact k (scaled frame sck): local solve, relaxation,
-    !> impulse applied to the bodies; adds to num = sum |W dr|^2, den = sum |W r|^2 and nloc.
-    subroutine update(config, omega, cs, im, vel, k, sck, num, den, nloc)
-        type(nlgs_config_t), intent(in) :: config
-        real(wp), intent(in) :: omega
-        type(contact_set_t), intent(inout) :: cs
-        real(wp), intent(in) :: im(:, :)
-        real(wp), intent(inout) :: vel(:, :)
-        integer, intent(in) :: k
-        real(wp), intent(in) :: sck(:)
-        real(wp), intent(inout) :: num, den
-        integer(i8), intent(inout) :: nloc
-        real(wp) :: u(3), r0(3), r(3), dr(3), wk(6)
-        integer :: it, pcase
-        call local_velocity(cs, k, vel, u)
-        wk = cs%w(:, k)
-        r0 = [cs%r(1, k) + cs%coh(k), cs%r(2, k), cs%r(3, k)]
-        r = r0
-        if (cs%erol(k) > 0.0_wp) then
-            call rolling_local_solve_scaled(sck, u - wmul(wk, r0), config%local_tol, config%local_max_iter, &
-                                            r, it, pcase)
-        else
-            ! no moment (r0(3) = 0, see contacts_set_laws): the two-component law
-            call bipotential_local_solve_scaled(sck(1:bipotential_n_scaling), u(1) - wk(1)*r0(1) - wk(2)*r0(2), &
-                                                u(2) - wk(2)*r0(1) - wk(3)*r0(2), config%local_tol, &
-                                                config%local_max_iter, r(1), r(2), it, pcase)
-        end if
-        nloc = nloc + it
-        cs%pcase(k) = pcase
-        if (omega /= 1.0_wp) call relax(omega, cs%mu(k), cs%erol(k), r0, r)
-        dr = r - r0
-        cs%r(1, k) = r(1) - cs%coh(k)
-        cs%r(2:3, k) = r(2:3)
-        call apply(cs, k, im, vel, dr(1), dr(2), dr(3))
-        num = num + wnorm2(wk, dr, cs%amoy(k))
-        den = den + wnorm2(wk, cs%r(:, k), cs%amoy(k))
-    end subroutine update
 
     !> The domain split of the sweeps (OpenMP): nb contiguous blocks of the contact list (in
     !> contact order, i.e. bottom-up for disks numbered by height), swept at the same time,
@@ -1141,12 +1137,16 @@ contains
         type(contact_set_t), intent(in) :: cs
         integer, intent(in) :: list(:), n_disks, nb
         integer, allocatable :: owner(:)
-        integer :: n, b, a, k, lo, hi, nint
+        integer :: n, b, a, k, lo, hi, nint, m
         logical, allocatable :: inter(:)
         n = size(list)
         split%nb = nb
         allocate (split%start(nb + 1))
-        if (nb == 1) return
+        if (nb == 1) then
+            split%start = [1, n + 1]
+            split%order = list
+            return
+        end if
         allocate (owner(n_disks), source=0)
         allocate (inter(n), source=.false.)
         do b = 1, nb
@@ -1164,15 +1164,20 @@ contains
             if (cs%i1(k) > 0) inter(a) = inter(a) .or. owner(cs%i1(k)) < 0
         end do
         nint = count(inter)
-        allocate (split%pos(n - nint), split%interface(nint))
-        split%interface = pack([(a, a=1, n)], inter)
-        split%start(1) = 1
+        allocate (split%order(n))
+        m = 0
         do b = 1, nb
+            split%start(b) = m + 1
             lo = 1 + int((int(b - 1, i8)*n)/nb)
             hi = int((int(b, i8)*n)/nb)
-            split%start(b + 1) = split%start(b) + count(.not. inter(lo:hi))
-            split%pos(split%start(b):split%start(b + 1) - 1) = pack([(a, a=lo, hi)],.not. inter(lo:hi))
+            do a = lo, hi
+                if (inter(a)) cycle
+                m = m + 1
+                split%order(m) = list(a)
+            end do
         end do
+        split%start(nb + 1) = m + 1
+        split%order(m + 1:n) = pack(list, inter)
     contains
         subroutine mark(d, b)
             integer, intent(in) :: d, b
@@ -1184,39 +1189,53 @@ contains
         end subroutine mark
     end subroutine split_build
 
-    !> One sweep with the domain split (split_build), forward or backward.
-    subroutine split_sweep(config, omega, cs, im, vel, list, sc, split, forward, num, den, nloc, bilateral)
+    !> One sweep with the domain split (split_build), forward or backward: the blocks in
+    !> parallel (each a plain sweep over its contiguous part of split%order and sc), the
+    !> interface serially, after the blocks when forward, before them when backward.
+    subroutine split_sweep(config, omega, cs, im, vel, sc, split, forward, num, den, nloc, bilateral)
         type(nlgs_config_t), intent(in) :: config
         real(wp), intent(in) :: omega
         type(contact_set_t), intent(inout) :: cs
         real(wp), intent(in) :: im(:, :)
         real(wp), intent(inout) :: vel(:, :)
-        integer, intent(in) :: list(:)
         real(wp), intent(in), contiguous :: sc(:, :)
         type(split_t), intent(in) :: split
         logical, intent(in) :: forward
         real(wp), intent(out) :: num, den
         integer(i8), intent(out) :: nloc
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
-        real(wp) :: nb_num(split%nb), nb_den(split%nb), inum, iden
-        integer(i8) :: nb_loc(split%nb), iloc
-        integer :: b
+        real(wp) :: nb_num(split%nb), nb_den(split%nb), inum, iden, lnum, lden
+        integer(i8) :: nb_loc(split%nb), iloc, lloc
+        integer :: b, n, fi
+        n = size(split%order)
         if (split%nb == 1) then
             if (forward) then
-                call sweep(config, omega, cs, im, vel, list, sc, 1, size(list), 1, num, den, nloc, bilateral)
+                call sweep(config, omega, cs, im, vel, split%order, sc, 1, n, 1, num, den, nloc, bilateral)
             else
-                call sweep(config, omega, cs, im, vel, list, sc, size(list), 1, -1, num, den, nloc, bilateral)
+                call sweep(config, omega, cs, im, vel, split%order, sc, n, 1, -1, num, den, nloc, bilateral)
             end if
             return
         end if
-        if (.not. forward) call positions(split%interface, .false., inum, iden, iloc)
-        !$omp parallel do schedule(static, 1) num_threads(split%nb)
+        fi = split%start(split%nb + 1)
+        if (.not. forward) call sweep(config, omega, cs, im, vel, split%order, sc, n, fi, -1, inum, iden, iloc)
+        ! The sums go to locals of the thread, stored once per block: accumulating into
+        ! nb_num(b) directly, the threads share a cache line and every update invalidates it
+        ! on the other core (2 threads were 2.3 times slower than 1 at 10^5 disks).
+        !$omp parallel do schedule(static, 1) num_threads(split%nb) private(lnum, lden, lloc)
         do b = 1, split%nb
-            call positions(split%pos(split%start(b):split%start(b + 1) - 1), forward, nb_num(b), nb_den(b), &
-                           nb_loc(b))
+            if (forward) then
+                call sweep(config, omega, cs, im, vel, split%order, sc, split%start(b), split%start(b + 1) - 1, 1, &
+                           lnum, lden, lloc)
+            else
+                call sweep(config, omega, cs, im, vel, split%order, sc, split%start(b + 1) - 1, split%start(b), -1, &
+                           lnum, lden, lloc)
+            end if
+            nb_num(b) = lnum
+            nb_den(b) = lden
+            nb_loc(b) = lloc
         end do
         !$omp end parallel do
-        if (forward) call positions(split%interface, .true., inum, iden, iloc)
+        if (forward) call sweep(config, omega, cs, im, vel, split%order, sc, fi, n, 1, inum, iden, iloc)
         num = 0.0_wp
         den = 0.0_wp
         nloc = iloc
@@ -1227,30 +1246,6 @@ contains
         end do
         num = num + inum
         den = den + iden
-    contains
-        !> Sweep of the positions pos. The sums are kept in locals of the thread and stored
-        !> once at the end: accumulating into pnum directly, the threads' nb_num(b) share a
-        !> cache line and every update would invalidate it on the other core (2 threads were
-        !> 2.3 times slower than 1 at 10^5 disks).
-        subroutine positions(pos, fwd, pnum, pden, ploc)
-            integer, intent(in) :: pos(:)
-            logical, intent(in) :: fwd
-            real(wp), intent(out) :: pnum, pden
-            integer(i8), intent(out) :: ploc
-            real(wp) :: lnum, lden
-            integer(i8) :: lloc
-            integer :: j, a
-            lnum = 0.0_wp
-            lden = 0.0_wp
-            lloc = 0_i8
-            do j = 1, size(pos)
-                a = merge(pos(j), pos(size(pos) + 1 - j), fwd)
-                call update(config, omega, cs, im, vel, list(a), sc(:, a), lnum, lden, lloc)
-            end do
-            pnum = lnum
-            pden = lden
-            ploc = lloc
-        end subroutine positions
     end subroutine split_sweep
 
     !> Over-relaxed update: r = P_K(r0 + omega (r - r0)) (Euclidean projection on the cone of
