@@ -31,7 +31,7 @@ program bench_bonded
     use driver_config, only: run_config_t, build_config
     use driver_config_dem, only: dem_config_t, build_dem_config
     use driver_config_coupling, only: coupled_setup_t, build_coupling_config
-    use driver_run_coupled, only: build_coupled
+    use driver_simulation_coupled, only: build_coupled
     use fem_beam_config, only: beam_config_t
     use coupling_arlequin, only: coupled_system_t, arlequin_step
     implicit none

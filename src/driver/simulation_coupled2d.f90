@@ -5,7 +5,8 @@
 !> the particle sections, and the particle part by the particle run's `init`
 !> (driver_simulation_dem) on the deck without [continuum]; every error keeps its file, line and
 !> keyword. [coupling] is read by driver_config_coupling2d, and coupling_arlequin2d builds the
-!> coupled system, whose time step (coupling_coupled_step's arlequin_step) is the beam's.
+!> coupled system, whose time step (coupling_coupled_step's arlequin_step) is the beam's; the
+!> time loop is driver_coupled_loop's.
 !>
 !> Results: /continuum (mesh, sets, displacement, velocity, centre stresses, and the FE side's
 !> energies: kinetic and strain weighted by alpha), /dem and /coupling as in beam-coupled runs,
@@ -19,50 +20,60 @@ module driver_simulation_coupled2d
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error, make_input_error
     use core_strings, only: to_str
-    use core_signals, only: caught_signal, signal_name
-    use io_deck, only: deck_t, deck_entry_t
+    use io_deck, only: deck_t
     use io_paths, only: basename
-    use io_progress, only: progress_t
+    use io_hdf5_file, only: h5_file_t
     use fem_continuum_dynamics, only: continuum_dynamics_t
-    use coupling_coupled_step, only: coupled_system_t, coupled_energies_t, arlequin_step, coupled_energies
+    use coupling_coupled_step, only: coupled_energies_t, coupled_energies
     use coupling_arlequin2d, only: build_coupled2d
     use driver_config_coupling2d, only: coupled2d_setup_t, build_coupling2d_config
     use driver_results, only: results_writer_t
     use driver_results_continuum, only: continuum_writer_t
-    use driver_results_dem, only: dem_writer_t
-    use driver_results_coupled, only: coupled_writer_t
-    use driver_run_dem, only: max_warnings, speed_warning, last_unconverged_warning
-    use driver_guards, only: check_disks_state, step_start_t, take_step_start, check_tunnelling
-    use io_hdf5_file, only: h5_file_t
-    use driver_checkpoint, only: checkpoint_run_t, end_of_step, loop_state_t, checkpoint_create, checkpoint_commit, &
-                                 checkpoint_discard, save_coupled, load_coupled, save_results, load_results, &
-                                 save_dem_writer, load_dem_writer, save_coupled_writer, load_coupled_writer
-    use driver_simulation, only: simulation_t, report_iface
+    use driver_simulation, only: report_iface
     use driver_simulation_continuum, only: continuum_simulation_t
     use driver_simulation_dem, only: dem_simulation_t
+    use driver_coupled_loop, only: arlequin_simulation_t
     implicit none
     private
     public :: coupled2d_simulation_t, write_disks_xdmf
 
     !> A 2D continuum and particles glued in overlap regions.
-    type, extends(simulation_t) :: coupled2d_simulation_t
+    type, extends(arlequin_simulation_t) :: coupled2d_simulation_t
         !> The continuum part (model, run settings, initial state).
         type(continuum_simulation_t) :: continuum
         !> The particle part (disks, walls, contact laws, solver).
         type(dem_simulation_t) :: particles
         !> The coupling from the deck.
         type(coupled2d_setup_t) :: coupling
-        !> The coupled system.
-        type(coupled_system_t), allocatable :: sys
+        !> Writer of /continuum (and of the XDMF file's mesh fields).
+        type(continuum_writer_t) :: fe_out
     contains
         !> See `simulation_t%init`.
         procedure :: init => coupled2d_init
         !> See `simulation_t%describe`.
         procedure :: describe => coupled2d_describe
-        !> See `simulation_t%run`.
-        procedure :: run => coupled2d_run
         !> See `simulation_t%checkpoint_kind`.
         procedure :: checkpoint_kind => coupled2d_checkpoint_kind
+        !> See `arlequin_simulation_t%particle_output`.
+        procedure :: particle_output => coupled2d_particle_output
+        !> See `arlequin_simulation_t%begin`.
+        procedure :: begin => coupled2d_begin
+        !> See `arlequin_simulation_t%after_step`.
+        procedure :: after_step => coupled2d_after_step
+        !> See `arlequin_simulation_t%check_part`.
+        procedure :: check_part => coupled2d_check_part
+        !> See `arlequin_simulation_t%store_part`.
+        procedure :: store_part => coupled2d_store_part
+        !> See `arlequin_simulation_t%unconverged_detail`.
+        procedure :: unconverged_detail => coupled2d_unconverged_detail
+        !> See `arlequin_simulation_t%summary_lines`.
+        procedure :: summary_lines => coupled2d_summary_lines
+        !> See `arlequin_simulation_t%save_part`.
+        procedure :: save_part => coupled2d_save_part
+        !> See `arlequin_simulation_t%load_part`.
+        procedure :: load_part => coupled2d_load_part
+        !> See `arlequin_simulation_t%finish`.
+        procedure :: finish => coupled2d_finish
     end type coupled2d_simulation_t
 
 contains
@@ -141,265 +152,205 @@ contains
                to_str(self%sys%dem%particles%n)//' disks, '//to_str(self%sys%op%n_points)//' coupled'
     end function coupled2d_describe
 
-    !> The coupled time integration; results into `out` and the XDMF file next to it.
-    subroutine coupled2d_run(self, out, quiet, report, ck, error)
+    !> 'coupled2d'.
+    function coupled2d_checkpoint_kind(self) result(kind)
+        !> The simulation.
+        class(coupled2d_simulation_t), intent(in) :: self
+        !> Kind of run of its checkpoints.
+        character(len=:), allocatable :: kind
+        kind = 'coupled2d'
+    end function coupled2d_checkpoint_kind
+
+    !> The particle materials and contact storage of the deck.
+    subroutine coupled2d_particle_output(self, material_id, store_contacts)
+        !> The simulation.
+        class(coupled2d_simulation_t), intent(in) :: self
+        !> Deck id of each particle material.
+        integer, allocatable, intent(out) :: material_id(:)
+        !> Whether the contacts are stored with each output.
+        logical, intent(out) :: store_contacts
+        material_id = self%particles%dem%material_id
+        store_contacts = self%particles%dem%store_contacts
+    end subroutine coupled2d_particle_output
+
+    !> /continuum (mesh and sets), the mediator nodes; the continuum's audit started.
+    subroutine coupled2d_begin(self, out, error)
         !> The simulation.
         class(coupled2d_simulation_t), intent(inout) :: self
         !> The results file.
         type(results_writer_t), intent(inout) :: out
-        !> No progress lines.
-        logical, intent(in) :: quiet
-        !> Where progress and summary lines go.
-        procedure(report_iface) :: report
-        !> Checkpoints (and the one to restart from).
-        type(checkpoint_run_t), intent(inout) :: ck
-        !> Set on a run or write failure.
+        !> Set on a write failure.
         type(error_t), allocatable, intent(out) :: error
-        type(continuum_writer_t) :: fe_out
-        type(dem_writer_t) :: dem_out
-        type(coupled_writer_t) :: cpl_out
-        type(progress_t) :: progress
-        type(step_start_t) :: start
-        character(len=:), allocatable :: xdmf
-        character(len=512) :: buf
-        integer(i8) :: n_steps, k, k0
-        integer :: unconverged
-        logical :: speed_warned, stop
-        associate (sys => self%sys, model => self%continuum%model, run => self%settings)
-            n_steps = run%n_steps
-            unconverged = 0
-            speed_warned = .false.
-            k0 = 0
-            if (ck%restart) then
-                call restore(error)
-                if (allocated(error)) return
+        call self%fe_out%begin(out%file, self%continuum%model%mesh, 'dynamic', error)
+        if (allocated(error)) return
+        if (size(self%sys%mediator_nodes) > 0) then
+            call out%file%write_dataset('/coupling/mediator_nodes', self%sys%mediator_nodes, error)
+            if (allocated(error)) return
+        end if
+        call audit_step(self, .true.)
+    end subroutine coupled2d_begin
+
+    !> The continuum's audit advanced by the step just made.
+    subroutine coupled2d_after_step(self)
+        !> The simulation.
+        class(coupled2d_simulation_t), intent(inout) :: self
+        call audit_step(self, .false.)
+    end subroutine coupled2d_after_step
+
+    !> The continuum's audit of the whole body (prescribed dofs and reactions included) on
+    !> the weighted operator: started (resumed with the totals of a checkpoint), or advanced
+    !> by the step just made.
+    subroutine audit_step(self, first, totals)
+        type(coupled2d_simulation_t), intent(inout) :: self
+        logical, intent(in) :: first
+        real(wp), intent(in), optional :: totals(4)
+        select type (ops => self%sys%model)
+        type is (continuum_dynamics_t)
+            if (first .and. present(totals)) then
+                call self%continuum%audit%resume(ops, self%continuum%model, self%sys%fe, totals)
+            else if (first) then
+                call self%continuum%audit%start(ops, self%continuum%model, self%sys%fe)
             else
-                call fe_out%begin(out%file, model%mesh, 'dynamic', error)
-                if (allocated(error)) return
-                call dem_out%begin(out%file, sys%dem, self%particles%dem%material_id, &
-                                   self%particles%dem%store_contacts, error)
-                if (allocated(error)) return
-                call cpl_out%begin(out%file, sys, error)
-                if (allocated(error)) return
-                if (size(sys%mediator_nodes) > 0) call out%file%write_dataset('/coupling/mediator_nodes', &
-                                                                              sys%mediator_nodes, error)
-                if (allocated(error)) return
-                k = 0
-                call audit_step(.true.)
-                call store(error)
-                if (allocated(error)) return
+                call self%continuum%audit%advance(ops, self%continuum%model, self%sys%fe)
             end if
-            call progress%start(n_steps, run%t_end, run%progress_seconds)
-            call ck%schedule%start()
-            do k = k0 + 1, n_steps
-                call take_step_start(start, sys%dem%particles, sys%dem%walls)
-                call arlequin_step(sys, error)
-                if (allocated(error)) return
-                call audit_step(.false.)
-                call check_step(error)
-                if (allocated(error)) return
-                call dem_out%record_step(out%file, sys%dem%stats, error)
-                if (allocated(error)) return
-                call cpl_out%record_step(out%file, sys, error)
-                if (allocated(error)) return
-                if (.not. sys%stats%converged) call warn_unconverged()
-                if (.not. speed_warned) call check_speed()
-                call end_of_step(k, n_steps, run%output_interval, ck%schedule, store, checkpoint, stop, error)
-                if (allocated(error)) return
-                if (stop) then
-                    ! Stop request: the step just done is the last output.
-                    call out%stop_at(signal_name(caught_signal()), k, sys%fe%t)
-                    n_steps = k
-                    exit
-                end if
-                if (.not. quiet .and. progress%due()) call report(progress%line(k, sys%fe%t))
-            end do
-            call dem_out%finish(out%file, sys%dem, unconverged, error)
-            if (allocated(error)) return
-            call cpl_out%finish(out%file, error)
-            if (allocated(error)) return
-            call summary()
-            call out%write_summary(int(n_steps), progress%elapsed(), error)
-            if (allocated(error)) return
-            if (out%stopped()) return
-            xdmf = out%final_path(1:len(out%final_path) - 3)//'.xdmf'
-            call fe_out%write_xdmf(xdmf, basename(out%final_path), error)
-            if (allocated(error)) return
-            call write_disks_xdmf(xdmf, basename(out%final_path), sys%dem%particles%n, fe_out%times, error)
+        end select
+    end subroutine audit_step
+
+    !> Finite continuum state and energy accounts (a checkpoint may follow: it must hold
+    !> finite values).
+    subroutine coupled2d_check_part(self, k, error)
+        !> The simulation.
+        class(coupled2d_simulation_t), intent(in) :: self
+        !> Steps done.
+        integer(i8), intent(in) :: k
+        !> Set at the first non-finite value.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=256) :: buf
+        associate (fe => self%sys%fe)
+            if (all(ieee_is_finite(fe%u)) .and. all(ieee_is_finite(fe%v)) .and. &
+                all(ieee_is_finite([fe%kinetic, fe%strain, fe%external_work, fe%damping_dissipation, &
+                                    fe%coupling_work]))) return
+            write (buf, '(a,i0,a,es13.5e3,a)') 'coupled continuum: the state is not finite after step ', k, &
+                ' (t = ', fe%t, ' s); likely cause: loads or moduli far out of scale'
         end associate
+        call make_error(error, trim(buf))
+    end subroutine coupled2d_check_part
 
-    contains
-
-        !> Restart: state, writer counters and results file from the checkpoint `ck%source`.
-        subroutine restore(error)
-            type(error_t), allocatable, intent(out) :: error
-            type(error_t), allocatable :: ignored
-            real(wp), allocatable :: totals(:)
-            call dem_out%resume(self%sys%dem, self%particles%dem%store_contacts)
-            call cpl_out%resume(self%sys)
-            call load_coupled(ck%source, self%sys, error)
-            ! The continuum's audit (its accumulated works; the rest follows from the state), the
-            ! multipliers' work through the prescribed dofs and C_p u_p at the restart time.
-            if (.not. allocated(error)) call ck%source%read_attribute('/coupling', 'continuum_audit', totals, error)
-            if (.not. allocated(error)) then
-                call audit_step(.true., totals(1:4))
-                self%sys%prescribed_coupling_work = totals(5)
-                self%sys%cp = 0.0_wp
-                call self%sys%op%add_prescribed(self%sys%fe%t, 0, self%sys%cp)
-            end if
-            if (.not. allocated(error)) call load_dem_writer(ck%source, dem_out, error)
-            if (.not. allocated(error)) call load_coupled_writer(ck%source, cpl_out, error)
-            if (.not. allocated(error)) call load_results(ck%source, out, error)
-            call ck%source%close(ignored)
+    !> Displacements, velocities, centre stresses and the continuum's energies.
+    subroutine coupled2d_store_part(self, out, error)
+        !> The simulation.
+        class(coupled2d_simulation_t), intent(inout) :: self
+        !> The results file.
+        type(results_writer_t), intent(inout) :: out
+        !> Set on a non-finite stress or energy, or a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: u(:), v(:), stress(:, :)
+        type(coupled_energies_t) :: en
+        character(len=256) :: buf
+        integer :: n
+        associate (sys => self%sys, model => self%continuum%model, au => self%continuum%audit)
+            u = model%expand(sys%fe%u, sys%fe%t)
+            v = model%expand(sys%fe%v, sys%fe%t, 1)
+            n = model%mesh%node_count()
+            call model%centre_stresses(u, stress, error)
             if (allocated(error)) return
-            call fe_out%resume(out%file, self%continuum%model%mesh, error)
-            if (allocated(error)) return
-            k0 = ck%start%step
-            unconverged = ck%start%unconverged
-            speed_warned = ck%start%speed_warned
-        end subroutine restore
-
-        !> Write a checkpoint after step k (the buffered per-step values are written first).
-        subroutine checkpoint(error)
-            type(error_t), allocatable, intent(out) :: error
-            type(h5_file_t) :: f
-            call dem_out%flush_buffer(out%file, error)
-            if (.not. allocated(error)) call cpl_out%flush_buffer(out%file, error)
-            if (allocated(error)) return
-            call checkpoint_create(f, ck%path, ck%deck_text, self%checkpoint_kind(), &
-                                   loop_state_t(k, unconverged, speed_warned, .false.), self%sys%fe%t, &
-                                   out%run_id, error)
-            if (.not. allocated(error)) call save_coupled(f, self%sys, error)
-            if (.not. allocated(error)) call f%write_attribute('/coupling', 'continuum_audit', &
-                                                               [self%continuum%audit%totals(), &
-                                                                self%sys%prescribed_coupling_work], error)
-            if (.not. allocated(error)) call save_dem_writer(f, dem_out, error)
-            if (.not. allocated(error)) call save_coupled_writer(f, cpl_out, error)
-            if (.not. allocated(error)) call save_results(f, out, error)
-            if (allocated(error)) then
-                call checkpoint_discard(f, ck%path)
+            en = coupled_energies(sys)
+            if (.not. (all(ieee_is_finite(stress)) .and. ieee_is_finite(en%balance))) then
+                write (buf, '(a,es13.5e3,a)') 'coupled continuum: a stress or an energy is not finite at t = ', &
+                    sys%fe%t, ' s; likely cause: a time step far too large, or loads or moduli far out of scale'
+                call make_error(error, trim(buf))
                 return
             end if
-            call checkpoint_commit(f, ck%path, error)
+            call self%fe_out%store(out%file, sys%fe%t, reshape(u, [2, n]), reshape(v, [2, n]), stress, error)
             if (allocated(error)) return
-            ck%last_step = k
-            ck%last_time = self%sys%fe%t
-        end subroutine checkpoint
+            call self%fe_out%store_energy(out%file, sys%fe%t, au%kinetic, au%strain, au%load_work, au%damping, &
+                                          au%balance(), error, au%reaction_work, au%reaction_resultant)
+        end associate
+    end subroutine coupled2d_store_part
 
-        !> One stored output of the three parts.
-        subroutine store(error)
-            type(error_t), allocatable, intent(out) :: error
-            real(wp), allocatable :: u(:), v(:), stress(:, :)
-            type(coupled_energies_t) :: en
-            integer :: n
-            associate (sys => self%sys, model => self%continuum%model)
-                u = model%expand(sys%fe%u, sys%fe%t)
-                v = model%expand(sys%fe%v, sys%fe%t, 1)
-                n = model%mesh%node_count()
-                call model%centre_stresses(u, stress, error)
-                if (allocated(error)) return
-                en = coupled_energies(sys)
-                if (.not. (all(ieee_is_finite(stress)) .and. ieee_is_finite(en%balance))) then
-                    write (buf, '(a,es13.5e3,a)') 'coupled continuum: a stress or an energy is not finite at t = ', &
-                        sys%fe%t, ' s; likely cause: a time step far too large, or loads or moduli far out of scale'
-                    call make_error(error, trim(buf))
-                    return
-                end if
-                call fe_out%store(out%file, sys%fe%t, reshape(u, [2, n]), reshape(v, [2, n]), stress, error)
-                if (allocated(error)) return
-                associate (au => self%continuum%audit)
-                    call fe_out%store_energy(out%file, sys%fe%t, au%kinetic, au%strain, au%load_work, au%damping, &
-                                             au%balance(), error, au%reaction_work, au%reaction_resultant)
-                end associate
-                if (allocated(error)) return
-                call dem_out%store(out%file, sys%dem, error)
-                if (allocated(error)) return
-                call cpl_out%store(out%file, sys, error)
-                if (allocated(error)) return
-            end associate
-            call out%flush(error)
-        end subroutine store
+    !> '; the constraint still holds'.
+    function coupled2d_unconverged_detail(self) result(text)
+        !> The simulation.
+        class(coupled2d_simulation_t), intent(in) :: self
+        !> Text after 'sweeps'.
+        character(len=:), allocatable :: text
+        text = '; the constraint still holds'
+    end function coupled2d_unconverged_detail
 
-        !> The continuum's audit of the whole body (prescribed dofs and reactions included) on
-        !> the weighted operator: started (resumed with the totals of a checkpoint), or advanced
-        !> by the step just made.
-        subroutine audit_step(first, totals)
-            logical, intent(in) :: first
-            real(wp), intent(in), optional :: totals(4)
-            select type (ops => self%sys%model)
-            type is (continuum_dynamics_t)
-                if (first .and. present(totals)) then
-                    call self%continuum%audit%resume(ops, self%continuum%model, self%sys%fe, totals)
-                else if (first) then
-                    call self%continuum%audit%start(ops, self%continuum%model, self%sys%fe)
-                else
-                    call self%continuum%audit%advance(ops, self%continuum%model, self%sys%fe)
-                end if
-            end select
-        end subroutine audit_step
-
-        !> Guards after a step: finite continuum and disk states, disks in the box, no tunnelling.
-        subroutine check_step(error)
-            type(error_t), allocatable, intent(out) :: error
-            associate (sys => self%sys)
-                ! State and energy accounts (a checkpoint may follow: it must hold finite values).
-                if (.not. (all(ieee_is_finite(sys%fe%u)) .and. all(ieee_is_finite(sys%fe%v)) .and. &
-                           all(ieee_is_finite([sys%fe%kinetic, sys%fe%strain, sys%fe%external_work, &
-                                               sys%fe%damping_dissipation, sys%fe%coupling_work])))) then
-                    write (buf, '(a,i0,a,es13.5e3,a)') 'coupled continuum: the state is not finite after step ', k, &
-                        ' (t = ', sys%fe%t, ' s); likely cause: loads or moduli far out of scale'
-                    call make_error(error, trim(buf))
-                    return
-                end if
-                call check_disks_state(k, sys%fe%t, sys%dem%particles, sys%dem%energies, error)
-                if (allocated(error)) return
-                call check_tunnelling(k, sys%fe%t, self%settings%h, sys%dem%scheme%alert, start, sys%dem%particles, &
-                                      sys%dem%walls, sys%dem%contacts, error)
-            end associate
-        end subroutine check_step
-
-        !> Warning for an unconverged step (the first max_warnings ones).
-        subroutine warn_unconverged()
-            unconverged = unconverged + 1
-            if (unconverged > max_warnings) return
-            write (buf, '(a,i0,a,es12.4e3,a,i0,a)') 'warning: step ', k, ' (t = ', self%sys%fe%t, &
-                ' s): the joint contact/multiplier solve did not converge in ', self%sys%stats%sweeps, &
-                ' sweeps; the constraint still holds'
+    !> Model, constraint residuals, unconverged steps.
+    subroutine coupled2d_summary_lines(self, n_steps, unconverged, report)
+        !> The simulation.
+        class(coupled2d_simulation_t), intent(in) :: self
+        !> Steps done.
+        integer(i8), intent(in) :: n_steps
+        !> Unconverged steps.
+        integer, intent(in) :: unconverged
+        !> Where the lines go.
+        procedure(report_iface) :: report
+        character(len=512) :: buf
+        associate (sys => self%sys)
+            write (buf, '(a,i0,a,i0,a,i0,a,i0,a,es13.5e3,a)') 'coupled run: ', &
+                self%continuum%model%mesh%element_count(), ' elements, ', sys%dem%particles%n, ' disks (', &
+                sys%op%n_points, ' coupled), ', n_steps, ' steps to t = ', sys%fe%t, ' s'
             call report(trim(buf))
-            if (unconverged == max_warnings) call report(last_unconverged_warning())
-        end subroutine warn_unconverged
+            write (buf, '(a,es11.3e3,a,es11.3e3,a,es11.3e3,a)') 'constraint: max |Pi (q - C u)| = ', &
+                self%cpl_out%max_position, ' m (per disk, from the coordinates ', self%cpl_out%max_coordinate, &
+                ' m), max velocity residual ', self%cpl_out%max_velocity, ' m/s'
+            call report(trim(buf))
+            call report('unconverged steps: '//to_str(unconverged)//' of '//to_str(n_steps))
+        end associate
+    end subroutine coupled2d_summary_lines
 
-        !> Warning (once) when a disk moved farther than the alert distance in the step.
-        subroutine check_speed()
-            character(len=:), allocatable :: line
-            line = speed_warning(self%sys%dem%particles, self%settings%h, self%sys%dem%scheme%alert, self%sys%fe%t)
-            if (len(line) == 0) return
-            speed_warned = .true.
-            call report(line)
-        end subroutine check_speed
+    !> The continuum's accumulated works (the rest of its audit follows from the state) and the
+    !> multipliers' work through the prescribed dofs.
+    subroutine coupled2d_save_part(self, f, error)
+        !> The simulation.
+        class(coupled2d_simulation_t), intent(in) :: self
+        !> The checkpoint being written.
+        type(h5_file_t), intent(inout) :: f
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call f%write_attribute('/coupling', 'continuum_audit', &
+                               [self%continuum%audit%totals(), self%sys%prescribed_coupling_work], error)
+    end subroutine coupled2d_save_part
 
-        !> Closing lines: model, residuals, energy balance, times.
-        subroutine summary()
-            type(coupled_energies_t) :: en
-            associate (sys => self%sys)
-                en = coupled_energies(sys)
-                write (buf, '(a,i0,a,i0,a,i0,a,i0,a,es13.5e3,a)') 'coupled run: ', &
-                    self%continuum%model%mesh%element_count(), ' elements, ', sys%dem%particles%n, ' disks (', &
-                    sys%op%n_points, ' coupled), ', n_steps, ' steps to t = ', sys%fe%t, ' s'
-                call report(trim(buf))
-                write (buf, '(a,es11.3e3,a,es11.3e3,a,es11.3e3,a)') 'constraint: max |Pi (q - C u)| = ', &
-                    cpl_out%max_position, ' m (per disk, from the coordinates ', cpl_out%max_coordinate, &
-                    ' m), max velocity residual ', cpl_out%max_velocity, ' m/s'
-                call report(trim(buf))
-                call report('unconverged steps: '//to_str(unconverged)//' of '//to_str(n_steps))
-                write (buf, '(a,es11.3e3,a,es11.3e3,a,es11.3e3,a)') 'energy balance residual ', en%balance, &
-                    ' J (max over the outputs ', cpl_out%max_balance, ' J; external work ', &
-                    en%fe_external_work + en%dem_external_work + en%dem_drive_work, ' J)'
-                call report(trim(buf))
-                call report(progress%summary_line(n_steps, sys%fe%t))
-            end associate
-        end subroutine summary
-    end subroutine coupled2d_run
+    !> The continuum's audit resumed with the totals of the checkpoint, C_p u_p at the restart
+    !> time, and the continuum writer's stored times from the results file.
+    subroutine coupled2d_load_part(self, f, out, error)
+        !> The simulation.
+        class(coupled2d_simulation_t), intent(inout) :: self
+        !> The checkpoint (open).
+        type(h5_file_t), intent(inout) :: f
+        !> The results file (restored).
+        type(results_writer_t), intent(inout) :: out
+        !> Set on a read failure.
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: totals(:)
+        call f%read_attribute('/coupling', 'continuum_audit', totals, error)
+        if (allocated(error)) return
+        call audit_step(self, .true., totals(1:4))
+        self%sys%prescribed_coupling_work = totals(5)
+        self%sys%cp = 0.0_wp
+        call self%sys%op%add_prescribed(self%sys%fe%t, 0, self%sys%cp)
+        call self%fe_out%resume(out%file, self%continuum%model%mesh, error)
+    end subroutine coupled2d_load_part
+
+    !> `<deck>.xdmf` next to the results file (mesh fields and disks), unless a signal stopped
+    !> the run.
+    subroutine coupled2d_finish(self, out, error)
+        !> The simulation.
+        class(coupled2d_simulation_t), intent(inout) :: self
+        !> The results file (summary written).
+        type(results_writer_t), intent(inout) :: out
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: xdmf
+        if (out%stopped()) return
+        xdmf = out%final_path(1:len(out%final_path) - 3)//'.xdmf'
+        call self%fe_out%write_xdmf(xdmf, basename(out%final_path), error)
+        if (allocated(error)) return
+        call write_disks_xdmf(xdmf, basename(out%final_path), self%sys%dem%particles%n, self%fe_out%times, error)
+    end subroutine coupled2d_finish
 
     !> Add the disks to an XDMF file written by continuum_writer_t%write_xdmf: a temporal
     !> collection "disks" of Polyvertex grids, the centres from /dem/position (x, y of each
@@ -479,12 +430,4 @@ contains
         end function slab
     end subroutine write_disks_xdmf
 
-    !> 'coupled2d'.
-    function coupled2d_checkpoint_kind(self) result(kind)
-        !> The simulation.
-        class(coupled2d_simulation_t), intent(in) :: self
-        !> Kind of run of its checkpoints.
-        character(len=:), allocatable :: kind
-        kind = 'coupled2d'
-    end function coupled2d_checkpoint_kind
 end module driver_simulation_coupled2d

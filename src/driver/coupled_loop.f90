@@ -1,0 +1,368 @@
+!> The time loop of the Arlequin-coupled runs (doc/theory.md section 6.8), shared by the beam
+!> and disks (driver_simulation_coupled) and the 2D continuum and disks
+!> (driver_simulation_coupled2d): one call of the coupling step (coupling_coupled_step's
+!> arlequin_step) per time step, which predicts both domains, solves the multipliers jointly
+!> with the contacts and corrects both.
+!>
+!> `arlequin_simulation_t` runs the loop and writes what the two kinds share: the disks in
+!> /dem, the multipliers, residuals and energy audit in /coupling (doc/output.md), the
+!> checkpoints (driver_checkpoint::save_coupled, under the kind of `checkpoint_kind`), the
+!> stop at a signal, the progress lines and the summary's closing lines. Its extensions write
+!> the finite-element side through the hooks: `begin` (mesh and static data of a new run),
+!> `check_part` (guard of the finite-element state), `after_step`, `store_part` (one stored
+!> output), `unconverged_detail` and `summary_lines` (report text), and, when they hold more
+!> than the coupled system, `save_part` / `load_part` (checkpoints) and `finish`.
+!>
+!> Warnings go through the report callback: steps whose joint solve did not converge (the
+!> first `max_warnings`, then only the count) and, once, a disk moving farther than the alert
+!> distance in a step. The initial state (step 0) and the state after every step are checked
+!> as in the uncoupled runs (driver_guards): the finite-element side by `check_part`, then the
+!> disks (non-finite values, beyond the representable box), then tunnelling (after a step).
+module driver_coupled_loop
+    use core_kinds, only: i8
+    use core_error, only: error_t
+    use core_signals, only: caught_signal, signal_name
+    use io_progress, only: progress_t
+    use io_hdf5_file, only: h5_file_t
+    use coupling_coupled_step, only: coupled_system_t, coupled_energies_t, arlequin_step, coupled_energies
+    use driver_results, only: results_writer_t
+    use driver_results_dem, only: dem_writer_t
+    use driver_results_coupled, only: coupled_writer_t
+    use driver_run_dem, only: max_warnings, speed_warning, last_unconverged_warning
+    use driver_guards, only: check_disks_state, step_start_t, take_step_start, check_tunnelling
+    use driver_checkpoint, only: checkpoint_run_t, end_of_step, loop_state_t, checkpoint_create, &
+                                 checkpoint_commit, checkpoint_discard, save_coupled, load_coupled, &
+                                 save_results, load_results, save_dem_writer, load_dem_writer, &
+                                 save_coupled_writer, load_coupled_writer
+    use driver_simulation, only: simulation_t, report_iface
+    implicit none
+    private
+    public :: arlequin_simulation_t
+
+    !> A finite-element model and particles glued in an overlap, integrated by one time loop.
+    type, abstract, extends(simulation_t) :: arlequin_simulation_t
+        !> The coupled system (built by `init`; it advances).
+        type(coupled_system_t), allocatable :: sys
+        !> Writer of /dem.
+        type(dem_writer_t) :: dem_out
+        !> Writer of /coupling (its maxima of the residuals feed the summary).
+        type(coupled_writer_t) :: cpl_out
+    contains
+        !> See `simulation_t%run`: the coupled time loop.
+        procedure :: run => arlequin_run
+        !> Material ids of the disks and whether contacts are stored (for /dem).
+        procedure(particle_output_iface), deferred :: particle_output
+        !> Static data of a new run (mesh, overlap), after /dem and /coupling are begun.
+        procedure(begin_iface), deferred :: begin
+        !> Guard of the finite-element state after step `k` (k = 0: the initial state).
+        procedure(check_part_iface), deferred :: check_part
+        !> Work after each step, before the guards (default: none).
+        procedure :: after_step => no_after_step
+        !> The finite-element side of one stored output (before the disks and /coupling).
+        procedure(store_part_iface), deferred :: store_part
+        !> Text after '... did not converge in N sweeps' of an unconverged step's warning.
+        procedure(unconverged_detail_iface), deferred :: unconverged_detail
+        !> Summary lines before the energy balance: model, constraint residuals, unconverged steps.
+        procedure(summary_lines_iface), deferred :: summary_lines
+        !> More of a checkpoint than the coupled system and the writers (default: none).
+        procedure :: save_part => no_save_part
+        !> Read back what `save_part` wrote, after the results file is restored (default: none).
+        procedure :: load_part => no_load_part
+        !> Last writes after the summary (default: none).
+        procedure :: finish => no_finish
+    end type arlequin_simulation_t
+
+    abstract interface
+        !> The particle deck data the /dem writer needs.
+        subroutine particle_output_iface(self, material_id, store_contacts)
+            import :: arlequin_simulation_t
+            !> The simulation (after `init`).
+            class(arlequin_simulation_t), intent(in) :: self
+            !> Deck id of each particle material.
+            integer, allocatable, intent(out) :: material_id(:)
+            !> Whether the contacts are stored with each output.
+            logical, intent(out) :: store_contacts
+        end subroutine particle_output_iface
+
+        !> Write the static data of a new run into the results file.
+        subroutine begin_iface(self, out, error)
+            import :: arlequin_simulation_t, results_writer_t, error_t
+            !> The simulation (after `init`).
+            class(arlequin_simulation_t), intent(inout) :: self
+            !> The results file.
+            type(results_writer_t), intent(inout) :: out
+            !> Set on a write failure.
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine begin_iface
+
+        !> Error when the finite-element state after step `k` is not finite.
+        subroutine check_part_iface(self, k, error)
+            import :: arlequin_simulation_t, error_t, i8
+            !> The simulation.
+            class(arlequin_simulation_t), intent(in) :: self
+            !> Steps done.
+            integer(i8), intent(in) :: k
+            !> Set at the first non-finite value.
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine check_part_iface
+
+        !> Store the finite-element side of one output.
+        subroutine store_part_iface(self, out, error)
+            import :: arlequin_simulation_t, results_writer_t, error_t
+            !> The simulation.
+            class(arlequin_simulation_t), intent(inout) :: self
+            !> The results file.
+            type(results_writer_t), intent(inout) :: out
+            !> Set on a non-finite output or a write failure.
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine store_part_iface
+
+        !> The end of an unconverged step's warning.
+        function unconverged_detail_iface(self) result(text)
+            import :: arlequin_simulation_t
+            !> The simulation.
+            class(arlequin_simulation_t), intent(in) :: self
+            !> Text after 'sweeps'.
+            character(len=:), allocatable :: text
+        end function unconverged_detail_iface
+
+        !> Report the summary lines of the model.
+        subroutine summary_lines_iface(self, n_steps, unconverged, report)
+            import :: arlequin_simulation_t, report_iface, i8
+            !> The simulation.
+            class(arlequin_simulation_t), intent(in) :: self
+            !> Steps done.
+            integer(i8), intent(in) :: n_steps
+            !> Unconverged steps.
+            integer, intent(in) :: unconverged
+            !> Where the lines go.
+            procedure(report_iface) :: report
+        end subroutine summary_lines_iface
+    end interface
+
+contains
+
+    !> Integrate the coupled model from t = 0 (or from a checkpoint) to the end time and write
+    !> its results; write checkpoints as `ck` says, at the end and at a stop signal.
+    subroutine arlequin_run(self, out, quiet, report, ck, error)
+        !> The simulation (after `init`).
+        class(arlequin_simulation_t), intent(inout) :: self
+        !> The results file.
+        type(results_writer_t), intent(inout) :: out
+        !> No progress lines (warnings and the summary are still reported).
+        logical, intent(in) :: quiet
+        !> Where progress, warning and summary lines go.
+        procedure(report_iface) :: report
+        !> Checkpoints (and the one to restart from).
+        type(checkpoint_run_t), intent(inout) :: ck
+        !> Set on a run or write failure.
+        type(error_t), allocatable, intent(out) :: error
+        type(progress_t) :: progress
+        type(step_start_t) :: start
+        integer(i8) :: n_steps, k, k0
+        integer :: unconverged
+        logical :: speed_warned, stop, store_contacts
+        integer, allocatable :: material_id(:)
+        character(len=512) :: buf
+
+        n_steps = self%settings%n_steps
+        unconverged = 0
+        speed_warned = .false.
+        k0 = 0
+        call self%particle_output(material_id, store_contacts)
+        if (ck%restart) then
+            call restore(error)
+            if (allocated(error)) return
+        else
+            call self%dem_out%begin(out%file, self%sys%dem, material_id, store_contacts, error)
+            if (allocated(error)) return
+            call self%cpl_out%begin(out%file, self%sys, error)
+            if (allocated(error)) return
+            call self%begin(out, error)
+            if (allocated(error)) return
+            k = 0
+            call check_step(error)
+            if (allocated(error)) return
+            call store(error)
+            if (allocated(error)) return
+        end if
+        call progress%start(n_steps, self%settings%t_end, self%settings%progress_seconds)
+        call ck%schedule%start()
+        do k = k0 + 1, n_steps
+            call take_step_start(start, self%sys%dem%particles, self%sys%dem%walls)
+            call arlequin_step(self%sys, error)
+            if (allocated(error)) return
+            call self%after_step()
+            call check_step(error)
+            if (allocated(error)) return
+            call self%dem_out%record_step(out%file, self%sys%dem%stats, error)
+            if (allocated(error)) return
+            call self%cpl_out%record_step(out%file, self%sys, error)
+            if (allocated(error)) return
+            if (.not. self%sys%stats%converged) call warn_unconverged()
+            if (.not. speed_warned) call check_speed()
+            call end_of_step(k, n_steps, self%settings%output_interval, ck%schedule, store, checkpoint, stop, &
+                             error)
+            if (allocated(error)) return
+            if (stop) then
+                ! Stop request: the step just done is the last output.
+                call out%stop_at(signal_name(caught_signal()), k, self%sys%fe%t)
+                n_steps = k
+                exit
+            end if
+            if (quiet) cycle
+            if (progress%due()) call report(progress%line(k, self%sys%fe%t))
+        end do
+        call self%dem_out%finish(out%file, self%sys%dem, unconverged, error)
+        if (allocated(error)) return
+        call self%cpl_out%finish(out%file, error)
+        if (allocated(error)) return
+        call summary()
+        ! n_steps <= max_steps = huge(0) (driver_config)
+        call out%write_summary(int(n_steps), progress%elapsed(), error)
+        if (allocated(error)) return
+        call self%finish(out, error)
+
+    contains
+
+        !> Restart: state, writer counters and results file from the checkpoint `ck%source`.
+        subroutine restore(error)
+            type(error_t), allocatable, intent(out) :: error
+            type(error_t), allocatable :: ignored
+            call self%dem_out%resume(self%sys%dem, store_contacts)
+            call self%cpl_out%resume(self%sys)
+            call load_coupled(ck%source, self%sys, error)
+            if (.not. allocated(error)) call load_dem_writer(ck%source, self%dem_out, error)
+            if (.not. allocated(error)) call load_coupled_writer(ck%source, self%cpl_out, error)
+            if (.not. allocated(error)) call load_results(ck%source, out, error)
+            if (.not. allocated(error)) call self%load_part(ck%source, out, error)
+            call ck%source%close(ignored)
+            if (allocated(error)) return
+            k0 = ck%start%step
+            unconverged = ck%start%unconverged
+            speed_warned = ck%start%speed_warned
+        end subroutine restore
+
+        !> Write a checkpoint after step k (the buffered per-step values are written first).
+        subroutine checkpoint(error)
+            type(error_t), allocatable, intent(out) :: error
+            type(h5_file_t) :: f
+            call self%dem_out%flush_buffer(out%file, error)
+            if (.not. allocated(error)) call self%cpl_out%flush_buffer(out%file, error)
+            if (allocated(error)) return
+            call checkpoint_create(f, ck%path, ck%deck_text, self%checkpoint_kind(), &
+                                   loop_state_t(k, unconverged, speed_warned, .false.), self%sys%fe%t, &
+                                   out%run_id, error)
+            if (.not. allocated(error)) call save_coupled(f, self%sys, error)
+            if (.not. allocated(error)) call self%save_part(f, error)
+            if (.not. allocated(error)) call save_dem_writer(f, self%dem_out, error)
+            if (.not. allocated(error)) call save_coupled_writer(f, self%cpl_out, error)
+            if (.not. allocated(error)) call save_results(f, out, error)
+            if (allocated(error)) then
+                call checkpoint_discard(f, ck%path)
+                return
+            end if
+            call checkpoint_commit(f, ck%path, error)
+            if (allocated(error)) return
+            ck%last_step = k
+            ck%last_time = self%sys%fe%t
+        end subroutine checkpoint
+
+        !> Guards after step k (k = 0: the initial state): the finite-element state, finite disk
+        !> states in the box, no tunnelling in the step.
+        subroutine check_step(error)
+            type(error_t), allocatable, intent(out) :: error
+            call self%check_part(k, error)
+            if (allocated(error)) return
+            associate (sys => self%sys)
+                call check_disks_state(k, sys%fe%t, sys%dem%particles, sys%dem%energies, error)
+                if (allocated(error)) return
+                if (k == 0) return
+                call check_tunnelling(k, sys%fe%t, self%settings%h, sys%dem%scheme%alert, start, &
+                                      sys%dem%particles, sys%dem%walls, sys%dem%contacts, error)
+            end associate
+        end subroutine check_step
+
+        !> One stored output: the finite-element side, the disks, the coupling.
+        subroutine store(error)
+            type(error_t), allocatable, intent(out) :: error
+            call self%store_part(out, error)
+            if (allocated(error)) return
+            call self%dem_out%store(out%file, self%sys%dem, error)
+            if (allocated(error)) return
+            call self%cpl_out%store(out%file, self%sys, error)
+            if (allocated(error)) return
+            call out%flush(error)
+        end subroutine store
+
+        !> Warning for an unconverged step (the first max_warnings ones).
+        subroutine warn_unconverged()
+            unconverged = unconverged + 1
+            if (unconverged > max_warnings) return
+            write (buf, '(a,i0,a,es12.4e3,a,i0,a)') 'warning: step ', k, ' (t = ', self%sys%fe%t, &
+                ' s): the joint contact/multiplier solve did not converge in ', self%sys%stats%sweeps, ' sweeps'
+            call report(trim(buf)//self%unconverged_detail())
+            if (unconverged == max_warnings) call report(last_unconverged_warning())
+        end subroutine warn_unconverged
+
+        !> Warning (once) when a disk moved farther than the alert distance in the step.
+        subroutine check_speed()
+            character(len=:), allocatable :: line
+            line = speed_warning(self%sys%dem%particles, self%settings%h, self%sys%dem%scheme%alert, &
+                                 self%sys%fe%t)
+            if (len(line) == 0) return
+            speed_warned = .true.
+            call report(line)
+        end subroutine check_speed
+
+        !> Closing lines: the model's (size, residuals, solver effort), energy balance, times.
+        subroutine summary()
+            type(coupled_energies_t) :: en
+            call self%summary_lines(n_steps, unconverged, report)
+            en = coupled_energies(self%sys)
+            write (buf, '(a,es11.3e3,a,es11.3e3,a,es11.3e3,a)') 'energy balance residual ', en%balance, &
+                ' J (max over the outputs ', self%cpl_out%max_balance, ' J; external work ', &
+                en%fe_external_work + en%dem_external_work + en%dem_drive_work, ' J)'
+            call report(trim(buf))
+            call report(progress%summary_line(n_steps, self%sys%fe%t))
+        end subroutine summary
+    end subroutine arlequin_run
+
+    !> No work after a step.
+    subroutine no_after_step(self)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(inout) :: self
+    end subroutine no_after_step
+
+    !> Nothing to add to a checkpoint.
+    subroutine no_save_part(self, f, error)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(in) :: self
+        !> The checkpoint being written.
+        type(h5_file_t), intent(inout) :: f
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+    end subroutine no_save_part
+
+    !> Nothing to read back from a checkpoint.
+    subroutine no_load_part(self, f, out, error)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(inout) :: self
+        !> The checkpoint (open).
+        type(h5_file_t), intent(inout) :: f
+        !> The results file (restored).
+        type(results_writer_t), intent(inout) :: out
+        !> Set on a read failure.
+        type(error_t), allocatable, intent(out) :: error
+    end subroutine no_load_part
+
+    !> No writes after the summary.
+    subroutine no_finish(self, out, error)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(inout) :: self
+        !> The results file (summary written).
+        type(results_writer_t), intent(inout) :: out
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+    end subroutine no_finish
+end module driver_coupled_loop
