@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Scenarios that used to run to NaN with exit 0, crash, or misbehave, and must now stop
-cleanly: guards after every step (non-finite state, disks beyond the representable box,
-tunnelling), one writer per results folder (lock file), --output '', three-digit exponents
-in messages, decks with a UTF-8 byte-order mark or CR-only line endings.
+cleanly: guards on the initial state and after every step (non-finite state, disks beyond
+the representable box, tunnelling), one writer per results folder (lock file), --output '',
+three-digit exponents in messages, decks with a UTF-8 byte-order mark or CR-only line endings.
 
 Each failed run must exit 1 with a message naming the deck, the step and the body, and leave
 an earlier finished result in the folder byte for byte.
@@ -115,6 +115,24 @@ def coupled_non_finite(exe, work, decks):
     failing_run(exe, work, "coupled_load_1e300", bad, r"step 1 \(t = .*\): beam", text)
 
 
+def coupled2d_initial_state(exe, work, src):
+    """A coupled continuum + disk run checks its initial state (step 0) as the beam-coupled
+    one does: a disk or continuum velocity of 1e200 m/s is finite, but its kinetic energy
+    (~1e400 J) is not; the run stops before step 1, naming step 0 and the part."""
+    text = (src / "input" / "coupled2d_block.dat").read_text()
+    disks = "initial_rigid = 1:last 0.3 -0.2 0.4 1.5 0.5"
+    block = "initial_velocity = 0.3 -0.2 0.4 1.5 0.5"
+    if disks not in text or block not in text:
+        check("coupled2d initial state: deck lines found", False, "input/coupled2d_block.dat changed")
+        return
+    fast_disks = text.replace(disks, disks.replace("0.3", "1e200", 1))
+    failing_run(exe, work, "coupled2d_disk_velocity_1e200", fast_disks,
+                r"step 0 \(t = 0\.00000E\+000 s\): particles: an energy account is not finite", text)
+    fast_block = text.replace(block, block.replace("0.3", "1e200", 1))
+    failing_run(exe, work, "coupled2d_block_velocity_1e200", fast_block,
+                r"coupled continuum: the state is not finite after step 0 ", text)
+
+
 def tunnelling(exe, work):
     """A step so large that disks pass through the floor ran to the end with one warning."""
     failing_run(exe, work, "dem_tunnelling_floor", dem_deck(step="0.05", end="1"),
@@ -225,6 +243,7 @@ def main():
     work.mkdir(parents=True, exist_ok=True)
     non_finite(exe, work)
     coupled_non_finite(exe, work, src / "tests" / "regression" / "decks")
+    coupled2d_initial_state(exe, work, src)
     tunnelling(exe, work)
     lock(exe, work)
     output_empty(exe, work)
