@@ -70,6 +70,10 @@ module driver_coupled_loop
         procedure :: load_part => no_load_part
         !> Last writes after the summary (default: none).
         procedure :: finish => no_finish
+        !> Summary line 'coupled run: <model>, N disks (M coupled), K steps to t = T s'.
+        procedure, non_overridable :: run_line
+        !> Summary line of the constraint residuals (position, from the coordinates, velocity).
+        procedure, non_overridable :: constraint_line
     end type arlequin_simulation_t
 
     abstract interface
@@ -327,6 +331,40 @@ contains
             call report(progress%summary_line(n_steps, self%sys%fe%t))
         end subroutine summary
     end subroutine arlequin_run
+
+    !> 'coupled run: <model>, N disks (M coupled), K steps to t = T s'.
+    function run_line(self, model, n_steps) result(line)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(in) :: self
+        !> Size of the finite-element model, e.g. '11 beam nodes'.
+        character(len=*), intent(in) :: model
+        !> Steps done.
+        integer(i8), intent(in) :: n_steps
+        !> The line.
+        character(len=:), allocatable :: line
+        character(len=512) :: buf
+        write (buf, '(a,i0,a,i0,a,i0,a,es13.5e3,a)') 'coupled run: '//model//', ', self%sys%dem%particles%n, &
+            ' disks (', self%sys%op%n_points, ' coupled), ', n_steps, ' steps to t = ', self%sys%fe%t, ' s'
+        line = trim(buf)
+    end function run_line
+
+    !> '<residual> = P m (<coordinates> C m), max velocity residual V m/s': the largest
+    !> residuals over the outputs.
+    function constraint_line(self, residual, coordinates) result(line)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(in) :: self
+        !> What the position residual is, e.g. 'constraint: max |q - C u|'.
+        character(len=*), intent(in) :: residual
+        !> How the residual from the coordinates is taken, e.g. 'from the coordinates'.
+        character(len=*), intent(in) :: coordinates
+        !> The line.
+        character(len=:), allocatable :: line
+        character(len=512) :: buf
+        write (buf, '(a,es11.3e3,a,es11.3e3,a,es11.3e3,a)') residual//' = ', self%cpl_out%max_position, &
+            ' m ('//coordinates//' ', self%cpl_out%max_coordinate, ' m), max velocity residual ', &
+            self%cpl_out%max_velocity, ' m/s'
+        line = trim(buf)
+    end function constraint_line
 
     !> No work after a step.
     subroutine no_after_step(self)

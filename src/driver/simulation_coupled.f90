@@ -224,28 +224,16 @@ contains
         integer, intent(in) :: unconverged
         !> Where the lines go.
         procedure(report_iface) :: report
-        character(len=512) :: buf
-        associate (sys => self%sys, cpl_out => self%cpl_out)
-            write (buf, '(a,i0,a,i0,a,i0,a,i0,a,es13.5e3,a)') 'coupled run: ', &
-                self%model%n_nodes, ' beam nodes, ', sys%dem%particles%n, ' disks (', &
-                sys%op%n_points, ' coupled), ', n_steps, ' steps to t = ', sys%fe%t, ' s'
-            call report(trim(buf))
-            if (sys%on_nodes) then
-                ! Only the projection on the mediator space is imposed: the per-disk residual
-                ! from the coordinates is free in the kernel of Pi.
-                write (buf, '(a,es11.3e3,a,es11.3e3,a,es11.3e3,a)') 'constraint (multipliers on '// &
-                    'the nodes): max |Pi (q - C u)| = ', cpl_out%max_position, &
-                    ' m (per disk, from the coordinates ', cpl_out%max_coordinate, &
-                    ' m), max velocity residual ', cpl_out%max_velocity, ' m/s'
-            else
-                write (buf, '(a,es11.3e3,a,es11.3e3,a,es11.3e3,a)') 'constraint: max |q - C u| = ', &
-                    cpl_out%max_position, ' m (from the coordinates ', cpl_out%max_coordinate, &
-                    ' m), max velocity residual ', cpl_out%max_velocity, ' m/s'
-            end if
-            call report(trim(buf))
-            call report('unconverged steps: '//to_str(unconverged)//' of '//to_str(n_steps)// &
-                        ' (tolerance '//to_str(sys%dem%solver%tol)//', at most '// &
-                        to_str(sys%dem%solver%max_sweeps)//' sweeps)')
-        end associate
+        call report(self%run_line(to_str(self%model%n_nodes)//' beam nodes', n_steps))
+        if (self%sys%on_nodes) then
+            ! Only the projection on the mediator space is imposed: the per-disk residual from
+            ! the coordinates is free in the kernel of Pi.
+            call report(self%constraint_line('constraint (multipliers on the nodes): max |Pi (q - C u)|', &
+                                             'per disk, from the coordinates'))
+        else
+            call report(self%constraint_line('constraint: max |q - C u|', 'from the coordinates'))
+        end if
+        call report('unconverged steps: '//to_str(unconverged)//' of '//to_str(n_steps)//' (tolerance '// &
+                    to_str(self%sys%dem%solver%tol)//', at most '//to_str(self%sys%dem%solver%max_sweeps)//' sweeps)')
     end subroutine coupled_summary_lines
 end module driver_simulation_coupled

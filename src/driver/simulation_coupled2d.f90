@@ -287,18 +287,9 @@ contains
         integer, intent(in) :: unconverged
         !> Where the lines go.
         procedure(report_iface) :: report
-        character(len=512) :: buf
-        associate (sys => self%sys)
-            write (buf, '(a,i0,a,i0,a,i0,a,i0,a,es13.5e3,a)') 'coupled run: ', &
-                self%continuum%model%mesh%element_count(), ' elements, ', sys%dem%particles%n, ' disks (', &
-                sys%op%n_points, ' coupled), ', n_steps, ' steps to t = ', sys%fe%t, ' s'
-            call report(trim(buf))
-            write (buf, '(a,es11.3e3,a,es11.3e3,a,es11.3e3,a)') 'constraint: max |Pi (q - C u)| = ', &
-                self%cpl_out%max_position, ' m (per disk, from the coordinates ', self%cpl_out%max_coordinate, &
-                ' m), max velocity residual ', self%cpl_out%max_velocity, ' m/s'
-            call report(trim(buf))
-            call report('unconverged steps: '//to_str(unconverged)//' of '//to_str(n_steps))
-        end associate
+        call report(self%run_line(to_str(self%continuum%model%mesh%element_count())//' elements', n_steps))
+        call report(self%constraint_line('constraint: max |Pi (q - C u)|', 'per disk, from the coordinates'))
+        call report('unconverged steps: '//to_str(unconverged)//' of '//to_str(n_steps))
     end subroutine coupled2d_summary_lines
 
     !> The continuum's accumulated works (the rest of its audit follows from the state) and the
