@@ -18,6 +18,7 @@ program multicor
     use core_error, only: error_t, error_internal
     use core_version, only: multicor_version
     use core_signals, only: signal_exit_code
+    use core_strings, only: parse_real
     use io_deck_schema, only: multicor_schema, schema_markdown
     use driver_run, only: run_options_t, run_deck
     implicit none
@@ -26,8 +27,8 @@ program multicor
     type(ieee_status_type) :: fp_status
     type(error_t), allocatable :: error
     character(len=:), allocatable :: arg, text
-    integer :: i, n, stopped_by, ios
-    logical :: take_output, take_restart, take_end
+    integer :: i, n, stopped_by
+    logical :: take_output, take_restart, take_end, ok
 
     n = command_argument_count()
     take_output = .false.
@@ -42,9 +43,11 @@ program multicor
             cycle
         end if
         if (take_end) then
-            read (arg, *, iostat=ios) opts%end_time
-            if (ios /= 0 .or. verify(trim(arg), '0123456789.eEdD+-') /= 0) &
-                call usage_error("--end needs a time in seconds, got '"//arg(:min(len(arg), 40))//"'")
+            ! parse_real checks the magnitude before reading: a plain read of '1e999' raises
+            ! a floating-point overflow (a crash where it traps), of 'inf'/'nan' a non-finite time
+            call parse_real(trim(arg), opts%end_time, ok)
+            if (.not. ok) call usage_error("--end needs a finite time in seconds, got '"// &
+                                           arg(:min(len(arg), 40))//"'")
             if (.not. (opts%end_time > 0.0_wp .and. opts%end_time <= huge(1.0_wp))) &
                 call usage_error("--end needs a positive time in seconds, got '"//arg(:min(len(arg), 40))//"'")
             take_end = .false.

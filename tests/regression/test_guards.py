@@ -2,7 +2,8 @@
 """Scenarios that used to run to NaN with exit 0, crash, or misbehave, and must now stop
 cleanly: guards on the initial state and after every step (non-finite state, disks beyond
 the representable box, tunnelling), one writer per results folder (lock file), --output '',
-three-digit exponents in messages, decks with a UTF-8 byte-order mark or CR-only line endings.
+--end 1e999, three-digit exponents in messages, decks with a UTF-8 byte-order mark or CR-only
+line endings.
 
 Each failed run must exit 1 with a message naming the deck, the step and the body, and leave
 an earlier finished result in the folder byte for byte.
@@ -201,6 +202,20 @@ def output_empty(exe, work):
           and not pathlib.Path("/empty_output.h5.partial").exists(), "")
 
 
+def end_option(exe, work):
+    """--end 1e999 died of SIGFPE while reading the number (Debug build: overflow trap in
+    strtod); 'inf', 'nan' and overflowing values are bad command lines (exit 2)."""
+    deck = work / "end_option.dat"
+    deck.write_text(beam_deck())
+    folder = work / "end_option"
+    for value in ("1e999", "-1e999", "1e400", "inf", "nan", "1e-400", "0", "-1"):
+        proc = multicor(exe, deck, "--output", folder, "--quiet", "--end", value)
+        check(f"--end {value}: bad command line (exit 2)", proc.returncode == 2
+              and "--end needs a" in proc.stderr and value in proc.stderr,
+              f"exit {proc.returncode} {proc.stderr.strip()[:300]}")
+    check("--end: nothing written", not folder.exists(), "")
+
+
 def exponents(exe, work):
     """tolerance = 1e-300 printed as '1.00-300' (no exponent letter) in the warnings."""
     deck = work / "tiny_tolerance.dat"
@@ -247,6 +262,7 @@ def main():
     tunnelling(exe, work)
     lock(exe, work)
     output_empty(exe, work)
+    end_option(exe, work)
     exponents(exe, work)
     line_endings(exe, work)
     print(f"{len(FAILED)} failed checks")
