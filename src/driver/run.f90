@@ -6,7 +6,8 @@
 !>
 !> Everything that can fail because of the input is checked before the results folder is
 !> touched; the HDF5 file is written as '<name>.h5.partial' and renamed only on success, so
-!> earlier results stay intact when a run fails.
+!> earlier results stay intact when a run fails, and a results folder the failed run created
+!> is removed again when it is left empty.
 !>
 !> Guards (driver_guards): before anything is built, the model's memory estimate is checked
 !> against the available memory; disks and walls must lie in the box the detection can
@@ -29,7 +30,7 @@ module driver_run
     use core_signals, only: caught_signal, signal_name, install_signal_handlers
     use io_deck_schema, only: multicor_schema
     use io_deck, only: deck_t, read_deck
-    use io_paths, only: stem, mkdir_p, file_exists
+    use io_paths, only: stem, mkdir_p, remove_empty_folders, file_exists
     use driver_results, only: results_writer_t
     use driver_guards, only: check_memory
     use driver_simulation, only: simulation_t, report_iface
@@ -78,7 +79,7 @@ contains
         type(results_writer_t) :: out
         type(lock_t) :: lock
         type(checkpoint_run_t) :: ck
-        character(len=:), allocatable :: dir, path, warning, kind, run_id
+        character(len=:), allocatable :: dir, created, path, warning, kind, run_id
         character(len=32) :: tbuf
 
         if (present(stopped_by)) stopped_by = 0
@@ -100,28 +101,36 @@ contains
 
         dir = 'results/'//stem(opts%deck_path)
         if (allocated(opts%output_dir)) dir = opts%output_dir
-        call mkdir_p(dir, error)
+        call mkdir_p(dir, error, created)
         if (allocated(error)) return
-        path = dir//'/'//stem(opts%deck_path)//'.h5'
-        call lock_acquire(lock, dir, warning, error)
-        if (allocated(error)) return
-        if (len(warning) > 0) call report(warning)
-        ck%path = dir//'/'//checkpoint_name
-        ck%deck_text = deck%text
-        ck%schedule%every = sim%settings%checkpoint_interval
-        ck%schedule%seconds = sim%settings%checkpoint_seconds
-        if (allocated(opts%restart)) call open_checkpoint(error)
-        ! Until here a signal kills the program at once (nothing is written yet).
-        if (.not. allocated(error)) call install_signal_handlers(error)
-        if (.not. allocated(error)) call write_results(error)
-        call lock_release(lock)
-        if (allocated(error)) return
-        call report('results written to '//path)
-        if (ck%last_step >= 0) call report('checkpoint: '//to_str(ck%last_step)//' steps, t = '// &
-                                           num(ck%last_time)//' s, in '//ck%path//' (to go on to a later end '// &
-                                           'time: '//continue_command()//' --end T)')
+        call write_into_folder(error)
+        ! A failed run leaves no folder of its own making behind empty (what it holds stays).
+        if (allocated(error)) call remove_empty_folders(dir, created)
 
     contains
+
+        !> Lock the results folder `dir` (it exists), run and write the results, report them.
+        subroutine write_into_folder(error)
+            type(error_t), allocatable, intent(out) :: error
+            path = dir//'/'//stem(opts%deck_path)//'.h5'
+            call lock_acquire(lock, dir, warning, error)
+            if (allocated(error)) return
+            if (len(warning) > 0) call report(warning)
+            ck%path = dir//'/'//checkpoint_name
+            ck%deck_text = deck%text
+            ck%schedule%every = sim%settings%checkpoint_interval
+            ck%schedule%seconds = sim%settings%checkpoint_seconds
+            if (allocated(opts%restart)) call open_checkpoint(error)
+            ! Until here a signal kills the program at once (nothing is written yet).
+            if (.not. allocated(error)) call install_signal_handlers(error)
+            if (.not. allocated(error)) call write_results(error)
+            call lock_release(lock)
+            if (allocated(error)) return
+            call report('results written to '//path)
+            if (ck%last_step >= 0) call report('checkpoint: '//to_str(ck%last_step)//' steps, t = '// &
+                                               num(ck%last_time)//' s, in '//ck%path//' (to go on to a later '// &
+                                               'end time: '//continue_command()//' --end T)')
+        end subroutine write_into_folder
 
         !> Run the analysis into '<path>.partial', renamed to `path` on success (the caller
         !> holds the folder's lock).

@@ -5,7 +5,7 @@ module io_paths
     use core_error, only: error_t, make_error
     implicit none
     private
-    public :: basename, stem, mkdir_p, file_exists, remove_file, rename_file, copy_file
+    public :: basename, stem, mkdir_p, remove_empty_folders, file_exists, remove_file, rename_file, copy_file
 
     interface
         function c_mkdir(path, mode) bind(C, name='mkdir') result(rc)
@@ -14,6 +14,11 @@ module io_paths
             integer(c_int), value :: mode
             integer(c_int) :: rc
         end function c_mkdir
+        function c_rmdir(path) bind(C, name='rmdir') result(rc)
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int) :: rc
+        end function c_rmdir
         function c_rename(old, new) bind(C, name='rename') result(rc)
             import :: c_char, c_int
             character(kind=c_char), intent(in) :: old(*), new(*)
@@ -52,13 +57,17 @@ contains
     end function file_exists
 
     !> Create a folder and its parents (like mkdir -p).
-    subroutine mkdir_p(path, error)
+    subroutine mkdir_p(path, error, created)
         !> Folder to create.
         character(len=*), intent(in) :: path
         !> Set if a folder could not be created.
         type(error_t), allocatable, intent(out) :: error
+        !> The outermost folder this call created ('' when `path` existed already), for
+        !> `remove_empty_folders` to undo the call.
+        character(len=:), allocatable, intent(out), optional :: created
         integer :: i
         integer(c_int) :: rc
+        if (present(created)) created = ''
         do i = 2, len_trim(path) + 1
             if (i <= len_trim(path)) then
                 if (path(i:i) /= '/') cycle
@@ -69,8 +78,35 @@ contains
                 call make_error(error, "cannot create folder '"//path(:i - 1)//"'")
                 return
             end if
+            if (present(created)) then
+                if (rc == 0 .and. len(created) == 0) created = path(:i - 1)
+            end if
         end do
     end subroutine mkdir_p
+
+    !> Undo `mkdir_p` where nothing was put in the folders it created: remove `path` and its
+    !> parents up to `created` (the outermost folder that call created) while they are empty.
+    !> Folders that hold anything are kept (rmdir refuses them), as is everything above `created`.
+    subroutine remove_empty_folders(path, created)
+        !> The folder given to `mkdir_p`.
+        character(len=*), intent(in) :: path
+        !> What `mkdir_p` returned as `created` ('': nothing to remove).
+        character(len=*), intent(in) :: created
+        integer :: i
+        character(len=:), allocatable :: folder
+        if (len(created) == 0) return
+        folder = trim(path)
+        do while (len(folder) > 1 .and. folder(len(folder):) == '/')
+            folder = folder(:len(folder) - 1)
+        end do
+        do while (len(folder) >= len(created))
+            if (c_rmdir(folder//c_null_char) /= 0) return
+            if (folder == created) return
+            i = index(folder, '/', back=.true.)
+            if (i <= 1) return
+            folder = folder(:i - 1)
+        end do
+    end subroutine remove_empty_folders
 
     !> Delete a file if it exists.
     subroutine remove_file(path)

@@ -2,8 +2,8 @@
 """Scenarios that used to run to NaN with exit 0, crash, or misbehave, and must now stop
 cleanly: guards on the initial state and after every step (non-finite state, disks beyond
 the representable box, tunnelling), one writer per results folder (lock file), --output '',
---end 1e999, three-digit exponents in messages, decks with a UTF-8 byte-order mark or CR-only
-line endings.
+--end 1e999, no empty folder left by a failed run, three-digit exponents in messages, decks
+with a UTF-8 byte-order mark or CR-only line endings.
 
 Each failed run must exit 1 with a message naming the deck, the step and the body, and leave
 an earlier finished result in the folder byte for byte.
@@ -216,6 +216,24 @@ def end_option(exe, work):
     check("--end: nothing written", not folder.exists(), "")
 
 
+def no_empty_folder(exe, work):
+    """A failed run given a new --output folder left it behind, empty; a folder that existed
+    before the run stays."""
+    deck = work / "new_folder.dat"
+    deck.write_text(beam_deck(load="-1e300"))
+    new = work / "new_folder_parent" / "a" / "b"
+    proc = multicor(exe, deck, "--output", new, "--quiet")
+    check("failed run into a new folder: exit 1", proc.returncode == 1, proc.stderr.strip()[:300])
+    check("failed run into a new folder: no folder left", not (work / "new_folder_parent").exists(),
+          "")
+    old = work / "old_folder"
+    old.mkdir(parents=True, exist_ok=True)
+    proc = multicor(exe, deck, "--output", old / "sub", "--quiet")
+    check("failed run into a new subfolder: exit 1", proc.returncode == 1, "")
+    check("failed run into a new subfolder: the existing parent kept, the subfolder removed",
+          old.is_dir() and not (old / "sub").exists(), "")
+
+
 def exponents(exe, work):
     """tolerance = 1e-300 printed as '1.00-300' (no exponent letter) in the warnings."""
     deck = work / "tiny_tolerance.dat"
@@ -263,6 +281,7 @@ def main():
     lock(exe, work)
     output_empty(exe, work)
     end_option(exe, work)
+    no_empty_folder(exe, work)
     exponents(exe, work)
     line_endings(exe, work)
     print(f"{len(FAILED)} failed checks")
