@@ -202,18 +202,22 @@ contains
             if (allocated(error)) call fail_at(error, list(1)%line, 'material')
         end subroutine set_materials
 
-        !> Supports (fix) and prescribed displacements.
+        !> Supports (fix) and prescribed displacements. A dof may be prescribed by several
+        !> records only with the same value and the same function (overlapping sets, e.g. the
+        !> corner node of left and bottom); different ones are an error naming both lines.
         subroutine set_constraints(error)
             type(error_t), allocatable, intent(out) :: error
             type(string_t), allocatable :: components(:)
+            ! Line of the record that prescribed each dof first (0: free so far).
+            integer, allocatable :: by_line(:)
             integer :: i, j, func
+            allocate (by_line(self%model%dof_count()), source=0)
             list = deck%records('continuum', 'fix')
             do i = 1, size(list)
                 e = list(i)
                 components = e%words_from('component')
                 do j = 1, size(components)
-                    call self%model%prescribe_set(e%word('node_set'), component(components(j)%s), 0.0_wp, error)
-                    if (allocated(error)) call fail_at(error, e%line, 'fix')
+                    call prescribe('fix', component(components(j)%s), 0.0_wp, 0, by_line, error)
                     if (allocated(error)) return
                 end do
             end do
@@ -222,12 +226,44 @@ contains
                 e = list(i)
                 call find_function('displacement', func, error)
                 if (allocated(error)) return
-                call self%model%prescribe_set(e%word('node_set'), component(e%word('component')), e%real('value'), error, &
-                                              func)
-                if (allocated(error)) call fail_at(error, e%line, 'displacement')
+                call prescribe('displacement', component(e%word('component')), e%real('value'), func, by_line, &
+                               error)
                 if (allocated(error)) return
             end do
         end subroutine set_constraints
+
+        !> Prescribe `value` times function `func` on one component of the node set of record
+        !> e, refusing a dof that an earlier record prescribed otherwise (`by_line`: line of
+        !> the record that prescribed each dof first, 0 for none yet).
+        subroutine prescribe(keyword, comp, value, func, by_line, error)
+            character(len=*), intent(in) :: keyword
+            integer, intent(in) :: comp, func
+            real(wp), intent(in) :: value
+            integer, intent(inout) :: by_line(:)
+            type(error_t), allocatable, intent(out) :: error
+            integer, allocatable :: ids(:)
+            integer :: k, dof
+            call self%model%mesh%node_set(e%word('node_set'), ids, error)
+            if (allocated(error)) call fail_at(error, e%line, keyword)
+            if (allocated(error)) return
+            do k = 1, size(ids)
+                dof = 2*ids(k) - 2 + comp
+                if (by_line(dof) == 0) then
+                    by_line(dof) = e%line
+                else if (self%model%prescribed_value(dof) /= value .or. &
+                         self%model%prescribed_function(dof) /= func) then
+                    call make_input_error(error, deck%file, e%line, keyword, 'node '//to_str(ids(k))// &
+                                          ' of set '//e%word('node_set')//', component '// &
+                                          merge('x', 'y', comp == 1)//', is already prescribed by line '// &
+                                          to_str(by_line(dof))//' with another value or function: give each '// &
+                                          'displacement component of a node one prescription (a repeated one '// &
+                                          'must be the same value and function)')
+                    return
+                end if
+            end do
+            call self%model%prescribe_set(e%word('node_set'), comp, value, error, func)
+            if (allocated(error)) call fail_at(error, e%line, keyword)
+        end subroutine prescribe
 
         !> Nodal loads and tractions (constant, or times a [functions] function), and gravity.
         subroutine set_loads(error)

@@ -39,13 +39,15 @@ contains
         call s%add_keyword('continuum', 'mass', [word_field('mass', 'consistent lumped')], &
                            'Mass matrix: consistent, or row-sum lumped (diagonal).', default='consistent')
         call s%add_keyword('continuum', 'fix', [word_field('node_set', '')], &
-                           'Zero displacement of the nodes of a set, components x and/or y.', &
+                           'Zero displacement of the nodes of a set, components x and/or y (a dof given by '// &
+                           'several fix or displacement records must get the same value and function from each).', &
                            tails=[tail([word_field('component', 'x y')], 1, 2)], repeatable=.true.)
         call s%add_keyword('continuum', 'displacement', [word_field('node_set', ''), &
                                                          word_field('component', 'x y'), real_field('value', 'm')], &
                            'Prescribed displacement of the nodes of a set: the value, or the value times a '// &
                            '[functions] time function (its rate and acceleration are the derivatives of the '// &
-                           'function).', tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
+                           'function); a dof given twice must get the same value and function both times.', &
+                           tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
         call s%add_keyword('continuum', 'load', [word_field('node_set', ''), &
                                                  word_field('component', 'x y'), real_field('value', 'N')], &
                            'Force on every node of a set, times a [functions] time function (none: constant 1).', &
