@@ -360,7 +360,8 @@ contains
             integer, allocatable :: eq(:)
             real(wp) :: vx, vy, omega, xc, yc
             integer :: a, n, c
-            ! The rotation about (xc, yc) is optional: an absent value reads as 0.
+            ! The rotation about (xc, yc) is optional (omega, xc and yc together, the schema checks):
+            ! absent, it reads as 0.
             e = deck%record('continuum', 'initial_velocity', 1)
             vx = deck%get_real('continuum', 'initial_velocity', 'vx')
             vy = deck%get_real('continuum', 'initial_velocity', 'vy')

@@ -652,7 +652,7 @@ contains
         end if
     end function tail_usage
 
-    !> "1 to 3 values", "at least 2 groups", "exactly 1 value".
+    !> "1 to 3 values", "at least 2 groups", "exactly 1 value", "none or 1 group".
     function count_text(lo, hi, noun) result(text)
         !> Least count.
         integer, intent(in) :: lo
@@ -665,6 +665,8 @@ contains
             text = 'at least '//to_str(lo)//' '//noun//'s'
         else if (hi == lo .and. lo == 1) then
             text = 'exactly 1 '//noun
+        else if (lo == 0 .and. hi == 1) then
+            text = 'none or 1 '//noun
         else if (hi == lo) then
             text = 'exactly '//to_str(lo)//' '//noun//'s'
         else

@@ -66,8 +66,9 @@ contains
                            'Rayleigh damping C = a0 M + a1 K.', default='0 0')
         call s%add_keyword('continuum', 'initial_velocity', [real_field('vx', 'm/s'), real_field('vy', 'm/s')], &
                            'Initial velocity of the free nodes (dynamic analysis): (vx, vy) plus a rotation '// &
-                           'omega (rad/s) about (xc, yc) (m), v = (vx - omega (y - yc), vy + omega (x - xc)).', &
+                           'omega (rad/s) about (xc, yc) (m), v = (vx - omega (y - yc), vy + omega (x - xc)); '// &
+                           'the rotation is given whole (omega, xc and yc) or not at all.', &
                            tails=[tail([real_field('omega', 'rad/s'), real_field('xc', 'm'), real_field('yc', 'm')], &
-                                       0, 3)], default='0 0')
+                                       0, 3, cyclic=.true.)], default='0 0')
     end subroutine add_continuum
 end module io_schema_continuum
