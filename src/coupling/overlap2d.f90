@@ -16,8 +16,9 @@
 !>
 !> Several disjoint regions (e.g. the two bands of an interface between two blocks) form an
 !> `overlap_set_t`: a point takes the weight of the first region holding it, and 1 (FE) or
-!> 0 (disks) outside all of them. Both types extend the abstract `weight_field_t` that the
-!> weighted assembly takes.
+!> 0 (disks) outside all of them. Regions that share more than boundary points would weight
+!> the same material twice: `regions_overlap` tells them apart from regions that only touch.
+!> Both types extend the abstract `weight_field_t` that the weighted assembly takes.
 module coupling_overlap2d
     use core_kinds, only: wp
     use core_constants, only: relative_roundoff
@@ -25,7 +26,7 @@ module coupling_overlap2d
     use coupling_weights, only: weight_config_t, overlap_weight_t, make_weight
     implicit none
     private
-    public :: weight_field_t, overlap2d_t, overlap_set_t, make_box_overlap, make_polygon_overlap
+    public :: weight_field_t, overlap2d_t, overlap_set_t, make_box_overlap, make_polygon_overlap, regions_overlap
 
     !> A weight field alpha(x, y) of the 2D coupling.
     type, abstract :: weight_field_t
@@ -219,6 +220,123 @@ contains
         ! Rounding of coordinates at the scale of the region.
         region%tol = relative_roundoff*max(region%box(2) - region%box(1), region%box(4) - region%box(3))
     end subroutine make_polygon_overlap
+
+    !> True when the interiors of two regions intersect (a common area, more than the
+    !> rounding of the coordinates: the larger `tol` of the two); regions that only touch along
+    !> an edge or at a point do not overlap. Each polygon is cut into triangles (ear
+    !> clipping), and two triangles overlap when no edge direction of either separates them
+    !> (separating axes, exact for convex shapes).
+    pure logical function regions_overlap(a, b) result(overlap)
+        !> The regions (simple polygons).
+        type(overlap2d_t), intent(in) :: a, b
+        real(wp), allocatable :: ta(:, :, :), tb(:, :, :)
+        real(wp) :: tol
+        integer :: i, j
+        overlap = .false.
+        tol = max(a%tol, b%tol)
+        if (a%box(1) >= b%box(2) - tol .or. b%box(1) >= a%box(2) - tol .or. &
+            a%box(3) >= b%box(4) - tol .or. b%box(3) >= a%box(4) - tol) return
+        call triangulate(a%vertex, ta)
+        call triangulate(b%vertex, tb)
+        do i = 1, size(ta, 3)
+            do j = 1, size(tb, 3)
+                if (.not. (separated(ta(:, :, i), tb(:, :, j)) .or. separated(tb(:, :, j), ta(:, :, i)))) then
+                    overlap = .true.
+                    return
+                end if
+            end do
+        end do
+    contains
+        !> Whether an edge normal of triangle p separates p and q (gap > -tol).
+        pure logical function separated(p, q)
+            real(wp), intent(in) :: p(2, 3), q(2, 3)
+            real(wp) :: n(2), lp, hp, lq, hq
+            integer :: k
+            separated = .false.
+            do k = 1, 3
+                n = p(:, modulo(k, 3) + 1) - p(:, k)
+                n = [-n(2), n(1)]/norm2(n)
+                lp = minval(matmul(n, p))
+                hp = maxval(matmul(n, p))
+                lq = minval(matmul(n, q))
+                hq = maxval(matmul(n, q))
+                if (lp >= hq - tol .or. lq >= hp - tol) then
+                    separated = .true.
+                    return
+                end if
+            end do
+        end function separated
+    end function regions_overlap
+
+    !> Triangles (2, 3, n_triangles) of a simple polygon by ear clipping, counter-clockwise;
+    !> vertices on a straight line between their neighbours are dropped (no zero-area triangle).
+    pure subroutine triangulate(vertex, tri)
+        !> Vertices (2, n), either orientation.
+        real(wp), intent(in) :: vertex(:, :)
+        !> The triangles.
+        real(wp), allocatable, intent(out) :: tri(:, :, :)
+        real(wp), allocatable :: v(:, :)
+        real(wp) :: area, turn
+        integer :: n, m, k, i, prev, next, j
+        logical :: ear
+        n = size(vertex, 2)
+        area = 0.0_wp
+        do k = 1, n
+            area = area + cross(vertex(:, k), vertex(:, modulo(k, n) + 1))
+        end do
+        if (area >= 0.0_wp) then
+            v = vertex
+        else
+            v = vertex(:, n:1:-1)
+        end if
+        allocate (tri(2, 3, max(n - 2, 0)))
+        m = 0
+        do while (size(v, 2) >= 3)
+            n = size(v, 2)
+            ear = .false.
+            do i = 1, n
+                prev = modulo(i - 2, n) + 1
+                next = modulo(i, n) + 1
+                turn = cross(v(:, i) - v(:, prev), v(:, next) - v(:, i))
+                if (turn == 0.0_wp) then
+                    ! on the line through its neighbours: drop it
+                    ear = .true.
+                    exit
+                end if
+                if (turn < 0.0_wp) cycle
+                ear = .true.
+                do j = 1, n
+                    if (j == i .or. j == prev .or. j == next) cycle
+                    if (in_triangle(v(:, j), v(:, prev), v(:, i), v(:, next))) then
+                        ear = .false.
+                        exit
+                    end if
+                end do
+                if (ear) then
+                    m = m + 1
+                    tri(:, :, m) = reshape([v(:, prev), v(:, i), v(:, next)], [2, 3])
+                    exit
+                end if
+            end do
+            ! No ear: not a simple polygon; the rest as a fan from its first vertex.
+            if (.not. ear) then
+                do k = 2, n - 1
+                    m = m + 1
+                    tri(:, :, m) = reshape([v(:, 1), v(:, k), v(:, k + 1)], [2, 3])
+                end do
+                exit
+            end if
+            v = v(:, pack([(k, k=1, n)], [(k /= i, k=1, n)]))
+        end do
+        tri = tri(:, :, :m)
+    end subroutine triangulate
+
+    !> Whether p lies in the counter-clockwise triangle (a, b, c), its boundary included.
+    pure logical function in_triangle(p, a, b, c)
+        real(wp), intent(in) :: p(2), a(2), b(2), c(2)
+        in_triangle = cross(b - a, p - a) >= 0.0_wp .and. cross(c - b, p - b) >= 0.0_wp .and. &
+                      cross(a - c, p - c) >= 0.0_wp
+    end function in_triangle
 
     !> z component of a x b.
     pure real(wp) function cross(a, b)

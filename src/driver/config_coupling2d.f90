@@ -7,7 +7,8 @@
 !>   `overlap`, `max_offset` and `coupled` have no meaning here and are refused;
 !> - [continuum] gravity and [particles] gravity agree (both sides carry their weighted share
 !>   of the weight in the overlap);
-!> - a polygon's edge numbers are integers within its edges.
+!> - a polygon's edge numbers are integers within its edges;
+!> - the regions are disjoint (they may share edges): a common area would be weighted twice.
 !> Errors name the deck file, the line and the keyword.
 module driver_config_coupling2d
     use core_kinds, only: wp
@@ -15,7 +16,8 @@ module driver_config_coupling2d
     use core_strings, only: string_t, to_str
     use io_deck, only: deck_t, deck_entry_t
     use coupling_weights, only: weight_config_t
-    use coupling_overlap2d, only: overlap2d_t, overlap_set_t, make_box_overlap, make_polygon_overlap
+    use coupling_overlap2d, only: overlap2d_t, overlap_set_t, make_box_overlap, make_polygon_overlap, &
+                                  regions_overlap
     use coupling_operator2d, only: pairing_l2, pairing_h1
     use coupling_coupled_step, only: multipliers_particles, multipliers_nodes
     use coupling_arlequin2d, only: coupling2d_config_t
@@ -54,7 +56,7 @@ contains
         character(len=*), parameter :: beam_only(3) = [character(len=10) :: 'overlap', 'max_offset', 'coupled']
         real(wp) :: gravity(2), theta
         character(len=:), allocatable :: message
-        integer :: k
+        integer :: j, k
         allocate (setup%warnings(0))
         call check_schemes(error)
         if (allocated(error)) return
@@ -95,6 +97,16 @@ contains
         do k = 1, size(regions)
             call make_region(regions(k), parts(k), error)
             if (allocated(error)) return
+            ! A point in two regions would be weighted twice (the Arlequin partition of unity).
+            do j = 1, k - 1
+                if (regions_overlap(parts(j), parts(k))) then
+                    call make_input_error(error, deck%file, regions(k)%line, 'region', 'this region and '// &
+                                          'the region of line '//to_str(regions(j)%line)//' overlap: the '// &
+                                          'Arlequin weights of their common area would count twice; make the '// &
+                                          'regions disjoint (they may share an edge)')
+                    return
+                end if
+            end do
         end do
         if (size(parts) == 1) then
             allocate (setup%config%region, source=parts(1))

@@ -73,8 +73,9 @@ contains
                        word_field('particle_side', 'bottom right top left none')], 6, 6, selected_by='box'), &
                  tail([real_field('a', ''), real_field('b', '')], 8, -1, cyclic=.true., selected_by='polygon')]
         call s%add_keyword('coupling', 'region', [word_field('kind', 'box polygon')], &
-                           'Overlap region of a [continuum] coupled to [particles] (one line per disjoint '// &
-                           'region; required there, not allowed with [beam]). box: [xmin, xmax] x [ymin, ymax], '// &
+                           'Overlap region of a [continuum] coupled to [particles] (one line per region, the '// &
+                           'regions disjoint: they may share edges, not areas; required there, not allowed with '// &
+                           '[beam]). box: [xmin, xmax] x [ymin, ymax], '// &
                            'the side next to the FE-only zone and the side next to the particle-only zone '// &
                            '(none with weight = constant). polygon: fe_edge particle_edge x1 y1 x2 y2 x3 y3 ...: '// &
                            'the numbers of the FE-side and particle-side edges (edge k joins vertex k to k + 1, '// &
