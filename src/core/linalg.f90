@@ -428,7 +428,7 @@ contains
         real(wp), allocatable, intent(out), optional :: vectors(:, :)
         real(wp), allocatable :: ab(:, :), bb(:, :), q(:, :), w(:), z(:, :), work(:)
         integer, allocatable :: iwork(:), ifail(:)
-        integer :: n, ka, m, nv, info
+        integer :: n, ka, m, nv, info, ea, eb
         character(len=1) :: jobz
         n = a%n
         if (b%n /= n .or. il < 1 .or. iu > n .or. il > iu) then
@@ -438,8 +438,14 @@ contains
         ! dsbgvx needs ka >= kb: widen A's storage when B is wider.
         ka = max(a%kd, b%kd)
         allocate (ab(ka + 1, n), source=0.0_wp)
-        ab(ka - a%kd + 1:, :) = a%ab
-        bb = b%ab
+        ! Both matrices scaled to entries of order 1 by even powers of 2 (exact, square roots
+        ! included): dsbgvx's bisection squares the entries of the reduced matrix, which
+        ! overflows from about 1e154 on (a Young's modulus of 1e300 or a density of 1e-300
+        ! returned fewer eigenvalues than asked, with info = 0). lambda = 2^(ea - eb) mu.
+        ea = even_exponent(a%ab)
+        eb = even_exponent(b%ab)
+        ab(ka - a%kd + 1:, :) = scale(a%ab, -ea)
+        bb = scale(b%ab, -eb)
         jobz = 'N'
         nv = 1
         if (present(vectors)) then
@@ -454,8 +460,21 @@ contains
                     0.0_wp, il, iu, 2*tiny(1.0_wp), m, w, z, n, work, iwork, ifail, info)
         call eigen_info_error(info, n, error)
         if (allocated(error)) return
-        lambda = w(1:m)
-        if (present(vectors)) vectors = z(:, 1:m)
+        ! Beyond the range of real(wp) the eigenvalues come out infinite: the caller checks.
+        lambda = scale(w(1:m), ea - eb)
+        ! z^T (B 2^-eb) z = 1: the B-normalised vectors are z 2^(-eb/2).
+        if (present(vectors)) vectors = scale(z(:, 1:m), -eb/2)
+    contains
+        !> Even exponent e such that the largest |entry| times 2^-e lies in [1/2, 2) (0 for a
+        !> zero or non-finite matrix).
+        pure integer function even_exponent(x) result(e)
+            real(wp), intent(in) :: x(:, :)
+            real(wp) :: big
+            e = 0
+            big = maxval(abs(x))
+            if (.not. (big > 0.0_wp .and. big <= huge(big))) return
+            e = 2*floor(0.5_wp*real(exponent(big), wp))
+        end function even_exponent
     end subroutine band_generalized_eigen
 
     !> Largest eigenvalue of A x = lambda B x (A symmetric, B symmetric positive definite,

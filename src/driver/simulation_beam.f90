@@ -32,6 +32,11 @@ module driver_simulation_beam
         type(beam_model_t) :: model
         !> Time integrator (dynamic analysis).
         class(time_integrator_t), allocatable :: integ
+        !> Circular frequencies [rad/s] (modal analysis, solved by `init`: its failures are
+        !> input errors).
+        real(wp), allocatable :: omega(:)
+        !> Mass-normalised mode shapes on the free DOFs (n_free, n_modes) (modal analysis).
+        real(wp), allocatable :: shapes(:, :)
     contains
         !> See `simulation_t%init`.
         procedure :: init => beam_init
@@ -65,6 +70,18 @@ contains
         if (allocated(error)) then
             error%message = deck%file//': '//error%message
             return
+        end if
+        if (self%settings%analysis == 'modal') then
+            call solve_modal(self%model, self%settings%n_modes, self%omega, self%shapes, error)
+            if (.not. allocated(error)) then
+                if (.not. (all(ieee_is_finite(self%omega)) .and. all(ieee_is_finite(self%shapes)))) &
+                    call make_error(error, 'modal analysis: a frequency or a mode shape is not finite; '// &
+                                    'likely cause: a stiffness, density or section far too large or too small')
+            end if
+            if (allocated(error)) then
+                message = error%message
+                call make_input_error(error, deck%file, deck%line('beam', 'section'), 'section', message)
+            end if
         end if
         if (self%settings%analysis == 'dynamic') then
             call make_integrator(self%settings, self%model, self%integ, error)
@@ -106,7 +123,7 @@ contains
         case ('static')
             call run_static(self%model, out, report, error)
         case ('modal')
-            call run_modal(self%settings, self%model, out, report, error)
+            call run_modal(self%settings, self%model, self%omega, self%shapes, out, report, error)
         case ('dynamic')
             call run_dynamic(self%settings, self%model, self%beam%node_id, self%integ, out, quiet, report, ck, &
                              error)
@@ -161,25 +178,18 @@ contains
         call report(trim(buf))
     end subroutine run_static
 
-    subroutine run_modal(run, model, out, report, error)
+    subroutine run_modal(run, model, omega, shapes, out, report, error)
         type(run_config_t), intent(in) :: run
         type(beam_model_t), intent(in) :: model
+        real(wp), intent(in) :: omega(:), shapes(:, :)
         type(results_writer_t), intent(inout) :: out
         procedure(report_iface) :: report
         type(error_t), allocatable, intent(out) :: error
-        real(wp), allocatable :: omega(:), shapes(:, :), full(:, :, :), fraction(:)
+        real(wp), allocatable :: full(:, :, :), fraction(:)
         character(len=160) :: buf
         character(len=:), allocatable :: kinds
         character(len=5) :: share
         integer :: k
-        call solve_modal(model, run%n_modes, omega, shapes, error)
-        if (allocated(error)) return
-        if (.not. (all(ieee_is_finite(omega)) .and. all(ieee_is_finite(shapes)))) then
-            call make_error(error, 'modal analysis: a frequency or a mode shape is not finite; '// &
-                            'likely cause: a stiffness, density or section far too large or too small '// &
-                            '(check the magnitudes in [beam])')
-            return
-        end if
         allocate (full(3, model%n_nodes, run%n_modes), fraction(run%n_modes))
         kinds = ''
         do k = 1, run%n_modes

@@ -679,7 +679,9 @@ contains
                 if (allocated(error)) return
                 norm = sqrt(dot_product(y(:, j), my(:, j)))
                 if (.not. norm > 0) then
-                    call make_error(error, 'modal analysis of the continuum: the subspace lost its rank')
+                    call make_error(error, 'modal analysis of the continuum: the subspace lost its rank (a '// &
+                                    'vector of M-norm zero or not finite: young and density at the ends of the '// &
+                                    'range of double precision? check the magnitudes in [continuum] material)')
                     return
                 end if
                 y(:, j) = y(:, j)/norm

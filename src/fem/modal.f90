@@ -5,7 +5,9 @@
 module fem_modal
     use core_kinds, only: wp
     use core_constants, only: relative_roundoff
-    use core_error, only: error_t, make_error, make_internal_error
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use core_error, only: error_t, make_error
+    use core_strings, only: to_str
     use core_linalg, only: band_generalized_eigen
     use fem_beam_model, only: beam_model_t
     use fem_beam_element, only: element_stiffness, rotation_matrix
@@ -42,9 +44,15 @@ contains
         end if
         call band_generalized_eigen(model%k, model%m, 1, n_modes, lambda, error, shapes)
         if (allocated(error)) return
-        if (size(lambda) /= n_modes) then
-            call make_internal_error(error, 'modal analysis', 'the eigensolver returned fewer '// &
-                                     'modes than asked')
+        ! The solver scales K and M to entries of order 1; what fails after that are magnitudes
+        ! that real(wp) cannot hold: omega^2 beyond 1.8e308, or K and M assembled from values
+        ! at the ends of the range (overflowed or subnormal entries), an input problem.
+        if (size(lambda) /= n_modes .or. .not. all(ieee_is_finite(lambda))) then
+            call make_error(error, 'modal analysis: the eigenvalue problem K phi = omega^2 M phi is '// &
+                            'beyond the range of double precision (stiffness entries up to '// &
+                            to_str(maxval(abs(model%k%ab)))//', mass entries up to '// &
+                            to_str(maxval(abs(model%m%ab)))//'): check the magnitudes of young, density, '// &
+                            'area and inertia in [beam] section')
             return
         end if
         ! Rigid-body eigenvalues are zero up to rounding and may come out slightly negative.

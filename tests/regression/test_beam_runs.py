@@ -149,6 +149,21 @@ def modal_cantilever(exe, decks, work):
     check("modal frequencies", bool(np.all(err < 1e-4)), f"relative errors {err}")
     check("modal Hz = rad/s / 2pi", bool(np.allclose(freq, omega / (2 * math.pi), rtol=1e-14)), "")
     check("modal shapes stored", shapes.shape == (4, 25, 3), f"shape {shapes.shape}")
+    # The same cantilever with E = 1e300 (omega ~ 1e146): exited 3 ('internal error') as the
+    # eigensolver squared entries of ~1e300. omega scales as sqrt(E): the closed form to the
+    # same discretisation error as above, and the ratio to the run at E = 1.1e11 to 1e-8: the
+    # solver scales K and M by powers of 2 (exact), but the assembly rounds differently, and
+    # the eigenvalues are accurate to ~eps times the largest one (~1e-9 relative for mode 1,
+    # omega_max/omega_1 ~ 1e3-1e4 on 24 elements).
+    big = work / "cantilever_modal_young_1e300.dat"
+    big.write_text((decks / "cantilever_modal.dat").read_text().replace("1.1e11", "1e300"))
+    with run(exe, big, work) as f:
+        omega_big = f["modal/omega"][...]
+    err_big = np.abs(omega_big[:3] / (ref * math.sqrt(1e300 / E)) - 1)
+    check("modal frequencies with E = 1e300", bool(np.all(err_big < 1e-4)), f"relative errors {err_big}")
+    ratio = omega_big / omega / math.sqrt(1e300 / E)
+    check("modal frequencies with E = 1e300 scale as sqrt(E)", bool(np.all(np.abs(ratio - 1) < 1e-8)),
+          f"ratio - 1 = {ratio - 1}")
 
 
 def modal_kinds(exe, decks, work):
