@@ -80,7 +80,8 @@ contains
         integer, allocatable :: function_ids(:)
         real(wp), allocatable :: constant(:)
         logical :: lumped
-        integer :: line
+        integer :: line, n_free
+        integer, allocatable :: eq(:)
         self%deck_file = deck%file
         call build_mesh(error)
         if (allocated(error)) return
@@ -95,6 +96,12 @@ contains
         if (allocated(error)) return
         call set_loads(error)
         if (allocated(error)) return
+        call self%model%equations(eq, n_free)
+        if (n_free == 0) then
+            call make_input_error(error, deck%file, deck%line('continuum', 'fix'), 'fix', &
+                                  'every dof of the continuum is prescribed: nothing to solve')
+            return
+        end if
         lumped = deck%get_word('continuum', 'mass') == 'lumped'
         call self%ops%build(self%model, lumped, deck%get_real('continuum', 'rayleigh', 'a0'), &
                             deck%get_real('continuum', 'rayleigh', 'a1'), error)
@@ -102,11 +109,6 @@ contains
         if (allocated(error)) return
         call build_run_settings(deck, self%ops%n_free, lumped, 'continuum', self%settings, error)
         if (allocated(error)) return
-        if (self%ops%n_free == 0) then
-            call make_input_error(error, deck%file, deck%line('continuum', 'fix'), 'fix', &
-                                  'every dof of the continuum is prescribed: nothing to solve')
-            return
-        end if
         select case (self%settings%analysis)
         case ('static')
             if (self%model%stops_rigid_motions()) call self%ops%factor_combination(0.0_wp, 1.0_wp, self%k_factor, error)
