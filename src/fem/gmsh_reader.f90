@@ -594,8 +594,11 @@ contains
                 end if
             end do
         end do
+        ! A mesh without physical groups has no named sets: empty lists, not unallocated ones.
+        if (.not. allocated(mesh%node_sets)) allocate (mesh%node_sets(0))
+        if (.not. allocated(mesh%element_sets)) allocate (mesh%element_sets(0))
+        if (.not. allocated(mesh%edge_sets)) allocate (mesh%edge_sets(0))
         call mesh%orient_edges(error)
         if (allocated(error)) error%message = cur%path//': '//error%message
-
     end subroutine build_mesh
 end module fem_gmsh_reader
