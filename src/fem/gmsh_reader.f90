@@ -11,6 +11,7 @@
 module fem_gmsh_reader
     use core_kinds, only: wp
     use core_error, only: error_t, make_input_error
+    use core_strings, only: string_t, split_words, parse_real
     use fem_mesh2d, only: mesh2d_t, element_t3, element_q4
     implicit none
     private
@@ -349,27 +350,34 @@ contains
         end do
     end subroutine read_entities
 
-    !> $Nodes: blocks of tags then coordinates; xtag(:, tag - min_tag + 1) = (x, y), NaN when the
-    !> tag is unused.
+    !> $Nodes: blocks of tags then coordinates; xtag(:, tag - min_tag + 1) = (x, y), -huge when
+    !> the tag is unused. The header's node count must be the blocks' total, a tag must appear
+    !> once, and coordinates must be finite numbers.
     subroutine read_nodes(cur, xtag, min_tag, error)
         type(cursor_t), intent(inout) :: cur
         real(wp), allocatable, intent(out) :: xtag(:, :)
         integer, intent(out) :: min_tag
         type(error_t), allocatable, intent(out) :: error
         character(len=:), allocatable :: text
-        integer :: head(4), bh(4), b, k, ios
+        type(string_t), allocatable :: words(:)
+        type(cursor_t) :: header
+        integer :: head(4), bh(4), b, k, i, total
         integer, allocatable :: tags(:)
         real(wp) :: xyz(3)
+        logical :: ok
+        character(len=64) :: buf
         call section_line(cur, text, error)
         if (allocated(error)) return
         call read_ints(cur, text, 4, head, error)
         if (allocated(error)) return
+        header = cur
         min_tag = head(3)
         if (head(2) > 0 .and. (head(3) < 1 .or. head(4) < head(3))) then
             call fail(cur, error, 'invalid node tag range in "'//trim(text)//'"')
             return
         end if
         allocate (xtag(2, max(head(4) - head(3) + 1, 0)), source=-huge(1.0_wp))
+        total = 0
         do b = 1, head(1)
             call section_line(cur, text, error)
             if (allocated(error)) return
@@ -379,6 +387,7 @@ contains
                 call fail(cur, error, 'negative number of nodes in block')
                 return
             end if
+            total = total + bh(4)
             allocate (tags(bh(4)))
             do k = 1, bh(4)
                 call section_line(cur, text, error)
@@ -393,15 +402,31 @@ contains
             do k = 1, bh(4)
                 call section_line(cur, text, error)
                 if (allocated(error)) return
-                read (text, *, iostat=ios) xyz
-                if (ios /= 0) then
-                    call fail(cur, error, 'expected node coordinates "x y z", found "'//trim(text)//'"')
+                ! Word by word: a list-directed read takes 'nan' and 'inf', and overflows on 1e999.
+                call split_words(text, words)
+                ok = size(words) >= 3
+                do i = 1, min(3, size(words))
+                    call parse_real(words(i)%s, xyz(i), ok)
+                    if (.not. ok) exit
+                end do
+                if (.not. ok) then
+                    call fail(cur, error, 'expected node coordinates "x y z" (finite numbers), found "'// &
+                              trim(text)//'"')
+                    return
+                end if
+                if (xtag(1, tags(k) - min_tag + 1) /= -huge(1.0_wp)) then
+                    write (buf, '(i0)') tags(k)
+                    call fail(cur, error, 'node '//trim(buf)//' is defined twice')
                     return
                 end if
                 xtag(:, tags(k) - min_tag + 1) = xyz(1:2)
             end do
             deallocate (tags)
         end do
+        if (total /= head(2)) then
+            write (buf, '(i0,a,i0)') head(2), ' nodes, its blocks hold ', total
+            call fail(header, error, 'the header gives '//trim(buf))
+        end if
     end subroutine read_nodes
 
     !> Number of nodes of a Gmsh element type this reader accepts (0 otherwise).
