@@ -255,11 +255,13 @@ contains
                 else if (self%model%prescribed_value(dof) /= value .or. &
                          self%model%prescribed_function(dof) /= func) then
                     call make_input_error(error, deck%file, e%line, keyword, 'node '//to_str(ids(k))// &
-                                          ' of set '//e%word('node_set')//', component '// &
-                                          merge('x', 'y', comp == 1)//', is already prescribed by line '// &
-                                          to_str(by_line(dof))//' with another value or function: give each '// &
-                                          'displacement component of a node one prescription (a repeated one '// &
-                                          'must be the same value and function)')
+                                          ' at ('//to_str(self%model%mesh%x(1, ids(k)))//', '// &
+                                          to_str(self%model%mesh%x(2, ids(k)))//') m of set '// &
+                                          e%word('node_set')//', component '//merge('x', 'y', comp == 1)// &
+                                          ', is already prescribed by line '//to_str(by_line(dof))// &
+                                          ' with another value or function: give each displacement component '// &
+                                          'of a node one prescription (a repeated one must be the same value '// &
+                                          'and function)')
                     return
                 end if
             end do
