@@ -35,7 +35,7 @@ module driver_checkpoint
     public :: save_integrator, load_integrator, save_dem, load_dem, save_coupled, load_coupled
     public :: save_results, load_results, save_dem_writer, load_dem_writer
     public :: save_coupled_writer, load_coupled_writer, save_loop, load_loop
-    public :: checkpoint_run_t, end_of_step
+    public :: checkpoint_run_t, step_end_t, end_of_step
 
     !> File name of the checkpoint in the results folder.
     character(len=*), parameter :: checkpoint_name = 'checkpoint.h5'
@@ -90,14 +90,19 @@ module driver_checkpoint
         real(wp) :: last_time = 0.0_wp
     end type checkpoint_run_t
 
-    abstract interface
-        !> An action of a time loop at the end of a step (store an output, write a checkpoint).
-        subroutine step_action(error)
-            import :: error_t
-            !> Set on a failure.
-            type(error_t), allocatable, intent(out) :: error
-        end subroutine step_action
-    end interface
+    !> What the end of a step of a time loop calls for, to be done in this order: the regular
+    !> output (`store_first`), the checkpoint, the extra output of the last step or of a stop
+    !> (`store_last`; never with `store_first`), then the end of the loop (`stop`).
+    type :: step_end_t
+        !> Store the regular output of the step.
+        logical :: store_first = .false.
+        !> Write a checkpoint (last step, stop request, or due by the schedule).
+        logical :: checkpoint = .false.
+        !> Store the extra output of the last step or of a stop.
+        logical :: store_last = .false.
+        !> A stop signal came before the last step: the loop ends at this step.
+        logical :: stop = .false.
+    end type step_end_t
 
 contains
 
@@ -1061,30 +1066,21 @@ contains
     !> makes a restart bitwise: the regular output of step k, then the checkpoint (last step,
     !> stop request, or due by the schedule), then the extra output of the last step or of a
     !> stop. The checkpoint thus holds the regular outputs up to step k and not the extra one
-    !> (a restart with a later end time cuts it).
-    subroutine end_of_step(k, n_steps, output_interval, schedule, store, checkpoint, stop, error)
+    !> (a restart with a later end time cuts it). The caller does the actions (its own
+    !> procedures, called directly: passing them here would need trampolines, an executable
+    !> stack).
+    function end_of_step(k, n_steps, output_interval, schedule) result(act)
         !> Steps done, and steps of the run.
         integer(i8), intent(in) :: k, n_steps
         !> Steps between regular outputs.
         integer, intent(in) :: output_interval
         !> When checkpoints are due.
         type(checkpoint_schedule_t), intent(inout) :: schedule
-        !> Store the output of the current step.
-        procedure(step_action) :: store
-        !> Write a checkpoint of the current state.
-        procedure(step_action) :: checkpoint
-        !> True when a stop signal came before the last step: the loop ends at step k.
-        logical, intent(out) :: stop
-        !> Set on a failure of either action.
-        type(error_t), allocatable, intent(out) :: error
-        logical :: regular
-        stop = .false.
-        regular = mod(k, int(output_interval, i8)) == 0
-        if (regular) call store(error)
-        if (allocated(error)) return
-        stop = k < n_steps .and. caught_signal() /= 0
-        if (k == n_steps .or. stop .or. schedule%due(k)) call checkpoint(error)
-        if (allocated(error)) return
-        if ((k == n_steps .or. stop) .and. .not. regular) call store(error)
-    end subroutine end_of_step
+        !> The actions due, in the order of their components.
+        type(step_end_t) :: act
+        act%store_first = mod(k, int(output_interval, i8)) == 0
+        act%stop = k < n_steps .and. caught_signal() /= 0
+        act%checkpoint = k == n_steps .or. act%stop .or. schedule%due(k)
+        act%store_last = (k == n_steps .or. act%stop) .and. .not. act%store_first
+    end function end_of_step
 end module driver_checkpoint

@@ -30,7 +30,7 @@ module driver_coupled_loop
     use driver_results_coupled, only: coupled_writer_t
     use driver_run_dem, only: max_warnings, speed_warning, last_unconverged_warning
     use driver_guards, only: check_disks_state, step_start_t, take_step_start, check_tunnelling
-    use driver_checkpoint, only: checkpoint_run_t, end_of_step, loop_state_t, checkpoint_create, &
+    use driver_checkpoint, only: checkpoint_run_t, end_of_step, step_end_t, loop_state_t, checkpoint_create, &
                                  checkpoint_commit, checkpoint_discard, save_coupled, load_coupled, &
                                  save_results, load_results, save_dem_writer, load_dem_writer, &
                                  save_coupled_writer, load_coupled_writer
@@ -165,7 +165,8 @@ contains
         type(step_start_t) :: start
         integer(i8) :: n_steps, k, k0
         integer :: unconverged
-        logical :: speed_warned, stop, store_contacts
+        logical :: speed_warned, store_contacts
+        type(step_end_t) :: act
         integer, allocatable :: material_id(:)
         character(len=512) :: buf
 
@@ -205,10 +206,12 @@ contains
             if (allocated(error)) return
             if (.not. self%sys%stats%converged) call warn_unconverged()
             if (.not. speed_warned) call check_speed()
-            call end_of_step(k, n_steps, self%settings%output_interval, ck%schedule, store, checkpoint, stop, &
-                             error)
+            act = end_of_step(k, n_steps, self%settings%output_interval, ck%schedule)
+            if (act%store_first) call store(error)
+            if (act%checkpoint .and. .not. allocated(error)) call checkpoint(error)
+            if (act%store_last .and. .not. allocated(error)) call store(error)
             if (allocated(error)) return
-            if (stop) then
+            if (act%stop) then
                 ! Stop request: the step just done is the last output.
                 call out%stop_at(signal_name(caught_signal()), k, self%sys%fe%t)
                 n_steps = k

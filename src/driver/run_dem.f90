@@ -23,7 +23,7 @@ module driver_run_dem
     use driver_results_dem, only: dem_writer_t, write_fclib_local
     use driver_guards, only: check_disks_state, step_start_t, take_step_start, check_tunnelling
     use io_hdf5_file, only: h5_file_t
-    use driver_checkpoint, only: end_of_step, checkpoint_run_t, loop_state_t, checkpoint_create, checkpoint_commit, &
+    use driver_checkpoint, only: end_of_step, step_end_t, checkpoint_run_t, loop_state_t, checkpoint_create, checkpoint_commit, &
                                  checkpoint_discard, &
                                  save_dem, load_dem, save_results, load_results, save_dem_writer, load_dem_writer
     implicit none
@@ -65,7 +65,8 @@ contains
         integer(i8) :: n_steps, k, k0
         integer :: unconverged
         logical :: blocked_warned
-        logical :: speed_warned, stop
+        logical :: speed_warned
+        type(step_end_t) :: act
         character(len=:), allocatable :: message
         character(len=512) :: buf
 
@@ -112,9 +113,12 @@ contains
                 blocked_warned = .true.
             end if
             if (.not. speed_warned) call check_speed()
-            call end_of_step(k, n_steps, run%output_interval, ck%schedule, store, checkpoint, stop, error)
+            act = end_of_step(k, n_steps, run%output_interval, ck%schedule)
+            if (act%store_first) call store(error)
+            if (act%checkpoint .and. .not. allocated(error)) call checkpoint(error)
+            if (act%store_last .and. .not. allocated(error)) call store(error)
             if (allocated(error)) return
-            if (stop) then
+            if (act%stop) then
                 ! Stop request: the step just done is the last output.
                 call out%stop_at(signal_name(caught_signal()), k, cfg%system%time)
                 n_steps = k

@@ -15,7 +15,7 @@ module driver_simulation_beam
     use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
     use driver_config, only: run_config_t, build_config
     use driver_results, only: results_writer_t
-    use driver_checkpoint, only: end_of_step, checkpoint_run_t, loop_state_t, checkpoint_create, checkpoint_commit, &
+    use driver_checkpoint, only: end_of_step, step_end_t, checkpoint_run_t, loop_state_t, checkpoint_create, checkpoint_commit, &
                                  checkpoint_discard, save_integrator, load_integrator, save_results, load_results
     use io_hdf5_file, only: h5_file_t
     use driver_guards, only: check_beam_state
@@ -222,7 +222,7 @@ contains
         type(progress_t) :: progress
         real(wp), allocatable :: d(:, :), v(:, :), a(:, :)
         integer(i8) :: n_steps, k, k0
-        logical :: stop
+        type(step_end_t) :: act
         character(len=160) :: buf
 
         n_steps = run%n_steps
@@ -244,9 +244,12 @@ contains
             if (allocated(error)) return
             call check(k, error)
             if (allocated(error)) return
-            call end_of_step(k, n_steps, run%output_interval, ck%schedule, store, checkpoint, stop, error)
+            act = end_of_step(k, n_steps, run%output_interval, ck%schedule)
+            if (act%store_first) call store(error)
+            if (act%checkpoint .and. .not. allocated(error)) call checkpoint(error)
+            if (act%store_last .and. .not. allocated(error)) call store(error)
             if (allocated(error)) return
-            if (stop) then
+            if (act%stop) then
                 ! Stop request: the step just done is the last output.
                 call out%stop_at(signal_name(caught_signal()), k, integ%t)
                 n_steps = k

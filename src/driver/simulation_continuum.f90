@@ -27,7 +27,7 @@ module driver_simulation_continuum
     use driver_config, only: run_config_t, build_run_settings, build_time_functions
     use driver_results, only: results_writer_t
     use io_hdf5_file, only: h5_file_t
-    use driver_checkpoint, only: checkpoint_run_t, end_of_step, loop_state_t, checkpoint_create, checkpoint_commit, &
+    use driver_checkpoint, only: checkpoint_run_t, end_of_step, step_end_t, loop_state_t, checkpoint_create, checkpoint_commit, &
                                  checkpoint_discard, save_integrator, load_integrator, save_results, load_results
     use driver_results_continuum, only: continuum_writer_t
     use driver_simulation, only: simulation_t, report_iface
@@ -295,7 +295,7 @@ contains
                 call start_load('traction', func, error)
                 if (allocated(error)) return
                 if (e%word('profile') == 'parabolic') then
-                    call add_parabolic(self%model, e%word('edge_set'), [e%real('tx'), e%real('ty')], error)
+                    call self%model%add_traction_parabolic(e%word('edge_set'), [e%real('tx'), e%real('ty')], error)
                 else
                     call self%model%add_traction(e%word('edge_set'), [e%real('tx'), e%real('ty')], error)
                 end if
@@ -398,36 +398,6 @@ contains
             if (allocated(error)) call fail_at(error, deck%line('time', 'step'), 'step')
         end subroutine make_integrator
     end subroutine continuum_init
-
-    !> Parabolic traction 1.5 t (1 - s^2) across an edge set (s = -1..1 along its longer
-    !> extent): the resultant of a uniform t.
-    subroutine add_parabolic(model, set, t, error)
-        !> The model.
-        type(continuum_model_t), intent(inout) :: model
-        !> Edge set.
-        character(len=*), intent(in) :: set
-        !> Mean traction [Pa].
-        real(wp), intent(in) :: t(2)
-        !> Set when the set is unknown.
-        type(error_t), allocatable, intent(out) :: error
-        integer, allocatable :: edges(:, :)
-        real(wp) :: lo(2), hi(2)
-        integer :: axis
-        call model%mesh%edge_set(set, edges, error)
-        if (allocated(error)) return
-        lo = minval(model%mesh%x(:, reshape(edges, [size(edges)])), dim=2)
-        hi = maxval(model%mesh%x(:, reshape(edges, [size(edges)])), dim=2)
-        axis = merge(1, 2, hi(1) - lo(1) >= hi(2) - lo(2))
-        call model%add_traction_field(set, profile, error)
-    contains
-        pure function profile(x) result(tr)
-            real(wp), intent(in) :: x(2)
-            real(wp) :: tr(2)
-            real(wp) :: s
-            s = (2*x(axis) - lo(axis) - hi(axis))/(hi(axis) - lo(axis))
-            tr = 1.5_wp*(1 - s**2)*t
-        end function profile
-    end subroutine add_parabolic
 
     !> Folder of a path, with its trailing '/' ('' for a bare name).
     pure function folder(path) result(dir)
@@ -547,7 +517,7 @@ contains
             type(error_t), allocatable, intent(out) :: error
             type(progress_t) :: progress
             integer(i8) :: n_steps
-            logical :: stop
+            type(step_end_t) :: act
             character(len=200) :: buf
             n_steps = self%settings%n_steps
             call progress%start(n_steps, self%settings%t_end, self%settings%progress_seconds)
@@ -574,9 +544,12 @@ contains
                     call make_error(error, trim(buf))
                     return
                 end if
-                call end_of_step(k, n_steps, self%settings%output_interval, ck%schedule, store, checkpoint, stop, error)
+                act = end_of_step(k, n_steps, self%settings%output_interval, ck%schedule)
+                if (act%store_first) call store(error)
+                if (act%checkpoint .and. .not. allocated(error)) call checkpoint(error)
+                if (act%store_last .and. .not. allocated(error)) call store(error)
                 if (allocated(error)) return
-                if (stop) then
+                if (act%stop) then
                     ! Stop request: the step just done is the last output.
                     call out%stop_at(signal_name(caught_signal()), k, self%integ%t)
                     n_steps = k

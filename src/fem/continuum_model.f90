@@ -20,7 +20,7 @@ module fem_continuum_model
     use fem_element_q4, only: element_q4_t
     use fem_element_t3, only: element_t3_t
     use fem_edge_load, only: edge_traction_linear, edge_traction_normal_tangential, &
-                             edge_traction_function, traction_field
+                             edge_traction_function, traction_field_t, parabolic_traction_t
     use fem_mesh2d, only: mesh2d_t, element_t3, element_q4, nodes_per_element
     use fem_triplets, only: fem_triplets_t
     implicit none
@@ -77,6 +77,9 @@ module fem_continuum_model
         procedure :: add_traction_nt => model_add_traction_nt
         !> Add a traction field t(x) on a named edge set.
         procedure :: add_traction_field => model_add_traction_field
+        !> Add a parabolic traction across a named edge set whose resultant is that of a
+        !> uniform (tx, ty).
+        procedure :: add_traction_parabolic => model_add_traction_parabolic
         !> Check that every element has a material.
         procedure :: check => model_check
         !> Global stiffness (all dofs) as triplets.
@@ -335,7 +338,7 @@ contains
         !> Edge set name.
         character(len=*), intent(in) :: set_name
         !> Traction field.
-        procedure(traction_field) :: traction
+        class(traction_field_t), intent(in) :: traction
         !> Set when the set is unknown or an edge has no element with a material.
         type(error_t), allocatable, intent(out) :: error
         integer, allocatable :: edges(:, :), owner(:)
@@ -351,6 +354,29 @@ contains
             call scatter_edge(self, edges(:, k), edge_traction_function(xa, xb, traction, t))
         end do
     end subroutine model_add_traction_field
+
+    !> Add the parabolic traction 1.5 t (1 - s^2) across a named edge set, s = -1..1 along the
+    !> longer extent of the set (the end shear of a beam): the resultant of the uniform t.
+    subroutine model_add_traction_parabolic(self, set_name, t, error)
+        !> The model.
+        class(continuum_model_t), intent(inout) :: self
+        !> Edge set name.
+        character(len=*), intent(in) :: set_name
+        !> Mean traction (tx, ty) (Pa).
+        real(wp), intent(in) :: t(2)
+        !> Set when the set is unknown or an edge has no element with a material.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: edges(:, :)
+        real(wp) :: lo(2), hi(2)
+        integer :: axis
+        call self%mesh%edge_set(set_name, edges, error)
+        if (allocated(error)) return
+        lo = minval(self%mesh%x(:, reshape(edges, [size(edges)])), dim=2)
+        hi = maxval(self%mesh%x(:, reshape(edges, [size(edges)])), dim=2)
+        axis = merge(1, 2, hi(1) - lo(1) >= hi(2) - lo(2))
+        call self%add_traction_field(set_name, parabolic_traction_t(mean=t, axis=axis, lo=lo(axis), &
+                                                                    hi=hi(axis)), error)
+    end subroutine model_add_traction_parabolic
 
     !> Add edge forces (f_ax, f_ay, f_bx, f_by) to the load vector.
     pure subroutine scatter_edge(self, nodes, f)

@@ -10,18 +10,42 @@ module fem_edge_load
     implicit none
     private
     public :: edge_normal, edge_traction_linear, edge_traction_normal_tangential, &
-              edge_traction_function, traction_field
+              edge_traction_function, traction_field_t, parabolic_traction_t
+
+    !> A traction field t(x) (Pa) over the boundary: a family of load distributions.
+    type, abstract :: traction_field_t
+    contains
+        !> Traction at a point of the boundary.
+        procedure(traction_at_iface), deferred :: at
+    end type traction_field_t
 
     abstract interface
-        !> A traction field t(x) (Pa) over the boundary.
-        pure function traction_field(x) result(t)
-            import :: wp
+        !> Traction (tx, ty) (Pa) at the point x of the boundary.
+        pure function traction_at_iface(self, x) result(t)
+            import :: wp, traction_field_t
+            !> The field.
+            class(traction_field_t), intent(in) :: self
             !> Point on the boundary.
             real(wp), intent(in) :: x(2)
             !> Traction (tx, ty) (Pa).
             real(wp) :: t(2)
-        end function traction_field
+        end function traction_at_iface
     end interface
+
+    !> Parabolic traction 1.5 mean (1 - s^2) across [lo, hi] along one axis (s = -1..1): the
+    !> profile of a shear across a beam's end, whose resultant over [lo, hi] is that of the
+    !> uniform traction `mean`.
+    type, extends(traction_field_t) :: parabolic_traction_t
+        !> Mean traction (tx, ty) (Pa).
+        real(wp) :: mean(2) = 0.0_wp
+        !> Axis across which the profile varies (1: x, 2: y).
+        integer :: axis = 2
+        !> Ends of the profile along that axis (m); the traction is zero there.
+        real(wp) :: lo = -1.0_wp, hi = 1.0_wp
+    contains
+        !> See `traction_field_t%at`.
+        procedure :: at => parabolic_at
+    end type parabolic_traction_t
 
 contains
 
@@ -83,13 +107,13 @@ contains
 
     !> Nodal forces of a traction field t(x), integrated with 3-point Gauss-Legendre on the
     !> edge (exact when t is a polynomial of degree <= 4 along the edge).
-    function edge_traction_function(xa, xb, traction, thickness) result(f)
+    pure function edge_traction_function(xa, xb, traction, thickness) result(f)
         !> First node.
         real(wp), intent(in) :: xa(2)
         !> Second node.
         real(wp), intent(in) :: xb(2)
         !> Traction field.
-        procedure(traction_field) :: traction
+        class(traction_field_t), intent(in) :: traction
         !> Thickness (m).
         real(wp), intent(in) :: thickness
         !> Nodal forces (4) (N).
@@ -103,9 +127,22 @@ contains
         do p = 1, 3
             na = 0.5_wp*(1.0_wp - gp(p))
             nb = 0.5_wp*(1.0_wp + gp(p))
-            t = traction(na*xa + nb*xb)
+            t = traction%at(na*xa + nb*xb)
             f(1:2) = f(1:2) + gw(p)*half*na*t
             f(3:4) = f(3:4) + gw(p)*half*nb*t
         end do
     end function edge_traction_function
+
+    !> See `traction_field_t%at`: 1.5 mean (1 - s^2), s = (2 x(axis) - lo - hi)/(hi - lo).
+    pure function parabolic_at(self, x) result(t)
+        !> The field.
+        class(parabolic_traction_t), intent(in) :: self
+        !> Point on the boundary.
+        real(wp), intent(in) :: x(2)
+        !> Traction (tx, ty) (Pa).
+        real(wp) :: t(2)
+        real(wp) :: s
+        s = (2*x(self%axis) - self%lo - self%hi)/(self%hi - self%lo)
+        t = 1.5_wp*(1 - s**2)*self%mean
+    end function parabolic_at
 end module fem_edge_load
