@@ -21,6 +21,7 @@ program multicor
     use core_strings, only: parse_real
     use io_deck_schema, only: multicor_schema, schema_markdown
     use driver_run, only: run_options_t, run_deck
+    use driver_simulation, only: report_to_stdout
     implicit none
 
     type(run_options_t) :: opts
@@ -99,7 +100,7 @@ program multicor
     call ieee_set_halting_mode(ieee_overflow, .false.)
     call ieee_set_halting_mode(ieee_invalid, .false.)
     call ieee_set_halting_mode(ieee_divide_by_zero, .false.)
-    call run_deck(opts, report, error, stopped_by)
+    call run_deck(opts, report_to_stdout, error, stopped_by)
     ! The exceptions raised on the way are handled (guards): back to the quiet flags and the
     ! modes of the start, or the end of the program would signal them again.
     call ieee_set_status(fp_status)
@@ -119,13 +120,6 @@ program multicor
     end if
 
 contains
-
-    !> Print one line of progress or summary.
-    subroutine report(line)
-        character(len=*), intent(in) :: line
-        write (output_unit, '(a)') line
-        flush (output_unit)
-    end subroutine report
 
     subroutine get_arg(i, value)
         integer, intent(in) :: i

@@ -9,6 +9,7 @@
 !> restart checks. Adding a kind of model adds an extension in its own file and one line in
 !> `driver_simulations`.
 module driver_simulation
+    use, intrinsic :: iso_fortran_env, only: output_unit
     use core_error, only: error_t
     use io_deck, only: deck_t
     use driver_results, only: results_writer_t
@@ -16,7 +17,7 @@ module driver_simulation
     use driver_checkpoint, only: checkpoint_run_t
     implicit none
     private
-    public :: simulation_t, report_iface
+    public :: simulation_t, report_iface, report_to_stdout
 
     abstract interface
         !> Receives one line of progress or summary text.
@@ -94,4 +95,14 @@ module driver_simulation
         end function simulation_checkpoint_kind
     end interface
 
+contains
+
+    !> The report of the command line program (a `report_iface`): the line on standard output,
+    !> flushed, so that a batch log follows the run.
+    subroutine report_to_stdout(line)
+        !> The line.
+        character(len=*), intent(in) :: line
+        write (output_unit, '(a)') line
+        flush (output_unit)
+    end subroutine report_to_stdout
 end module driver_simulation
