@@ -674,6 +674,7 @@ contains
             sys%solver%check_every = deck%get_int('solver', 'check_every')
             sys%solver%anderson = deck%get_int('solver', 'anderson')
             sys%solver%hydrostatic = deck%get_word('solver', 'cold_start') == 'hydrostatic'
+            sys%solver%symmetric = deck%get_word('solver', 'sweep_order') == 'alternating'
             sys%solver%criterion = criterion_lmgc90
             if (deck%get_word('solver', 'criterion') == 'siconos') sys%solver%criterion = criterion_siconos
             if (deck%has('solver', 'fclib_step')) cfg%fclib_step = deck%get_int('solver', 'fclib_step')
