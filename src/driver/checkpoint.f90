@@ -88,6 +88,9 @@ module driver_checkpoint
         integer(i8) :: last_step = -1
         !> Time of the state in the last checkpoint written [s].
         real(wp) :: last_time = 0.0_wp
+    contains
+        !> End the checkpoint being written: committed, or discarded after a failed write.
+        procedure :: finish => checkpoint_run_finish
     end type checkpoint_run_t
 
     !> What the end of a step of a time loop calls for, to be done in this order: the regular
@@ -210,6 +213,30 @@ contains
         call file%close(ignored)
         call remove_file(path//'.tmp')
     end subroutine checkpoint_discard
+
+    !> End the checkpoint `file` being written for step k (time t): after a failure while
+    !> writing it (`error` set on entry) the partial file is discarded and the error kept, the
+    !> previous checkpoint staying; otherwise it is committed and becomes the run's last one.
+    subroutine checkpoint_run_finish(self, file, k, t, error)
+        !> The run's checkpoints.
+        class(checkpoint_run_t), intent(inout) :: self
+        !> The checkpoint being written (from checkpoint_create); closed on return.
+        type(h5_file_t), intent(inout) :: file
+        !> Step of the state written.
+        integer(i8), intent(in) :: k
+        !> Time of the state written [s].
+        real(wp), intent(in) :: t
+        !> The error of the writes (kept), or set when the commit fails.
+        type(error_t), allocatable, intent(inout) :: error
+        if (allocated(error)) then
+            call checkpoint_discard(file, self%path)
+            return
+        end if
+        call checkpoint_commit(file, self%path, error)
+        if (allocated(error)) return
+        self%last_step = k
+        self%last_time = t
+    end subroutine checkpoint_run_finish
 
     !> Open a checkpoint for reading and check it belongs to this deck, this code version and
     !> this kind of run.

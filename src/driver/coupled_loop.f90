@@ -31,7 +31,7 @@ module driver_coupled_loop
     use driver_run_dem, only: max_warnings, speed_warning, last_unconverged_warning
     use driver_guards, only: check_disks_state, step_start_t, take_step_start, check_tunnelling
     use driver_checkpoint, only: checkpoint_run_t, end_of_step, step_end_t, loop_state_t, checkpoint_create, &
-                                 checkpoint_commit, checkpoint_discard, save_coupled, load_coupled, &
+                                 save_coupled, load_coupled, &
                                  save_results, load_results, save_dem_writer, load_dem_writer, &
                                  save_coupled_writer, load_coupled_writer
     use driver_simulation, only: simulation_t, report_iface
@@ -265,14 +265,7 @@ contains
             if (.not. allocated(error)) call save_dem_writer(f, self%dem_out, error)
             if (.not. allocated(error)) call save_coupled_writer(f, self%cpl_out, error)
             if (.not. allocated(error)) call save_results(f, out, error)
-            if (allocated(error)) then
-                call checkpoint_discard(f, ck%path)
-                return
-            end if
-            call checkpoint_commit(f, ck%path, error)
-            if (allocated(error)) return
-            ck%last_step = k
-            ck%last_time = self%sys%fe%t
+            call ck%finish(f, k, self%sys%fe%t, error)
         end subroutine checkpoint
 
         !> Guards after step k (k = 0: the initial state): the finite-element state, finite disk

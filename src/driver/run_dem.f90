@@ -23,8 +23,7 @@ module driver_run_dem
     use driver_results_dem, only: dem_writer_t, write_fclib_local
     use driver_guards, only: check_disks_state, step_start_t, take_step_start, check_tunnelling
     use io_hdf5_file, only: h5_file_t
-    use driver_checkpoint, only: end_of_step, step_end_t, checkpoint_run_t, loop_state_t, checkpoint_create, checkpoint_commit, &
-                                 checkpoint_discard, &
+    use driver_checkpoint, only: end_of_step, step_end_t, checkpoint_run_t, loop_state_t, checkpoint_create, &
                                  save_dem, load_dem, save_results, load_results, save_dem_writer, load_dem_writer
     implicit none
     private
@@ -163,14 +162,7 @@ contains
             if (.not. allocated(error)) call save_dem(f, '/dem', cfg%system, error)
             if (.not. allocated(error)) call save_dem_writer(f, writer, error)
             if (.not. allocated(error)) call save_results(f, out, error)
-            if (allocated(error)) then
-                call checkpoint_discard(f, ck%path)
-                return
-            end if
-            call checkpoint_commit(f, ck%path, error)
-            if (allocated(error)) return
-            ck%last_step = k
-            ck%last_time = cfg%system%time
+            call ck%finish(f, k, cfg%system%time, error)
         end subroutine checkpoint
 
         !> One step (as mj_step) that writes its local contact problem in FCLIB's format to

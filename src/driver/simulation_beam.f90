@@ -15,8 +15,8 @@ module driver_simulation_beam
     use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
     use driver_config, only: run_config_t, build_config
     use driver_results, only: results_writer_t
-    use driver_checkpoint, only: end_of_step, step_end_t, checkpoint_run_t, loop_state_t, checkpoint_create, checkpoint_commit, &
-                                 checkpoint_discard, save_integrator, load_integrator, save_results, load_results
+    use driver_checkpoint, only: end_of_step, step_end_t, checkpoint_run_t, loop_state_t, checkpoint_create, &
+                                 save_integrator, load_integrator, save_results, load_results
     use io_hdf5_file, only: h5_file_t
     use driver_guards, only: check_beam_state
     use driver_simulation, only: simulation_t, report_iface
@@ -285,14 +285,7 @@ contains
                                    integ%t, out%run_id, error)
             if (.not. allocated(error)) call save_integrator(f, '/fe', integ, error)
             if (.not. allocated(error)) call save_results(f, out, error)
-            if (allocated(error)) then
-                call checkpoint_discard(f, ck%path)
-                return
-            end if
-            call checkpoint_commit(f, ck%path, error)
-            if (allocated(error)) return
-            ck%last_step = k
-            ck%last_time = integ%t
+            call ck%finish(f, k, integ%t, error)
         end subroutine checkpoint
 
         !> Guard after step k (0: the initial state).

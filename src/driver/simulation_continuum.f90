@@ -27,8 +27,8 @@ module driver_simulation_continuum
     use driver_config, only: run_config_t, build_run_settings, build_time_functions
     use driver_results, only: results_writer_t
     use io_hdf5_file, only: h5_file_t
-    use driver_checkpoint, only: checkpoint_run_t, end_of_step, step_end_t, loop_state_t, checkpoint_create, checkpoint_commit, &
-                                 checkpoint_discard, save_integrator, load_integrator, save_results, load_results
+    use driver_checkpoint, only: checkpoint_run_t, end_of_step, step_end_t, loop_state_t, checkpoint_create, &
+                                 save_integrator, load_integrator, save_results, load_results
     use driver_results_continuum, only: continuum_writer_t
     use driver_simulation, only: simulation_t, report_iface
     implicit none
@@ -590,14 +590,7 @@ contains
             if (.not. allocated(error)) call save_integrator(f, '/fe', self%integ, error)
             if (.not. allocated(error)) call f%write_attribute('/fe', 'continuum_audit', self%audit%totals(), error)
             if (.not. allocated(error)) call save_results(f, out, error)
-            if (allocated(error)) then
-                call checkpoint_discard(f, ck%path)
-                return
-            end if
-            call checkpoint_commit(f, ck%path, error)
-            if (allocated(error)) return
-            ck%last_step = k
-            ck%last_time = self%integ%t
+            call ck%finish(f, k, self%integ%t, error)
         end subroutine checkpoint
 
         !> Store the current state and energies.
