@@ -57,6 +57,11 @@ def reduced_case(exe, src, work):
         if old not in deck:
             raise SystemExit(f"input/interface_shear.dat has no '{old}': update this test")
         deck = deck.replace(old, new)
+    # The sweeps to 1e-6 instead of the deck's 1.666e-4: the balance of the two bands below is
+    # the disks' momentum rate, which the looser tolerance leaves at 4.3 % (measured).
+    if "[solver]" in deck:
+        raise SystemExit("input/interface_shear.dat has a [solver] section: update this test")
+    deck += "\n[solver]\ntolerance = 1e-6\n"
     path = work / "interface_small.dat"
     path.write_text(deck)
     out = work / "interface_small"
@@ -98,7 +103,8 @@ def main():
     check("the top block slides (slip > 1.5 mm at 6 ms)", s[-1] > 1.5e-3, f"slip {s[-1] * 1e3:.3f} mm")
     check("the sliding phase has outputs", sliding.sum() >= 10, f"{sliding.sum()}")
     # Equal and opposite: the sum is the rate of the disks' momentum; at a constant drive rate
-    # only the sliding rows' small accelerations remain (0.7 % measured at most); asserted at 5 %.
+    # only the sliding rows' small accelerations remain (1.5 % measured at most with the sweeps
+    # to 1e-6, 2.8 % with forward sweeps; 4.3 % at the deck's 1.666e-4); asserted at 5 %.
     imbalance = np.abs(t_top[sliding] + t_bot[sliding]) / np.abs(t_top[sliding])
     check("sliding: the two bands' tangential forces balance", imbalance.max() <= 0.05,
           f"max |T_top + T_bot| / |T_top| = {imbalance.max():.3f}")
