@@ -57,11 +57,6 @@ def reduced_case(exe, src, work):
         if old not in deck:
             raise SystemExit(f"input/interface_shear.dat has no '{old}': update this test")
         deck = deck.replace(old, new)
-    # The sweeps to 1e-6 instead of the deck's 1.666e-4: the balance of the two bands below is
-    # the disks' momentum rate, which the looser tolerance leaves at 4.3 % (measured).
-    if "[solver]" in deck:
-        raise SystemExit("input/interface_shear.dat has a [solver] section: update this test")
-    deck += "\n[solver]\ntolerance = 1e-6\n"
     path = work / "interface_small.dat"
     path.write_text(deck)
     out = work / "interface_small"
@@ -102,12 +97,15 @@ def main():
     sliding = run.time >= 4.5e-3
     check("the top block slides (slip > 1.5 mm at 6 ms)", s[-1] > 1.5e-3, f"slip {s[-1] * 1e3:.3f} mm")
     check("the sliding phase has outputs", sliding.sum() >= 10, f"{sliding.sum()}")
-    # Equal and opposite: the sum is the rate of the disks' momentum; at a constant drive rate
-    # only the sliding rows' small accelerations remain (1.5 % measured at most with the sweeps
-    # to 1e-6, 2.8 % with forward sweeps; 4.3 % at the deck's 1.666e-4); asserted at 5 %.
-    imbalance = np.abs(t_top[sliding] + t_bot[sliding]) / np.abs(t_top[sliding])
-    check("sliding: the two bands' tangential forces balance", imbalance.max() <= 0.05,
-          f"max |T_top + T_bot| / |T_top| = {imbalance.max():.3f}")
+    # Equal and opposite on average: T_top + T_bot is the rate of the disks' x momentum. While
+    # sliding at the drive's constant rate the layer's momentum hardly changes, so its mean over
+    # the sliding phase is small against T_top (measured 0.04-0.56 % over the deck's solver
+    # settings, the sweeps to 1e-6, a cap of 1000 sweeps, alternating or forward sweeps); asserted
+    # at 2 %: a band missing its weight or sign would give tens of %. The instantaneous sum is
+    # not small: rows slipping and sticking give spikes of up to 8 % of T_top.
+    balance = abs(np.mean(t_top[sliding] + t_bot[sliding])) / np.mean(np.abs(t_top[sliding]))
+    check("sliding: the two bands' tangential forces balance on average", balance <= 0.02,
+          f"|mean(T_top + T_bot)| / mean|T_top| = {balance:.4f}")
     mu_app = t_top[sliding] / -n_top[sliding]
     theory = sliding_over_disks(MU, s[sliding], R)
     # Quasi-static at 0.5 m/s (the top block's inertia acts only through the small vertical
