@@ -7,9 +7,11 @@
 !> elements, an element set when it is 2D and an edge set when it is 1D; it is named by its
 !> $PhysicalNames entry, or 'physical_<dim>_<tag>' when it has none. Nodes that belong to no
 !> triangle or quadrangle are dropped; elements are turned counter-clockwise and edges are
-!> oriented with the body on their left. Malformed input gives an error naming file and line.
+!> oriented with the body on their left. Malformed input gives an error naming file and line;
+!> a count read from the file is checked against the file's size before it sizes an array, and
+!> node tags must be numbered nearly contiguously (the node table is indexed by tag).
 module fem_gmsh_reader
-    use core_kinds, only: wp
+    use core_kinds, only: wp, i8
     use core_error, only: error_t, make_input_error
     use core_strings, only: string_t, split_words, parse_real
     use fem_mesh2d, only: mesh2d_t, element_t3, element_q4
@@ -50,7 +52,15 @@ module fem_gmsh_reader
         integer :: line = 0
         character(len=:), allocatable :: path
         character(len=:), allocatable :: section
+        !> Size of the file in bytes (bounds the counts read from it).
+        integer(i8) :: bytes = 0
     end type cursor_t
+
+    !> Node tags may leave gaps, up to this many tags per node (or up to min_tag_span): the
+    !> node table is indexed by tag, 16 bytes per tag.
+    integer, parameter :: tags_per_node = 8
+    !> Tag span always accepted, whatever the number of nodes (16 MiB of node table).
+    integer, parameter :: min_tag_span = 2**20
 
 contains
 
@@ -78,6 +88,7 @@ contains
             call make_input_error(error, path, 0, '', 'cannot open the mesh file: '//trim(msg))
             return
         end if
+        inquire (unit=cur%unit, size=cur%bytes)
         allocate (entities(0), names(0), blocks(0))
         min_tag = 1
         seen_format = .false.
@@ -186,6 +197,25 @@ contains
         call make_input_error(error, cur%path, cur%line, cur%section, message)
     end subroutine fail
 
+    !> A count read from the file must fit in it: `count` records of `lines` lines each, a line
+    !> taking at least 2 bytes (a character and the end of line). Checked before the count
+    !> sizes an array, which an absurd count (a typo, a damaged file) would make fail.
+    subroutine check_count(cur, count, lines, what, error)
+        type(cursor_t), intent(in) :: cur
+        !> The count (integer(i8): a sum of counts may exceed the default integer range).
+        integer(i8), intent(in) :: count
+        integer, intent(in) :: lines
+        character(len=*), intent(in) :: what
+        type(error_t), allocatable, intent(out) :: error
+        character(len=100) :: buf
+        if (count < 0) then
+            call fail(cur, error, 'negative number of '//what)
+        else if (count > huge(0) .or. (cur%bytes >= 0 .and. count*lines*2 > cur%bytes)) then
+            write (buf, '(i0,a,i0,a)') count, ' '//what//', more than the file holds (', cur%bytes, ' bytes)'
+            call fail(cur, error, 'the header gives '//trim(buf))
+        end if
+    end subroutine check_count
+
     !> Integers of a line: exactly n of them, or at least n when at_least.
     subroutine read_ints(cur, text, n, values, error, at_least)
         type(cursor_t), intent(in) :: cur
@@ -283,7 +313,9 @@ contains
         if (allocated(error)) return
         call read_ints(cur, text, 1, n, error)
         if (allocated(error)) return
-        allocate (names(max(n(1), 0)))
+        call check_count(cur, int(n(1), i8), 1, 'physical names', error)
+        if (allocated(error)) return
+        allocate (names(n(1)))
         do k = 1, n(1)
             call section_line(cur, text, error)
             if (allocated(error)) return
@@ -318,6 +350,8 @@ contains
             call fail(cur, error, 'negative number of entities')
             return
         end if
+        call check_count(cur, sum(int(counts, i8)), 1, 'entities', error)
+        if (allocated(error)) return
         allocate (entities(sum(counts)))
         m = 0
         do dim = 0, 3
@@ -329,7 +363,9 @@ contains
                 else
                     read (text, *, iostat=ios) tag, box(1:6), nphys
                 end if
-                if (ios == 0 .and. nphys >= 0) then
+                ! the tags follow on the line: no more of them than words
+                if (ios == 0 .and. (nphys < 0 .or. nphys > count_words(text))) ios = 1
+                if (ios == 0) then
                     allocate (phys(nphys))
                     if (dim == 0) then
                         read (text, *, iostat=ios) tag, box(1:3), nphys, phys
@@ -337,7 +373,7 @@ contains
                         read (text, *, iostat=ios) tag, box(1:6), nphys, phys
                     end if
                 end if
-                if (ios /= 0 .or. nphys < 0) then
+                if (ios /= 0) then
                     call fail(cur, error, 'malformed entity record "'//trim(text)//'"')
                     return
                 end if
@@ -372,8 +408,19 @@ contains
         if (allocated(error)) return
         header = cur
         min_tag = head(3)
+        call check_count(cur, int(head(1), i8), 1, 'node blocks', error)
+        if (allocated(error)) return
+        call check_count(cur, int(head(2), i8), 2, 'nodes', error)
+        if (allocated(error)) return
         if (head(2) > 0 .and. (head(3) < 1 .or. head(4) < head(3))) then
             call fail(cur, error, 'invalid node tag range in "'//trim(text)//'"')
+            return
+        end if
+        if (int(head(4), i8) - head(3) + 1 > max(int(min_tag_span, i8), int(tags_per_node, i8)*head(2))) then
+            write (buf, '(a,i0,a,i0,a,i0,a)') 'node tags span ', head(3), ' to ', head(4), ' for ', head(2), &
+                ' nodes'
+            call fail(cur, error, trim(buf)//': number the nodes contiguously (Gmsh does by default: '// &
+                      'Mesh.Renumber = 1)')
             return
         end if
         allocate (xtag(2, max(head(4) - head(3) + 1, 0)), source=-huge(1.0_wp))
@@ -383,10 +430,8 @@ contains
             if (allocated(error)) return
             call read_ints(cur, text, 4, bh, error)
             if (allocated(error)) return
-            if (bh(4) < 0) then
-                call fail(cur, error, 'negative number of nodes in block')
-                return
-            end if
+            call check_count(cur, int(bh(4), i8), 2, 'nodes in the block', error)
+            if (allocated(error)) return
             total = total + bh(4)
             allocate (tags(bh(4)))
             do k = 1, bh(4)
@@ -461,7 +506,9 @@ contains
         if (allocated(error)) return
         call read_ints(cur, text, 4, head, error)
         if (allocated(error)) return
-        allocate (blocks(max(head(1), 0)))
+        call check_count(cur, int(head(1), i8), 1, 'element blocks', error)
+        if (allocated(error)) return
+        allocate (blocks(head(1)))
         do b = 1, head(1)
             call section_line(cur, text, error)
             if (allocated(error)) return
@@ -474,10 +521,8 @@ contains
                           '3-node triangles, 4-node quadrangles and points: mesh in 2D with Mesh.ElementOrder = 1)')
                 return
             end if
-            if (bh(4) < 0) then
-                call fail(cur, error, 'negative number of elements in block')
-                return
-            end if
+            call check_count(cur, int(bh(4), i8), 1, 'elements in the block', error)
+            if (allocated(error)) return
             associate (blk => blocks(b))
                 blk%dim = bh(1)
                 blk%tag = bh(2)
