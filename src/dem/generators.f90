@@ -132,7 +132,9 @@ contains
             return
         end if
         pitch = 2.0_wp*rmax*(1.0_wp + gap_ratio)
-        nx = int((xmax - xmin)/pitch)
+        ! Never more sites per row than disks: a box wider than huge(0) sites (xmax - xmin =
+        ! 1e300 m) would overflow the integer conversion.
+        nx = int(min((xmax - xmin)/pitch, real(n, wp)))
         if (nx < 1) then
             call make_error(error, 'generate_random_deposit: box narrower than one disk site 2 rmax (1 + gap_ratio)')
             return
