@@ -210,6 +210,21 @@ contains
         call particles_add_disks(cfg%system%particles, x(:n), y(:n), r(:n), density(mat(:n)), &
                                  error)
         if (allocated(error)) return
+        ! Masses and inertias must be normal numbers: an inertia that underflows to zero (radius
+        ! 1e-100 m) gives a NaN rotation at the first step, a mass that overflows (radius 1e150
+        ! m) a non-finite energy; both with no force at all.
+        do k = 1, n
+            associate (m => cfg%system%particles%mass(k), inertia => cfg%system%particles%inertia(k))
+                if (m >= tiny(m) .and. m <= huge(m) .and. inertia >= tiny(m) .and. inertia <= huge(m)) cycle
+                call make_input_error(error, deck%file, line(k), '', 'disk '//to_str(k)//' (radius '// &
+                                      to_str(r(k))//' m, density '//to_str(density(mat(k)))//' kg/m3): its '// &
+                                      'mass pi density radius^2 = '//to_str(m)//' kg/m or its moment of '// &
+                                      'inertia mass radius^2 / 2 = '//to_str(inertia)//' kg m is beyond the '// &
+                                      'range of double precision (2.2e-308 to 1.8e308): check the radius '// &
+                                      '(in m) and the density (in kg/m3)')
+                return
+            end associate
+        end do
         cfg%system%particles%mat(1:n) = mat(:n)
         cfg%disk_line = line(:n)
 
