@@ -16,6 +16,7 @@
 !>   coupling_operator2d); only Pi e = 0 is imposed, the disks may move in the kernel of Pi.
 !> Adding a space adds an extension of `multiplier_space_t`, not a branch in the coupled step.
 module coupling_multiplier_space
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
     use core_linalg, only: dense_spd_t
@@ -232,6 +233,12 @@ contains
             if (allocated(error)) return
             b = matmul(transpose(pi), p)
             self%recovery = matmul(p, a%a)
+            ! A factor can succeed on entries out of scale and still give an overflowing inverse
+            if (.not. (all(ieee_is_finite(b)) .and. all(ieee_is_finite(self%recovery)))) then
+                call make_error(error, 'coupling: multipliers = nodes: A_m = Pi A Pi^T is out of '// &
+                                'scale: its inverse is not finite')
+                return
+            end if
         end associate
     end subroutine mediator_inverse
 

@@ -120,7 +120,15 @@ contains
                              v0=self%continuum%integ%v)
         if (allocated(error)) then
             message = error%message
-            call make_input_error(error, deck%file, self%coupling%region_line, 'region', message)
+            if (index(message, 'A_m = Pi A Pi^T') > 0 .and. deck%has('coupling', 'h1_length')) then
+                ! The H1 pairing scales the conditioning of A_m by about (l / element size)^4.
+                call make_input_error(error, deck%file, deck%line('coupling', 'h1_length'), 'h1_length', &
+                                      message//': the conditioning of A_m grows as (h1_length / element '// &
+                                      'size)^4 with pairing = h1; lower h1_length (of the order of the '// &
+                                      'element size)')
+            else
+                call make_input_error(error, deck%file, self%coupling%region_line, 'region', message)
+            end if
         end if
     end subroutine coupled2d_init
 
