@@ -91,6 +91,10 @@ contains
             call store(error)
             if (allocated(error)) return
         end if
+        ! An export the run never reaches would pass unnoticed (the deck's end or --end).
+        if (cfg%fclib_step > n_steps) call report('warning: [solver] fclib_step = '// &
+                                                  to_str(cfg%fclib_step)//' is after the last step of the '// &
+                                                  'run ('//to_str(n_steps)//'): no FCLIB problem written')
         call progress%start(n_steps, run%t_end, run%progress_seconds)
         call ck%schedule%start()
         do k = k0 + 1, n_steps

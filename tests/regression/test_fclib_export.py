@@ -181,6 +181,16 @@ def main():
     crit = crit.decode() if isinstance(crit, bytes) else str(crit)
     check("criterion = siconos stops at the tolerance", crit == "siconos" and conv.all()
           and e.max() <= 1e-6, f"{len(e)} steps, max error {e.max():.2e}")
+    # An export after the last step (300 steps: end 0.06 s, step 2e-4 s) writes nothing and
+    # says so, even with --quiet; it used to pass unnoticed.
+    deck = with_export(decks / "dem_small_deposit.dat", 301, work, name="export_after_end.dat")
+    out = work / deck.stem
+    proc = subprocess.run([str(exe), str(deck), "--output", str(out), "--quiet"],
+                          capture_output=True, text=True)
+    written = sorted(p.name for p in out.glob("*_fclib_*.h5")) if out.is_dir() else []
+    check("fclib_step after the end: warned, nothing written", proc.returncode == 0 and not written
+          and "warning: [solver] fclib_step = 301 is after the last step of the run (300)" in proc.stdout,
+          f"exit {proc.returncode}, files {written}")
     if FAILED:
         print("FAILED:", ", ".join(FAILED))
         return 1
