@@ -18,6 +18,7 @@ module driver_checkpoint
     use core_error, only: error_t, make_error
     use core_version, only: multicor_version
     use core_signals, only: caught_signal
+    use core_strings, only: to_str
     use io_hdf5_file, only: h5_file_t
     use io_paths, only: rename_file, remove_file, file_exists
     use fem_newmark, only: time_integrator_t, newmark_t
@@ -899,8 +900,24 @@ contains
         allocate (saved(0))
         if (n_saved > 0) call file%read_dataset('/results/records', saved, error)
         if (allocated(error)) return
+        if (size(saved) /= n_saved) then
+            call make_error(error, 'checkpoint: '//to_str(size(saved))//' record counts for '// &
+                            to_str(n_saved)//' datasets: the checkpoint is damaged')
+            return
+        end if
         call out%file%list_datasets(paths, counts, error)
         if (allocated(error)) return
+        ! The results file holds at least the records of the checkpoint: a count beyond it
+        ! (a damaged checkpoint) would extend the series instead of cutting it.
+        do k = 1, size(paths)
+            j = find(trim(paths(k)))
+            if (j == 0) cycle
+            if (saved(j) >= 0 .and. saved(j) <= counts(k)) cycle
+            call make_error(error, "checkpoint: it counts "//to_str(saved(j))//" records of '"// &
+                            trim(paths(k))//"', the results file '"//out%file%path//"' holds "// &
+                            to_str(counts(k))//': the checkpoint is damaged or not of these results')
+            return
+        end do
         ! Every dataset of the file: kept (series cut to the checkpoint) or deleted.
         do k = 1, size(paths)
             j = find(trim(paths(k)))

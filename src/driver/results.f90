@@ -44,7 +44,8 @@ module driver_results
         !> Root attribute 'run_id' of the file: start date-time and clock count of the run,
         !> kept by its restarts.
         character(len=:), allocatable :: run_id
-        !> Whether the file continues an earlier run (`resume`): a failed run then keeps it.
+        !> Whether the file is the partial file of an earlier run, continued (`resume`): the
+        !> only copy of its outputs, which a failed run then keeps (not a copy of the finished file).
         logical :: resumed = .false.
     contains
         !> Create the results file (written as .partial until `close`).
@@ -180,6 +181,8 @@ contains
                 error%message = 'results: '//error%message
                 return
             end if
+            ! a copy: the finished file keeps the outputs, a failure removes the copy
+            self%resumed = .false.
         end if
         call self%file%open(self%partial_path, error, writable=.true.)
         if (allocated(error)) then
@@ -537,8 +540,9 @@ contains
     end subroutine writer_close_unfinished
 
     !> Close and delete the partial file after a failed run (an earlier result is untouched).
-    !> A resumed file is kept: it holds the outputs of the earlier part of the run, and a
-    !> restart from the checkpoint cuts what came after it. Does nothing when the writer is
+    !> A resumed partial file is kept: it holds the outputs of the earlier part of the run,
+    !> and a restart from the checkpoint cuts what came after it; a copy of the finished file
+    !> made to continue it is removed. Does nothing when the writer is
     !> not open.
     subroutine writer_abort(self)
         !> The writer; closed on return.

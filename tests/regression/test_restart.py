@@ -263,6 +263,15 @@ def refusals(exe, deck, work):
     proc = run(exe, deck, "--output", folder, "--restart", beam_deck, "--end", 0.1)
     check("a results file is not a checkpoint", proc.returncode == 1 and
           "is not a MULTICOR checkpoint" in proc.stderr, proc.stderr.strip())
+    # A damaged checkpoint counting more records than the results file holds: the restart
+    # extended the series to 2^31 records (a results file no reader can load).
+    damaged = work / "damaged_records.h5"
+    shutil.copy(ckpt, damaged)
+    with h5py.File(damaged, "r+") as f:
+        f["results/records"][0] = 2**31 - 1
+    proc = run(exe, deck, "--output", folder, "--restart", damaged, "--end", 0.1)
+    check("a checkpoint counting records the results lack refused", proc.returncode == 1 and
+          "records of" in proc.stderr and "the checkpoint is damaged" in proc.stderr, proc.stderr.strip())
     check("refusals leave the result untouched", digest(result) == before, "")
     check("refusals leave no partial file", not (folder / f"{deck.stem}.h5.partial").exists(), "")
 
