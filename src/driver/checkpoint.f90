@@ -75,7 +75,7 @@ module driver_checkpoint
     type :: checkpoint_run_t
         !> Where checkpoints are written ('<results folder>/checkpoint.h5').
         character(len=:), allocatable :: path
-        !> The deck's text (hashed into every checkpoint).
+        !> The deck's text followed by the files it reads (a mesh), hashed into every checkpoint.
         character(len=:), allocatable :: deck_text
         !> When to write them besides signals and the end.
         type(checkpoint_schedule_t) :: schedule
@@ -289,8 +289,9 @@ contains
                         'version (run the deck from the start, or use that version)')
         else if (hash /= deck_hash(deck_text)) then
             call refuse("checkpoint '"//path//"' was written for another deck (deck hash "// &
-                        hash//", '"//deck_file//"' has "//deck_hash(deck_text)//'): restart with '// &
-                        'the deck of that run, unchanged (a new end time goes on the command line: --end)')
+                        hash//", '"//deck_file//"' has "//deck_hash(deck_text)//'; the hash covers '// &
+                        'the deck and the mesh file it reads): restart with the deck of that run and '// &
+                        'its mesh, unchanged (a new end time goes on the command line: --end)')
         else if (ckind /= kind) then
             call refuse("checkpoint '"//path//"' holds a "//ckind//' run, the deck is a '//kind//' run')
         else

@@ -117,7 +117,8 @@ contains
             if (allocated(error)) return
             if (len(warning) > 0) call report(warning)
             ck%path = dir//'/'//checkpoint_name
-            ck%deck_text = deck%text
+            ! The deck and the files it reads (a mesh): a restart must find them unchanged.
+            ck%deck_text = deck%text//sim%inputs_text()
             ck%schedule%every = sim%settings%checkpoint_interval
             ck%schedule%seconds = sim%settings%checkpoint_seconds
             if (allocated(opts%restart)) call open_checkpoint(error)
@@ -219,7 +220,7 @@ contains
                                 'integrations have checkpoints)')
                 return
             end if
-            call checkpoint_open(ck%source, opts%restart, deck%file, deck%text, kind, ck%start, run_id, error)
+            call checkpoint_open(ck%source, opts%restart, deck%file, ck%deck_text, kind, ck%start, run_id, error)
             if (allocated(error)) return
             if (ck%start%step >= sim%settings%n_steps) then
                 call ck%source%close(ignored)

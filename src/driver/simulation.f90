@@ -43,6 +43,10 @@ module driver_simulation
         !> 'coupled', 'continuum', 'coupled2d'); '' for a run without checkpoints (static and
         !> modal analyses).
         procedure(simulation_checkpoint_kind), deferred :: checkpoint_kind
+        !> Text of the files besides the deck that the model was read from (a Gmsh mesh);
+        !> hashed into checkpoints with the deck, so that a restart refuses a changed mesh.
+        !> Default: none.
+        procedure :: inputs_text => simulation_inputs_text
     end type simulation_t
 
     abstract interface
@@ -105,4 +109,12 @@ contains
         write (output_unit, '(a)') line
         flush (output_unit)
     end subroutine report_to_stdout
+    !> See `simulation_t%inputs_text`: no file besides the deck.
+    function simulation_inputs_text(self) result(text)
+        !> The simulation.
+        class(simulation_t), intent(in) :: self
+        !> Their text ('').
+        character(len=:), allocatable :: text
+        text = ''
+    end function simulation_inputs_text
 end module driver_simulation

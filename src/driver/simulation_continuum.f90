@@ -19,6 +19,7 @@ module driver_simulation_continuum
     use fem_mesh2d, only: mesh2d_t
     use fem_mesh_generator, only: rectangle_mesh
     use fem_gmsh_reader, only: read_gmsh
+    use io_paths, only: read_file_text
     use fem_elastic2d, only: elastic2d_t, make_elastic2d
     use fem_continuum_model, only: continuum_model_t
     use fem_continuum_dynamics, only: continuum_dynamics_t, continuum_audit_t
@@ -49,6 +50,8 @@ module driver_simulation_continuum
         character(len=:), allocatable :: deck_file
         !> Energy audit of the whole body (prescribed dofs and their reactions included).
         type(continuum_audit_t) :: audit
+        !> Text of the Gmsh mesh file ('' for a generated mesh), for the checkpoints' hash.
+        character(len=:), allocatable :: mesh_text
     contains
         !> See `simulation_t%init`.
         procedure :: init => continuum_init
@@ -58,6 +61,8 @@ module driver_simulation_continuum
         procedure :: run => continuum_run
         !> See `simulation_t%checkpoint_kind`.
         procedure :: checkpoint_kind => continuum_checkpoint_kind
+        !> See `simulation_t%inputs_text`: the Gmsh mesh file.
+        procedure :: inputs_text => continuum_inputs_text
     end type continuum_simulation_t
 
 contains
@@ -155,6 +160,7 @@ contains
                 path = e%word('path')
                 if (path(1:1) /= '/') path = folder(deck%file)//path
                 call read_gmsh(path, mesh, error)
+                if (.not. allocated(error)) call read_file_text(path, self%mesh_text, error)
                 if (.not. allocated(error)) then
                     if (.not. any([(mesh%element_sets(i)%name == 'all', i=1, size(mesh%element_sets))])) &
                         call mesh%add_element_set('all', [(i, i=1, mesh%element_count())])
@@ -632,4 +638,13 @@ contains
         kind = ''
         if (self%settings%analysis == 'dynamic') kind = 'continuum'
     end function continuum_checkpoint_kind
+    !> See `simulation_t%inputs_text`: the text of the Gmsh mesh file ('' for a generated mesh).
+    function continuum_inputs_text(self) result(text)
+        !> The simulation (after `init`).
+        class(continuum_simulation_t), intent(in) :: self
+        !> The mesh file's text.
+        character(len=:), allocatable :: text
+        text = ''
+        if (allocated(self%mesh_text)) text = self%mesh_text
+    end function continuum_inputs_text
 end module driver_simulation_continuum

@@ -74,6 +74,8 @@ module driver_simulation_coupled2d
         procedure :: load_part => coupled2d_load_part
         !> See `arlequin_simulation_t%finish`.
         procedure :: finish => coupled2d_finish
+        !> See `simulation_t%inputs_text`: the continuum's mesh file.
+        procedure :: inputs_text => coupled2d_inputs_text
     end type coupled2d_simulation_t
 
 contains
@@ -429,4 +431,12 @@ contains
         end function slab
     end subroutine write_disks_xdmf
 
+    !> See `simulation_t%inputs_text`: the continuum's Gmsh mesh file ('' for a generated mesh).
+    function coupled2d_inputs_text(self) result(text)
+        !> The simulation (after `init`).
+        class(coupled2d_simulation_t), intent(in) :: self
+        !> The mesh file's text.
+        character(len=:), allocatable :: text
+        text = self%continuum%inputs_text()
+    end function coupled2d_inputs_text
 end module driver_simulation_coupled2d

@@ -6,6 +6,7 @@ module io_paths
     implicit none
     private
     public :: basename, stem, mkdir_p, remove_empty_folders, file_exists, remove_file, rename_file, copy_file
+    public :: read_file_text
 
     interface
         function c_mkdir(path, mode) bind(C, name='mkdir') result(rc)
@@ -174,4 +175,33 @@ contains
             call make_error(error, "cannot copy '"//old//"' to '"//new//"' (disk full?)")
         end if
     end subroutine copy_file
+    !> The whole content of a file, its bytes as characters (for hashing the inputs of a run).
+    subroutine read_file_text(path, text, error)
+        !> File to read.
+        character(len=*), intent(in) :: path
+        !> Its content.
+        character(len=:), allocatable, intent(out) :: text
+        !> Set if the file cannot be read (or holds 2 GiB or more).
+        type(error_t), allocatable, intent(out) :: error
+        character(len=256) :: msg
+        integer :: unit, ios
+        integer(int64) :: size_bytes
+        open (newunit=unit, file=path, access='stream', form='unformatted', status='old', &
+              action='read', iostat=ios, iomsg=msg)
+        if (ios /= 0) then
+            call make_error(error, "cannot read '"//path//"': "//trim(msg))
+            return
+        end if
+        inquire (unit=unit, size=size_bytes)
+        if (size_bytes < 0 .or. size_bytes > huge(0)) then
+            close (unit)
+            call make_error(error, "cannot read '"//path//"': size unknown or 2 GiB or more")
+            return
+        end if
+        allocate (character(len=int(size_bytes)) :: text)
+        ios = 0
+        if (size_bytes > 0) read (unit, iostat=ios, iomsg=msg) text
+        close (unit)
+        if (ios /= 0) call make_error(error, "cannot read '"//path//"': "//trim(msg))
+    end subroutine read_file_text
 end module io_paths

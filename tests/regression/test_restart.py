@@ -276,6 +276,58 @@ def refusals(exe, deck, work):
     check("refusals leave no partial file", not (folder / f"{deck.stem}.h5.partial").exists(), "")
 
 
+def changed_mesh(exe, src, work):
+    """A continuum run on a Gmsh mesh, stopped by --end: restarting it after one node of the
+    .msh moved (same node count, same deck) is refused like a changed deck, nothing written;
+    with the mesh restored the restart runs (the hash covers the deck and its mesh)."""
+    gmsh = shutil.which("gmsh")
+    if gmsh is None:
+        check("gmsh available for the changed-mesh restart", False, "gmsh not found (Debian package gmsh)")
+        return
+    folder = work / "mesh_restart"
+    folder.mkdir()
+    msh = folder / "two_blocks.msh"
+    subprocess.run([gmsh, "-2", "-format", "msh41", str(src / "tests" / "data" / "gmsh" / "two_blocks.geo"),
+                    "-o", str(msh)], check=True, capture_output=True)
+    deck = folder / "mesh_restart.dat"
+    deck.write_text("""[run]
+analysis = dynamic
+[continuum]
+mesh = file two_blocks.msh
+material = 1e9 0.25 1000 0.5 plane_stress
+fix = clamped x y
+traction = loaded 1e6 0
+[time]
+step = 1e-5
+end = 2e-4
+[output]
+interval = 5
+""")
+    out = folder / "out"
+    first = run(exe, deck, "--output", out, "--quiet", "--end", 1e-4)
+    assert first.returncode == 0, first.stderr
+    result = out / "mesh_restart.h5"
+    before = digest(result)
+    original = msh.read_text()
+    # the first node line after the $Nodes block header of the first entity: "x y z"
+    lines = original.split("\n")
+    k = lines.index("$Nodes") + 2
+    while len(lines[k].split()) != 1:
+        k += 1
+    n_block = int(lines[k - 1].split()[3])
+    coordinate = k + n_block
+    x, y, z = (float(v) for v in lines[coordinate].split())
+    lines[coordinate] = f"{x + 1e-3} {y} {z}"
+    msh.write_text("\n".join(lines))
+    proc = run(exe, deck, "--output", out, "--restart", out / "checkpoint.h5")
+    check("a restart with a changed mesh refused", proc.returncode == 1 and
+          "was written for another deck" in proc.stderr and "mesh" in proc.stderr, proc.stderr.strip())
+    check("the refused restart leaves the result untouched", digest(result) == before, "")
+    msh.write_text(original)
+    proc = run(exe, deck, "--output", out, "--restart", out / "checkpoint.h5", "--quiet")
+    check("the restart with the mesh restored runs", proc.returncode == 0, proc.stderr.strip())
+
+
 def new_end_time(exe, deck, work):
     """A finished run continued to a later end time equals the run to that end time; a
     continuation that fails leaves the earlier finished result as it was."""
@@ -383,6 +435,7 @@ def main():
     # multipliers' work through the prescribed dofs come back from the checkpoint.
     by_end_time(exe, decks / "coupled2d_driven_edge.dat", work, "coupled2d_driven_end", 4.43e-4)
     refusals(exe, beam, work)
+    changed_mesh(exe, src, work)
     new_end_time(exe, beam, work)
     if FAILED:
         print(f"{len(FAILED)} check(s) failed: {', '.join(FAILED)}")
