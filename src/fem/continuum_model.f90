@@ -14,6 +14,7 @@ module fem_continuum_model
     use core_kinds, only: wp
     use core_constants, only: singular_ratio
     use core_error, only: error_t, make_error
+    use core_strings, only: to_str
     use core_timefunc, only: time_function_t
     use fem_elastic2d, only: elastic2d_t
     use fem_element2d, only: element2d_t
@@ -114,7 +115,7 @@ contains
         !> edge set is not a side of any element.
         type(error_t), allocatable, intent(out) :: error
         integer :: e
-        character(len=120) :: buf
+        real(wp), allocatable :: xe(:, :)
         allocate (element_t3_t :: self%family(element_t3)%element)
         allocate (element_q4_t :: self%family(element_q4)%element)
         self%mesh = mesh
@@ -124,10 +125,13 @@ contains
         end if
         do e = 1, mesh%element_count()
             associate (el => self%family(mesh%kind(e))%element)
-                if (.not. el%min_jacobian(mesh%element_coordinates(e)) > 0.0_wp) then
-                    write (buf, '(a,i0,a)') 'continuum model: element ', e, &
-                        ' is inverted, degenerate or not convex (det J <= 0)'
-                    call make_error(error, trim(buf))
+                xe = mesh%element_coordinates(e)
+                if (.not. el%min_jacobian(xe) > 0.0_wp) then
+                    ! The index is the mesh's, not a Gmsh tag: the centroid locates the element.
+                    call make_error(error, 'continuum model: element '//to_str(e)//' (centroid ('// &
+                                    to_str(sum(xe(1, :))/size(xe, 2))//', '// &
+                                    to_str(sum(xe(2, :))/size(xe, 2))//') m) is inverted, '// &
+                                    'degenerate or not convex (det J <= 0)')
                     return
                 end if
             end associate
