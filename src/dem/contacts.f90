@@ -24,6 +24,7 @@ module dem_contacts
     public :: contact_set_t, contact_law_t
     public :: status_open, status_stick, status_slip, status_cohesive, status_broken
     public :: contacts_begin_detection, contacts_append, contacts_append_owner
+    public :: contacts_extend, contacts_fill
     public :: contacts_set_frames, contacts_set_laws, contacts_finish, contacts_impulses
     public :: contacts_local_velocity, contacts_count_status, contacts_bytes, contacts_moments_active
 
@@ -181,15 +182,75 @@ contains
         end do
     end subroutine contacts_append_owner
 
+    !> Extend the list by m contacts, slots n + 1 to n + m, which contacts_fill then fills.
+    subroutine contacts_extend(cs, m)
+        !> Contacts.
+        type(contact_set_t), intent(inout) :: cs
+        !> Number of slots to add (>= 0).
+        integer, intent(in) :: m
+        if (cs%n + m > cs%capacity) call ensure_capacity(cs, cs%n + m)
+        cs%n = cs%n + m
+    end subroutine contacts_extend
+
+    !> Store pairs (i1(a), i2(a)), in contact order, with their geometry at slots k0, k0 + 1, ...
+    !> (reserved by contacts_extend); reaction and status as contacts_append gives them. The
+    !> previous list is searched from its first pair not before (i1(1), i2(1)), found by
+    !> bisection, instead of from where the last append stopped: calls on disjoint ranges of
+    !> slots may run at the same time (OpenMP threads), and give exactly what contacts_append
+    !> gives pair by pair, the previous list being in contact order (as the detection leaves
+    !> it). Does not move the merge position of contacts_append.
+    subroutine contacts_fill(cs, k0, i1, i2, nrm, gap)
+        !> Contacts.
+        type(contact_set_t), intent(inout) :: cs
+        !> Slot of the first pair.
+        integer, intent(in) :: k0
+        !> First body (disk, or -wall) and second body (disk) of each pair.
+        integer, intent(in) :: i1(:), i2(:)
+        !> Unit normals (2, :) from the first body of each pair to the second.
+        real(wp), intent(in) :: nrm(:, :)
+        !> Gaps [m].
+        real(wp), intent(in) :: gap(:)
+        integer(i8) :: key
+        integer :: a, p, lo, hi, mid
+        if (size(i1) == 0) return
+        ! first previous pair whose key is not below the first new one
+        key = pair_key(i1(1), i2(1))
+        lo = 1
+        hi = cs%n_prev + 1
+        do while (lo < hi)
+            mid = lo + (hi - lo)/2
+            if (pair_key(cs%prev_i1(mid), cs%prev_i2(mid)) < key) then
+                lo = mid + 1
+            else
+                hi = mid
+            end if
+        end do
+        p = lo
+        do a = 1, size(i1)
+            call set_one(cs, k0 + a - 1, i1(a), i2(a), nrm(1, a), nrm(2, a), gap(a), p)
+        end do
+    end subroutine contacts_fill
+
     !> Append one pair (capacity available), merging with the previous list for the warm start.
     pure subroutine append_one(cs, i1, i2, nx, ny, gap)
         type(contact_set_t), intent(inout) :: cs
         integer, intent(in) :: i1, i2
         real(wp), intent(in) :: nx, ny, gap
+        integer :: p
+        cs%n = cs%n + 1
+        p = cs%merge_pos
+        call set_one(cs, cs%n, i1, i2, nx, ny, gap, p)
+        cs%merge_pos = p
+    end subroutine append_one
+
+    !> Store one pair at slot k; p is the next entry of the previous list to compare with
+    !> (merge for the warm start), advanced past the entries that come before the pair.
+    pure subroutine set_one(cs, k, i1, i2, nx, ny, gap, p)
+        type(contact_set_t), intent(inout) :: cs
+        integer, intent(in) :: k, i1, i2
+        real(wp), intent(in) :: nx, ny, gap
+        integer, intent(inout) :: p
         integer(i8) :: key
-        integer :: k, p
-        k = cs%n + 1
-        cs%n = k
         cs%i1(k) = i1
         cs%i2(k) = i2
         cs%nrm(1, k) = nx
@@ -204,23 +265,21 @@ contains
         cs%break_mode(k) = break_none
         ! skip the previous pairs that come before this one
         key = pair_key(i1, i2)
-        p = cs%merge_pos
         do while (p <= cs%n_prev)
             if (pair_key(cs%prev_i1(p), cs%prev_i2(p)) >= key) exit
             p = p + 1
         end do
-        cs%merge_pos = p
         if (p <= cs%n_prev) then
             if (cs%prev_i1(p) == i1 .and. cs%prev_i2(p) == i2) then
                 cs%r(:, k) = cs%prev_r(:, p)
                 cs%status(k) = cs%prev_status(p)
-                cs%merge_pos = p + 1
+                p = p + 1
                 return
             end if
         end if
         cs%r(:, k) = 0.0_wp
         cs%status(k) = status_open
-    end subroutine append_one
+    end subroutine set_one
 
     !> Grow every per-contact array to hold at least m contacts (keeps the first n).
     subroutine ensure_capacity(cs, m)

@@ -10,6 +10,17 @@
 !> Candidates of each owner disk are sorted so that the list comes out in the contact order of
 !> `dem_contacts`, which matches them with the previous list for the warm start.
 !>
+!> OpenMP: the owners are scanned in rounds of at most `scan_round` owners per thread; in a round
+!> each thread scans a contiguous range of owners (the round cut in equal parts, in thread
+!> order). The first thread appends its pairs straight to the contact list, as the serial
+!> scan does; each other thread fills its own pair list, and after a barrier these lists are
+!> stored in the contact list after the first thread's, in range order (offsets by prefix
+!> sums), each thread storing its own. That is the serial order, with the same arithmetic per
+!> pair: the list (pairs, order, normals, gaps, reactions carried over) is the same bit for bit
+!> for any number of threads. The extra memory (the pair lists) is bounded by the round, not
+!> by N, and a step has few synchronisations (three per round). With one thread, or fewer than
+!> scan_min owners per thread, the serial scan appends straight to the list.
+!>
 !> Coordinates must lie in the box |x|, |y| <= coordinate_limit(smallest radius): there a
 !> coordinate is known to 1e-6 of the smallest radius, and the grid and gap arithmetic cannot
 !> overflow. Outside it (or for a non-finite coordinate), `detect_contacts` finds nothing and
@@ -19,14 +30,41 @@ module dem_detection
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
     use dem_contacts, only: contact_set_t, contacts_begin_detection, contacts_append, &
-                            contacts_append_owner
+                            contacts_append_owner, contacts_extend, contacts_fill
     use dem_walls, only: segment_closest_point
+!$  use omp_lib, only: omp_get_max_threads, omp_get_num_threads, omp_get_thread_num
     implicit none
     private
     public :: detector_t, detect_contacts, detect_brute_force, detector_bytes, coordinate_limit
 
+    !> Fewest owners per thread for the parallel scan (fewer threads below).
+    integer, parameter :: scan_min = 512
+
+    !> Pairs found by one thread in a round, in contact order (work arrays).
+    type :: pair_list_t
+        !> Number of pairs.
+        integer :: n = 0
+        !> First and second body of each pair (as in contact_set_t).
+        integer, allocatable :: i1(:), i2(:)
+        !> Normals (2, :) and gaps.
+        real(wp), allocatable :: nrm(:, :), gap(:)
+    end type pair_list_t
+
+    !> Work arrays of one thread of the scan.
+    type :: scan_work_t
+        !> Candidate buffer of one owner: other body.
+        integer, allocatable :: cand(:)
+        !> Candidate normals (2, :) and gaps.
+        real(wp), allocatable :: cand_n(:, :), cand_gap(:)
+        !> Pairs found in the current round (parallel scan only).
+        type(pair_list_t) :: found
+    end type scan_work_t
+
     !> Reusable grid of the broad phase.
     type :: detector_t
+        !> Owners scanned per thread and per round of the parallel scan (bounds its pair
+        !> lists; a test lowers it to have several rounds on a small problem).
+        integer :: scan_round = 16384
         !> Cell side [m] and its inverse [1/m].
         real(wp) :: cell = 0.0_wp, inv_cell = 0.0_wp
         !> Lower-left corner of the grid [m].
@@ -45,10 +83,10 @@ module dem_detection
         integer, allocatable :: wall_list(:), wall_start(:)
         !> Fill pointers of the wall lists (work array).
         integer, allocatable :: wall_pos(:)
-        !> Candidate buffer of one owner: other body, normal, gap.
-        integer, allocatable :: cand(:)
-        !> Candidate normals (2, :) and gaps.
-        real(wp), allocatable :: cand_n(:, :), cand_gap(:)
+        !> Work arrays of each thread of the scan.
+        type(scan_work_t), allocatable :: work(:)
+        !> Slot in the contact list of the first pair of each thread in a round.
+        integer, allocatable :: offset(:)
     end type detector_t
 
 contains
@@ -68,7 +106,7 @@ contains
         type(contact_set_t), intent(inout) :: cs
         !> Set when a coordinate is outside the representable box (the list is then empty).
         type(error_t), allocatable, intent(out), optional :: error
-        integer :: need
+        integer :: need, nt, t
         real(wp) :: limit
         call contacts_begin_detection(cs)
         if (size(x) == 0) return
@@ -84,13 +122,29 @@ contains
         call build_wall_lists(det, maxval(radius) + alert, wx1, wy1, wx2, wy2)
         ! room for every candidate of one owner: its walls and the disks of 9 cells
         need = size(wx1) + 9*det%max_occupancy
-        if (allocated(det%cand)) then
-            if (size(det%cand) < need) deallocate (det%cand, det%cand_n, det%cand_gap)
+        nt = 1
+!$      nt = max(1, min(omp_get_max_threads(), size(x)/scan_min))
+        if (allocated(det%work)) then
+            if (size(det%work) < nt) deallocate (det%work)
         end if
-        if (.not. allocated(det%cand)) allocate (det%cand(need), det%cand_n(2, need), det%cand_gap(need))
-        call scan_owners(alert, det%x0, det%y0, det%inv_cell, det%ncx, det%ncy, x, y, radius, &
-                         det%cell_of, det%start, det%sorted, det%xs, det%ys, det%rs, det%wall_start, &
-                         det%wall_list, wx1, wy1, wx2, wy2, det%cand, det%cand_n, det%cand_gap, cs)
+        if (.not. allocated(det%work)) allocate (det%work(nt))
+        call resize(det%offset, nt + 1)
+        do t = 1, nt
+            associate (w => det%work(t))
+                if (allocated(w%cand)) then
+                    if (size(w%cand) < need) deallocate (w%cand, w%cand_n, w%cand_gap)
+                end if
+                if (.not. allocated(w%cand)) allocate (w%cand(need), w%cand_n(2, need), w%cand_gap(need))
+            end associate
+        end do
+        if (nt == 1) then
+            call scan_owners(1, size(x), alert, det%x0, det%y0, det%inv_cell, det%ncx, det%ncy, x, y, &
+                             radius, det%cell_of, det%start, det%sorted, det%xs, det%ys, det%rs, &
+                             det%wall_start, det%wall_list, wx1, wy1, wx2, wy2, det%work(1)%cand, &
+                             det%work(1)%cand_n, det%work(1)%cand_gap, cs=cs)
+        else
+            call scan_parallel(det, nt, x, y, radius, alert, wx1, wy1, wx2, wy2, cs)
+        end if
 
     contains
 
@@ -241,13 +295,75 @@ contains
         c = int(floor(min(max(s, -1.0_wp), real(nc, wp))))
     end function clamp_cell
 
+    !> The scan of all owners on up to nt threads, in rounds (see the module's description): in
+    !> each round thread 0 appends the pairs of the first range straight to the contact list,
+    !> as the serial scan; every other thread scans its range into its pair list, which then
+    !> goes to the slots after those of threads 0 .. t - 1.
+    subroutine scan_parallel(det, nt, x, y, radius, alert, wx1, wy1, wx2, wy2, cs)
+        type(detector_t), intent(inout) :: det
+        integer, intent(in) :: nt
+        real(wp), intent(in), contiguous :: x(:), y(:), radius(:)
+        real(wp), intent(in) :: alert
+        real(wp), intent(in) :: wx1(:), wy1(:), wx2(:), wy2(:)
+        type(contact_set_t), intent(inout) :: cs
+        integer :: n, base, span, team, t, s, lo, hi
+        n = size(x)
+        !$omp parallel num_threads(nt) default(shared) private(base, span, team, t, s, lo, hi)
+        ! the team may be smaller than asked for: the split follows the team actually formed
+        team = 1
+        t = 0
+!$      team = omp_get_num_threads()
+!$      t = omp_get_thread_num()
+        base = 0
+        do while (base < n)
+            span = int(min(int(team, i8)*det%scan_round, int(n - base, i8)))
+            lo = base + int((int(t, i8)*span)/team) + 1
+            hi = base + int((int(t + 1, i8)*span)/team)
+            associate (w => det%work(t + 1))
+                if (t == 0) then
+                    ! the other threads leave the contact list alone until the barrier
+                    call scan_owners(lo, hi, alert, det%x0, det%y0, det%inv_cell, det%ncx, det%ncy, x, y, &
+                                     radius, det%cell_of, det%start, det%sorted, det%xs, det%ys, det%rs, &
+                                     det%wall_start, det%wall_list, wx1, wy1, wx2, wy2, w%cand, w%cand_n, &
+                                     w%cand_gap, cs=cs)
+                else
+                    w%found%n = 0
+                    call scan_owners(lo, hi, alert, det%x0, det%y0, det%inv_cell, det%ncx, det%ncy, x, y, &
+                                     radius, det%cell_of, det%start, det%sorted, det%xs, det%ys, det%rs, &
+                                     det%wall_start, det%wall_list, wx1, wy1, wx2, wy2, w%cand, w%cand_n, &
+                                     w%cand_gap, found=w%found)
+                end if
+            end associate
+            !$omp barrier
+            !$omp single
+            det%offset(2) = cs%n + 1
+            do s = 2, team
+                det%offset(s + 1) = det%offset(s) + det%work(s)%found%n
+            end do
+            call contacts_extend(cs, det%offset(team + 1) - det%offset(2))
+            !$omp end single
+            if (t > 0) then
+                associate (f => det%work(t + 1)%found)
+                    call contacts_fill(cs, det%offset(t + 1), f%i1(1:f%n), f%i2(1:f%n), f%nrm(:, 1:f%n), &
+                                       f%gap(1:f%n))
+                end associate
+            end if
+            ! the slots are filled before thread 0 appends again
+            !$omp barrier
+            base = base + span
+        end do
+        !$omp end parallel
+    end subroutine scan_parallel
+
     !> Broad and narrow phase, owner by owner (i = 1, 2, ...): the walls listed for the cell of
     !> disk i, then the disks j > i of the 9 cells around it (three contiguous ranges of the
-    !> cell-ordered arrays); the hits are sorted by the other body and appended to the list.
+    !> cell-ordered arrays); the hits are sorted by the other body and appended to the contact
+    !> list cs, or to the pair list found (one of the two is given). Owners lo to hi.
     !> The grid is passed as plain arrays so that the compiler keeps them in registers.
-    subroutine scan_owners(alert, x0, y0, inv_cell, ncx, ncy, x, y, radius, cell_of, start, &
+    subroutine scan_owners(lo, hi, alert, x0, y0, inv_cell, ncx, ncy, x, y, radius, cell_of, start, &
                            sorted, xs, ys, rs, wall_start, wall_list, wx1, wy1, wx2, wy2, &
-                           cand, cand_n, cand_gap, cs)
+                           cand, cand_n, cand_gap, cs, found)
+        integer, intent(in) :: lo, hi
         real(wp), intent(in) :: alert, x0, y0, inv_cell
         integer, intent(in) :: ncx, ncy
         real(wp), intent(in), contiguous :: x(:), y(:), radius(:)
@@ -257,11 +373,12 @@ contains
         real(wp), intent(in) :: wx1(:), wy1(:), wx2(:), wy2(:)
         integer, intent(inout), contiguous :: cand(:)
         real(wp), intent(inout), contiguous :: cand_n(:, :), cand_gap(:)
-        type(contact_set_t), intent(inout) :: cs
+        type(contact_set_t), intent(inout), optional :: cs
+        type(pair_list_t), intent(inout), optional :: found
         integer :: i, m, c, cx, cy, dy, p, j, k, row
         real(wp) :: nx, ny, gap, xi, yi, ri
         logical :: hit
-        do i = 1, size(x)
+        do i = lo, hi
             m = 0
             xi = x(i)
             yi = y(i)
@@ -296,9 +413,59 @@ contains
                 end do
             end do
             call sort_candidates(m, cand, cand_n, cand_gap)
-            call contacts_append_owner(cs, i, cand(1:m), cand_n(:, 1:m), cand_gap(1:m))
+            if (present(cs)) then
+                call contacts_append_owner(cs, i, cand(1:m), cand_n(:, 1:m), cand_gap(1:m))
+            else
+                call list_owner(found, i, cand(1:m), cand_n(:, 1:m), cand_gap(1:m))
+            end if
         end do
     end subroutine scan_owners
+
+    !> Append the sorted candidates of one owner to a pair list, as contacts_append_owner
+    !> appends them to the contact list.
+    pure subroutine list_owner(found, owner, other, nrm, gap)
+        type(pair_list_t), intent(inout) :: found
+        integer, intent(in) :: owner, other(:)
+        real(wp), intent(in) :: nrm(:, :), gap(:)
+        integer :: a, k
+        if (found%n + size(other) > isize(found%i1)) call grow_list(found, found%n + size(other))
+        do a = 1, size(other)
+            k = found%n + a
+            if (other(a) < 0) then
+                found%i1(k) = other(a)
+                found%i2(k) = owner
+            else
+                found%i1(k) = owner
+                found%i2(k) = other(a)
+            end if
+            found%nrm(1, k) = nrm(1, a)
+            found%nrm(2, k) = nrm(2, a)
+            found%gap(k) = gap(a)
+        end do
+        found%n = found%n + size(other)
+    end subroutine list_owner
+
+    !> Room for at least m pairs in a pair list (keeps the first n).
+    pure subroutine grow_list(found, m)
+        type(pair_list_t), intent(inout) :: found
+        integer, intent(in) :: m
+        integer, allocatable :: ti1(:), ti2(:)
+        real(wp), allocatable :: tn(:, :), tg(:)
+        integer :: cap, n
+        n = found%n
+        cap = max(isize(found%i1) + isize(found%i1)/2, m, 1024)
+        allocate (ti1(cap), ti2(cap), tn(2, cap), tg(cap))
+        if (n > 0) then
+            ti1(1:n) = found%i1(1:n)
+            ti2(1:n) = found%i2(1:n)
+            tn(:, 1:n) = found%nrm(:, 1:n)
+            tg(1:n) = found%gap(1:n)
+        end if
+        call move_alloc(ti1, found%i1)
+        call move_alloc(ti2, found%i2)
+        call move_alloc(tn, found%nrm)
+        call move_alloc(tg, found%gap)
+    end subroutine grow_list
 
     !> Insertion sort of the m candidates of one owner by the other body (walls, negative,
     !> first); they come nearly sorted when disks are numbered by position.
@@ -404,17 +571,25 @@ contains
     pure integer(i8) function detector_bytes(det) result(b)
         !> Detection workspace.
         type(detector_t), intent(in) :: det
+        integer :: t
         b = 4_i8*(isize(det%cell_of) + isize(det%sorted) + isize(det%start) + isize(det%wall_list) &
-                  + isize(det%wall_start) + isize(det%wall_pos) + isize(det%cand))
-        if (allocated(det%cand_n)) b = b + 8_i8*(size(det%cand_n) + size(det%cand_gap))
+                  + isize(det%wall_start) + isize(det%wall_pos) + isize(det%offset))
         if (allocated(det%xs)) b = b + 8_i8*(size(det%xs) + size(det%ys) + size(det%rs))
-    contains
-        pure integer(i8) function isize(a)
-            integer, allocatable, intent(in) :: a(:)
-            isize = 0_i8
-            if (allocated(a)) isize = size(a)
-        end function isize
+        if (.not. allocated(det%work)) return
+        do t = 1, size(det%work)
+            associate (w => det%work(t))
+                ! candidates: 4 + 3 x 8 bytes; pairs found: 2 x 4 + 3 x 8 bytes
+                b = b + 28_i8*isize(w%cand) + 32_i8*isize(w%found%i1)
+            end associate
+        end do
     end function detector_bytes
+
+    !> Size of an integer work array, 0 when not allocated.
+    pure integer function isize(a)
+        integer, allocatable, intent(in) :: a(:)
+        isize = 0
+        if (allocated(a)) isize = size(a)
+    end function isize
 
     !> Make sure an integer work array has at least m entries.
     subroutine resize(a, m)
