@@ -188,7 +188,14 @@ contains
         type(contact_set_t), intent(inout) :: cs
         !> Number of slots to add (>= 0).
         integer, intent(in) :: m
-        if (cs%n + m > cs%capacity) call ensure_capacity(cs, cs%n + m)
+        integer :: cap
+        ! grow by quarters, as appending the contacts owner by owner does: the capacity, hence
+        ! the memory, does not depend on how the list was cut (number of threads)
+        cap = cs%capacity
+        do while (cap < cs%n + m)
+            cap = max(cap + cap/4, 64)
+        end do
+        if (cap > cs%capacity) call ensure_capacity(cs, cap)
         cs%n = cs%n + m
     end subroutine contacts_extend
 
