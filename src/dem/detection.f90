@@ -18,7 +18,8 @@
 !> sums), each thread storing its own. That is the serial order, with the same arithmetic per
 !> pair: the list (pairs, order, normals, gaps, reactions carried over) is the same bit for bit
 !> for any number of threads. The extra memory (the pair lists) is bounded by the round, not
-!> by N, and a step has few synchronisations (three per round). With one thread, or fewer than
+!> by N, and a step has few synchronisations (three per round: each costs a time slice when
+!> the cores are shared with other jobs). With one thread, or fewer than
 !> scan_min owners per thread, the serial scan appends straight to the list.
 !>
 !> Coordinates must lie in the box |x|, |y| <= coordinate_limit(smallest radius): there a
@@ -64,7 +65,7 @@ module dem_detection
     type :: detector_t
         !> Owners scanned per thread and per round of the parallel scan (bounds its pair
         !> lists; a test lowers it to have several rounds on a small problem).
-        integer :: scan_round = 16384
+        integer :: scan_round = 65536
         !> Cell side [m] and its inverse [1/m].
         real(wp) :: cell = 0.0_wp, inv_cell = 0.0_wp
         !> Lower-left corner of the grid [m].
@@ -453,7 +454,7 @@ contains
         real(wp), allocatable :: tn(:, :), tg(:)
         integer :: cap, n
         n = found%n
-        cap = max(isize(found%i1) + isize(found%i1)/2, m, 1024)
+        cap = max(isize(found%i1) + isize(found%i1)/4, m, 1024)
         allocate (ti1(cap), ti2(cap), tn(2, cap), tg(cap))
         if (n > 0) then
             ti1(1:n) = found%i1(1:n)
