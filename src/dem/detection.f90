@@ -317,7 +317,7 @@ contains
 !$      t = omp_get_thread_num()
         base = 0
         do while (base < n)
-            span = int(min(int(team, i8)*det%scan_round, int(n - base, i8)))
+            span = int(min(int(team, i8)*max(det%scan_round, 1), int(n - base, i8)))
             lo = base + int((int(t, i8)*span)/team) + 1
             hi = base + int((int(t + 1, i8)*span)/team)
             associate (w => det%work(t + 1))
