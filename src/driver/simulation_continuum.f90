@@ -465,6 +465,19 @@ contains
 
     contains
 
+        !> What makes a step's state blow up: the stability limit only for a conditionally
+        !> stable scheme (central differences, or Newmark with 2 beta < gamma).
+        function likely_cause() result(cause)
+            character(len=:), allocatable :: cause
+            if (self%settings%scheme == 'central_difference' .or. &
+                2*self%settings%beta < self%settings%gamma) then
+                cause = 'a time step above the stability limit of the scheme, or loads far too large'
+            else
+                cause = 'loads, moduli or densities far out of range (this Newmark scheme is '// &
+                        'unconditionally stable: the time step is not the cause)'
+            end if
+        end function likely_cause
+
         !> K_ff u_f = f_f - K_fp u_p.
         subroutine run_static(error)
             type(error_t), allocatable, intent(out) :: error
@@ -545,9 +558,8 @@ contains
                            all(ieee_is_finite([self%integ%kinetic, self%integ%strain, self%integ%external_work, &
                                                self%integ%damping_dissipation, self%audit%balance()])))) then
                     write (buf, '(a,i0,a,es13.5e3,a)') 'continuum: the state is not finite after step ', k, &
-                        ' (t = ', self%integ%t, ' s); likely cause: a time step above the stability limit or '// &
-                        'loads far too large'
-                    call make_error(error, trim(buf))
+                        ' (t = ', self%integ%t, ' s); likely cause:'
+                    call make_error(error, trim(buf)//' '//likely_cause())
                     return
                 end if
                 act = end_of_step(k, n_steps, self%settings%output_interval, ck%schedule)

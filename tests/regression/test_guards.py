@@ -134,6 +134,26 @@ def coupled2d_initial_state(exe, work, src):
                 r"coupled continuum: the state is not finite after step 0 ", text)
 
 
+def continuum_blow_up_cause(exe, work, src):
+    """A dynamic continuum with a density of 1e-300 blows up at the first step. Average
+    acceleration is unconditionally stable, so the message must not blame the time step (it
+    did). With Newmark beta = 0.1, gamma = 0.5 (2 beta < gamma, conditionally stable) the time
+    step is refused before the run, at its keyword (the critical step of that model is 0)."""
+    text = (src / "input" / "continuum_cantilever_dynamic.dat").read_text()
+    material = "material = 70e9 0.3 2700 0.1 plane_stress"
+    if material not in text or "end = 0.5" not in text:
+        check("continuum blow-up: deck lines found", False, "input/continuum_cantilever_dynamic.dat changed")
+        return
+    light = text.replace(material, material.replace("2700", "1e-300")).replace("end = 0.5", "end = 0.01")
+    failing_run(exe, work, "continuum_density_1e-300", light,
+                r"continuum: the state is not finite after step 1 .*likely cause: loads, moduli or densities "
+                r"far out of range \(this Newmark scheme is unconditionally stable", text)
+    conditional = light.replace("[time]", "[time]\nscheme = newmark\nbeta = 0.1\ngamma = 0.5", 1)
+    failing_run(exe, work, "continuum_density_1e-300_beta", conditional,
+                r":\d+: keyword 'step': time step .* exceeds the critical time step .* only conditionally stable",
+                text)
+
+
 def tunnelling(exe, work):
     """A step so large that disks pass through the floor ran to the end with one warning."""
     failing_run(exe, work, "dem_tunnelling_floor", dem_deck(step="0.05", end="1"),
@@ -277,6 +297,7 @@ def main():
     non_finite(exe, work)
     coupled_non_finite(exe, work, src / "tests" / "regression" / "decks")
     coupled2d_initial_state(exe, work, src)
+    continuum_blow_up_cause(exe, work, src)
     tunnelling(exe, work)
     lock(exe, work)
     output_empty(exe, work)
