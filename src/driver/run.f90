@@ -29,7 +29,7 @@ module driver_run
     use io_memory, only: available_memory
     use core_signals, only: caught_signal, signal_name, install_signal_handlers
     use io_deck_schema, only: multicor_schema
-    use io_deck, only: deck_t, read_deck
+    use io_deck, only: deck_t, deck_entry_t, read_deck
     use io_paths, only: stem, mkdir_p, remove_empty_folders, file_exists
     use driver_results, only: results_writer_t
     use driver_guards, only: check_memory
@@ -94,6 +94,7 @@ contains
         kind = sim%checkpoint_kind()
         call apply_end_time(error)
         if (allocated(error)) return
+        call warn_aliased_functions()
         if (opts%check_only) then
             call report(opts%deck_path//': deck is valid ('//sim%describe()//')')
             return
@@ -184,6 +185,26 @@ contains
 
         !> Option `--end`: a new end time (the models built by `init` do not depend on it, the step
         !> count does).
+        !> Warn about a harmonic function faster than half the sampling rate of the time step:
+        !> the run sees it at fewer than two steps per period, i.e. an alias of another
+        !> frequency. Allowed (the deck may mean it), said once per function.
+        subroutine warn_aliased_functions()
+            type(deck_entry_t), allocatable :: list(:)
+            real(wp) :: nyquist
+            integer :: i
+            if (sim%settings%analysis /= 'dynamic' .or. .not. sim%settings%h > 0.0_wp) return
+            nyquist = 0.5_wp/sim%settings%h
+            allocate (list, source=deck%records('functions', 'function'))
+            do i = 1, size(list)
+                if (list(i)%word('kind') /= 'harmonic') cycle
+                if (.not. list(i)%real('freq') > nyquist) cycle
+                call report('warning: '//deck%file//':'//to_str(list(i)%line)//': harmonic function '// &
+                            to_str(list(i)%int('id'))//' at '//to_str(list(i)%real('freq'))// &
+                            ' Hz is above 1/(2 h) = '//to_str(nyquist)//' Hz of [time] step: the run '// &
+                            'samples it below two steps per period and sees an alias; lower the step')
+            end do
+        end subroutine warn_aliased_functions
+
         subroutine apply_end_time(error)
             type(error_t), allocatable, intent(out) :: error
             real(wp) :: steps

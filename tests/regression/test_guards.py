@@ -154,6 +154,25 @@ def continuum_blow_up_cause(exe, work, src):
                 text)
 
 
+def aliased_harmonic(exe, work):
+    """A harmonic load faster than 1/(2h) ran without a word (the run sees an alias of it):
+    warned once, naming the deck line and both frequencies; below 1/(2h) nothing is said."""
+    for freq, warned in (("3000", True), ("2000", False)):   # h = 2e-4 s: 1/(2h) = 2500 Hz
+        text = beam_deck(load="-10.0 1", extra=f"[functions]\nfunction = 1 harmonic {freq}")
+        deck = work / f"harmonic_{freq}.dat"
+        deck.write_text(text)
+        proc = multicor(exe, deck, "--output", work / f"harmonic_{freq}", "--quiet")
+        out = proc.stdout + proc.stderr
+        if warned:
+            said = re.search(r"harmonic_%s\.dat:\d+: harmonic function 1 at %s Hz is above 1/\(2 h\) = 2500 Hz"
+                             % (freq, freq), out) is not None
+        else:
+            said = "warning" in out
+        check(f"harmonic at {freq} Hz runs", proc.returncode == 0, proc.stderr.strip())
+        check(f"harmonic at {freq} Hz: aliasing warning {'given' if warned else 'absent'}", said == warned,
+              out.strip()[:300])
+
+
 def tunnelling(exe, work):
     """A step so large that disks pass through the floor ran to the end with one warning."""
     failing_run(exe, work, "dem_tunnelling_floor", dem_deck(step="0.05", end="1"),
@@ -298,6 +317,7 @@ def main():
     coupled_non_finite(exe, work, src / "tests" / "regression" / "decks")
     coupled2d_initial_state(exe, work, src)
     continuum_blow_up_cause(exe, work, src)
+    aliased_harmonic(exe, work)
     tunnelling(exe, work)
     lock(exe, work)
     output_empty(exe, work)
