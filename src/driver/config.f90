@@ -853,6 +853,8 @@ contains
         if (run%analysis == 'dynamic') then
             call count_steps(error)
             if (allocated(error)) return
+            call check_damping(error)
+            if (allocated(error)) return
         end if
         run%n_modes = deck%get_int('modal', 'modes')
         if (run%analysis == 'modal' .and. run%n_modes > n_free) then
@@ -884,6 +886,25 @@ contains
             end if
             run%n_steps = max(ceiling(steps, i8), 1_i8)
         end subroutine count_steps
+
+        !> Refuse Rayleigh damping beyond double precision over one step (a0 h or a1 / h above
+        !> 1/epsilon): the inertia and stiffness terms of the step's matrix are then lost in
+        !> round-off, and the motion and the energy audit with them.
+        subroutine check_damping(error)
+            type(error_t), allocatable, intent(out) :: error
+            real(wp) :: a0, a1, limit
+            a0 = deck%get_real(section, 'rayleigh', 'a0')
+            a1 = deck%get_real(section, 'rayleigh', 'a1')
+            limit = 1.0_wp/epsilon(1.0_wp)
+            if (a0*run%h > limit .or. a1/run%h > limit) then
+                call make_input_error(error, deck%file, deck%line(section, 'rayleigh'), 'rayleigh', &
+                                      'Rayleigh damping a0 = '//to_str(a0)//' 1/s, a1 = '//to_str(a1)// &
+                                      ' s damps more in one step (a0 h = '//to_str(a0*run%h)//', a1/h = '// &
+                                      to_str(a1/run%h)//') than double precision can hold next to the '// &
+                                      'inertia and stiffness (1/epsilon = '//to_str(limit)//'): check the '// &
+                                      'values (a0 in 1/s, a1 in s)')
+            end if
+        end subroutine check_damping
 
     end subroutine build_run_settings
 
