@@ -28,7 +28,7 @@ module driver_simulation_continuum
     use driver_config, only: run_config_t, build_run_settings, build_time_functions
     use driver_results, only: results_writer_t
     use io_hdf5_file, only: h5_file_t
-    use driver_checkpoint, only: checkpoint_run_t, end_of_step, step_end_t, loop_state_t, checkpoint_create, &
+    use driver_checkpoint, only: deck_hash, checkpoint_run_t, end_of_step, step_end_t, loop_state_t, checkpoint_create, &
                                  save_integrator, load_integrator, save_results, load_results
     use driver_results_continuum, only: continuum_writer_t
     use driver_simulation, only: simulation_t, report_iface
@@ -50,8 +50,8 @@ module driver_simulation_continuum
         character(len=:), allocatable :: deck_file
         !> Energy audit of the whole body (prescribed dofs and their reactions included).
         type(continuum_audit_t) :: audit
-        !> Text of the Gmsh mesh file ('' for a generated mesh), for the checkpoints' hash.
-        character(len=:), allocatable :: mesh_text
+        !> Hash of the Gmsh mesh file's text ('' for a generated mesh), for the checkpoints.
+        character(len=:), allocatable :: mesh_hash
     contains
         !> See `simulation_t%init`.
         procedure :: init => continuum_init
@@ -145,7 +145,7 @@ contains
         !> The mesh: generated rectangle or Gmsh file (relative to the deck's folder).
         subroutine build_mesh(error)
             type(error_t), allocatable, intent(out) :: error
-            character(len=:), allocatable :: path
+            character(len=:), allocatable :: path, text
             integer :: i
             if (.not. deck%has('continuum', 'mesh')) then
                 call make_input_error(error, deck%file, first_line(), 'mesh', '[continuum] needs a mesh: '// &
@@ -160,7 +160,8 @@ contains
                 path = e%word('path')
                 if (path(1:1) /= '/') path = folder(deck%file)//path
                 call read_gmsh(path, mesh, error)
-                if (.not. allocated(error)) call read_file_text(path, self%mesh_text, error)
+                if (.not. allocated(error)) call read_file_text(path, text, error)
+                if (.not. allocated(error)) self%mesh_hash = deck_hash(text)
                 if (.not. allocated(error)) then
                     if (.not. any([(mesh%element_sets(i)%name == 'all', i=1, size(mesh%element_sets))])) &
                         call mesh%add_element_set('all', [(i, i=1, mesh%element_count())])
@@ -650,13 +651,13 @@ contains
         kind = ''
         if (self%settings%analysis == 'dynamic') kind = 'continuum'
     end function continuum_checkpoint_kind
-    !> See `simulation_t%inputs_text`: the text of the Gmsh mesh file ('' for a generated mesh).
+    !> See `simulation_t%inputs_text`: the hash of the Gmsh mesh file ('' for a generated mesh).
     function continuum_inputs_text(self) result(text)
         !> The simulation (after `init`).
         class(continuum_simulation_t), intent(in) :: self
-        !> The mesh file's text.
+        !> The mesh file's hash.
         character(len=:), allocatable :: text
         text = ''
-        if (allocated(self%mesh_text)) text = self%mesh_text
+        if (allocated(self%mesh_hash)) text = self%mesh_hash
     end function continuum_inputs_text
 end module driver_simulation_continuum
