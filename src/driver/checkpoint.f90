@@ -75,7 +75,8 @@ module driver_checkpoint
     type :: checkpoint_run_t
         !> Where checkpoints are written ('<results folder>/checkpoint.h5').
         character(len=:), allocatable :: path
-        !> The deck's text followed by the files it reads (a mesh), hashed into every checkpoint.
+        !> The deck's text followed by what stands for the files it reads (a mesh's hash), hashed
+        !> into every checkpoint.
         character(len=:), allocatable :: deck_text
         !> When to write them besides signals and the end.
         type(checkpoint_schedule_t) :: schedule

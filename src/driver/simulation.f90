@@ -43,9 +43,9 @@ module driver_simulation
         !> 'coupled', 'continuum', 'coupled2d'); '' for a run without checkpoints (static and
         !> modal analyses).
         procedure(simulation_checkpoint_kind), deferred :: checkpoint_kind
-        !> Text of the files besides the deck that the model was read from (a Gmsh mesh);
-        !> hashed into checkpoints with the deck, so that a restart refuses a changed mesh.
-        !> Default: none.
+        !> Text that stands for the files besides the deck the model was read from (the hash of
+        !> a Gmsh mesh); hashed into checkpoints with the deck, so that a restart refuses a
+        !> changed mesh. Default: none.
         procedure :: inputs_text => simulation_inputs_text
     end type simulation_t
 
