@@ -44,6 +44,8 @@ module fem_gmsh_reader
         integer :: first = 0
         !> Line of the block header in the file.
         integer :: line = 0
+        !> Line of each element in the file.
+        integer, allocatable :: lines(:)
     end type block_t
 
     !> Line-by-line reading state.
@@ -528,10 +530,11 @@ contains
                 blk%tag = bh(2)
                 blk%type = bh(3)
                 blk%line = cur%line
-                allocate (blk%nodes(nn, bh(4)), values(nn + 1))
+                allocate (blk%nodes(nn, bh(4)), blk%lines(bh(4)), values(nn + 1))
                 do k = 1, bh(4)
                     call section_line(cur, text, error)
                     if (allocated(error)) return
+                    blk%lines(k) = cur%line
                     call read_ints(cur, text, nn + 1, values, error)
                     if (allocated(error)) return
                     blk%nodes(:, k) = values(2:)
@@ -603,7 +606,7 @@ contains
         type(mesh2d_t), intent(out) :: mesh
         type(error_t), allocatable, intent(out) :: error
         integer, allocatable :: index_of_tag(:), phys(:), local(:, :)
-        integer :: b, ne, e, k, p, nnodes
+        integer :: b, ne, e, k, p, nnodes, failed(2)
         character(len=64) :: buf
         character(len=:), allocatable :: name
         ! Map tags to compact node indices, keeping the nodes of triangles and quadrangles.
@@ -668,7 +671,40 @@ contains
         if (.not. allocated(mesh%node_sets)) allocate (mesh%node_sets(0))
         if (.not. allocated(mesh%element_sets)) allocate (mesh%element_sets(0))
         if (.not. allocated(mesh%edge_sets)) allocate (mesh%edge_sets(0))
-        call mesh%orient_edges(error)
-        if (allocated(error)) error%message = cur%path//': '//error%message
+        call mesh%orient_edges(error, failed)
+        if (allocated(error)) then
+            call locate_edge(failed, b, k)
+            if (b > 0) then
+                write (buf, '(i0,a,i0)') blocks(b)%nodes(1, k), ' and ', blocks(b)%nodes(2, k)
+                deallocate (error)
+                call make_input_error(error, cur%path, blocks(b)%lines(k), '$Elements', 'the line element '// &
+                                      'of physical group '''//mesh%edge_sets(failed(1))%name//''' between '// &
+                                      'nodes '//trim(buf)//' is not a side of any triangle or quadrangle')
+            else
+                error%message = cur%path//': '//error%message
+            end if
+        end if
+
+    contains
+
+        !> Block bb and element kk in it of edge failed(2) of edge set failed(1) (the sets gather
+        !> the line blocks of their physical group in block order); bb = 0 when not found.
+        subroutine locate_edge(failed, bb, kk)
+            integer, intent(in) :: failed(2)
+            integer, intent(out) :: bb, kk
+            integer :: q
+            kk = failed(2)
+            do bb = 1, size(blocks)
+                if (blocks(bb)%type /= 1) cycle
+                phys = entity_physical(entities, blocks(bb)%dim, blocks(bb)%tag)
+                do q = 1, size(phys)
+                    if (group_name(names, blocks(bb)%dim, phys(q)) /= mesh%edge_sets(failed(1))%name) cycle
+                    if (kk <= size(blocks(bb)%lines)) return
+                    kk = kk - size(blocks(bb)%lines)
+                    exit
+                end do
+            end do
+            bb = 0
+        end subroutine locate_edge
     end subroutine build_mesh
 end module fem_gmsh_reader

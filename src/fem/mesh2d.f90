@@ -332,11 +332,13 @@ contains
     !> Orient each edge a -> b of the edge sets as a side of a counter-clockwise element (a
     !> followed by b among its nodes), so that the element lies on the edge's left.
     !> An edge in no element is an error; an interior edge takes the first element found.
-    subroutine mesh_orient_edges(self, error)
+    subroutine mesh_orient_edges(self, error, failed)
         !> The mesh.
         class(mesh2d_t), intent(inout) :: self
         !> Set when an edge is not a side of any element.
         type(error_t), allocatable, intent(out) :: error
+        !> With an error: the edge set and the index of the edge in it.
+        integer, intent(out), optional :: failed(2)
         integer, allocatable :: start(:), list(:), fill(:), nodes(:)
         integer :: e, k, a, b, s, m, i, n, p
         character(len=80) :: buf
@@ -381,6 +383,7 @@ contains
                     if (found) exit
                 end do
                 if (.not. found) then
+                    if (present(failed)) failed = [s, k]
                     write (buf, '(a,i0,a,i0,a,i0)') ': edge ', k, ' (nodes ', a, ', ', b
                     call make_error(error, "mesh: edge set '"//self%edge_sets(s)%name//"'"// &
                                     trim(buf)//') is not a side of any element')
