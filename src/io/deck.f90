@@ -2,7 +2,8 @@
 !>
 !> Syntax: `[section]` headers, then `keyword = value value ...` lines; `#` starts a comment
 !> that runs to the end of the line; blank lines and tabs are fine. Lines end with LF, CR LF
-!> or a lone CR (old Mac files); a UTF-8 byte-order mark at the start of the file is skipped. Every line is checked
+!> or a lone CR (old Mac files); a UTF-8 byte-order mark at the start of the file is skipped;
+!> another control character outside a comment is an error. Every line is checked
 !> against the schema as it is read (known section and keyword, number of values, types,
 !> ranges, allowed words, duplicates of scalar keywords); then required keywords and
 !> conditional ones (`required_when`, `allowed_when`) are checked. The first problem found
@@ -200,6 +201,25 @@ contains
 
     contains
 
+        !> A control character (other than a tab, or the CR of CR LF) outside a comment is an error: a terminal
+        !> would not show it in the message, and it means a binary or damaged file.
+        subroutine check_control(s)
+            character(len=*), intent(in) :: s
+            character(len=8) :: code
+            integer :: i, c
+            do i = 1, len(s)
+                c = iachar(s(i:i))
+                if (c == 13 .and. i == len(s)) cycle  ! the CR of a CR LF line end
+                if ((c < 32 .and. c /= 9) .or. c == 127) then
+                    write (code, '(a,z2.2)') '0x', c
+                    call make_input_error(error, file, line_no, '', 'control character '//trim(code)// &
+                                          ' at column '//to_str(i)//': a deck is plain text '// &
+                                          '(a binary or damaged file?)')
+                    return
+                end if
+            end do
+        end subroutine check_control
+
         !> Validate one line and store its entry.
         subroutine parse_line(raw)
             character(len=*), intent(in) :: raw
@@ -213,6 +233,12 @@ contains
                 s = strip(raw)
             end if
             if (len(s) == 0) return
+            if (hash > 0) then
+                call check_control(raw(:hash - 1))
+            else
+                call check_control(raw)
+            end if
+            if (allocated(error)) return
             if (s(1:1) == '[') then
                 call parse_header(s)
                 return
