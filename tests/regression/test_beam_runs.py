@@ -14,13 +14,7 @@ import sys
 import h5py
 import numpy as np
 
-FAILED = []
-
-
-def check(name, ok, detail):
-    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
-    if not ok:
-        FAILED.append(name)
+from checks import check, summary
 
 
 def run(exe, deck, work):
@@ -234,8 +228,7 @@ def main():
     modal_cantilever(exe, decks, work)
     modal_kinds(exe, decks, work)
     dynamic_cantilever(exe, src, work)
-    print(f"{len(FAILED)} failed checks")
-    return 1 if FAILED else 0
+    return summary()
 
 
 if __name__ == "__main__":

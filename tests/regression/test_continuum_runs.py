@@ -29,13 +29,7 @@ import sys
 import h5py
 import numpy as np
 
-FAILED = []
-
-
-def check(name, ok, detail):
-    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
-    if not ok:
-        FAILED.append(name)
+from checks import check, summary
 
 
 def run(exe, deck, work):
@@ -360,8 +354,7 @@ def main():
     gmsh_block(exe, src, work)
     timed_loads(exe, work)
     xdmf_paraview(h5_static, work / "continuum_cantilever_dynamic" / "continuum_cantilever_dynamic.h5", work)
-    print(f"{len(FAILED)} failed checks")
-    return 1 if FAILED else 0
+    return summary()
 
 
 if __name__ == "__main__":

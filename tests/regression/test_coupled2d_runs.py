@@ -34,14 +34,9 @@ import sys
 import h5py
 import numpy as np
 
-FAILED = []
+from checks import check, summary
+
 E, RHO, THICK = 210.0e9, 7800.0, 0.05
-
-
-def check(name, ok, detail=""):
-    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
-    if not ok:
-        FAILED.append(name)
 
 
 def run(exe, deck, work, extra=()):
@@ -322,6 +317,7 @@ def xdmf(h5):
     script.write_text("""import sys
 from paraview.simple import XDMFReader
 from paraview import servermanager as sm
+
 r = XDMFReader(FileNames=[sys.argv[1]])
 r.UpdatePipelineInformation()
 r.PointArrayStatus = r.GetProperty("PointArrayInfo")[::2]
@@ -373,8 +369,7 @@ def main():
     interface_ramp(exe, src, work)
     xdmf(work / "rigid_per_disk" / "rigid_per_disk.h5")
     restart_refused(exe, src, work)
-    print(f"{len(FAILED)} failed checks")
-    return 1 if FAILED else 0
+    return summary()
 
 
 if __name__ == "__main__":

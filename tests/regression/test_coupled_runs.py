@@ -21,16 +21,11 @@ import time
 import h5py
 import numpy as np
 
-FAILED = []
+from checks import check, summary
+
 #: Data set of the experiment decks (their headers): steel, section 1 cm x 1 cm, R = 5 mm.
 E, RHO, AREA, PITCH, RADIUS, THICK = 2.1e11, 7800.0, 1.0e-4, 0.01, 0.005, 0.01
 M_DISK = RHO * np.pi * RADIUS**2 * THICK
-
-
-def check(name, ok, detail=""):
-    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
-    if not ok:
-        FAILED.append(name)
 
 
 def run(exe, deck, work):
@@ -328,8 +323,7 @@ def main():
     bending_stack(exe, src, work)
     rigid_arm(exe, src, work)
     strategies(exe, src, work)
-    print(f"{len(FAILED)} failed checks")
-    return 1 if FAILED else 0
+    return summary()
 
 
 if __name__ == "__main__":

@@ -8,7 +8,6 @@ Kept small: the Debug build runs them.
 Usage (ctest does this): test_dem_runs.py --exe multicor --work DIR --source REPO
 """
 import argparse
-import math
 import pathlib
 import subprocess
 import sys
@@ -16,14 +15,9 @@ import sys
 import h5py
 import numpy as np
 
+from checks import check, summary
+
 G = 9.81
-FAILED = []
-
-
-def check(name, ok, detail=""):
-    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
-    if not ok:
-        FAILED.append(name)
 
 
 def run(exe, deck, work, quiet=True):
@@ -359,8 +353,7 @@ def main():
     strategies(exe, src, work)
     deposit_strategies(exe, decks, work)
     rigid_spin(exe, decks, work)
-    print(f"{len(FAILED)} failed checks")
-    return 1 if FAILED else 0
+    return summary()
 
 
 if __name__ == "__main__":

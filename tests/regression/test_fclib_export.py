@@ -16,13 +16,7 @@ import sys
 import h5py
 import numpy as np
 
-FAILED = []
-
-
-def check(name, ok, detail=""):
-    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
-    if not ok:
-        FAILED.append(name)
+from checks import check, summary
 
 
 def with_export(deck, step, work, extra=(), replace=None, name=None):
@@ -191,10 +185,7 @@ def main():
     check("fclib_step after the end: warned, nothing written", proc.returncode == 0 and not written
           and "warning: [solver] fclib_step = 301 is after the last step of the run (300)" in proc.stdout,
           f"exit {proc.returncode}, files {written}")
-    if FAILED:
-        print("FAILED:", ", ".join(FAILED))
-        return 1
-    return 0
+    return summary()
 
 
 if __name__ == "__main__":

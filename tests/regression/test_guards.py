@@ -21,13 +21,7 @@ import sys
 import h5py
 import numpy as np
 
-FAILED = []
-
-
-def check(name, ok, detail=""):
-    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
-    if not ok:
-        FAILED.append(name)
+from checks import check, summary
 
 
 def multicor(exe, *args):
@@ -325,8 +319,7 @@ def main():
     no_empty_folder(exe, work)
     exponents(exe, work)
     line_endings(exe, work)
-    print(f"{len(FAILED)} failed checks")
-    return 1 if FAILED else 0
+    return summary()
 
 
 if __name__ == "__main__":

@@ -27,14 +27,9 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "postproc"))
 from multicor_post.interface import InterfaceRun, sliding_over_disks  # noqa: E402
 
-FAILED = []
+from checks import check, summary
+
 P, WIDTH, THICK, MU, R = 1.0e6, 0.2, 0.01, 0.3, 0.0125
-
-
-def check(name, ok, detail=""):
-    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
-    if not ok:
-        FAILED.append(name)
 
 
 def reduced_case(exe, src, work):
@@ -133,8 +128,7 @@ def main():
     check("continuum audit (with reaction work) constant after the last kink of the drive",
           drift <= 1e-9 * abs(reaction_work), f"spread {drift:.2e} J, reaction work {reaction_work:.3e} J, "
           f"balance {fe_bal[-1]:.3e} J")
-    print(f"{len(FAILED)} failed checks")
-    return 1 if FAILED else 0
+    return summary()
 
 
 if __name__ == "__main__":

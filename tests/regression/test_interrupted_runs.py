@@ -26,13 +26,7 @@ import time
 import h5py
 import numpy as np
 
-FAILED = []
-
-
-def check(name, ok, detail=""):
-    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
-    if not ok:
-        FAILED.append(name)
+from checks import check, summary
 
 
 def deck_with_end(src, dst, end, progress=None):
@@ -195,7 +189,7 @@ def stop_by_signal(exe, src, work, deck_name, sig, name):
           f"{proc.returncode} ({delay:.2f} s after the signal)")
     m = re.search(rf"stopped: signal {signame} at step (\d+), t = (\S+) s", out)
     check(f"{name}: says at which step it stopped", m is not None, out.strip()[-300:])
-    check(f"{name}: says what was saved", f"saved: every output up to t = " in out and
+    check(f"{name}: says what was saved", "saved: every output up to t = " in out and
           str(partial) in out, "")
     check(f"{name}: error line names the signal", f"run stopped by {signame}" in err,
           err.strip()[-200:])
@@ -291,10 +285,7 @@ def main():
     stop_by_signal(exe, src, work, "bending_case2.dat", signal.SIGINT, "int_coupled")
     write_error(exe, src, work)
     full_disk(exe, src, work)
-    if FAILED:
-        print(f"{len(FAILED)} check(s) failed: {', '.join(FAILED)}")
-        sys.exit(1)
-    print("all checks passed")
+    sys.exit(summary())
 
 
 if __name__ == "__main__":

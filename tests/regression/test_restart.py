@@ -35,16 +35,11 @@ import sys
 import h5py
 import numpy as np
 
-FAILED = []
+from checks import check, summary
+
 # Attributes that measure wall-clock time or dates: they differ between any two runs.
 CLOCK_ATTRIBUTES = {"created", "ended", "wall_seconds", "detection_seconds", "solver_seconds",
                     "run_id"}
-
-
-def check(name, ok, detail=""):
-    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
-    if not ok:
-        FAILED.append(name)
 
 
 def edit_deck(src, dst, end=None, extra_output=None, progress=None):
@@ -437,10 +432,7 @@ def main():
     refusals(exe, beam, work)
     changed_mesh(exe, src, work)
     new_end_time(exe, beam, work)
-    if FAILED:
-        print(f"{len(FAILED)} check(s) failed: {', '.join(FAILED)}")
-        sys.exit(1)
-    print("all checks passed")
+    sys.exit(summary())
 
 
 if __name__ == "__main__":

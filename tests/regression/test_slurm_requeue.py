@@ -31,14 +31,9 @@ import time
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from slurm_local import ClusterError, LocalSlurm  # noqa: E402
 
-FAILED = []
+from checks import check, summary
+
 SIN_PHI, COS_PHI, T_END, G, MU2 = 0.6, 0.8, 0.5, 9.81, 0.1     # input/incline.dat
-
-
-def check(name, ok, detail=""):
-    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
-    if not ok:
-        FAILED.append(name)
 
 
 def sweep_tool(src, args, env=None):
@@ -179,10 +174,7 @@ def main():
     check("requeued point = uninterrupted run, bit for bit (every dataset of /dem)",
           names and not differ, f"{len(names) - len(differ)} of {len(names)} equal; "
           f"differ: {differ}")
-    if FAILED:
-        print(f"{len(FAILED)} check(s) failed: {', '.join(FAILED)}")
-        return 1
-    return 0
+    return summary()
 
 
 if __name__ == "__main__":

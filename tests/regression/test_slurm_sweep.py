@@ -27,14 +27,9 @@ import h5py
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from slurm_local import ClusterError, LocalSlurm  # noqa: E402
 
-FAILED = []
+from checks import check, summary
+
 SIN_PHI, COS_PHI, T_END = 0.6, 0.8, 0.5      # input/incline.dat
-
-
-def check(name, ok, detail=""):
-    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
-    if not ok:
-        FAILED.append(name)
 
 
 def sweep_tool(src, args, env=None, expect=0):
@@ -184,8 +179,7 @@ def main():
         check("Slurm and local tables: same values (same executable and decks)",
               not same and len(slurm_rows) == 4, str(same))
     print(f"total {time.monotonic() - t0:.1f} s")
-    if FAILED:
-        print(f"{len(FAILED)} check(s) failed: {', '.join(FAILED)}")
+    if summary():
         return 1
     if isinstance(slurm_rows, str):
         print(f"skipped: the Slurm part: {slurm_rows} (the local part passed)")

@@ -22,14 +22,9 @@ import shutil
 import subprocess
 import sys
 
-FAILED = []
+from checks import check, summary
+
 SIN_PHI, COS_PHI, T_END, G = 0.6, 0.8, 0.5, 9.81      # input/incline.dat
-
-
-def check(name, ok, detail=""):
-    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
-    if not ok:
-        FAILED.append(name)
 
 
 def sweep_tool(src, args, expect=0):
@@ -164,10 +159,7 @@ def main():
     folder = generated_decks(src, exe, work)
     sequential_run(src, folder)
     failing_point(src, exe, work)
-    if FAILED:
-        print(f"{len(FAILED)} check(s) failed: {', '.join(FAILED)}")
-        return 1
-    return 0
+    return summary()
 
 
 if __name__ == "__main__":

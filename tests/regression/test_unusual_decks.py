@@ -26,13 +26,7 @@ import sys
 import h5py
 import numpy as np
 
-FAILED = []
-
-
-def check(name, ok, detail=""):
-    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
-    if not ok:
-        FAILED.append(name)
+from checks import check, summary
 
 
 def run(exe, work, name, text):
@@ -213,8 +207,7 @@ def main():
     free_fall(exe, work)
     collision(exe, work)
     one_element_cantilever(exe, work)
-    print(f"{len(FAILED)} failed checks")
-    return 1 if FAILED else 0
+    return summary()
 
 
 if __name__ == "__main__":

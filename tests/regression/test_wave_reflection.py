@@ -38,7 +38,8 @@ import time
 import h5py
 import numpy as np
 
-FAILED = []
+from checks import check, summary
+
 #: Data set of the deck (its header): steel, section 1 cm x 1 cm, disks R = 5 mm, depth 1 cm.
 E, RHO, AREA, RADIUS, THICK = 2.1e11, 7800.0, 1.0e-4, 0.005, 0.01
 PITCH = 2 * RADIUS
@@ -47,12 +48,6 @@ Z = RHO * AREA * C_BAR
 M_DISK = RHO * math.pi * RADIUS**2 * THICK
 S_FE = 0.15          # start of the overlap (end of the FE-only zone) in every variant
 N_FREE = 4           # disks beyond the overlap in every variant
-
-
-def check(name, ok, detail=""):
-    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
-    if not ok:
-        FAILED.append(name)
 
 
 # ---------------------------------------------------------------------------------------
@@ -417,10 +412,7 @@ def main():
     if args.study:
         study(exe, base, work)
     print(f"       total {time.perf_counter() - start:.1f} s")
-    if FAILED:
-        print(f"{len(FAILED)} check(s) failed")
-        return 1
-    return 0
+    return summary()
 
 
 def study(exe, base, work):

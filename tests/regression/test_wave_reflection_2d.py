@@ -14,13 +14,7 @@ import pathlib
 import shutil
 import sys
 
-FAILED = []
-
-
-def check(name, ok, detail=""):
-    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
-    if not ok:
-        FAILED.append(name)
+from checks import check, summary
 
 
 def main():
@@ -70,11 +64,7 @@ def main():
     same = [m["r_meas"] for n, s, m in rows if n == 8]
     check("band 8: R independent of the weight shape", max(same) - min(same) < 1e-8,
           f"spread {max(same) - min(same):.1e}")
-    if FAILED:
-        print(f"{len(FAILED)} check(s) failed: {', '.join(FAILED)}")
-        return 1
-    print("all checks passed")
-    return 0
+    return summary()
 
 
 if __name__ == "__main__":
