@@ -73,6 +73,9 @@ module core_linalg
         procedure :: add => dense_add
         !> Cholesky factorisation (dpotrf).
         procedure :: factor => dense_factor
+        !> Estimate of the reciprocal condition number in the 1-norm of the factored matrix
+        !> (dlansy, dpocon).
+        procedure :: rcond => dense_rcond
         procedure, private :: dense_solve_vec, dense_solve_mat
         !> Solve A x = b in place, one or several right-hand sides (dpotrs).
         generic :: solve => dense_solve_vec, dense_solve_mat
@@ -109,6 +112,22 @@ module core_linalg
             real(wp), intent(inout) :: a(lda, *)
             integer, intent(out) :: info
         end subroutine dpotrf
+        subroutine dpocon(uplo, n, a, lda, anorm, rcond, work, iwork, info)
+            import :: wp
+            character(len=1), intent(in) :: uplo
+            integer, intent(in) :: n, lda
+            real(wp), intent(in) :: a(lda, *), anorm
+            real(wp), intent(out) :: rcond, work(*)
+            integer, intent(out) :: iwork(*), info
+        end subroutine dpocon
+        function dlansy(norm, uplo, n, a, lda, work) result(value)
+            import :: wp
+            character(len=1), intent(in) :: norm, uplo
+            integer, intent(in) :: n, lda
+            real(wp), intent(in) :: a(lda, *)
+            real(wp), intent(inout) :: work(*)
+            real(wp) :: value
+        end function dlansy
         subroutine dpotrs(uplo, n, nrhs, a, lda, b, ldb, info)
             import :: wp
             character(len=1), intent(in) :: uplo
@@ -380,6 +399,23 @@ contains
             self%factored = .true.
         end if
     end subroutine dense_factor
+
+    !> Reciprocal condition number 1/(|A|_1 |A^-1|_1), estimated by LAPACK (dpocon) from the
+    !> Cholesky factor; 0 when the matrix is not factored.
+    real(wp) function dense_rcond(self) result(rcond)
+        !> The factored matrix.
+        class(dense_spd_t), intent(in) :: self
+        real(wp), allocatable :: work(:)
+        integer, allocatable :: iwork(:)
+        real(wp) :: anorm
+        integer :: info
+        rcond = 0.0_wp
+        if (.not. self%factored .or. self%n == 0) return
+        allocate (work(3*self%n), iwork(self%n))
+        anorm = dlansy('1', 'U', self%n, self%a, self%n, work)
+        call dpocon('U', self%n, self%fac, self%n, anorm, rcond, work, iwork, info)
+        if (info /= 0) rcond = 0.0_wp
+    end function dense_rcond
 
     !> Solve A x = b for one right-hand side; b is overwritten by x.
     subroutine dense_solve_vec(self, b, error)
