@@ -36,7 +36,7 @@
 !> (siconos_deposit); --csv FILE and --deck FILE write its layout as CSV and as a deck.
 !> Run: cmake --build <build> --target bench_dem && OMP_NUM_THREADS=1 <build>/bench/bench_dem
 program bench_dem
-    use, intrinsic :: iso_fortran_env, only: output_unit, compiler_version, compiler_options
+    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit, compiler_version, compiler_options
     use core_kinds, only: wp, i8
     use core_error, only: error_t
     use core_sort, only: sort_in_place
@@ -106,9 +106,9 @@ program bench_dem
             convergence = .true.
             iarg = iarg - 1
         case ('--relaxation')
-            read (val, *) relaxation
+            call read_real_value(arg, val, relaxation)
         case ('--max-sweeps')
-            read (val, *) max_sweeps
+            call read_int_value(arg, val, max_sweeps)
         case ('--forward')
             symmetric = .false.
             iarg = iarg - 1
@@ -116,9 +116,9 @@ program bench_dem
             verbose = .true.
             iarg = iarg - 1
         case ('--anderson')
-            read (val, *) anderson
+            call read_int_value(arg, val, anderson)
         case ('--siconos')
-            read (val, *) siconos_n
+            call read_int_value(arg, val, siconos_n)
         case ('--csv')
             csv_path = val
         case ('--deck')
@@ -127,25 +127,31 @@ program bench_dem
             hydrostatic = .true.
             iarg = iarg - 1
         case ('--settle-anderson')
-            read (val, *) settle_anderson
+            call read_int_value(arg, val, settle_anderson)
         case ('--settle')
-            read (val, *) n_settle
+            call read_int_value(arg, val, n_settle)
         case ('--settle-sweeps')
-            read (val, *) settle_sweeps
+            call read_int_value(arg, val, settle_sweeps)
         case ('--method')
             method = method_code(val)
         case ('--settle-method')
             settle_method = method_code(val)
         case ('--coarse-every')
-            read (val, *) coarse_every
+            call read_int_value(arg, val, coarse_every)
         case ('--coarse-size')
-            read (val, *) coarse_size
+            call read_int_value(arg, val, coarse_size)
         case ('--check-every')
-            read (val, *) check_every
+            call read_int_value(arg, val, check_every)
         case ('--criterion')
             criterion_given = .true.
-            if (val == 'siconos') criterion = criterion_siconos
-            if (val == 'lmgc90') criterion = criterion_lmgc90
+            select case (val)
+            case ('siconos')
+                criterion = criterion_siconos
+            case ('lmgc90')
+                criterion = criterion_lmgc90
+            case default
+                call usage_error('--criterion takes lmgc90 or siconos, got '''//trim(val)//'''')
+            end select
         case ('--sizes')
             sizes = [integer ::]
             sizes_given = .true.
@@ -153,12 +159,15 @@ program bench_dem
                 call get_command_argument(iarg + 1, val)
                 if (val(1:1) == '-') exit
                 sizes = [sizes, 0]
-                read (val, *) sizes(size(sizes))
+                call read_int_value(arg, val, sizes(size(sizes)))
                 iarg = iarg + 1
             end do
             iarg = iarg - 1
+        case ('--help', '-h')
+            call print_usage(output_unit)
+            stop
         case default
-            error stop 'bench_dem: unknown argument'
+            call usage_error('unknown argument '''//trim(arg)//'''')
         end select
         iarg = iarg + 2
     end do
@@ -195,9 +204,47 @@ contains
         case ('coarse')
             code = nlgs_method_coarse
         case default
-            error stop 'bench_dem: --method nlgs|block|coarse'
+            call usage_error('--method takes nlgs, block or coarse, got '''//trim(word)//'''')
         end select
     end function method_code
+
+    !> The integer value of option `option`.
+    subroutine read_int_value(option, text, value)
+        character(len=*), intent(in) :: option, text
+        integer, intent(out) :: value
+        integer :: ios
+        read (text, *, iostat=ios) value
+        if (ios /= 0 .or. len_trim(text) == 0) call usage_error(trim(option)//' takes an integer, got '''//trim(text)//'''')
+    end subroutine read_int_value
+
+    !> The real value of option `option`.
+    subroutine read_real_value(option, text, value)
+        character(len=*), intent(in) :: option, text
+        real(wp), intent(out) :: value
+        integer :: ios
+        read (text, *, iostat=ios) value
+        if (ios /= 0 .or. len_trim(text) == 0) call usage_error(trim(option)//' takes a number, got '''//trim(text)//'''')
+    end subroutine read_real_value
+
+    !> The options (the header of this file).
+    subroutine print_usage(unit)
+        integer, intent(in) :: unit
+        write (unit, '(a)') 'usage: bench_dem [--sizes N...] [--settle S] [--max-sweeps C] [--anderson M]', &
+            '         [--relaxation W --check-every K] [--criterion lmgc90|siconos] [--forward]', &
+            '         [--hydrostatic] [--method nlgs|block|coarse] [--coarse-every K] [--coarse-size M]', &
+            '         [--settle-anderson M] [--settle-sweeps C] [--settle-method M] [--verbose]', &
+            '       bench_dem --convergence', &
+            '       bench_dem --siconos 200|2000 [--csv FILE] [--deck FILE] [--anderson M] [--forward] [--verbose]', &
+            'Options and figures: the header of bench/bench_dem.f90 and doc/performance.md.'
+    end subroutine print_usage
+
+    !> A bad command line: the message and the usage on standard error, exit code 2.
+    subroutine usage_error(message)
+        character(len=*), intent(in) :: message
+        write (error_unit, '(a)') 'bench_dem: '//message
+        call print_usage(error_unit)
+        stop 2, quiet=.true.
+    end subroutine usage_error
 
     !> Build, settle, time and measure one case (the system is kept for time_detection).
     subroutine run_case(sys, n, c)
@@ -350,7 +397,7 @@ contains
             n_row = 40
             n_rows = 50
         case default
-            error stop 'bench_dem: --siconos takes 200 or 2000'
+            call usage_error('--siconos takes 200 or 2000')
         end select
         call staggered_layout(n_row, n_rows, rmean, seed, x, y, radius, width)
         top = maxval(y + radius) + 5.0_wp*rmean
