@@ -19,7 +19,7 @@
 !> Run: cmake --build <build> --target bench_bonded && OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
 !>      <build>/bench/bench_bonded [deck [nlgs_steps]]
 program bench_bonded
-    use, intrinsic :: iso_fortran_env, only: output_unit, compiler_version
+    use, intrinsic :: iso_fortran_env, only: output_unit, error_unit, compiler_version
     use core_kinds, only: wp, i8
     use core_error, only: error_t
     use io_deck_schema, only: multicor_schema
@@ -38,7 +38,7 @@ program bench_bonded
 
     character(len=512) :: arg
     character(len=:), allocatable :: deck_path
-    integer :: nlgs_steps
+    integer :: nlgs_steps, ios
     write (output_unit, '(a)') '# bonded block against NLGS (1 core); compiler: '//compiler_version()
     deck_path = 'input/bending_stack.dat'
     if (command_argument_count() >= 1) then
@@ -48,7 +48,12 @@ program bench_bonded
     nlgs_steps = 5
     if (command_argument_count() >= 2) then
         call get_command_argument(2, arg)
-        read (arg, *) nlgs_steps
+        read (arg, *, iostat=ios) nlgs_steps
+        if (ios /= 0 .or. nlgs_steps < 0) then
+            write (error_unit, '(a)') 'bench_bonded: usage: bench_bonded [deck [nlgs_steps >= 0]] (got '// &
+                trim(arg)//')'
+            stop 2, quiet=.true.
+        end if
     end if
     write (output_unit, '(a)') '# clamped bonded row, 50 disks, tip load, one step from rest, tol 1e-10'
     write (output_unit, '(a)') '# method  iterations  converged  time[s]  err_rn/Ph  err_rt/Ph  err_M/(PR(2N-1)h)'
