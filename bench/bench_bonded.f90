@@ -52,7 +52,7 @@ program bench_bonded
         if (ios /= 0 .or. nlgs_steps < 0) then
             write (error_unit, '(a)') 'bench_bonded: usage: bench_bonded [deck [nlgs_steps >= 0]] (got '// &
                 trim(arg)//')'
-            stop 2, quiet=.true.
+            stop 2, quiet = .true.
         end if
     end if
     write (output_unit, '(a)') '# clamped bonded row, 50 disks, tip load, one step from rest, tol 1e-10'

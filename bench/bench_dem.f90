@@ -243,7 +243,7 @@ contains
         character(len=*), intent(in) :: message
         write (error_unit, '(a)') 'bench_dem: '//message
         call print_usage(error_unit)
-        stop 2, quiet=.true.
+        stop 2, quiet = .true.
     end subroutine usage_error
 
     !> Build, settle, time and measure one case (the system is kept for time_detection).
