@@ -13,6 +13,8 @@
 module driver_results_dem
     use core_kinds, only: wp
     use core_error, only: error_t, make_error, make_internal_error
+    use core_strings, only: to_str
+    use core_version, only: multicor_name, multicor_version
     use io_hdf5_file, only: h5_file_t
     use dem_nlgs, only: nlgs_stats_t, criterion_names
     use dem_moreau_jean, only: dem_system_t, energies_balance
@@ -484,13 +486,15 @@ contains
     !> Write a local contact problem to a new HDF5 file in FCLIB's layout (fclib.c,
     !> fclib_write_local and fclib_write_solution): /fclib_local/spacedim, /fclib_local/W
     !> (compressed sparse columns, nz = -1, 0-based: nzmax, m, n, nz, p, i, x),
-    !> /fclib_local/vectors/q and mu, /solution/r and u; MULTICOR's extra data, which FCLIB
-    !> readers ignore, in /multicor: cohesion (r_cohe h), rolling (moment lengths), i1 and i2
-    !> (bodies), and the attributes step, time and siconos_error (doc/theory.md, "Siconos
-    !> error").
-    subroutine write_fclib_local(path, lp, step, time, siconos_error, error)
+    !> /fclib_local/vectors/q and mu, /fclib_local/info (title, description, math_info:
+    !> fixed-length strings), /solution/r and u; MULTICOR's extra data, which FCLIB readers
+    !> ignore, in /multicor: cohesion (r_cohe h), rolling (moment lengths), i1 and i2 (bodies),
+    !> and the attributes step, time and siconos_error (doc/theory.md, "Siconos error").
+    subroutine write_fclib_local(path, title, lp, step, time, siconos_error, error)
         !> File name (created, or truncated).
         character(len=*), intent(in) :: path
+        !> Title of the run ([run] title; empty: none given).
+        character(len=*), intent(in) :: title
         !> The problem.
         type(local_problem_t), intent(in) :: lp
         !> Step number.
@@ -539,6 +543,8 @@ contains
             if (allocated(error)) return
             call file%write_dataset('/fclib_local/vectors/mu', lp%mu, error)
             if (allocated(error)) return
+            call write_info(error)
+            if (allocated(error)) return
             call file%create_group('/solution', error)
             if (allocated(error)) return
             call file%write_dataset('/solution/r', lp%r, error)
@@ -569,5 +575,28 @@ contains
                                           '|r_t| <= mu r_n', error)
             end if
         end subroutine body
+
+        !> /fclib_local/info, FCLIB's description of the problem for other solvers.
+        subroutine write_info(error)
+            type(error_t), allocatable, intent(out) :: error
+            character(len=:), allocatable :: text
+            text = trim(title)
+            if (len(text) == 0) text = multicor_name//' run'
+            call file%write_dataset('/fclib_local/info/title', text//', step '//to_str(step), error)
+            if (allocated(error)) return
+            text = multicor_name//' '//multicor_version//': local contact problem of step '//to_str(step)// &
+                   ' (t = '//to_str(time)//' s) between 2D disks and walls, u = W r + q with W = H^T M^-1 H, '// &
+                   to_str(lp%n)//' contacts; per contact (normal, tangential'
+            if (lp%dim == 3) text = text//', moment'
+            text = text//'); r_n includes the cohesion impulse r_cohe h (/multicor/cohesion); '// &
+                   '/solution is the one found by '//multicor_name//', its Siconos error in /multicor'
+            call file%write_dataset('/fclib_local/info/description', text, error)
+            if (allocated(error)) return
+            text = 'W symmetric positive semi-definite (singular when the contacts are hyperstatic); '// &
+                   'cone |r_t| <= mu r_n'
+            if (lp%dim == 3) text = text//' and |M| <= e r_n with e = /multicor/rolling (the third '// &
+                                    'component is a moment: not the circular cone of FCLIB''s 3D problems)'
+            call file%write_dataset('/fclib_local/info/math_info', text, error)
+        end subroutine write_info
     end subroutine write_fclib_local
 end module driver_results_dem

@@ -188,8 +188,8 @@ contains
                 if (len(path) > 3) then
                     if (path(len(path) - 2:) == '.h5') path = path(:len(path) - 3)
                 end if
-                call write_fclib_local(path//trim(tag), lp, sys%step + 1, sys%time + sys%scheme%h, &
-                                       sys%stats%siconos_error, error)
+                call write_fclib_local(path//trim(tag), run%title, lp, sys%step + 1, &
+                                       sys%time + sys%scheme%h, sys%stats%siconos_error, error)
                 if (allocated(error)) return
                 call mj_end_step(sys)
             end associate

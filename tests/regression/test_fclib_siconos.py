@@ -6,7 +6,8 @@ components per contact), the ones Siconos' fc2d solvers take.
 For each exported step, siconos_fc2d.py runs under the system Python that has Siconos (the
 test environment does not see it, as with ParaView's pvpython in test_continuum_runs.py; set
 MULTICOR_SICONOS_PYTHON to use another interpreter): it reads the file as FCLIB's reader does
-(any departure from FCLIB's layout fails here), evaluates Siconos' own error function
+(any departure from FCLIB's layout fails here; the optional /fclib_local/info must be
+there, in fixed-length strings that FCLIB's reader reads), evaluates Siconos' own error function
 (fc2d_compute_error) on MULTICOR's stored solution, and solves the problem with Siconos' fc2d
 NSGS from zero. This script then asserts:
 (a) Siconos' error of our solution equals the one multicor stored (/dem/solver/siconos_error),
@@ -125,6 +126,10 @@ def case(exe, python, env, deck, step, work, sic_tol, hyperstatic=False):
           "; ".join(s["layout"]) or f"{len(mu)} contacts, Siconos {s['siconos']}")
     if s["layout"]:
         return
+    info = s["info"]
+    check(f"{name}: FCLIB problem information (/fclib_local/info)",
+          set(info) == {"title", "description", "math_info"} and info["title"].endswith(f"step {step}")
+          and f"step {step} " in info["description"], f"title {info.get('title')!r}")
     lam = np.linalg.eigvalsh(W)
     rank = int(np.sum(lam > 1e-12 * lam[-1]))
     print(f"       {name}: {len(mu)} contacts, rank of W {rank} of {m}, eigenvalues "
