@@ -30,7 +30,8 @@ import sys
 import h5py
 import numpy as np
 
-FAILED = []
+from checks import check, summary
+
 HERE = pathlib.Path(__file__).resolve().parent
 
 # A hyperstatic stack: 4 rows of 6 touching disks of 1 cm on a hexagonal lattice, on the floor
@@ -57,12 +58,6 @@ fclib_step = 3
 step = 1e-3
 end = 3e-3
 """
-
-
-def check(name, ok, detail=""):
-    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
-    if not ok:
-        FAILED.append(name)
 
 
 def siconos_python():
@@ -250,10 +245,7 @@ def main():
     stack = work / "stack.dat"
     stack.write_text(STACK)
     case(exe, python, env, stack, 3, work, 1e-8, hyperstatic=True)
-    if FAILED:
-        print("FAILED:", ", ".join(FAILED))
-        return 1
-    return 0
+    return summary()
 
 
 if __name__ == "__main__":
