@@ -7,7 +7,8 @@ MULTICOR_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 # python3-paraview only the XDMF test of the continuum (meshio stands in without pvpython): a
 # user who is not root and lacks only these gets a note, not an error. python3-siconos and
 # python3-h5py (Siconos 4.4 for the system python3) are required: the FCLIB cross-check
-# (tests/regression/test_fclib_siconos.py) fails without them on Debian.
+# (tests/regression/test_fclib_siconos.py) fails without them on Debian; python3-siconos also
+# runs bench/siconos_deposit.py and its comparison test.
 MULTICOR_APT_OPTIONAL="slurm-wlm munge paraview python3-paraview"
 MULTICOR_APT_PACKAGES="gfortran cmake ninja-build libhdf5-dev hdf5-tools libopenblas-dev liblapack-dev libsuitesparse-dev gmsh python3 python3-venv python3-pip slurm-wlm munge paraview python3-paraview python3-siconos python3-h5py"
 
@@ -49,7 +50,7 @@ ensure_system_deps() {
             case " $MULTICOR_APT_OPTIONAL " in *" $pkg "*) ;; *) required="$required $pkg" ;; esac
         done
         if [ -z "$required" ]; then
-            say "note: without$missing the Slurm sweep tests skip (as root: apt-get install$missing)"
+            say "note: without$missing the tests that need them skip (as root: apt-get install$missing)"
             return 0
         fi
         printf '[multicor] missing system packages:%s\n' "$missing" >&2

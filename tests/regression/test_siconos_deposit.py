@@ -1,0 +1,171 @@
+#!/usr/bin/env python3
+"""MULTICOR and Siconos 4.4 (bench/siconos_deposit.py) on the same small deposit, both against
+its closed form: 10 equal disks (R = 1 cm) dropped from 0.5 mm apart into a triangle 4-3-2-1
+in a box 8 R wide, whose bottom row fills the box. At rest, row j sits at y = R + j sqrt(3) R,
+x unchanged. The layout is written once, as a deck for multicor and as the CSV that
+`bench_dem --siconos N --csv` writes for bench/siconos_deposit.py, so this also checks that the
+script rebuilds the problem of the CSV (radii, masses, box, gravity, law).
+
+Siconos runs under the system Python (MULTICOR_SICONOS_PYTHON, default /usr/bin/python3,
+Debian's python3-siconos); without it the test reports as skipped (exit 77).
+Usage (ctest does this): test_siconos_deposit.py --exe multicor --work DIR --source REPO
+"""
+import argparse
+import os
+import pathlib
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+FAILED = []
+R = 0.01  # disk radius [m]
+RHO = 2500.0
+DELTA = 5.0e-4  # initial gap below every row [m]
+H = 5.0e-4  # time step [s]
+STEPS = 400  # 0.2 s: the last row lands after about 0.03 s
+G = 9.81
+
+
+def check(name, ok, detail=""):
+    print(f"{'ok    ' if ok else 'FAILED'} {name}: {detail}")
+    if not ok:
+        FAILED.append(name)
+
+
+def layout():
+    """Start positions (rows 4, 3, 2, 1; each row DELTA above its resting height plus the
+    gaps below) and the closed-form positions at rest."""
+    x, y, y_rest = [], [], []
+    for j in range(4):
+        for i in range(4 - j):
+            x.append(R * (1 + j + 2 * i))
+            y.append(R + DELTA + j * (np.sqrt(3.0) * R + DELTA))
+            y_rest.append(R + j * np.sqrt(3.0) * R)
+    return np.array(x), np.array(y), np.array(y_rest), 8 * R
+
+
+def write_inputs(work, x, y, width):
+    mass = RHO * np.pi * R**2
+    csv = work / "triangle.csv"
+    with open(csv, "w", encoding="ascii") as f:
+        f.write(f"# MULTICOR deposit against Siconos: {len(x)} disks; box: floor y = 0, side walls "
+                f"x = 0 and x = {width:.16e} m\n# test_siconos_deposit.py\nx,y,radius,mass,inertia\n")
+        for xi, yi in zip(x, y):
+            f.write(f"{xi:.17e},{yi:.17e},{R:.17e},{mass:.17e},{0.5 * mass * R**2:.17e}\n")
+    top = y.max() + 5 * R
+    disks = "\n".join(f"disk = {xi:.17e} {yi:.17e} {R:.17e} 1" for xi, yi in zip(x, y))
+    deck = work / "triangle.dat"
+    deck.write_text(f"""[run]
+title = ten disks settling into a triangle (compared with Siconos)
+analysis = dynamic
+
+[particles]
+material = 1 {RHO}
+gravity = 0 -{G}
+{disks}
+
+[walls]
+wall = 0 0 {width:.17e} 0
+wall = 0 0 0 {top:.17e}
+wall = {width:.17e} 0 {width:.17e} {top:.17e}
+
+[contacts]
+law = 1 1 0.3 0 0
+alert = 5e-3
+
+[solver]
+tolerance = 1e-4
+criterion = siconos
+max_sweeps = 10000
+
+[time]
+step = {H}
+end = {H * STEPS}
+
+[output]
+interval = {STEPS}
+""")
+    return csv, deck
+
+
+def compare(name, pos, x, y_rest, bound):
+    dx = np.abs(pos[:, 0] - x).max()
+    dy = pos[:, 1] - y_rest
+    # Every disk ends at most `bound` below its closed-form height (the interpenetration that
+    # Moreau-Jean leaves after the impacts, see main) and not above it (a disk at rest above its
+    # supports would hang in the air; a wrong radius, box or layout shows as millimetres).
+    # 1e-7 m above: a step converged to 1e-4 relative leaves velocities of at most
+    # 1e-4 * 0.2 m/s, i.e. 1e-8 m per step of h = 5e-4 s.
+    check(f"{name}: rows at rest at R + j sqrt(3) R", dy.min() >= -bound and dy.max() <= 1e-7,
+          f"y - y_rest in [{dy.min() * 1e3:.4f}, {dy.max() * 1e3:.4f}] mm (bound -{bound * 1e3:.3f} mm)")
+    # The triangle is symmetric and the bottom row cannot move sideways (walls and neighbours
+    # touch): the same bound on the lateral drift.
+    check(f"{name}: columns in place", dx <= bound, f"max |x - x0| {dx * 1e3:.4f} mm")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--exe", required=True)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("--source", required=True)
+    args = ap.parse_args()
+    work = pathlib.Path(args.work)
+    work.mkdir(parents=True, exist_ok=True)
+    script = pathlib.Path(args.source) / "bench" / "siconos_deposit.py"
+    python = os.environ.get("MULTICOR_SICONOS_PYTHON", "/usr/bin/python3")
+    probe = subprocess.run([python, "-c", "import siconos.kernel, siconos.mechanics.collision.bodies"],
+                           capture_output=True, text=True) if os.path.exists(python) else None
+    if probe is None or probe.returncode != 0:
+        print(f"skipped: Siconos not importable by {python} (apt-get install python3-siconos; "
+              "MULTICOR_SICONOS_PYTHON names another interpreter)")
+        return 77
+
+    x, y, y_rest, width = layout()
+    csv, deck = write_inputs(work, x, y, width)
+    # Bound on the sinking. The disks reach at most v = sqrt(2 g 4 DELTA) (the top row falls
+    # its own gap and the three below). With e = 0, theta = 1/2 and no position correction, an
+    # impact leaves an overlap of at most h v_n on each contact (Siconos activates a contact when
+    # g + h/2 v_n <= 0 on the start of the step, so it stops between 0 and h |v_n| inside;
+    # MULTICOR within h/2 |v_n| either side). Row j rests on the floor and j hollows, and an
+    # overlap d on both contacts of a hollow lowers the disk by d / cos 30 deg.
+    v_max = np.sqrt(2 * G * 4 * DELTA)
+    bound = H * v_max * (1 + 3 * 2 / np.sqrt(3.0))
+
+    out = work / "multicor"
+    proc = subprocess.run([args.exe, str(deck), "--output", str(out), "--quiet"],
+                          capture_output=True, text=True)
+    if proc.returncode != 0:
+        print(proc.stdout, proc.stderr)
+        raise SystemExit(f"multicor failed (exit {proc.returncode})")
+    with h5py.File(out / "triangle.h5", "r") as f:
+        mc = f["dem/position"][-1]
+        conv = f["dem/solver/converged"][...]
+    check("multicor: every step converged", conv.all(), f"{conv.sum()} of {len(conv)}")
+    compare("multicor", mc, x, y_rest, bound)
+
+    final = work / "siconos_final.csv"
+    proc = subprocess.run([python, str(script), str(csv), "--h", str(H), "--steps", str(STEPS),
+                           "--final", str(final)], capture_output=True, text=True)
+    print(proc.stdout)
+    if proc.returncode != 0:
+        print(proc.stderr)
+        raise SystemExit(f"siconos_deposit.py failed (exit {proc.returncode})")
+    summary = [ln.split() for ln in proc.stdout.splitlines() if ln and not ln.startswith("#")]
+    conv_fraction = float(summary[-1][9])  # N steps 3 step times osnsp solve 2 iters conv
+    check("siconos: every step converged", conv_fraction == 1.0, f"fraction {conv_fraction}")
+    sic = np.loadtxt(final, delimiter=",", skiprows=1)
+    compare("siconos", sic[:, :2], x, y_rest, bound)
+    # the two codes' centres of mass: each within the bound below the closed form
+    com = [float(np.mean(p[:, 1])) for p in (mc, sic)]
+    check("centres of mass agree", abs(com[0] - com[1]) <= bound,
+          f"multicor {com[0]:.6f} m, siconos {com[1]:.6f} m, closed form {np.mean(y_rest):.6f} m")
+    if FAILED:
+        print("FAILED:", ", ".join(FAILED))
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
