@@ -22,7 +22,9 @@ Timers (time.perf_counter around Siconos calls; nothing is written to disk):
 - solve: the numerics call alone (`FrictionContact.solve`: NSGS and its final error).
 The per-step statistics are read from the solver options between the calls (untimed). With
 --errors, the error of the returned (r, u) is also computed with numpy after each solve (untimed)
-both as Siconos normalises it and as MULTICOR does (see doc/performance.md).
+divided by max(|q|, |r|, |u|) (Siconos 4.4's normalisation, the same as MULTICOR's; it must
+equal the residual NSGS returns) and by |q| alone (doc/performance.md, "Siconos 4.4 on the
+same layout").
 """
 import argparse
 import math
@@ -55,15 +57,22 @@ DENSE_CHECK = 2000  # largest problem (rows) whose W is made dense to check u = 
 
 def read_layout(path):
     """Disks (x, y, radius, mass, inertia) and the box width from a bench_dem CSV."""
-    with open(path, encoding="ascii") as f:
-        head = [f.readline() for _ in range(3)]
+    try:
+        with open(path, encoding="ascii") as f:
+            head = [f.readline() for _ in range(3)]
+    except (OSError, UnicodeDecodeError) as exc:
+        sys.exit(f"siconos_deposit.py: {path}: {exc}")
     match = re.search(r"x = 0 and x =\s*([0-9.Ee+-]+) m", head[0])
     if not head[0].startswith("#") or not match or not head[2].startswith("x,y,radius"):
         sys.exit(f"siconos_deposit.py: {path}: not a layout written by bench_dem --csv "
                  "(line 1 must give the box, line 3 the column names)")
-    disks = np.loadtxt(path, delimiter=",", skiprows=3, ndmin=2)
-    if disks.shape[1] != 5 or not np.all(np.isfinite(disks)) or np.any(disks[:, 2:] <= 0):
-        sys.exit(f"siconos_deposit.py: {path}: expected 5 finite columns with positive "
+    try:
+        disks = np.loadtxt(path, delimiter=",", skiprows=3, ndmin=2)
+    except ValueError as exc:
+        sys.exit(f"siconos_deposit.py: {path}: {exc}")
+    if disks.shape[0] == 0 or disks.shape[1] != 5 or not np.all(np.isfinite(disks)) \
+            or np.any(disks[:, 2:] <= 0):
+        sys.exit(f"siconos_deposit.py: {path}: expected disks in 5 finite columns with positive "
                  "radius, mass and inertia")
     return disks, float(match.group(1))
 
