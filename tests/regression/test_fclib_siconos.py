@@ -21,9 +21,7 @@ Usage (ctest does this): test_fclib_siconos.py --exe multicor --work DIR --sourc
 """
 import argparse
 import json
-import os
 import pathlib
-import shutil
 import subprocess
 import sys
 
@@ -31,6 +29,7 @@ import h5py
 import numpy as np
 
 from checks import check, summary
+from siconos_env import siconos_python
 
 HERE = pathlib.Path(__file__).resolve().parent
 
@@ -58,20 +57,6 @@ fclib_step = 3
 step = 1e-3
 end = 3e-3
 """
-
-
-def siconos_python():
-    """(interpreter, None) when it imports siconos.numerics and h5py, else (None, reason)."""
-    python = os.environ.get("MULTICOR_SICONOS_PYTHON", "/usr/bin/python3")
-    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV")}
-    if shutil.which(python) is None:
-        return None, f"no {python}", env
-    proc = subprocess.run([python, "-c", "import siconos.numerics, h5py"], capture_output=True,
-                          text=True, env=env)
-    if proc.returncode != 0:
-        return None, f"{python} cannot import siconos.numerics and h5py: " + \
-            (proc.stderr.strip().splitlines() or ["?"])[-1], env
-    return python, None, env
 
 
 def with_solver(deck, work, name, solver_lines):
@@ -223,14 +208,7 @@ def main():
     args = ap.parse_args()
     exe, work, src = pathlib.Path(args.exe), pathlib.Path(args.work), pathlib.Path(args.source)
     work.mkdir(parents=True, exist_ok=True)
-    python, reason, env = siconos_python()
-    if python is None:
-        if shutil.which("dpkg-query") or pathlib.Path("/etc/debian_version").exists():
-            print(f"FAILED Siconos: {reason}. On Debian: apt-get install -y python3-siconos python3-h5py "
-                  "(scripts/bootstrap.sh installs them)")
-            return 1
-        print(f"skipped: {reason} (Siconos 4.4 with h5py; set MULTICOR_SICONOS_PYTHON)")
-        return 77
+    python, env = siconos_python()
     deposit = src / "tests" / "regression" / "decks" / "dem_small_deposit.dat"
     # A loose solution (tolerance 1e-3 of the LMGC90 norm: Siconos error 1.4e-4), so that
     # the error compared in (a) is far above round-off; Siconos solves to 1e-14.
