@@ -176,22 +176,25 @@ def overlaps(x, y, r, width):
 
 
 def build(disks, width, args):
-    """Siconos model, simulation and solver options for the layout."""
+    """Siconos model, simulation and solver options for the layout, with lengths in units of
+    1/args.unit m (kilograms and seconds unchanged: the same problem, scaled)."""
     nsds = sk.NonSmoothDynamicalSystem(0.0, args.steps*args.h)
     bodies = []
+    L = args.unit
     for x, y, r, m, inertia in disks:
-        body = Disk(float(r), float(m), [float(x), float(y), 0.0], [0.0, 0.0, 0.0])
+        body = Disk(float(r*L), float(m), [float(x*L), float(y*L), 0.0], [0.0, 0.0, 0.0])
+        inertia = inertia*L*L
         if abs(np.array(body.mass())[2, 2] - inertia) > 1e-9*inertia:
             sys.exit(f"siconos_deposit.py: Siconos' Disk inertia {np.array(body.mass())[2, 2]} "
                      f"differs from the CSV's {inertia} (radius {r})")
-        body.setFExtPtr(np.array([0.0, -m*GRAVITY, 0.0]))
+        body.setFExtPtr(np.array([0.0, -m*GRAVITY*L, 0.0]))
         nsds.insertDynamicalSystem(body)
         bodies.append(body)
     # plane rows (A, B, C, x_centre, y_centre, width 0 = infinite): A x + B y + C = 0
     planes = np.array([[0.0, 1.0, 0.0, 0.0, 0.0, 0.0],
                        [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-                       [1.0, 0.0, -width, 0.0, 0.0, 0.0]])
-    # bbox factor 3, cell size 1 (SpaceFilter takes unsigned integers, in metres here)
+                       [1.0, 0.0, -width*L, 0.0, 0.0, 0.0]])
+    # bbox factor 3, cell size args.cell (SpaceFilter takes unsigned integers, in length units)
     manager = SpaceFilter(3, args.cell, planes)
     law = sk.NewtonImpactFrictionNSL(args.e, 0.0, args.mu, 2)
     manager.insertNonSmoothLaw(law, 0, 0)
@@ -224,15 +227,19 @@ def main():
     ap.add_argument("--newton-iter", type=int, default=1,
                     help="Newton iterations per step, each one NSGS solve (default 1)")
     ap.add_argument("--cell", type=int, default=1,
-                    help="SpaceFilter cell size, an integer in metres (default 1)")
+                    help="SpaceFilter cell size, an integer in length units (default 1)")
+    ap.add_argument("--unit", type=int, default=1,
+                    help="length units per metre inside Siconos (default 1: metres; 100: "
+                         "centimetres, so that a cell of 1 is 1 cm; results are printed in metres)")
     ap.add_argument("--errors", action="store_true",
                     help="also compute both error normalisations per step (untimed)")
     ap.add_argument("--verbose", action="store_true", help="one line per step")
     ap.add_argument("--final", metavar="FILE",
                     help="write the final state as CSV: x, y, theta, vx, vy, omega per disk")
     args = ap.parse_args()
-    if args.steps < 1 or args.h <= 0 or args.max_iter < 1 or args.newton_iter < 1 or args.cell < 1:
-        ap.error("--steps, --max-iter, --newton-iter and --cell must be >= 1, --h > 0")
+    if args.steps < 1 or args.h <= 0 or args.max_iter < 1 or args.newton_iter < 1 or args.cell < 1 \
+            or args.unit < 1:
+        ap.error("--steps, --max-iter, --newton-iter, --cell and --unit must be >= 1, --h > 0")
 
     disks, width = read_layout(args.csv)
     n = len(disks)
@@ -243,7 +250,7 @@ def main():
           f"e {args.e}, theta {args.theta}, h {args.h*1e3:g} ms, {args.steps} steps")
     print(f"# FrictionContact(2) + SICONOS_FRICTION_2D_NSGS, tolerance {args.tol:.2e}, cap "
           f"{args.max_iter}, {args.newton_iter} Newton iteration(s) per step; native SpaceFilter "
-          f"(cell {args.cell} m); model built in {t_build:.3f} s")
+          f"(cell {args.cell} length units of 1/{args.unit} m); model built in {t_build:.3f} s")
     if args.verbose:
         print("# step  contacts  interactions  iters  info  residual  step[ms]  solve[ms]  top[m]"
               + ("  err/max(|q|,|r|,|u|)  err/|q|" if args.errors else ""))
@@ -278,7 +285,7 @@ def main():
             err_d.append(abs(osnspb.errors["max"] - osnspb.residual))
             u_gap.append(osnspb.errors["u_gap"])
         if args.verbose:
-            top = max(float(b.q()[1]) + b.getRadius() for b in bodies)
+            top = max(float(b.q()[1]) + b.getRadius() for b in bodies)/args.unit
             line = (f"{k:6d} {osnspb.contacts:9d} {nsds.getNumberOfInteractions():13d} "
                     f"{osnspb.iters:6d} {osnspb.info:5d} {osnspb.residual:9.2e} "
                     f"{t_step[-1]*1e3:9.3f} {t_solve[-1]*1e3:10.3f} {top:8.5f}")
@@ -288,8 +295,10 @@ def main():
     wall = time.perf_counter() - wall0 - wall_errors
     cpu = time.process_time() - cpu0 - cpu_errors
 
-    q = np.array([np.array(b.q()) for b in bodies])
-    v = np.array([np.array(b.velocity()) for b in bodies])
+    # back to metres (the angles and angular velocities are unchanged by the scaling)
+    back = np.array([1.0/args.unit, 1.0/args.unit, 1.0])
+    q = np.array([np.array(b.q()) for b in bodies])*back
+    v = np.array([np.array(b.velocity()) for b in bodies])*back
     if args.final:
         np.savetxt(args.final, np.hstack([q, v]), delimiter=",", fmt="%.17e",
                    header="x,y,theta,vx,vy,omega", comments="")
