@@ -1,6 +1,11 @@
 """The checks of the regression scripts: each prints one line, 'ok' or 'FAILED', with its
 name and the figures behind it; `summary` prints the closing line 'N passed, M failed' and
-gives the exit code (0 only when every check passed and at least one ran)."""
+gives the exit code (0 only when every check passed and at least one ran). Also the command
+line of the scripts and a run of multicor."""
+import argparse
+import pathlib
+import shutil
+import subprocess
 
 FAILED = []
 PASSED = []
@@ -20,3 +25,31 @@ def summary():
         print("failed:", ", ".join(FAILED))
     print(f"{len(PASSED)} passed, {len(FAILED)} failed")
     return 1 if FAILED or not PASSED else 0
+
+
+def arguments(fresh=False):
+    """The command line of the scripts (ctest gives it): --exe multicor --work DIR --source
+    REPO; returns the three as absolute paths, the work folder created (emptied first when
+    `fresh`)."""
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--exe", required=True)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("--source", required=True)
+    args = ap.parse_args()
+    work = pathlib.Path(args.work).resolve()
+    if fresh:
+        shutil.rmtree(work, ignore_errors=True)
+    work.mkdir(parents=True, exist_ok=True)
+    return pathlib.Path(args.exe).resolve(), work, pathlib.Path(args.source).resolve()
+
+
+def multicor(exe, deck, work, quiet=True):
+    """Run multicor on `deck` with the results in work/<deck stem>; on a non-zero exit print
+    its output and stop the script. Returns (path of the results file, completed process)."""
+    out = work / deck.stem
+    proc = subprocess.run([str(exe), str(deck), "--output", str(out)] + (["--quiet"] if quiet else []),
+                          capture_output=True, text=True)
+    if proc.returncode != 0:
+        print(proc.stdout, proc.stderr)
+        raise SystemExit(f"multicor failed on {deck} (exit {proc.returncode})")
+    return out / f"{deck.stem}.h5", proc

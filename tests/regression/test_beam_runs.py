@@ -5,26 +5,17 @@ Each check reads the results back from the HDF5 file written by the run. The dec
 tests/regression/decks/ (their headers state the reference) and input/.
 Usage (ctest does this): test_beam_runs.py --exe multicor --work DIR --source REPO
 """
-import argparse
 import math
-import pathlib
-import subprocess
 import sys
 
 import h5py
 import numpy as np
 
-from checks import check, summary
+from checks import arguments, check, multicor, summary
 
 
 def run(exe, deck, work):
-    out = work / deck.stem
-    proc = subprocess.run([str(exe), str(deck), "--output", str(out), "--quiet"],
-                          capture_output=True, text=True)
-    if proc.returncode != 0:
-        print(proc.stdout, proc.stderr)
-        raise SystemExit(f"multicor failed on {deck} (exit {proc.returncode})")
-    return h5py.File(out / f"{deck.stem}.h5", "r")
+    return h5py.File(multicor(exe, deck, work)[0], "r")
 
 
 def static_cantilever(exe, decks, work):
@@ -212,13 +203,7 @@ def dynamic_cantilever(exe, src, work):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--source", required=True)
-    args = ap.parse_args()
-    exe, work, src = pathlib.Path(args.exe), pathlib.Path(args.work), pathlib.Path(args.source)
-    work.mkdir(parents=True, exist_ok=True)
+    exe, work, src = arguments()
     decks = src / "tests" / "regression" / "decks"
     static_cantilever(exe, decks, work)
     static_lframe(exe, decks, work)

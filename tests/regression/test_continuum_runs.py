@@ -19,9 +19,7 @@
   (static file only: meshio does not read XDMF hyperslabs).
 Usage (ctest does this): test_continuum_runs.py --exe multicor --work DIR --source REPO
 """
-import argparse
 import math
-import pathlib
 import shutil
 import subprocess
 import sys
@@ -29,17 +27,11 @@ import sys
 import h5py
 import numpy as np
 
-from checks import check, summary
+from checks import arguments, check, multicor, summary
 
 
 def run(exe, deck, work):
-    out = work / deck.stem
-    proc = subprocess.run([str(exe), str(deck), "--output", str(out), "--quiet"],
-                          capture_output=True, text=True)
-    if proc.returncode != 0:
-        print(proc.stdout, proc.stderr)
-        raise SystemExit(f"multicor failed on {deck} (exit {proc.returncode})")
-    return out / f"{deck.stem}.h5"
+    return multicor(exe, deck, work)[0]
 
 
 def write_deck(work, name, text):
@@ -340,13 +332,7 @@ for path in sys.argv[1:]:
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--source", required=True)
-    args = ap.parse_args()
-    exe, work, src = pathlib.Path(args.exe), pathlib.Path(args.work), pathlib.Path(args.source)
-    work.mkdir(parents=True, exist_ok=True)
+    exe, work, src = arguments()
     h5_static = static_cantilever(exe, src, work)
     modal_strip(exe, work)
     rigid_motion(exe, work)

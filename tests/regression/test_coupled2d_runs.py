@@ -25,8 +25,6 @@
   checkpoints of dynamic continuum and coupled runs are tested in test_restart.py).
 Usage (ctest does this): test_coupled2d_runs.py --exe multicor --work DIR --source REPO
 """
-import argparse
-import pathlib
 import shutil
 import subprocess
 import sys
@@ -34,7 +32,7 @@ import sys
 import h5py
 import numpy as np
 
-from checks import check, summary
+from checks import arguments, check, summary
 
 E, RHO, THICK = 210.0e9, 7800.0, 0.05
 
@@ -354,13 +352,7 @@ def restart_refused(exe, src, work):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--source", required=True)
-    args = ap.parse_args()
-    exe, work, src = pathlib.Path(args.exe), pathlib.Path(args.work), pathlib.Path(args.source).resolve()
-    work.mkdir(parents=True, exist_ok=True)
+    exe, work, src = arguments()
     rigid_motion(exe, src, work)
     driven_edge(exe, src, work)
     free_fall(exe, src, work)

@@ -12,8 +12,6 @@ tests/regression/decks/coupled_rigid_translation.dat; case 1 (5 steps) with both
 methods, compared.
 Usage (ctest does this): test_coupled_runs.py --exe multicor --work DIR --source REPO
 """
-import argparse
-import pathlib
 import subprocess
 import sys
 import time
@@ -21,7 +19,7 @@ import time
 import h5py
 import numpy as np
 
-from checks import check, summary
+from checks import arguments, check, summary
 
 #: Data set of the experiment decks (their headers): steel, section 1 cm x 1 cm, R = 5 mm.
 E, RHO, AREA, PITCH, RADIUS, THICK = 2.1e11, 7800.0, 1.0e-4, 0.01, 0.005, 0.01
@@ -309,13 +307,7 @@ def free_fall(exe, decks, work):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--source", required=True)
-    args = ap.parse_args()
-    exe, work, src = pathlib.Path(args.exe), pathlib.Path(args.work), pathlib.Path(args.source)
-    work.mkdir(parents=True, exist_ok=True)
+    exe, work, src = arguments()
     decks = src / "tests" / "regression" / "decks"
     rigid_translation(exe, decks, work)
     free_fall(exe, decks, work)

@@ -7,28 +7,20 @@ input/incline.dat and input/cohesive_row.dat (also with both [solver] methods, c
 Kept small: the Debug build runs them.
 Usage (ctest does this): test_dem_runs.py --exe multicor --work DIR --source REPO
 """
-import argparse
-import pathlib
-import subprocess
 import sys
 
 import h5py
 import numpy as np
 
-from checks import check, summary
+from checks import arguments, check, multicor, summary
 
 G = 9.81
 
 
 def run(exe, deck, work, quiet=True):
     """Run a deck; return (open results file, stdout)."""
-    out = work / deck.stem
-    args = [str(exe), str(deck), "--output", str(out)] + (["--quiet"] if quiet else [])
-    proc = subprocess.run(args, capture_output=True, text=True)
-    if proc.returncode != 0:
-        print(proc.stdout, proc.stderr)
-        raise SystemExit(f"multicor failed on {deck} (exit {proc.returncode})")
-    return h5py.File(out / f"{deck.stem}.h5", "r"), proc.stdout
+    path, proc = multicor(exe, deck, work, quiet)
+    return h5py.File(path, "r"), proc.stdout
 
 
 def contacts_at(f, k):
@@ -336,13 +328,7 @@ def rigid_spin(exe, decks, work):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--source", required=True)
-    args = ap.parse_args()
-    exe, work, src = pathlib.Path(args.exe), pathlib.Path(args.work), pathlib.Path(args.source)
-    work.mkdir(parents=True, exist_ok=True)
+    exe, work, src = arguments()
     decks = src / "tests" / "regression" / "decks"
     incline(exe, src, work)
     column(exe, decks, work)

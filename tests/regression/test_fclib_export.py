@@ -8,15 +8,13 @@ the exported sparse matrix and u = W r + q. Two decks: a frictional deposit (2 c
 contact, no cohesion) and the cohesive hanging row (bonds: cohesion and moments, 3 components).
 Usage (ctest does this): test_fclib_export.py --exe multicor --work DIR --source REPO
 """
-import argparse
-import pathlib
 import subprocess
 import sys
 
 import h5py
 import numpy as np
 
-from checks import check, summary
+from checks import arguments, check, multicor, summary
 
 
 def with_export(deck, step, work, extra=(), replace=None, name=None):
@@ -40,13 +38,7 @@ def with_export(deck, step, work, extra=(), replace=None, name=None):
 
 
 def run(exe, deck, work):
-    out = work / deck.stem
-    proc = subprocess.run([str(exe), str(deck), "--output", str(out), "--quiet"],
-                          capture_output=True, text=True)
-    if proc.returncode != 0:
-        print(proc.stdout, proc.stderr)
-        raise SystemExit(f"multicor failed on {deck} (exit {proc.returncode})")
-    return out / f"{deck.stem}.h5"
+    return multicor(exe, deck, work)[0]
 
 
 def proj_coulomb(t, mu):
@@ -144,13 +136,7 @@ def case(exe, deck, step, work, expect_dim, extra=(), replace=None, name=None):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--source", required=True)
-    args = ap.parse_args()
-    exe, work, src = pathlib.Path(args.exe), pathlib.Path(args.work), pathlib.Path(args.source)
-    work.mkdir(parents=True, exist_ok=True)
+    exe, work, src = arguments()
     decks = src / "tests" / "regression" / "decks"
     # a loose tolerance, so that the error compared is well above round-off
     case(exe, decks / "dem_small_deposit.dat", 276, work, 2, ("tolerance = 1e-3",))

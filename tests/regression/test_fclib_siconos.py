@@ -19,7 +19,6 @@ Without Siconos on a Debian machine the test fails with the command that install
 (scripts/bootstrap.sh lists python3-siconos and python3-h5py); elsewhere it skips (exit 77).
 Usage (ctest does this): test_fclib_siconos.py --exe multicor --work DIR --source REPO
 """
-import argparse
 import json
 import pathlib
 import subprocess
@@ -28,7 +27,7 @@ import sys
 import h5py
 import numpy as np
 
-from checks import check, summary
+from checks import arguments, check, multicor, summary
 from siconos_env import siconos_python
 
 HERE = pathlib.Path(__file__).resolve().parent
@@ -70,13 +69,7 @@ def with_solver(deck, work, name, solver_lines):
 
 
 def run(exe, deck, work):
-    out = work / deck.stem
-    proc = subprocess.run([str(exe), str(deck), "--output", str(out), "--quiet"],
-                          capture_output=True, text=True)
-    if proc.returncode != 0:
-        print(proc.stdout, proc.stderr)
-        raise SystemExit(f"multicor failed on {deck} (exit {proc.returncode})")
-    return out / f"{deck.stem}.h5"
+    return multicor(exe, deck, work)[0]
 
 
 def case(exe, python, env, deck, step, work, sic_tol, hyperstatic=False):
@@ -201,13 +194,7 @@ def natural_map_error(W, q, r, mu):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--source", required=True)
-    args = ap.parse_args()
-    exe, work, src = pathlib.Path(args.exe), pathlib.Path(args.work), pathlib.Path(args.source)
-    work.mkdir(parents=True, exist_ok=True)
+    exe, work, src = arguments()
     python, env = siconos_python()
     deposit = src / "tests" / "regression" / "decks" / "dem_small_deposit.dat"
     # A loose solution (tolerance 1e-3 of the LMGC90 norm: Siconos error 1.4e-4), so that

@@ -9,7 +9,6 @@ Each failed run must exit 1 with a message naming the deck, the step and the bod
 an earlier finished result in the folder byte for byte.
 Usage (ctest does this): test_guards.py --exe multicor --work DIR --source REPO
 """
-import argparse
 import hashlib
 import os
 import pathlib
@@ -21,7 +20,7 @@ import sys
 import h5py
 import numpy as np
 
-from checks import check, summary
+from checks import arguments, check, summary
 
 
 def multicor(exe, *args):
@@ -300,13 +299,7 @@ def line_endings(exe, work):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--source", required=True)
-    args = ap.parse_args()
-    exe, work, src = pathlib.Path(args.exe), pathlib.Path(args.work), pathlib.Path(args.source)
-    work.mkdir(parents=True, exist_ok=True)
+    exe, work, src = arguments()
     non_finite(exe, work)
     coupled_non_finite(exe, work, src / "tests" / "regression" / "decks")
     coupled2d_initial_state(exe, work, src)

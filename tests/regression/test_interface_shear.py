@@ -15,7 +15,6 @@ of 8 disks, the same pressure, drive and laws, 6 ms (slip 1.9 mm).
   the scheme does not represent) and is constant to round-off after the last one.
 Usage (ctest does this): test_interface_shear.py --exe multicor --work DIR --source REPO
 """
-import argparse
 import pathlib
 import shutil
 import subprocess
@@ -27,7 +26,7 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "postproc"))
 from multicor_post.interface import InterfaceRun, sliding_over_disks  # noqa: E402
 
-from checks import check, summary
+from checks import arguments, check, summary
 
 P, WIDTH, THICK, MU, R = 1.0e6, 0.2, 0.01, 0.3, 0.0125
 
@@ -63,14 +62,8 @@ def reduced_case(exe, src, work):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--source", required=True)
-    args = ap.parse_args()
-    work, src = pathlib.Path(args.work), pathlib.Path(args.source).resolve()
-    work.mkdir(parents=True, exist_ok=True)
-    h5 = reduced_case(args.exe, src, work)
+    exe, work, src = arguments()
+    h5 = reduced_case(exe, src, work)
     run = InterfaceRun(h5)
     t_top, n_top, t_bot, n_bot = run.band_resultants()
     s = run.slip()

@@ -11,15 +11,13 @@ Debian's python3-siconos); without it the test fails on Debian (scripts/bootstra
 it) and reports as skipped (exit 77) elsewhere.
 Usage (ctest does this): test_siconos_deposit.py --exe multicor --work DIR --source REPO
 """
-import argparse
-import pathlib
 import subprocess
 import sys
 
 import h5py
 import numpy as np
 
-from checks import check, summary
+from checks import arguments, check, summary
 from siconos_env import siconos_python
 
 R = 0.01  # disk radius [m]
@@ -102,14 +100,8 @@ def compare(name, pos, x, y_rest, bound):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--source", required=True)
-    args = ap.parse_args()
-    work = pathlib.Path(args.work)
-    work.mkdir(parents=True, exist_ok=True)
-    script = pathlib.Path(args.source) / "bench" / "siconos_deposit.py"
+    exe, work, src = arguments()
+    script = src / "bench" / "siconos_deposit.py"
     python, env = siconos_python("siconos.kernel, siconos.mechanics.collision.bodies")
 
     x, y, y_rest, width = layout()
@@ -124,7 +116,7 @@ def main():
     bound = H * v_max * (1 + 3 * 2 / np.sqrt(3.0))
 
     out = work / "multicor"
-    proc = subprocess.run([args.exe, str(deck), "--output", str(out), "--quiet"],
+    proc = subprocess.run([str(exe), str(deck), "--output", str(out), "--quiet"],
                           capture_output=True, text=True)
     if proc.returncode != 0:
         print(proc.stdout, proc.stderr)

@@ -13,11 +13,9 @@ the tool without Slurm: keys refused, decks written, failures.)
 Skips (exit 77, reason printed) when not root or when slurm-wlm / munge are missing.
 Usage (ctest does this): test_slurm_sweep.py --exe multicor --work DIR --source REPO
 """
-import argparse
 import csv
 import math
 import pathlib
-import shutil
 import subprocess
 import sys
 import time
@@ -27,7 +25,7 @@ import h5py
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from slurm_local import ClusterError, LocalSlurm  # noqa: E402
 
-from checks import check, summary
+from checks import arguments, check, summary
 
 SIN_PHI, COS_PHI, T_END = 0.6, 0.8, 0.5      # input/incline.dat
 
@@ -160,16 +158,7 @@ def locally(src, exe, work):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--source", required=True)
-    args = ap.parse_args()
-    exe = pathlib.Path(args.exe).resolve()
-    src = pathlib.Path(args.source).resolve()
-    work = pathlib.Path(args.work).resolve()
-    shutil.rmtree(work, ignore_errors=True)
-    work.mkdir(parents=True)
+    exe, work, src = arguments(fresh=True)
     t0 = time.monotonic()
     local_rows = locally(src, exe, work)
     slurm_rows = on_slurm(src, exe, work)

@@ -14,15 +14,12 @@
   reported as failed; the next `run` runs only that point again.
 Usage (ctest does this): test_sweep.py --exe multicor --work DIR --source REPO
 """
-import argparse
 import csv
 import math
-import pathlib
-import shutil
 import subprocess
 import sys
 
-from checks import check, summary
+from checks import arguments, check, summary
 
 SIN_PHI, COS_PHI, T_END, G = 0.6, 0.8, 0.5, 9.81      # input/incline.dat
 
@@ -145,16 +142,7 @@ def failing_point(src, exe, work):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--source", required=True)
-    args = ap.parse_args()
-    exe = pathlib.Path(args.exe).resolve()
-    src = pathlib.Path(args.source).resolve()
-    work = pathlib.Path(args.work).resolve()
-    shutil.rmtree(work, ignore_errors=True)
-    work.mkdir(parents=True)
+    exe, work, src = arguments(fresh=True)
     refused_keys(src, exe, work)
     folder = generated_decks(src, exe, work)
     sequential_run(src, folder)

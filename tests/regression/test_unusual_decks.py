@@ -18,15 +18,13 @@ language allows, where every number of the result is known.
 
 Usage (ctest does this): test_unusual_decks.py --exe multicor --work DIR --source REPO
 """
-import argparse
-import pathlib
 import subprocess
 import sys
 
 import h5py
 import numpy as np
 
-from checks import check, summary
+from checks import arguments, check, summary
 
 
 def run(exe, work, name, text):
@@ -197,13 +195,7 @@ def one_element_cantilever(exe, work):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--source", required=True)
-    args = ap.parse_args()
-    exe, work = pathlib.Path(args.exe), pathlib.Path(args.work)
-    work.mkdir(parents=True, exist_ok=True)
+    exe, work, _ = arguments()
     free_fall(exe, work)
     collision(exe, work)
     one_element_cantilever(exe, work)

@@ -9,26 +9,17 @@ equals 1 - M v(t)^2 / (2 E_inc) of the bar ending on that body, R falls with the
 as the body's mass grows, and the weight shape has no effect beyond the mass.
 Usage (ctest does this): test_wave_reflection_2d.py --exe multicor --work DIR --source REPO
 """
-import argparse
-import pathlib
-import shutil
 import sys
 
-from checks import check, summary
+from checks import arguments, check, summary
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--source", required=True)
-    args = ap.parse_args()
-    sys.path.insert(0, str(pathlib.Path(args.source).resolve() / "postproc"))
+    exe, work, src = arguments(fresh=True)
+    sys.path.insert(0, str(src / "postproc"))
     import wave_reflection_2d as w
-    work = pathlib.Path(args.work).resolve()
-    shutil.rmtree(work, ignore_errors=True)
     cases = [(4, "cubic"), (8, "constant"), (8, "linear"), (8, "cubic"), (16, "cubic")]
-    rows = w.study(pathlib.Path(args.exe).resolve(), work, cases)
+    rows = w.study(exe, work, cases)
     print(w.table(rows))
     for n_band, shape, m in rows:
         name = f"band {n_band}, {shape}"
