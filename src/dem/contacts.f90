@@ -27,6 +27,7 @@ module dem_contacts
     public :: contacts_extend, contacts_fill
     public :: contacts_set_frames, contacts_set_laws, contacts_finish, contacts_impulses
     public :: contacts_local_velocity, contacts_count_status, contacts_bytes, contacts_moments_active
+    public :: contacts_list_problem
 
     !> Contact status, no reaction (separated or not active this step).
     integer, parameter :: status_open = 0
@@ -317,6 +318,37 @@ contains
 
     !> Sort key of a pair: (owner, other) in lexicographic order, owner = the disk i1 of a
     !> disk pair or the disk i2 of a wall contact, other = the other body (walls negative).
+    !> What is wrong with a contact list read back (a checkpoint): a body index out of range,
+    !> a disk in contact with itself, or the pairs out of the detection's order (which the
+    !> warm-start matching relies on); '' when nothing.
+    pure function contacts_list_problem(cs, n_disks, n_walls) result(problem)
+        !> Contacts.
+        type(contact_set_t), intent(in) :: cs
+        !> Number of disks.
+        integer, intent(in) :: n_disks
+        !> Number of walls.
+        integer, intent(in) :: n_walls
+        character(len=:), allocatable :: problem
+        character(len=120) :: buf
+        integer :: k
+        problem = ''
+        do k = 1, cs%n
+            if (cs%i2(k) < 1 .or. cs%i2(k) > n_disks .or. cs%i1(k) < -n_walls .or. cs%i1(k) == 0 &
+                .or. cs%i1(k) > n_disks .or. cs%i1(k) == cs%i2(k)) then
+                write (buf, '(a,i0,a,i0,a,i0,a,i0,a,i0,a)') 'contact ', k, ' joins bodies ', cs%i1(k), &
+                    ' and ', cs%i2(k), ' (', n_disks, ' disks, ', n_walls, ' walls)'
+                problem = trim(buf)
+                return
+            end if
+            if (k == 1) cycle
+            if (pair_key(cs%i1(k), cs%i2(k)) <= pair_key(cs%i1(k - 1), cs%i2(k - 1))) then
+                write (buf, '(a,i0,a,i0,a)') 'contacts ', k - 1, ' and ', k, ' are out of order'
+                problem = trim(buf)
+                return
+            end if
+        end do
+    end function contacts_list_problem
+
     pure integer(i8) function pair_key(i1, i2) result(key)
         integer, intent(in) :: i1, i2
         if (i1 > 0) then

@@ -22,6 +22,7 @@ module driver_checkpoint
     use io_hdf5_file, only: h5_file_t
     use io_paths, only: rename_file, remove_file, file_exists
     use fem_newmark, only: time_integrator_t, newmark_t
+    use dem_contacts, only: contacts_list_problem
     use dem_moreau_jean, only: dem_system_t
     use dem_nlgs, only: nlgs_stats_t
     use dem_bonded_block, only: bonded_block_restore
@@ -685,7 +686,7 @@ contains
 
         subroutine load_contacts(error)
             type(error_t), allocatable, intent(out) :: error
-            character(len=:), allocatable :: g
+            character(len=:), allocatable :: g, problem
             integer, allocatable :: active(:)
             integer :: m
             g = group//'/contacts'
@@ -724,6 +725,11 @@ contains
                 if (.not. allocated(error)) call file%read_dataset(g//'/active', active, error)
                 if (allocated(error)) return
                 cs%active = active /= 0
+                problem = contacts_list_problem(cs, sys%particles%n, sys%walls%n)
+                if (len(problem) > 0) then
+                    call make_error(error, 'checkpoint: '//problem//': the checkpoint is damaged')
+                    return
+                end if
             end associate
         end subroutine load_contacts
 

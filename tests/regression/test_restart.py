@@ -271,6 +271,40 @@ def refusals(exe, deck, work):
     check("refusals leave no partial file", not (folder / f"{deck.stem}.h5.partial").exists(), "")
 
 
+def damaged_contacts(exe, src, work):
+    """A checkpoint whose contact list names a body that does not exist, or lists two pairs
+    out of the detection's order (the warm-start matching merges on that order): refused as
+    damaged, exit 1, the results untouched (it was an out-of-bounds access, or a warm start
+    that silently lost its reactions)."""
+    deck = src / "input" / "cohesive_row.dat"
+    folder = work / "damaged_contacts"
+    first = run(exe, deck, "--output", folder, "--quiet", "--end", 0.01)
+    assert first.returncode == 0, first.stderr
+    ckpt = folder / "checkpoint.h5"
+    result = folder / f"{deck.stem}.h5"
+    before = digest(result)
+    def no_such_body(i1, i2):
+        i2[0] = 10**6
+
+    def swapped(i1, i2):
+        i1[[0, 1]], i2[[0, 1]] = i1[[1, 0]], i2[[1, 0]]
+
+    for name, edit, says in [("a body that does not exist", no_such_body, "joins bodies"),
+                             ("two pairs out of order", swapped, "are out of order")]:
+        damaged = work / "damaged_contacts.h5"
+        shutil.copy(ckpt, damaged)
+        with h5py.File(damaged, "r+") as f:
+            g = f["dem/contacts"]
+            i1, i2 = g["i1"][...], g["i2"][...]
+            check("damaged contacts: the checkpoint has at least 2 contacts", len(i1) >= 2, f"{len(i1)}")
+            edit(i1, i2)
+            g["i1"][...], g["i2"][...] = i1, i2
+        proc = run(exe, deck, "--output", folder, "--restart", damaged)
+        check(f"damaged contacts: {name} refused", proc.returncode == 1 and says in proc.stderr and
+              "the checkpoint is damaged" in proc.stderr, proc.stderr.strip())
+    check("damaged contacts: the results untouched", digest(result) == before, "")
+
+
 def changed_mesh(exe, src, work):
     """A continuum run on a Gmsh mesh, stopped by --end: restarting it after one node of the
     .msh moved (same node count, same deck) is refused like a changed deck, nothing written;
@@ -430,6 +464,7 @@ def main():
     # multipliers' work through the prescribed dofs come back from the checkpoint.
     by_end_time(exe, decks / "coupled2d_driven_edge.dat", work, "coupled2d_driven_end", 4.43e-4)
     refusals(exe, beam, work)
+    damaged_contacts(exe, src, work)
     changed_mesh(exe, src, work)
     new_end_time(exe, beam, work)
     sys.exit(summary())
