@@ -57,7 +57,10 @@
 !> every `coarse_every` sweeps, the reactions of aggregates of consecutive contacts are
 !> scaled by the Galerkin solution of a small system (one unknown per aggregate), which
 !> moves the weight through the whole height of a packing at once. It does nothing at a
-!> solution of the sweeps, and the sweeps alone decide convergence.
+!> solution of the sweeps, and the sweeps alone decide convergence. Safeguard: when the
+!> error at a correction is larger than at the previous one (the corrections undo what the
+!> sweeps between them did), the step goes on without corrections: on the impacts of a
+!> deposit every correction raised the error tenfold and 13 % of the steps never converged.
 module dem_nlgs
     use core_kinds, only: wp, i8
     use core_constants, only: diagonal_floor
@@ -336,6 +339,7 @@ contains
         type(anderson_t) :: aa
         type(split_t) :: split
         logical :: accelerate, coarse
+        real(wp) :: error_corrected
         integer :: s, k, n_swept, nb
         stats%n_contacts = cs%n
         call skip_blocked(cs, stats%n_blocked)
@@ -396,6 +400,7 @@ contains
         coarse = config%method == nlgs_method_coarse .and. .not. present(bilateral) .and. stats%n_block == 0 &
                  .and. n_swept > 0
         stats%corrections = 0
+        error_corrected = huge(1.0_wp)
         if (coarse) then
             call coarse_correct(cs, list, im, vel, config%coarse_size)
             stats%corrections = 1
@@ -434,7 +439,11 @@ contains
                     checked = stats%error
                 end if
                 if (accelerate) call anderson_mix(aa, cs, list, im, vfree, vel, split)
+                ! safeguard of the coarse correction: no more corrections once the error at one
+                ! is larger than at the previous one
+                if (coarse .and. mod(s, config%coarse_every) == 0) coarse = stats%error <= error_corrected
                 if (coarse .and. mod(s, config%coarse_every) == 0) then
+                    error_corrected = stats%error
                     call coarse_correct(cs, list, im, vel, config%coarse_size)
                     stats%corrections = stats%corrections + 1
                     ! the correction is not a sweep: the history of the sweep map restarts
