@@ -159,7 +159,9 @@ contains
                            'bonds break as with `nlgs`. Without bonds both are the same sweeps. `coarse`: the '// &
                            'sweeps of `nlgs` with a coarse correction every `coarse_every` sweeps, which scales '// &
                            'the reactions of aggregates of `coarse_size` consecutive contacts at once (for tall '// &
-                           'packings away from rest, doc/performance.md; it changes nothing at a solution). Every '// &
+                           'packings away from rest and deposits, doc/performance.md; it changes nothing at a '// &
+                           'solution, and a step stops correcting once the error at a correction is larger '// &
+                           'than at the previous one). Every '// &
                            'unilateral or frictional contact uses the bi-potential local solver in all three.', &
                            default='block')
         call s%add_keyword('solver', 'tolerance', [positive('tolerance', '')], &
