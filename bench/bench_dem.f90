@@ -85,7 +85,7 @@ program bench_dem
     !> Solver options from the command line (see the header).
     real(wp) :: relaxation = 1.0_wp
     integer :: criterion = criterion_lmgc90, max_sweeps = 200, check_every = 10, settle_sweeps = 0, iarg
-    integer :: anderson = 0, settle_anderson = -1
+    integer :: anderson = 5, settle_anderson = -1, anderson_after = 50
     logical :: convergence = .false., sizes_given = .false., verbose = .false., symmetric = .true.
     logical :: hydrostatic = .false., criterion_given = .false.
     !> Global strategy (`[solver] method`; of the settling steps, -1: the same) and the
@@ -117,6 +117,8 @@ program bench_dem
             iarg = iarg - 1
         case ('--anderson')
             call read_int_value(arg, val, anderson)
+        case ('--anderson-after')
+            call read_int_value(arg, val, anderson_after)
         case ('--siconos')
             call read_int_value(arg, val, siconos_n)
         case ('--csv')
@@ -229,12 +231,13 @@ contains
     !> The options (the header of this file).
     subroutine print_usage(unit)
         integer, intent(in) :: unit
-        write (unit, '(a)') 'usage: bench_dem [--sizes N...] [--settle S] [--max-sweeps C] [--anderson M]', &
+        write (unit, '(a)') 'usage: bench_dem [--sizes N...] [--settle S] [--max-sweeps C] [--anderson M] [--anderson-after K]', &
             '         [--relaxation W --check-every K] [--criterion lmgc90|siconos] [--forward]', &
             '         [--hydrostatic] [--method nlgs|block|coarse] [--coarse-every K] [--coarse-size M]', &
             '         [--settle-anderson M] [--settle-sweeps C] [--settle-method M] [--verbose]', &
             '       bench_dem --convergence', &
-            '       bench_dem --siconos 200|2000 [--csv FILE] [--deck FILE] [--anderson M] [--forward] [--verbose]', &
+            '       bench_dem --siconos 200|2000 [--csv FILE] [--deck FILE] [--anderson M] [--anderson-after K]', &
+            '         [--forward] [--verbose]', &
             'Options and figures: the header of bench/bench_dem.f90 and doc/performance.md.'
     end subroutine print_usage
 
@@ -265,6 +268,7 @@ contains
         end do
         sys%solver%max_sweeps = max_sweeps
         sys%solver%anderson = anderson
+        sys%solver%anderson_after = anderson_after
         sys%solver%method = method
         allocate (t_det(n_steps), t_sol(n_steps), rate(n_steps))
         sweeps = 0
@@ -421,6 +425,7 @@ contains
         if (criterion_given) sys%solver%criterion = criterion
         sys%solver%relaxation = relaxation
         sys%solver%anderson = anderson
+        sys%solver%anderson_after = anderson_after
         sys%solver%hydrostatic = hydrostatic
         sys%solver%symmetric = symmetric
         sys%solver%method = method
@@ -590,6 +595,7 @@ contains
         sys%solver%relaxation = relaxation
         sys%solver%check_every = check_every
         sys%solver%anderson = anderson
+        sys%solver%anderson_after = anderson_after
         sys%solver%hydrostatic = hydrostatic
         sys%solver%symmetric = symmetric
         sys%solver%method = method

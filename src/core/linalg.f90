@@ -8,6 +8,9 @@
 !> - `band_generalized_eigen`: selected eigenpairs of A x = lambda B x for band A, B (dsbgvx),
 !>   eigenvectors B-normalised; `largest_generalized_eigenvalue` for the critical time step.
 !>
+!> - `dot`: the dot product of two contiguous vectors (ddot; vectorised, where a Fortran
+!>   loop must add in order).
+!>
 !> Every LAPACK failure (info /= 0) comes back as an `error_t` with the routine's name and
 !> what the value of info means.
 module core_linalg
@@ -15,7 +18,7 @@ module core_linalg
     use core_error, only: error_t, make_error, make_internal_error
     implicit none
     private
-    public :: band_spd_t, dense_spd_t, band_generalized_eigen, largest_generalized_eigenvalue
+    public :: band_spd_t, dense_spd_t, band_generalized_eigen, largest_generalized_eigenvalue, dot
 
     !> Symmetric positive-definite band matrix (upper band storage) and its Cholesky factor.
     type :: band_spd_t
@@ -82,6 +85,12 @@ module core_linalg
     end type dense_spd_t
 
     interface
+        function ddot(n, x, incx, y, incy) result(value)
+            import :: wp
+            integer, intent(in) :: n, incx, incy
+            real(wp), intent(in) :: x(*), y(*)
+            real(wp) :: value
+        end function ddot
         subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
             import :: wp
             character(len=1), intent(in) :: uplo
@@ -149,6 +158,17 @@ module core_linalg
     end interface
 
 contains
+
+    !> x . y (BLAS ddot) of two vectors of the same size. Callers that need the same sum
+    !> for any number of threads keep the vectors short (dem_nlgs: at most 3072 entries):
+    !> OpenBLAS splits a dot product over its threads only beyond 10 000 entries.
+    real(wp) function dot(x, y)
+        !> First vector.
+        real(wp), intent(in), contiguous :: x(:)
+        !> Second vector, of the size of x.
+        real(wp), intent(in), contiguous :: y(:)
+        dot = ddot(size(x), x, 1, y, 1)
+    end function dot
 
     !> Allocate an n x n zero band matrix with kd super-diagonals.
     pure subroutine band_init(self, n, kd)

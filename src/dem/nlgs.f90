@@ -23,16 +23,20 @@
 !> state (scaled frame, bipotential_residual / rolling_residual) is reported too, with the
 !> same normalisation.
 !> Sweeps alternate direction when `symmetric` (symmetric Gauss-Seidel).
-!> Acceleration (doc/theory.md 4.4), off by default: over-relaxation (`relaxation` omega,
+!> Acceleration (doc/theory.md 4.4): over-relaxation (`relaxation` omega, off by default;
 !> each update P_K(r0 + omega (r_loc - r0)), back to omega = 1 when the error measured every
-!> `check_every` sweeps rose), and Anderson mixing of the last `anderson` sweeps (one sweep
-!> in the fixed contact order is the map; the history restarts when |G(x) - x| grows).
+!> `check_every` sweeps rose), and Anderson mixing of the last `anderson` sweeps (on by
+!> default, depth 5; one sweep in the fixed contact order is the map; the history restarts
+!> when |G(x) - x| grows), after `anderson_after` plain sweeps (default 50).
 !> Cold start (`hydrostatic`, off by default): when no contact of the solve carries a
 !> reaction yet (a fresh packing), the sweeps start from the hydrostatic estimate of
 !> hydrostatic_guess instead of zero reactions.
 !> The Siconos error (nlgs_siconos_error, doc/theory.md 4.5) of the final state is always
 !> computed, from u = H^T (v_free + M^-1 H r) + shift in full; `criterion` chooses which
-!> error stops the sweeps.
+!> error stops the sweeps. As a stopping test it is evaluated after each sweep from the
+!> velocities the sweeps keep up to date (the same up to round-off, and one pass over the
+!> contacts instead of three); once that is below the tolerance it is computed again in
+!> full, and only that value stops the sweeps (Siconos' "light, full final" evaluation).
 !> Blocked contacts (both bodies immobile along the normal: W_nn = 0) are taken out of the
 !> solve with r = 0 and counted in the statistics (`nlgs_stats_t%n_blocked`).
 !> The constants of each contact's scaled frame (bipotential_scaling) are computed once per
@@ -63,10 +67,11 @@
 !> deposit every correction raised the error tenfold and 13 to 16 % of the steps never
 !> converged.
 module dem_nlgs
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp, i8
     use core_constants, only: diagonal_floor
     use core_error, only: error_t
-    use core_linalg, only: dense_spd_t
+    use core_linalg, only: dense_spd_t, dot
     use dem_contacts, only: contact_set_t
 !$  use omp_lib, only: omp_get_max_threads
     use dem_bipotential, only: bipotential_residual, bipotential_scaling, bipotential_local_solve_scaled, &
@@ -132,7 +137,10 @@ module dem_nlgs
         integer :: criterion = criterion_lmgc90
         !> Anderson acceleration of the sweeps (module header): depth (number of previous
         !> sweeps mixed); 0: none. Not used with bilateral constraints.
-        integer :: anderson = 0
+        integer :: anderson = 5
+        !> Plain sweeps before the Anderson steps start: a solve that converges within them
+        !> is not accelerated (near rest a plain sweep is cheaper, doc/performance.md).
+        integer :: anderson_after = 50
         !> Domain split of the sweeps over the OpenMP threads (split_build): fewest contacts
         !> per block (smaller solves, and all solves on one thread, are serial).
         integer :: split_min = 2000
@@ -178,9 +186,11 @@ module dem_nlgs
     type :: anderson_t
         integer :: depth = 0, used = 0, next = 1
         real(wp), allocatable :: df(:, :), dg(:, :), gram(:, :)
-        real(wp), allocatable :: x(:), f(:), g(:), fprev(:), gprev(:), d(:)
+        !> The iterate x (the scaled reactions the next sweep starts from, valid when
+        !> x_valid), the residual f and output g of the last sweep, the scaling D.
+        real(wp), allocatable :: x(:), fprev(:), gprev(:), d(:)
         real(wp) :: fnorm_prev = huge(1.0_wp)
-        logical :: started = .false.
+        logical :: started = .false., x_valid = .false.
     end type anderson_t
 
     !> Domain split of the sweeps (split_build): the contacts of the solve in block order,
@@ -195,8 +205,8 @@ module dem_nlgs
     !> Largest number of aggregates of the coarse correction (its system is factored dense:
     !> 2000^3/3 flops, about 1 s; larger aggregates are used beyond).
     integer, parameter :: max_aggregates = 2000
-    !> Chunk of the deterministic parallel dot products (pdot).
-    integer, parameter :: dot_chunk = 4096
+    !> Contacts per chunk of the deterministic parallel sums of the Anderson step.
+    integer, parameter :: dot_chunk = 1024
     !> Tikhonov term of the Anderson least-squares system, relative to its trace: far above
     !> the rounding of the Gram matrix (1e-16), far below its genuine eigenvalues.
     real(wp), parameter :: anderson_regularisation = 1.0e-12_wp
@@ -336,6 +346,8 @@ contains
         real(wp), allocatable :: sc(:, :)
         ! free velocities (the Siconos error is computed from them in full) and a work copy
         real(wp), allocatable :: vfree(:, :), vwork(:, :)
+        ! with the Siconos criterion: |q|^2 (constant over the solve)
+        real(wp) :: nq
         real(wp) :: floor, omega, checked
         type(anderson_t) :: aa
         type(split_t) :: split
@@ -354,6 +366,8 @@ contains
         allocate (list(n_swept), sc(rolling_n_scaling, n_swept))
         allocate (vfree, source=vel)
         allocate (vwork, mold=vel)
+        nq = 0.0_wp
+        if (config%criterion == criterion_siconos) nq = siconos_free_norm2(cs, im, vfree)
         s = 0
         floor = 0.0_wp
         do k = 1, cs%n
@@ -409,9 +423,10 @@ contains
         if (stats%n_active > 0) then
             stats%converged = .false.
             do s = 1, config%max_sweeps
-                if (accelerate) then
+                if (accelerate .and. s > config%anderson_after) then
                     ! the map accelerated is one sweep in the fixed (bottom-up) contact order
-                    call gather(cs, list, aa%d, aa%x)
+                    if (.not. aa%x_valid) call gather(cs, list, aa%d, aa%x)
+                    aa%x_valid = .true.
                     call split_sweep(config, omega, cs, im, vel, sc, split, .true., num, den, nloc)
                 else
                     call split_sweep(config, omega, cs, im, vel, sc, split, &
@@ -425,7 +440,11 @@ contains
                 stats%sweeps = s
                 stats%local_iterations = stats%local_iterations + nloc
                 if (config%criterion == criterion_siconos) then
-                    stats%error = siconos_error(cs, im, vfree, vel, vwork, present(bilateral))
+                    ! from the velocities the sweeps keep up to date; below the tolerance, again
+                    ! from u = W r + q in full, which alone stops the sweeps
+                    stats%error = siconos_ratio(cs, vel, nq)
+                    if (stats%error <= config%tol) stats%error = siconos_error(cs, im, vfree, vel, vwork, &
+                                                                               present(bilateral))
                 else
                     stats%error = relative(max(num - floor, 0.0_wp), den)
                 end if
@@ -439,7 +458,7 @@ contains
                     if (stats%error > checked) omega = 1.0_wp
                     checked = stats%error
                 end if
-                if (accelerate) call anderson_mix(aa, cs, list, im, vfree, vel, split)
+                if (accelerate .and. s > config%anderson_after) call anderson_mix(aa, cs, list, im, vfree, vel, split)
                 if (coarse .and. mod(s, config%coarse_every) == 0) then
                     ! safeguard: no more corrections once the error at one is larger than at
                     ! the previous one
@@ -457,7 +476,12 @@ contains
         stats%relaxation = omega
         stats%updates = int(n_swept, i8)*stats%sweeps
         stats%residual = nlgs_residual(cs, vel)
-        stats%siconos_error = siconos_error(cs, im, vfree, vel, vwork, present(bilateral))
+        if (config%criterion == criterion_siconos .and. stats%converged) then
+            ! the last error of the sweeps, computed in full
+            stats%siconos_error = stats%error
+        else
+            stats%siconos_error = siconos_error(cs, im, vfree, vel, vwork, present(bilateral))
+        end if
     end subroutine nlgs_solve
 
     !> Hydrostatic estimate of the reactions of a cold solve (config%hydrostatic): the
@@ -757,6 +781,7 @@ contains
         aa%next = 1
         aa%started = .false.
         aa%fnorm_prev = huge(1.0_wp)
+        aa%x_valid = .false.
     end subroutine anderson_restart
 
     !> Size the history and the scaling D = sqrt(diag W) of the Anderson acceleration.
@@ -769,7 +794,7 @@ contains
         n = 3*size(list)
         aa%depth = depth
         allocate (aa%df(n, depth), aa%dg(n, depth), aa%gram(depth, depth))
-        allocate (aa%x(n), aa%f(n), aa%g(n), aa%fprev(n), aa%gprev(n), aa%d(n))
+        allocate (aa%x(n), aa%fprev(n), aa%gprev(n), aa%d(n))
         do a = 1, size(list)
             k = list(a)
             aa%d(3*a - 2) = sqrt(cs%w(1, k))
@@ -800,6 +825,11 @@ contains
     !> f = g - x; the new iterate is g - dG gamma, gamma minimising |f - dF gamma| over the
     !> history, projected on the cones, and the velocities are recomputed from it. When |f|
     !> rose since the last sweep the history is cleared and g is kept (plain NLGS step).
+    !> Three passes over the contacts: g, f, their differences and |f| (pass_residual); the
+    !> new row of the Gram matrix and the right-hand side (pass_products); the mixed,
+    !> projected iterate, kept in x for the next step (pass_mix). The sums are taken by
+    !> fixed chunks of contacts, in parallel, then over the chunks in order: the same result
+    !> for any number of threads. f and g of the step are kept in fprev and gprev.
     subroutine anderson_mix(aa, cs, list, im, vfree, vel, split)
         type(anderson_t), intent(inout) :: aa
         type(contact_set_t), intent(inout) :: cs
@@ -807,108 +837,128 @@ contains
         real(wp), intent(in) :: im(:, :), vfree(:, :)
         real(wp), intent(inout) :: vel(:, :)
         type(split_t), intent(in) :: split
-        real(wp) :: gamma(aa%depth), rhs(aa%depth), fnorm, t(3), p(3)
-        integer :: a, k, j, pcase, slot, m, i
-        call gather(cs, list, aa%d, aa%g)
-        !$omp parallel do schedule(static)
-        do i = 1, size(aa%f)
-            aa%f(i) = aa%g(i) - aa%x(i)
-        end do
-        !$omp end parallel do
-        fnorm = sqrt(pdot(aa%f, aa%f))
+        real(wp) :: gamma(aa%depth), rhs(aa%depth), fnorm
+        real(wp), allocatable :: part(:, :)
+        integer :: slot, m, nc, c, j
+        nc = (size(list) + dot_chunk - 1)/dot_chunk
+        allocate (part(2*aa%depth, nc))
+        slot = aa%next
+        call pass_residual(aa%started)
+        fnorm = sqrt(sum(part(1, :)))
+        if ((aa%started .and. fnorm > aa%fnorm_prev) .or. .not. ieee_is_finite(fnorm)) then
+            ! safeguard: the residual rose (or overflowed), restart from the plain sweep's result
+            aa%used = 0
+            aa%next = 1
+            aa%fnorm_prev = fnorm
+            aa%x = aa%gprev
+            return
+        end if
         if (aa%started) then
-            if (fnorm > aa%fnorm_prev) then
-                ! safeguard: the residual rose, restart from the plain sweep's result
-                aa%used = 0
-                aa%next = 1
-                call shift_history(-1)
-                aa%fnorm_prev = fnorm
-                return
-            end if
-            slot = aa%next
-            call shift_history(slot)
             aa%used = min(aa%used + 1, aa%depth)
             aa%next = mod(slot, aa%depth) + 1
-            do j = 1, aa%used
-                aa%gram(slot, j) = pdot(aa%df(:, slot), aa%df(:, j))
-                aa%gram(j, slot) = aa%gram(slot, j)
-            end do
-        else
-            call shift_history(-1)
         end if
         aa%started = .true.
         aa%fnorm_prev = fnorm
         m = aa%used
-        if (m == 0) return
+        if (m == 0) then
+            aa%x = aa%gprev
+            return
+        end if
+        call pass_products(m)
         do j = 1, m
-            rhs(j) = pdot(aa%df(:, j), aa%f)
+            aa%gram(slot, j) = 0.0_wp
+            rhs(j) = 0.0_wp
+            do c = 1, nc
+                aa%gram(slot, j) = aa%gram(slot, j) + part(j, c)
+                rhs(j) = rhs(j) + part(m + j, c)
+            end do
+            aa%gram(j, slot) = aa%gram(slot, j)
         end do
         call solve_small(aa%gram(1:m, 1:m), rhs(1:m), gamma(1:m))
-        !$omp parallel do schedule(static) private(j)
-        do i = 1, size(aa%x)
-            aa%x(i) = aa%g(i)
-            do j = 1, m
-                aa%x(i) = aa%x(i) - gamma(j)*aa%dg(i, j)
-            end do
-        end do
-        !$omp end parallel do
-        ! back to reactions, on the cones
-        !$omp parallel do schedule(static) private(a, k, t, p, pcase)
-        do a = 1, size(list)
-            k = list(a)
-            t = 0.0_wp
-            if (aa%d(3*a - 2) > 0.0_wp) t(1) = aa%x(3*a - 2)/aa%d(3*a - 2)
-            if (aa%d(3*a - 1) > 0.0_wp) t(2) = aa%x(3*a - 1)/aa%d(3*a - 1)
-            if (aa%d(3*a) > 0.0_wp) t(3) = aa%x(3*a)/aa%d(3*a)
-            if (cs%erol(k) > 0.0_wp) then
-                call rolling_projection(t(1), t(2), t(3), cs%mu(k), cs%erol(k), p(1), p(2), p(3), pcase)
-            else
-                call coulomb_projection(t(1), t(2), cs%mu(k), p(1), p(2), pcase)
-                p(3) = 0.0_wp
-            end if
-            cs%r(1, k) = p(1) - cs%coh(k)
-            cs%r(2:3, k) = p(2:3)
-        end do
-        !$omp end parallel do
+        call pass_mix(m)
         vel = vfree
         call split_apply(cs, split, im, vel)
     contains
-        ! new differences in column `slot` (none for slot < 0), then fprev = f, gprev = g
-        subroutine shift_history(slot)
-            integer, intent(in) :: slot
-            integer :: i
-            !$omp parallel do schedule(static)
-            do i = 1, size(aa%f)
-                if (slot > 0) then
-                    aa%df(i, slot) = aa%f(i) - aa%fprev(i)
-                    aa%dg(i, slot) = aa%g(i) - aa%gprev(i)
-                end if
-                aa%fprev(i) = aa%f(i)
-                aa%gprev(i) = aa%g(i)
+        ! g = D (r_n + r_cohe h, r_t, M), f = g - x, |f|^2 per chunk in part(1, :); with
+        ! `history`, their differences with the previous ones in column slot
+        subroutine pass_residual(history)
+            logical, intent(in) :: history
+            real(wp) :: gv, fv, acc
+            integer :: c, a, k, i, q
+            !$omp parallel do schedule(static) private(a, k, i, q, gv, fv, acc)
+            do c = 1, nc
+                acc = 0.0_wp
+                do a = (c - 1)*dot_chunk + 1, min(c*dot_chunk, size(list))
+                    k = list(a)
+                    do q = 1, 3
+                        i = 3*a - 3 + q
+                        gv = cs%r(q, k)
+                        if (q == 1) gv = gv + cs%coh(k)
+                        gv = aa%d(i)*gv
+                        fv = gv - aa%x(i)
+                        if (history) then
+                            aa%df(i, slot) = fv - aa%fprev(i)
+                            aa%dg(i, slot) = gv - aa%gprev(i)
+                        end if
+                        aa%fprev(i) = fv
+                        aa%gprev(i) = gv
+                        acc = acc + fv*fv
+                    end do
+                end do
+                part(1, c) = acc
             end do
             !$omp end parallel do
-        end subroutine shift_history
-    end subroutine anderson_mix
+        end subroutine pass_residual
 
-    !> Dot product summed by fixed chunks of `dot_chunk` entries (in parallel), then over
-    !> the chunks in order: the same result for any number of threads.
-    real(wp) function pdot(x, y) result(s)
-        real(wp), intent(in) :: x(:), y(:)
-        real(wp), allocatable :: part(:)
-        integer :: c, nc
-        nc = (size(x) + dot_chunk - 1)/dot_chunk
-        allocate (part(nc))
-        !$omp parallel do schedule(static)
-        do c = 1, nc
-            part(c) = dot_product(x((c - 1)*dot_chunk + 1:min(c*dot_chunk, size(x))), &
-                                  y((c - 1)*dot_chunk + 1:min(c*dot_chunk, size(x))))
-        end do
-        !$omp end parallel do
-        s = 0.0_wp
-        do c = 1, nc
-            s = s + part(c)
-        end do
-    end function pdot
+        ! per chunk: df_slot . df_j in part(j, :), df_j . f in part(m + j, :), j = 1..m
+        ! (a chunk's columns stay in cache while they are read again)
+        subroutine pass_products(m)
+            integer, intent(in) :: m
+            integer :: c, j, lo, hi
+            !$omp parallel do schedule(static) private(j, lo, hi)
+            do c = 1, nc
+                lo = 3*(c - 1)*dot_chunk + 1
+                hi = 3*min(c*dot_chunk, size(list))
+                do j = 1, m
+                    part(j, c) = dot(aa%df(lo:hi, slot), aa%df(lo:hi, j))
+                    part(m + j, c) = dot(aa%df(lo:hi, j), aa%fprev(lo:hi))
+                end do
+            end do
+            !$omp end parallel do
+        end subroutine pass_products
+
+        ! x = g - dG gamma, back to reactions on the cones, and x = D r of the result
+        subroutine pass_mix(m)
+            integer, intent(in) :: m
+            real(wp) :: t(3), p(3)
+            integer :: c, a, k, i, j, lo, hi, pcase
+            !$omp parallel do schedule(static) private(a, k, i, j, lo, hi, t, p, pcase)
+            do c = 1, nc
+                lo = 3*(c - 1)*dot_chunk + 1
+                hi = 3*min(c*dot_chunk, size(list))
+                aa%x(lo:hi) = aa%gprev(lo:hi)
+                do j = 1, m
+                    aa%x(lo:hi) = aa%x(lo:hi) - gamma(j)*aa%dg(lo:hi, j)
+                end do
+                do a = (c - 1)*dot_chunk + 1, min(c*dot_chunk, size(list))
+                    k = list(a)
+                    i = 3*a - 3
+                    t = 0.0_wp
+                    where (aa%d(i + 1:i + 3) > 0.0_wp) t = aa%x(i + 1:i + 3)/aa%d(i + 1:i + 3)
+                    if (cs%erol(k) > 0.0_wp) then
+                        call rolling_projection(t(1), t(2), t(3), cs%mu(k), cs%erol(k), p(1), p(2), p(3), pcase)
+                    else
+                        call coulomb_projection(t(1), t(2), cs%mu(k), p(1), p(2), pcase)
+                        p(3) = 0.0_wp
+                    end if
+                    cs%r(1, k) = p(1) - cs%coh(k)
+                    cs%r(2:3, k) = p(2:3)
+                    aa%x(i + 1:i + 3) = aa%d(i + 1:i + 3)*p
+                end do
+            end do
+            !$omp end parallel do
+        end subroutine pass_mix
+    end subroutine anderson_mix
 
     !> vel += M^-1 H r over the contacts of the solve, with the domain split: the blocks in
     !> parallel, then the interface (serial order for one block).
@@ -944,7 +994,7 @@ contains
     !> dependent. x = 0 (a plain sweep) if the regularised system is still not positive definite.
     subroutine solve_small(a, b, x)
         real(wp), intent(in) :: a(:, :), b(:)
-        real(wp), intent(out) :: x(:)
+        real(wp), intent(out), contiguous :: x(:)
         type(dense_spd_t) :: g
         type(error_t), allocatable :: error
         real(wp) :: lambda
@@ -959,6 +1009,7 @@ contains
         x = b
         if (.not. allocated(error)) call g%solve(x, error)
         if (allocated(error)) x = 0.0_wp
+        if (.not. all(ieee_is_finite(x))) x = 0.0_wp
     end subroutine solve_small
 
     !> Round-off floor of the convergence norm's denominator for contact k (module header).
@@ -1105,14 +1156,30 @@ contains
         real(wp), intent(out) :: num, den
         integer(i8), intent(out) :: nloc
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
-        real(wp) :: u(3), r0(3), r(3), dr(3), wk(6)
-        integer :: a, k, it, pcase
+        real(wp) :: u(3), r0(3), r(3), dr(3), wk(6), dvx, dvy, nx, ny, px, py
+        integer :: a, k, it, pcase, i1, i2
         num = 0.0_wp
         den = 0.0_wp
         nloc = 0_i8
         do a = first, last, step
             k = list(a)
-            call local_velocity(cs, k, vel, u)
+            ! u = H^T v + shift (local_velocity, written out)
+            i1 = cs%i1(k)
+            i2 = cs%i2(k)
+            dvx = vel(1, i2)
+            dvy = vel(2, i2)
+            u(2) = cs%lever(2, k)*vel(3, i2) + cs%shift(2, k)
+            u(3) = vel(3, i2)
+            if (i1 > 0) then
+                dvx = dvx - vel(1, i1)
+                dvy = dvy - vel(2, i1)
+                u(2) = u(2) + cs%lever(1, k)*vel(3, i1)
+                u(3) = u(3) - vel(3, i1)
+            end if
+            nx = cs%nrm(1, k)
+            ny = cs%nrm(2, k)
+            u(1) = nx*dvx + ny*dvy + cs%shift(1, k)
+            u(2) = u(2) - ny*dvx + nx*dvy
             wk = cs%w(:, k)
             r0 = [cs%r(1, k) + cs%coh(k), cs%r(2, k), cs%r(3, k)]
             r = r0
@@ -1131,7 +1198,17 @@ contains
             dr = r - r0
             cs%r(1, k) = r(1) - cs%coh(k)
             cs%r(2:3, k) = r(2:3)
-            call apply(cs, k, im, vel, dr(1), dr(2), dr(3))
+            ! v += M^-1 H dr (apply, written out)
+            px = dr(1)*nx - dr(2)*ny
+            py = dr(1)*ny + dr(2)*nx
+            vel(1, i2) = vel(1, i2) + im(1, i2)*px
+            vel(2, i2) = vel(2, i2) + im(2, i2)*py
+            vel(3, i2) = vel(3, i2) + im(3, i2)*(cs%lever(2, k)*dr(2) + dr(3))
+            if (i1 > 0) then
+                vel(1, i1) = vel(1, i1) - im(1, i1)*px
+                vel(2, i1) = vel(2, i1) - im(2, i1)*py
+                vel(3, i1) = vel(3, i1) + im(3, i1)*(cs%lever(1, k)*dr(2) - dr(3))
+            end if
             num = num + wnorm2(wk, dr, cs%amoy(k))
             den = den + wnorm2(wk, cs%r(:, k), cs%amoy(k))
             if (present(bilateral)) call bilateral%update(cs%i1(k), cs%i2(k), vel)
@@ -1309,44 +1386,63 @@ contains
         !> Velocities (3, n_disks) of the reactions (vfree + M^-1 H r).
         real(wp), intent(in) :: vel(:, :)
         real(wp) :: err
+        err = siconos_ratio(cs, vel, siconos_free_norm2(cs, im, vfree))
+    end function nlgs_siconos_error
+
+    !> |q|^2 over the active contacts: q = H^T vq + shift, vq the velocities of the free
+    !> term in the shifted unknown (the free motion minus the cohesion impulses).
+    real(wp) function siconos_free_norm2(cs, im, vfree) result(nq)
+        type(contact_set_t), intent(in) :: cs
+        real(wp), intent(in) :: im(:, :), vfree(:, :)
         real(wp), allocatable :: vq(:, :)
-        real(wp) :: u(3), q(3), r(3), t(3), p(3), num, nq, nr, nu, den
-        integer :: k, pcase
-        ! free term in the shifted unknown: velocities of the free motion minus the cohesion
+        real(wp) :: q(3)
+        integer :: k
         allocate (vq, source=vfree)
         do k = 1, cs%n
             if (.not. cs%active(k)) cycle
             if (cs%coh(k) /= 0.0_wp) call apply(cs, k, im, vq, -cs%coh(k), 0.0_wp, 0.0_wp)
         end do
-        num = 0.0_wp
         nq = 0.0_wp
+        do k = 1, cs%n
+            if (.not. cs%active(k)) cycle
+            call local_velocity(cs, k, vq, q)
+            if (cs%erol(k) <= 0.0_wp) q(3) = 0.0_wp
+            nq = nq + sum(q**2)
+        end do
+    end function siconos_free_norm2
+
+    !> The ratio of nlgs_siconos_error for the velocities vel, with nq = |q|^2
+    !> (siconos_free_norm2).
+    pure real(wp) function siconos_ratio(cs, vel, nq) result(err)
+        type(contact_set_t), intent(in) :: cs
+        real(wp), intent(in) :: vel(:, :), nq
+        real(wp) :: u(3), r(3), t(3), p(3), num, nr, nu, den
+        integer :: k, pcase
+        num = 0.0_wp
         nr = 0.0_wp
         nu = 0.0_wp
         do k = 1, cs%n
             if (.not. cs%active(k)) cycle
             call local_velocity(cs, k, vel, u)
-            call local_velocity(cs, k, vq, q)
             r = [cs%r(1, k) + cs%coh(k), cs%r(2, k), cs%r(3, k)]
             if (cs%erol(k) > 0.0_wp) then
                 t = r - [u(1) + cs%mu(k)*abs(u(2)) + cs%erol(k)*abs(u(3)), u(2), u(3)]
                 call rolling_projection(t(1), t(2), t(3), cs%mu(k), cs%erol(k), p(1), p(2), p(3), pcase)
             else
                 u(3) = 0.0_wp
-                q(3) = 0.0_wp
                 r(3) = 0.0_wp
                 t = [r(1) - (u(1) + cs%mu(k)*abs(u(2))), r(2) - u(2), 0.0_wp]
                 call coulomb_projection(t(1), t(2), cs%mu(k), p(1), p(2), pcase)
                 p(3) = 0.0_wp
             end if
             num = num + sum((r - p)**2)
-            nq = nq + sum(q**2)
             nr = nr + sum(r**2)
             nu = nu + sum(u**2)
         end do
         den = sqrt(max(nq, nr, nu))
         err = 0.0_wp
         if (den > 0.0_wp) err = sqrt(num)/den
-    end function nlgs_siconos_error
+    end function siconos_ratio
 
     !> Relative residual of the contact laws in the current state:
     !> sqrt(sum res_a^2) / sqrt(sum |r'_a|^2) over active contacts, with res_a from

@@ -688,6 +688,7 @@ contains
             sys%solver%relaxation = deck%get_real('solver', 'relaxation')
             sys%solver%check_every = deck%get_int('solver', 'check_every')
             sys%solver%anderson = deck%get_int('solver', 'anderson')
+            sys%solver%anderson_after = deck%get_int('solver', 'anderson_after')
             sys%solver%hydrostatic = deck%get_word('solver', 'cold_start') == 'hydrostatic'
             sys%solver%symmetric = deck%get_word('solver', 'sweep_order') == 'alternating'
             sys%solver%criterion = criterion_lmgc90

@@ -189,11 +189,16 @@ contains
                            '(r_local - r)). Every `check_every` sweeps the error is compared with the one '// &
                            'before; omega falls back to 1 for the rest of the step when it rose.', default='1')
         call s%add_keyword('solver', 'anderson', [int_field('anderson', lower=0, upper=20)], &
-                           'Anderson acceleration of the sweeps: the number of previous sweeps mixed (5 is '// &
-                           'a good choice for tall packings, doc/performance.md); 0: plain sweeps. The '// &
+                           'Anderson acceleration of the sweeps: the number of previous sweeps mixed; 0: '// &
+                           'plain sweeps (the default, 5, is the fastest measured on deposits and tall '// &
+                           'packings, doc/performance.md). The '// &
                            'accelerated sweeps run in the fixed contact order; the history restarts when the '// &
                            'change over a sweep grows. Not used with the Arlequin coupling rows, nor in a step '// &
-                           'where method = block solves intact bonds directly.', default='0')
+                           'where method = block solves intact bonds directly.', default='5')
+        call s%add_keyword('solver', 'anderson_after', [int_field('anderson_after', lower=0)], &
+                           'With `anderson` > 0: plain sweeps before the Anderson steps start. A step that '// &
+                           'converges within them is not accelerated: near rest a plain sweep is cheaper and '// &
+                           'a few suffice (doc/performance.md).', default='50')
         call s%add_keyword('solver', 'sweep_order', [word_field('sweep_order', 'alternating forward')], &
                            'Order of the plain sweeps: `alternating` (forward, then backward through the '// &
                            'contact list, in turn: symmetric Gauss-Seidel) or `forward` (every sweep in the '// &
