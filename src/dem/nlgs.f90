@@ -207,6 +207,11 @@ module dem_nlgs
     integer, parameter :: max_aggregates = 2000
     !> Contacts per chunk of the deterministic parallel sums of the Anderson step.
     integer, parameter :: dot_chunk = 1024
+    !> Siconos criterion: the error is evaluated at least every siconos_period sweeps, and at
+    !> every sweep once the norm of the sweeps times their last measured ratio is below
+    !> siconos_margin times the tolerance.
+    integer, parameter :: siconos_period = 8
+    real(wp), parameter :: siconos_margin = 4.0_wp
     !> Tikhonov term of the Anderson least-squares system, relative to its trace: far above
     !> the rounding of the Gram matrix (1e-16), far below its genuine eigenvalues.
     real(wp), parameter :: anderson_regularisation = 1.0e-12_wp
@@ -346,8 +351,11 @@ contains
         real(wp), allocatable :: sc(:, :)
         ! free velocities (the Siconos error is computed from them in full) and a work copy
         real(wp), allocatable :: vfree(:, :), vwork(:, :)
-        ! with the Siconos criterion: |q|^2 (constant over the solve)
-        real(wp) :: nq
+        ! with the Siconos criterion: |q|^2 (constant over the solve), the ratio of the
+        ! Siconos error to the norm of the sweeps at its last evaluation, and that sweep
+        real(wp) :: nq, per_norm, norm
+        integer :: last_evaluation
+        logical :: evaluated
         real(wp) :: floor, omega, checked
         type(anderson_t) :: aa
         type(split_t) :: split
@@ -368,6 +376,8 @@ contains
         allocate (vwork, mold=vel)
         nq = 0.0_wp
         if (config%criterion == criterion_siconos) nq = siconos_free_norm2(cs, im, vfree)
+        per_norm = 0.0_wp
+        last_evaluation = 0
         s = 0
         floor = 0.0_wp
         do k = 1, cs%n
@@ -439,16 +449,32 @@ contains
                 end if
                 stats%sweeps = s
                 stats%local_iterations = stats%local_iterations + nloc
+                stats%error = relative(max(num - floor, 0.0_wp), den)
+                evaluated = .true.
                 if (config%criterion == criterion_siconos) then
-                    ! from the velocities the sweeps keep up to date; below the tolerance, again
-                    ! from u = W r + q in full, which alone stops the sweeps
-                    stats%error = siconos_ratio(cs, vel, nq)
-                    if (stats%error <= config%tol) stats%error = siconos_error(cs, im, vfree, vel, vwork, &
-                                                                               present(bilateral))
-                else
-                    stats%error = relative(max(num - floor, 0.0_wp), den)
+                    ! evaluated when it may be near the tolerance (the norm of the sweeps times
+                    ! their last measured ratio), every siconos_period sweeps, and where a
+                    ! safeguard or the cap needs it; from the velocities the sweeps keep up to
+                    ! date, and below the tolerance again from u = W r + q in full, which alone
+                    ! stops the sweeps
+                    evaluated = s - last_evaluation >= siconos_period .or. s == config%max_sweeps &
+                                .or. stats%error*per_norm <= siconos_margin*config%tol &
+                                .or. (omega /= 1.0_wp .and. mod(s, config%check_every) == 0) &
+                                .or. (coarse .and. mod(s, config%coarse_every) == 0)
+                    if (evaluated) then
+                        norm = stats%error
+                        stats%error = siconos_ratio(cs, vel, nq)
+                        per_norm = 0.0_wp
+                        if (norm > 0.0_wp) per_norm = stats%error/norm
+                        last_evaluation = s
+                        if (stats%error <= config%tol) stats%error = siconos_error(cs, im, vfree, vel, vwork, &
+                                                                                   present(bilateral))
+                    else
+                        ! an estimate, which does not stop the sweeps
+                        stats%error = stats%error*per_norm
+                    end if
                 end if
-                if (stats%error <= config%tol) then
+                if (evaluated .and. stats%error <= config%tol) then
                     stats%converged = .true.
                     exit
                 end if
@@ -1416,14 +1442,28 @@ contains
     pure real(wp) function siconos_ratio(cs, vel, nq) result(err)
         type(contact_set_t), intent(in) :: cs
         real(wp), intent(in) :: vel(:, :), nq
-        real(wp) :: u(3), r(3), t(3), p(3), num, nr, nu, den
-        integer :: k, pcase
+        real(wp) :: u(3), r(3), t(3), p(3), num, nr, nu, den, dvx, dvy
+        integer :: k, pcase, i1, i2
         num = 0.0_wp
         nr = 0.0_wp
         nu = 0.0_wp
         do k = 1, cs%n
             if (.not. cs%active(k)) cycle
-            call local_velocity(cs, k, vel, u)
+            ! u = H^T v + shift (local_velocity, written out: this runs after most sweeps)
+            i1 = cs%i1(k)
+            i2 = cs%i2(k)
+            dvx = vel(1, i2)
+            dvy = vel(2, i2)
+            u(2) = cs%lever(2, k)*vel(3, i2) + cs%shift(2, k)
+            u(3) = vel(3, i2)
+            if (i1 > 0) then
+                dvx = dvx - vel(1, i1)
+                dvy = dvy - vel(2, i1)
+                u(2) = u(2) + cs%lever(1, k)*vel(3, i1)
+                u(3) = u(3) - vel(3, i1)
+            end if
+            u(1) = cs%nrm(1, k)*dvx + cs%nrm(2, k)*dvy + cs%shift(1, k)
+            u(2) = u(2) - cs%nrm(2, k)*dvx + cs%nrm(1, k)*dvy
             r = [cs%r(1, k) + cs%coh(k), cs%r(2, k), cs%r(3, k)]
             if (cs%erol(k) > 0.0_wp) then
                 t = r - [u(1) + cs%mu(k)*abs(u(2)) + cs%erol(k)*abs(u(3)), u(2), u(3)]
