@@ -420,7 +420,6 @@ contains
         ! the Anderson steps rebuild the velocities from the swept contacts: not with members
         ! of a block or bilateral constraints, whose impulses are not among them
         accelerate = config%anderson > 0 .and. .not. present(bilateral) .and. stats%n_block == 0 .and. n_swept > 0
-        if (accelerate) call anderson_init(aa, config%anderson, cs, list)
         ! the coarse correction scales swept contacts only: not with a block or bilateral rows
         coarse = config%method == nlgs_method_coarse .and. .not. present(bilateral) .and. stats%n_block == 0 &
                  .and. n_swept > 0
@@ -434,7 +433,9 @@ contains
             stats%converged = .false.
             do s = 1, config%max_sweeps
                 if (accelerate .and. s > config%anderson_after) then
-                    ! the map accelerated is one sweep in the fixed (bottom-up) contact order
+                    ! the map accelerated is one sweep in the fixed (bottom-up) contact order;
+                    ! the history is sized when a step first needs it
+                    if (aa%depth == 0) call anderson_init(aa, config%anderson, cs, list)
                     if (.not. aa%x_valid) call gather(cs, list, aa%d, aa%x)
                     aa%x_valid = .true.
                     call split_sweep(config, omega, cs, im, vel, sc, split, .true., num, den, nloc)
