@@ -189,6 +189,8 @@ module dem_nlgs
         !> The iterate x (the scaled reactions the next sweep starts from, valid when
         !> x_valid), the residual f and output g of the last sweep, the scaling D.
         real(wp), allocatable :: x(:), fprev(:), gprev(:), d(:)
+        !> 1/D where D > 0, else 0 (no moment, or W_tt = 0).
+        real(wp), allocatable :: dinv(:)
         real(wp) :: fnorm_prev = huge(1.0_wp)
         logical :: started = .false., x_valid = .false.
     end type anderson_t
@@ -821,7 +823,7 @@ contains
         n = 3*size(list)
         aa%depth = depth
         allocate (aa%df(n, depth), aa%dg(n, depth), aa%gram(depth, depth))
-        allocate (aa%x(n), aa%fprev(n), aa%gprev(n), aa%d(n))
+        allocate (aa%x(n), aa%fprev(n), aa%gprev(n), aa%d(n), aa%dinv(n))
         do a = 1, size(list)
             k = list(a)
             aa%d(3*a - 2) = sqrt(cs%w(1, k))
@@ -829,6 +831,8 @@ contains
             ! no moment: the third component stays 0
             aa%d(3*a) = merge(sqrt(max(cs%w(6, k), 0.0_wp)), 0.0_wp, cs%erol(k) > 0.0_wp)
         end do
+        ! (no division by zero even where a vectorised merge evaluates both branches)
+        aa%dinv = merge(1.0_wp/max(aa%d, tiny(1.0_wp)), 0.0_wp, aa%d > 0.0_wp)
     end subroutine anderson_init
 
     !> Scaled shifted reactions x = D (r_n + r_cohe h, r_t, M) of the contacts of the solve.
@@ -970,8 +974,7 @@ contains
                 do a = (c - 1)*dot_chunk + 1, min(c*dot_chunk, size(list))
                     k = list(a)
                     i = 3*a - 3
-                    t = 0.0_wp
-                    where (aa%d(i + 1:i + 3) > 0.0_wp) t = aa%x(i + 1:i + 3)/aa%d(i + 1:i + 3)
+                    t = aa%x(i + 1:i + 3)*aa%dinv(i + 1:i + 3)
                     if (cs%erol(k) > 0.0_wp) then
                         call rolling_projection(t(1), t(2), t(3), cs%mu(k), cs%erol(k), p(1), p(2), p(3), pcase)
                     else
