@@ -206,16 +206,21 @@ def strategies(exe, src, work):
 
 def deposit_strategies(exe, decks, work):
     """dem_small_deposit.dat (40 frictional disks falling into a pile, impacts, no bonds) solved
-    at tolerance 1e-12 by the three global strategies: plain sweeps, the bonded block (no bonds
-    here: the same sweeps) and the sweeps with coarse corrections (aggregates of 10 contacts,
-    every 5 sweeps) give the same motion; so do the plain sweeps in forward order only
-    (`sweep_order = forward`, "forward")."""
+    at tolerance 1e-12 by the three global strategies with plain sweeps (`anderson = 0`): the
+    sweeps, the bonded block (no bonds here: the same sweeps) and the sweeps with coarse
+    corrections (aggregates of 10 contacts, every 5 sweeps) give the same motion; so do the
+    plain sweeps in forward order only (`sweep_order = forward`, "forward"), the Anderson steps
+    from the first sweep ("anderson") and the default solver (Anderson after 50 sweeps,
+    "default")."""
     res = {}
     text = (decks / "dem_small_deposit.dat").read_text()
-    for method in ("nlgs", "block", "coarse", "forward"):
+    variants = ("nlgs", "block", "coarse", "forward", "anderson", "default")
+    for method in variants:
         deck = work / f"deposit_{method}.dat"
         order = "forward" if method == "forward" else "alternating"
-        deck.write_text(text + f"[solver]\nmethod = {'nlgs' if method == 'forward' else method}\n"
+        solver = {"forward": "anderson = 0\n", "anderson": "anderson = 5\nanderson_after = 0\n",
+                  "default": ""}.get(method, f"method = {method}\nanderson = 0\n")
+        deck.write_text(text + f"[solver]\n{solver}"
                         f"sweep_order = {order}\ntolerance = 1e-12\nmax_sweeps = 100000\n"
                         "coarse_size = 10\ncoarse_every = 5\n")
         f, _ = run(exe, deck, work)
@@ -223,13 +228,13 @@ def deposit_strategies(exe, decks, work):
             res[method] = (f["dem/position"][...], f["dem/solver/sweeps"][...], f["dem/solver/converged"][...])
     (pa, na, ca) = res["nlgs"]
     drop = np.abs(pa - pa[0])[..., :2].max()
-    for method in ("block", "coarse", "forward"):
+    for method in variants[1:]:
         pb, nb, cb = res[method]
         diff = np.abs(pa - pb)[..., :2].max()
         # both stop at 1e-12 of the change of W r per sweep at every one of the 300 steps; the
         # difference of the two iterations stays at that level through the impacts
         # (measured 2e-13 m of a 1.8e-2 m drop for coarse, 0 for block, 2e-13 for forward): 1e-8
-        # of the drop
+        # of the drop; the Anderson steps stop on the change of one sweep of theirs too
         check(f"deposit strategies: {method} and NLGS positions agree", diff < 1e-8 * drop,
               f"max |x_nlgs - x_{method}| = {diff:.2e} m of {drop:.3e} m; sweeps mean {na.mean():.1f} (nlgs), "
               f"{nb.mean():.1f} ({method})")
