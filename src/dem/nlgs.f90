@@ -1446,28 +1446,14 @@ contains
     pure real(wp) function siconos_ratio(cs, vel, nq) result(err)
         type(contact_set_t), intent(in) :: cs
         real(wp), intent(in) :: vel(:, :), nq
-        real(wp) :: u(3), r(3), t(3), p(3), num, nr, nu, den, dvx, dvy
-        integer :: k, pcase, i1, i2
+        real(wp) :: u(3), r(3), t(3), p(3), num, nr, nu, den
+        integer :: k, pcase
         num = 0.0_wp
         nr = 0.0_wp
         nu = 0.0_wp
         do k = 1, cs%n
             if (.not. cs%active(k)) cycle
-            ! u = H^T v + shift (local_velocity, written out: this runs after most sweeps)
-            i1 = cs%i1(k)
-            i2 = cs%i2(k)
-            dvx = vel(1, i2)
-            dvy = vel(2, i2)
-            u(2) = cs%lever(2, k)*vel(3, i2) + cs%shift(2, k)
-            u(3) = vel(3, i2)
-            if (i1 > 0) then
-                dvx = dvx - vel(1, i1)
-                dvy = dvy - vel(2, i1)
-                u(2) = u(2) + cs%lever(1, k)*vel(3, i1)
-                u(3) = u(3) - vel(3, i1)
-            end if
-            u(1) = cs%nrm(1, k)*dvx + cs%nrm(2, k)*dvy + cs%shift(1, k)
-            u(2) = u(2) - cs%nrm(2, k)*dvx + cs%nrm(1, k)*dvy
+            call local_velocity(cs, k, vel, u)
             r = [cs%r(1, k) + cs%coh(k), cs%r(2, k), cs%r(3, k)]
             if (cs%erol(k) > 0.0_wp) then
                 t = r - [u(1) + cs%mu(k)*abs(u(2)) + cs%erol(k)*abs(u(3)), u(2), u(3)]
