@@ -33,10 +33,11 @@
 !> hydrostatic_guess instead of zero reactions.
 !> The Siconos error (nlgs_siconos_error, doc/theory.md 4.5) of the final state is always
 !> computed, from u = H^T (v_free + M^-1 H r) + shift in full; `criterion` chooses which
-!> error stops the sweeps. As a stopping test it is evaluated after each sweep from the
-!> velocities the sweeps keep up to date (the same up to round-off, and one pass over the
-!> contacts instead of three); once that is below the tolerance it is computed again in
-!> full, and only that value stops the sweeps (Siconos' "light, full final" evaluation).
+!> error stops the sweeps. As a stopping test it is evaluated from the velocities the sweeps
+!> keep up to date (the same up to round-off, and one pass over the contacts instead of
+!> three), only after the sweeps where it may be near the tolerance (siconos_period,
+!> siconos_margin); once that is below the tolerance it is computed again in full, and only
+!> that value stops the sweeps (Siconos' "light, full final" evaluation).
 !> Blocked contacts (both bodies immobile along the normal: W_nn = 0) are taken out of the
 !> solve with r = 0 and counted in the statistics (`nlgs_stats_t%n_blocked`).
 !> The constants of each contact's scaled frame (bipotential_scaling) are computed once per
