@@ -194,7 +194,8 @@ contains
                            'packings, doc/performance.md). The '// &
                            'accelerated sweeps run in the fixed contact order; the history restarts when the '// &
                            'change over a sweep grows. Not used with the Arlequin coupling rows, nor in a step '// &
-                           'where method = block solves intact bonds directly.', default='5')
+                           'with intact bonds among the swept contacts (method = block solves them directly).', &
+                           default='5')
         call s%add_keyword('solver', 'anderson_after', [int_field('anderson_after', lower=0)], &
                            'With `anderson` > 0: plain sweeps before the Anderson steps start. A step that '// &
                            'converges within them is not accelerated: near rest a plain sweep is cheaper and '// &
