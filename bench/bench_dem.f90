@@ -21,7 +21,9 @@
 !> With the argument `--convergence`, prints instead the sweeps one step needs to reach the
 !> tolerance from a cold start (no warm start, cap 50000) on packings of 250 to 16000 disks:
 !> what limits the solver on tall static packings.
-!> Options: --sizes N... (the packings to run), --anderson M (Anderson depth), --relaxation W,
+!> Options: --sizes N... (the packings to run), --anderson M (Anderson depth; default 5 as in
+!> the decks, 0: plain sweeps), --anderson-after K (plain sweeps before the Anderson steps;
+!> default 50, `[solver] anderson_after`), --relaxation W,
 !> --check-every K (safeguard period of the over-relaxation), --criterion siconos,
 !> --max-sweeps C (cap of the timed steps), --forward (no alternating sweeps), --settle S (steps
 !> before timing, default 10), --settle-anderson M and --settle-sweeps C (solver of those
