@@ -919,29 +919,28 @@ contains
         ! `history`, their differences with the previous ones in column slot
         subroutine pass_residual(history)
             logical, intent(in) :: history
-            real(wp) :: gv, fv, acc
-            integer :: c, a, k, i, q
-            !$omp parallel do schedule(static) private(a, k, i, q, gv, fv, acc)
+            real(wp) :: g(3*dot_chunk), f(3*dot_chunk)
+            integer :: c, a, k, lo, hi, n
+            !$omp parallel do schedule(static) private(a, k, lo, hi, n, g, f)
             do c = 1, nc
-                acc = 0.0_wp
+                lo = 3*(c - 1)*dot_chunk + 1
+                hi = 3*min(c*dot_chunk, size(list))
+                n = hi - lo + 1
                 do a = (c - 1)*dot_chunk + 1, min(c*dot_chunk, size(list))
                     k = list(a)
-                    do q = 1, 3
-                        i = 3*a - 3 + q
-                        gv = cs%r(q, k)
-                        if (q == 1) gv = gv + cs%coh(k)
-                        gv = aa%d(i)*gv
-                        fv = gv - aa%x(i)
-                        if (history) then
-                            aa%df(i, slot) = fv - aa%fprev(i)
-                            aa%dg(i, slot) = gv - aa%gprev(i)
-                        end if
-                        aa%fprev(i) = fv
-                        aa%gprev(i) = gv
-                        acc = acc + fv*fv
-                    end do
+                    g(3*a - 2 - lo + 1) = cs%r(1, k) + cs%coh(k)
+                    g(3*a - 1 - lo + 1) = cs%r(2, k)
+                    g(3*a - lo + 1) = cs%r(3, k)
                 end do
-                part(1, c) = acc
+                g(1:n) = aa%d(lo:hi)*g(1:n)
+                f(1:n) = g(1:n) - aa%x(lo:hi)
+                if (history) then
+                    aa%df(lo:hi, slot) = f(1:n) - aa%fprev(lo:hi)
+                    aa%dg(lo:hi, slot) = g(1:n) - aa%gprev(lo:hi)
+                end if
+                aa%fprev(lo:hi) = f(1:n)
+                aa%gprev(lo:hi) = g(1:n)
+                part(1, c) = dot(f(1:n), f(1:n))
             end do
             !$omp end parallel do
         end subroutine pass_residual
