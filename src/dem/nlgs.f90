@@ -193,6 +193,8 @@ module dem_nlgs
         real(wp), allocatable :: x(:), fprev(:), gprev(:), d(:)
         !> 1/D where D > 0, else 0 (no moment, or W_tt = 0).
         real(wp), allocatable :: dinv(:)
+        !> Partial sums of the step by chunk of dot_chunk contacts (2 depth, chunks).
+        real(wp), allocatable :: part(:, :)
         real(wp) :: fnorm_prev = huge(1.0_wp)
         logical :: started = .false., x_valid = .false.
     end type anderson_t
@@ -829,6 +831,7 @@ contains
         aa%depth = depth
         allocate (aa%df(n, depth), aa%dg(n, depth), aa%gram(depth, depth))
         allocate (aa%x(n), aa%fprev(n), aa%gprev(n), aa%d(n), aa%dinv(n))
+        allocate (aa%part(2*depth, (size(list) + dot_chunk - 1)/dot_chunk))
         do a = 1, size(list)
             k = list(a)
             aa%d(3*a - 2) = sqrt(cs%w(1, k))
@@ -874,13 +877,11 @@ contains
         real(wp), intent(inout) :: vel(:, :)
         type(split_t), intent(in) :: split
         real(wp) :: gamma(aa%depth), rhs(aa%depth), fnorm
-        real(wp), allocatable :: part(:, :)
         integer :: slot, m, nc, c, j
-        nc = (size(list) + dot_chunk - 1)/dot_chunk
-        allocate (part(2*aa%depth, nc))
+        nc = size(aa%part, 2)
         slot = aa%next
         call pass_residual(aa%started)
-        fnorm = sqrt(sum(part(1, :)))
+        fnorm = sqrt(sum(aa%part(1, :)))
         if ((aa%started .and. fnorm > aa%fnorm_prev) .or. .not. ieee_is_finite(fnorm)) then
             ! safeguard: the residual rose (or overflowed), restart from the plain sweep's result
             aa%used = 0
@@ -905,8 +906,8 @@ contains
             aa%gram(slot, j) = 0.0_wp
             rhs(j) = 0.0_wp
             do c = 1, nc
-                aa%gram(slot, j) = aa%gram(slot, j) + part(j, c)
-                rhs(j) = rhs(j) + part(m + j, c)
+                aa%gram(slot, j) = aa%gram(slot, j) + aa%part(j, c)
+                rhs(j) = rhs(j) + aa%part(m + j, c)
             end do
             aa%gram(j, slot) = aa%gram(slot, j)
         end do
@@ -915,7 +916,7 @@ contains
         vel = vfree
         call split_apply(cs, split, im, vel)
     contains
-        ! g = D (r_n + r_cohe h, r_t, M), f = g - x, |f|^2 per chunk in part(1, :); with
+        ! g = D (r_n + r_cohe h, r_t, M), f = g - x, |f|^2 per chunk in aa%part(1, :); with
         ! `history`, their differences with the previous ones in column slot
         subroutine pass_residual(history)
             logical, intent(in) :: history
@@ -940,12 +941,12 @@ contains
                 end if
                 aa%fprev(lo:hi) = f(1:n)
                 aa%gprev(lo:hi) = g(1:n)
-                part(1, c) = dot(f(1:n), f(1:n))
+                aa%part(1, c) = dot(f(1:n), f(1:n))
             end do
             !$omp end parallel do
         end subroutine pass_residual
 
-        ! per chunk: df_slot . df_j in part(j, :), df_j . f in part(m + j, :), j = 1..m
+        ! per chunk: df_slot . df_j in aa%part(j, :), df_j . f in aa%part(m + j, :), j = 1..m
         ! (a chunk's columns stay in cache while they are read again)
         subroutine pass_products(m)
             integer, intent(in) :: m
@@ -955,8 +956,8 @@ contains
                 lo = 3*(c - 1)*dot_chunk + 1
                 hi = 3*min(c*dot_chunk, size(list))
                 do j = 1, m
-                    part(j, c) = dot(aa%df(lo:hi, slot), aa%df(lo:hi, j))
-                    part(m + j, c) = dot(aa%df(lo:hi, j), aa%fprev(lo:hi))
+                    aa%part(j, c) = dot(aa%df(lo:hi, slot), aa%df(lo:hi, j))
+                    aa%part(m + j, c) = dot(aa%df(lo:hi, j), aa%fprev(lo:hi))
                 end do
             end do
             !$omp end parallel do
