@@ -351,7 +351,7 @@ contains
         class(nlgs_block_t), intent(inout), optional :: block
         real(wp) :: num, den, num_b, den_b
         integer(i8) :: nloc
-        integer, allocatable :: list(:)
+        integer, allocatable :: list(:), act(:)
         ! per contact of the solve, constant over the solve: the scaled frame of its local
         ! problem (bipotential_scaling, or rolling_scaling for a law with moments)
         real(wp), allocatable :: sc(:, :)
@@ -380,6 +380,8 @@ contains
         allocate (list(n_swept), sc(rolling_n_scaling, n_swept))
         allocate (vfree, source=vel)
         allocate (vwork, mold=vel)
+        ! the active contacts, in increasing order (the Siconos criterion runs over them)
+        act = pack([(k, k=1, cs%n)], cs%active(1:cs%n))
         nq = 0.0_wp
         if (config%criterion == criterion_siconos) nq = siconos_free_norm2(cs, im, vfree)
         per_norm = 0.0_wp
@@ -473,7 +475,7 @@ contains
                                 .or. (coarse .and. mod(s, config%coarse_every) == 0)
                     if (evaluated) then
                         norm = stats%error
-                        stats%error = siconos_ratio(cs, vel, nq)
+                        stats%error = siconos_ratio(cs, act, vel, nq)
                         per_norm = 0.0_wp
                         if (norm > 0.0_wp) per_norm = stats%error/norm
                         last_evaluation = s
@@ -912,9 +914,15 @@ contains
             aa%gram(j, slot) = aa%gram(slot, j)
         end do
         call solve_small(aa%gram(1:m, 1:m), rhs(1:m), gamma(1:m))
-        call pass_mix(m)
         vel = vfree
-        call split_apply(cs, split, im, vel)
+        if (split%nb == 1) then
+            ! one pass: each contact's impulse applied where its reaction is set, in the order
+            ! of split_apply for one block
+            call pass_mix(m, .true.)
+        else
+            call pass_mix(m, .false.)
+            call split_apply(cs, split, im, vel)
+        end if
     contains
         ! g = D (r_n + r_cohe h, r_t, M), f = g - x, |f|^2 per chunk in aa%part(1, :); with
         ! `history`, their differences with the previous ones in column slot
@@ -963,12 +971,13 @@ contains
             !$omp end parallel do
         end subroutine pass_products
 
-        ! x = g - dG gamma, back to reactions on the cones, and x = D r of the result
-        subroutine pass_mix(m)
+        ! x = g - dG gamma, back to reactions on the cones, and x = D r of the result; with
+        ! `apply_now`, serially, vel += M^-1 H r of each contact too
+        subroutine pass_mix(m, apply_now)
             integer, intent(in) :: m
-            real(wp) :: t(3), p(3)
-            integer :: c, a, k, i, j, lo, hi, pcase
-            !$omp parallel do schedule(static) private(a, k, i, j, lo, hi, t, p, pcase)
+            logical, intent(in) :: apply_now
+            integer :: c, j, lo, hi
+            !$omp parallel do schedule(static) private(j, lo, hi) if (.not. apply_now)
             do c = 1, nc
                 lo = 3*(c - 1)*dot_chunk + 1
                 hi = 3*min(c*dot_chunk, size(list))
@@ -976,24 +985,54 @@ contains
                 do j = 1, m
                     aa%x(lo:hi) = aa%x(lo:hi) - gamma(j)*aa%dg(lo:hi, j)
                 end do
-                do a = (c - 1)*dot_chunk + 1, min(c*dot_chunk, size(list))
-                    k = list(a)
-                    i = 3*a - 3
-                    t = aa%x(i + 1:i + 3)*aa%dinv(i + 1:i + 3)
-                    if (cs%erol(k) > 0.0_wp) then
-                        call rolling_projection(t(1), t(2), t(3), cs%mu(k), cs%erol(k), p(1), p(2), p(3), pcase)
-                    else
-                        call coulomb_projection(t(1), t(2), cs%mu(k), p(1), p(2), pcase)
-                        p(3) = 0.0_wp
-                    end if
-                    cs%r(1, k) = p(1) - cs%coh(k)
-                    cs%r(2:3, k) = p(2:3)
-                    aa%x(i + 1:i + 3) = aa%d(i + 1:i + 3)*p
-                end do
+                call project_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%erol, cs%mu, cs%coh, cs%r, size(vel, 2), &
+                                      im, vel, size(list), list, (c - 1)*dot_chunk + 1, min(c*dot_chunk, size(list)), &
+                                      aa%x, aa%d, aa%dinv, apply_now)
             end do
             !$omp end parallel do
         end subroutine pass_mix
     end subroutine anderson_mix
+
+    !> The mixed iterate of the contacts list(first:last) back to reactions on their cones:
+    !> r = P_K(x / D), x = D r, on the arrays of the contact set (explicit shapes, as
+    !> sweep_contacts); with apply_now, vel += M^-1 H r of each contact too (apply, written out).
+    subroutine project_contacts(n, i1s, i2s, nrm, lever, erol, mu, coh, rc, nd, im, vel, nl, list, first, last, x, d, &
+                                dinv, apply_now)
+        integer, intent(in) :: n, nd, nl, first, last
+        integer, intent(in) :: i1s(n), i2s(n), list(nl)
+        real(wp), intent(in) :: nrm(2, n), lever(2, n), erol(n), mu(n), coh(n), im(3, nd), d(3*nl), dinv(3*nl)
+        real(wp), intent(inout) :: rc(3, n), vel(3, nd), x(3*nl)
+        logical, intent(in) :: apply_now
+        real(wp) :: t(3), p(3), px, py
+        integer :: a, k, i, i1, i2, pcase
+        do a = first, last
+            k = list(a)
+            i = 3*a - 3
+            t = x(i + 1:i + 3)*dinv(i + 1:i + 3)
+            if (erol(k) > 0.0_wp) then
+                call rolling_projection(t(1), t(2), t(3), mu(k), erol(k), p(1), p(2), p(3), pcase)
+            else
+                call coulomb_projection(t(1), t(2), mu(k), p(1), p(2), pcase)
+                p(3) = 0.0_wp
+            end if
+            rc(1, k) = p(1) - coh(k)
+            rc(2:3, k) = p(2:3)
+            x(i + 1:i + 3) = d(i + 1:i + 3)*p
+            if (.not. apply_now) cycle
+            i1 = i1s(k)
+            i2 = i2s(k)
+            px = rc(1, k)*nrm(1, k) - rc(2, k)*nrm(2, k)
+            py = rc(1, k)*nrm(2, k) + rc(2, k)*nrm(1, k)
+            vel(1, i2) = vel(1, i2) + im(1, i2)*px
+            vel(2, i2) = vel(2, i2) + im(2, i2)*py
+            vel(3, i2) = vel(3, i2) + im(3, i2)*(lever(2, k)*rc(2, k) + rc(3, k))
+            if (i1 > 0) then
+                vel(1, i1) = vel(1, i1) - im(1, i1)*px
+                vel(2, i1) = vel(2, i1) - im(2, i1)*py
+                vel(3, i1) = vel(3, i1) + im(3, i1)*(lever(1, k)*rc(2, k) - rc(3, k))
+            end if
+        end do
+    end subroutine project_contacts
 
     !> vel += M^-1 H r over the contacts of the solve, with the domain split: the blocks in
     !> parallel, then the interface (serial order for one block).
@@ -1176,10 +1215,8 @@ contains
     !> list(last), with the scaled frames sc(:, first), sc(:, first + step), ... Per contact:
     !> local solve, relaxation, impulse applied to the bodies. num = sum |W dr|^2, den = sum
     !> |W r|^2 (r applied, not shifted), nloc = local iterations. With bilateral constraints,
-    !> they are restored after each contact update. The update is written out here rather than
-    !> in a procedure of its own: this loop is the hot path of the solver, and whether gfortran
-    !> inlined such a procedure depended on how many callers it had (one more caller made the
-    !> sweep 35 % slower at 10^5 disks).
+    !> they are restored after each contact update. The work is done by sweep_contacts, on
+    !> the arrays of the contact set.
     subroutine sweep(config, omega, cs, im, vel, list, sc, first, last, step, num, den, nloc, bilateral)
         type(nlgs_config_t), intent(in) :: config
         real(wp), intent(in) :: omega
@@ -1191,6 +1228,38 @@ contains
         real(wp), intent(out) :: num, den
         integer(i8), intent(out) :: nloc
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
+        num = 0.0_wp
+        den = 0.0_wp
+        nloc = 0_i8
+        ! (no contact arrays to pass before the first contact)
+        if ((last - first)*step < 0) return
+        call sweep_contacts(config%local_tol, config%local_max_iter, omega, size(vel, 2), cs%n, cs%i1, cs%i2, &
+                            cs%nrm, cs%lever, cs%shift, cs%w, cs%coh, cs%erol, cs%mu, cs%amoy, cs%r, cs%pcase, &
+                            im, vel, size(list), list, size(sc, 2), sc, first, last, step, num, den, nloc, bilateral)
+    end subroutine sweep
+
+    !> The sweep on the arrays of the contact set (explicit shapes: the compiler keeps their
+    !> addresses in registers instead of reloading the components' descriptors at every
+    !> contact; the arithmetic is the same). The update is written out here rather than in a
+    !> procedure of its own: this loop is the hot path of the solver, and whether gfortran
+    !> inlined such a procedure depended on how many callers it had (one more caller made the
+    !> sweep 35 % slower at 10^5 disks).
+    subroutine sweep_contacts(local_tol, local_max_iter, omega, nd, n, i1s, i2s, nrm, lever, shift, w, coh, erol, &
+                              mu, amoy, rc, pcases, im, vel, nl, list, ns, sc, first, last, step, num, den, nloc, &
+                              bilateral)
+        real(wp), intent(in) :: local_tol, omega
+        integer, intent(in) :: local_max_iter, nd, n, nl, ns
+        integer, intent(in) :: i1s(n), i2s(n)
+        real(wp), intent(in) :: nrm(2, n), lever(2, n), shift(2, n), w(6, n), coh(n), erol(n), mu(n), amoy(n)
+        real(wp), intent(inout) :: rc(3, n)
+        integer, intent(inout) :: pcases(n)
+        real(wp), intent(in) :: im(3, nd)
+        real(wp), intent(inout) :: vel(3, nd)
+        integer, intent(in) :: list(nl), first, last, step
+        real(wp), intent(in) :: sc(rolling_n_scaling, ns)
+        real(wp), intent(out) :: num, den
+        integer(i8), intent(out) :: nloc
+        class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         real(wp) :: u(3), r0(3), r(3), dr(3), wk(6), dvx, dvy, nx, ny, px, py
         integer :: a, k, it, pcase, i1, i2
         num = 0.0_wp
@@ -1199,56 +1268,55 @@ contains
         do a = first, last, step
             k = list(a)
             ! u = H^T v + shift (local_velocity, written out)
-            i1 = cs%i1(k)
-            i2 = cs%i2(k)
+            i1 = i1s(k)
+            i2 = i2s(k)
             dvx = vel(1, i2)
             dvy = vel(2, i2)
-            u(2) = cs%lever(2, k)*vel(3, i2) + cs%shift(2, k)
+            u(2) = lever(2, k)*vel(3, i2) + shift(2, k)
             u(3) = vel(3, i2)
             if (i1 > 0) then
                 dvx = dvx - vel(1, i1)
                 dvy = dvy - vel(2, i1)
-                u(2) = u(2) + cs%lever(1, k)*vel(3, i1)
+                u(2) = u(2) + lever(1, k)*vel(3, i1)
                 u(3) = u(3) - vel(3, i1)
             end if
-            nx = cs%nrm(1, k)
-            ny = cs%nrm(2, k)
-            u(1) = nx*dvx + ny*dvy + cs%shift(1, k)
+            nx = nrm(1, k)
+            ny = nrm(2, k)
+            u(1) = nx*dvx + ny*dvy + shift(1, k)
             u(2) = u(2) - ny*dvx + nx*dvy
-            wk = cs%w(:, k)
-            r0 = [cs%r(1, k) + cs%coh(k), cs%r(2, k), cs%r(3, k)]
+            wk = w(:, k)
+            r0 = [rc(1, k) + coh(k), rc(2, k), rc(3, k)]
             r = r0
-            if (cs%erol(k) > 0.0_wp) then
-                call rolling_local_solve_scaled(sc(:, a), u - wmul(wk, r0), config%local_tol, config%local_max_iter, &
-                                                r, it, pcase)
+            if (erol(k) > 0.0_wp) then
+                call rolling_local_solve_scaled(sc(:, a), u - wmul(wk, r0), local_tol, local_max_iter, r, it, pcase)
             else
                 ! no moment (r0(3) = 0, see contacts_set_laws): the two-component law
                 call bipotential_local_solve_scaled(sc(1:bipotential_n_scaling, a), u(1) - wk(1)*r0(1) - wk(2)*r0(2), &
-                                                    u(2) - wk(2)*r0(1) - wk(3)*r0(2), config%local_tol, &
-                                                    config%local_max_iter, r(1), r(2), it, pcase)
+                                                    u(2) - wk(2)*r0(1) - wk(3)*r0(2), local_tol, local_max_iter, &
+                                                    r(1), r(2), it, pcase)
             end if
             nloc = nloc + it
-            cs%pcase(k) = pcase
-            if (omega /= 1.0_wp) call relax(omega, cs%mu(k), cs%erol(k), r0, r)
+            pcases(k) = pcase
+            if (omega /= 1.0_wp) call relax(omega, mu(k), erol(k), r0, r)
             dr = r - r0
-            cs%r(1, k) = r(1) - cs%coh(k)
-            cs%r(2:3, k) = r(2:3)
+            rc(1, k) = r(1) - coh(k)
+            rc(2:3, k) = r(2:3)
             ! v += M^-1 H dr (apply, written out)
             px = dr(1)*nx - dr(2)*ny
             py = dr(1)*ny + dr(2)*nx
             vel(1, i2) = vel(1, i2) + im(1, i2)*px
             vel(2, i2) = vel(2, i2) + im(2, i2)*py
-            vel(3, i2) = vel(3, i2) + im(3, i2)*(cs%lever(2, k)*dr(2) + dr(3))
+            vel(3, i2) = vel(3, i2) + im(3, i2)*(lever(2, k)*dr(2) + dr(3))
             if (i1 > 0) then
                 vel(1, i1) = vel(1, i1) - im(1, i1)*px
                 vel(2, i1) = vel(2, i1) - im(2, i1)*py
-                vel(3, i1) = vel(3, i1) + im(3, i1)*(cs%lever(1, k)*dr(2) - dr(3))
+                vel(3, i1) = vel(3, i1) + im(3, i1)*(lever(1, k)*dr(2) - dr(3))
             end if
-            num = num + wnorm2(wk, dr, cs%amoy(k))
-            den = den + wnorm2(wk, cs%r(:, k), cs%amoy(k))
-            if (present(bilateral)) call bilateral%update(cs%i1(k), cs%i2(k), vel)
+            num = num + wnorm2(wk, dr, amoy(k))
+            den = den + wnorm2(wk, rc(:, k), amoy(k))
+            if (present(bilateral)) call bilateral%update(i1s(k), i2s(k), vel)
         end do
-    end subroutine sweep
+    end subroutine sweep_contacts
 
     !> The domain split of the sweeps (OpenMP): nb contiguous blocks of the contact list (in
     !> contact order, i.e. bottom-up for disks numbered by height), swept at the same time,
@@ -1421,7 +1489,8 @@ contains
         !> Velocities (3, n_disks) of the reactions (vfree + M^-1 H r).
         real(wp), intent(in) :: vel(:, :)
         real(wp) :: err
-        err = siconos_ratio(cs, vel, siconos_free_norm2(cs, im, vfree))
+        integer :: k
+        err = siconos_ratio(cs, pack([(k, k=1, cs%n)], cs%active(1:cs%n)), vel, siconos_free_norm2(cs, im, vfree))
     end function nlgs_siconos_error
 
     !> |q|^2 over the active contacts: q = H^T vq + shift, vq the velocities of the free
@@ -1447,27 +1516,58 @@ contains
     end function siconos_free_norm2
 
     !> The ratio of nlgs_siconos_error for the velocities vel, with nq = |q|^2
-    !> (siconos_free_norm2).
-    pure real(wp) function siconos_ratio(cs, vel, nq) result(err)
+    !> (siconos_free_norm2), over the active contacts act (in increasing order).
+    pure real(wp) function siconos_ratio(cs, act, vel, nq) result(err)
         type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: act(:)
         real(wp), intent(in) :: vel(:, :), nq
-        real(wp) :: u(3), r(3), t(3), p(3), num, nr, nu, den
-        integer :: k, pcase
+        err = 0.0_wp
+        ! (no contact arrays to pass before the first contact)
+        if (size(act) == 0) return
+        err = siconos_ratio_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%shift, cs%r, cs%coh, cs%erol, cs%mu, &
+                                     size(vel, 2), vel, size(act), act, nq)
+    end function siconos_ratio
+
+    !> siconos_ratio on the arrays of the contact set (explicit shapes, as sweep_contacts; the
+    !> local velocity written out: this runs after most sweeps of a long solve).
+    pure real(wp) function siconos_ratio_contacts(n, i1s, i2s, nrm, lever, shift, rc, coh, erol, mu, nd, vel, na, &
+                                                  act, nq) result(err)
+        integer, intent(in) :: n, nd, na
+        integer, intent(in) :: i1s(n), i2s(n), act(na)
+        real(wp), intent(in) :: nrm(2, n), lever(2, n), shift(2, n), rc(3, n), coh(n), erol(n), mu(n)
+        real(wp), intent(in) :: vel(3, nd), nq
+        real(wp) :: u(3), r(3), t(3), p(3), num, nr, nu, den, dvx, dvy, nx, ny
+        integer :: a, k, i1, i2, pcase
         num = 0.0_wp
         nr = 0.0_wp
         nu = 0.0_wp
-        do k = 1, cs%n
-            if (.not. cs%active(k)) cycle
-            call local_velocity(cs, k, vel, u)
-            r = [cs%r(1, k) + cs%coh(k), cs%r(2, k), cs%r(3, k)]
-            if (cs%erol(k) > 0.0_wp) then
-                t = r - [u(1) + cs%mu(k)*abs(u(2)) + cs%erol(k)*abs(u(3)), u(2), u(3)]
-                call rolling_projection(t(1), t(2), t(3), cs%mu(k), cs%erol(k), p(1), p(2), p(3), pcase)
+        do a = 1, na
+            k = act(a)
+            i1 = i1s(k)
+            i2 = i2s(k)
+            dvx = vel(1, i2)
+            dvy = vel(2, i2)
+            u(2) = lever(2, k)*vel(3, i2) + shift(2, k)
+            u(3) = vel(3, i2)
+            if (i1 > 0) then
+                dvx = dvx - vel(1, i1)
+                dvy = dvy - vel(2, i1)
+                u(2) = u(2) + lever(1, k)*vel(3, i1)
+                u(3) = u(3) - vel(3, i1)
+            end if
+            nx = nrm(1, k)
+            ny = nrm(2, k)
+            u(1) = nx*dvx + ny*dvy + shift(1, k)
+            u(2) = u(2) - ny*dvx + nx*dvy
+            r = [rc(1, k) + coh(k), rc(2, k), rc(3, k)]
+            if (erol(k) > 0.0_wp) then
+                t = r - [u(1) + mu(k)*abs(u(2)) + erol(k)*abs(u(3)), u(2), u(3)]
+                call rolling_projection(t(1), t(2), t(3), mu(k), erol(k), p(1), p(2), p(3), pcase)
             else
                 u(3) = 0.0_wp
                 r(3) = 0.0_wp
-                t = [r(1) - (u(1) + cs%mu(k)*abs(u(2))), r(2) - u(2), 0.0_wp]
-                call coulomb_projection(t(1), t(2), cs%mu(k), p(1), p(2), pcase)
+                t = [r(1) - (u(1) + mu(k)*abs(u(2))), r(2) - u(2), 0.0_wp]
+                call coulomb_projection(t(1), t(2), mu(k), p(1), p(2), pcase)
                 p(3) = 0.0_wp
             end if
             num = num + sum((r - p)**2)
@@ -1477,7 +1577,7 @@ contains
         den = sqrt(max(nq, nr, nu))
         err = 0.0_wp
         if (den > 0.0_wp) err = sqrt(num)/den
-    end function siconos_ratio
+    end function siconos_ratio_contacts
 
     !> Relative residual of the contact laws in the current state:
     !> sqrt(sum res_a^2) / sqrt(sum |r'_a|^2) over active contacts, with res_a from
