@@ -216,9 +216,9 @@ module dem_nlgs
     !> Siconos criterion: the error is evaluated at least every siconos_period sweeps, and at
     !> every sweep once the norm of the sweeps times their last measured ratio is below
     !> siconos_margin times the tolerance. A margin of 2 rather than 4: on the 200-disk deposit
-    !> over 24 layouts 0.819 against 0.853 ms per step, on the 2 000-disk one over 6 layouts
-    !> 18.7 against 20.6 ms, with the same sweeps (doc/performance.md, "Explicit-shape
-    !> kernels"); the deposits are chaotic, so one layout does not decide.
+    !> over 24 layouts 0.789 against 0.813 ms per step, on the 2 000-disk one over 6 layouts
+    !> 18.7 against 20.6 ms, with the same sweeps on average (doc/performance.md,
+    !> "Explicit-shape kernels"); the deposits are chaotic, so one layout does not decide.
     integer, parameter :: siconos_period = 8
     real(wp), parameter :: siconos_margin = 2.0_wp
     !> Tikhonov term of the Anderson least-squares system, relative to its trace: far above
