@@ -404,8 +404,10 @@ contains
         if (present(bilateral) .or. stats%n_block > 0) nb = 1
         nb = max(1, min(nb, n_swept/max(config%split_min, 1)))
         call split_build(split, cs, list, size(vel, 2), nb)
-        ! the scaled frames in the order of the sweeps (split%order)
-        !$omp parallel do schedule(static) private(k)
+        ! the scaled frames in the order of the sweeps (split%order); like every loop of the
+        ! solve, on the threads only when the sweeps are split (below, waking the threads costs
+        ! more than the loop)
+        !$omp parallel do schedule(static) private(k) if (split%nb > 1)
         do s = 1, n_swept
             k = split%order(s)
             if (cs%erol(k) > 0.0_wp) then
@@ -450,7 +452,7 @@ contains
                     ! the map accelerated is one sweep in the fixed (bottom-up) contact order;
                     ! the history is sized when a step first needs it
                     if (aa%depth == 0) call anderson_init(aa, config%anderson, cs, list)
-                    if (.not. aa%x_valid) call gather(cs, list, aa%d, aa%x)
+                    if (.not. aa%x_valid) call gather(cs, list, aa%d, aa%x, split%nb > 1)
                     aa%x_valid = .true.
                     call split_sweep(config, omega, cs, im, vel, sc, split, .true., num, den, nloc)
                 else
@@ -848,14 +850,16 @@ contains
         aa%dinv = merge(1.0_wp/max(aa%d, tiny(1.0_wp)), 0.0_wp, aa%d > 0.0_wp)
     end subroutine anderson_init
 
-    !> Scaled shifted reactions x = D (r_n + r_cohe h, r_t, M) of the contacts of the solve.
-    subroutine gather(cs, list, d, x)
+    !> Scaled shifted reactions x = D (r_n + r_cohe h, r_t, M) of the contacts of the solve
+    !> (on the OpenMP threads when `parallel`).
+    subroutine gather(cs, list, d, x, parallel)
         type(contact_set_t), intent(in) :: cs
         integer, intent(in) :: list(:)
         real(wp), intent(in) :: d(:)
         real(wp), intent(out) :: x(:)
+        logical, intent(in) :: parallel
         integer :: a, k
-        !$omp parallel do schedule(static) private(k)
+        !$omp parallel do schedule(static) private(k) if (parallel)
         do a = 1, size(list)
             k = list(a)
             x(3*a - 2) = d(3*a - 2)*(cs%r(1, k) + cs%coh(k))
@@ -933,7 +937,7 @@ contains
             logical, intent(in) :: history
             real(wp) :: g(3*dot_chunk), f(3*dot_chunk)
             integer :: c, a, k, lo, hi, n
-            !$omp parallel do schedule(static) private(a, k, lo, hi, n, g, f)
+            !$omp parallel do schedule(static) private(a, k, lo, hi, n, g, f) if (split%nb > 1)
             do c = 1, nc
                 lo = 3*(c - 1)*dot_chunk + 1
                 hi = 3*min(c*dot_chunk, size(list))
@@ -962,7 +966,7 @@ contains
         subroutine pass_products(m)
             integer, intent(in) :: m
             integer :: c, j, lo, hi
-            !$omp parallel do schedule(static) private(j, lo, hi)
+            !$omp parallel do schedule(static) private(j, lo, hi) if (split%nb > 1)
             do c = 1, nc
                 lo = 3*(c - 1)*dot_chunk + 1
                 hi = 3*min(c*dot_chunk, size(list))
