@@ -199,6 +199,10 @@ def build(disks, width, args):
     law = sk.NewtonImpactFrictionNSL(args.e, 0.0, args.mu, 2)
     manager.insertNonSmoothLaw(law, 0, 0)
     osi = sk.MoreauJeanOSI(args.theta)
+    if args.gamma is not None:
+        # activation of a contact when y + gamma h y' <= 0 (Siconos' default gamma 1/2)
+        osi.setGamma(args.gamma)
+        osi.setUseGamma(True)
     options = sk.solver_options_create(sn.SICONOS_FRICTION_2D_NSGS)
     options.iparam[sn.SICONOS_IPARAM_MAX_ITER] = args.max_iter
     options.dparam[sn.SICONOS_DPARAM_TOL] = args.tol
@@ -220,6 +224,9 @@ def main():
     ap.add_argument("--steps", type=int, default=500, help="time steps (default 500 = 1 s)")
     ap.add_argument("--h", type=float, default=2e-3, help="time step [s] (default 2e-3)")
     ap.add_argument("--theta", type=float, default=0.5, help="Moreau-Jean theta (default 1/2)")
+    ap.add_argument("--gamma", type=float, default=None,
+                    help="activation of a contact when its gap plus gamma h times its velocity "
+                         "is <= 0 (default: Siconos' 1/2)")
     ap.add_argument("--mu", type=float, default=0.3, help="friction coefficient (default 0.3)")
     ap.add_argument("--e", type=float, default=0.0, help="Newton restitution (default 0)")
     ap.add_argument("--tol", type=float, default=1e-4, help="NSGS tolerance (default 1e-4)")
