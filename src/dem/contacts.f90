@@ -39,11 +39,6 @@ module dem_contacts
     integer, parameter :: status_cohesive = 3
     !> Contact status, cohesive bond broken for good (now a plain frictional contact).
     integer, parameter :: status_broken = 4
-    !> Fewest contacts for which the loops over the contacts run on the OpenMP threads: below,
-    !> waking the threads costs more than the loop (2 000-disk deposit, 3 700 contacts: 26.3
-    !> ms per step on 2 threads against 17.9 on one when they ran there). The same value as
-    !> the sweeps' domain split, two blocks of nlgs_config_t%split_min.
-    integer, parameter :: parallel_min = 4000
 
     !> Parameters of the step needed to set the contact laws.
     type :: contact_law_t
@@ -374,7 +369,7 @@ contains
         real(wp), intent(in) :: im(:, :)
         integer :: k, a, b
         real(wp) :: nx, ny
-        !$omp parallel do schedule(static) private(k, a, b, nx, ny) if (cs%n >= parallel_min)
+        !$omp parallel do schedule(static) private(k, a, b, nx, ny)
         do k = 1, cs%n
             a = cs%i1(k)
             b = cs%i2(k)
@@ -477,8 +472,7 @@ contains
         integer :: k, ma, mb
         real(wp) :: ub(3), uf(3), uw(2), amoy, target, e, gp
         ! contacts are independent: the loop runs over the OpenMP threads (same result)
-        !$omp parallel do schedule(static) private(k, ma, mb, ub, uf, uw, amoy, target, e, gp) &
-        !$omp if (cs%n >= parallel_min)
+        !$omp parallel do schedule(static) private(k, ma, mb, ub, uf, uw, amoy, target, e, gp)
         do k = 1, cs%n
             mb = mat(cs%i2(k))
             if (cs%i1(k) > 0) then
