@@ -1536,7 +1536,8 @@ contains
     end function siconos_ratio
 
     !> siconos_ratio on the arrays of the contact set (explicit shapes, as sweep_contacts; the
-    !> local velocity written out: this runs after most sweeps of a long solve).
+    !> local velocity written out as there: this runs after most sweeps of a long solve, and a
+    !> shared procedure for it was not inlined, 3 % more time on the 200-disk deposit).
     pure real(wp) function siconos_ratio_contacts(n, i1s, i2s, nrm, lever, shift, rc, coh, erol, mu, nd, vel, na, &
                                                   act, nq) result(err)
         integer, intent(in) :: n, nd, na
