@@ -383,10 +383,12 @@ contains
         allocate (list(n_swept), sc(rolling_n_scaling, n_swept))
         allocate (vfree, source=vel)
         allocate (vwork, mold=vel)
-        ! the active contacts, in increasing order (the Siconos criterion runs over them)
-        act = pack([(k, k=1, cs%n)], cs%active(1:cs%n))
         nq = 0.0_wp
-        if (config%criterion == criterion_siconos) nq = siconos_free_norm2(cs, im, vfree)
+        if (config%criterion == criterion_siconos) then
+            ! the active contacts, in increasing order: the running criterion runs over them
+            act = pack([(k, k=1, cs%n)], cs%active(1:cs%n))
+            nq = siconos_free_norm2(cs, im, vfree)
+        end if
         per_norm = 0.0_wp
         last_evaluation = 0
         s = 0
