@@ -243,6 +243,9 @@ def main():
     ap.add_argument("--verbose", action="store_true", help="one line per step")
     ap.add_argument("--final", metavar="FILE",
                     help="write the final state as CSV: x, y, theta, vx, vy, omega per disk")
+    ap.add_argument("--trajectory", metavar="FILE",
+                    help="write every step's positions (steps, disks, 3: x, y, theta) in metres and "
+                         "whether its NSGS converged (steps,) as a numpy .npz (arrays q, converged)")
     args = ap.parse_args()
     if args.steps < 1 or args.h <= 0 or args.max_iter < 1 or args.newton_iter < 1 or args.cell < 1 \
             or args.unit < 1:
@@ -266,6 +269,8 @@ def main():
     n_conv = n_contacts = n_solves = 0
     err_s, err_m, err_d, u_gap = [], [], [], []
     wall_errors = cpu_errors = 0.0
+    traj_q, traj_conv = [], []
+    back = np.array([1.0/args.unit, 1.0/args.unit, 1.0])
     wall0, cpu0 = time.perf_counter(), time.process_time()
     for k in range(1, args.steps + 1):
         osnspb.reset_step()
@@ -284,6 +289,9 @@ def main():
         # a step without active contacts has no problem to solve: converged, 0 iterations
         if osnspb.calls == 0 or osnspb.info == 0:
             n_conv += 1
+        if args.trajectory:
+            traj_q.append(np.array([np.array(b.q()) for b in bodies])*back)
+            traj_conv.append(osnspb.calls == 0 or osnspb.info == 0)
         if osnspb.calls:
             residuals.append(osnspb.residual)
         if osnspb.errors:
@@ -303,7 +311,8 @@ def main():
     cpu = time.process_time() - cpu0 - cpu_errors
 
     # back to metres (the angles and angular velocities are unchanged by the scaling)
-    back = np.array([1.0/args.unit, 1.0/args.unit, 1.0])
+    if args.trajectory:
+        np.savez(args.trajectory, q=np.array(traj_q), converged=np.array(traj_conv))
     q = np.array([np.array(b.q()) for b in bodies])*back
     v = np.array([np.array(b.velocity()) for b in bodies])*back
     if args.final:

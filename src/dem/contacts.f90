@@ -19,6 +19,7 @@ module dem_contacts
     use dem_materials, only: materials_t, bond_e_default
     use dem_bipotential, only: case_separation, case_slip, case_roll, case_slip_roll
     use dem_bonds, only: break_none, break_tension, break_shear, break_moment, break_shear_moment
+    use dem_activation, only: activation_t, pair_output_none
     implicit none
     private
     public :: contact_set_t, contact_law_t
@@ -94,6 +95,13 @@ module dem_contacts
         integer, allocatable :: break_mode(:)
         !> Cohesive impulse r_cohe h of intact bonds (0 otherwise) [N s/m].
         real(wp), allocatable :: coh(:)
+        !> Output of the pair at this step (2, n): the gap at the detection configuration and
+        !> the normal relative velocity at the start of the step [m, m/s]; the next step's
+        !> rule of activation may use it (dem_activation, the Siconos rule).
+        real(wp), allocatable :: y(:, :)
+        !> The pair's output at the previous step (2, n), carried over with the warm start
+        !> (pair_output_none, 0 for a pair new to the list).
+        real(wp), allocatable :: y_prev(:, :)
         !> Contact takes part in the solve this step.
         logical, allocatable :: active(:)
         !> status_open, status_stick, status_slip, status_cohesive or status_broken.
@@ -108,6 +116,8 @@ module dem_contacts
         real(wp), allocatable :: prev_r(:, :)
         !> Statuses of the previous list.
         integer, allocatable :: prev_status(:)
+        !> Outputs of the previous list (y of the previous step).
+        real(wp), allocatable :: prev_y(:, :)
     end type contact_set_t
 
 contains
@@ -130,6 +140,9 @@ contains
         call move_alloc(cs%prev_r, tr)
         if (allocated(cs%r)) call move_alloc(cs%r, cs%prev_r)
         if (allocated(tr)) call move_alloc(tr, cs%r)
+        call move_alloc(cs%prev_y, tr)
+        if (allocated(cs%y)) call move_alloc(cs%y, cs%prev_y)
+        if (allocated(tr)) call move_alloc(tr, cs%y)
         cs%n_prev = cs%n
         cs%n = 0
         cs%merge_pos = 1
@@ -138,6 +151,7 @@ contains
         call grow_int(cs%i2, cs%capacity, 0)
         call grow_int(cs%status, cs%capacity, 0)
         call grow_real2(cs%r, 3, cs%capacity, 0)
+        call grow_real2(cs%y, 2, cs%capacity, 0)
         ! the new list is usually about as long as the previous one
         call ensure_capacity(cs, cs%n_prev + cs%n_prev/8)
     end subroutine contacts_begin_detection
@@ -264,7 +278,8 @@ contains
         cs%nrm(1, k) = nx
         cs%nrm(2, k) = ny
         cs%gap(k) = gap
-        ! the law is set by contacts_set_laws; until then: none
+        ! the law and the output are set by contacts_set_laws; until then: none
+        cs%y(:, k) = [pair_output_none, 0.0_wp]
         cs%mu(k) = 0.0_wp
         cs%erol(k) = 0.0_wp
         cs%coh(k) = 0.0_wp
@@ -281,12 +296,14 @@ contains
             if (cs%prev_i1(p) == i1 .and. cs%prev_i2(p) == i2) then
                 cs%r(:, k) = cs%prev_r(:, p)
                 cs%status(k) = cs%prev_status(p)
+                cs%y_prev(:, k) = cs%prev_y(:, p)
                 p = p + 1
                 return
             end if
         end if
         cs%r(:, k) = 0.0_wp
         cs%status(k) = status_open
+        cs%y_prev(:, k) = [pair_output_none, 0.0_wp]
     end subroutine set_one
 
     !> Grow every per-contact array to hold at least m contacts (keeps the first n).
@@ -305,6 +322,8 @@ contains
         call grow_real2(cs%shift, 2, cap, cs%n)
         call grow_real2(cs%r, 3, cap, cs%n)
         call grow_real2(cs%u, 3, cap, cs%n)
+        call grow_real2(cs%y, 2, cap, cs%n)
+        call grow_real2(cs%y_prev, 2, cap, cs%n)
         call grow_real1(cs%mu, cap, cs%n)
         call grow_real1(cs%erol, cap, cs%n)
         call grow_real1(cs%amoy, cap, cs%n)
@@ -433,32 +452,30 @@ contains
     end function contacts_local_velocity
 
     !> Material law, bonds, solver shifts and activation of every contact for the step.
-    !> With g the gap at the detection (mid) configuration and g_p = g + theta h u_n(free) the
-    !> gap predicted with the free velocities, a contact is active (takes part in the solve) if
-    !>  - it is an intact bond, or
-    !>  - g_p <= gap_allowance * mean radius (a round-off allowance: disks that touch at rest
-    !>    have g and g_p of either sign at the level of the rounding of their coordinates), or
-    !>  - it carried a compressive reaction at the previous step (warm start r_n > 0): a
-    !>    loaded contact stays in the solve even when the rounding or the solver tolerance left
-    !>    it slightly open.
-    !> Normal law of an active contact, u_n >= target (the solver shifts u_n by -target):
-    !>  - g_p <= 0 (the free motion closes it), and intact bonds: Newton restitution,
-    !>    target = e max(-u_n(begin), 0) (a bond holds its gap, <= bond_ratio * mean radius,
-    !>    rather than pulling it shut with its cohesion);
-    !>  - otherwise (g_p > 0): gap term, target = -max(g, 0)/(theta h), i.e. the end-of-step gap
-    !>    g + theta h u_n >= 0: the contact may close its gap during the step but not overlap;
-    !>    it then carries a reaction only if the other contacts push it shut. Activating such
-    !>    a contact is therefore exact: it changes the work of the solver, not the solution.
+    !> Intact bonds are always active, with Newton restitution: target = e max(-u_n(begin), 0)
+    !> (a bond holds its gap, <= bond_ratio * mean radius, rather than pulling it shut with its
+    !> cohesion). Whether any other contact is active, and its normal target u_n >= target
+    !> (the solver shifts u_n by -target), is the rule's (dem_activation): by default the
+    !> predicted gap g_p = g + theta h u_n(free) on the mid configuration, with the round-off
+    !> allowance gap_allowance * mean radius (disks that touch at rest have g and g_p of either
+    !> sign at the level of the rounding of their coordinates), the warm start r_n > 0 (a
+    !> loaded contact stays in the solve even when the rounding or the solver tolerance left it
+    !> slightly open), Newton restitution when g_p <= 0 and otherwise the gap term
+    !> -max(g, 0)/(theta h): the contact may close its gap during the step but not overlap, so
+    !> activating it changes the work of the solver, not the solution.
     !> There is no position correction (standard Moreau-Jean): with theta = 1 an active
     !> contact never closes past its gap at the start of the step; with theta < 1 an impact
     !> may overlap by up to (1 - theta) h |u_n|, and the overlap is kept. (A full push-out
     !> -g/(theta h) of overlaps was tried and makes dense packings unstable.)
-    subroutine contacts_set_laws(cs, law, radius, mat, wall_mat, materials, vel_begin, vel_free, &
+    !> The pair's output y = (g, u_n(begin)) is stored for the next step's rule.
+    subroutine contacts_set_laws(cs, law, rule, radius, mat, wall_mat, materials, vel_begin, vel_free, &
                                  wall_vel_begin, wall_vel_end)
         !> Contacts.
         type(contact_set_t), intent(inout) :: cs
         !> Step parameters.
         type(contact_law_t), intent(in) :: law
+        !> Rule of activation of the contacts without a bond.
+        class(activation_t), intent(in) :: rule
         !> Disk radii [m].
         real(wp), intent(in) :: radius(:)
         !> Disk and wall materials.
@@ -470,9 +487,10 @@ contains
         !> Wall velocities at the start and at the end of the step (2, n_walls).
         real(wp), intent(in) :: wall_vel_begin(:, :), wall_vel_end(:, :)
         integer :: k, ma, mb
-        real(wp) :: ub(3), uf(3), uw(2), amoy, target, e, gp
+        real(wp) :: ub(3), uf(3), uw(2), amoy, target, e
+        logical :: active
         ! contacts are independent: the loop runs over the OpenMP threads (same result)
-        !$omp parallel do schedule(static) private(k, ma, mb, ub, uf, uw, amoy, target, e, gp)
+        !$omp parallel do schedule(static) private(k, ma, mb, ub, uf, uw, amoy, target, e, active)
         do k = 1, cs%n
             mb = mat(cs%i2(k))
             if (cs%i1(k) > 0) then
@@ -503,16 +521,17 @@ contains
             uf = contacts_local_velocity(cs, k, vel_free, wall_vel_end)
             uw = 0.0_wp
             if (cs%i1(k) < 0) uw = -wall_term(cs%nrm(:, k), wall_vel_end(:, -cs%i1(k)))
-            gp = cs%gap(k) + law%theta*law%h*uf(1)
-            if (gp <= 0.0_wp .or. cs%status(k) == status_cohesive) then
+            if (cs%status(k) == status_cohesive) then
+                active = .true.
                 target = e*max(-ub(1), 0.0_wp)
             else
-                target = -max(cs%gap(k), 0.0_wp)/(law%theta*law%h)
+                call rule%decide(law%h, law%theta, e, law%gap_allowance*amoy, cs%gap(k), ub(1), uf(1), &
+                                 cs%r(1, k), cs%y_prev(:, k), active, target)
             end if
+            cs%y(:, k) = [cs%gap(k), ub(1)]
             cs%shift(1, k) = uw(1) - target
             cs%shift(2, k) = uw(2)
-            cs%active(k) = cs%status(k) == status_cohesive .or. gp <= law%gap_allowance*amoy .or. &
-                           cs%r(1, k) > 0.0_wp
+            cs%active(k) = active
             if (.not. cs%active(k)) cs%r(:, k) = 0.0_wp
         end do
         !$omp end parallel do
@@ -653,6 +672,8 @@ contains
         if (allocated(cs%nrm)) b = b + 8_i8*(size(cs%nrm) + size(cs%gap))
         if (allocated(cs%lever)) b = b + 8_i8*(size(cs%lever) + size(cs%w) + size(cs%shift) + size(cs%r) &
                                                + size(cs%u) + size(cs%mu) + size(cs%coh) + size(cs%erol) + size(cs%amoy))
+        if (allocated(cs%y)) b = b + 8_i8*(size(cs%y) + size(cs%y_prev))
+        if (allocated(cs%prev_y)) b = b + 8_i8*size(cs%prev_y)
         if (allocated(cs%status)) b = b + 4_i8*(size(cs%status) + size(cs%active) + size(cs%pcase) &
                                                 + size(cs%break_mode))
         if (allocated(cs%prev_i1)) b = b + 4_i8*(size(cs%prev_i1) + size(cs%prev_i2))

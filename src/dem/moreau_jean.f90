@@ -4,9 +4,10 @@
 !> One step from t to t + h:
 !>   1. free velocities v_free = v + h M^-1 F_theta (F_theta = (1 - theta) F(t) + theta F(t + h));
 !>      imposed and fixed DOFs take their values at t + h;
-!>   2. detection on the mid configuration q + (1 - theta) h v (warm start by pair);
-!>   3. contact laws (activation on the predicted gap with a round-off allowance, or on the
-!>      previous reaction; Newton restitution or gap term; cohesion), frames;
+!>   2. detection on the mid configuration q + (1 - theta) h v (warm start by pair), or on
+!>      q + h v with Siconos' rule of activation (`scheme%activation`, dem_activation);
+!>   3. contact laws (by default activation on the predicted gap with a round-off allowance,
+!>      or on the previous reaction; Newton restitution or gap term; cohesion), frames;
 !>   4. NLGS with the bi-potential local solver: v+ and the impulses (blocked contacts, whose
 !>      bodies are both immobile along the normal, are left out and counted in `stats`);
 !>   5. q+ = q + h [(1 - theta) v + theta v+]; bonds pulled beyond their cohesion break;
@@ -42,6 +43,7 @@ module dem_moreau_jean
     use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_bilateral_t, nlgs_method_block
     use dem_bonded_block, only: bonded_block_t, bonded_block_solve
     use dem_bonds, only: rupture_log_t, break_none
+    use dem_activation, only: activation_t, activation_predicted_t
     implicit none
     private
     public :: mj_config_t, energies_t, dem_system_t, mj_init, mj_step, energies_balance, dem_system_bytes
@@ -64,6 +66,10 @@ module dem_moreau_jean
         !> (mean) radius: contacts whose predicted gap is at most this are active
         !> (dem_contacts, contacts_set_laws).
         real(wp) :: gap_allowance = 1.0e-10_wp
+        !> How the contacts enter the step (dem_activation; `[time] contact_scheme`): where
+        !> they are detected, which are active, their normal targets. mj_init sets MULTICOR's
+        !> rule (activation_predicted_t) when none is given.
+        class(activation_t), allocatable :: activation
     end type mj_config_t
 
     !> Energies and works per unit thickness [J/m] since the start.
@@ -144,6 +150,7 @@ contains
         integer :: n, nw
         call check_settings(sys, error)
         if (allocated(error)) return
+        if (.not. allocated(sys%scheme%activation)) allocate (activation_predicted_t :: sys%scheme%activation)
         n = sys%particles%n
         nw = sys%walls%n
         if (allocated(sys%vel0)) deallocate (sys%vel0, sys%vel, sys%im, sys%load, sys%impulse, sys%xm, &
@@ -230,7 +237,7 @@ contains
                              sys%wx1, sys%wy1, sys%wx2, sys%wy2, sys%contacts)
         call system_clock(c1)
         call contacts_set_frames(sys%contacts, sys%particles%radius, sys%im)
-        call contacts_set_laws(sys%contacts, step_law(sys), sys%particles%radius, sys%particles%mat, &
+        call contacts_set_laws(sys%contacts, step_law(sys), sys%scheme%activation, sys%particles%radius, sys%particles%mat, &
                                sys%walls%mat, sys%materials, sys%vel0, sys%vel, sys%wall_v0, sys%wall_v1)
         call system_clock(c2)
         sys%time_detection = sys%time_detection + real(c1 - c0, wp)/real(rate, wp)
@@ -306,11 +313,13 @@ contains
         end do
     end subroutine free_velocities
 
-    !> Mid configuration q + (1 - theta) h v of disks and walls (where contacts are detected).
+    !> Configuration q + a h v of disks and walls where the contacts are detected: the mid
+    !> configuration a = 1 - theta with MULTICOR's rule of activation, a = 1 with Siconos'
+    !> (dem_activation).
     subroutine mid_configuration(sys)
         type(dem_system_t), intent(inout) :: sys
         real(wp) :: a
-        a = (1.0_wp - sys%scheme%theta)*sys%scheme%h
+        a = sys%scheme%activation%offset(sys%scheme%theta)*sys%scheme%h
         sys%xm = sys%particles%x(1:sys%particles%n) + a*sys%vel0(1, :)
         sys%ym = sys%particles%y(1:sys%particles%n) + a*sys%vel0(2, :)
         if (sys%walls%n == 0) return

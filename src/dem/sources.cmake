@@ -5,6 +5,7 @@ set(MULTICOR_DEM_SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/generators.f90
     ${CMAKE_CURRENT_LIST_DIR}/walls.f90
     ${CMAKE_CURRENT_LIST_DIR}/materials.f90
+    ${CMAKE_CURRENT_LIST_DIR}/activation.f90
     ${CMAKE_CURRENT_LIST_DIR}/contacts.f90
     ${CMAKE_CURRENT_LIST_DIR}/detection.f90
     ${CMAKE_CURRENT_LIST_DIR}/bipotential.f90

@@ -541,6 +541,7 @@ contains
                 if (.not. allocated(error)) call file%write_dataset(g//'/shift', cs%shift(:, 1:m), error)
                 if (.not. allocated(error)) call file%write_dataset(g//'/r', cs%r(:, 1:m), error)
                 if (.not. allocated(error)) call file%write_dataset(g//'/u', cs%u(:, 1:m), error)
+                if (.not. allocated(error)) call file%write_dataset(g//'/y', cs%y(:, 1:m), error)
                 if (.not. allocated(error)) call file%write_dataset(g//'/mu', cs%mu(1:m), error)
                 if (.not. allocated(error)) call file%write_dataset(g//'/erol', cs%erol(1:m), error)
                 if (.not. allocated(error)) call file%write_dataset(g//'/amoy', cs%amoy(1:m), error)
@@ -696,6 +697,8 @@ contains
                 if (allocated(cs%i1)) deallocate (cs%i1, cs%i2, cs%nrm, cs%gap, cs%lever, cs%w, cs%shift, &
                                                   cs%r, cs%u, cs%mu, cs%erol, cs%amoy, cs%coh, cs%pcase, &
                                                   cs%break_mode, cs%status, cs%active)
+                if (allocated(cs%y)) deallocate (cs%y)
+                if (allocated(cs%y_prev)) deallocate (cs%y_prev)
                 cs%n = m
                 cs%capacity = m
                 cs%n_prev = 0
@@ -703,7 +706,8 @@ contains
                 if (m == 0) then
                     allocate (cs%i1(0), cs%i2(0), cs%nrm(2, 0), cs%gap(0), cs%lever(2, 0), cs%w(6, 0), &
                               cs%shift(2, 0), cs%r(3, 0), cs%u(3, 0), cs%mu(0), cs%erol(0), cs%amoy(0), &
-                              cs%coh(0), cs%pcase(0), cs%break_mode(0), cs%status(0), cs%active(0))
+                              cs%coh(0), cs%pcase(0), cs%break_mode(0), cs%status(0), cs%active(0), &
+                              cs%y(2, 0), cs%y_prev(2, 0))
                     return
                 end if
                 call file%read_dataset(g//'/i1', cs%i1, error)
@@ -715,6 +719,7 @@ contains
                 if (.not. allocated(error)) call file%read_dataset(g//'/shift', cs%shift, error)
                 if (.not. allocated(error)) call file%read_dataset(g//'/r', cs%r, error)
                 if (.not. allocated(error)) call file%read_dataset(g//'/u', cs%u, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/y', cs%y, error)
                 if (.not. allocated(error)) call file%read_dataset(g//'/mu', cs%mu, error)
                 if (.not. allocated(error)) call file%read_dataset(g//'/erol', cs%erol, error)
                 if (.not. allocated(error)) call file%read_dataset(g//'/amoy', cs%amoy, error)
@@ -725,6 +730,8 @@ contains
                 if (.not. allocated(error)) call file%read_dataset(g//'/active', active, error)
                 if (allocated(error)) return
                 cs%active = active /= 0
+                ! the outputs of the previous step are not needed after the step's laws
+                allocate (cs%y_prev(2, m), source=0.0_wp)
                 problem = contacts_list_problem(cs, sys%particles%n, sys%walls%n)
                 if (len(problem) > 0) then
                     call make_error(error, 'checkpoint: '//problem//': the checkpoint is damaged')

@@ -20,6 +20,7 @@ module driver_config_dem
     use core_timefunc, only: time_function_t
     use io_deck, only: deck_t, deck_entry_t
     use io_deck_schema, only: parse_selection
+    use dem_activation, only: activation_siconos_t, activation_predicted_t
     use dem_particles, only: particles_add_disks, particles_fix, particles_impose_velocity, &
                              particles_add_load, dof_x, dof_y, dof_rot
     use dem_generators, only: generate_row, generate_square_lattice, generate_hex_lattice, &
@@ -669,6 +670,13 @@ contains
         associate (sys => cfg%system)
             sys%scheme%h = run%h
             sys%scheme%theta = deck%get_real('time', 'theta')
+            if (allocated(sys%scheme%activation)) deallocate (sys%scheme%activation)
+            select case (deck%get_word('time', 'contact_scheme'))
+            case ('siconos')
+                allocate (activation_siconos_t :: sys%scheme%activation)
+            case default
+                allocate (activation_predicted_t :: sys%scheme%activation)
+            end select
             cfg%default_alert = .not. deck%has('contacts', 'alert')
             if (cfg%default_alert) then
                 sys%scheme%alert = default_alert_ratio* &

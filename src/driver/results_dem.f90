@@ -128,6 +128,8 @@ contains
             if (allocated(error)) return
             call file%write_attribute('/dem', 'theta', sys%scheme%theta, error)
             if (allocated(error)) return
+            call file%write_attribute('/dem', 'contact_scheme', sys%scheme%activation%name(), error)
+            if (allocated(error)) return
             call file%write_attribute('/dem', 'alert', sys%scheme%alert, error)
             if (allocated(error)) return
             call file%write_attribute('/dem', 'gravity', sys%particles%gravity, error)

@@ -102,7 +102,8 @@ contains
     end subroutine check_run_kind
 
     !> Error for a deck without [particles] that sets particle-only keywords ([walls],
-    !> [contacts], [solver], [time] theta, [output] contacts): they would have no effect.
+    !> [contacts], [solver], [time] theta and contact_scheme, [output] contacts): they would
+    !> have no effect.
     subroutine check_particle_keywords_unused(deck, error)
         !> The deck.
         type(deck_t), intent(in) :: deck
@@ -114,7 +115,7 @@ contains
                 select case (e%section)
                 case ('walls', 'contacts', 'solver')
                 case ('time')
-                    if (e%keyword /= 'theta') cycle
+                    if (e%keyword /= 'theta' .and. e%keyword /= 'contact_scheme') cycle
                 case ('output')
                     if (e%keyword /= 'contacts') cycle
                 case default

@@ -68,6 +68,15 @@ contains
                            'Moreau-Jean theta of the particles: positions advance with (1 - theta) v(t) + '// &
                            'theta v(t + h); 1/2 conserves energy in free flight and elastic impacts, '// &
                            '1 is fully implicit (dissipative, never overlaps).', default='0.5')
+        call s%add_keyword('time', 'contact_scheme', [word_field('contact_scheme', 'multicor siconos')], &
+                           'How the contacts of the particles enter a step. multicor: detected on the '// &
+                           'mid configuration q + (1 - theta) h v, active when the free motion closes '// &
+                           'them or when they carried a load, a gap term for those still open '// &
+                           '(doc/theory.md 2.3-2.4). siconos: the step of Siconos 4.4 (TimeStepping, '// &
+                           'MoreauJeanOSI, one Newton iteration), to compare with it on the same discrete '// &
+                           'problem: geometry at q + h v, active when the previous step''s gap plus h/2 '// &
+                           'times its normal velocity is <= 0, no gap term (doc/theory.md 2.6).', &
+                           default='multicor')
     end subroutine add_time
 
     !> [output]: what is stored and shown.

@@ -427,6 +427,13 @@ def main():
     block.write_text(re.sub(r"^\[solver\]\s*$", "[solver]\nmethod = block",
                             (src / "input" / "cohesive_row.dat").read_text(), count=1, flags=re.M))
     by_end_time(exe, block, work, "block_end", 0.1)
+    # The deposit compared with Siconos, with Siconos' rule of activation ([time] contact_scheme
+    # = siconos): the rule reads the outputs of the previous step's contacts, which the
+    # checkpoint keeps (dem/contacts/y). Stopped at step 85, while the pile forms.
+    sic = edit_deck(src / "input" / "siconos_deposit_200.dat", work / "siconos_scheme.dat", end=0.3)
+    check("siconos_scheme_end: the deck uses the Siconos scheme",
+          re.search(r"^contact_scheme\s*=\s*siconos\s*$", sic.read_text(), flags=re.M) is not None, "")
+    by_end_time(exe, sic, work, "siconos_scheme_end", 0.17)
     stack = edit_deck(src / "input" / "bending_stack.dat", work / "coupled_stack.dat", end=3.0e-4)
     by_end_time(exe, stack, work, "coupled_end", 1.3e-4)
     by_signal(exe, src / "input" / "cantilever.dat", work, "beam_term", signal.SIGTERM, 3.0, 1000)
