@@ -42,6 +42,9 @@
 !> (siconos_deposit); --csv FILE and --deck FILE write its layout as CSV and as a deck, --seed S
 !> draws other radii (default 8, the layout of input/siconos_deposit_*.dat): the deposit is
 !> chaotic, so a change of the solver that moves the stopping points is judged over many seeds.
+!> --scheme multicor|siconos chooses the rule of activation of the contacts (`[time]
+!> contact_scheme`, doc/theory.md 2.6): with --siconos the default is siconos, so that the
+!> deposit is the discrete problem Siconos 4.4 integrates; otherwise multicor, the deck default.
 !> Run: cmake --build <build> --target bench_dem && OMP_NUM_THREADS=1 <build>/bench/bench_dem
 program bench_dem
     use, intrinsic :: iso_fortran_env, only: output_unit, error_unit, compiler_version, compiler_options
@@ -53,6 +56,7 @@ program bench_dem
     use dem_materials, only: materials_init, materials_set_pair
     use dem_detection, only: detect_contacts
     use dem_moreau_jean, only: dem_system_t, mj_init, mj_step, dem_system_bytes
+    use dem_activation, only: activation_siconos_t, activation_predicted_t
     use dem_nlgs, only: criterion_lmgc90, criterion_siconos, nlgs_method_nlgs, nlgs_method_block, &
                         nlgs_method_coarse
     use bench_packing, only: deposit_disks, deposit_width, staggered_layout
@@ -106,6 +110,10 @@ program bench_dem
     !> with Siconos).
     integer :: layout_seed = 8
     character(len=256) :: csv_path = '', deck_path = ''
+    !> Rule of activation (--scheme, `[time] contact_scheme`): multicor or siconos; '' for the
+    !> default of the mode (siconos for --siconos, the deposit compared with Siconos 4.4 on
+    !> the same discrete problem; multicor otherwise).
+    character(len=16) :: scheme_word = ''
     integer :: k
     sizes = [1000, 10000, 100000]
     iarg = 1
@@ -134,6 +142,10 @@ program bench_dem
             call read_int_value(arg, val, siconos_n)
         case ('--seed')
             call read_int_value(arg, val, layout_seed)
+        case ('--scheme')
+            if (val /= 'multicor' .and. val /= 'siconos') &
+                call usage_error('--scheme takes multicor or siconos, got '''//trim(val)//'''')
+            scheme_word = val
         case ('--csv')
             csv_path = val
         case ('--deck')
@@ -187,6 +199,7 @@ program bench_dem
         iarg = iarg + 2
     end do
     if (siconos_n > 0) then
+        if (len_trim(scheme_word) == 0) scheme_word = 'siconos'
         write (output_unit, '(a)') '# compiler: '//compiler_version()
         call siconos_deposit(siconos_n)
         stop
@@ -207,6 +220,18 @@ program bench_dem
         call print_table(res)
     end if
 contains
+
+    !> The rule of activation of --scheme (none: mj_init's default, MULTICOR's rule).
+    subroutine set_scheme(sys)
+        type(dem_system_t), intent(inout) :: sys
+        if (allocated(sys%scheme%activation)) deallocate (sys%scheme%activation)
+        select case (scheme_word)
+        case ('siconos')
+            allocate (activation_siconos_t :: sys%scheme%activation)
+        case ('multicor')
+            allocate (activation_predicted_t :: sys%scheme%activation)
+        end select
+    end subroutine set_scheme
 
     !> Code of a `--method` value.
     integer function method_code(word) result(code)
@@ -247,10 +272,11 @@ contains
         write (unit, '(a)') 'usage: bench_dem [--sizes N...] [--settle S] [--max-sweeps C] [--anderson M] [--anderson-after K]', &
             '         [--relaxation W --check-every K] [--criterion lmgc90|siconos] [--forward]', &
             '         [--hydrostatic] [--method nlgs|block|coarse] [--coarse-every K] [--coarse-size M]', &
-            '         [--settle-anderson M] [--settle-sweeps C] [--settle-method M] [--verbose]', &
+            '         [--settle-anderson M] [--settle-sweeps C] [--settle-method M] [--scheme multicor|siconos]', &
+            '         [--verbose]', &
             '       bench_dem --convergence', &
-            '       bench_dem --siconos 200|2000 [--seed S] [--csv FILE] [--deck FILE] [--anderson M] [--anderson-after K]', &
-            '         [--forward] [--verbose]', &
+            '       bench_dem --siconos 200|2000 [--seed S] [--scheme siconos|multicor] [--csv FILE] [--deck FILE]', &
+            '         [--anderson M] [--anderson-after K] [--forward] [--verbose]', &
             'Options and figures: the header of bench/bench_dem.f90 and doc/performance.md.'
     end subroutine print_usage
 
@@ -444,6 +470,7 @@ contains
         sys%solver%method = method
         sys%solver%coarse_every = coarse_every
         sys%solver%coarse_size = coarse_size
+        call set_scheme(sys)
         call mj_init(sys, error)
         if (allocated(error)) error stop 'bench_dem: invalid setup'
         n_steps = nint(t_end/h)
@@ -455,7 +482,7 @@ contains
         sic_max = 0.0_wp
         write (output_unit, '(a, i0, a, i0, a, i0, a, f0.4, a, i0, a)') '# deposit against Siconos: N = ', n, ' (', &
             n_row, ' x ', n_rows, '), box width ', width, ' m, mean radius 1 cm, seed ', layout_seed, &
-            ', mu 0.3, e 0, h 2 ms, 500 steps'
+            ', mu 0.3, e 0, h 2 ms, 500 steps, contact scheme '//trim(scheme_word)
         write (output_unit, '(a, i0, a, es9.2, a, i0, a, i0, a, l1)') '# criterion ', sys%solver%criterion, &
             ' (1 lmgc90, 2 siconos), tolerance ', tol, ', cap ', cap, ' sweeps, anderson ', anderson, &
             ', hydrostatic ', hydrostatic
@@ -522,11 +549,14 @@ contains
         write (u, '(a, i0, a)') '# MULTICOR deck: gravity deposit of ', n, ' disks, the layout compared with' &
             //' Siconos 4.4 NSGS'
         write (u, '(a)') '# (doc/performance.md, "Deposit against Siconos"). Written by'
-        if (layout_seed == 8) then
+        if (layout_seed == 8 .and. scheme_word == 'siconos') then
             write (u, '(a, i0, a)') '#   build-release/bench/bench_dem --siconos ', n, ' --deck <this file>'
-        else
+        else if (scheme_word == 'siconos') then
             write (u, '(a, i0, a, i0, a)') '#   build-release/bench/bench_dem --siconos ', n, ' --seed ', layout_seed, &
                 ' --deck <this file>'
+        else
+            write (u, '(a, i0, a, i0, a)') '#   build-release/bench/bench_dem --siconos ', n, ' --seed ', layout_seed, &
+                ' --scheme '//trim(scheme_word)//' --deck <this file>'
         end if
         write (u, '(a, i0, a, i0, a)') '# Staggered lattice of ', n_row, ' x ', n_rows, &
             ' disks, pitch 2.5 R (R = 1 cm), every other row shifted by'
@@ -536,7 +566,9 @@ contains
             //'1e-4 on the'
         write (u, '(a)') '# Siconos error. Coordinates with 17 significant digits: read back, they are the ' &
             //'doubles of the'
-        write (u, '(a)') '# benchmark. Per unit thickness, SI units.'
+        write (u, '(a)') '# benchmark. Per unit thickness, SI units. Contact scheme '//trim(scheme_word)// &
+            ' ([time] contact_scheme;'
+        write (u, '(a)') '# siconos: the discrete problem of Siconos 4.4, doc/theory.md 2.6).'
         write (u, '(a)') ''
         write (u, '(a)') '[run]'
         write (u, '(a, i0, a)') 'title    = Gravity deposit of ', n, ' disks (layout compared with Siconos)'
@@ -568,6 +600,7 @@ contains
         write (u, '(a)') '[time]'
         write (u, '(a)') 'step     = 2e-3'
         write (u, '(a)') 'end      = 1.0'
+        write (u, '(a)') 'contact_scheme = '//trim(scheme_word)
         write (u, '(a)') ''
         write (u, '(a)') '[output]'
         write (u, '(a)') 'interval = 50'
@@ -621,6 +654,7 @@ contains
         sys%solver%coarse_every = coarse_every
         sys%solver%coarse_size = coarse_size
         sys%solver%criterion = criterion
+        call set_scheme(sys)
         call mj_init(sys, error)
         if (allocated(error)) error stop 'bench_dem: invalid setup'
     end subroutine build

@@ -109,8 +109,8 @@ def main():
     # Bound on the sinking. The disks reach at most v = sqrt(2 g 4 DELTA) (the top row falls
     # its own gap and the three below). With e = 0, theta = 1/2 and no position correction, an
     # impact leaves an overlap of at most h v_n on each contact (Siconos activates a contact when
-    # g + h/2 v_n <= 0 on the start of the step, so it stops between 0 and h |v_n| inside;
-    # MULTICOR within h/2 |v_n| either side). Row j rests on the floor and j hollows, and an
+    # g + h/2 v_n <= 0 on the output of the previous step, doc/theory.md 2.6, so it stops between
+    # 0 and h |v_n| inside; MULTICOR's scheme within h/2 |v_n| either side). Row j rests on the floor and j hollows, and an
     # overlap d on both contacts of a hollow lowers the disk by d / cos 30 deg.
     v_max = np.sqrt(2 * G * 4 * DELTA)
     bound = H * v_max * (1 + 3 * 2 / np.sqrt(3.0))
