@@ -6,7 +6,8 @@ one Newton iteration, NSGS) on the same layout, both solved to a tight tolerance
 Cases (the layouts are written as a deck for multicor and as the CSV of `bench_dem --csv`):
 - a column of 3 disks, off centre, falling on the floor: the top disks roll off their supports
   (friction mu = 0.3, rotations), with e = 0 and with e = 1/2 (the restitution acts on the
-  velocity of the previous step's output in Siconos, doc/theory.md 2.6);
+  velocity of the previous step's output in Siconos, doc/theory.md 2.6), theta = 1/2, and with
+  e = 0 and theta = 1;
 - a staggered deposit of 30 disks with radii in [0.8 R, 1.2 R] falling into a pile.
 MULTICOR's default scheme (`multicor`: detection on the mid configuration, activation on the
 predicted gap, gap term) is run too: its trajectories must differ from Siconos', or the
@@ -60,7 +61,7 @@ def deposit(n_row=5, n_rows=6, r=0.01, seed=3):
     return np.array(out)
 
 
-def write_inputs(work, name, disks, e, tol, steps, scheme):
+def write_inputs(work, name, disks, e, tol, steps, scheme, theta):
     """The layout as the CSV of bench_dem (for siconos_deposit.py) and as a deck."""
     csv = work / f"{name}.csv"
     with open(csv, "w", encoding="ascii") as f:
@@ -98,6 +99,7 @@ max_sweeps = 1000000
 [time]
 step = {H}
 end = {H * steps}
+theta = {theta}
 contact_scheme = {scheme}
 
 [output]
@@ -117,8 +119,9 @@ def run_multicor(exe, deck, out):
         return f["dem/position"][1:], f["dem/solver/converged"][...], scheme
 
 
-def run_siconos(python, env, script, csv, e, tol, steps, traj):
+def run_siconos(python, env, script, csv, e, tol, steps, theta, traj):
     proc = subprocess.run([python, str(script), str(csv), "--h", str(H), "--steps", str(steps), "--e", str(e),
+                           "--theta", str(theta),
                            "--mu", str(MU), "--tol", str(tol), "--max-iter", "100000", "--trajectory", str(traj)],
                           capture_output=True, text=True, env=env)
     if proc.returncode != 0:
@@ -128,12 +131,12 @@ def run_siconos(python, env, script, csv, e, tol, steps, traj):
     return data["q"], data["converged"]
 
 
-def case(exe, work, python, env, script, name, disks, e, tol, steps, min_compared):
-    csv, deck = write_inputs(work, name, disks, e, tol, steps, "siconos")
-    _, deck_default = write_inputs(work, name, disks, e, tol, steps, "multicor")
+def case(exe, work, python, env, script, name, disks, e, tol, steps, min_compared, theta=0.5):
+    csv, deck = write_inputs(work, name, disks, e, tol, steps, "siconos", theta)
+    _, deck_default = write_inputs(work, name, disks, e, tol, steps, "multicor", theta)
     mc, mc_conv, scheme = run_multicor(exe, deck, work / f"{name}_siconos")
     other, _, _ = run_multicor(exe, deck_default, work / f"{name}_multicor")
-    sic, sic_conv = run_siconos(python, env, script, csv, e, tol, steps, work / f"{name}.npz")
+    sic, sic_conv = run_siconos(python, env, script, csv, e, tol, steps, theta, work / f"{name}.npz")
     check(f"{name}: the results name the scheme", scheme == "siconos", f"contact_scheme = {scheme!r}")
     check(f"{name}: every MULTICOR step converged", mc_conv.all(), f"{mc_conv.sum()} of {len(mc_conv)}")
     # compare up to the first step where Siconos' NSGS stopped at its cap (after that the two
@@ -158,6 +161,7 @@ def main():
     # every step converges on the column (three contacts at most): all 100 compared
     case(exe, work, python, env, script, "column", column(), 0.0, 1e-12, 100, 100)
     case(exe, work, python, env, script, "column_e", column(), 0.5, 1e-12, 100, 100)
+    case(exe, work, python, env, script, "column_theta1", column(), 0.0, 1e-12, 100, 100, theta=1.0)
     # the deposit: the pile forms from step 25 on; NSGS at 1e-10 may stop at its cap later
     case(exe, work, python, env, script, "deposit", deposit(), 0.0, 1e-10, 120, 60)
     return summary()
