@@ -17,6 +17,7 @@ import sys
 import h5py
 import numpy as np
 
+from box_layout import write_box_layout
 from checks import arguments, check, summary
 from siconos_env import siconos_python
 
@@ -41,46 +42,10 @@ def layout():
 
 
 def write_inputs(work, x, y, width):
-    mass = RHO * np.pi * R**2
-    csv = work / "triangle.csv"
-    with open(csv, "w", encoding="ascii") as f:
-        f.write(f"# MULTICOR deposit against Siconos: {len(x)} disks; box: floor y = 0, side walls "
-                f"x = 0 and x = {width:.16e} m\n# test_siconos_deposit.py\nx,y,radius,mass,inertia\n")
-        for xi, yi in zip(x, y):
-            f.write(f"{xi:.17e},{yi:.17e},{R:.17e},{mass:.17e},{0.5 * mass * R**2:.17e}\n")
-    top = y.max() + 5 * R
-    disks = "\n".join(f"disk = {xi:.17e} {yi:.17e} {R:.17e} 1" for xi, yi in zip(x, y))
-    deck = work / "triangle.dat"
-    deck.write_text(f"""[run]
-title = ten disks settling into a triangle (compared with Siconos)
-analysis = dynamic
-
-[particles]
-material = 1 {RHO}
-gravity = 0 -{G}
-{disks}
-
-[walls]
-wall = 0 0 {width:.17e} 0
-wall = 0 0 0 {top:.17e}
-wall = {width:.17e} 0 {width:.17e} {top:.17e}
-
-[contacts]
-law = 1 1 0.3 0 0
-alert = 5e-3
-
-[solver]
-tolerance = 1e-4
-criterion = siconos
-max_sweeps = 10000
-
-[time]
-step = {H}
-end = {H * STEPS}
-
-[output]
-interval = {STEPS}
-""")
+    disks = [(xi, yi, R) for xi, yi in zip(x, y)]
+    csv, deck = write_box_layout(work, "triangle", disks, width, rho=RHO, g=G, mu=0.3, e=0, tol=1e-4,
+                                 max_sweeps=10000, h=H, steps=STEPS, interval=STEPS,
+                                 title="ten disks settling into a triangle (compared with Siconos)")
     return csv, deck
 
 

@@ -24,6 +24,7 @@ import sys
 import h5py
 import numpy as np
 
+from box_layout import write_box_layout
 from checks import arguments, check, summary
 from siconos_env import siconos_python
 
@@ -63,48 +64,10 @@ def deposit(n_row=5, n_rows=6, r=0.01, seed=3):
 
 def write_inputs(work, name, disks, e, tol, steps, scheme, theta):
     """The layout as the CSV of bench_dem (for siconos_deposit.py) and as a deck."""
-    csv = work / f"{name}.csv"
-    with open(csv, "w", encoding="ascii") as f:
-        f.write(f"# MULTICOR deposit against Siconos: {len(disks)} disks; box: floor y = 0, side walls "
-                f"x = 0 and x = {WIDTH:.16e} m\n# test_siconos_scheme.py\nx,y,radius,mass,inertia\n")
-        for x, y, r in disks:
-            m = RHO * np.pi * r * r
-            f.write(f"{x:.17e},{y:.17e},{r:.17e},{m:.17e},{0.5 * m * r * r:.17e}\n")
-    top = disks[:, 1].max() + 0.05
-    lines = "\n".join(f"disk = {x:.17e} {y:.17e} {r:.17e} 1" for x, y, r in disks)
-    deck = work / f"{name}_{scheme}.dat"
-    deck.write_text(f"""[run]
-title = {name}: MULTICOR with the {scheme} contact scheme
-analysis = dynamic
-
-[particles]
-material = 1 {RHO}
-gravity = 0 -{G}
-{lines}
-
-[walls]
-wall = 0 0 {WIDTH:.17e} 0
-wall = 0 0 0 {top:.17e}
-wall = {WIDTH:.17e} 0 {WIDTH:.17e} {top:.17e}
-
-[contacts]
-law = 1 1 {MU} {e} 0
-alert = 5e-3
-
-[solver]
-tolerance = {tol}
-criterion = siconos
-max_sweeps = 1000000
-
-[time]
-step = {H}
-end = {H * steps}
-theta = {theta}
-contact_scheme = {scheme}
-
-[output]
-interval = 1
-""")
+    csv, deck = write_box_layout(work, f"{name}_{scheme}", disks, WIDTH, rho=RHO, g=G, mu=MU, e=e, tol=tol,
+                                 max_sweeps=1000000, h=H, steps=steps, interval=1,
+                                 title=f"{name}: MULTICOR with the {scheme} contact scheme",
+                                 time_extra=f"theta = {theta}\ncontact_scheme = {scheme}\n")
     return csv, deck
 
 
