@@ -25,9 +25,8 @@ module dem_activation
     private
     public :: activation_t, activation_predicted_t, activation_siconos_t, pair_output_none
 
-    !> Output of a pair that was not in the contact list of the previous step: far, so that
-    !> the Siconos rule leaves it inactive (it was farther than the alert distance one step
-    !> earlier; see activation_siconos_t).
+    !> Output of a pair that was not in the contact list of the previous step (it was farther
+    !> than the alert distance): none (see siconos_decide).
     real(wp), parameter :: pair_output_none = huge(1.0_wp)
 
     !> A rule of activation (module header).
@@ -131,16 +130,21 @@ contains
     end function siconos_offset
 
     !> Active when y + h/2 y' <= 0 (Siconos' activation with gamma = 1/2 and threshold 0) on
-    !> the previous step's output (y, y') = y_prev; target -e y'.
+    !> the previous step's output (y, y') = y_prev; target -e y'. A pair new to the list has
+    !> no output yet: it takes the one extrapolated back from this step's geometry, (g - h u_n,
+    !> u_n) (q + h v moves by about h v from one step to the next). Such a pair was beyond the
+    !> alert distance at the previous step, so that extrapolation leaves it inactive, as in
+    !> Siconos, unless it closes by more than the alert distance in half a step; then it is
+    !> the nearest guess of the output Siconos would have.
     pure subroutine siconos_decide(h, theta, e, allowance, gap, un_begin, un_free, rn, y_prev, active, target)
         real(wp), intent(in) :: h, theta, e, allowance, gap, un_begin, un_free, rn, y_prev(2)
         logical, intent(out) :: active
         real(wp), intent(out) :: target
-        active = .false.
-        target = 0.0_wp
-        if (y_prev(1) >= pair_output_none) return
-        active = y_prev(1) + 0.5_wp*h*y_prev(2) <= 0.0_wp
-        target = -e*y_prev(2)
+        real(wp) :: y(2)
+        y = y_prev
+        if (y_prev(1) >= pair_output_none) y = [gap - h*un_begin, un_begin]
+        active = y(1) + 0.5_wp*h*y(2) <= 0.0_wp
+        target = -e*y(2)
     end subroutine siconos_decide
 
     pure function siconos_name() result(word)
