@@ -50,8 +50,9 @@ module driver_checkpoint
         integer(i8) :: step = 0
         !> Unconverged steps so far.
         integer :: unconverged = 0
-        !> Warnings given once: disk faster than the alert distance, blocked contacts.
-        logical :: speed_warned = .false., blocked_warned = .false.
+        !> Warnings given once: disk faster than the alert distance, blocked contacts, bonded
+        !> coupled disks rotated beyond the range of the linear coupling.
+        logical :: speed_warned = .false., blocked_warned = .false., rotation_warned = .false.
     end type loop_state_t
 
     !> When a time loop writes a checkpoint (besides signals and the end of the run).
@@ -330,6 +331,8 @@ contains
         call file%write_attribute('/loop', 'speed_warned', merge(1, 0, loop%speed_warned), error)
         if (allocated(error)) return
         call file%write_attribute('/loop', 'blocked_warned', merge(1, 0, loop%blocked_warned), error)
+        if (allocated(error)) return
+        call file%write_attribute('/loop', 'rotation_warned', merge(1, 0, loop%rotation_warned), error)
     end subroutine save_loop
 
     !> Read the loop counters.
@@ -352,6 +355,9 @@ contains
         call file%read_attribute('/loop', 'blocked_warned', k, error)
         if (allocated(error)) return
         loop%blocked_warned = k /= 0
+        call file%read_attribute('/loop', 'rotation_warned', k, error)
+        if (allocated(error)) return
+        loop%rotation_warned = k /= 0
     end subroutine load_loop
 
     ! ---------------------------------------------------------------------------------------

@@ -19,7 +19,7 @@
 !> as in the uncoupled runs (driver_guards): the finite-element side by `check_part`, then the
 !> disks (non-finite values, beyond the representable box), then tunnelling (after a step).
 module driver_coupled_loop
-    use core_kinds, only: i8
+    use core_kinds, only: wp, i8
     use core_error, only: error_t
     use core_signals, only: caught_signal, signal_name
     use io_progress, only: progress_t
@@ -29,6 +29,7 @@ module driver_coupled_loop
     use driver_results_dem, only: dem_writer_t
     use driver_results_coupled, only: coupled_writer_t
     use driver_run_dem, only: max_warnings, speed_warning, last_unconverged_warning
+    use dem_contacts, only: status_cohesive
     use driver_guards, only: check_disks_state, step_start_t, take_step_start, check_tunnelling
     use driver_checkpoint, only: checkpoint_run_t, end_of_step, step_end_t, loop_state_t, checkpoint_create, &
                                  save_coupled, load_coupled, &
@@ -165,7 +166,7 @@ contains
         type(step_start_t) :: start
         integer(i8) :: n_steps, k, k0
         integer :: unconverged
-        logical :: speed_warned, store_contacts
+        logical :: speed_warned, rotation_warned, store_contacts
         type(step_end_t) :: act
         integer, allocatable :: material_id(:)
         character(len=512) :: buf
@@ -173,6 +174,7 @@ contains
         n_steps = self%settings%n_steps
         unconverged = 0
         speed_warned = .false.
+        rotation_warned = .false.
         k0 = 0
         call self%particle_output(material_id, store_contacts)
         if (ck%restart) then
@@ -206,6 +208,7 @@ contains
             if (allocated(error)) return
             if (.not. self%sys%stats%converged) call warn_unconverged()
             if (.not. speed_warned) call check_speed()
+            if (.not. rotation_warned) call check_rotation()
             act = end_of_step(k, n_steps, self%settings%output_interval, ck%schedule)
             if (act%store_first) call store(error)
             if (act%checkpoint .and. .not. allocated(error)) call checkpoint(error)
@@ -248,6 +251,7 @@ contains
             k0 = ck%start%step
             unconverged = ck%start%unconverged
             speed_warned = ck%start%speed_warned
+            rotation_warned = ck%start%rotation_warned
         end subroutine restore
 
         !> Write a checkpoint after step k (the buffered per-step values are written first).
@@ -258,7 +262,8 @@ contains
             if (.not. allocated(error)) call self%cpl_out%flush_buffer(out%file, error)
             if (allocated(error)) return
             call checkpoint_create(f, ck%path, ck%deck_text, self%checkpoint_kind(), &
-                                   loop_state_t(k, unconverged, speed_warned, .false.), self%sys%fe%t, &
+                                   loop_state_t(k, unconverged, speed_warned, .false., rotation_warned), &
+                                   self%sys%fe%t, &
                                    out%run_id, error)
             if (.not. allocated(error)) call save_coupled(f, self%sys, error)
             if (.not. allocated(error)) call self%save_part(f, error)
@@ -314,6 +319,38 @@ contains
             speed_warned = .true.
             call report(line)
         end subroutine check_speed
+
+        !> Warning (once) when two coupled disks joined by an intact bond have turned by more than
+        !> rotation_limit. The bond keeps their distance through the rotation, the coupling
+        !> (C built on the reference configuration) moves them with the linear field, which
+        !> stretches the chord by about theta^2/2 of its length: the multipliers then carry a
+        !> spurious axial force of about alpha E A theta^2/2 and the bending moments come out
+        !> short (doc/theory.md 6.3).
+        subroutine check_rotation()
+            real(wp), parameter :: rotation_limit = 1.0e-2_wp
+            logical, allocatable :: coupled(:)
+            real(wp) :: theta
+            integer :: c
+            associate (p => self%sys%dem%particles, cs => self%sys%dem%contacts)
+                if (p%n == 0 .or. size(self%sys%coupled) == 0) return
+                allocate (coupled(p%n), source=.false.)
+                coupled(self%sys%coupled) = .true.
+                theta = 0.0_wp
+                do c = 1, cs%n
+                    if (cs%status(c) /= status_cohesive .or. cs%i1(c) <= 0) cycle
+                    if (.not. (coupled(cs%i1(c)) .and. coupled(cs%i2(c)))) cycle
+                    theta = max(theta, abs(p%rot(cs%i1(c))), abs(p%rot(cs%i2(c))))
+                end do
+                if (theta <= rotation_limit) return
+                write (buf, '(a,es12.4e3,a,es10.2e3,a,es8.1e2,a)') 'warning: at t = ', self%sys%fe%t, &
+                    ' s bonded coupled disks have turned by ', theta, ' rad (more than ', rotation_limit, &
+                    '): the linear coupling stretches their bonds by about theta^2/2, which adds an '// &
+                    'axial force of about alpha E A theta^2/2 and shortens the bending moments by a few % '// &
+                    '(doc/theory.md 6.3); lower the load or treat the results as approximate'
+                rotation_warned = .true.
+                call report(trim(buf))
+            end associate
+        end subroutine check_rotation
 
         !> Closing lines: the model's (size, residuals, solver effort), energy balance, times.
         subroutine summary()

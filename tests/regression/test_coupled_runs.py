@@ -12,6 +12,7 @@ tests/regression/decks/coupled_rigid_translation.dat; case 1 (5 steps) with both
 methods, compared.
 Usage (ctest does this): test_coupled_runs.py --exe multicor --work DIR --source REPO
 """
+import re
 import subprocess
 import sys
 import time
@@ -91,12 +92,7 @@ def profile(f, k):
 
 def truncated(src_deck, work, end):
     """Copy of a deck with [time] end replaced (Debug build: fewer steps)."""
-    text = src_deck.read_text()
-    lines = [f"end  = {end}" if ln.split("=")[0].strip() == "end" else ln for ln in text.splitlines()]
-    out = work / src_deck.name
-    work.mkdir(parents=True, exist_ok=True)
-    out.write_text("\n".join(lines) + "\n")
-    return out
+    return truncated_text(src_deck.read_text(), work / src_deck.name, end)
 
 
 def bending_row(exe, src, work):
@@ -306,6 +302,32 @@ def free_fall(exe, decks, work):
         check("free fall: lambda ~ 0", lam < 1e-6 * weight, f"max |lambda| {lam:.3e} N vs {weight:.3e} N")
 
 
+def rotation_warning(exe, src, work):
+    """The warning on bonded coupled disks turned beyond the linear coupling's range (0.01 rad,
+    doc/theory.md 6.3): silent on the reference case 1 (10 N; its coupled disks turn by at most
+    6.0e-3 rad), given once with 40 N (four times the rotation: 0.01 rad after about 3 ms)."""
+    for name, force, expected in (("case1_10N", "-1000", False), ("case1_40N", "-4000", True)):
+        text = (src / "input" / "bending_case1.dat").read_text()
+        text = re.sub(r"^force(\s*)=(\s*)last(\s*)y(\s*)-1000 ", f"force\\1=\\2last\\3y\\4{force} ", text,
+                      count=1, flags=re.M)
+        check(f"rotation warning {name}: the load is set", f"{force} " in text, "")
+        deck = truncated_text(text, work / f"{name}.dat", 5e-3)
+        proc = subprocess.run([str(exe), str(deck), "--output", str(work / name), "--quiet"],
+                              capture_output=True, text=True)
+        lines = [ln for ln in (proc.stdout + proc.stderr).splitlines() if "bonded coupled disks have turned" in ln]
+        check(f"rotation warning {name}: exit 0", proc.returncode == 0, f"exit {proc.returncode}")
+        check(f"rotation warning {name}: {'given once' if expected else 'none'}",
+              len(lines) == (1 if expected else 0), "; ".join(lines) or "no warning")
+
+
+def truncated_text(text, out, end):
+    """Write a deck's text with [time] end replaced."""
+    lines = [f"end  = {end}" if ln.split("=")[0].strip() == "end" else ln for ln in text.splitlines()]
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text("\n".join(lines) + "\n")
+    return out
+
+
 def main():
     exe, work, src = arguments()
     decks = src / "tests" / "regression" / "decks"
@@ -315,6 +337,7 @@ def main():
     bending_stack(exe, src, work)
     rigid_arm(exe, src, work)
     strategies(exe, src, work)
+    rotation_warning(exe, src, work)
     return summary()
 
 
