@@ -23,6 +23,7 @@ module driver_guards
     use dem_contacts, only: contact_set_t
     use dem_moreau_jean, only: energies_t
     use dem_detection, only: coordinate_limit
+    use core_sort, only: sort_index
     implicit none
     private
     public :: check_beam_state, check_disks_state, step_start_t, take_step_start, check_tunnelling
@@ -158,9 +159,11 @@ contains
     end subroutine take_step_start
 
     !> Error when, within the step just done, a disk centre crossed a wall (the segment swept
-    !> by the centre relative to the wall meets the wall), or two disks of the step's contact
-    !> candidates passed each other (their centre line turned by more than 90 degrees while
-    !> they overlapped by more than half the sum of their radii).
+    !> by the centre relative to the wall meets the wall), or two disks passed each other
+    !> (their centre line turned by more than 90 degrees while they overlapped by more than
+    !> half the sum of their radii): the pairs among the step's contact candidates, and, when
+    !> a disk moved farther than the alert distance (the detection may then have missed the
+    !> pair), every pair with such a disk whose swept boxes meet (sort and sweep along x).
     subroutine check_tunnelling(step, t, h, alert, start, p, w, cs, error)
         !> Steps done.
         integer(i8), intent(in) :: step
@@ -199,13 +202,66 @@ contains
             if (.not. passed(i, j)) cycle
             travel = hypot((p%x(j) - p%x(i)) - (start%x(j) - start%x(i)), &
                            (p%y(j) - p%y(i)) - (start%y(j) - start%y(i)))
+            call through_each_other(i, j)
+            return
+        end do
+        call swept_pairs()
+    contains
+        !> The error for disks i and j passing each other.
+        subroutine through_each_other(i, j)
+            integer, intent(in) :: i, j
+            travel = hypot((p%x(j) - p%x(i)) - (start%x(j) - start%x(i)), &
+                           (p%y(j) - p%y(i)) - (start%y(j) - start%y(i)))
             call make_error(error, when(step, t)//'disks '//to_str(i)//' and '//to_str(j)// &
                             ' passed through each other within one step (relative motion '// &
                             num(travel)//' m, radii '//num(p%radius(i))//' and '// &
                             num(p%radius(j))//' m): '//advice(travel))
-            return
-        end do
-    contains
+        end subroutine through_each_other
+
+        !> Integer keys in the order of the (finite) reals x: the IEEE bit patterns, the 63 low
+        !> bits flipped for negative numbers (whose patterns grow with the magnitude).
+        pure function real_keys(x) result(k)
+            real(wp), intent(in) :: x(:)
+            integer(i8) :: k(size(x))
+            integer :: a
+            do a = 1, size(x)
+                k(a) = transfer(x(a), 0_i8)
+                if (k(a) < 0_i8) k(a) = ieor(k(a), huge(0_i8))
+            end do
+        end function real_keys
+
+        !> The pairs with a disk that moved farther than the alert distance: sorted by the low
+        !> x end of their swept boxes (start and end centres, plus the radius), each box is
+        !> compared with those that start before its high end; a pair whose boxes meet in y
+        !> too is tested with `passed`.
+        subroutine swept_pairs()
+            real(wp), allocatable :: lo(:), hi(:), ylo(:), yhi(:)
+            logical, allocatable :: fast(:)
+            integer, allocatable :: order(:)
+            integer :: a, b, m
+            m = p%n
+            if (m < 2) return
+            fast = hypot(p%x(1:m) - start%x, p%y(1:m) - start%y) > alert
+            if (.not. any(fast)) return
+            lo = min(start%x, p%x(1:m)) - p%radius(1:m)
+            hi = max(start%x, p%x(1:m)) + p%radius(1:m)
+            ylo = min(start%y, p%y(1:m)) - p%radius(1:m)
+            yhi = max(start%y, p%y(1:m)) + p%radius(1:m)
+            order = sort_index(real_keys(lo))
+            do a = 1, m
+                i = order(a)
+                do b = a + 1, m
+                    j = order(b)
+                    if (lo(j) > hi(i)) exit
+                    if (.not. (fast(i) .or. fast(j))) cycle
+                    if (ylo(j) > yhi(i) .or. ylo(i) > yhi(j)) cycle
+                    if (.not. passed(min(i, j), max(i, j))) cycle
+                    call through_each_other(min(i, j), max(i, j))
+                    return
+                end do
+            end do
+        end subroutine swept_pairs
+
         !> The centre path of disk i relative to wall k meets the wall: the signed distance to
         !> the wall's line changes sign, at a point between the wall's ends.
         logical function crosses_wall(i, k)

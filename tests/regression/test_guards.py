@@ -189,6 +189,27 @@ progress = 0
     # 0.025 m), the contact of the step then pushes them further through.
     failing_run(exe, work, "dem_tunnelling_pair", pair.format(h="0.01"),
                 r"disks 1 and 2 passed through each other within one step", pair.format(h="1e-4"))
+    # Two disks 0.1 m apart closing at 20 m/s with h = 0.05 s: 1 m per step, so they are never
+    # near each other at a detection (the mid configuration already has them 0.4 m apart on
+    # the other side) and are no contact candidates; the swept-box check finds them.
+    far = """[run]
+analysis = dynamic
+[particles]
+material = 1 2500
+disk = 0.05 0.011 0.01 1
+disk = 0.15 0.011 0.01 1
+initial_velocity = 1 x 10
+initial_velocity = 2 x -10
+[contacts]
+law = 1 1 0.3 0 0
+[time]
+step = {h}
+end = 0.5
+[output]
+progress = 0
+"""
+    failing_run(exe, work, "dem_tunnelling_unseen_pair", far.format(h="0.05"),
+                r"disks 1 and 2 passed through each other within one step", far.format(h="1e-4"))
 
 
 def lock(exe, work):
