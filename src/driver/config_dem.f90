@@ -14,12 +14,14 @@
 !> they are filled directly: `dem_config_t%system` is ready for `mj_init`.
 module driver_config_dem
     use core_kinds, only: wp, i8
-    use core_constants, only: deg_to_rad
+    use core_constants, only: deg_to_rad, pi
     use core_error, only: error_t, make_input_error
     use core_strings, only: string_t, to_str
     use core_timefunc, only: time_function_t
     use io_deck, only: deck_t, deck_entry_t
     use io_deck_schema, only: parse_selection
+    use io_memory, only: available_memory
+    use core_sort, only: sort_index
     use dem_activation, only: activation_siconos_t, activation_predicted_t
     use dem_particles, only: particles_add_disks, particles_fix, particles_impose_velocity, &
                              particles_add_load, dof_x, dof_y, dof_rot
@@ -108,7 +110,67 @@ contains
         if (allocated(error)) return
         call build_settings(deck, run, cfg)
         call check_overlaps(deck, cfg, error)
+        if (allocated(error)) return
+        call check_alert_reach(deck, cfg, available_memory(), error)
     end subroutine build_dem_config
+
+    !> Error when the alert distance makes so many disk pairs contact candidates that their
+    !> contact list would not fit in the available memory (nothing checked when that is
+    !> unknown, available < 0). The pairs within reach = 2 r_max + alert are estimated on a
+    !> grid of cells of side `reach` (sorted cell keys, no dense grid): a disk of a cell
+    !> holding c disks has about pi c other disks within reach (the density c/reach^2 over
+    !> the disk of radius reach), so a cell adds about pi c^2/2 pairs; capped at n(n - 1)/2.
+    !> Each candidate costs about bytes_per_candidate. A dense packing gives about 2.5 pairs
+    !> per disk, 10^5 disks about 0.1 GiB: only alert distances of many radii come near the
+    !> limit.
+    subroutine check_alert_reach(deck, cfg, available, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> The model (disks, alert distance).
+        type(dem_config_t), intent(in) :: cfg
+        !> Available memory [bytes] (-1: unknown).
+        integer(i8), intent(in) :: available
+        !> Error naming [contacts] alert, if any.
+        type(error_t), allocatable, intent(out) :: error
+        !> Contact set arrays (about 45 reals and integers per contact, the previous list,
+        !> the detection's candidate buffers): 500 bytes per pair, rounded up.
+        integer(i8), parameter :: bytes_per_candidate = 500
+        integer(i8), allocatable :: key(:)
+        integer, allocatable :: order(:)
+        real(wp) :: reach, x0, y0, pairs
+        integer :: i, run_start
+        if (available < 0) return
+        associate (p => cfg%system%particles)
+            if (p%n < 2) return
+            reach = 2.0_wp*maxval(p%radius(1:p%n)) + cfg%system%scheme%alert
+            x0 = minval(p%x(1:p%n))
+            y0 = minval(p%y(1:p%n))
+            allocate (key(p%n))
+            do i = 1, p%n
+                key(i) = ishft(int(min((p%x(i) - x0)/reach, 2.0e9_wp), i8), 32) + &
+                         int(min((p%y(i) - y0)/reach, 2.0e9_wp), i8)
+            end do
+            order = sort_index(key)
+            pairs = 0.0_wp
+            run_start = 1
+            do i = 2, p%n + 1
+                if (i <= p%n) then
+                    if (key(order(i)) == key(order(run_start))) cycle
+                end if
+                pairs = pairs + 0.5_wp*pi*real(i - run_start, wp)**2
+                run_start = i
+            end do
+            pairs = min(pairs, 0.5_wp*real(p%n, wp)*real(p%n - 1, wp))
+            if (pairs*real(bytes_per_candidate, wp) <= real(available, wp)) return
+            call make_input_error(error, deck%file, deck%line('contacts', 'alert'), 'alert', &
+                                  '[contacts] alert = '//length_text(cfg%system%scheme%alert)// &
+                                  ' m makes up to about '//length_text(pairs)//' disk pairs contact '// &
+                                  'candidates (disks within 2 r_max + alert of each other), about '// &
+                                  length_text(pairs*real(bytes_per_candidate, wp)/1024.0_wp**3)// &
+                                  ' GiB, more than the memory available: use an alert distance of a '// &
+                                  'fraction of the radius')
+        end associate
+    end subroutine check_alert_reach
 
     !> Materials: unique ids, densities; the material table of the contact laws.
     subroutine build_materials(deck, cfg, density, error)
