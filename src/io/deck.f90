@@ -198,6 +198,8 @@ contains
             return
         end if
         call check_required(deck, first_line, section_line, error)
+        if (allocated(error)) return
+        call check_empty_sections(deck, section_line, error)
 
     contains
 
@@ -527,6 +529,26 @@ contains
     end subroutine check_values
 
     !> Check required and conditional keywords once the whole deck is read.
+    !> Error for a section header followed by no keyword: the header would have no effect
+    !> (a deck of beams with an empty [particles] is still a deck of beams), and is most
+    !> likely what is left of a section the user meant to fill.
+    subroutine check_empty_sections(deck, section_line, error)
+        !> The deck (entries filled).
+        type(deck_t), intent(in) :: deck
+        !> First header line of each schema section (0 if absent).
+        integer, intent(in) :: section_line(:)
+        !> Error naming the header's line, if any.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: k
+        do k = 1, size(deck%schema%sections)
+            if (section_line(k) == 0) cycle
+            if (deck%has_section(deck%schema%sections(k)%name)) cycle
+            call make_input_error(error, deck%file, section_line(k), '', '['//deck%schema%sections(k)%name// &
+                                  '] has no keyword: give its keywords or remove the header')
+            return
+        end do
+    end subroutine check_empty_sections
+
     subroutine check_required(deck, first_line, section_line, error)
         !> The deck (entries filled).
         type(deck_t), intent(in) :: deck

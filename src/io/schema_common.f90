@@ -51,14 +51,16 @@ contains
         type(schema_t), intent(inout) :: s
         call s%add_section('time', 'Time integration (dynamic analysis).')
         call s%add_keyword('time', 'step', [positive('step', 's')], &
-                           'Time step h.', required_when=when('run', 'analysis', 'dynamic'))
+                           'Time step h.', required_when=when('run', 'analysis', 'dynamic'), &
+                           allowed_when=when('run', 'analysis', 'dynamic'))
         call s%add_keyword('time', 'end', [positive('end', 's')], &
-                           'End time (the run starts at t = 0).', required_when=when('run', 'analysis', 'dynamic'))
+                           'End time (the run starts at t = 0).', required_when=when('run', 'analysis', 'dynamic'), &
+                           allowed_when=when('run', 'analysis', 'dynamic'))
         call s%add_keyword('time', 'scheme', &
                            [word_field('scheme', 'average_acceleration newmark central_difference')], &
                            'Newmark family: average_acceleration (beta 1/4, gamma 1/2), newmark (beta and '// &
                            'gamma below), central_difference (beta 0, gamma 1/2, explicit).', &
-                           default='average_acceleration')
+                           default='average_acceleration', allowed_when=when('run', 'analysis', 'dynamic'))
         call s%add_keyword('time', 'beta', [real_field('beta', '', lower=0.0_wp, upper=0.5_wp)], &
                            'Newmark beta.', default='0.25', allowed_when=when('time', 'scheme', 'newmark'))
         call s%add_keyword('time', 'gamma', [real_field('gamma', '', lower=0.5_wp, upper=1.0_wp)], &
@@ -67,7 +69,8 @@ contains
         call s%add_keyword('time', 'theta', [real_field('theta', '', lower=0.5_wp, upper=1.0_wp)], &
                            'Moreau-Jean theta of the particles: positions advance with (1 - theta) v(t) + '// &
                            'theta v(t + h); 1/2 conserves energy in free flight and elastic impacts, '// &
-                           '1 is fully implicit (dissipative, never overlaps).', default='0.5')
+                           '1 is fully implicit (dissipative, never overlaps).', default='0.5', &
+                           allowed_when=when('run', 'analysis', 'dynamic'))
         call s%add_keyword('time', 'contact_scheme', [word_field('contact_scheme', 'multicor siconos')], &
                            'How the contacts of the particles enter a step. multicor: detected on the '// &
                            'mid configuration q + (1 - theta) h v, active when the free motion closes '// &
@@ -76,7 +79,7 @@ contains
                            'MoreauJeanOSI, one Newton iteration), to compare with it on the same discrete '// &
                            'problem: geometry at q + h v, active when the previous step''s gap plus h/2 '// &
                            'times its normal velocity is <= 0, no gap term (doc/theory.md 2.6).', &
-                           default='multicor')
+                           default='multicor', allowed_when=when('run', 'analysis', 'dynamic'))
     end subroutine add_time
 
     !> [output]: what is stored and shown.

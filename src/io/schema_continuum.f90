@@ -3,7 +3,7 @@
 !> builders: io_deck_schema.
 module io_schema_continuum
     use core_kinds, only: wp
-    use io_deck_schema, only: schema_t, tail_spec_t, int_field, real_field, positive, word_field, tail
+    use io_deck_schema, only: schema_t, tail_spec_t, int_field, real_field, positive, word_field, tail, when
     implicit none
     private
     public :: add_continuum
@@ -63,12 +63,12 @@ contains
                            'Acceleration of gravity (body force rho g).', default='0 0')
         call s%add_keyword('continuum', 'rayleigh', &
                            [real_field('a0', '1/s', lower=0.0_wp), real_field('a1', 's', lower=0.0_wp)], &
-                           'Rayleigh damping C = a0 M + a1 K.', default='0 0')
+                           'Rayleigh damping C = a0 M + a1 K.', default='0 0', allowed_when=when('run', 'analysis', 'dynamic'))
         call s%add_keyword('continuum', 'initial_velocity', [real_field('vx', 'm/s'), real_field('vy', 'm/s')], &
                            'Initial velocity of the free nodes (dynamic analysis): (vx, vy) plus a rotation '// &
                            'omega (rad/s) about (xc, yc) (m), v = (vx - omega (y - yc), vy + omega (x - xc)); '// &
                            'the rotation is given whole (omega, xc and yc) or not at all.', &
                            tails=[tail([real_field('omega', 'rad/s'), real_field('xc', 'm'), real_field('yc', 'm')], &
-                                       0, 3, cyclic=.true.)], default='0 0')
+                                       0, 3, cyclic=.true.)], default='0 0', allowed_when=when('run', 'analysis', 'dynamic'))
     end subroutine add_continuum
 end module io_schema_continuum

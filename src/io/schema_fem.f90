@@ -3,7 +3,7 @@
 !> the nodes). Machinery and field builders: io_deck_schema.
 module io_schema_fem
     use core_kinds, only: wp
-    use io_deck_schema, only: schema_t, int_field, real_field, positive, word_field, tail
+    use io_deck_schema, only: schema_t, int_field, real_field, positive, word_field, tail, when
     implicit none
     private
 
@@ -74,7 +74,7 @@ contains
                            default='0 0')
         call s%add_keyword('beam', 'rayleigh', &
                            [real_field('a0', '1/s', lower=0.0_wp), real_field('a1', 's', lower=0.0_wp)], &
-                           'Rayleigh damping C = a0 M + a1 K.', default='0 0')
+                           'Rayleigh damping C = a0 M + a1 K.', default='0 0', allowed_when=when('run', 'analysis', 'dynamic'))
     end subroutine add_beam
 
     !> [modal]: natural modes.
@@ -83,7 +83,7 @@ contains
         type(schema_t), intent(inout) :: s
         call s%add_section('modal', 'Natural modes (modal analysis).')
         call s%add_keyword('modal', 'modes', [int_field('modes', lower=1)], &
-                           'Number of lowest modes to compute.', default='3')
+                           'Number of lowest modes to compute.', default='3', allowed_when=when('run', 'analysis', 'modal'))
     end subroutine add_modal
 
     !> [initial]: initial conditions.
@@ -94,10 +94,12 @@ contains
                            'Initial conditions on free DOFs (dynamic analysis); the others start at zero.')
         call s%add_keyword('initial', 'velocity', [int_field('node', lower=1), &
                                                    word_field('dof', dof_words), real_field('value', 'm/s or rad/s')], &
-                           'Initial velocity of one DOF of a node.', repeatable=.true.)
+                           'Initial velocity of one DOF of a node.', repeatable=.true., &
+                           allowed_when=when('run', 'analysis', 'dynamic'))
         call s%add_keyword('initial', 'displacement', [int_field('node', lower=1), &
                                                        word_field('dof', dof_words), real_field('value', 'm or rad')], &
-                           'Initial displacement of one DOF of a node.', repeatable=.true.)
+                           'Initial displacement of one DOF of a node.', repeatable=.true., &
+                           allowed_when=when('run', 'analysis', 'dynamic'))
         call s%add_keyword('initial', 'rigid', [int_field('node_a', lower=1), int_field('node_b', lower=1), &
                                                 real_field('vx', 'm/s'), real_field('vy', 'm/s'), &
                                                 real_field('omega', 'rad/s'), &
