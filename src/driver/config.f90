@@ -23,7 +23,7 @@ module driver_config
     use driver_run_kind, only: run_kind_of, run_particles
     implicit none
     private
-    public :: run_config_t, build_config, max_steps, build_run_settings, steps_to_end, build_time_functions
+    public :: run_config_t, build_config, max_steps, build_run_settings, steps_to_end, build_time_functions, repeated_dof
 
     !> Largest number of time steps of a run. The step counter is 64-bit; the bound is that of
     !> the 32-bit step counts stored in the results file (/summary steps, /dem/solver).
@@ -647,6 +647,11 @@ contains
                 return
             end if
             dofs = e%words_from('dof')
+            if (len(repeated_dof(dofs)) > 0) then
+                call make_input_error(error, deck%file, e%line, 'fix', 'the DOF '//repeated_dof(dofs)// &
+                                      ' is named twice in this record (each of u, w, theta once, or all)')
+                return
+            end if
             do k = 1, size(dofs)
                 if (dofs(k)%s == 'all') then
                     where (fix_line(:, node) == 0) fix_line(:, node) = e%line
@@ -1051,6 +1056,32 @@ contains
     end function dof_word
 
     !> DOF index of a DOF word: u, w, theta or their [particles] names x, y, rot.
+    !> The first DOF word of a `fix` record that names a DOF already named in the record
+    !> ('all' names the three), or '' when each is named once: `fix = 1 u u u` (meant
+    !> u w theta) would otherwise fix one DOF without a word.
+    pure function repeated_dof(words) result(word)
+        !> The DOF words of the record ('u'/'x', 'w'/'y', 'theta'/'rot', 'all').
+        type(string_t), intent(in) :: words(:)
+        character(len=:), allocatable :: word
+        logical :: named(3)
+        integer :: k
+        named = .false.
+        word = ''
+        do k = 1, size(words)
+            if (words(k)%s == 'all') then
+                if (any(named)) word = 'all'
+                if (any(named)) return
+                named = .true.
+            else
+                if (named(dof_index(words(k)%s))) then
+                    word = words(k)%s
+                    return
+                end if
+                named(dof_index(words(k)%s)) = .true.
+            end if
+        end do
+    end function repeated_dof
+
     pure integer function dof_index(word)
         !> 'u' or 'x', 'w' or 'y', 'theta' or 'rot'.
         character(len=*), intent(in) :: word

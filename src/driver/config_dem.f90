@@ -33,7 +33,7 @@ module driver_config_dem
     use dem_detection, only: detector_t, detect_contacts
     use dem_moreau_jean, only: dem_system_t
     use dem_nlgs, only: nlgs_method_nlgs, nlgs_method_block, nlgs_method_coarse, criterion_lmgc90, criterion_siconos
-    use driver_config, only: run_config_t
+    use driver_config, only: run_config_t, repeated_dof
     implicit none
     private
     public :: dem_config_t, build_dem_config
@@ -497,6 +497,11 @@ contains
             if (allocated(error)) return
             if (e%keyword == 'fix') then
                 words = e%words_from('dof')
+                if (len(repeated_dof(words)) > 0) then
+                    call make_input_error(error, deck%file, e%line, 'fix', 'the DOF '//repeated_dof(words)// &
+                                          ' is named twice in this record (each of x, y, rot once, or all)')
+                    return
+                end if
                 do k = 1, size(words)
                     word = words(k)%s
                     do dof = 1, 3
