@@ -95,6 +95,7 @@ contains
         call apply_end_time(error)
         if (allocated(error)) return
         call warn_aliased_functions()
+        call warn_end_off_the_steps()
         if (opts%check_only) then
             call report(opts%deck_path//': deck is valid ('//sim%describe()//')')
             return
@@ -204,6 +205,30 @@ contains
                             'samples it below two steps per period and sees an alias; lower the step')
             end do
         end subroutine warn_aliased_functions
+
+        !> Warn when the end time (the deck's, or --end) is not a whole number of time steps: the
+        !> run goes on to the next step, past the end asked for.
+        subroutine warn_end_off_the_steps()
+            real(wp) :: t_last
+            character(len=24) :: buf
+            if (sim%settings%analysis /= 'dynamic' .or. .not. sim%settings%h > 0.0_wp) return
+            associate (run => sim%settings)
+                t_last = real(run%n_steps, wp)*run%h
+                ! a whole number of steps up to the rounding of end / step (steps_to_end)
+                if (abs(t_last - run%t_end) <= 1.0e-9_wp*run%t_end) return
+                if (opts%end_time >= 0.0_wp) then
+                    write (buf, '(es17.10e3)') run%t_end
+                    call report('warning: --end '//trim(adjustl(buf))//' s is not a whole number of time '// &
+                                'steps of '//num(run%h)//' s: the run ends after '//to_str(run%n_steps)// &
+                                ' steps, at t = '//num(t_last)//' s')
+                else
+                    call report('warning: '//deck%file//':'//to_str(deck%line('time', 'end'))//': [time] end = '// &
+                                deck%get_word('time', 'end')//' s is not a whole number of time steps of '// &
+                                deck%get_word('time', 'step')//' s: the run ends after '//to_str(run%n_steps)// &
+                                ' steps, at t = '//num(t_last)//' s')
+                end if
+            end associate
+        end subroutine warn_end_off_the_steps
 
         subroutine apply_end_time(error)
             type(error_t), allocatable, intent(out) :: error

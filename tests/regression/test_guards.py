@@ -319,6 +319,23 @@ def line_endings(exe, work):
                   np.array_equal(results[name], results["plain"]), "")
 
 
+def end_off_the_steps(exe, work):
+    """An end time that is not a whole number of steps: the run goes to the next step, and says
+    so once; a whole number (2e-3 s of 2e-4 s steps, a quotient rounded in floating point) is
+    silent."""
+    for name, end, steps, warned in (("end_on_steps", "2e-3", 10, False), ("end_off_steps", "2.0000001e-3", 11, True)):
+        deck = work / f"{name}.dat"
+        deck.write_text(beam_deck().replace("end = 2e-3", f"end = {end}"))
+        proc = multicor(exe, deck, "--output", work / name, "--quiet")
+        said = [ln for ln in (proc.stdout + proc.stderr).splitlines() if "is not a whole number of time steps" in ln]
+        check(f"{name}: exit 0", proc.returncode == 0, f"exit {proc.returncode}")
+        check(f"{name}: {'warned once' if warned else 'no warning'}", len(said) == (1 if warned else 0),
+              "; ".join(said) or "none")
+        with h5py.File(work / name / f"{name}.h5", "r") as f:
+            done = int(f["summary"].attrs["steps"])
+        check(f"{name}: {steps} steps done", done == steps, f"{done}")
+
+
 def main():
     exe, work, src = arguments()
     non_finite(exe, work)
@@ -333,6 +350,7 @@ def main():
     no_empty_folder(exe, work)
     exponents(exe, work)
     line_endings(exe, work)
+    end_off_the_steps(exe, work)
     return summary()
 
 
