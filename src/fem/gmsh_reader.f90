@@ -399,9 +399,9 @@ contains
         character(len=:), allocatable :: text
         type(string_t), allocatable :: words(:)
         type(cursor_t) :: header
-        integer :: head(4), bh(4), b, k, i, total
+        integer :: head(4), bh(4), b, k, i, total, n_words
         integer, allocatable :: tags(:)
-        real(wp) :: xyz(3)
+        real(wp) :: xyz(3), value
         logical :: ok
         character(len=64) :: buf
         call section_line(cur, text, error)
@@ -434,6 +434,13 @@ contains
             if (allocated(error)) return
             call check_count(cur, int(bh(4), i8), 2, 'nodes in the block', error)
             if (allocated(error)) return
+            ! 'entityDim entityTag parametric numNodesInBlock': a parametric block (1) gives, after
+            ! x y z, entityDim parametric coordinates, which are not used.
+            if (bh(3) /= 0 .and. bh(3) /= 1) then
+                call fail(cur, error, 'the parametric flag of a node block is 0 or 1, found "'//trim(text)//'"')
+                return
+            end if
+            n_words = 3 + merge(bh(1), 0, bh(3) == 1)
             total = total + bh(4)
             allocate (tags(bh(4)))
             do k = 1, bh(4)
@@ -450,15 +457,25 @@ contains
                 call section_line(cur, text, error)
                 if (allocated(error)) return
                 ! Word by word: a list-directed read takes 'nan' and 'inf', and overflows on 1e999.
+                ! All 3 coordinates, exactly: a short line left the missing ones from the node before.
                 call split_words(text, words)
-                ok = size(words) >= 3
-                do i = 1, min(3, size(words))
-                    call parse_real(words(i)%s, xyz(i), ok)
-                    if (.not. ok) exit
-                end do
+                ok = size(words) == n_words
+                if (ok) then
+                    do i = 1, size(words)
+                        call parse_real(words(i)%s, value, ok)
+                        if (.not. ok) exit
+                        if (i <= 3) xyz(i) = value
+                    end do
+                end if
                 if (.not. ok) then
-                    call fail(cur, error, 'expected node coordinates "x y z" (finite numbers), found "'// &
-                              trim(text)//'"')
+                    if (n_words == 3) then
+                        call fail(cur, error, 'expected node coordinates "x y z" (finite numbers), found "'// &
+                                  trim(text)//'"')
+                    else
+                        write (buf, '(i0)') n_words - 3
+                        call fail(cur, error, 'expected node coordinates "x y z" and '//trim(buf)//' parametric '// &
+                                  'coordinates (finite numbers), found "'//trim(text)//'"')
+                    end if
                     return
                 end if
                 if (xtag(1, tags(k) - min_tag + 1) /= -huge(1.0_wp)) then
