@@ -11,8 +11,9 @@
 !>   within the step, or two candidate disks (pairs found by the detection of the step) whose
 !>   centres passed each other while overlapping by more than half their radii, stop the run
 !>   with the step to use instead.
-!> - `model_memory_bytes`, `check_memory`: the memory a model will need, from the numbers of
-!>   disks, nodes and elements, against the memory available.
+!> - `model_size_t`, `model_memory_bytes`, `check_memory`: the memory a model will need, from
+!>   the numbers of disks, beam nodes and elements and continuum elements, against the memory
+!>   available.
 module driver_guards
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
     use core_kinds, only: wp, i8
@@ -27,7 +28,8 @@ module driver_guards
     implicit none
     private
     public :: check_beam_state, check_disks_state, step_start_t, take_step_start, check_tunnelling
-    public :: model_memory_bytes, check_memory, bytes_per_disk, bytes_per_node, bytes_per_element
+    public :: model_size_t, model_memory_bytes, check_memory
+    public :: bytes_per_disk, bytes_per_node, bytes_per_element, bytes_per_q4, bytes_per_t3
 
     !> Peak memory per disk of a run [bytes]: state, properties and work arrays, detection
     !> grid, contact candidates, output buffers. Measured: 0.79 kB per disk (maximum resident
@@ -39,6 +41,29 @@ module driver_guards
     integer(i8), parameter :: bytes_per_node = 1200
     !> Peak memory per element [bytes] (connectivity, section, element matrices).
     integer(i8), parameter :: bytes_per_element = 200
+    !> Peak memory per Q4 element of the continuum [bytes]: element triplets, sparse stiffness
+    !> and mass, CHOLMOD factor, state vectors. Measured: 10.1 to 10.2 kB per element (maximum
+    !> resident size of static and dynamic runs on rectangle meshes of 100 x 100, 200 x 200 and
+    !> 300 x 300 Q4, differences between them); the factor's fill grows like log(n), hence the
+    !> margin.
+    integer(i8), parameter :: bytes_per_q4 = 11000
+    !> Peak memory per T3 element of the continuum [bytes]. Measured: 6.3 kB per element (the
+    !> same runs with 2 T3 per cell: 12.7 kB per cell, against 10.2 kB for one Q4).
+    integer(i8), parameter :: bytes_per_t3 = 7000
+
+    !> Numbers of things a model holds, for its memory estimate.
+    type :: model_size_t
+        !> Disks.
+        integer(i8) :: disks = 0
+        !> Beam nodes.
+        integer(i8) :: beam_nodes = 0
+        !> Beam elements.
+        integer(i8) :: beam_elements = 0
+        !> Q4 elements of the continuum.
+        integer(i8) :: q4 = 0
+        !> T3 elements of the continuum.
+        integer(i8) :: t3 = 0
+    end type model_size_t
 
     !> Where the disks and walls were at the start of a step.
     type :: step_start_t
@@ -324,39 +349,42 @@ contains
         end function advice
     end subroutine check_tunnelling
 
-    !> Memory a model will need at its peak [bytes] (see bytes_per_disk and bytes_per_node).
-    pure integer(i8) function model_memory_bytes(n_disks, n_nodes, n_elements) result(bytes)
-        !> Number of disks.
-        integer(i8), intent(in) :: n_disks
-        !> Number of beam nodes.
-        integer(i8), intent(in) :: n_nodes
-        !> Number of beam elements.
-        integer(i8), intent(in) :: n_elements
-        bytes = bytes_per_disk*n_disks + bytes_per_node*n_nodes + bytes_per_element*n_elements
+    !> Memory a model will need at its peak [bytes] (see bytes_per_disk, bytes_per_node,
+    !> bytes_per_element, bytes_per_q4, bytes_per_t3); huge(0_i8) when that exceeds 2^62 bytes
+    !> (the counts may each approach 2^63: summed in real(wp), which cannot overflow).
+    pure integer(i8) function model_memory_bytes(counts) result(bytes)
+        !> Numbers of disks, nodes and elements.
+        type(model_size_t), intent(in) :: counts
+        real(wp) :: total
+        total = real(bytes_per_disk, wp)*real(counts%disks, wp) + &
+                real(bytes_per_node, wp)*real(counts%beam_nodes, wp) + &
+                real(bytes_per_element, wp)*real(counts%beam_elements, wp) + &
+                real(bytes_per_q4, wp)*real(counts%q4, wp) + real(bytes_per_t3, wp)*real(counts%t3, wp)
+        if (total < 2.0_wp**62) then
+            bytes = int(total, i8)
+        else
+            bytes = huge(0_i8)
+        end if
     end function model_memory_bytes
 
     !> Error when the model's estimated memory exceeds what is available (nothing is checked
     !> when the available memory is unknown, `available` < 0).
-    subroutine check_memory(n_disks, n_nodes, n_elements, available, error)
-        !> Number of disks.
-        integer(i8), intent(in) :: n_disks
-        !> Number of beam nodes.
-        integer(i8), intent(in) :: n_nodes
-        !> Number of beam elements.
-        integer(i8), intent(in) :: n_elements
+    subroutine check_memory(counts, available, error)
+        !> Numbers of disks, nodes and elements.
+        type(model_size_t), intent(in) :: counts
         !> Available memory [bytes] (-1: unknown).
         integer(i8), intent(in) :: available
         !> Set when the model does not fit.
         type(error_t), allocatable, intent(out) :: error
         integer(i8) :: need
         if (available < 0) return
-        need = model_memory_bytes(n_disks, n_nodes, n_elements)
+        need = model_memory_bytes(counts)
         if (need <= available) return
         call make_error(error, 'the model needs about '//gib(need)//' of memory ('// &
-                        to_str(n_disks)//' disks, '//to_str(n_nodes)//' beam nodes, '// &
-                        to_str(n_elements)//' elements) and only '//gib(available)// &
-                        ' are available (MemAvailable in /proc/meminfo): make the model smaller, or '// &
-                        'run it on a machine with more memory')
+                        to_str(counts%disks)//' disks, '//to_str(counts%beam_nodes)//' beam nodes, '// &
+                        to_str(counts%beam_elements)//' beam elements, '//continuum()//') and only '// &
+                        gib(available)//' are available (MemAvailable in /proc/meminfo): make the model '// &
+                        'smaller, or run it on a machine with more memory')
     contains
         function gib(b) result(text)
             integer(i8), intent(in) :: b
@@ -367,6 +395,16 @@ contains
             if (text(1:1) == '.') text = '0'//text
             text = text//' GiB'
         end function gib
+
+        !> 'n continuum elements', or 'n Q4 and m T3 continuum elements' when both kinds are there.
+        function continuum() result(text)
+            character(len=:), allocatable :: text
+            if (counts%q4 > 0 .and. counts%t3 > 0) then
+                text = to_str(counts%q4)//' Q4 and '//to_str(counts%t3)//' T3 continuum elements'
+            else
+                text = to_str(counts%q4 + counts%t3)//' continuum elements'
+            end if
+        end function continuum
     end subroutine check_memory
 
     !> 'step k (t = ... s): '

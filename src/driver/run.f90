@@ -23,7 +23,7 @@
 !> end time (`--end`).
 module driver_run
     use core_kinds, only: wp, i8
-    use core_error, only: error_t, make_error
+    use core_error, only: error_t, make_error, make_input_error
     use core_strings, only: to_str
     use io_lock, only: lock_t, lock_acquire, lock_release
     use io_memory, only: available_memory
@@ -32,7 +32,8 @@ module driver_run
     use io_deck, only: deck_t, deck_entry_t, read_deck
     use io_paths, only: stem, mkdir_p, remove_empty_folders, file_exists
     use driver_results, only: results_writer_t
-    use driver_guards, only: check_memory
+    use driver_guards, only: model_size_t, model_memory_bytes, check_memory
+    use fem_mesh_generator, only: rectangle_size, check_rectangle_size
     use driver_simulation, only: simulation_t, report_iface
     use driver_simulations, only: select_simulation
     use driver_config, only: steps_to_end, max_steps
@@ -87,7 +88,7 @@ contains
         if (allocated(error)) return
         call select_simulation(deck, sim, error)
         if (allocated(error)) return
-        call check_model_size(error)
+        call check_model_size(deck, error)
         if (allocated(error)) return
         call sim%init(deck, report, error)
         if (allocated(error)) return
@@ -289,47 +290,6 @@ contains
             text = trim(adjustl(buf))
         end function num
 
-        !> Refuse a model whose memory estimate exceeds the available memory, from the
-        !> numbers of disks, nodes and elements the deck asks for (before allocating them).
-        subroutine check_model_size(error)
-            type(error_t), allocatable, intent(out) :: error
-            integer(i8) :: n_disks, n_nodes, n_elements, m
-            integer :: k
-            character(len=:), allocatable :: message
-            n_disks = deck%count('particles', 'disk')
-            n_nodes = deck%count('beam', 'node')
-            n_elements = deck%count('beam', 'element')
-            do k = 1, size(deck%entries)
-                associate (e => deck%entries(k))
-                    select case (e%section//' '//e%keyword)
-                    case ('particles row', 'particles deposit')
-                        n_disks = n_disks + e%int('n')
-                    case ('particles square_lattice', 'particles hex_lattice')
-                        n_disks = n_disks + int(e%int('nx'), i8)*int(e%int('ny'), i8)
-                    case ('beam line', 'beam polar_line')
-                        m = e%int('elements')
-                        n_nodes = n_nodes + m + 1
-                        n_elements = n_elements + m
-                    case ('continuum mesh')
-                        ! A Q4 or T3 keeps ~6 kB (4 triplet copies of 64 entries, sparse K and M,
-                        ! a CHOLMOD factor of ~100 nonzeros per dof): 32 beam elements' worth.
-                        if (e%word('kind') == 'rectangle') n_elements = n_elements + 32_i8*int(e%int('nx'), i8)* &
-                                                                        int(e%int('ny'), i8)*merge(2, 1, e%word('element') == 't3')
-                    end select
-                end associate
-            end do
-            if (n_disks > huge(0)) then
-                call make_error(error, deck%file//': the deck asks for '//to_str(n_disks)// &
-                                ' disks, more than a run can number ('//to_str(huge(0))//')')
-                return
-            end if
-            call check_memory(n_disks, n_nodes, n_elements, available_memory(), error)
-            if (allocated(error)) then
-                message = error%message
-                call make_error(error, deck%file//': '//message)
-            end if
-        end subroutine check_model_size
-
         !> Title of the run ([run] title).
         function sim_title() result(text)
             character(len=:), allocatable :: text
@@ -342,4 +302,89 @@ contains
             text = deck%get_word('run', 'analysis')
         end function sim_analysis
     end subroutine run_deck
+
+    !> Refuse a model whose memory estimate exceeds the available memory, from the numbers of
+    !> disks, nodes and elements the deck asks for (before allocating them), and a rectangle
+    !> mesh with more nodes or elements than a mesh can number. The memory error names the
+    !> generator record (lattice, row, deposit, beam line, continuum mesh) that asks for the
+    !> most memory; the counts are summed without overflow (saturating at huge(0_i8), where
+    !> the estimate is refused anyway).
+    subroutine check_model_size(deck, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Set when the model is too large.
+        type(error_t), allocatable, intent(out) :: error
+        type(model_size_t) :: total, part
+        integer(i8) :: n_nodes, n_elements, largest
+        integer :: k, line
+        character(len=:), allocatable :: keyword, message
+        largest = -1
+        line = 0
+        keyword = ''
+        total%disks = deck%count('particles', 'disk')
+        total%beam_nodes = deck%count('beam', 'node')
+        total%beam_elements = deck%count('beam', 'element')
+        do k = 1, size(deck%entries)
+            associate (e => deck%entries(k))
+                part = model_size_t()
+                select case (e%section//' '//e%keyword)
+                case ('particles row', 'particles deposit')
+                    part%disks = e%int('n')
+                case ('particles square_lattice', 'particles hex_lattice')
+                    part%disks = int(e%int('nx'), i8)*int(e%int('ny'), i8)
+                case ('beam line', 'beam polar_line')
+                    part%beam_nodes = int(e%int('elements'), i8) + 1
+                    part%beam_elements = e%int('elements')
+                case ('continuum mesh')
+                    if (e%word('kind') /= 'rectangle') cycle
+                    call check_rectangle_size(e%int('nx'), e%int('ny'), e%word('element') == 't3', error)
+                    if (allocated(error)) then
+                        message = error%message
+                        call make_input_error(error, deck%file, e%line, e%keyword, message)
+                        return
+                    end if
+                    call rectangle_size(e%int('nx'), e%int('ny'), e%word('element') == 't3', n_nodes, n_elements)
+                    if (e%word('element') == 't3') then
+                        part%t3 = n_elements
+                    else
+                        part%q4 = n_elements
+                    end if
+                case default
+                    cycle
+                end select
+                total%disks = add(total%disks, part%disks)
+                total%beam_nodes = add(total%beam_nodes, part%beam_nodes)
+                total%beam_elements = add(total%beam_elements, part%beam_elements)
+                total%q4 = add(total%q4, part%q4)
+                total%t3 = add(total%t3, part%t3)
+                if (model_memory_bytes(part) > largest) then
+                    largest = model_memory_bytes(part)
+                    line = e%line
+                    keyword = e%keyword
+                end if
+            end associate
+        end do
+        if (total%disks > huge(0)) then
+            call make_error(error, deck%file//': the deck asks for '//to_str(total%disks)// &
+                            ' disks, more than a run can number ('//to_str(huge(0))//')')
+            return
+        end if
+        call check_memory(total, available_memory(), error)
+        if (allocated(error)) then
+            message = error%message
+            call make_input_error(error, deck%file, line, keyword, message)
+        end if
+
+    contains
+
+        !> a + b for counts >= 0, huge(0_i8) when that overflows.
+        pure integer(i8) function add(a, b)
+            integer(i8), intent(in) :: a, b
+            if (a > huge(0_i8) - b) then
+                add = huge(0_i8)
+            else
+                add = a + b
+            end if
+        end function add
+    end subroutine check_model_size
 end module driver_run

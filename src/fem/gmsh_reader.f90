@@ -10,10 +10,19 @@
 !> oriented with the body on their left. Malformed input gives an error naming file and line;
 !> a count read from the file is checked against the file's size before it sizes an array, and
 !> node tags must be numbered nearly contiguously (the node table is indexed by tag).
+!>
+!> Refused as well: a path that is not a readable file (a directory), an empty file, a second
+!> $MeshFormat, $PhysicalNames, $Entities, $Nodes or $Elements section (it replaced the first),
+!> a node line without its 3 coordinates, a header count of nodes or elements that is not the
+!> blocks' total, a node or element tag outside the header's range or given twice, and two
+!> line, triangle or quadrangle elements on the same nodes (an element listed twice: its
+!> stiffness, mass or edge load counted twice). Elements that overlap on different nodes are
+!> not detected.
 module fem_gmsh_reader
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_input_error
     use core_strings, only: string_t, split_words, parse_real
+    use core_sort, only: sort_index
     use fem_mesh2d, only: mesh2d_t, element_t3, element_q4
     implicit none
     private
@@ -46,6 +55,8 @@ module fem_gmsh_reader
         integer :: line = 0
         !> Line of each element in the file.
         integer, allocatable :: lines(:)
+        !> Tag of each element.
+        integer, allocatable :: tags(:)
     end type block_t
 
     !> Line-by-line reading state.
@@ -63,6 +74,9 @@ module fem_gmsh_reader
     integer, parameter :: tags_per_node = 8
     !> Tag span always accepted, whatever the number of nodes (16 MiB of node table).
     integer, parameter :: min_tag_span = 2**20
+    !> Sections that build the mesh: each may appear once.
+    character(len=14), parameter :: mesh_sections(5) = &
+                                    [character(len=14) :: '$MeshFormat', '$PhysicalNames', '$Entities', '$Nodes', '$Elements']
 
 contains
 
@@ -80,22 +94,30 @@ contains
         type(physical_name_t), allocatable :: names(:)
         type(block_t), allocatable :: blocks(:)
         real(wp), allocatable :: xtag(:, :)
-        integer :: ios, min_tag
+        integer :: ios, min_tag, s, k, seen_at(size(mesh_sections))
         logical :: eof, seen_format, seen_nodes, seen_elements
         character(len=256) :: msg
         cur%path = path
         cur%section = ''
+        call check_readable(path, error)
+        if (allocated(error)) return
         open (newunit=cur%unit, file=path, status='old', action='read', iostat=ios, iomsg=msg)
         if (ios /= 0) then
             call make_input_error(error, path, 0, '', 'cannot open the mesh file: '//trim(msg))
             return
         end if
         inquire (unit=cur%unit, size=cur%bytes)
+        if (cur%bytes == 0) then
+            close (cur%unit)
+            call make_input_error(error, path, 0, '', 'the mesh file is empty (expected a Gmsh 4.1 ASCII mesh)')
+            return
+        end if
         allocate (entities(0), names(0), blocks(0))
         min_tag = 1
         seen_format = .false.
         seen_nodes = .false.
         seen_elements = .false.
+        seen_at = 0
         do
             call next_line(cur, text, eof, error)
             if (allocated(error)) exit
@@ -109,6 +131,20 @@ contains
             if (.not. seen_format .and. cur%section /= '$MeshFormat') then
                 call fail(cur, error, 'the file must start with $MeshFormat (is this a Gmsh .msh file?)')
                 exit
+            end if
+            ! A loop, not findloc: gfortran 12's findloc misses a shorter deferred-length string.
+            s = 0
+            do k = 1, size(mesh_sections)
+                if (mesh_sections(k) == cur%section) s = k
+            end do
+            if (s > 0) then
+                if (seen_at(s) > 0) then
+                    write (msg, '(i0)') seen_at(s)
+                    call fail(cur, error, 'second '//cur%section//' section (the first is on line '//trim(msg)// &
+                              '): a mesh file holds one')
+                    exit
+                end if
+                seen_at(s) = cur%line
             end if
             select case (cur%section)
             case ('$MeshFormat')
@@ -132,8 +168,7 @@ contains
                 call skip_section(cur, error)
             end select
             if (allocated(error)) exit
-            if (cur%section /= '$MeshFormat' .and. cur%section /= '$PhysicalNames' .and. &
-                cur%section /= '$Entities' .and. cur%section /= '$Nodes' .and. cur%section /= '$Elements') cycle
+            if (s == 0) cycle
             call expect_end(cur, error)
             if (allocated(error)) exit
         end do
@@ -147,6 +182,29 @@ contains
         end if
         call build_mesh(cur, entities, names, blocks, xtag, min_tag, mesh, error)
     end subroutine read_gmsh
+
+    !> Error unless `path` can be read as a file: opening a directory succeeds, and reading it
+    !> then looked like an empty file ('missing $MeshFormat ...'); reading its first byte fails
+    !> with the system's reason ('Is a directory').
+    subroutine check_readable(path, error)
+        character(len=*), intent(in) :: path
+        type(error_t), allocatable, intent(out) :: error
+        integer :: unit, ios
+        integer(i8) :: bytes
+        character(len=1) :: first
+        character(len=256) :: msg
+        open (newunit=unit, file=path, access='stream', form='unformatted', status='old', &
+              action='read', iostat=ios, iomsg=msg)
+        if (ios /= 0) then
+            call make_input_error(error, path, 0, '', 'cannot open the mesh file: '//trim(msg))
+            return
+        end if
+        inquire (unit=unit, size=bytes)
+        if (bytes > 0) read (unit, iostat=ios, iomsg=msg) first
+        close (unit)
+        if (ios /= 0) call make_input_error(error, path, 0, '', 'cannot read the mesh file ('//trim(msg)// &
+                                            '): give the path of a Gmsh .msh file')
+    end subroutine check_readable
 
     !> Read the next line (any length) into text; eof at the end of the file.
     subroutine next_line(cur, text, eof, error)
@@ -399,9 +457,9 @@ contains
         character(len=:), allocatable :: text
         type(string_t), allocatable :: words(:)
         type(cursor_t) :: header
-        integer :: head(4), bh(4), b, k, i, total
+        integer :: head(4), bh(4), b, k, i, total, n_words
         integer, allocatable :: tags(:)
-        real(wp) :: xyz(3)
+        real(wp) :: xyz(3), value
         logical :: ok
         character(len=64) :: buf
         call section_line(cur, text, error)
@@ -434,6 +492,13 @@ contains
             if (allocated(error)) return
             call check_count(cur, int(bh(4), i8), 2, 'nodes in the block', error)
             if (allocated(error)) return
+            ! 'entityDim entityTag parametric numNodesInBlock': a parametric block (1) gives, after
+            ! x y z, entityDim parametric coordinates, which are not used.
+            if (bh(3) /= 0 .and. bh(3) /= 1) then
+                call fail(cur, error, 'the parametric flag of a node block is 0 or 1, found "'//trim(text)//'"')
+                return
+            end if
+            n_words = 3 + merge(bh(1), 0, bh(3) == 1)
             total = total + bh(4)
             allocate (tags(bh(4)))
             do k = 1, bh(4)
@@ -450,15 +515,25 @@ contains
                 call section_line(cur, text, error)
                 if (allocated(error)) return
                 ! Word by word: a list-directed read takes 'nan' and 'inf', and overflows on 1e999.
+                ! All 3 coordinates, exactly: a short line left the missing ones from the node before.
                 call split_words(text, words)
-                ok = size(words) >= 3
-                do i = 1, min(3, size(words))
-                    call parse_real(words(i)%s, xyz(i), ok)
-                    if (.not. ok) exit
-                end do
+                ok = size(words) == n_words
+                if (ok) then
+                    do i = 1, size(words)
+                        call parse_real(words(i)%s, value, ok)
+                        if (.not. ok) exit
+                        if (i <= 3) xyz(i) = value
+                    end do
+                end if
                 if (.not. ok) then
-                    call fail(cur, error, 'expected node coordinates "x y z" (finite numbers), found "'// &
-                              trim(text)//'"')
+                    if (n_words == 3) then
+                        call fail(cur, error, 'expected node coordinates "x y z" (finite numbers), found "'// &
+                                  trim(text)//'"')
+                    else
+                        write (buf, '(i0)') n_words - 3
+                        call fail(cur, error, 'expected node coordinates "x y z" and '//trim(buf)//' parametric '// &
+                                  'coordinates (finite numbers), found "'//trim(text)//'"')
+                    end if
                     return
                 end if
                 if (xtag(1, tags(k) - min_tag + 1) /= -huge(1.0_wp)) then
@@ -493,7 +568,10 @@ contains
         end select
     end function type_nodes
 
-    !> $Elements: blocks 'dim entity type count' then 'tag node...' lines.
+    !> $Elements: header 'blocks elements min_tag max_tag', then blocks 'dim entity type count'
+    !> and 'tag node...' lines. As for $Nodes, the header's element count must be the blocks'
+    !> total and every tag lie in its range; a tag must appear once, and no two line, triangle
+    !> or quadrangle elements may have the same nodes.
     subroutine read_elements(cur, xtag, min_tag, blocks, error)
         type(cursor_t), intent(inout) :: cur
         real(wp), intent(in) :: xtag(:, :)
@@ -501,16 +579,26 @@ contains
         type(block_t), allocatable, intent(out) :: blocks(:)
         type(error_t), allocatable, intent(out) :: error
         character(len=:), allocatable :: text
+        type(cursor_t) :: header
         integer :: head(4), bh(4), b, k, nn
+        integer(i8) :: total
         integer, allocatable :: values(:)
-        character(len=32) :: buf
+        character(len=64) :: buf
         call section_line(cur, text, error)
         if (allocated(error)) return
         call read_ints(cur, text, 4, head, error)
         if (allocated(error)) return
+        header = cur
         call check_count(cur, int(head(1), i8), 1, 'element blocks', error)
         if (allocated(error)) return
+        call check_count(cur, int(head(2), i8), 1, 'elements', error)
+        if (allocated(error)) return
+        if (head(2) > 0 .and. (head(3) < 1 .or. head(4) < head(3))) then
+            call fail(cur, error, 'invalid element tag range in "'//trim(text)//'"')
+            return
+        end if
         allocate (blocks(head(1)))
+        total = 0
         do b = 1, head(1)
             call section_line(cur, text, error)
             if (allocated(error)) return
@@ -525,18 +613,24 @@ contains
             end if
             call check_count(cur, int(bh(4), i8), 1, 'elements in the block', error)
             if (allocated(error)) return
+            total = total + bh(4)
             associate (blk => blocks(b))
                 blk%dim = bh(1)
                 blk%tag = bh(2)
                 blk%type = bh(3)
                 blk%line = cur%line
-                allocate (blk%nodes(nn, bh(4)), blk%lines(bh(4)), values(nn + 1))
+                allocate (blk%nodes(nn, bh(4)), blk%lines(bh(4)), blk%tags(bh(4)), values(nn + 1))
                 do k = 1, bh(4)
                     call section_line(cur, text, error)
                     if (allocated(error)) return
                     blk%lines(k) = cur%line
                     call read_ints(cur, text, nn + 1, values, error)
                     if (allocated(error)) return
+                    if (values(1) < head(3) .or. values(1) > head(4)) then
+                        call fail(cur, error, 'element tag outside the range given in the $Elements header')
+                        return
+                    end if
+                    blk%tags(k) = values(1)
                     blk%nodes(:, k) = values(2:)
                     call check_tags(values(2:))
                     if (allocated(error)) return
@@ -544,6 +638,14 @@ contains
                 deallocate (values)
             end associate
         end do
+        if (total /= head(2)) then
+            write (buf, '(i0,a,i0)') head(2), ' elements, its blocks hold ', total
+            call fail(header, error, 'the header gives '//trim(buf))
+            return
+        end if
+        call check_unique_tags(cur, blocks, error)
+        if (allocated(error)) return
+        call check_distinct_nodes(cur, blocks, error)
 
     contains
 
@@ -562,6 +664,109 @@ contains
             end do
         end subroutine check_tags
     end subroutine read_elements
+
+    !> An element tag may appear once (over all blocks); the error is at the second occurrence
+    !> that comes first in the file.
+    subroutine check_unique_tags(cur, blocks, error)
+        type(cursor_t), intent(in) :: cur
+        type(block_t), intent(in) :: blocks(:)
+        type(error_t), allocatable, intent(out) :: error
+        integer(i8), allocatable :: keys(:)
+        integer, allocatable :: lines(:), order(:)
+        integer :: b, k, n, at, first
+        character(len=64) :: buf
+        allocate (keys(sum([(size(blocks(b)%tags), b=1, size(blocks))])))
+        allocate (lines(size(keys)))
+        n = 0
+        do b = 1, size(blocks)
+            keys(n + 1:n + size(blocks(b)%tags)) = blocks(b)%tags
+            lines(n + 1:n + size(blocks(b)%tags)) = blocks(b)%lines
+            n = n + size(blocks(b)%tags)
+        end do
+        order = sort_index(keys)
+        at = 0
+        ! sort_index is stable: of two equal tags, the earlier in the file comes first.
+        do k = 2, size(order)
+            if (keys(order(k)) /= keys(order(k - 1))) cycle
+            if (at > 0) then
+                if (lines(order(k)) >= lines(at)) cycle
+            end if
+            at = order(k)
+            first = order(k - 1)
+        end do
+        if (at == 0) return
+        write (buf, '(i0,a,i0,a)') keys(at), ' is defined twice (first on line ', lines(first), ')'
+        call make_input_error(error, cur%path, lines(at), '$Elements', 'element '//trim(buf))
+    end subroutine check_unique_tags
+
+    !> No two elements of dimension 1 or 2 may have the same set of nodes (whatever their order):
+    !> an element listed twice under two tags counts its stiffness and mass, or its share of an
+    !> edge load, twice. The nodes of each element, sorted in decreasing order and padded with
+    !> 0 to 4 (a line has 2, a triangle 3, a quadrangle 4: different kinds never compare
+    !> equal), are packed two by two in 64-bit keys (tags < 2^31) and sorted lexicographically
+    !> by two stable passes.
+    subroutine check_distinct_nodes(cur, blocks, error)
+        type(cursor_t), intent(in) :: cur
+        type(block_t), intent(in) :: blocks(:)
+        type(error_t), allocatable, intent(out) :: error
+        integer(i8), allocatable :: high(:), low(:)
+        integer, allocatable :: lines(:), tags(:), order(:)
+        integer :: b, k, n, at, first, sorted(4)
+        character(len=96) :: buf
+        n = 0
+        do b = 1, size(blocks)
+            if (blocks(b)%type /= 1 .and. blocks(b)%type /= 2 .and. blocks(b)%type /= 3) cycle
+            n = n + size(blocks(b)%tags)
+        end do
+        allocate (high(n), low(n), lines(n), tags(n))
+        n = 0
+        do b = 1, size(blocks)
+            if (blocks(b)%type /= 1 .and. blocks(b)%type /= 2 .and. blocks(b)%type /= 3) cycle
+            do k = 1, size(blocks(b)%tags)
+                n = n + 1
+                sorted = 0
+                sorted(1:size(blocks(b)%nodes, 1)) = blocks(b)%nodes(:, k)
+                call sort_decreasing(sorted)
+                high(n) = int(sorted(1), i8)*2_i8**31 + sorted(2)
+                low(n) = int(sorted(3), i8)*2_i8**31 + sorted(4)
+                lines(n) = blocks(b)%lines(k)
+                tags(n) = blocks(b)%tags(k)
+            end do
+        end do
+        order = sort_index(low)
+        order = order(sort_index(high(order)))
+        at = 0
+        do k = 2, n
+            if (high(order(k)) /= high(order(k - 1)) .or. low(order(k)) /= low(order(k - 1))) cycle
+            if (at > 0) then
+                if (lines(order(k)) >= lines(at)) cycle
+            end if
+            at = order(k)
+            first = order(k - 1)
+        end do
+        if (at == 0) return
+        write (buf, '(a,i0,a,i0,a,i0,a)') 'element ', tags(at), ' has the same nodes as element ', tags(first), &
+            ' (line ', lines(first), ')'
+        call make_input_error(error, cur%path, lines(at), '$Elements', trim(buf)//': an element may be listed once')
+
+    contains
+
+        !> Sort 4 integers in decreasing order (insertion sort).
+        pure subroutine sort_decreasing(a)
+            integer, intent(inout) :: a(4)
+            integer :: i, j, v
+            do i = 2, 4
+                v = a(i)
+                j = i - 1
+                do while (j >= 1)
+                    if (a(j) >= v) exit
+                    a(j + 1) = a(j)
+                    j = j - 1
+                end do
+                a(j + 1) = v
+            end do
+        end subroutine sort_decreasing
+    end subroutine check_distinct_nodes
 
     !> Name of a physical group.
     pure function group_name(names, dim, tag) result(name)
