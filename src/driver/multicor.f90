@@ -78,10 +78,14 @@ program multicor
         case ('-q', '--quiet')
             opts%quiet = .true.
         case ('-o', '--output')
+            ! a repeated option is refused, as a repeated keyword in a deck: which one was meant?
+            if (allocated(opts%output_dir)) call usage_error('--output given twice')
             take_output = .true.
         case ('--restart')
+            if (allocated(opts%restart)) call usage_error('--restart given twice')
             take_restart = .true.
         case ('--end')
+            if (opts%end_time >= 0.0_wp) call usage_error('--end given twice')
             take_end = .true.
         case default
             if (arg(1:1) == '-') call usage_error("unknown option '"//arg//"'")

@@ -267,6 +267,14 @@ def end_option(exe, work):
               and "--end needs a" in proc.stderr and value in proc.stderr,
               f"exit {proc.returncode} {proc.stderr.strip()[:300]}")
     check("--end: nothing written", not folder.exists(), "")
+    # a repeated option is a bad command line, as a repeated keyword in a deck is an error
+    for args, name in ((["--output", folder, "--output", work / "other"], "--output"),
+                       (["--output", folder, "--end", "1e-3", "--end", "2e-3"], "--end"),
+                       (["--output", folder, "--restart", work / "a.h5", "--restart", work / "b.h5"], "--restart")):
+        proc = multicor(exe, deck, *args, "--quiet")
+        check(f"{name} twice: bad command line (exit 2)", proc.returncode == 2 and f"{name} given twice" in proc.stderr,
+              f"exit {proc.returncode} {proc.stderr.strip()[:200]}")
+    check("repeated options: nothing written", not folder.exists() and not (work / "other").exists(), "")
 
 
 def no_empty_folder(exe, work):
