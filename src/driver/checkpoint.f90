@@ -12,7 +12,11 @@
 !> loop: the random deposit is generated from the deck's seed when the model is built.
 !>
 !> The file is written as '<path>.tmp' and renamed to `path` (atomic on POSIX): a kill
-!> during the write leaves the previous checkpoint intact.
+!> during the write leaves the previous checkpoint intact. Before a run replaces the
+!> checkpoint it found (an earlier run's, or the one it restarts from) for the first time,
+!> that one gets the second name '<path>.prev' (a hard link): a run that fails puts it back
+!> (`checkpoint_run_t%revert`), a run that ends or is stopped by a signal deletes it
+!> (`settle`).
 module driver_checkpoint
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
@@ -20,7 +24,7 @@ module driver_checkpoint
     use core_signals, only: caught_signal
     use core_strings, only: to_str
     use io_hdf5_file, only: h5_file_t
-    use io_paths, only: rename_file, remove_file, file_exists
+    use io_paths, only: rename_file, remove_file, file_exists, link_or_copy_file
     use fem_newmark, only: time_integrator_t, newmark_t
     use dem_contacts, only: contacts_list_problem
     use dem_moreau_jean, only: dem_system_t
@@ -43,6 +47,8 @@ module driver_checkpoint
     character(len=*), parameter :: checkpoint_name = 'checkpoint.h5'
     !> Format tag written in every checkpoint.
     character(len=*), parameter :: format_tag = 'MULTICOR checkpoint 1'
+    !> States of `checkpoint_run_t%found`.
+    integer, parameter :: found_unknown = 0, found_kept = 1, found_none = 2
 
     !> Counters of a time loop that the results depend on.
     type :: loop_state_t
@@ -92,9 +98,17 @@ module driver_checkpoint
         integer(i8) :: last_step = -1
         !> Time of the state in the last checkpoint written [s].
         real(wp) :: last_time = 0.0_wp
+        !> The checkpoint this run found at `path`: not looked at yet (before the run's first
+        !> commit), kept as '<path>.prev', or none.
+        integer, private :: found = found_unknown
     contains
         !> End the checkpoint being written: committed, or discarded after a failed write.
         procedure :: finish => checkpoint_run_finish
+        !> After a failed run: the checkpoint it found at `path` back in place (or none).
+        procedure :: revert => checkpoint_run_revert
+        !> After a run that ended or was stopped: its own checkpoint stays, the one it found
+        !> is deleted.
+        procedure :: settle => checkpoint_run_settle
     end type checkpoint_run_t
 
     !> What the end of a step of a time loop calls for, to be done in this order: the regular
@@ -236,11 +250,52 @@ contains
             call checkpoint_discard(file, self%path)
             return
         end if
+        if (self%found == found_unknown) then
+            self%found = found_none
+            if (file_exists(self%path)) then
+                call link_or_copy_file(self%path, self%path//'.prev', error)
+                if (allocated(error)) then
+                    call checkpoint_discard(file, self%path)
+                    error%message = 'checkpoint: '//error%message//' (the checkpoint found in the folder, '// &
+                                    'kept until this run ends)'
+                    return
+                end if
+                self%found = found_kept
+            end if
+        end if
         call checkpoint_commit(file, self%path, error)
         if (allocated(error)) return
         self%last_step = k
         self%last_time = t
     end subroutine checkpoint_run_finish
+
+    !> After a failed run: the checkpoint found at `path` before the run's first commit is
+    !> put back, or, when there was none, the run's own is deleted (it belongs to results
+    !> the failure deleted, or to a restart that leaves the state it started from).
+    subroutine checkpoint_run_revert(self)
+        !> The run's checkpoints.
+        class(checkpoint_run_t), intent(inout) :: self
+        type(error_t), allocatable :: ignored
+        select case (self%found)
+        case (found_kept)
+            call rename_file(self%path//'.prev', self%path, ignored)
+            ! still there when both names were one file (the commit never replaced it)
+            call remove_file(self%path//'.prev')
+        case (found_none)
+            call remove_file(self%path)
+        end select
+        self%found = found_unknown
+        self%last_step = -1
+    end subroutine checkpoint_run_revert
+
+    !> After a run that ended or was stopped by a signal: its own last checkpoint stays at
+    !> `path`, the one it found there is deleted.
+    subroutine checkpoint_run_settle(self)
+        !> The run's checkpoints.
+        class(checkpoint_run_t), intent(inout) :: self
+        if (self%found == found_kept) call remove_file(self%path//'.prev')
+        self%found = found_unknown
+    end subroutine checkpoint_run_settle
 
     !> Open a checkpoint for reading and check it belongs to this deck, this code version and
     !> this kind of run.
