@@ -241,7 +241,7 @@ contains
             type(error_t), allocatable :: ignored
             call self%dem_out%resume(self%sys%dem, store_contacts)
             call self%cpl_out%resume(self%sys)
-            call load_coupled(ck%source, self%sys, error)
+            call load_coupled(ck%source, self%sys, ck%start%step, error)
             if (.not. allocated(error)) call load_dem_writer(ck%source, self%dem_out, error)
             if (.not. allocated(error)) call load_coupled_writer(ck%source, self%cpl_out, error)
             if (.not. allocated(error)) call load_results(ck%source, out, error)

@@ -57,6 +57,8 @@ module driver_results
         procedure :: open => writer_open
         !> Reopen the results file of a checkpointed run to continue it (restart).
         procedure :: resume => writer_resume
+        !> Mark a resumed file unfinished again (after the checkpoint is read).
+        procedure :: mark_running => writer_mark_running
         !> Write the mesh of the beam: node ids, coordinates, connectivity.
         procedure :: write_mesh => writer_write_mesh
         !> Append one stored state: time, displacements, velocities, accelerations.
@@ -155,7 +157,8 @@ contains
     !> Open the results file of a run to continue it (restart): '<final_path>.partial' when
     !> it exists and belongs to that run, else a copy of `final_path` made as the partial file
     !> (the finished file stays as it is until the continued run ends normally). The run is
-    !> recognised by the root attribute 'run_id'. /summary is marked unfinished again.
+    !> recognised by the root attribute 'run_id'. Nothing is written to it until the
+    !> checkpoint is read (`mark_running`).
     subroutine writer_resume(self, final_path, run_id, error)
         !> The writer; must not be open.
         class(results_writer_t), intent(inout) :: self
@@ -202,13 +205,6 @@ contains
             error%message = 'results: '//error%message
             return
         end if
-        call self%file%write_attribute('/summary', 'finished', 0, error)
-        if (.not. allocated(error)) call self%file%write_attribute('/summary', 'status', &
-                                                                   'running (or killed)', error)
-        if (allocated(error)) then
-            call self%abort()
-            error%message = 'results: '//error%message
-        end if
     contains
         !> Whether `path` is an HDF5 file whose 'run_id' attribute is `run_id`.
         logical function belongs(path)
@@ -225,6 +221,21 @@ contains
             call f%close(e)
         end function belongs
     end subroutine writer_resume
+
+    !> Mark a resumed file as the file of a running run again (/summary finished = 0), once
+    !> the checkpoint it continues from has been read and checked.
+    subroutine writer_mark_running(self, error)
+        !> An open writer.
+        class(results_writer_t), intent(inout) :: self
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call require_open(self, 'mark_running', error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/summary', 'finished', 0, error)
+        if (.not. allocated(error)) call self%file%write_attribute('/summary', 'status', &
+                                                                   'running (or killed)', error)
+        if (allocated(error)) error%message = 'results: '//error%message
+    end subroutine writer_mark_running
 
     !> Write the FE mesh: /fem/mesh/{node_id, coordinates, connectivity}.
     subroutine writer_write_mesh(self, node_id, x, y, conn, error)

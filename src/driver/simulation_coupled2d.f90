@@ -33,6 +33,7 @@ module driver_simulation_coupled2d
     use driver_simulation_continuum, only: continuum_simulation_t
     use driver_simulation_dem, only: dem_simulation_t
     use driver_coupled_loop, only: arlequin_simulation_t
+    use driver_checkpoint, only: read_finite_attribute
     implicit none
     private
     public :: coupled2d_simulation_t, write_disks_xdmf
@@ -327,7 +328,7 @@ contains
         !> Set on a read failure.
         type(error_t), allocatable, intent(out) :: error
         real(wp), allocatable :: totals(:)
-        call f%read_attribute('/coupling', 'continuum_audit', totals, error)
+        call read_finite_attribute(f, '/coupling', 'continuum_audit', totals, 5, error)
         if (allocated(error)) return
         call audit_step(self, .true., totals(1:4))
         self%sys%prescribed_coupling_work = totals(5)
