@@ -341,9 +341,11 @@ interval = 5
          "/dem/vy value 1 is Infinity"),
     ]
     before = {d: digest(d / f"{deck.stem}.h5") for deck, d in [(beam_deck, folder), (dem_deck, dem_folder)]}
+    # each edit on a copy of the original (a restart that wrongly runs replaces the folder's)
+    original = {d: shutil.copy(d / "checkpoint.h5", work / f"{d.name}_original.h5") for d in before}
     for deck, out, name, edit, says in cases:
         damaged = work / "damaged_values.h5"
-        shutil.copy(out / "checkpoint.h5", damaged)
+        shutil.copy(original[out], damaged)
         with h5py.File(damaged, "r+") as f:
             edit(f)
         proc = run(exe, deck, "--output", out, "--restart", damaged, "--end", 4e-3 if deck == dem_deck else 0.1)
