@@ -11,16 +11,26 @@
 !> built again from the deck at restart and not stored. There is no random state in a time
 !> loop: the random deposit is generated from the deck's seed when the model is built.
 !>
+!> Every value read back is checked before the run uses it: reals finite, counts, step
+!> numbers, body numbers and codes in their ranges, array sizes those of the deck's model;
+!> anything else is refused as 'the checkpoint is damaged', naming the value, before the
+!> results file is written to.
+!>
 !> The file is written as '<path>.tmp' and renamed to `path` (atomic on POSIX): a kill
-!> during the write leaves the previous checkpoint intact.
+!> during the write leaves the previous checkpoint intact. Before a run replaces the
+!> checkpoint it found (an earlier run's, or the one it restarts from) for the first time,
+!> that one gets the second name '<path>.prev' (a hard link): a run that fails puts it back
+!> (`checkpoint_run_t%revert`), a run that ends or is stopped by a signal deletes it
+!> (`settle`).
 module driver_checkpoint
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
     use core_version, only: multicor_version
     use core_signals, only: caught_signal
     use core_strings, only: to_str
     use io_hdf5_file, only: h5_file_t
-    use io_paths, only: rename_file, remove_file, file_exists
+    use io_paths, only: rename_file, remove_file, file_exists, link_or_copy_file
     use fem_newmark, only: time_integrator_t, newmark_t
     use dem_contacts, only: contacts_list_problem
     use dem_moreau_jean, only: dem_system_t
@@ -37,12 +47,25 @@ module driver_checkpoint
     public :: save_integrator, load_integrator, save_dem, load_dem, save_coupled, load_coupled
     public :: save_results, load_results, save_dem_writer, load_dem_writer
     public :: save_coupled_writer, load_coupled_writer, save_loop, load_loop
-    public :: checkpoint_run_t, step_end_t, end_of_step
+    public :: checkpoint_run_t, step_end_t, end_of_step, read_finite_attribute
 
     !> File name of the checkpoint in the results folder.
     character(len=*), parameter :: checkpoint_name = 'checkpoint.h5'
     !> Format tag written in every checkpoint.
     character(len=*), parameter :: format_tag = 'MULTICOR checkpoint 1'
+    !> What the attribute 'scalars' of an integrator's group holds (for messages).
+    character(len=*), parameter :: integrator_scalars(9) = [character(len=20) :: &
+                                                            'time', 'time step', 'start time', 'kinetic energy', &
+                                                            'strain energy', 'external work', 'damping dissipation', &
+                                                            'initial energy', 'coupling work']
+    !> What the attribute 'scalars' of a particle system's group holds (for messages).
+    character(len=*), parameter :: dem_scalars(13) = [character(len=20) :: &
+                                                      'time', 'detection seconds', 'solver seconds', 'kinetic energy', &
+                                                      'potential energy', 'external work', 'drive work', &
+                                                      'contact dissipation', 'numerical dissip.', 'initial energy', &
+                                                      'coupling work', 'solver error', 'solver residual']
+    !> States of `checkpoint_run_t%found`.
+    integer, parameter :: found_unknown = 0, found_kept = 1, found_none = 2
 
     !> Counters of a time loop that the results depend on.
     type :: loop_state_t
@@ -92,9 +115,17 @@ module driver_checkpoint
         integer(i8) :: last_step = -1
         !> Time of the state in the last checkpoint written [s].
         real(wp) :: last_time = 0.0_wp
+        !> The checkpoint this run found at `path`: not looked at yet (before the run's first
+        !> commit), kept as '<path>.prev', or none.
+        integer, private :: found = found_unknown
     contains
         !> End the checkpoint being written: committed, or discarded after a failed write.
         procedure :: finish => checkpoint_run_finish
+        !> After a failed run: the checkpoint it found at `path` back in place (or none).
+        procedure :: revert => checkpoint_run_revert
+        !> After a run that ended or was stopped: its own checkpoint stays, the one it found
+        !> is deleted.
+        procedure :: settle => checkpoint_run_settle
     end type checkpoint_run_t
 
     !> What the end of a step of a time loop calls for, to be done in this order: the regular
@@ -236,11 +267,52 @@ contains
             call checkpoint_discard(file, self%path)
             return
         end if
+        if (self%found == found_unknown) then
+            self%found = found_none
+            if (file_exists(self%path)) then
+                call link_or_copy_file(self%path, self%path//'.prev', error)
+                if (allocated(error)) then
+                    call checkpoint_discard(file, self%path)
+                    error%message = 'checkpoint: '//error%message//' (the checkpoint found in the folder, '// &
+                                    'kept until this run ends)'
+                    return
+                end if
+                self%found = found_kept
+            end if
+        end if
         call checkpoint_commit(file, self%path, error)
         if (allocated(error)) return
         self%last_step = k
         self%last_time = t
     end subroutine checkpoint_run_finish
+
+    !> After a failed run: the checkpoint found at `path` before the run's first commit is
+    !> put back, or, when there was none, the run's own is deleted (it belongs to results
+    !> the failure deleted, or to a restart that leaves the state it started from).
+    subroutine checkpoint_run_revert(self)
+        !> The run's checkpoints.
+        class(checkpoint_run_t), intent(inout) :: self
+        type(error_t), allocatable :: ignored
+        select case (self%found)
+        case (found_kept)
+            call rename_file(self%path//'.prev', self%path, ignored)
+            ! still there when both names were one file (the commit never replaced it)
+            call remove_file(self%path//'.prev')
+        case (found_none)
+            call remove_file(self%path)
+        end select
+        self%found = found_unknown
+        self%last_step = -1
+    end subroutine checkpoint_run_revert
+
+    !> After a run that ended or was stopped by a signal: its own last checkpoint stays at
+    !> `path`, the one it found there is deleted.
+    subroutine checkpoint_run_settle(self)
+        !> The run's checkpoints.
+        class(checkpoint_run_t), intent(inout) :: self
+        if (self%found == found_kept) call remove_file(self%path//'.prev')
+        self%found = found_unknown
+    end subroutine checkpoint_run_settle
 
     !> Open a checkpoint for reading and check it belongs to this deck, this code version and
     !> this kind of run.
@@ -299,7 +371,10 @@ contains
             call refuse("checkpoint '"//path//"' holds a "//ckind//' run, the deck is a '//kind//' run')
         else
             call load_loop(file, loop, error)
-            if (allocated(error)) call file%close(ignored)
+            if (allocated(error)) then
+                call file%close(ignored)
+                error%message = "--restart: '"//path//"': "//error%message
+            end if
         end if
     contains
         subroutine refuse(message)
@@ -346,18 +421,28 @@ contains
         integer :: k
         call file%read_attribute('/loop', 'step', k, error)
         if (allocated(error)) return
+        call require_range([k], 0, huge(0), '/loop@step', error)
+        if (allocated(error)) return
         loop%step = int(k, i8)
         call file%read_attribute('/loop', 'unconverged', loop%unconverged, error)
         if (allocated(error)) return
-        call file%read_attribute('/loop', 'speed_warned', k, error)
+        call require_range([loop%unconverged], 0, k, '/loop@unconverged (at most the steps done)', error)
         if (allocated(error)) return
-        loop%speed_warned = k /= 0
-        call file%read_attribute('/loop', 'blocked_warned', k, error)
-        if (allocated(error)) return
-        loop%blocked_warned = k /= 0
-        call file%read_attribute('/loop', 'rotation_warned', k, error)
-        if (allocated(error)) return
-        loop%rotation_warned = k /= 0
+        call read_flag('speed_warned', loop%speed_warned, error)
+        if (.not. allocated(error)) call read_flag('blocked_warned', loop%blocked_warned, error)
+        if (.not. allocated(error)) call read_flag('rotation_warned', loop%rotation_warned, error)
+    contains
+        subroutine read_flag(name, flag, error)
+            character(len=*), intent(in) :: name
+            logical, intent(out) :: flag
+            type(error_t), allocatable, intent(out) :: error
+            integer :: v
+            flag = .false.
+            call file%read_attribute('/loop', name, v, error)
+            if (allocated(error)) return
+            call require_range([v], 0, 1, '/loop@'//name, error)
+            flag = v /= 0
+        end subroutine read_flag
     end subroutine load_loop
 
     ! ---------------------------------------------------------------------------------------
@@ -405,21 +490,30 @@ contains
     end subroutine save_integrator
 
     !> Read the state of a time integrator (built from the deck) from `group`.
-    subroutine load_integrator(file, group, integ, error)
+    subroutine load_integrator(file, group, integ, step, error)
         !> Checkpoint being read.
         type(h5_file_t), intent(inout) :: file
         !> Group, e.g. '/fe'.
         character(len=*), intent(in) :: group
         !> The integrator (init done).
         class(time_integrator_t), intent(inout) :: integ
-        !> Set on a read failure or a size mismatch.
+        !> Steps done at the checkpoint (/loop@step).
+        integer(i8), intent(in) :: step
+        !> Set on a read failure, a size mismatch or a damaged value.
         type(error_t), allocatable, intent(out) :: error
         real(wp), allocatable :: s(:)
         integer :: k
-        call file%read_attribute(group, 'scalars', s, error)
+        call read_finite_attribute(file, group, 'scalars', s, 9, error, names=integrator_scalars)
         if (allocated(error)) return
-        if (size(s) /= 9) then
-            call make_error(error, 'checkpoint: '//group//': wrong number of scalars')
+        call file%read_attribute(group, 'step_count', k, error)
+        if (allocated(error)) return
+        call require_range([k], int(step), int(step), group//'@step_count (the steps of /loop@step)', error)
+        if (allocated(error)) return
+        ! the deck (same hash) gives the step; the time is t0 + steps * h exactly (fem_newmark)
+        if (s(2) /= integ%h .or. s(1) /= s(3) + k*s(2)) then
+            call damaged(error, group//'@scalars: time step '//real_text(s(2))//' s (the deck''s: '// &
+                         real_text(integ%h)//' s) and time '//real_text(s(1))//' s do not match the '// &
+                         to_str(k)//' steps from '//real_text(s(3))//' s')
             return
         end if
         integ%t = s(1)
@@ -431,8 +525,7 @@ contains
         integ%damping_dissipation = s(7)
         integ%initial_energy = s(8)
         integ%coupling_work = s(9)
-        call file%read_attribute(group, 'step_count', integ%step_count, error)
-        if (allocated(error)) return
+        integ%step_count = k
         call get_r1(file, group//'/u', integ%u, error)
         if (allocated(error)) return
         call get_r1(file, group//'/v', integ%v, error)
@@ -450,6 +543,8 @@ contains
         select type (integ)
         type is (newmark_t)
             call file%read_attribute(group, 'predicted', k, error)
+            if (allocated(error)) return
+            call require_range([k], 0, 1, group//'@predicted', error)
             if (allocated(error)) return
             integ%predicted = k /= 0
             call get_r1(file, group//'/fc_old', integ%fc_old, error)
@@ -582,30 +677,44 @@ contains
     end subroutine save_dem
 
     !> Read the mutable state of a particle system (built from the deck, mj_init done).
-    subroutine load_dem(file, group, sys, error)
+    subroutine load_dem(file, group, sys, step, error)
         !> Checkpoint being read.
         type(h5_file_t), intent(inout) :: file
         !> Group, e.g. '/dem'.
         character(len=*), intent(in) :: group
         !> The system.
         type(dem_system_t), intent(inout) :: sys
-        !> Set on a read failure or when the numbers of disks or walls differ.
+        !> Steps done at the checkpoint (/loop@step).
+        integer(i8), intent(in) :: step
+        !> Set on a read failure, when the numbers of disks or walls differ, or on a damaged value.
         type(error_t), allocatable, intent(out) :: error
         real(wp), allocatable :: s(:), c(:)
         integer, allocatable :: iv(:)
         integer :: n
-        call file%read_attribute(group, 'scalars', s, error)
+        call read_finite_attribute(file, group, 'scalars', s, 13, error, names=dem_scalars)
         if (allocated(error)) return
         call read_int_attr_1d(file, group, 'integers', iv, error)
         if (allocated(error)) return
-        call file%read_attribute(group, 'counts_i8', c, error)
+        call read_finite_attribute(file, group, 'counts_i8', c, 2, error)
         if (allocated(error)) return
-        if (size(s) /= 13 .or. size(iv) /= 9 .or. size(c) /= 2) then
+        if (size(iv) /= 9) then
             call make_error(error, 'checkpoint: '//group//': wrong number of values')
             return
         end if
         if (iv(8) /= sys%particles%n .or. iv(9) /= sys%walls%n) then
             call make_error(error, 'checkpoint: '//group//': numbers of disks or walls differ from the deck')
+            return
+        end if
+        ! step (that of /loop), bonds pending, sweeps, contacts, active, blocked, converged
+        call require_range(iv(1:1), int(step), int(step), group//'@integers value 1 (the steps of /loop@step)', error)
+        if (.not. allocated(error)) call require_range(iv(2:2), 0, 1, group//'@integers value 2 (bonds pending)', error)
+        if (.not. allocated(error)) call require_range(iv(3:6), 0, huge(0), group//'@integers (counts '// &
+                                                       'of sweeps and contacts)', error, first=3)
+        if (.not. allocated(error)) call require_range(iv(7:7), 0, 1, group//'@integers value 7 (converged)', error)
+        if (allocated(error)) return
+        if (any(c < 0.0_wp) .or. any(c > 2.0_wp**62) .or. any(c /= aint(c))) then
+            call damaged(error, group//'@counts_i8: '//real_text(c(1))//', '//real_text(c(2))// &
+                         ' are not counts')
             return
         end if
         sys%time = s(1)
@@ -671,6 +780,14 @@ contains
             if (.not. allocated(error)) call file%read_dataset(g//'/key_rows', kr, error)
             if (.not. allocated(error)) call file%read_dataset(g//'/values', v, error)
             if (allocated(error)) return
+            if (size(k2) /= size(k1) .or. size(kr) /= size(k1)) then
+                call damaged(error, g//': key_i1, key_i2 and key_rows differ in size')
+                return
+            end if
+            call require_range(k1, -sys%walls%n, sys%particles%n, g//'/key_i1', error)
+            if (.not. allocated(error)) call require_range(k2, 1, sys%particles%n, g//'/key_i2', error)
+            if (.not. allocated(error)) call require_finite(v, g//'/values', error)
+            if (allocated(error)) return
             allocate (sys%block)
             call bonded_block_restore(sys%block, k1, k2, kr, v)
         end subroutine load_block
@@ -688,6 +805,8 @@ contains
                 call make_error(error, 'checkpoint: '//path//': size differs from the deck')
                 return
             end if
+            call require_finite(v, path, error)
+            if (allocated(error)) return
             x(1:n) = v
         end subroutine get_part
 
@@ -699,6 +818,8 @@ contains
             g = group//'/contacts'
             associate (cs => sys%contacts)
                 call file%read_attribute(g, 'n', m, error)
+                if (allocated(error)) return
+                call require_range([m], 0, huge(0), g//'@n', error)
                 if (allocated(error)) return
                 if (allocated(cs%i1)) deallocate (cs%i1, cs%i2, cs%nrm, cs%gap, cs%lever, cs%w, cs%shift, &
                                                   cs%r, cs%u, cs%mu, cs%erol, cs%amoy, cs%coh, cs%pcase, &
@@ -735,6 +856,27 @@ contains
                 if (.not. allocated(error)) call file%read_dataset(g//'/status', cs%status, error)
                 if (.not. allocated(error)) call file%read_dataset(g//'/active', active, error)
                 if (allocated(error)) return
+                call check_sizes(g, m, active, error)
+                if (allocated(error)) return
+                call require_finite([cs%nrm], g//'/nrm', error)
+                if (.not. allocated(error)) call require_finite(cs%gap, g//'/gap', error)
+                if (.not. allocated(error)) call require_finite([cs%lever], g//'/lever', error)
+                if (.not. allocated(error)) call require_finite([cs%w], g//'/w', error)
+                if (.not. allocated(error)) call require_finite([cs%shift], g//'/shift', error)
+                if (.not. allocated(error)) call require_finite([cs%r], g//'/r', error)
+                if (.not. allocated(error)) call require_finite([cs%u], g//'/u', error)
+                if (.not. allocated(error)) call require_finite([cs%y], g//'/y', error)
+                if (.not. allocated(error)) call require_finite(cs%mu, g//'/mu', error)
+                if (.not. allocated(error)) call require_finite(cs%erol, g//'/erol', error)
+                if (.not. allocated(error)) call require_finite(cs%amoy, g//'/amoy', error)
+                if (.not. allocated(error)) call require_finite(cs%coh, g//'/coh', error)
+                ! codes: dem_contacts status_*, dem_bipotential case_* (0 before a solve),
+                ! dem_bonds break_*
+                if (.not. allocated(error)) call require_range(cs%status, 0, 4, g//'/status', error)
+                if (.not. allocated(error)) call require_range(cs%pcase, 0, 5, g//'/pcase', error)
+                if (.not. allocated(error)) call require_range(cs%break_mode, 0, 4, g//'/break_mode', error)
+                if (.not. allocated(error)) call require_range(active, 0, 1, g//'/active', error)
+                if (allocated(error)) return
                 cs%active = active /= 0
                 ! the outputs of the previous step are not needed after the step's laws
                 allocate (cs%y_prev(2, m), source=0.0_wp)
@@ -746,25 +888,55 @@ contains
             end associate
         end subroutine load_contacts
 
+        !> Every per-contact dataset holds the n contacts of the list.
+        subroutine check_sizes(g, m, active, error)
+            character(len=*), intent(in) :: g
+            integer, intent(in) :: m, active(:)
+            type(error_t), allocatable, intent(out) :: error
+            associate (cs => sys%contacts)
+                if (size(cs%i1) /= m .or. size(cs%i2) /= m .or. size(cs%gap) /= m .or. size(cs%mu) /= m .or. &
+                    size(cs%erol) /= m .or. size(cs%amoy) /= m .or. size(cs%coh) /= m .or. &
+                    size(cs%pcase) /= m .or. size(cs%break_mode) /= m .or. size(cs%status) /= m .or. &
+                    size(active) /= m .or. any(shape(cs%nrm) /= [2, m]) .or. any(shape(cs%lever) /= [2, m]) .or. &
+                    any(shape(cs%w) /= [6, m]) .or. any(shape(cs%shift) /= [2, m]) .or. &
+                    any(shape(cs%r) /= [3, m]) .or. any(shape(cs%u) /= [3, m]) .or. any(shape(cs%y) /= [2, m])) &
+                    call damaged(error, g//': a dataset does not hold the '//to_str(m)//' contacts of '//g//'@n')
+            end associate
+        end subroutine check_sizes
+
         subroutine load_ruptures(error)
             type(error_t), allocatable, intent(out) :: error
             character(len=:), allocatable :: g
-            integer, allocatable :: step(:)
+            integer, allocatable :: rupture_step(:)
             integer :: m
             g = group//'/ruptures'
             associate (rl => sys%ruptures)
                 call file%read_attribute(g, 'n', m, error)
+                if (allocated(error)) return
+                call require_range([m], 0, huge(0), g//'@n', error)
                 if (allocated(error)) return
                 rl%n = m
                 if (allocated(rl%i1)) deallocate (rl%i1, rl%i2, rl%step, rl%time, rl%mode)
                 if (m == 0) return
                 call file%read_dataset(g//'/i1', rl%i1, error)
                 if (.not. allocated(error)) call file%read_dataset(g//'/i2', rl%i2, error)
-                if (.not. allocated(error)) call file%read_dataset(g//'/step', step, error)
+                if (.not. allocated(error)) call file%read_dataset(g//'/step', rupture_step, error)
                 if (.not. allocated(error)) call file%read_dataset(g//'/time', rl%time, error)
                 if (.not. allocated(error)) call file%read_dataset(g//'/mode', rl%mode, error)
                 if (allocated(error)) return
-                rl%step = int(step, i8)
+                if (size(rl%i1) /= m .or. size(rl%i2) /= m .or. size(rupture_step) /= m .or. &
+                    size(rl%time) /= m .or. size(rl%mode) /= m) then
+                    call damaged(error, g//': a dataset does not hold the '//to_str(m)//' ruptures of '//g//'@n')
+                    return
+                end if
+                call require_range(rl%i1, -sys%walls%n, sys%particles%n, g//'/i1', error)
+                if (.not. allocated(error)) call require_range(rl%i2, 1, sys%particles%n, g//'/i2', error)
+                if (.not. allocated(error)) call require_range(rupture_step, 1, int(step), g//'/step', error)
+                if (.not. allocated(error)) call require_finite(rl%time, g//'/time', error)
+                ! dem_bonds break_tension .. break_shear_moment
+                if (.not. allocated(error)) call require_range(rl%mode, 1, 4, g//'/mode', error)
+                if (allocated(error)) return
+                rl%step = int(rupture_step, i8)
             end associate
         end subroutine load_ruptures
     end subroutine load_dem
@@ -811,27 +983,35 @@ contains
     end subroutine save_coupled
 
     !> Read the state of a coupled system (built from the deck).
-    subroutine load_coupled(file, sys, error)
+    subroutine load_coupled(file, sys, step, error)
         !> Checkpoint being read.
         type(h5_file_t), intent(inout) :: file
         !> The coupled system.
         type(coupled_system_t), intent(inout) :: sys
-        !> Set on a read failure.
+        !> Steps done at the checkpoint (/loop@step).
+        integer(i8), intent(in) :: step
+        !> Set on a read failure or a damaged value.
         type(error_t), allocatable, intent(out) :: error
         integer, allocatable :: iv(:)
         real(wp), allocatable :: s(:)
-        call load_integrator(file, '/fe', sys%fe, error)
+        call load_integrator(file, '/fe', sys%fe, step, error)
         if (allocated(error)) return
-        call load_dem(file, '/dem', sys%dem, error)
+        call load_dem(file, '/dem', sys%dem, step, error)
         if (allocated(error)) return
         call read_int_attr_1d(file, '/coupling', 'integers', iv, error)
         if (allocated(error)) return
-        call file%read_attribute('/coupling', 'scalars', s, error)
+        call read_finite_attribute(file, '/coupling', 'scalars', s, 7, error)
         if (allocated(error)) return
-        if (size(iv) /= 6 .or. size(s) /= 7) then
+        if (size(iv) /= 6) then
             call make_error(error, 'checkpoint: /coupling: wrong number of values')
             return
         end if
+        ! step (that of /loop), sweeps, corrections, contacts, active, converged
+        call require_range(iv(1:1), int(step), int(step), '/coupling@integers value 1 (the steps of /loop@step)', error)
+        if (.not. allocated(error)) call require_range(iv(2:5), 0, huge(0), '/coupling@integers (counts)', &
+                                                       error, first=2)
+        if (.not. allocated(error)) call require_range(iv(6:6), 0, 1, '/coupling@integers value 6 (converged)', error)
+        if (allocated(error)) return
         associate (st => sys%stats)
             sys%step = iv(1)
             st%sweeps = iv(2)
@@ -897,6 +1077,8 @@ contains
 
     !> Restore the results writer's counters, and bring its (open) results file back to the
     !> checkpoint: datasets written after it are deleted, series cut to their record counts.
+    !> The first write to the results file of a restart: everything read before it (the state)
+    !> and in it is checked first.
     subroutine load_results(file, out, error)
         !> Checkpoint being read.
         type(h5_file_t), intent(inout) :: file
@@ -908,13 +1090,23 @@ contains
         integer, allocatable :: counts(:), saved(:), w(:)
         character(len=:), allocatable :: joined
         integer :: k, j, start, n_saved
+        real(wp) :: energy0
         call read_int_attr_1d(file, '/results', 'writer', w, error)
+        if (allocated(error)) return
+        if (size(w) /= 3) then
+            call damaged(error, '/results@writer: '//to_str(size(w))//' values, not 3')
+            return
+        end if
+        ! nodes, state series written, energy series written
+        call require_range(w(1:1), 0, huge(0), '/results@writer value 1 (nodes)', error)
+        if (.not. allocated(error)) call require_range(w(2:3), 0, 1, '/results@writer (flags)', error, first=2)
+        if (.not. allocated(error)) call file%read_attribute('/results', 'energy0', energy0, error)
+        if (.not. allocated(error)) call require_finite([energy0], '/results@energy0', error)
         if (allocated(error)) return
         out%n_nodes = w(1)
         out%have_state = w(2) /= 0
         out%have_energy = w(3) /= 0
-        call file%read_attribute('/results', 'energy0', out%energy0, error)
-        if (allocated(error)) return
+        out%energy0 = energy0
         call file%read_attribute('/results', 'datasets', joined, error)
         if (allocated(error)) return
         n_saved = count([(joined(k:k) == new_line('a'), k=1, len(joined))])
@@ -939,16 +1131,6 @@ contains
                             to_str(counts(k))//': the checkpoint is damaged or not of these results')
             return
         end do
-        ! Every dataset of the file: kept (series cut to the checkpoint) or deleted.
-        do k = 1, size(paths)
-            j = find(trim(paths(k)))
-            if (j == 0) then
-                call out%file%delete(trim(paths(k)), error)
-            else if (counts(k) /= saved(j)) then
-                call out%file%resize_series(trim(paths(k)), saved(j), error)
-            end if
-            if (allocated(error)) return
-        end do
         ! Every dataset of the checkpoint must be there.
         start = 1
         do k = 1, len(joined)
@@ -959,6 +1141,18 @@ contains
                 return
             end if
             start = k + 1
+        end do
+        call out%mark_running(error)
+        if (allocated(error)) return
+        ! Every dataset of the file: kept (series cut to the checkpoint) or deleted.
+        do k = 1, size(paths)
+            j = find(trim(paths(k)))
+            if (j == 0) then
+                call out%file%delete(trim(paths(k)), error)
+            else if (counts(k) /= saved(j)) then
+                call out%file%resize_series(trim(paths(k)), saved(j), error)
+            end if
+            if (allocated(error)) return
         end do
     contains
         !> Index of `path` in the checkpoint's list (0: not there).
@@ -1009,6 +1203,8 @@ contains
             call make_error(error, 'checkpoint: /writers: wrong number of particle writer counters')
             return
         end if
+        call require_range(c, 0, huge(0), '/writers@dem', error)
+        if (allocated(error)) return
         if (c(4) /= 0) then
             call make_error(error, 'checkpoint: the particle writer had unwritten statistics')
             return
@@ -1049,7 +1245,12 @@ contains
         real(wp), allocatable :: m(:)
         call read_int_attr_1d(file, '/writers', 'coupled', c, error)
         if (allocated(error)) return
-        call file%read_attribute('/writers', 'coupled_max', m, error)
+        if (size(c) /= 3) then
+            call make_error(error, 'checkpoint: /writers: wrong number of coupling writer counters')
+            return
+        end if
+        call require_range(c, 0, huge(0), '/writers@coupled', error)
+        if (.not. allocated(error)) call read_finite_attribute(file, '/writers', 'coupled_max', m, 4, error)
         if (allocated(error)) return
         if (c(3) /= 0) then
             call make_error(error, 'checkpoint: the coupling writer had unwritten statistics')
@@ -1111,6 +1312,8 @@ contains
                 return
             end if
         end if
+        call require_finite(v, path, error)
+        if (allocated(error)) return
         call move_alloc(v, x)
     end subroutine get_r1
 
@@ -1122,10 +1325,120 @@ contains
         integer, allocatable, intent(out) :: values(:)
         type(error_t), allocatable, intent(out) :: error
         real(wp), allocatable :: r(:)
+        integer :: k
         call file%read_attribute(object, name, r, error)
         if (allocated(error)) return
+        do k = 1, size(r)
+            if (ieee_is_finite(r(k))) then
+                if (r(k) == aint(r(k)) .and. abs(r(k)) <= real(huge(0), wp)) cycle
+            end if
+            call damaged(error, object//'@'//name//' value '//to_str(k)//' is '//real_text(r(k))// &
+                         ', not a 32-bit integer')
+            return
+        end do
         values = nint(r)
     end subroutine read_int_attr_1d
+
+    !> Read a real attribute array of n values, all finite (else the checkpoint is damaged).
+    subroutine read_finite_attribute(file, object, name, values, n, error, names)
+        !> Checkpoint being read.
+        type(h5_file_t), intent(inout) :: file
+        !> Group or dataset, and name of the attribute.
+        character(len=*), intent(in) :: object, name
+        !> The values.
+        real(wp), allocatable, intent(out) :: values(:)
+        !> Number of values expected.
+        integer, intent(in) :: n
+        !> Set on a read failure, another number of values, or a value not finite.
+        type(error_t), allocatable, intent(out) :: error
+        !> What each value is (for the message).
+        character(len=*), intent(in), optional :: names(:)
+        call file%read_attribute(object, name, values, error)
+        if (allocated(error)) return
+        if (size(values) /= n) then
+            call damaged(error, object//'@'//name//': '//to_str(size(values))//' values, not '//to_str(n))
+            return
+        end if
+        call require_finite(values, object//'@'//name, error, names)
+    end subroutine read_finite_attribute
+
+    !> Refuse a value read from a checkpoint that is not finite, naming it.
+    subroutine require_finite(values, what, error, names)
+        !> The values.
+        real(wp), intent(in) :: values(:)
+        !> Where they come from ('/fe@scalars', '/dem/x').
+        character(len=*), intent(in) :: what
+        !> Set on the first value that is NaN or infinite.
+        type(error_t), allocatable, intent(out) :: error
+        !> What each value is (for the message).
+        character(len=*), intent(in), optional :: names(:)
+        integer :: k
+        do k = 1, size(values)
+            if (ieee_is_finite(values(k))) cycle
+            if (present(names)) then
+                call damaged(error, what//' value '//to_str(k)//' ('//trim(names(k))//') is '// &
+                             real_text(values(k)))
+            else if (size(values) == 1) then
+                call damaged(error, what//' is '//real_text(values(k)))
+            else
+                call damaged(error, what//' value '//to_str(k)//' is '//real_text(values(k)))
+            end if
+            return
+        end do
+    end subroutine require_finite
+
+    !> Refuse integers read from a checkpoint outside [lo, hi], naming the first.
+    subroutine require_range(values, lo, hi, what, error, first)
+        !> The values.
+        integer, intent(in) :: values(:)
+        !> Allowed range.
+        integer, intent(in) :: lo, hi
+        !> Where they come from ('/dem/contacts/status').
+        character(len=*), intent(in) :: what
+        !> Set on the first value out of range.
+        type(error_t), allocatable, intent(out) :: error
+        !> Index of values(1) in the message (default 1).
+        integer, intent(in), optional :: first
+        integer :: k, k0
+        k0 = 0
+        if (present(first)) k0 = first - 1
+        do k = 1, size(values)
+            if (values(k) >= lo .and. values(k) <= hi) cycle
+            if (size(values) == 1 .and. .not. present(first)) then
+                call damaged(error, what//' is '//to_str(values(k))//', outside '//to_str(lo)//'..'//to_str(hi))
+            else
+                call damaged(error, what//' value '//to_str(k + k0)//' is '//to_str(values(k))//', outside '// &
+                             to_str(lo)//'..'//to_str(hi))
+            end if
+            return
+        end do
+    end subroutine require_range
+
+    !> The error for a damaged checkpoint: 'checkpoint: <problem>: the checkpoint is damaged'.
+    subroutine damaged(error, problem)
+        !> Set.
+        type(error_t), allocatable, intent(out) :: error
+        !> What is wrong, naming the value.
+        character(len=*), intent(in) :: problem
+        call make_error(error, 'checkpoint: '//problem//': the checkpoint is damaged')
+    end subroutine damaged
+
+    !> A real for messages: 'NaN', 'Infinity', '-Infinity' or 4 significant digits.
+    function real_text(x) result(text)
+        !> The value.
+        real(wp), intent(in) :: x
+        character(len=:), allocatable :: text
+        character(len=24) :: buf
+        if (ieee_is_nan(x)) then
+            text = 'NaN'
+        else if (.not. ieee_is_finite(x)) then
+            text = merge('Infinity ', '-Infinity', x > 0.0_wp)
+            text = trim(text)
+        else
+            write (buf, '(es11.3e3)') x
+            text = trim(adjustl(buf))
+        end if
+    end function real_text
 
     !> Outputs, checkpoint and stop test after step k of a time loop, in the one order that
     !> makes a restart bitwise: the regular output of step k, then the checkpoint (last step,

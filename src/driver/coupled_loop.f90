@@ -67,6 +67,8 @@ module driver_coupled_loop
         procedure(summary_lines_iface), deferred :: summary_lines
         !> More of a checkpoint than the coupled system and the writers (default: none).
         procedure :: save_part => no_save_part
+        !> Check what `save_part` wrote, before the results file is touched (default: none).
+        procedure :: check_saved_part => no_check_saved_part
         !> Read back what `save_part` wrote, after the results file is restored (default: none).
         procedure :: load_part => no_load_part
         !> Last writes after the summary (default: none).
@@ -241,9 +243,10 @@ contains
             type(error_t), allocatable :: ignored
             call self%dem_out%resume(self%sys%dem, store_contacts)
             call self%cpl_out%resume(self%sys)
-            call load_coupled(ck%source, self%sys, error)
+            call load_coupled(ck%source, self%sys, ck%start%step, error)
             if (.not. allocated(error)) call load_dem_writer(ck%source, self%dem_out, error)
             if (.not. allocated(error)) call load_coupled_writer(ck%source, self%cpl_out, error)
+            if (.not. allocated(error)) call self%check_saved_part(ck%source, error)
             if (.not. allocated(error)) call load_results(ck%source, out, error)
             if (.not. allocated(error)) call self%load_part(ck%source, out, error)
             call ck%source%close(ignored)
@@ -414,6 +417,16 @@ contains
         !> Set on a write failure.
         type(error_t), allocatable, intent(out) :: error
     end subroutine no_save_part
+
+    !> Nothing more to check in a checkpoint.
+    subroutine no_check_saved_part(self, f, error)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(in) :: self
+        !> The checkpoint (open).
+        type(h5_file_t), intent(inout) :: f
+        !> Set when a value is damaged.
+        type(error_t), allocatable, intent(out) :: error
+    end subroutine no_check_saved_part
 
     !> Nothing to read back from a checkpoint.
     subroutine no_load_part(self, f, out, error)

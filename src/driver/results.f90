@@ -2,7 +2,9 @@
 !>
 !> The file is written as '<final_path>.partial' and renamed to `final_path` by `close` only
 !> when the run succeeded: an earlier result stays intact until then, and `abort` deletes the
-!> partial file. /summary is written at creation with finished = 0 and set to 1 by `close`;
+!> partial file. The partial file of an earlier run (interrupted, perhaps resumable) is set
+!> aside as '<final_path>.partial.prev' while this run writes its own: `abort` puts it back,
+!> `close` and `close_unfinished` (this run's own file takes its place) delete it. /summary is written at creation with finished = 0 and set to 1 by `close`;
 !> the run loops `flush` after every output, so the partial file of a killed run opens and
 !> holds every output up to the last one. A run stopped by a signal (`stop_at`) is closed by
 !> `close_unfinished`: it stays '.partial' with finished = 0 and the reason in /summary.
@@ -47,11 +49,16 @@ module driver_results
         !> Whether the file is the partial file of an earlier run, continued (`resume`): the
         !> only copy of its outputs, which a failed run then keeps (not a copy of the finished file).
         logical :: resumed = .false.
+        !> Whether an earlier partial file was set aside as '<partial_path>.prev' (`abort`
+        !> puts it back).
+        logical :: set_aside = .false.
     contains
         !> Create the results file (written as .partial until `close`).
         procedure :: open => writer_open
         !> Reopen the results file of a checkpointed run to continue it (restart).
         procedure :: resume => writer_resume
+        !> Mark a resumed file unfinished again (after the checkpoint is read).
+        procedure :: mark_running => writer_mark_running
         !> Write the mesh of the beam: node ids, coordinates, connectivity.
         procedure :: write_mesh => writer_write_mesh
         !> Append one stored state: time, displacements, velocities, accelerations.
@@ -115,6 +122,8 @@ contains
         self%stop_time = 0.0_wp
         self%run_id = new_run_id()
         self%resumed = .false.
+        call set_aside_partial(self, error)
+        if (allocated(error)) return
         call self%file%create(self%partial_path, error)
         if (allocated(error)) return
         call root_attributes(error)
@@ -148,7 +157,8 @@ contains
     !> Open the results file of a run to continue it (restart): '<final_path>.partial' when
     !> it exists and belongs to that run, else a copy of `final_path` made as the partial file
     !> (the finished file stays as it is until the continued run ends normally). The run is
-    !> recognised by the root attribute 'run_id'. /summary is marked unfinished again.
+    !> recognised by the root attribute 'run_id'. Nothing is written to it until the
+    !> checkpoint is read (`mark_running`).
     subroutine writer_resume(self, final_path, run_id, error)
         !> The writer; must not be open.
         class(results_writer_t), intent(inout) :: self
@@ -169,6 +179,7 @@ contains
         self%stop_time = 0.0_wp
         self%run_id = run_id
         self%resumed = .true.
+        self%set_aside = .false.
         if (.not. belongs(self%partial_path)) then
             if (.not. belongs(final_path)) then
                 call make_error(error, "results: neither '"//self%partial_path//"' nor '"// &
@@ -176,25 +187,23 @@ contains
                                 run_id//'): it was moved, deleted or replaced by another run')
                 return
             end if
+            ! a copy: the finished file keeps the outputs, a failure removes the copy (and puts
+            ! back the partial file of another run it set aside)
+            self%resumed = .false.
+            call set_aside_partial(self, error)
+            if (allocated(error)) return
             call copy_file(final_path, self%partial_path, error)
             if (allocated(error)) then
+                call self%abort()
                 error%message = 'results: '//error%message
                 return
             end if
-            ! a copy: the finished file keeps the outputs, a failure removes the copy
-            self%resumed = .false.
         end if
         call self%file%open(self%partial_path, error, writable=.true.)
         if (allocated(error)) then
-            error%message = 'results: '//error%message
-            return
-        end if
-        call self%file%write_attribute('/summary', 'finished', 0, error)
-        if (.not. allocated(error)) call self%file%write_attribute('/summary', 'status', &
-                                                                   'running (or killed)', error)
-        if (allocated(error)) then
             call self%abort()
             error%message = 'results: '//error%message
+            return
         end if
     contains
         !> Whether `path` is an HDF5 file whose 'run_id' attribute is `run_id`.
@@ -212,6 +221,21 @@ contains
             call f%close(e)
         end function belongs
     end subroutine writer_resume
+
+    !> Mark a resumed file as the file of a running run again (/summary finished = 0), once
+    !> the checkpoint it continues from has been read and checked.
+    subroutine writer_mark_running(self, error)
+        !> An open writer.
+        class(results_writer_t), intent(inout) :: self
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call require_open(self, 'mark_running', error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/summary', 'finished', 0, error)
+        if (.not. allocated(error)) call self%file%write_attribute('/summary', 'status', &
+                                                                   'running (or killed)', error)
+        if (allocated(error)) error%message = 'results: '//error%message
+    end subroutine writer_mark_running
 
     !> Write the FE mesh: /fem/mesh/{node_id, coordinates, connectivity}.
     subroutine writer_write_mesh(self, node_id, x, y, conn, error)
@@ -508,13 +532,18 @@ contains
         call self%file%close(error)
         if (allocated(error)) then
             ! An HDF5 file that failed to close is not trustworthy.
-            call remove_file(self%partial_path)
+            if (.not. self%resumed) call remove_file(self%partial_path)
+            call put_back_partial(self)
             error%message = 'results: '//error%message
             return
         end if
         call rename_file(self%partial_path, self%final_path, error)
-        if (allocated(error)) error%message = 'results: '//error%message//' (the results are ' &
-                                              //"kept in '"//self%partial_path//"')"
+        if (allocated(error)) then
+            error%message = 'results: '//error%message//' (the results are '//"kept in '"// &
+                            self%partial_path//"')"
+            return
+        end if
+        call drop_set_aside(self)
     end subroutine writer_close
 
     !> Close the file of a run stopped early (`stop_at`) and keep it as '<final_path>.partial'
@@ -536,22 +565,65 @@ contains
             return
         end if
         call self%file%close(error)
-        if (allocated(error)) error%message = 'results: '//error%message
+        if (allocated(error)) then
+            error%message = 'results: '//error%message
+            return
+        end if
+        call drop_set_aside(self)
     end subroutine writer_close_unfinished
 
-    !> Close and delete the partial file after a failed run (an earlier result is untouched).
-    !> A resumed partial file is kept: it holds the outputs of the earlier part of the run,
-    !> and a restart from the checkpoint cuts what came after it; a copy of the finished file
-    !> made to continue it is removed. Does nothing when the writer is
-    !> not open.
+    !> Close and delete the partial file after a failed run (an earlier result is untouched)
+    !> and put back the earlier partial file set aside for it. A resumed partial file is
+    !> kept: it holds the outputs of the earlier part of the run, and a restart from the
+    !> checkpoint cuts what came after it; a copy of the finished file made to continue it is
+    !> removed.
     subroutine writer_abort(self)
         !> The writer; closed on return.
         class(results_writer_t), intent(inout) :: self
         type(error_t), allocatable :: ignored
-        if (.not. self%file%is_open()) return
-        call self%file%close(ignored)
-        if (.not. self%resumed) call remove_file(self%partial_path)
+        if (self%file%is_open()) then
+            call self%file%close(ignored)
+            if (.not. self%resumed) call remove_file(self%partial_path)
+        end if
+        call put_back_partial(self)
     end subroutine writer_abort
+
+    !> Before this run creates '<partial_path>': rename the partial file of an earlier run,
+    !> if any, to '<partial_path>.prev' (`abort` puts it back).
+    subroutine set_aside_partial(self, error)
+        !> The writer, partial_path set, not open.
+        class(results_writer_t), intent(inout) :: self
+        !> Set if the rename fails.
+        type(error_t), allocatable, intent(out) :: error
+        self%set_aside = .false.
+        if (.not. file_exists(self%partial_path)) return
+        call rename_file(self%partial_path, self%partial_path//'.prev', error)
+        if (allocated(error)) then
+            error%message = 'results: '//error%message//' (the partial file of an earlier run, kept '// &
+                            'until this run ends)'
+            return
+        end if
+        self%set_aside = .true.
+    end subroutine set_aside_partial
+
+    !> Give the earlier partial file set aside its name back (after this run failed).
+    subroutine put_back_partial(self)
+        !> The writer, closed.
+        class(results_writer_t), intent(inout) :: self
+        type(error_t), allocatable :: ignored
+        if (.not. self%set_aside) return
+        call rename_file(self%partial_path//'.prev', self%partial_path, ignored)
+        self%set_aside = .false.
+    end subroutine put_back_partial
+
+    !> Delete the earlier partial file set aside (this run's own file took its place).
+    subroutine drop_set_aside(self)
+        !> The writer.
+        class(results_writer_t), intent(inout) :: self
+        if (.not. self%set_aside) return
+        call remove_file(self%partial_path//'.prev')
+        self%set_aside = .false.
+    end subroutine drop_set_aside
 
     !> Whether a results file is being written.
     pure logical function writer_is_open(self)

@@ -137,10 +137,29 @@ contains
         end subroutine write_into_folder
 
         !> Run the analysis into '<path>.partial', renamed to `path` on success (the caller
-        !> holds the folder's lock).
+        !> holds the folder's lock). A failed run leaves the folder's results, partial file and
+        !> checkpoint as it found them (a resumed partial file keeps the outputs after its
+        !> checkpoint, which the next restart cuts); a run that ends or is stopped by a signal
+        !> leaves its own.
         subroutine write_results(error)
             type(error_t), allocatable, intent(out) :: error
+            logical :: kept
+            call run_and_close(error, kept)
+            if (kept) then
+                call ck%settle()
+            else
+                call ck%revert()
+            end if
+        end subroutine write_results
+
+        !> Open or resume the results file, run, and close the file (finished or stopped; the
+        !> writer cleans up after its own failures).
+        subroutine run_and_close(error, kept)
+            type(error_t), allocatable, intent(out) :: error
+            !> Whether the run ended or was stopped cleanly: its files are the folder's now.
+            logical, intent(out) :: kept
             type(error_t), allocatable :: ignored
+            kept = .false.
             if (ck%restart) then
                 call out%resume(path, run_id, error)
                 if (allocated(error)) call ck%source%close(ignored)
@@ -157,6 +176,7 @@ contains
             if (out%stopped()) then
                 call out%close_unfinished(error)
                 if (allocated(error)) return
+                kept = .true.
                 if (present(stopped_by)) stopped_by = caught_signal()
                 write (tbuf, '(es16.8e3)') out%stop_time
                 call report('stopped: '//out%stop_reason)
@@ -175,7 +195,8 @@ contains
                 return
             end if
             call out%close(error)
-        end subroutine write_results
+            kept = .not. allocated(error)
+        end subroutine run_and_close
 
         !> The command that continues this run from its checkpoint.
         function continue_command() result(command)

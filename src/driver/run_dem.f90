@@ -143,7 +143,7 @@ contains
             type(error_t), allocatable, intent(out) :: error
             type(error_t), allocatable :: ignored
             call writer%resume(cfg%system, cfg%store_contacts)
-            call load_dem(ck%source, '/dem', cfg%system, error)
+            call load_dem(ck%source, '/dem', cfg%system, ck%start%step, error)
             if (.not. allocated(error)) call load_dem_writer(ck%source, writer, error)
             if (.not. allocated(error)) call load_results(ck%source, out, error)
             call ck%source%close(ignored)

@@ -268,7 +268,7 @@ contains
         subroutine restore(error)
             type(error_t), allocatable, intent(out) :: error
             type(error_t), allocatable :: ignored
-            call load_integrator(ck%source, '/fe', integ, error)
+            call load_integrator(ck%source, '/fe', integ, ck%start%step, error)
             if (.not. allocated(error)) call load_results(ck%source, out, error)
             call ck%source%close(ignored)
             if (allocated(error)) return

@@ -29,7 +29,8 @@ module driver_simulation_continuum
     use driver_results, only: results_writer_t
     use io_hdf5_file, only: h5_file_t
     use driver_checkpoint, only: deck_hash, checkpoint_run_t, end_of_step, step_end_t, loop_state_t, checkpoint_create, &
-                                 save_integrator, load_integrator, save_results, load_results
+                                 save_integrator, load_integrator, save_results, load_results, &
+                                 read_finite_attribute
     use driver_results_continuum, only: continuum_writer_t
     use driver_simulation, only: simulation_t, report_iface
     implicit none
@@ -588,8 +589,8 @@ contains
             type(error_t), allocatable, intent(out) :: error
             type(error_t), allocatable :: ignored
             real(wp), allocatable :: totals(:)
-            call load_integrator(ck%source, '/fe', self%integ, error)
-            if (.not. allocated(error)) call ck%source%read_attribute('/fe', 'continuum_audit', totals, error)
+            call load_integrator(ck%source, '/fe', self%integ, ck%start%step, error)
+            if (.not. allocated(error)) call read_finite_attribute(ck%source, '/fe', 'continuum_audit', totals, 4, error)
             if (.not. allocated(error)) call self%audit%resume(self%ops, self%model, self%integ, totals)
             if (.not. allocated(error)) call load_results(ck%source, out, error)
             call ck%source%close(ignored)

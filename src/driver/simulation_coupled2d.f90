@@ -33,6 +33,7 @@ module driver_simulation_coupled2d
     use driver_simulation_continuum, only: continuum_simulation_t
     use driver_simulation_dem, only: dem_simulation_t
     use driver_coupled_loop, only: arlequin_simulation_t
+    use driver_checkpoint, only: read_finite_attribute
     implicit none
     private
     public :: coupled2d_simulation_t, write_disks_xdmf
@@ -70,6 +71,8 @@ module driver_simulation_coupled2d
         procedure :: summary_lines => coupled2d_summary_lines
         !> See `arlequin_simulation_t%save_part`.
         procedure :: save_part => coupled2d_save_part
+        !> See `arlequin_simulation_t%check_saved_part`.
+        procedure :: check_saved_part => coupled2d_check_saved_part
         !> See `arlequin_simulation_t%load_part`.
         procedure :: load_part => coupled2d_load_part
         !> See `arlequin_simulation_t%finish`.
@@ -315,6 +318,18 @@ contains
                                [self%continuum%audit%totals(), self%sys%prescribed_coupling_work], error)
     end subroutine coupled2d_save_part
 
+    !> The totals `save_part` wrote are finite (before the results file is cut back).
+    subroutine coupled2d_check_saved_part(self, f, error)
+        !> The simulation.
+        class(coupled2d_simulation_t), intent(in) :: self
+        !> The checkpoint (open).
+        type(h5_file_t), intent(inout) :: f
+        !> Set when the attribute is missing, of another size or not finite.
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: totals(:)
+        call read_finite_attribute(f, '/coupling', 'continuum_audit', totals, 5, error)
+    end subroutine coupled2d_check_saved_part
+
     !> The continuum's audit resumed with the totals of the checkpoint, C_p u_p at the restart
     !> time, and the continuum writer's stored times from the results file.
     subroutine coupled2d_load_part(self, f, out, error)
@@ -327,7 +342,7 @@ contains
         !> Set on a read failure.
         type(error_t), allocatable, intent(out) :: error
         real(wp), allocatable :: totals(:)
-        call f%read_attribute('/coupling', 'continuum_audit', totals, error)
+        call read_finite_attribute(f, '/coupling', 'continuum_audit', totals, 5, error)
         if (allocated(error)) return
         call audit_step(self, .true., totals(1:4))
         self%sys%prescribed_coupling_work = totals(5)

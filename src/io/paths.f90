@@ -6,6 +6,7 @@ module io_paths
     implicit none
     private
     public :: basename, stem, mkdir_p, remove_empty_folders, file_exists, remove_file, rename_file, copy_file
+    public :: link_or_copy_file
     public :: read_file_text
 
     interface
@@ -25,6 +26,11 @@ module io_paths
             character(kind=c_char), intent(in) :: old(*), new(*)
             integer(c_int) :: rc
         end function c_rename
+        function c_link(old, new) bind(C, name='link') result(rc)
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: old(*), new(*)
+            integer(c_int) :: rc
+        end function c_link
     end interface
 
 contains
@@ -175,6 +181,21 @@ contains
             call make_error(error, "cannot copy '"//old//"' to '"//new//"' (disk full?)")
         end if
     end subroutine copy_file
+
+    !> Give a file a second name `new` (replaced if it exists): a hard link, or a copy where
+    !> the file system has no hard links. Renaming another file onto `old` afterwards leaves
+    !> `new` with the earlier content.
+    subroutine link_or_copy_file(old, new, error)
+        !> Existing file.
+        character(len=*), intent(in) :: old
+        !> Second name.
+        character(len=*), intent(in) :: new
+        !> Set if neither a link nor a copy could be made.
+        type(error_t), allocatable, intent(out) :: error
+        call remove_file(new)
+        if (c_link(old//c_null_char, new//c_null_char) == 0) return
+        call copy_file(old, new, error)
+    end subroutine link_or_copy_file
     !> The whole content of a file, its bytes as characters (for hashing the inputs of a run).
     subroutine read_file_text(path, text, error)
         !> File to read.

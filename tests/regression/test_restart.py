@@ -17,9 +17,12 @@ exact command the program prints is run), and by kill -9 after a periodic checkp
 byte, to that of the uninterrupted run, and so must every attribute except the wall-clock
 ones (dates, wall and solver seconds); for the continuum runs the XDMF file next to the
 results is equal byte for byte as well. Refusals: a checkpoint of another deck, of another
-code version, of another kind of run, a restart with nothing left to do. A new end time
-(--end) continues a finished run; the earlier finished result stays untouched when the
-continued run fails.
+code version, of another kind of run, a restart with nothing left to do, a damaged checkpoint
+(a value edited: NaN, a step, a count or a code out of range). A new end time (--end)
+continues a finished run; the earlier finished result stays untouched when the continued run
+fails. A failing run leaves the folder as it found it: a finished result and its checkpoint,
+an interrupted run's partial file and checkpoint (the printed command still continues it),
+the checkpoint a failed restart started from.
 Usage (ctest does this): test_restart.py --exe multicor --work DIR --source REPO
 """
 import argparse
@@ -271,6 +274,88 @@ def refusals(exe, deck, work):
     check("refusals leave no partial file", not (folder / f"{deck.stem}.h5.partial").exists(), "")
 
 
+def damaged_values(exe, src, work):
+    """A checkpoint with one value edited: a NaN time, energy reference, state entry or wall
+    coordinate, a step that is negative or not the integrator's, a counter beyond the
+    integers. Refused as damaged, naming the value, exit 1, the results untouched (they were
+    accepted: NaN written with exit 0, a run past its end, an internal error)."""
+    beam_deck = edit_deck(src / "input" / "cantilever.dat", work / "damaged_values.dat", end=0.1)
+    folder = work / "damaged_values"
+    first = run(exe, beam_deck, "--output", folder, "--quiet", "--end", 0.05)
+    assert first.returncode == 0, first.stderr
+    dem_deck = work / "damaged_walls.dat"
+    dem_deck.write_text("""[run]
+analysis = dynamic
+[particles]
+material = 1 2500
+row = 5 0.05 0.011 0.01 1 0.001
+gravity = 0 -9.81
+[walls]
+wall = 0 0 0.2 0
+[contacts]
+law = 1 1 0.3 0 0
+[time]
+step = 1e-4
+end = 4e-3
+[output]
+interval = 5
+""")
+    dem_folder = work / "damaged_walls"
+    first = run(exe, dem_deck, "--output", dem_folder, "--quiet", "--end", 2e-3)
+    assert first.returncode == 0, first.stderr
+
+    def scalar(index):
+        def edit(f):
+            a = f["fe"].attrs["scalars"]
+            a[index] = np.nan
+            f["fe"].attrs["scalars"] = a
+        return edit
+
+    def attribute(group, name, value):
+        def edit(f):
+            f[group].attrs[name] = value
+        return edit
+
+    def entry(path, value):
+        def edit(f):
+            a = f[path][...]
+            a.flat[0] = value
+            f[path][...] = a
+        return edit
+
+    cases = [
+        (beam_deck, folder, "the time NaN", scalar(0), "/fe@scalars value 1 (time) is NaN"),
+        (beam_deck, folder, "the start time NaN", scalar(2), "/fe@scalars value 3 (start time) is NaN"),
+        (beam_deck, folder, "the energy reference NaN", attribute("results", "energy0", np.nan),
+         "/results@energy0 is NaN"),
+        (beam_deck, folder, "a displacement NaN", entry("fe/u", np.nan), "/fe/u value 1 is NaN"),
+        (beam_deck, folder, "a negative step", attribute("loop", "step", np.int32(-5)),
+         "/loop@step is -5"),
+        (beam_deck, folder, "a step not the integrator's", attribute("loop", "step", np.int32(400)),
+         "/fe@step_count"),
+        (beam_deck, folder, "a writer counter beyond the integers",
+         attribute("results", "writer", np.array([-1.0, 1e30, 0.0])), "not a 32-bit integer"),
+        (dem_deck, dem_folder, "a wall coordinate NaN", entry("dem/walls/x1", np.nan),
+         "/dem/walls/x1 is NaN"),
+        (dem_deck, dem_folder, "a disk velocity infinite", entry("dem/vy", np.inf),
+         "/dem/vy value 1 is Infinity"),
+    ]
+    before = {d: digest(d / f"{deck.stem}.h5") for deck, d in [(beam_deck, folder), (dem_deck, dem_folder)]}
+    # each edit on a copy of the original (a restart that wrongly runs replaces the folder's)
+    original = {d: shutil.copy(d / "checkpoint.h5", work / f"{d.name}_original.h5") for d in before}
+    for deck, out, name, edit, says in cases:
+        damaged = work / "damaged_values.h5"
+        shutil.copy(original[out], damaged)
+        with h5py.File(damaged, "r+") as f:
+            edit(f)
+        proc = run(exe, deck, "--output", out, "--restart", damaged, "--end", 4e-3 if deck == dem_deck else 0.1)
+        check(f"damaged values: {name} refused, naming it", proc.returncode == 1 and says in proc.stderr and
+              "the checkpoint is damaged" in proc.stderr, f"exit {proc.returncode}: {proc.stderr.strip()[-300:]}")
+    for d, h in before.items():
+        check(f"damaged values: {d.name}: the result untouched, no partial file",
+              digest(next(d.glob("*.h5"))) == h and not list(d.glob("*.partial*")), str(sorted(d.iterdir())))
+
+
 def damaged_contacts(exe, src, work):
     """A checkpoint whose contact list names a body that does not exist, or lists two pairs
     out of the detection's order (the warm-start matching merges on that order): refused as
@@ -289,16 +374,37 @@ def damaged_contacts(exe, src, work):
     def swapped(i1, i2):
         i1[[0, 1]], i2[[0, 1]] = i1[[1, 0]], i2[[1, 0]]
 
-    for name, edit, says in [("a body that does not exist", no_such_body, "joins bodies"),
-                             ("two pairs out of order", swapped, "are out of order")]:
-        damaged = work / "damaged_contacts.h5"
-        shutil.copy(ckpt, damaged)
-        with h5py.File(damaged, "r+") as f:
-            g = f["dem/contacts"]
+    def pairs(edit):
+        def apply(g):
             i1, i2 = g["i1"][...], g["i2"][...]
             check("damaged contacts: the checkpoint has at least 2 contacts", len(i1) >= 2, f"{len(i1)}")
             edit(i1, i2)
             g["i1"][...], g["i2"][...] = i1, i2
+        return apply
+
+    def negative_count(g):
+        g.attrs["n"] = np.int32(-3)
+
+    def status(g):
+        a = g["status"][...]
+        a[0] = 7
+        g["status"][...] = a
+
+    def reaction(g):
+        a = g["r"][...]
+        a[0, 0] = np.nan
+        g["r"][...] = a
+
+    # status codes 0..4 (doc/output.md, /dem/contacts)
+    for name, edit, says in [("a body that does not exist", pairs(no_such_body), "joins bodies"),
+                             ("two pairs out of order", pairs(swapped), "are out of order"),
+                             ("a negative number of contacts", negative_count, "/dem/contacts@n is -3"),
+                             ("a status that is no code", status, "/dem/contacts/status value 1 is 7, outside 0..4"),
+                             ("a reaction NaN", reaction, "/dem/contacts/r value 1 is NaN")]:
+        damaged = work / "damaged_contacts.h5"
+        shutil.copy(ckpt, damaged)
+        with h5py.File(damaged, "r+") as f:
+            edit(f["dem/contacts"])
         proc = run(exe, deck, "--output", folder, "--restart", damaged)
         check(f"damaged contacts: {name} refused", proc.returncode == 1 and says in proc.stderr and
               "the checkpoint is damaged" in proc.stderr, proc.stderr.strip())
@@ -355,6 +461,109 @@ interval = 5
     msh.write_text(original)
     proc = run(exe, deck, "--output", out, "--restart", out / "checkpoint.h5", "--quiet")
     check("the restart with the mesh restored runs", proc.returncode == 0, proc.stderr.strip())
+
+
+SMALL_BEAM = """[run]
+analysis = dynamic
+[beam]
+section = 1 2.1e11 7800 2.0e-4 1.6666666666666667e-9
+line = 1 0 0 1 0 10 1
+fix = 1 all
+load = 11 w {load} 1
+[functions]
+function = 1 step {load_from}
+[time]
+step = 2e-4
+end = {end}
+[output]
+interval = 2
+{extra}
+"""
+
+
+def small_beam(path, load=-10, load_from=0, end=2e-3, extra=""):
+    """A 10-element cantilever; a load of -1e300 from t = load_from makes the run fail there
+    (the guard on non-finite energies) in a run that writes a checkpoint every 2 steps."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(SMALL_BEAM.format(load=load, load_from=load_from, end=end, extra=extra))
+    return path
+
+
+def failed_runs_keep_state(exe, src, work):
+    """A failing run leaves the results folder as it found it (doc/output.md, "Interrupted
+    runs"): the finished result and its checkpoint, the partial file and checkpoint of a run
+    stopped by SIGTERM (the command it printed still continues it), the checkpoint a failed
+    restart started from (the next restart runs). Before, the failing run's own periodic
+    checkpoints replaced them, and its failure deleted the earlier partial file."""
+    failing = dict(load=-1e300, extra="checkpoint_interval = 2")
+
+    def state(folder):
+        return {p.name: digest(p) for p in sorted(folder.iterdir()) if p.is_file()}
+
+    # (a) a finished run, then a failing run of another deck of the same name (fails at step 8)
+    folder = work / "keep_finished"
+    good = small_beam(work / "keep_good" / "beam.dat")
+    assert run(exe, good, "--output", folder, "--quiet").returncode == 0
+    before = state(folder)
+    bad = small_beam(work / "keep_bad" / "beam.dat", load_from=1.5e-3, **failing)
+    proc = run(exe, bad, "--output", folder, "--quiet")
+    check("failing run after a finished one: exit 1", proc.returncode == 1, proc.stderr.strip()[-300:])
+    check("failing run after a finished one: result and checkpoint as they were", state(folder) == before,
+          f"{before} -> {state(folder)}")
+    proc = run(exe, good, "--output", folder, "--quiet", "--restart", folder / "checkpoint.h5", "--end", 3e-3)
+    check("failing run after a finished one: the finished run still continues", proc.returncode == 0,
+          proc.stderr.strip()[-300:])
+
+    # (b) a finished run to 2e-3 (step 10), continued to 4e-3: fails at step 15 (t = 3e-3),
+    # after its checkpoints at steps 12 and 14
+    folder = work / "keep_restart"
+    late = small_beam(work / "keep_late" / "beam.dat", load_from=3e-3, **failing)
+    assert run(exe, late, "--output", folder, "--quiet").returncode == 0
+    before = state(folder)
+    proc = run(exe, late, "--output", folder, "--quiet", "--restart", folder / "checkpoint.h5", "--end", 4e-3)
+    check("failed restart: exit 1 at step 15", proc.returncode == 1 and "step 15" in proc.stderr,
+          proc.stderr.strip()[-300:])
+    check("failed restart: result and the checkpoint it started from as they were", state(folder) == before,
+          f"{before} -> {state(folder)}")
+    proc = run(exe, late, "--output", folder, "--restart", folder / "checkpoint.h5", "--end", 2.8e-3)
+    check("failed restart: the next restart runs from step 10", proc.returncode == 0 and
+          "at step 10" in proc.stdout, (proc.stdout + proc.stderr).strip()[-300:])
+
+    # (c) a long run stopped by SIGTERM, then a failing run of another deck of the same name
+    # (fails at step 8), then a restart from a damaged copy of the checkpoint
+    folder = work / "keep_partial"
+    long = small_beam(work / "keep_long" / "beam.dat", end=20, extra="progress = 0.02")
+    proc = start(exe, long, folder)
+    lines = []
+    if not wait_for_step(proc, 200, lines):
+        check("keep_partial: run reached step 200", False, proc.communicate()[1][-300:])
+        return
+    proc.send_signal(signal.SIGTERM)
+    out, _ = proc.communicate()
+    command = re.search(r"^to continue: multicor (.*)$", "".join(lines) + out, flags=re.M)
+    check("keep_partial: SIGTERM stops the run with the command to continue", proc.returncode == 143 and
+          command is not None, f"exit {proc.returncode}")
+    if command is None:
+        return
+    before = state(folder)
+    check("keep_partial: partial file and checkpoint", set(before) == {"beam.h5.partial", "checkpoint.h5"},
+          str(before))
+    proc = run(exe, bad, "--output", folder, "--quiet")
+    check("failing run after a stopped one: exit 1", proc.returncode == 1, proc.stderr.strip()[-300:])
+    check("failing run after a stopped one: partial file and checkpoint as they were", state(folder) == before,
+          f"{before} -> {state(folder)}")
+    damaged = work / "keep_partial_damaged.h5"
+    shutil.copy(folder / "checkpoint.h5", damaged)
+    with h5py.File(damaged, "r+") as f:
+        f["results"].attrs["energy0"] = np.nan
+    proc = run(exe, long, "--output", folder, "--quiet", "--restart", damaged)
+    check("damaged checkpoint of a stopped run: refused, the partial file not written to",
+          proc.returncode == 1 and "the checkpoint is damaged" in proc.stderr and state(folder) == before,
+          proc.stderr.strip()[-300:])
+    proc = run(exe, *command.group(1).split(), "--end", 2.0)
+    check("failing run after a stopped one: the printed command continues the run", proc.returncode == 0,
+          proc.stderr.strip()[-300:])
+    check("keep_partial: nothing set aside is left", not list(folder.glob("*.prev")), str(sorted(folder.iterdir())))
 
 
 def new_end_time(exe, deck, work):
@@ -471,7 +680,9 @@ def main():
     # multipliers' work through the prescribed dofs come back from the checkpoint.
     by_end_time(exe, decks / "coupled2d_driven_edge.dat", work, "coupled2d_driven_end", 4.43e-4)
     refusals(exe, beam, work)
+    damaged_values(exe, src, work)
     damaged_contacts(exe, src, work)
+    failed_runs_keep_state(exe, src, work)
     changed_mesh(exe, src, work)
     new_end_time(exe, beam, work)
     sys.exit(summary())
