@@ -7,7 +7,7 @@ module core_strings
     implicit none
     private
     public :: string_t, to_lower, strip, is_blank_char, split_words, join_words
-    public :: levenshtein, closest_match, parse_real, parse_int, to_str, shorten, max_echo
+    public :: levenshtein, closest_match, parse_real, parse_int, to_str, shorten, max_echo, is_real_syntax
 
     !> Longest token echoed whole in a message (see `shorten`).
     integer, parameter :: max_echo = 40
@@ -231,6 +231,15 @@ contains
         if (ok) ok = abs(big) <= huge(value)
         if (ok) value = int(big)
     end subroutine parse_int
+
+    !> Whether `text` has the form of a real number (parse_real may still refuse it for its
+    !> magnitude).
+    pure logical function is_real_syntax(text) result(ok)
+        !> The token.
+        character(len=*), intent(in) :: text
+        integer :: magnitude
+        call scan_real(text, ok, magnitude)
+    end function is_real_syntax
 
     !> Check the syntax of a real number (see parse_real) and estimate its decimal magnitude,
     !> so that values beyond the range of real(wp) are rejected before reading them (reading

@@ -20,7 +20,7 @@
 !> is checked when the model is built.
 module io_deck_schema
     use core_kinds, only: wp
-    use core_strings, only: string_t, split_words, join_words, to_str, parse_real, parse_int, shorten
+    use core_strings, only: string_t, split_words, join_words, to_str, parse_real, parse_int, shorten, is_real_syntax
     implicit none
     private
     public :: field_spec_t, tail_spec_t, condition_t, keyword_spec_t, section_spec_t, schema_t
@@ -526,6 +526,9 @@ contains
             call parse_real(token, x, ok)
             if (.not. ok) then
                 message = "expected a real number, got '"//shorten(token)//"'"
+                ! a number of the right form out of the range read (parse_real)
+                if (is_real_syntax(token)) message = "expected a real number between 1e-307 and 1e308 in "// &
+                                                     "magnitude (or 0), got '"//shorten(token)//"'"
                 return
             end if
         case (field_word)
