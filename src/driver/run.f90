@@ -201,10 +201,34 @@ contains
         !> The command that continues this run from its checkpoint.
         function continue_command() result(command)
             character(len=:), allocatable :: command
-            command = 'multicor '//opts%deck_path
-            if (allocated(opts%output_dir)) command = command//' --output '//opts%output_dir
-            command = command//' --restart '//ck%path
+            command = 'multicor '//shell_word(opts%deck_path)
+            if (allocated(opts%output_dir)) command = command//' --output '//shell_word(opts%output_dir)
+            command = command//' --restart '//shell_word(ck%path)
         end function continue_command
+
+        !> A path as one word of a POSIX shell command, so that the printed command can be
+        !> pasted: as it is when it holds only safe characters, else in single quotes (a quote
+        !> inside written '\'').
+        function shell_word(path) result(word)
+            character(len=*), intent(in) :: path
+            character(len=:), allocatable :: word
+            character(len=*), parameter :: safe = 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789'// &
+                                           '_-./+=:,@%'
+            integer :: i
+            if (len(path) > 0 .and. verify(path, safe) == 0) then
+                word = path
+                return
+            end if
+            word = "'"
+            do i = 1, len(path)
+                if (path(i:i) == "'") then
+                    word = word//"'\''"
+                else
+                    word = word//path(i:i)
+                end if
+            end do
+            word = word//"'"
+        end function shell_word
 
         !> Option `--end`: a new end time (the models built by `init` do not depend on it, the step
         !> count does).
