@@ -213,10 +213,12 @@ contains
         do i = 1, p%n
             do k = 1, w%n
                 if (.not. crosses_wall(i, k)) cycle
-                travel = hypot(p%x(i) - start%x(i), p%y(i) - start%y(i))
+                ! the motion relative to the wall (a moving wall: its mid-point's displacement)
+                travel = hypot((p%x(i) - start%x(i)) - 0.5_wp*((w%x1(k) - start%wx1(k)) + (w%x2(k) - start%wx2(k))), &
+                               (p%y(i) - start%y(i)) - 0.5_wp*((w%y1(k) - start%wy1(k)) + (w%y2(k) - start%wy2(k))))
                 call make_error(error, when(step, t)//'disk '//to_str(i)//' passed through wall '// &
                                 to_str(k)//' within one step (its centre moved '//num(travel)// &
-                                ' m, its radius is '//num(p%radius(i))//' m): '//advice(travel))
+                                ' m relative to the wall, its radius is '//num(p%radius(i))//' m): '//advice(travel))
                 return
             end do
         end do
