@@ -393,8 +393,15 @@ contains
                 end if
                 length = hypot(e%real('x2') - e%real('x1'), e%real('y2') - e%real('y1'))
                 if (length <= 1.0e-9_wp*size_model) then
-                    call make_input_error(error, deck%file, e%line, 'wall', &
-                                          'zero-length wall: (x1, y1) and (x2, y2) coincide')
+                    if (length > 0.0_wp) then
+                        call make_input_error(error, deck%file, e%line, 'wall', 'wall of length '// &
+                                              length_text(length)//' m, below 1e-9 of the size of the model ('// &
+                                              length_text(size_model)//' m, disks and walls): its ends cannot be '// &
+                                              'told apart at that scale; check the coordinates of the model')
+                    else
+                        call make_input_error(error, deck%file, e%line, 'wall', &
+                                              'zero-length wall: (x1, y1) and (x2, y2) coincide')
+                    end if
                     return
                 end if
                 call walls_add(cfg%system%walls, e%real('x1'), e%real('y1'), e%real('x2'), e%real('y2'), &
