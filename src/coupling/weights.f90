@@ -87,8 +87,8 @@ contains
         case ('constant')
             if (.not. (config%constant >= config%alpha_min .and. &
                        config%constant <= 1 - config%alpha_min)) then
-                write (buf, '(a,es11.3e3,a)') 'coupling weight: constant = ', config%constant, &
-                    ' must lie in [alpha_min, 1 - alpha_min]'
+                write (buf, '(a,es23.15e3,a,es10.2e3,a)') 'coupling weight: constant = ', config%constant, &
+                    ' must lie in [alpha_min, 1 - alpha_min] (alpha_min = ', config%alpha_min, ')'
                 call make_error(error, trim(buf))
                 return
             end if

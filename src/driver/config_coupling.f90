@@ -132,7 +132,12 @@ contains
         if (allocated(error)) return
         call make_weight(setup%config%weight, weight, error)
         if (allocated(error)) then
-            call reattach(deck, setup%overlap_line, 'overlap', error)
+            ! the value at fault: constant (when given), else the overlap it weights
+            if (index(error%message, 'constant =') > 0 .and. deck%has('coupling', 'constant')) then
+                call reattach(deck, deck%line('coupling', 'constant'), 'constant', error)
+            else
+                call reattach(deck, setup%overlap_line, 'overlap', error)
+            end if
             return
         end if
         associate (p => dem%system%particles)
