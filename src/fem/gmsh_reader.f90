@@ -22,7 +22,7 @@ module fem_gmsh_reader
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_input_error
     use core_strings, only: string_t, split_words, parse_real
-    use core_sort, only: sort_index
+    use core_sort, only: sort_index, sort_in_place
     use fem_mesh2d, only: mesh2d_t, element_t3, element_q4
     implicit none
     private
@@ -684,16 +684,9 @@ contains
             n = n + size(blocks(b)%tags)
         end do
         order = sort_index(keys)
-        at = 0
         ! sort_index is stable: of two equal tags, the earlier in the file comes first.
-        do k = 2, size(order)
-            if (keys(order(k)) /= keys(order(k - 1))) cycle
-            if (at > 0) then
-                if (lines(order(k)) >= lines(at)) cycle
-            end if
-            at = order(k)
-            first = order(k - 1)
-        end do
+        call earliest_repeat(order, [.false., (keys(order(k)) == keys(order(k - 1)), k=2, size(order))], lines, &
+                             at, first)
         if (at == 0) return
         write (buf, '(i0,a,i0,a)') keys(at), ' is defined twice (first on line ', lines(first), ')'
         call make_input_error(error, cur%path, lines(at), '$Elements', 'element '//trim(buf))
@@ -735,15 +728,8 @@ contains
         end do
         order = sort_index(low)
         order = order(sort_index(high(order)))
-        at = 0
-        do k = 2, n
-            if (high(order(k)) /= high(order(k - 1)) .or. low(order(k)) /= low(order(k - 1))) cycle
-            if (at > 0) then
-                if (lines(order(k)) >= lines(at)) cycle
-            end if
-            at = order(k)
-            first = order(k - 1)
-        end do
+        call earliest_repeat(order, [.false., (high(order(k)) == high(order(k - 1)) .and. &
+                                               low(order(k)) == low(order(k - 1)), k=2, n)], lines, at, first)
         if (at == 0) return
         write (buf, '(a,i0,a,i0,a,i0,a)') 'element ', tags(at), ' has the same nodes as element ', tags(first), &
             ' (line ', lines(first), ')'
@@ -751,22 +737,36 @@ contains
 
     contains
 
-        !> Sort 4 integers in decreasing order (insertion sort).
+        !> Sort 4 node tags (< 2^31: exact as reals) in decreasing order.
         pure subroutine sort_decreasing(a)
             integer, intent(inout) :: a(4)
-            integer :: i, j, v
-            do i = 2, 4
-                v = a(i)
-                j = i - 1
-                do while (j >= 1)
-                    if (a(j) >= v) exit
-                    a(j + 1) = a(j)
-                    j = j - 1
-                end do
-                a(j + 1) = v
-            end do
+            real(wp) :: r(4)
+            r = real(a, wp)
+            call sort_in_place(r)
+            a = nint(r(4:1:-1))
         end subroutine sort_decreasing
     end subroutine check_distinct_nodes
+
+    !> Of the entries in sorted order that repeat the one before them (repeat(k) for order(k)),
+    !> the one on the earliest line: at = that entry, first = the entry it repeats (at = 0
+    !> when nothing repeats).
+    pure subroutine earliest_repeat(order, repeat, lines, at, first)
+        integer, intent(in) :: order(:)
+        logical, intent(in) :: repeat(:)
+        integer, intent(in) :: lines(:)
+        integer, intent(out) :: at, first
+        integer :: k
+        at = 0
+        first = 0
+        do k = 2, size(order)
+            if (.not. repeat(k)) cycle
+            if (at > 0) then
+                if (lines(order(k)) >= lines(at)) cycle
+            end if
+            at = order(k)
+            first = order(k - 1)
+        end do
+    end subroutine earliest_repeat
 
     !> Name of a physical group.
     pure function group_name(names, dim, tag) result(name)
