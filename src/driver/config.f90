@@ -995,6 +995,9 @@ contains
             type(deck_entry_t), intent(in) :: list(:)
             real(wp), intent(inout) :: values(:, :)
             integer :: i, node, dof
+            integer, allocatable :: given(:, :)
+            ! line of the record that gave each DOF its value (0: none yet)
+            allocate (given(size(values, 1), size(values, 2)), source=0)
             do i = 1, size(list)
                 node = find_node(beam%node_id, list(i)%int('node'))
                 if (node == 0) then
@@ -1006,6 +1009,14 @@ contains
                     call on_fixed_dof(deck, list(i), list(i)%keyword, fix_line(dof, node), error)
                     return
                 end if
+                if (given(dof, node) > 0) then
+                    call make_input_error(error, deck%file, list(i)%line, list(i)%keyword, '[initial] '// &
+                                          list(i)%keyword//' of node '//list(i)%word('node')//' '// &
+                                          list(i)%word('dof')//' is already given on line '// &
+                                          to_str(given(dof, node))//': give each DOF once')
+                    return
+                end if
+                given(dof, node) = list(i)%line
                 values(dof, node) = list(i)%real('value')
             end do
         end subroutine fill
