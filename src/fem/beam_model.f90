@@ -965,9 +965,36 @@ contains
             write (buf, '(a,i0,a,i0,a)') 'node ', c, ' (id ', self%node_id(c), ')'
             call make_error(error, 'stiffness matrix is singular: the part of the frame '// &
                             'that contains '//trim(buf)//' can move as a rigid body (its '// &
-                            'supports do not hold x, y and rotation); fix more DOFs (supports)')
+                            'supports do not hold x, y and rotation); fix more DOFs (supports)'// &
+                            coincident_hint(c))
             return
         end do
+    contains
+        !> When a node of part c lies where a node of another part lies, elements meant to meet
+        !> there most likely got two node ids: say which (the first pair found).
+        function coincident_hint(c) result(hint)
+            integer, intent(in) :: c
+            character(len=:), allocatable :: hint
+            character(len=160) :: pair
+            real(wp) :: tol
+            integer :: i, j
+            hint = ''
+            ! a pairwise search, on the error path only: skipped beyond 2e4 nodes (4e8 pairs)
+            if (self%n_nodes > 20000) return
+            tol = 1.0e-12_wp*max(maxval(abs(self%x)), maxval(abs(self%y)), tiny(1.0_wp))
+            do i = 1, self%n_nodes
+                if (comp(i) /= c) cycle
+                do j = 1, self%n_nodes
+                    if (comp(j) == c) cycle
+                    if (abs(self%x(i) - self%x(j)) > tol .or. abs(self%y(i) - self%y(j)) > tol) cycle
+                    write (pair, '(a,i0,a,i0,a)') '; or join the parts: node id ', self%node_id(i), &
+                        ' lies where node id ', self%node_id(j), &
+                        ' of another part does, and elements connect only through a shared node id'
+                    hint = trim(pair)
+                    return
+                end do
+            end do
+        end function coincident_hint
     end subroutine check_supports
 
     !> Smallest node index of the connected part of each node (union-find over elements).
