@@ -103,9 +103,15 @@ module fem_continuum_model
         procedure :: stops_rigid_motions => model_stops_rigid_motions
     end type continuum_model_t
 
+    !> Largest aspect ratio of an element (aspect_ratio). The stiffness of an element scales
+    !> with its shape's condition, about the square of the ratio: at 1e6 it is 1e12 against
+    !> the round-off of 1e-16 of the sums that assemble it. Far beyond any usable element
+    !> (accuracy is lost long before; Gmsh's meshes of a body stay below 10).
+    real(wp), parameter :: max_aspect = 1.0e6_wp
+
 contains
 
-    !> Take a mesh and check that no element is inverted or degenerate.
+    !> Take a mesh and check that no element is inverted, degenerate or needle-thin.
     subroutine model_init(self, mesh, error)
         !> The model.
         class(continuum_model_t), intent(out) :: self
@@ -134,6 +140,15 @@ contains
                                     'degenerate or not convex (det J <= 0)')
                     return
                 end if
+                if (aspect_ratio(xe) > max_aspect) then
+                    call make_error(error, 'continuum model: element '//to_str(e)//' (centroid ('// &
+                                    to_str(sum(xe(1, :))/size(xe, 2))//', '// &
+                                    to_str(sum(xe(2, :))/size(xe, 2))//') m) has an aspect ratio of '// &
+                                    to_str(aspect_ratio(xe))//' (longest side over smallest height), above '// &
+                                    to_str(max_aspect)//': its stiffness is lost in the rounding of double '// &
+                                    'precision; mesh the body with elements of reasonable shape')
+                    return
+                end if
             end associate
         end do
         ! Edge loads need the body on the left of each edge and the element carrying it.
@@ -146,6 +161,31 @@ contains
         allocate (self%prescribed_value(self%dof_count()), self%load(self%dof_count()), source=0.0_wp)
         allocate (self%functions(0), self%timed_load(self%dof_count(), 0))
     end subroutine model_init
+
+    !> Longest side of an element over its smallest height: the heights of the triangles of
+    !> each side with the next corner (a T3's own three heights; for a Q4, the four corner
+    !> triangles). 1 for a square, 2/sqrt(3) for an equilateral triangle.
+    pure real(wp) function aspect_ratio(xe) result(ratio)
+        !> Node coordinates (2, 3 or 4), counter-clockwise.
+        real(wp), intent(in) :: xe(:, :)
+        real(wp) :: longest, height, side, twice_area
+        integer :: m, i, j, k
+        m = size(xe, 2)
+        longest = 0.0_wp
+        do i = 1, m
+            longest = max(longest, hypot(xe(1, mod(i, m) + 1) - xe(1, i), xe(2, mod(i, m) + 1) - xe(2, i)))
+        end do
+        height = huge(1.0_wp)
+        do i = 1, m
+            j = mod(i, m) + 1
+            k = mod(i + 1, m) + 1
+            side = hypot(xe(1, j) - xe(1, i), xe(2, j) - xe(2, i))
+            twice_area = abs((xe(1, j) - xe(1, i))*(xe(2, k) - xe(2, i)) - (xe(2, j) - xe(2, i))*(xe(1, k) - xe(1, i)))
+            if (side > 0.0_wp) height = min(height, twice_area/side)
+        end do
+        ratio = huge(1.0_wp)
+        if (height > 0.0_wp) ratio = longest/height
+    end function aspect_ratio
 
     !> Number of dofs.
     pure integer function model_dof_count(self)
