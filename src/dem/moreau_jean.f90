@@ -20,7 +20,7 @@
 !> of imposed velocities and moving walls on the disks.
 !>
 !> Coupled steps (Arlequin, coupling_arlequin): `mj_step` is also available in four parts,
-!> `mj_free_velocities` (1 and the mid configuration), `mj_detect` (2, 3; contacts are
+!> `mj_free_velocities` (1 and the detection configuration), `mj_detect` (2, 3; contacts are
 !> activated on the velocities found in `vel`, which the coupling may have changed),
 !> `mj_solve` (4, optionally with bilateral constraints kept by the NLGS) and `mj_end_step`
 !> (5); in that order they are `mj_step`, bit for bit. An external impulse applied to the
@@ -128,7 +128,8 @@ module dem_moreau_jean
         type(rupture_log_t) :: ruptures
         !> Work arrays (3, n): start and current velocities, inverse mass, loads, impulses.
         real(wp), allocatable :: vel0(:, :), vel(:, :), im(:, :), load(:, :), impulse(:, :)
-        !> Work arrays: mid configuration of the disks and walls.
+        !> Work arrays: the detection configuration of the disks and walls (the mid
+        !> configuration, or q + h v with Siconos' rule of activation).
         real(wp), allocatable :: xm(:), ym(:), wx1(:), wy1(:), wx2(:), wy2(:)
         !> Wall velocities at the start and the end of the step (2, n_walls).
         real(wp), allocatable :: wall_v0(:, :), wall_v1(:, :)
@@ -210,7 +211,7 @@ contains
     end function step_law
 
     !> Part 1 of a step: start velocities vel0, free velocities vel (loads and gravity,
-    !> imposed DOFs), wall velocities, mid configuration; coupling_impulse = 0.
+    !> imposed DOFs), wall velocities, detection configuration; coupling_impulse = 0.
     subroutine mj_free_velocities(sys)
         !> System (mj_init done).
         type(dem_system_t), intent(inout) :: sys
@@ -219,9 +220,9 @@ contains
         sys%coupling_impulse = 0.0_wp
     end subroutine mj_free_velocities
 
-    !> Part 2 of a step: detection on the mid configuration, frames and Delassus blocks,
-    !> contact laws; contacts are activated on the velocities in `vel` (the free velocities,
-    !> plus whatever a coupling added since `mj_free_velocities`).
+    !> Part 2 of a step: detection (on the configuration of the rule of activation), frames
+    !> and Delassus blocks, contact laws; contacts are activated on the velocities in `vel`
+    !> (the free velocities, plus whatever a coupling added since `mj_free_velocities`).
     subroutine mj_detect(sys)
         !> System, after `mj_free_velocities`.
         type(dem_system_t), intent(inout) :: sys

@@ -210,6 +210,10 @@ contains
         type(error_t), allocatable, intent(out) :: error
         integer :: i, j, k, c
         real(wp) :: travel
+        ! swept boxes of the disks over the step, and which disks moved beyond the alert
+        ! distance (swept_pairs)
+        real(wp), allocatable :: lo(:), hi(:), ylo(:), yhi(:)
+        logical, allocatable :: fast(:)
         do i = 1, p%n
             do k = 1, w%n
                 if (.not. crosses_wall(i, k)) cycle
@@ -262,9 +266,8 @@ contains
         !> compared with those that start before its high end; a pair whose boxes meet in y
         !> too is tested with `passed`.
         subroutine swept_pairs()
-            real(wp), allocatable :: lo(:), hi(:), ylo(:), yhi(:)
-            logical, allocatable :: fast(:)
             integer, allocatable :: order(:)
+            real(wp) :: reach
             integer :: a, b, m
             m = p%n
             if (m < 2) return
@@ -275,19 +278,35 @@ contains
             ylo = min(start%y, p%y(1:m)) - p%radius(1:m)
             yhi = max(start%y, p%y(1:m)) + p%radius(1:m)
             order = sort_index(real_keys(lo))
+            ! only the boxes near a fast disk's are visited: ahead of it in the sorted order up
+            ! to its own high end, behind it back to the widest box of a slow disk (a fast box
+            ! behind is met when that fast disk is visited)
+            reach = maxval(hi - lo, mask=.not. fast)
+            if (all(fast)) reach = 0.0_wp
             do a = 1, m
                 i = order(a)
+                if (.not. fast(i)) cycle
                 do b = a + 1, m
-                    j = order(b)
-                    if (lo(j) > hi(i)) exit
-                    if (.not. (fast(i) .or. fast(j))) cycle
-                    if (ylo(j) > yhi(i) .or. ylo(i) > yhi(j)) cycle
-                    if (.not. passed(min(i, j), max(i, j))) cycle
-                    call through_each_other(min(i, j), max(i, j))
-                    return
+                    if (lo(order(b)) > hi(i)) exit
+                    if (meet(i, order(b))) return
+                end do
+                do b = a - 1, 1, -1
+                    if (lo(order(b)) < lo(i) - reach) exit
+                    if (fast(order(b))) cycle
+                    if (meet(i, order(b))) return
                 end do
             end do
         end subroutine swept_pairs
+
+        !> The boxes of disks i and j meet and the disks passed each other: the error set.
+        logical function meet(i, j)
+            integer, intent(in) :: i, j
+            meet = .false.
+            if (hi(j) < lo(i) .or. ylo(j) > yhi(i) .or. ylo(i) > yhi(j)) return
+            if (.not. passed(min(i, j), max(i, j))) return
+            call through_each_other(min(i, j), max(i, j))
+            meet = .true.
+        end function meet
 
         !> The centre path of disk i relative to wall k meets the wall: the signed distance to
         !> the wall's line changes sign, at a point between the wall's ends.

@@ -210,6 +210,25 @@ progress = 0
 """
     failing_run(exe, work, "dem_tunnelling_unseen_pair", far.format(h="0.05"),
                 r"disks 1 and 2 passed through each other within one step", far.format(h="1e-4"))
+    # A fast disk falling through a resting one: its swept box starts to the right of the
+    # resting disk's, so the search looks behind it in the sorted order too.
+    through = """[run]
+analysis = dynamic
+[particles]
+material = 1 2500
+disk = 0.100 0.0 0.01 1
+disk = 0.102 0.5 0.01 1
+initial_velocity = 2 y -20
+[contacts]
+law = 1 1 0.3 0 0
+[time]
+step = {h}
+end = 0.5
+[output]
+progress = 0
+"""
+    failing_run(exe, work, "dem_tunnelling_falling_through", through.format(h="0.05"),
+                r"disks 1 and 2 passed through each other within one step", through.format(h="1e-4"))
 
 
 def lock(exe, work):
