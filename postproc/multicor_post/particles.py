@@ -372,6 +372,15 @@ def plot_solver(res: DemResults) -> Figure:
     if ax_s.get_legend_handles_labels()[0]:
         ax_s.legend(loc="best", fontsize="small")
     positive = lambda v: np.where(v > 0, v, np.nan)  # noqa: E731 (log axes skip zeros)
+    if not np.any(s.error > 0) and not np.any(s.residual > 0):
+        # Every step solved exactly (a direct block solve): the log axis would have nothing
+        # to scale to but the tolerance line (matplotlib warns of identical limits), so it is
+        # given its limits before anything is drawn, and the fact is written out.
+        ref = s.tolerance if np.isfinite(s.tolerance) and s.tolerance > 0 else 1.0
+        ax_e.set_yscale("log")
+        ax_e.set_ylim(ref / 10.0, ref * 10.0)
+        ax_e.text(0.5, 0.3, "error and residual 0 at every step", transform=ax_e.transAxes,
+                  ha="center", va="center", fontsize="small", color="0.3")
     ax_e.semilogy(t, positive(s.error), lw=0.8, label="convergence error (sweep change)")
     ax_e.semilogy(t, positive(s.residual), lw=0.8, label="Signorini-Coulomb residual")
     if np.isfinite(s.tolerance):

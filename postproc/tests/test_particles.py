@@ -82,6 +82,28 @@ def test_solver_plot_marks_the_unconverged_step(tmp_path):
     assert marked[0].get_xdata()[0] == pytest.approx(8.0)
 
 
+def test_solver_plot_of_exact_steps_draws_without_warning(tmp_path):
+    # a direct block solve stores error and residual 0 at every step (input/bending_case1.dat):
+    # the log axis of the errors must not be left to autoscale on no data (matplotlib then
+    # warns "identical low and high ylims" at savefig)
+    import warnings
+
+    import h5py
+    path = write_dem(tmp_path / "col.h5")
+    with h5py.File(path, "r+") as f:
+        for name in ("dem/solver/error", "dem/solver/residual"):
+            f[name][...] = 0.0
+        f["dem/solver"].attrs["tolerance"] = 1e-8     # that deck's (the warning depends on it)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fig = plot_solver(load_dem(path))
+        fig.savefig(tmp_path / "solver.png")
+    texts = [t.get_text() for t in fig.axes[1].texts]
+    assert texts == ["error and residual 0 at every step"]
+    # the plot of a run with nonzero errors has no such note
+    assert not plot_solver(load_dem(write_dem(tmp_path / "b.h5"))).axes[1].texts
+
+
 def check_pngs(paths):
     assert paths
     for path in paths:
