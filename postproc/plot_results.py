@@ -11,8 +11,12 @@ walls and contact force network at the stored time nearest to T; default the las
 <name>_velocities.png; and, for a coupled run (a /coupling group), both of these and
 <name>_profiles.png (displacement and velocity along x of the beam nodes and the disks),
 <name>_configuration.png (deformed beam, disks, overlap) and <name>_coupling.png (constraint
-residuals, multipliers, energy audit). Exit code 1 with a message on a missing or invalid
-file.
+residuals, multipliers, energy audit). For a 2D continuum (a /continuum group, alone or
+coupled to disks): <name>_stress.png (stress per element on the deformed mesh at the state
+nearest to T), and for a dynamic run <name>_continuum_energy.png and <name>_history.png (the
+node --node, a 1-based mesh index; default the node that moves most), for a modal run
+<name>_modes.png; with disks, their particle plots too. Exit code 1 with a message on a
+missing or invalid file.
 """
 import argparse
 import os
@@ -22,12 +26,13 @@ import h5py
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from multicor_post import beam, coupled, particles  # noqa: E402
+from multicor_post import beam, continuum, coupled, particles  # noqa: E402
 from multicor_post.results import ResultsError, load_results  # noqa: E402
 
 
 def contents(path):
-    """(has beam results, has particle results, is a coupled run) of a results file."""
+    """(has beam results, has particle results, is a coupled run, has a 2D continuum) of a
+    results file."""
     if not os.path.exists(path):
         hint = ""
         if os.path.exists(path + ".partial"):
@@ -35,7 +40,7 @@ def contents(path):
         raise ResultsError(f"results file '{path}' does not exist{hint}")
     try:
         with h5py.File(path, "r") as f:
-            return "fem/mesh" in f, "dem" in f, "coupling" in f
+            return "fem/mesh" in f, "dem" in f, "coupling" in f, "continuum/mesh" in f
     except OSError as exc:
         raise ResultsError(f"'{path}' is not a readable HDF5 file ({exc})") from None
 
@@ -50,18 +55,23 @@ def main(argv=None):
                         help="folder for the PNG files (default: the results file's folder)")
     parser.add_argument("--node", type=int, default=None,
                         help="beam: deck id of the node whose history is plotted (default: the "
-                             "tip)")
+                             "tip); continuum: 1-based mesh node (default: the node that moves "
+                             "most)")
     parser.add_argument("--scale", type=float, default=None,
-                        help="beam: displacement scale factor of deformed shapes (default: auto)")
+                        help="beam and continuum: displacement scale factor of deformed shapes "
+                             "(default: auto)")
     args = parser.parse_args(argv)
     out = args.out if args.out is not None else (os.path.dirname(args.results) or ".")
     try:
-        has_beam, has_particles, is_coupled = contents(args.results)
-        if not (has_beam or has_particles):
-            raise ResultsError(f"{args.results}: neither /fem/mesh nor /dem: not a MULTICOR "
-                               "results file")
+        has_beam, has_particles, is_coupled, has_continuum = contents(args.results)
+        if not (has_beam or has_particles or has_continuum):
+            raise ResultsError(f"{args.results}: neither /fem/mesh, /continuum nor /dem: not a "
+                               "MULTICOR results file")
         paths = []
-        if is_coupled:
+        if has_continuum:
+            paths += continuum.write_all(continuum.load_continuum(args.results), out,
+                                         time=args.time, scale=args.scale, node=args.node)
+        if is_coupled and has_beam:
             paths += coupled.write_all(coupled.load_coupled(args.results), out, time=args.time,
                                        scale=args.scale)
         if has_beam:

@@ -27,6 +27,7 @@ from matplotlib.collections import LineCollection, PatchCollection, PolyCollecti
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
+from .continuum import element_polygons
 from .results import ResultsError
 
 
@@ -153,12 +154,7 @@ def _figure(size):
 
 def _element_polygons(run, k, scale=1.0):
     """Deformed element outlines at output k (list of (n, 2) arrays)."""
-    xy = run.x + scale * run.u[k]
-    polys = []
-    for e in range(run.connectivity.shape[0]):
-        n = 3 if run.kind[e] == 1 else 4
-        polys.append(xy[run.connectivity[e, :n] - 1])
-    return polys
+    return element_polygons(run.x, run.connectivity, run.kind, run.u[k], scale)
 
 
 def plot_configuration(run, k, window=None):

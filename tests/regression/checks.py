@@ -53,3 +53,20 @@ def multicor(exe, deck, work, quiet=True):
         print(proc.stdout, proc.stderr)
         raise SystemExit(f"multicor failed on {deck} (exit {proc.returncode})")
     return out / f"{deck.stem}.h5", proc
+
+
+def plots(src, h5, out, names):
+    """plot_results.py on a results file, as ./run.sh calls it after a run (with Python's
+    warnings turned into errors): check that it exits 0, prints nothing on stderr and writes
+    exactly the PNG files <stem>_<name>.png of `names`, in that order."""
+    import sys
+    out = pathlib.Path(out)
+    proc = subprocess.run([sys.executable, "-W", "error", str(src / "postproc" / "plot_results.py"), str(h5),
+                           "--out", str(out)], capture_output=True, text=True)
+    stem = pathlib.Path(h5).stem
+    expected = [str(out / f"{stem}_{n}.png") for n in names]
+    printed = proc.stdout.split()
+    check(f"plot_results.py on {pathlib.Path(h5).name}",
+          proc.returncode == 0 and not proc.stderr and printed == expected
+          and all(pathlib.Path(p).stat().st_size > 0 for p in printed),
+          f"exit {proc.returncode}, stderr {proc.stderr.strip()[-300:]!r}, printed {printed}")

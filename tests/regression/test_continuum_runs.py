@@ -16,7 +16,8 @@
   between 0 and twice that; a static run takes the functions' values at t = 0; an undefined
   function id is an input error;
 - the XDMF file opened by ParaView (pvpython, the 'XDMF Reader') when installed, else meshio
-  (static file only: meshio does not read XDMF hyperslabs).
+  (static file only: meshio does not read XDMF hyperslabs);
+- postproc/plot_results.py, as ./run.sh calls it, on the static, dynamic and modal files.
 Usage (ctest does this): test_continuum_runs.py --exe multicor --work DIR --source REPO
 """
 import math
@@ -27,7 +28,7 @@ import sys
 import h5py
 import numpy as np
 
-from checks import arguments, check, multicor, summary
+from checks import arguments, check, multicor, plots, summary
 
 
 def run(exe, deck, work):
@@ -341,7 +342,12 @@ def main():
     energy_balance(exe, src, work)
     gmsh_block(exe, src, work)
     timed_loads(exe, work)
-    xdmf_paraview(h5_static, work / "continuum_cantilever_dynamic" / "continuum_cantilever_dynamic.h5", work)
+    h5_dynamic = work / "continuum_cantilever_dynamic" / "continuum_cantilever_dynamic.h5"
+    xdmf_paraview(h5_static, h5_dynamic, work)
+    # the plots ./run.sh draws after a continuum run: static, dynamic and modal
+    plots(src, h5_static, work / "png", ["stress"])
+    plots(src, h5_dynamic, work / "png", ["stress", "continuum_energy", "history"])
+    plots(src, work / "strip_160x4" / "strip_160x4.h5", work / "png", ["modes"])
     return summary()
 
 

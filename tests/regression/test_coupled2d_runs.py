@@ -21,6 +21,7 @@
   same pressure ramped by a time function reaches the same state with about half the work;
 - the energy audit of the coupled system closes on every run;
 - the XDMF file shows the mesh and the disks (ParaView's pvpython when installed);
+- postproc/plot_results.py, as ./run.sh calls it, draws the continuum's and the disks' plots;
 - --restart is refused with a clear message for a static continuum deck (no time steps; the
   checkpoints of dynamic continuum and coupled runs are tested in test_restart.py).
 Usage (ctest does this): test_coupled2d_runs.py --exe multicor --work DIR --source REPO
@@ -32,7 +33,7 @@ import sys
 import h5py
 import numpy as np
 
-from checks import arguments, check, summary
+from checks import arguments, check, plots, summary
 
 E, RHO, THICK = 210.0e9, 7800.0, 0.05
 
@@ -360,6 +361,9 @@ def main():
     interface_normal(exe, src, work)
     interface_ramp(exe, src, work)
     xdmf(work / "rigid_per_disk" / "rigid_per_disk.h5")
+    # the plots ./run.sh draws after a continuum-particle run
+    plots(src, work / "rigid_per_disk" / "rigid_per_disk.h5", work / "png",
+          ["stress", "continuum_energy", "history", "particles_start", "particles", "dem_energy", "solver"])
     restart_refused(exe, src, work)
     return summary()
 

@@ -1,0 +1,303 @@
+"""2D continuum results (the /continuum group of doc/output.md): static, modal and dynamic
+runs, alone or coupled to disks.
+
+Figures (``write_all``):
+- <name>_stress.png: sigma_xx, sigma_yy and sigma_xy per element (centre values, as stored) on
+  the deformed mesh at one state (static: the solution; dynamic: the stored state nearest to
+  the time asked, default the last), the undeformed outline in grey and, in a coupled run, the
+  disks (their displacements from the first output magnified like the mesh's). Small
+  displacements are magnified (the factor is in the title).
+- <name>_continuum_energy.png (dynamic): the energy audit of /continuum/energy.
+- <name>_history.png (dynamic): the displacement of one node against time (default: the node
+  that moves most at the last state).
+- <name>_modes.png (modal): the first mode shapes with their frequencies.
+"""
+from dataclasses import dataclass
+import os
+from typing import Optional
+
+import h5py
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import PatchCollection, PolyCollection
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle
+
+from .results import ResultsError
+
+
+@dataclass
+class ContinuumResults:
+    """The /continuum group of one results file. ``u`` has one row per state: the static
+    solution (time None), or the stored states of a dynamic run; ``stress`` likewise (None
+    for a modal run)."""
+    path: str
+    title: str
+    analysis: str
+    x: np.ndarray              # (n_nodes, 2) reference coordinates [m]
+    connectivity: np.ndarray   # (n_elements, 4), 1-based, 0 after a triangle's third node
+    kind: np.ndarray           # (n_elements,) 1 = T3, 2 = Q4
+    time: Optional[np.ndarray]
+    u: np.ndarray              # (n_states, n_nodes, 2) [m]
+    stress: Optional[np.ndarray]   # (n_states, n_elements, 3) [Pa]
+    energy: Optional[dict]
+    frequency: Optional[np.ndarray] = None   # modal [Hz]
+    disk_position: Optional[np.ndarray] = None   # coupled: (n_out, n_disks, 3)
+    disk_radius: Optional[np.ndarray] = None
+    disk_time: Optional[np.ndarray] = None
+
+    def nearest_index(self, t: Optional[float]) -> int:
+        """The stored state nearest to time t (the last one for None or a static run)."""
+        if t is None or self.time is None:
+            return self.u.shape[0] - 1
+        return int(np.argmin(np.abs(self.time - t)))
+
+
+ENERGY_TERMS = ("kinetic", "strain", "external_work", "damping", "reaction_work", "balance")
+
+
+def has_continuum(path) -> bool:
+    """Whether the results file holds a 2D continuum."""
+    with h5py.File(path, "r") as f:
+        return "continuum/mesh/coordinates" in f
+
+
+def load_continuum(path) -> ContinuumResults:
+    """Read the /continuum group (and the disks of a coupled run); ResultsError when a dataset
+    the file's kind of run must hold is missing."""
+    path = os.fspath(path)
+    try:
+        f = h5py.File(path, "r")
+    except OSError as exc:
+        raise ResultsError(f"'{path}' is not a readable HDF5 file ({exc})") from None
+    with f:
+        def need(name):
+            if name not in f:
+                raise ResultsError(f"{path}: missing dataset '/{name}' (not a MULTICOR continuum "
+                                   "results file, or one from another version)")
+            return f[name][...]
+
+        x = need("continuum/mesh/coordinates")
+        connectivity = need("continuum/mesh/connectivity")
+        kind = need("continuum/mesh/kind")
+        title = str(f.attrs.get("title", os.path.basename(path)))
+        analysis = str(f.attrs.get("analysis", ""))
+        time = stress = energy = frequency = None
+        if "continuum/static" in f:
+            analysis = "static"
+            u = need("continuum/static/displacement")[None]
+            stress = need("continuum/static/stress")[None]
+        elif "continuum/modal" in f:
+            analysis = "modal"
+            u = need("continuum/modal/shapes")
+            frequency = need("continuum/modal/frequency")
+        else:
+            analysis = "dynamic"
+            time = need("continuum/time")
+            u = need("continuum/displacement")
+            stress = need("continuum/stress")
+            energy = {name: need(f"continuum/energy/{name}") for name in ENERGY_TERMS}
+            energy["time"] = need("continuum/energy/time")
+        res = ContinuumResults(path, title, analysis, x, connectivity, kind, time, u, stress,
+                               energy, frequency)
+        if "dem/position" in f:
+            res.disk_position = f["dem/position"][...]
+            res.disk_radius = need("dem/particles/radius")
+            res.disk_time = need("dem/time")
+    return res
+
+
+def element_polygons(x, connectivity, kind, u=None, scale=1.0):
+    """Outlines of the elements (list of (3 or 4, 2) arrays) at x + scale u."""
+    xy = x if u is None else x + scale * u
+    return [xy[connectivity[e, :3 if kind[e] == 1 else 4] - 1] for e in range(connectivity.shape[0])]
+
+
+def auto_scale(res: ContinuumResults, u: np.ndarray, fraction: float = 0.1) -> float:
+    """Magnification of the displacements u: the largest drawn as `fraction` of the mesh's
+    larger side when it is smaller than that, else 1 (true scale)."""
+    size = float(np.max(np.ptp(res.x, axis=0)))
+    umax = float(np.max(np.hypot(u[:, 0], u[:, 1]))) if u.size else 0.0
+    if umax == 0.0 or umax >= fraction * size:
+        return 1.0
+    return fraction * size / umax
+
+
+def _figure(width=8.0, height=6.0):
+    fig = Figure(figsize=(width, height), layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _time_unit(values) -> tuple[float, str]:
+    vmax = float(np.max(np.abs(values))) if np.size(values) else 0.0
+    if vmax >= 1.0 or vmax == 0.0:
+        return 1.0, "s"
+    if vmax >= 1e-3:
+        return 1e3, "ms"
+    return 1e6, "µs"
+
+
+def _stress_unit(values) -> tuple[float, str]:
+    vmax = float(np.max(np.abs(values))) if np.size(values) else 0.0
+    for factor, unit in ((1e-9, "GPa"), (1e-6, "MPa"), (1e-3, "kPa")):
+        if vmax * factor >= 1.0:
+            return factor, unit
+    return 1.0, "Pa"
+
+
+def _draw_disks(ax, res: ContinuumResults, k: int, scale: float):
+    """The disks of a coupled run at the DEM output nearest to the continuum's state k, their
+    displacements from the first output magnified by the mesh's `scale`."""
+    if res.disk_position is None:
+        return
+    j = res.disk_position.shape[0] - 1
+    if res.time is not None and res.disk_time is not None:
+        j = int(np.argmin(np.abs(res.disk_time - res.time[k])))
+    start = res.disk_position[0]
+    pos = start + scale * (res.disk_position[j] - start)
+    ax.add_collection(PatchCollection([Circle((p[0], p[1]), r) for p, r in zip(pos, res.disk_radius)],
+                                      facecolor="none", edgecolor="0.25", lw=0.4))
+
+
+def plot_stress(res: ContinuumResults, time: Optional[float] = None,
+                scale: Optional[float] = None) -> Figure:
+    """sigma_xx, sigma_yy, sigma_xy per element on the deformed mesh (module doc)."""
+    if res.stress is None:
+        raise ResultsError(f"{res.path}: a {res.analysis} run stores no stress")
+    k = res.nearest_index(time)
+    u = res.u[k]
+    s = scale if scale is not None else auto_scale(res, u)
+    deformed = element_polygons(res.x, res.connectivity, res.kind, u, s)
+    outline = element_polygons(res.x, res.connectivity, res.kind)
+    fs, us = _stress_unit(res.stress[k])
+    # one panel per component, as high as the body's shape asks (a slender one gets thin ones)
+    corners = np.concatenate([res.x, res.x + s * u])
+    extent = np.ptp(corners, axis=0)
+    panel = float(np.clip(6.5 * extent[1] / max(extent[0], 1e-300) + 0.9, 1.6, 3.5))
+    fig = _figure(height=1.0 + 3 * panel)
+    axes = fig.subplots(3, 1, sharex=True)
+    for c, (ax, name) in enumerate(zip(axes, ("σ_xx", "σ_yy", "σ_xy"))):
+        values = res.stress[k, :, c] * fs
+        # colour limits at the 99th percentile of |value|, so that a few elements at a corner
+        # singularity (a clamped edge) do not wash out the field; the colour bar says so
+        top = float(np.max(np.abs(values)))
+        lim = float(np.percentile(np.abs(values), 99)) if values.size else 0.0
+        lim = lim if lim > 0 else (top or 1.0)
+        ax.add_collection(PolyCollection(outline, facecolor="none", edgecolor="0.8", lw=0.3))
+        pc = PolyCollection(deformed, array=values, cmap="RdBu_r", edgecolor="face", lw=0.2)
+        pc.set_clim(-lim, lim)
+        ax.add_collection(pc)
+        _draw_disks(ax, res, k, s)
+        ax.autoscale_view()
+        ax.set_aspect("equal")
+        ax.set_ylabel("y [m]")
+        label = f"{name} [{us}]" + (f" (largest {top:.3g})" if top > lim * (1 + 1e-12) else "")
+        fig.colorbar(pc, ax=ax, label=label, extend="both" if top > lim * (1 + 1e-12) else "neither")
+    axes[-1].set_xlabel("x [m]")
+    when = ""
+    if res.time is not None:
+        ft, ut = _time_unit(res.time)
+        when = f", t = {res.time[k] * ft:.6g} {ut}"
+    magnified = "true scale" if s == 1.0 else f"displacements × {s:.3g}"
+    axes[0].set_title(f"{res.title}\nstress per element on the deformed mesh{when} ({magnified})")
+    return fig
+
+
+def default_node(res: ContinuumResults) -> int:
+    """0-based index of the node that moves most at the last state."""
+    u = res.u[-1]
+    return int(np.argmax(np.hypot(u[:, 0], u[:, 1])))
+
+
+def plot_history(res: ContinuumResults, node: Optional[int] = None) -> tuple[Figure, int]:
+    """u_x and u_y of a node against time (dynamic runs); node is the 1-based mesh index
+    (default: `default_node`). Returns the figure and the 1-based node plotted."""
+    if res.time is None:
+        raise ResultsError(f"{res.path}: a {res.analysis} run has no time history")
+    n = default_node(res) if node is None else node - 1
+    if not 0 <= n < res.x.shape[0]:
+        raise ResultsError(f"{res.path}: no node {node} (the mesh has {res.x.shape[0]} nodes)")
+    ft, ut = _time_unit(res.time)
+    fig = _figure(height=4.5)
+    ax = fig.subplots()
+    ax.plot(res.time * ft, res.u[:, n, 0], label="u_x")
+    ax.plot(res.time * ft, res.u[:, n, 1], label="u_y")
+    ax.set_xlabel(f"time [{ut}]")
+    ax.set_ylabel("displacement [m]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="best", fontsize="small")
+    ax.set_title(f"{res.title}\nnode {n + 1} at ({res.x[n, 0]:.4g}, {res.x[n, 1]:.4g}) m")
+    return fig, n + 1
+
+
+def plot_energy(res: ContinuumResults) -> Figure:
+    """The energy audit of a dynamic run: kinetic, strain, works, damping and the balance
+    residual (doc/output.md)."""
+    if res.energy is None:
+        raise ResultsError(f"{res.path}: a {res.analysis} run has no energy audit")
+    e = res.energy
+    ft, ut = _time_unit(e["time"])
+    t = e["time"] * ft
+    fig = _figure(height=6.5)
+    ax, ax_b = fig.subplots(2, 1, sharex=True)
+    labels = {"kinetic": "kinetic", "strain": "strain", "external_work": "work of the loads",
+              "damping": "damping (dissipated)", "reaction_work": "work of the reactions"}
+    for name, label in labels.items():
+        ax.plot(t, e[name], lw=1.0, label=label)
+    ax.set_ylabel("energy [J]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="best", fontsize="small")
+    ax_b.plot(t, e["balance"], lw=1.0, color="k")
+    ax_b.set_ylabel("balance residual [J]")
+    ax_b.set_xlabel(f"time [{ut}]")
+    ax_b.grid(True, alpha=0.3)
+    ax.set_title(f"{res.title}\ncontinuum energy audit")
+    return fig
+
+
+def plot_modes(res: ContinuumResults, max_modes: int = 6,
+               scale: Optional[float] = None) -> Figure:
+    """The first mode shapes (mass-normalised, each magnified to a tenth of the mesh) with
+    their frequencies."""
+    if res.frequency is None:
+        raise ResultsError(f"{res.path}: not a modal run")
+    n = min(max_modes, res.u.shape[0])
+    fig = _figure(height=2.0 + 1.6 * n)
+    axes = np.atleast_1d(fig.subplots(n, 1, sharex=True))
+    outline = element_polygons(res.x, res.connectivity, res.kind)
+    for m, ax in enumerate(axes):
+        s = scale if scale is not None else auto_scale(res, res.u[m])
+        ax.add_collection(PolyCollection(outline, facecolor="none", edgecolor="0.8", lw=0.3))
+        ax.add_collection(PolyCollection(element_polygons(res.x, res.connectivity, res.kind, res.u[m], s),
+                                         facecolor="#c6dbef", edgecolor="0.2", lw=0.3))
+        ax.autoscale_view()
+        ax.set_aspect("equal")
+        ax.set_ylabel("y [m]")
+        ax.set_title(f"mode {m + 1}: {res.frequency[m]:.6g} Hz", fontsize="small")
+    axes[-1].set_xlabel("x [m]")
+    fig.suptitle(res.title)
+    return fig
+
+
+def write_all(res: ContinuumResults, out_dir, time: Optional[float] = None,
+              scale: Optional[float] = None, node: Optional[int] = None) -> list[str]:
+    """Write the figures of the module doc as PNG files in ``out_dir``; return their paths."""
+    out_dir = os.fspath(out_dir)
+    os.makedirs(out_dir, exist_ok=True)
+    stem = os.path.splitext(os.path.basename(res.path))[0]
+    written = []
+
+    def save(fig, name):
+        path = os.path.join(out_dir, f"{stem}_{name}.png")
+        fig.savefig(path, dpi=120)
+        written.append(path)
+
+    if res.analysis == "modal":
+        save(plot_modes(res, scale=scale), "modes")
+        return written
+    save(plot_stress(res, time=time, scale=scale), "stress")
+    if res.analysis == "dynamic":
+        save(plot_energy(res), "continuum_energy")
+        save(plot_history(res, node)[0], "history")
+    return written

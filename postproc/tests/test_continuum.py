@@ -1,0 +1,159 @@
+"""2D continuum results (/continuum of doc/output.md): the loader, the stress plot on the
+deformed mesh (magnification, values per element, the disks of a coupled run), the history,
+the energy audit and the mode shapes, and plot_results.py dispatching to them.
+
+The synthetic mesh: two Q4 and one T3, nodes 1..7; a displacement field u = A k (y, x^2)
+at state k (dynamic), k = 1 for the static solution; stress of element e at state k equal to
+k (e + 1) (1, 2, 3) kPa, so that every value drawn can be traced to its element and state."""
+import h5py
+import numpy as np
+import pytest
+
+import plot_results
+from multicor_post import continuum
+from multicor_post.results import ResultsError
+
+X = np.array([[0, 0], [1, 0], [2, 0], [0, 1], [1, 1], [2, 1], [3, 0.5]], float)
+CONN = np.array([[1, 2, 5, 4], [2, 3, 6, 5], [3, 7, 6, 0]], np.int32)
+KIND = np.array([2, 2, 1], np.int32)
+A = 1e-4
+N_OUT = 5
+
+
+def field(k):
+    return A * k * np.stack([X[:, 1], X[:, 0] ** 2], axis=1)
+
+
+def stress(k):
+    return 1e3 * k * np.outer(np.arange(1, 4), [1.0, 2.0, 3.0])
+
+
+def write(path, analysis="dynamic", disks=False):
+    with h5py.File(path, "w") as f:
+        f.attrs["title"] = f"synthetic {analysis}"
+        f.attrs["analysis"] = analysis
+        f["continuum/mesh/coordinates"] = X
+        f["continuum/mesh/connectivity"] = CONN
+        f["continuum/mesh/kind"] = KIND
+        if analysis == "static":
+            f["continuum/static/displacement"] = field(1)
+            f["continuum/static/stress"] = stress(1)
+        elif analysis == "modal":
+            f["continuum/modal/frequency"] = np.array([10.0, 25.0])
+            f["continuum/modal/omega"] = 2 * np.pi * np.array([10.0, 25.0])
+            f["continuum/modal/shapes"] = np.stack([field(1), field(-2)])
+        else:
+            t = 1e-3 * np.arange(N_OUT)
+            f["continuum/time"] = t
+            f["continuum/displacement"] = np.stack([field(k) for k in range(N_OUT)])
+            f["continuum/velocity"] = np.zeros((N_OUT, len(X), 2))
+            f["continuum/stress"] = np.stack([stress(k) for k in range(N_OUT)])
+            f["continuum/energy/time"] = t
+            for i, name in enumerate(continuum.ENERGY_TERMS):
+                f[f"continuum/energy/{name}"] = (i + 1) * t
+            if disks:
+                # two disks moving with the mesh's node 3 and 6 (a coupled run's glue)
+                start = np.array([[2.0, 0.0, 0.0], [2.0, 1.0, 0.0]])
+                move = np.stack([np.concatenate([field(k)[[2, 5]], np.zeros((2, 1))], axis=1)
+                                 for k in range(N_OUT)])
+                f["dem/position"] = start + move
+                f["dem/particles/radius"] = np.array([0.1, 0.2])
+                f["dem/time"] = t
+    return path
+
+
+def test_loader_reads_each_kind_of_run(tmp_path):
+    s = continuum.load_continuum(write(tmp_path / "s.h5", "static"))
+    assert (s.analysis, s.time, s.u.shape, s.stress.shape) == ("static", None, (1, 7, 2), (1, 3, 3))
+    d = continuum.load_continuum(write(tmp_path / "d.h5"))
+    assert d.analysis == "dynamic" and d.u.shape == (N_OUT, 7, 2) and d.stress.shape == (N_OUT, 3, 3)
+    assert d.nearest_index(2.4e-3) == 2 and d.nearest_index(None) == N_OUT - 1
+    m = continuum.load_continuum(write(tmp_path / "m.h5", "modal"))
+    assert m.analysis == "modal" and list(m.frequency) == [10.0, 25.0] and m.stress is None
+
+
+def test_missing_dataset_names_it(tmp_path):
+    path = write(tmp_path / "d.h5")
+    with h5py.File(path, "r+") as f:
+        del f["continuum/stress"]
+    with pytest.raises(ResultsError, match="/continuum/stress"):
+        continuum.load_continuum(path)
+    assert plot_results.main([str(path), "--out", str(tmp_path / "png")]) == 1
+
+
+def test_small_displacements_are_magnified_to_a_tenth_of_the_mesh(tmp_path):
+    res = continuum.load_continuum(write(tmp_path / "s.h5", "static"))
+    u = res.u[0]
+    s = continuum.auto_scale(res, u)
+    # the mesh's larger side is 3 m: the largest displacement is drawn as 0.3 m
+    assert s * np.max(np.hypot(u[:, 0], u[:, 1])) == pytest.approx(0.3, rel=1e-12)
+    # displacements already larger than that are drawn at true scale
+    assert continuum.auto_scale(res, 1e4 * u) == 1.0
+
+
+def test_stress_plot_colours_each_element_on_the_deformed_mesh(tmp_path):
+    res = continuum.load_continuum(write(tmp_path / "d.h5"))
+    k = 3
+    fig = continuum.plot_stress(res, time=3e-3, scale=50.0)
+    assert len(fig.axes) == 6                       # three panels and their colour bars
+    for c in range(3):
+        ax = fig.axes[c]
+        outline, deformed = ax.collections[0], ax.collections[1]
+        # values in kPa (largest 3 (3) 3 = 27 kPa at k = 3), element by element
+        np.testing.assert_allclose(deformed.get_array(), stress(k)[:, c] / 1e3, rtol=1e-12)
+        # vertices: x + scale u at state k; the T3 has 3 of them, the outline the reference x
+        for e, path in enumerate(deformed.get_paths()):
+            n = 3 if KIND[e] == 1 else 4
+            expected = X[CONN[e, :n] - 1] + 50.0 * field(k)[CONN[e, :n] - 1]
+            np.testing.assert_allclose(path.vertices[:n], expected, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(outline.get_paths()[1].vertices[:4], X[CONN[1] - 1], atol=0)
+    assert "t = 3 ms" in fig.axes[0].get_title() and "× 50" in fig.axes[0].get_title()
+
+
+def test_disks_of_a_coupled_run_move_with_the_same_magnification(tmp_path):
+    res = continuum.load_continuum(write(tmp_path / "c.h5", disks=True))
+    k, s = N_OUT - 1, 20.0
+    disks = continuum.plot_stress(res, scale=s).axes[0].collections[2]
+    # the paths of a PatchCollection are in data coordinates: a circle's centre is the middle
+    # of its extent
+    drawn = np.array([(p.vertices.min(axis=0) + p.vertices.max(axis=0)) / 2 for p in disks.get_paths()])
+    radii = np.array([np.ptp(p.vertices[:, 0]) / 2 for p in disks.get_paths()])
+    # the node each disk follows, drawn magnified like the mesh
+    expected = X[[2, 5]] + s * field(k)[[2, 5]]
+    np.testing.assert_allclose(drawn, expected, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(radii, [0.1, 0.2], rtol=1e-12)
+
+
+def test_history_of_the_node_that_moves_most(tmp_path):
+    res = continuum.load_continuum(write(tmp_path / "d.h5"))
+    fig, node = continuum.plot_history(res)
+    assert node == 7                                 # x = 3: u_y = A k 9, the largest
+    ux, uy = fig.axes[0].get_lines()
+    np.testing.assert_allclose(uy.get_ydata(), [field(k)[6, 1] for k in range(N_OUT)], rtol=1e-12)
+    np.testing.assert_allclose(ux.get_ydata(), [field(k)[6, 0] for k in range(N_OUT)], rtol=1e-12)
+    assert continuum.plot_history(res, node=2)[1] == 2
+    with pytest.raises(ResultsError, match="no node 8"):
+        continuum.plot_history(res, node=8)
+
+
+def test_energy_plot_draws_the_audit(tmp_path):
+    res = continuum.load_continuum(write(tmp_path / "d.h5"))
+    ax, ax_b = continuum.plot_energy(res).axes
+    t = 1e-3 * np.arange(N_OUT)
+    drawn = {line.get_label(): line.get_ydata() for line in ax.get_lines()}
+    np.testing.assert_allclose(drawn["strain"], 2 * t, rtol=1e-12)          # term 2 of the file
+    np.testing.assert_allclose(ax_b.get_lines()[0].get_ydata(), 6 * t, rtol=1e-12)   # balance
+
+
+def test_cli_writes_the_figures_of_each_kind(tmp_path, capsys):
+    for analysis, names in (("static", ["stress"]),
+                            ("dynamic", ["stress", "continuum_energy", "history"]),
+                            ("modal", ["modes"])):
+        path = write(tmp_path / f"{analysis}.h5", analysis)
+        out = tmp_path / analysis
+        assert plot_results.main([str(path), "--out", str(out)]) == 0
+        printed = capsys.readouterr().out.split()
+        assert printed == [str(out / f"{analysis}_{n}.png") for n in names]
+        for p in printed:
+            with open(p, "rb") as f:
+                assert f.read(8) == b"\x89PNG\r\n\x1a\n"
