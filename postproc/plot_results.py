@@ -14,7 +14,7 @@ walls and contact force network at the stored time nearest to T; default the las
 residuals, multipliers, energy audit). For a 2D continuum (a /continuum group, alone or
 coupled to disks): <name>_stress.png (stress per element on the deformed mesh at the state
 nearest to T), and for a dynamic run <name>_continuum_energy.png and <name>_history.png (the
-node --node, a 1-based mesh index; default the node that moves most), for a modal run
+node --node, a 1-based mesh index; default the node with the largest displacement), for a modal run
 <name>_modes.png; with disks, their particle plots too. Exit code 1 with a message on a
 missing or invalid file.
 """
@@ -55,8 +55,8 @@ def main(argv=None):
                         help="folder for the PNG files (default: the results file's folder)")
     parser.add_argument("--node", type=int, default=None,
                         help="beam: deck id of the node whose history is plotted (default: the "
-                             "tip); continuum: 1-based mesh node (default: the node that moves "
-                             "most)")
+                             "tip); continuum: 1-based mesh node (default: the largest "
+                             "displacement)")
     parser.add_argument("--scale", type=float, default=None,
                         help="beam and continuum: displacement scale factor of deformed shapes "
                              "(default: auto)")

@@ -9,7 +9,7 @@ Figures (``write_all``):
   displacements are magnified (the factor is in the title).
 - <name>_continuum_energy.png (dynamic): the energy audit of /continuum/energy.
 - <name>_history.png (dynamic): the displacement of one node against time (default: the node
-  that moves most at the last state).
+  with the largest displacement over the stored states).
 - <name>_modes.png (modal): the first mode shapes with their frequencies.
 """
 from dataclasses import dataclass
@@ -205,9 +205,8 @@ def plot_stress(res: ContinuumResults, time: Optional[float] = None,
 
 
 def default_node(res: ContinuumResults) -> int:
-    """0-based index of the node that moves most at the last state."""
-    u = res.u[-1]
-    return int(np.argmax(np.hypot(u[:, 0], u[:, 1])))
+    """0-based index of the node with the largest displacement over the stored states."""
+    return int(np.argmax(np.max(np.hypot(res.u[..., 0], res.u[..., 1]), axis=0)))
 
 
 def plot_history(res: ContinuumResults, node: Optional[int] = None) -> tuple[Figure, int]:

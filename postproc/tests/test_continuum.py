@@ -132,6 +132,10 @@ def test_history_of_the_node_that_moves_most(tmp_path):
     np.testing.assert_allclose(uy.get_ydata(), [field(k)[6, 1] for k in range(N_OUT)], rtol=1e-12)
     np.testing.assert_allclose(ux.get_ydata(), [field(k)[6, 0] for k in range(N_OUT)], rtol=1e-12)
     assert continuum.plot_history(res, node=2)[1] == 2
+    # the default is the largest displacement over the run, not at the last state
+    res.u[-1] = 0.0
+    res.u[-1, 1] = [1e-9, 0.0]
+    assert continuum.plot_history(res)[1] == 7
     with pytest.raises(ResultsError, match="no node 8"):
         continuum.plot_history(res, node=8)
 
