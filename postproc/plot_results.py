@@ -40,6 +40,13 @@ def contents(path):
         raise ResultsError(f"results file '{path}' does not exist{hint}")
     try:
         with h5py.File(path, "r") as f:
+            # the other HDF5 files multicor writes: say what they are and where the results are
+            if str(f.attrs.get("format", "")).startswith("MULTICOR checkpoint"):
+                raise ResultsError(f"'{path}' is a MULTICOR checkpoint (for --restart), not a "
+                                   "results file: plot the <deck name>.h5 next to it")
+            if "fclib_local" in f:
+                raise ResultsError(f"'{path}' is a contact problem exported in FCLIB's format "
+                                   "([solver] fclib_step), not a results file")
             return "fem/mesh" in f, "dem" in f, "coupling" in f, "continuum/mesh" in f
     except OSError as exc:
         raise ResultsError(f"'{path}' is not a readable HDF5 file ({exc})") from None

@@ -104,6 +104,21 @@ def test_solver_plot_of_exact_steps_draws_without_warning(tmp_path):
     assert not plot_solver(load_dem(write_dem(tmp_path / "b.h5"))).axes[1].texts
 
 
+def test_cli_says_what_a_checkpoint_or_an_fclib_file_is(tmp_path, capsys):
+    # the other HDF5 files multicor writes next to the results (attributes as multicor writes
+    # them: doc/output.md, checkpoint and FCLIB export)
+    import h5py
+    with h5py.File(tmp_path / "checkpoint.h5", "w") as f:
+        f.attrs["format"] = "MULTICOR checkpoint 1"
+        f.create_group("dem")
+    with h5py.File(tmp_path / "run_fclib_3.h5", "w") as f:
+        f.create_group("fclib_local")
+    assert plot_results.main([str(tmp_path / "checkpoint.h5")]) == 1
+    assert "is a MULTICOR checkpoint (for --restart)" in capsys.readouterr().err
+    assert plot_results.main([str(tmp_path / "run_fclib_3.h5")]) == 1
+    assert "exported in FCLIB's format ([solver] fclib_step)" in capsys.readouterr().err
+
+
 def check_pngs(paths):
     assert paths
     for path in paths:
