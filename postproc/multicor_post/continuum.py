@@ -23,6 +23,7 @@ from matplotlib.collections import PatchCollection, PolyCollection
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
+from .beam import _time_unit
 from .results import ResultsError
 
 
@@ -127,15 +128,6 @@ def _figure(width=8.0, height=6.0):
     fig = Figure(figsize=(width, height), layout="constrained")
     FigureCanvasAgg(fig)
     return fig
-
-
-def _time_unit(values) -> tuple[float, str]:
-    vmax = float(np.max(np.abs(values))) if np.size(values) else 0.0
-    if vmax >= 1.0 or vmax == 0.0:
-        return 1.0, "s"
-    if vmax >= 1e-3:
-        return 1e3, "ms"
-    return 1e6, "µs"
 
 
 def _stress_unit(values) -> tuple[float, str]:

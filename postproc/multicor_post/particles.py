@@ -17,6 +17,7 @@ from matplotlib.collections import EllipseCollection, LineCollection
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
+from .beam import _time_unit
 from .results import ResultsError, _decode_attrs, _Getter, _open_results
 
 #: Columns of the per-disk arrays: x [m], y [m], rotation [rad].
@@ -180,15 +181,6 @@ def _new_figure(width=8.0, height=6.0):
     fig = Figure(figsize=(width, height), layout="constrained")
     FigureCanvasAgg(fig)
     return fig
-
-
-def _time_unit(values) -> tuple[float, str]:
-    vmax = float(np.max(np.abs(values))) if np.size(values) else 0.0
-    if vmax >= 1.0 or vmax == 0.0:
-        return 1.0, "s"
-    if vmax >= 1e-3:
-        return 1e3, "ms"
-    return 1e6, "µs"
 
 
 def force_segments(res: DemResults, k: int):
