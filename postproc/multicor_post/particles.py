@@ -354,9 +354,13 @@ def plot_solver(res: DemResults) -> Figure:
     fig = _new_figure(height=7.5)
     ax_s, ax_e, ax_c = fig.subplots(3, 1, sharex=True)
     ax_s.plot(t, s.sweeps, lw=0.8, color="C0")
-    if s.max_sweeps:
+    if s.max_sweeps and np.max(s.sweeps, initial=0) >= 0.1 * s.max_sweeps:
         ax_s.axhline(s.max_sweeps, color="0.5", ls="--", lw=0.8,
                      label=f"max_sweeps = {s.max_sweeps}")
+    elif s.max_sweeps:
+        # a cap far above every step would squash the sweeps to the bottom of the axis
+        ax_s.text(0.99, 0.95, f"max_sweeps = {s.max_sweeps} (off the scale)", transform=ax_s.transAxes,
+                  ha="right", va="top", fontsize="small", color="0.3")
     if np.any(bad):
         ax_s.plot(t[bad], s.sweeps[bad], "o", color="tab:red", ms=3,
                   label=f"not converged ({int(np.count_nonzero(bad))} steps)")

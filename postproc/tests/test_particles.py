@@ -98,6 +98,9 @@ def test_solver_plot_of_exact_steps_draws_without_warning(tmp_path):
         warnings.simplefilter("error")
         fig = plot_solver(load_dem(path))
         fig.savefig(tmp_path / "solver.png")
+    # the cap of 1000 sweeps is far above the 1 to 15 of the steps: written, not drawn
+    assert [t.get_text() for t in fig.axes[0].texts] == ["max_sweeps = 1000 (off the scale)"]
+    assert not [line for line in fig.axes[0].get_lines() if line.get_linestyle() == "--"]
     texts = [t.get_text() for t in fig.axes[1].texts]
     assert texts == ["error and residual 0 at every step"]
     # the plot of a run with nonzero errors has no such note
@@ -117,6 +120,16 @@ def test_cli_says_what_a_checkpoint_or_an_fclib_file_is(tmp_path, capsys):
     assert "is a MULTICOR checkpoint (for --restart)" in capsys.readouterr().err
     assert plot_results.main([str(tmp_path / "run_fclib_3.h5")]) == 1
     assert "exported in FCLIB's format ([solver] fclib_step)" in capsys.readouterr().err
+
+
+def test_solver_plot_draws_the_cap_when_a_step_comes_near_it(tmp_path):
+    import h5py
+    path = write_dem(tmp_path / "col.h5")
+    with h5py.File(path, "r+") as f:
+        f["dem/solver/sweeps"][7] = 1000          # the unconverged step stopped at the cap
+    ax = plot_solver(load_dem(path)).axes[0]
+    caps = [line for line in ax.get_lines() if line.get_linestyle() == "--"]
+    assert len(caps) == 1 and caps[0].get_ydata()[0] == 1000 and not ax.texts
 
 
 def check_pngs(paths):
