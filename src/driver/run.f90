@@ -15,6 +15,9 @@
 !> may tunnel through a wall or another disk). One run at a time writes a results folder: a
 !> lock file (io_lock) is held while writing and removed on every way out.
 !>
+!> Every run that ends normally also gets `<name>.xdmf` (driver_results_xdmf), written beside
+!> the open results file and renamed into place once the HDF5 file has its final name.
+!>
 !> Checkpoints (driver_checkpoint): the time loops of every kind of run (beam, particles,
 !> beam-particle coupled, continuum, continuum-particle coupled) write
 !> '<results folder>/checkpoint.h5' as the deck's [output] checkpoint_interval /
