@@ -32,11 +32,7 @@ module driver_results_continuum
         integer :: n_out = 0
         !> Analysis ('static', 'modal', 'dynamic').
         character(len=:), allocatable :: analysis
-        !> Number of modes (modal).
-        integer :: n_modes = 0
-        !> Stored times (dynamic).
-        real(wp), allocatable :: times(:)
-        !> XDMF topology: 'Triangle', 'Quadrilateral' or 'Mixed'; nodes per element (0: mixed).
+        !> XDMF topology of /continuum/mesh/topology: 'Triangle', 'Quadrilateral' or 'Mixed'.
         character(len=:), allocatable :: topology
         !> Number of values of the topology dataset.
         integer :: topology_size = 0
@@ -75,7 +71,6 @@ contains
         self%n_elements = mesh%element_count()
         self%analysis = analysis
         self%n_out = 0
-        allocate (self%times(0))
         call file%create_group('/continuum', error)
         if (allocated(error)) return
         call file%create_group('/continuum/mesh', error)
@@ -164,7 +159,7 @@ contains
     end subroutine set_topology
 
     !> Take up the results file of a dynamic run at a restart, its series already cut to the
-    !> checkpoint (driver_checkpoint::load_results): the stored times are read back from
+    !> checkpoint (driver_checkpoint::load_results): the count of stored states is that of
     !> /continuum/time.
     subroutine writer_resume(self, file, mesh, error)
         !> The writer.
@@ -175,14 +170,14 @@ contains
         type(mesh2d_t), intent(in) :: mesh
         !> Set on a read failure.
         type(error_t), allocatable, intent(out) :: error
-        integer, allocatable :: topo(:)
+        integer, allocatable :: topo(:), dims(:)
         self%n_nodes = mesh%node_count()
         self%n_elements = mesh%element_count()
         self%analysis = 'dynamic'
         call set_topology(self, mesh, topo)
-        call file%read_dataset('/continuum/time', self%times, error)
+        call file%dataset_shape('/continuum/time', dims, error)
         if (allocated(error)) return
-        self%n_out = size(self%times)
+        self%n_out = dims(1)
     end subroutine writer_resume
 
     !> Static displacements (2, n_nodes), centre stresses (3, n_elements) and strain energy.
@@ -205,8 +200,6 @@ contains
         if (.not. allocated(error)) call file%write_dataset('/continuum/static/displacement', d, error)
         if (.not. allocated(error)) call file%write_dataset('/continuum/static/stress', stress, error)
         if (.not. allocated(error)) call file%write_attribute('/continuum/static', 'strain_energy', strain_energy, error)
-        if (allocated(error)) return
-        self%times = [0.0_wp]
     end subroutine writer_write_static
 
     !> Circular frequencies, frequencies and mode shapes (2, n_nodes, n_modes).
@@ -225,7 +218,6 @@ contains
         if (.not. allocated(error)) call file%write_dataset('/continuum/modal/omega', omega, error)
         if (.not. allocated(error)) call file%write_dataset('/continuum/modal/frequency', omega/two_pi, error)
         if (.not. allocated(error)) call file%write_dataset('/continuum/modal/shapes', shapes, error)
-        self%n_modes = size(omega)
     end subroutine writer_write_modal
 
     !> Append one state: time, displacements, velocities (2, n_nodes), stresses (3, n_elements).
@@ -250,7 +242,6 @@ contains
         if (.not. allocated(error)) call file%append('/continuum/stress', stress, error)
         if (allocated(error)) return
         self%n_out = self%n_out + 1
-        self%times = [self%times, t]
     end subroutine writer_store
 
     !> Append one energy record [J]; balance = kinetic + strain + damping - external work -

@@ -14,7 +14,7 @@
 !> next to the HDF5 file with the mesh's fields and the disks per stored state. Checkpoints hold what a beam-particle coupled
 !> run's hold (driver_checkpoint::save_coupled: the Newmark state of the continuum, the disks,
 !> contacts and bonds, the multipliers and the constraint state) under the kind 'coupled2d';
-!> at a restart the continuum writer reads its stored times back from the results file.
+!> at a restart the continuum writer counts its stored states in the results file.
 module driver_simulation_coupled2d
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp, i8
@@ -328,7 +328,7 @@ contains
     end subroutine coupled2d_check_saved_part
 
     !> The continuum's audit resumed with the totals of the checkpoint, C_p u_p at the restart
-    !> time, and the continuum writer's stored times from the results file.
+    !> time, and the continuum writer's count of stored states from the results file.
     subroutine coupled2d_load_part(self, f, out, error)
         !> The simulation.
         class(coupled2d_simulation_t), intent(inout) :: self

@@ -131,6 +131,7 @@ contains
             self%unit = -1
             return
         end if
+        self%depth = 0
         call put(self, ' </Domain>')
         call put(self, '</Xdmf>')
         close (self%unit, iostat=ios)

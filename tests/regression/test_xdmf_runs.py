@@ -9,12 +9,17 @@ file only points into the HDF5 file: no value is copied or converted): the numbe
 states (modes), the number of points, and the positions / displacements of the last state.
 For the dynamic beam, ParaView's Warp By Vector on "displacement" must give the deformed
 nodes. A restart that continues the dynamic beam to a later end rewrites the XDMF file with
-every state of the continued file. Without pvpython the XDMF file is read by a small
+every state of the continued file; a later run in that folder stopped by SIGTERM leaves the
+XDMF file and the finished HDF5 file as they were (no XDMF file for the partial file, none
+claiming the stopped run's states). Without pvpython the XDMF file is read by a small
 interpreter of its hyperslab references here (meshio does not read XDMF hyperslabs).
 Usage (ctest does this): test_xdmf_runs.py --exe multicor --work DIR --source REPO
 """
+import hashlib
 import json
+import re
 import shutil
+import signal
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -170,6 +175,38 @@ def same(name, got, want):
     return check(name, ok, f"{want.shape}, largest difference {err}")
 
 
+def interrupted(exe, work, folder):
+    """A run of the same deck to a far end, stopped by SIGTERM in `folder`: the finished
+    result and its XDMF file stay as they were."""
+    h5, xdmf = folder / "xdmf_beam_dynamic.h5", folder / "xdmf_beam_dynamic.xdmf"
+    before = {p: hashlib.sha256(p.read_bytes()).hexdigest() for p in (h5, xdmf) if p.exists()}
+    long_deck = work / "long" / "xdmf_beam_dynamic.dat"
+    long_deck.parent.mkdir(exist_ok=True)
+    long_deck.write_text(BEAM.format(analysis="dynamic", function="1",
+                                     extra=DYNAMIC.format(end="1000.0") + "progress = 0.02\n"))
+    proc = subprocess.Popen([str(exe), str(long_deck), "--output", str(folder)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    started = False
+    for line in proc.stdout:
+        m = re.match(r"step (\d+)/", line)
+        if m and int(m.group(1)) >= 100:
+            started = True
+            break
+    proc.send_signal(signal.SIGTERM)
+    try:
+        proc.communicate(timeout=120)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.communicate()
+    check("stopped run: exit 143 after a few outputs", started and proc.returncode == 128 + signal.SIGTERM,
+          f"exit {proc.returncode}")
+    after = {p: hashlib.sha256(p.read_bytes()).hexdigest() for p in (h5, xdmf) if p.exists()}
+    check("stopped run: the finished result and its XDMF file are left as they were", len(before) == 2
+          and after == before, ", ".join(p.name for p in before if after.get(p) != before[p]))
+    check("stopped run: no XDMF file for the partial file", not list(folder.glob("*.xdmf.partial")) and
+          (folder / "xdmf_beam_dynamic.h5.partial").exists(), sorted(p.name for p in folder.iterdir()))
+
+
 def main():
     exe, work, src = arguments(fresh=True)
     decks = {
@@ -199,6 +236,7 @@ def main():
     check("dynamic beam to 6 ms, continued to 10 ms", first.returncode == 0 and again.returncode == 0,
           (first.stderr + again.stderr)[-300:])
     h5["continued"] = cont / "xdmf_beam_dynamic.h5"
+    interrupted(exe, work, cont)
     xdmf = {k: v.with_suffix(".xdmf") for k, v in h5.items()}
     check("an XDMF file next to every results file", all(p.exists() for p in xdmf.values()),
           ", ".join(p.name for p in xdmf.values() if not p.exists()) or "all")
