@@ -12,8 +12,8 @@
 !> state) with /continuum/energy/reaction (2: the x and y resultants of the reactions on the
 !> prescribed dofs, N) per record.
 !>
-!> The XDMF file (`write_xdmf`) describes the mesh and its fields per stored state (a temporal
-!> collection) by reference into the HDF5 file, so that ParaView or meshio open them.
+!> The XDMF file next to the results file (driver_results_xdmf) describes the mesh and its
+!> fields from what this writer stored, by reference into the HDF5 file.
 module driver_results_continuum
     use core_kinds, only: wp
     use core_constants, only: two_pi
@@ -32,11 +32,7 @@ module driver_results_continuum
         integer :: n_out = 0
         !> Analysis ('static', 'modal', 'dynamic').
         character(len=:), allocatable :: analysis
-        !> Number of modes (modal).
-        integer :: n_modes = 0
-        !> Stored times (dynamic).
-        real(wp), allocatable :: times(:)
-        !> XDMF topology: 'Triangle', 'Quadrilateral' or 'Mixed'; nodes per element (0: mixed).
+        !> XDMF topology of /continuum/mesh/topology: 'Triangle', 'Quadrilateral' or 'Mixed'.
         character(len=:), allocatable :: topology
         !> Number of values of the topology dataset.
         integer :: topology_size = 0
@@ -53,8 +49,6 @@ module driver_results_continuum
         procedure :: store => writer_store
         !> One energy record.
         procedure :: store_energy => writer_store_energy
-        !> Write the XDMF description of what was stored.
-        procedure :: write_xdmf => writer_write_xdmf
     end type continuum_writer_t
 
 contains
@@ -77,7 +71,6 @@ contains
         self%n_elements = mesh%element_count()
         self%analysis = analysis
         self%n_out = 0
-        allocate (self%times(0))
         call file%create_group('/continuum', error)
         if (allocated(error)) return
         call file%create_group('/continuum/mesh', error)
@@ -166,7 +159,7 @@ contains
     end subroutine set_topology
 
     !> Take up the results file of a dynamic run at a restart, its series already cut to the
-    !> checkpoint (driver_checkpoint::load_results): the stored times are read back from
+    !> checkpoint (driver_checkpoint::load_results): the count of stored states is that of
     !> /continuum/time.
     subroutine writer_resume(self, file, mesh, error)
         !> The writer.
@@ -177,14 +170,14 @@ contains
         type(mesh2d_t), intent(in) :: mesh
         !> Set on a read failure.
         type(error_t), allocatable, intent(out) :: error
-        integer, allocatable :: topo(:)
+        integer, allocatable :: topo(:), dims(:)
         self%n_nodes = mesh%node_count()
         self%n_elements = mesh%element_count()
         self%analysis = 'dynamic'
         call set_topology(self, mesh, topo)
-        call file%read_dataset('/continuum/time', self%times, error)
+        call file%dataset_shape('/continuum/time', dims, error)
         if (allocated(error)) return
-        self%n_out = size(self%times)
+        self%n_out = dims(1)
     end subroutine writer_resume
 
     !> Static displacements (2, n_nodes), centre stresses (3, n_elements) and strain energy.
@@ -207,8 +200,6 @@ contains
         if (.not. allocated(error)) call file%write_dataset('/continuum/static/displacement', d, error)
         if (.not. allocated(error)) call file%write_dataset('/continuum/static/stress', stress, error)
         if (.not. allocated(error)) call file%write_attribute('/continuum/static', 'strain_energy', strain_energy, error)
-        if (allocated(error)) return
-        self%times = [0.0_wp]
     end subroutine writer_write_static
 
     !> Circular frequencies, frequencies and mode shapes (2, n_nodes, n_modes).
@@ -227,7 +218,6 @@ contains
         if (.not. allocated(error)) call file%write_dataset('/continuum/modal/omega', omega, error)
         if (.not. allocated(error)) call file%write_dataset('/continuum/modal/frequency', omega/two_pi, error)
         if (.not. allocated(error)) call file%write_dataset('/continuum/modal/shapes', shapes, error)
-        self%n_modes = size(omega)
     end subroutine writer_write_modal
 
     !> Append one state: time, displacements, velocities (2, n_nodes), stresses (3, n_elements).
@@ -252,7 +242,6 @@ contains
         if (.not. allocated(error)) call file%append('/continuum/stress', stress, error)
         if (allocated(error)) return
         self%n_out = self%n_out + 1
-        self%times = [self%times, t]
     end subroutine writer_store
 
     !> Append one energy record [J]; balance = kinetic + strain + damping - external work -
@@ -301,118 +290,4 @@ contains
             size(stress, 2) /= self%n_elements) &
             call make_error(error, 'results: continuum fields do not match the mesh (begin first)')
     end subroutine check_shapes
-
-    !> Write `path` (XDMF 3): the mesh with, per stored state, displacement and velocity at the
-    !> nodes and stress at the elements (static: one state; modal: one grid per mode shape).
-    subroutine writer_write_xdmf(self, path, h5_name, error)
-        !> The writer (after the run).
-        class(continuum_writer_t), intent(in) :: self
-        !> XDMF file to write.
-        character(len=*), intent(in) :: path
-        !> Name of the HDF5 file as seen from the XDMF file's folder.
-        character(len=*), intent(in) :: h5_name
-        !> Set when the file cannot be written.
-        type(error_t), allocatable, intent(out) :: error
-        integer :: unit, ios, k
-        character(len=64) :: buf
-        open (newunit=unit, file=path, status='replace', action='write', iostat=ios)
-        if (ios /= 0) then
-            call make_error(error, "results: cannot write the XDMF file '"//path//"'")
-            return
-        end if
-        write (unit, '(a)') '<?xml version="1.0" ?>'
-        write (unit, '(a)') '<Xdmf Version="2.0">'
-        write (unit, '(a)') ' <Domain>'
-        select case (self%analysis)
-        case ('dynamic')
-            write (unit, '(a)') '  <Grid Name="continuum" GridType="Collection" CollectionType="Temporal">'
-            do k = 1, self%n_out
-                write (buf, '(es24.16e3)') self%times(k)
-                call grid('state '//itoa(k - 1), trim(adjustl(buf)), k)
-            end do
-            write (unit, '(a)') '  </Grid>'
-        case ('static')
-            call grid('static', '0', 0)
-        case ('modal')
-            write (unit, '(a)') '  <Grid Name="modes" GridType="Collection" CollectionType="Temporal">'
-            do k = 1, self%n_modes
-                call grid('mode '//itoa(k), itoa(k), k)
-            end do
-            write (unit, '(a)') '  </Grid>'
-        end select
-        write (unit, '(a)') ' </Domain>'
-        write (unit, '(a)') '</Xdmf>'
-        close (unit, iostat=ios)
-        if (ios /= 0) call make_error(error, "results: cannot write the XDMF file '"//path//"'")
-    contains
-        !> One uniform grid: the mesh and the fields of record k.
-        subroutine grid(name, time, k)
-            character(len=*), intent(in) :: name, time
-            integer, intent(in) :: k
-            character(len=:), allocatable :: nn, ne
-            nn = itoa(self%n_nodes)
-            ne = itoa(self%n_elements)
-            write (unit, '(a)') '   <Grid Name="'//name//'" GridType="Uniform">'
-            if (self%analysis /= 'static') write (unit, '(a)') '    <Time Value="'//time//'"/>'
-            if (self%topology == 'Mixed') then
-                write (unit, '(a)') '    <Topology TopologyType="Mixed" NumberOfElements="'//ne//'">'
-                write (unit, '(a)') '     <DataItem Dimensions="'//itoa(self%topology_size)// &
-                    '" NumberType="Int" Format="HDF">'//h5_name//':/continuum/mesh/topology</DataItem>'
-            else
-                write (unit, '(a)') '    <Topology TopologyType="'//self%topology//'" NumberOfElements="'//ne//'">'
-                write (unit, '(a)') '     <DataItem Dimensions="'//ne//' '//itoa(self%topology_size/self%n_elements)// &
-                    '" NumberType="Int" Format="HDF">'//h5_name//':/continuum/mesh/topology</DataItem>'
-            end if
-            write (unit, '(a)') '    </Topology>'
-            write (unit, '(a)') '    <Geometry GeometryType="XY">'
-            write (unit, '(a)') '     <DataItem Dimensions="'//nn//' 2" NumberType="Float" Precision="8" '// &
-                'Format="HDF">'//h5_name//':/continuum/mesh/coordinates</DataItem>'
-            write (unit, '(a)') '    </Geometry>'
-            select case (self%analysis)
-            case ('static')
-                call whole('displacement', 'Node', nn//' 2', '/continuum/static/displacement')
-                call whole('stress', 'Cell', ne//' 3', '/continuum/static/stress')
-            case ('modal')
-                call slab('mode_shape', 'Node', k, itoa(self%n_modes), nn, '2', '/continuum/modal/shapes')
-            case ('dynamic')
-                call slab('displacement', 'Node', k, itoa(self%n_out), nn, '2', '/continuum/displacement')
-                call slab('velocity', 'Node', k, itoa(self%n_out), nn, '2', '/continuum/velocity')
-                call slab('stress', 'Cell', k, itoa(self%n_out), ne, '3', '/continuum/stress')
-            end select
-            write (unit, '(a)') '   </Grid>'
-        end subroutine grid
-
-        !> An attribute that is a whole dataset.
-        subroutine whole(name, centre, dims, dataset)
-            character(len=*), intent(in) :: name, centre, dims, dataset
-            write (unit, '(a)') '    <Attribute Name="'//name//'" AttributeType="Vector" Center="'//centre//'">'
-            write (unit, '(a)') '     <DataItem Dimensions="'//dims//'" NumberType="Float" Precision="8" '// &
-                'Format="HDF">'//h5_name//':'//dataset//'</DataItem>'
-            write (unit, '(a)') '    </Attribute>'
-        end subroutine whole
-
-        !> An attribute that is record k of a (records, n, m) dataset.
-        subroutine slab(name, centre, k, records, n, m, dataset)
-            character(len=*), intent(in) :: name, centre, records, n, m, dataset
-            integer, intent(in) :: k
-            write (unit, '(a)') '    <Attribute Name="'//name//'" AttributeType="Vector" Center="'//centre//'">'
-            write (unit, '(a)') '     <DataItem ItemType="HyperSlab" Dimensions="1 '//n//' '//m// &
-                '" Type="HyperSlab" NumberType="Float" Precision="8">'
-            write (unit, '(a)') '      <DataItem Dimensions="3 3" Format="XML">'//itoa(k - 1)//' 0 0 1 1 1 1 '// &
-                n//' '//m//'</DataItem>'
-            write (unit, '(a)') '      <DataItem Dimensions="'//records//' '//n//' '//m//'" NumberType="Float" '// &
-                'Precision="8" Format="HDF">'//h5_name//':'//dataset//'</DataItem>'
-            write (unit, '(a)') '     </DataItem>'
-            write (unit, '(a)') '    </Attribute>'
-        end subroutine slab
-    end subroutine writer_write_xdmf
-
-    !> Integer as text.
-    pure function itoa(i) result(text)
-        integer, intent(in) :: i
-        character(len=:), allocatable :: text
-        character(len=16) :: buf
-        write (buf, '(i0)') i
-        text = trim(buf)
-    end function itoa
 end module driver_results_continuum

@@ -15,6 +15,9 @@
 !> may tunnel through a wall or another disk). One run at a time writes a results folder: a
 !> lock file (io_lock) is held while writing and removed on every way out.
 !>
+!> Every run that ends normally also gets `<name>.xdmf` (driver_results_xdmf), written beside
+!> the open results file and renamed into place once the HDF5 file has its final name.
+!>
 !> Checkpoints (driver_checkpoint): the time loops of every kind of run (beam, particles,
 !> beam-particle coupled, continuum, continuum-particle coupled) write
 !> '<results folder>/checkpoint.h5' as the deck's [output] checkpoint_interval /
@@ -30,8 +33,9 @@ module driver_run
     use core_signals, only: caught_signal, signal_name, install_signal_handlers
     use io_deck_schema, only: multicor_schema
     use io_deck, only: deck_t, deck_entry_t, read_deck
-    use io_paths, only: stem, mkdir_p, remove_empty_folders, file_exists
+    use io_paths, only: stem, basename, mkdir_p, remove_empty_folders, file_exists, remove_file, rename_file
     use driver_results, only: results_writer_t
+    use driver_results_xdmf, only: write_results_xdmf
     use driver_guards, only: model_size_t, model_memory_bytes, check_memory
     use fem_mesh_generator, only: rectangle_size, check_rectangle_size
     use driver_simulation, only: simulation_t, report_iface
@@ -158,8 +162,10 @@ contains
             type(error_t), allocatable, intent(out) :: error
             !> Whether the run ended or was stopped cleanly: its files are the folder's now.
             logical, intent(out) :: kept
-            type(error_t), allocatable :: ignored
+            type(error_t), allocatable :: ignored, xdmf_error
+            character(len=:), allocatable :: xdmf
             kept = .false.
+            xdmf = path(1:len(path) - 3)//'.xdmf'
             if (ck%restart) then
                 call out%resume(path, run_id, error)
                 if (allocated(error)) call ck%source%close(ignored)
@@ -194,8 +200,25 @@ contains
                                 '; results so far in '//out%partial_path)
                 return
             end if
+            ! The XDMF file of the complete run, written beside the partial file and renamed
+            ! once the results file has its final name: a failed run leaves an earlier result's
+            ! XDMF file as it was, and a stopped run writes none (the earlier one still
+            ! describes the earlier result, which is left as it was).
+            call write_results_xdmf(out%file, xdmf//'.partial', basename(path), error)
+            if (allocated(error)) then
+                call out%abort()
+                call remove_file(xdmf//'.partial')
+                error%message = deck%file//': '//error%message
+                return
+            end if
             call out%close(error)
             kept = .not. allocated(error)
+            if (.not. kept) then
+                call remove_file(xdmf//'.partial')
+                return
+            end if
+            call rename_file(xdmf//'.partial', xdmf, xdmf_error)
+            if (allocated(xdmf_error)) call report('warning: '//xdmf_error%message)
         end subroutine run_and_close
 
         !> The command that continues this run from its checkpoint.

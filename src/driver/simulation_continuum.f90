@@ -14,7 +14,6 @@ module driver_simulation_continuum
     use core_strings, only: string_t, to_str
     use core_signals, only: caught_signal, signal_name
     use io_deck, only: deck_t, deck_entry_t
-    use io_paths, only: basename, stem
     use io_progress, only: progress_t
     use fem_mesh2d, only: mesh2d_t
     use fem_mesh_generator, only: rectangle_mesh
@@ -47,7 +46,7 @@ module driver_simulation_continuum
         class(time_integrator_t), allocatable :: integ
         !> Factor of K_ff (static).
         class(spd_factor_t), allocatable :: k_factor
-        !> Deck file (for the XDMF file's name).
+        !> Deck file.
         character(len=:), allocatable :: deck_file
         !> Energy audit of the whole body (prescribed dofs and their reactions included).
         type(continuum_audit_t) :: audit
@@ -430,7 +429,7 @@ contains
                ' elements, '//to_str(self%model%mesh%node_count())//' nodes, '//to_str(self%ops%n_free)//' free dofs'
     end function continuum_describe
 
-    !> Static solve, modes or time integration; results into `out` and an XDMF file next to it.
+    !> Static solve, modes or time integration; results into `out` (driver_run adds the XDMF file).
     subroutine continuum_run(self, out, quiet, report, ck, error)
         !> The simulation.
         class(continuum_simulation_t), intent(inout) :: self
@@ -445,7 +444,6 @@ contains
         !> Set on a run or write failure.
         type(error_t), allocatable, intent(out) :: error
         type(continuum_writer_t) :: writer
-        character(len=:), allocatable :: xdmf
         ! Steps done, and at the start of the loop (a checkpoint's at a restart).
         integer(i8) :: k, k0
         ! At a restart the file has the mesh and the series already (run_dynamic's restore).
@@ -459,11 +457,6 @@ contains
         case ('dynamic')
             call run_dynamic(error)
         end select
-        if (allocated(error)) return
-        ! The XDMF file names the HDF5 file as it is after a successful run.
-        if (out%stopped()) return
-        xdmf = out%final_path(1:len(out%final_path) - 3)//'.xdmf'
-        call writer%write_xdmf(xdmf, basename(out%final_path), error)
 
     contains
 

@@ -10,18 +10,17 @@
 !>
 !> Results: /continuum (mesh, sets, displacement, velocity, centre stresses, and the FE side's
 !> energies: kinetic and strain weighted by alpha), /dem and /coupling as in beam-coupled runs,
-!> and `<deck>.xdmf` next to the HDF5 file with the mesh's fields and the disks (points with
-!> their radius, grid "disks") per stored state. Checkpoints hold what a beam-particle coupled
+!> and, written by driver_run at the end as for every run (driver_results_xdmf), `<deck>.xdmf`
+!> next to the HDF5 file with the mesh's fields and the disks per stored state. Checkpoints hold what a beam-particle coupled
 !> run's hold (driver_checkpoint::save_coupled: the Newmark state of the continuum, the disks,
 !> contacts and bonds, the multipliers and the constraint state) under the kind 'coupled2d';
-!> at a restart the continuum writer reads its stored times back from the results file.
+!> at a restart the continuum writer counts its stored states in the results file.
 module driver_simulation_coupled2d
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error, make_input_error
     use core_strings, only: to_str
     use io_deck, only: deck_t
-    use io_paths, only: basename
     use io_hdf5_file, only: h5_file_t
     use fem_continuum_dynamics, only: continuum_dynamics_t
     use coupling_coupled_step, only: coupled_energies_t, coupled_energies
@@ -36,7 +35,7 @@ module driver_simulation_coupled2d
     use driver_checkpoint, only: read_finite_attribute
     implicit none
     private
-    public :: coupled2d_simulation_t, write_disks_xdmf
+    public :: coupled2d_simulation_t
 
     !> A 2D continuum and particles glued in overlap regions.
     type, extends(arlequin_simulation_t) :: coupled2d_simulation_t
@@ -46,7 +45,7 @@ module driver_simulation_coupled2d
         type(dem_simulation_t) :: particles
         !> The coupling from the deck.
         type(coupled2d_setup_t) :: coupling
-        !> Writer of /continuum (and of the XDMF file's mesh fields).
+        !> Writer of /continuum.
         type(continuum_writer_t) :: fe_out
     contains
         !> See `simulation_t%init`.
@@ -75,8 +74,6 @@ module driver_simulation_coupled2d
         procedure :: check_saved_part => coupled2d_check_saved_part
         !> See `arlequin_simulation_t%load_part`.
         procedure :: load_part => coupled2d_load_part
-        !> See `arlequin_simulation_t%finish`.
-        procedure :: finish => coupled2d_finish
         !> See `simulation_t%inputs_text`: the continuum's mesh file.
         procedure :: inputs_text => coupled2d_inputs_text
     end type coupled2d_simulation_t
@@ -331,7 +328,7 @@ contains
     end subroutine coupled2d_check_saved_part
 
     !> The continuum's audit resumed with the totals of the checkpoint, C_p u_p at the restart
-    !> time, and the continuum writer's stored times from the results file.
+    !> time, and the continuum writer's count of stored states from the results file.
     subroutine coupled2d_load_part(self, f, out, error)
         !> The simulation.
         class(coupled2d_simulation_t), intent(inout) :: self
@@ -350,101 +347,6 @@ contains
         call self%sys%op%add_prescribed(self%sys%fe%t, 0, self%sys%cp)
         call self%fe_out%resume(out%file, self%continuum%model%mesh, error)
     end subroutine coupled2d_load_part
-
-    !> `<deck>.xdmf` next to the results file (mesh fields and disks), unless a signal stopped
-    !> the run.
-    subroutine coupled2d_finish(self, out, error)
-        !> The simulation.
-        class(coupled2d_simulation_t), intent(inout) :: self
-        !> The results file (summary written).
-        type(results_writer_t), intent(inout) :: out
-        !> Set on a write failure.
-        type(error_t), allocatable, intent(out) :: error
-        character(len=:), allocatable :: xdmf
-        if (out%stopped()) return
-        xdmf = out%final_path(1:len(out%final_path) - 3)//'.xdmf'
-        call self%fe_out%write_xdmf(xdmf, basename(out%final_path), error)
-        if (allocated(error)) return
-        call write_disks_xdmf(xdmf, basename(out%final_path), self%sys%dem%particles%n, self%fe_out%times, error)
-    end subroutine coupled2d_finish
-
-    !> Add the disks to an XDMF file written by continuum_writer_t%write_xdmf: a temporal
-    !> collection "disks" of Polyvertex grids, the centres from /dem/position (x, y of each
-    !> stored state), with the radius and the velocity as point attributes (ParaView: Glyph,
-    !> sphere or 2D disk scaled by "radius", scale factor 2 for the diameter).
-    subroutine write_disks_xdmf(path, h5_name, n, times, error)
-        !> The XDMF file (rewritten with the disks before its closing tags).
-        character(len=*), intent(in) :: path
-        !> Name of the HDF5 file next to it.
-        character(len=*), intent(in) :: h5_name
-        !> Number of disks.
-        integer, intent(in) :: n
-        !> Stored times (one per state of /dem/position).
-        real(wp), intent(in) :: times(:)
-        !> Set when the file cannot be read or written.
-        type(error_t), allocatable, intent(out) :: error
-        character(len=:), allocatable :: text, tail
-        character(len=4096) :: line
-        character(len=32) :: tb
-        integer :: unit, ios, k, cut
-        open (newunit=unit, file=path, status='old', action='read', iostat=ios)
-        if (ios /= 0) then
-            call make_error(error, 'cannot read '//path)
-            return
-        end if
-        text = ''
-        do
-            read (unit, '(a)', iostat=ios) line
-            if (ios /= 0) exit
-            text = text//trim(line)//new_line('a')
-        end do
-        close (unit)
-        cut = index(text, ' </Domain>')
-        if (cut == 0) then
-            call make_error(error, path//': no </Domain> to add the disks before')
-            return
-        end if
-        tail = text(cut:)
-        text = text(1:cut - 1)
-        text = text//'  <Grid Name="disks" GridType="Collection" CollectionType="Temporal">'//new_line('a')
-        do k = 1, size(times)
-            write (tb, '(es24.16e3)') times(k)
-            text = text//'   <Grid Name="disks_'//to_str(k - 1)//'" GridType="Uniform">'//new_line('a')// &
-                   '    <Time Value="'//trim(adjustl(tb))//'"/>'//new_line('a')// &
-                   '    <Topology TopologyType="Polyvertex" NumberOfElements="'//to_str(n)//'"/>'//new_line('a')// &
-                   '    <Geometry GeometryType="XY">'//new_line('a')// &
-                   slab('/dem/position')// &
-                   '    </Geometry>'//new_line('a')// &
-                   '    <Attribute Name="radius" AttributeType="Scalar" Center="Node">'//new_line('a')// &
-                   '     <DataItem Dimensions="'//to_str(n)//'" NumberType="Float" Precision="8" Format="HDF">'// &
-                   h5_name//':/dem/particles/radius</DataItem>'//new_line('a')// &
-                   '    </Attribute>'//new_line('a')// &
-                   '    <Attribute Name="velocity" AttributeType="Vector" Center="Node">'//new_line('a')// &
-                   slab('/dem/velocity')// &
-                   '    </Attribute>'//new_line('a')// &
-                   '   </Grid>'//new_line('a')
-        end do
-        text = text//'  </Grid>'//new_line('a')//tail
-        open (newunit=unit, file=path, status='replace', action='write', iostat=ios)
-        if (ios /= 0) then
-            call make_error(error, 'cannot write '//path)
-            return
-        end if
-        write (unit, '(a)', advance='no') text
-        close (unit)
-    contains
-        !> x, y of state k of a (records, n, 3) series.
-        function slab(dataset) result(s)
-            character(len=*), intent(in) :: dataset
-            character(len=:), allocatable :: s
-            s = '     <DataItem ItemType="HyperSlab" Dimensions="'//to_str(n)//' 2" Type="HyperSlab">'//new_line('a')// &
-                '      <DataItem Dimensions="3 3" Format="XML">'//to_str(k - 1)//' 0 0 1 1 1 1 '//to_str(n)// &
-                ' 2</DataItem>'//new_line('a')// &
-                '      <DataItem Dimensions="'//to_str(size(times))//' '//to_str(n)//' 3" NumberType="Float" '// &
-                'Precision="8" Format="HDF">'//h5_name//':'//dataset//'</DataItem>'//new_line('a')// &
-                '     </DataItem>'//new_line('a')
-        end function slab
-    end subroutine write_disks_xdmf
 
     !> See `simulation_t%inputs_text`: the continuum's Gmsh mesh file ('' for a generated mesh).
     function coupled2d_inputs_text(self) result(text)
