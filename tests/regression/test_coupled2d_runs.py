@@ -34,6 +34,7 @@ import h5py
 import numpy as np
 
 from checks import arguments, check, plots, summary
+from paraview_read import read_paraview
 
 E, RHO, THICK = 210.0e9, 7800.0, 0.05
 
@@ -308,39 +309,24 @@ def xdmf(h5):
         n_out = f["continuum/time"].shape[0]
         last = f["dem/position"][-1]
         n_nodes = f["continuum/mesh/coordinates"].shape[0]
-    pvpython = shutil.which("pvpython")
-    if pvpython is None:
+    if shutil.which("pvpython") is None:
         print("skip   XDMF through ParaView: no pvpython (meshio does not read XDMF hyperslabs)")
         return
-    script = h5.parent / "read_xdmf.py"
-    script.write_text("""import sys
-from paraview.simple import XDMFReader
-from paraview import servermanager as sm
-
-r = XDMFReader(FileNames=[sys.argv[1]])
-r.UpdatePipelineInformation()
-r.PointArrayStatus = r.GetProperty("PointArrayInfo")[::2]
-times = list(r.TimestepValues)
-r.UpdatePipeline(times[-1])
-d = sm.Fetch(r)
-for b in range(d.GetNumberOfBlocks()):
-    g = d.GetBlock(b)
-    rad = g.GetPointData().GetArray("radius")
-    print("RESULT", d.GetMetaData(b).Get(d.NAME()), len(times), g.GetNumberOfPoints(),
-          rad.GetRange()[1] if rad else 0, *g.GetPoint(0)[:2])
-""")
-    proc = subprocess.run([pvpython, "--force-offscreen-rendering", str(script), str(h5.with_suffix(".xdmf"))],
-                          capture_output=True, text=True, timeout=300)
-    rows = {l.split()[1]: l.split()[2:] for l in proc.stdout.splitlines() if l.startswith("RESULT")}
-    ok = proc.returncode == 0 and set(rows) == {"continuum", "disks"}
-    check("ParaView opens the mesh and the disks (two grids)", ok, proc.stderr[-300:] if not ok else "XDMF Reader")
-    if ok:
-        check("ParaView: every stored state", int(rows["disks"][0]) == n_out, f"{rows['disks'][0]} vs {n_out}")
-        check("ParaView: the mesh's nodes", int(rows["continuum"][1]) == n_nodes, rows["continuum"][1])
-        check("ParaView: disks as points with a radius", int(rows["disks"][1]) == last.shape[0]
-              and float(rows["disks"][2]) == 0.0625, f"{rows['disks'][1]} points, radius {rows['disks'][2]}")
-        check("ParaView: the last disk positions", float(rows["disks"][3]) == last[0, 0]
-              and float(rows["disks"][4]) == last[0, 1], f"{rows['disks'][3:]} vs {last[0, :2]}")
+    rows = read_paraview([xdmf_path], h5.parent, "ParaView opens the mesh and the disks (two grids)")
+    if rows is None:
+        return
+    r = rows[str(xdmf_path)]
+    blocks = r["blocks"]
+    check("ParaView: the mesh and the disks", set(blocks) == {"continuum", "disks"}, sorted(blocks))
+    if set(blocks) != {"continuum", "disks"}:
+        return
+    disks = blocks["disks"]
+    check("ParaView: every stored state", r["times"] == n_out, f"{r['times']} vs {n_out}")
+    check("ParaView: the mesh's nodes", len(blocks["continuum"]["points"]) == n_nodes, len(blocks["continuum"]["points"]))
+    check("ParaView: disks as points with a radius", len(disks["points"]) == last.shape[0]
+          and max(disks["data"]["radius"]) == 0.0625, f"{len(disks['points'])} points, radius {max(disks['data']['radius'])}")
+    check("ParaView: the last disk positions", disks["points"][0][:2] == [last[0, 0], last[0, 1]],
+          f"{disks['points'][0][:2]} vs {last[0, :2]}")
 
 
 def restart_refused(exe, src, work):

@@ -16,7 +16,6 @@ interpreter of its hyperslab references here (meshio does not read XDMF hypersla
 Usage (ctest does this): test_xdmf_runs.py --exe multicor --work DIR --source REPO
 """
 import hashlib
-import json
 import re
 import shutil
 import signal
@@ -28,6 +27,7 @@ import h5py
 import numpy as np
 
 from checks import arguments, check, multicor, summary
+from paraview_read import read_paraview
 
 DISKS = """# A column of 5 disks dropped onto a floor between two side walls.
 [run]
@@ -70,52 +70,6 @@ end = {end}
 [output]
 interval = 2
 """
-
-READER = """import json, sys
-from paraview.simple import XDMFReader, WarpByVector
-from paraview import servermanager as sm
-from vtk.numpy_interface import dataset_adapter as dsa
-for path in sys.argv[1:]:
-    r = XDMFReader(FileNames=[path])
-    r.UpdatePipelineInformation()
-    r.PointArrayStatus = r.GetProperty("PointArrayInfo")[::2]
-    r.CellArrayStatus = r.GetProperty("CellArrayInfo")[::2]
-    times = list(r.TimestepValues) if r.TimestepValues else [0.0]
-    r.UpdatePipeline(times[-1])
-    d = sm.Fetch(r)
-    if d.IsA("vtkMultiBlockDataSet"):
-        blocks = [(d.GetMetaData(b).Get(d.NAME()), d.GetBlock(b)) for b in range(d.GetNumberOfBlocks())]
-    else:
-        blocks = [("", d)]
-    out = {"times": len(times), "blocks": {}}
-    for name, g in blocks:
-        w = dsa.WrapDataObject(g)
-        out["blocks"][name] = {"points": w.Points.tolist(), "cells": g.GetNumberOfCells(),
-                               "data": {k: w.PointData[k].tolist() for k in w.PointData.keys()}}
-    if "displacement" in out["blocks"].get("", {}).get("data", {}):
-        warp = WarpByVector(Input=r, Vectors=["POINTS", "displacement"])
-        warp.UpdatePipeline(times[-1])
-        out["warped"] = dsa.WrapDataObject(sm.Fetch(warp)).Points.tolist()
-    print("RESULT", path, json.dumps(out))
-"""
-
-
-def read_paraview(paths, work):
-    """{path: what ParaView reads at the last time}, through pvpython."""
-    script = work / "read_xdmf.py"
-    script.write_text(READER)
-    proc = subprocess.run(["pvpython", "--force-offscreen-rendering", str(script)] + [str(p) for p in paths],
-                          capture_output=True, text=True, timeout=300)
-    rows = {}
-    for line in proc.stdout.splitlines():
-        if line.startswith("RESULT "):
-            _, path, text = line.split(" ", 2)
-            rows[path] = json.loads(text)
-    ok = proc.returncode == 0 and len(rows) == len(paths)
-    check("ParaView (pvpython, XDMF Reader) opens every XDMF file", ok,
-          proc.stderr[-400:] if not ok else f"{len(rows)} files")
-    return rows if ok else None
-
 
 def item_values(item, folder):
     """The values of an XDMF DataItem (an HDF5 dataset or a hyperslab of one), by h5py."""
