@@ -161,7 +161,8 @@ contains
                            'the reactions of aggregates of `coarse_size` consecutive contacts at once (for tall '// &
                            'packings away from rest and deposits, doc/performance.md; it changes nothing at a '// &
                            'solution, and a step stops correcting once the error at a correction is larger '// &
-                           'than at the previous one). Every '// &
+                           'than at the previous one; not with the Arlequin coupling rows: a coupled run '// &
+                           'sweeps as with `nlgs`). Every '// &
                            'unilateral or frictional contact uses the bi-potential local solver in all three.', &
                            default='block')
         call s%add_keyword('solver', 'tolerance', [positive('tolerance', '')], &
