@@ -144,7 +144,7 @@ contains
 
     subroutine print_help()
         write (output_unit, '(a)') 'MULTICOR '//multicor_version// &
-            ' - discrete elements (Contact Dynamics) coupled with beam finite elements', &
+            ' - discrete elements (Contact Dynamics) coupled with beam and 2D finite elements', &
             '', &
             'usage: multicor [options] deck.dat', &
             '', &
@@ -157,7 +157,8 @@ contains
             '  -V, --version        print the version', &
             '  -h, --help           print this help', &
             '', &
-            'Results: DIR/<deck name>.h5 (HDF5, layout in doc/output.md).', &
+            'Results: DIR/<deck name>.h5 (HDF5, layout in doc/output.md) and DIR/<deck name>.xdmf', &
+            '(the same results for ParaView''s XDMF Reader); plots: postproc/plot_results.py.', &
             'Exit codes: 0 success, 1 error in the deck or the run, 2 bad command line,', &
             '128 + signal number when SIGTERM (143), SIGINT (130) or SIGUSR1 (138) stopped the', &
             'run: the results so far are then in DIR/<deck name>.h5.partial, and the state in the', &
