@@ -102,7 +102,8 @@ contains
         integer :: ios
         character(len=256) :: msg
         self%path = path
-        self%h5_name = h5_name
+        ! a file name is element text: '&' and '<' (a deck named 'a&b.dat') would end the XML
+        self%h5_name = xml_text(h5_name)
         self%depth = 0
         self%ios = 0
         open (newunit=self%unit, file=path, status='replace', action='write', iostat=ios, iomsg=msg)
@@ -315,4 +316,26 @@ contains
             text = text//int_text(values(k))
         end do
     end function ints_text
+
+    !> Text as XML character data: `&`, `<` and `>` written as entities.
+    pure function xml_text(text) result(escaped)
+        !> The raw text.
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: escaped
+        integer :: i
+        escaped = ''
+        do i = 1, len(text)
+            select case (text(i:i))
+            case ('&')
+                escaped = escaped//'&amp;'
+            case ('<')
+                escaped = escaped//'&lt;'
+            case ('>')
+                escaped = escaped//'&gt;'
+            case default
+                escaped = escaped//text(i:i)
+            end select
+        end do
+    end function xml_text
+
 end module io_xdmf

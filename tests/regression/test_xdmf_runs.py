@@ -168,6 +168,9 @@ def main():
         "xdmf_beam_static": BEAM.format(analysis="static", function="", extra=""),
         "xdmf_beam_dynamic": BEAM.format(analysis="dynamic", function="1", extra=DYNAMIC.format(end="0.01")),
         "xdmf_beam_modal": BEAM.format(analysis="modal", function="", extra="[modal]\nmodes = 3\n"),
+        # XML's markup characters in the deck's name, hence in the HDF5 file's name that the
+        # XDMF file quotes: they must be written as entities (else the XML ends there)
+        "xdmf_a&b<c>": BEAM.format(analysis="static", function="", extra=""),
     }
     h5 = {}
     for name, text in decks.items():
@@ -226,6 +229,13 @@ def main():
     same("beam static: reference coordinates", b["points"], xyz(x))
     same("beam static: displacement (u, w, 0)", b["data"]["displacement"], xyz(u))
     same("beam static: rotation", b["data"]["rotation"], u[:, 2])
+
+    with h5py.File(h5["xdmf_a&b<c>"], "r") as f:
+        u = f["static/displacement"][...]
+    s = r["xdmf_a&b<c>"]
+    check("a deck named with '&', '<' and '>': one state, 5 nodes", s["times"] == 1 and
+          len(s["blocks"][""]["points"]) == 5, f"{s['times']} states")
+    same("a deck named with '&', '<' and '>': displacement", s["blocks"][""]["data"]["displacement"], xyz(u))
 
     with h5py.File(h5["xdmf_beam_dynamic"], "r") as f:
         t, x, u = f["fem/time"][...], f["fem/mesh/coordinates"][...], f["fem/displacement"][-1]
