@@ -137,7 +137,7 @@ contains
             call report('results written to '//path)
             if (ck%last_step >= 0) call report('checkpoint: '//to_str(ck%last_step)//' steps, t = '// &
                                                num(ck%last_time)//' s, in '//ck%path//' (to go on to a later '// &
-                                               'end time: '//continue_command()//' --end T)')
+                                               'end time: '//continue_command(.false.)//' --end T)')
         end subroutine write_into_folder
 
         !> Run the analysis into '<path>.partial', renamed to `path` on success (the caller
@@ -192,7 +192,7 @@ contains
                 if (ck%last_step >= 0) then
                     call report('checkpoint: '//to_str(ck%last_step)//' steps, t = '//num(ck%last_time)// &
                                 ' s, in '//ck%path)
-                    call report('to continue: '//continue_command())
+                    call report('to continue: '//continue_command(.true.))
                 else
                     call report('to continue: run the deck again (no checkpoint was written)')
                 end if
@@ -221,12 +221,21 @@ contains
             if (allocated(xdmf_error)) call report('warning: '//xdmf_error%message)
         end subroutine run_and_close
 
-        !> The command that continues this run from its checkpoint.
-        function continue_command() result(command)
+        !> The command that continues this run from its checkpoint; with `same_end`, to the end
+        !> time this run was given: `--end T` again when the run had one (17 significant
+        !> digits: read back as the same double, the same step count), else the deck's end.
+        function continue_command(same_end) result(command)
+            !> Whether to repeat this run's `--end` (else the caller appends its own).
+            logical, intent(in) :: same_end
             character(len=:), allocatable :: command
+            character(len=32) :: end_text
             command = 'multicor '//shell_word(opts%deck_path)
             if (allocated(opts%output_dir)) command = command//' --output '//shell_word(opts%output_dir)
             command = command//' --restart '//shell_word(ck%path)
+            if (same_end .and. opts%end_time >= 0.0_wp) then
+                write (end_text, '(es25.17e3)') opts%end_time
+                command = command//' --end '//trim(adjustl(end_text))
+            end if
         end function continue_command
 
         !> A path as one word of a POSIX shell command, so that the printed command can be

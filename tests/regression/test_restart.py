@@ -603,6 +603,41 @@ def new_end_time(exe, deck, work):
               f"{len(b)} datasets" if not bad else ", ".join(bad[:5]))
 
 
+def signal_with_end(exe, deck_src, work, name, end, t_stop, min_step):
+    """A run given `--end t_stop` (before the deck's end), stopped by SIGTERM after min_step:
+    the command printed repeats `--end` and continues to t_stop, not to the deck's end; the
+    continued file equals the uninterrupted run to t_stop."""
+    deck = edit_deck(deck_src, work / f"{name}.dat", end=end, progress=0.02)
+    folder = work / name
+    ref_folder = work / f"ref_{name}"
+    proc = run(exe, deck, "--output", ref_folder, "--quiet", "--end", t_stop)
+    if proc.returncode != 0:
+        raise SystemExit(f"reference run of {deck} failed: {proc.stdout}{proc.stderr}")
+    proc = subprocess.Popen([str(exe), str(deck), "--output", str(folder), "--end", str(t_stop)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    lines = []
+    if not wait_for_step(proc, min_step, lines):
+        check(f"{name}: run reached step {min_step}", False, proc.communicate()[1][-300:])
+        return
+    proc.send_signal(signal.SIGTERM)
+    out, _ = proc.communicate()
+    c = re.search(r"^to continue: (multicor .*)$", "".join(lines) + out, flags=re.M)
+    check(f"{name}: SIGTERM stops the run with the command to continue", proc.returncode == 143 and
+          c is not None, f"exit {proc.returncode}")
+    if c is None:
+        return
+    command = c.group(1).split()
+    check(f"{name}: the command gives --end again", command[-2:-1] == ["--end"] and
+          float(command[-1]) == t_stop, c.group(1))
+    second = run(exe, *command[1:])
+    check(f"{name}: the command continues the run", second.returncode == 0, (second.stdout + second.stderr)[-300:])
+    later = re.search(r"to go on to a later end time: (multicor .*) --end T\)", second.stdout)
+    check(f"{name}: the command to go on later has one --end, the T to give", later is not None and
+          "--end" not in later.group(1), second.stdout.strip()[-300:])
+    if second.returncode == 0:
+        compare(name, folder / f"{deck.stem}.h5", ref_folder / f"{deck.stem}.h5")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--exe", required=True)
@@ -647,6 +682,8 @@ def main():
     by_end_time(exe, stack, work, "coupled_end", 1.3e-4)
     by_signal(exe, src / "input" / "cantilever.dat", work, "beam_term", signal.SIGTERM, 3.0, 1000)
     by_signal(exe, src / "input" / "incline.dat", work, "dem_usr1", signal.SIGUSR1, 20.0, 2000)
+    # Started with --end 2.0 s (the deck says 3.0 s): the printed command ends at 2.0 s too.
+    signal_with_end(exe, src / "input" / "cantilever.dat", work, "beam_term_end", 3.0, 2.0, 1000)
     by_signal(exe, decks / "coupled_rigid_translation.dat", work, "coupled_term", signal.SIGTERM,
               0.05, 1000)
     by_kill_9(exe, src / "input" / "cantilever.dat", work, "beam_kill9", 3.0, 700, 2000)
