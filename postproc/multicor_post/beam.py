@@ -66,8 +66,9 @@ def auto_scale(mesh: Mesh, d: np.ndarray, fraction: float = 0.1) -> float:
 
 
 def default_node(res: Results) -> int:
-    """Deck id of the 'tip': the end node (in one element only) that moves most; the last
-    node when the mesh has no free end."""
+    """Deck id of the 'tip': the end node (in one element only) that moves most; when no end
+    node moves (a frame supported at both ends, a mesh without ends), the node that moves
+    most; the last end node (else the last node) when nothing moves."""
     mesh = res.mesh
     if res.dynamic is not None:
         motion = np.max(np.hypot(res.dynamic.displacement[..., U],
@@ -77,7 +78,9 @@ def default_node(res: Results) -> int:
     else:
         motion = np.zeros(mesh.n_nodes)
     ends = mesh.end_nodes()
-    candidates = ends if ends.size else np.arange(mesh.n_nodes)
+    candidates = ends if ends.size and motion[ends].any() else np.arange(mesh.n_nodes)
+    if not motion.any():
+        candidates = ends if ends.size else candidates
     best = candidates[np.argmax(motion[candidates])] if motion.any() else candidates[-1]
     return int(mesh.node_id[best])
 

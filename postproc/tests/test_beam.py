@@ -53,6 +53,21 @@ def test_default_node_is_the_free_end(cantilever_file):
     assert default_node(res) == 90
 
 
+def test_default_node_of_a_frame_clamped_at_both_ends_is_the_one_that_moves_most(tmp_path):
+    # A portal frame (nodes 1-3 up, 3-5 across, 5-7 down) clamped at nodes 1 and 7, its ends:
+    # they do not move, so the history would be a flat line at zero; the top swings most at
+    # node 4 (the sway u = 1e-3 y plus a sag of the beam, largest at mid-span).
+    from synthetic import write_results
+    ids = np.arange(1, 8, dtype=np.int32)
+    xy = np.array([[0, 0], [0, 1], [0, 2], [1, 2], [2, 2], [2, 1], [2, 0]], dtype=float)
+    conn = np.column_stack([np.arange(1, 7), np.arange(2, 8)]).astype(np.int32)
+    d = np.zeros((7, 3))
+    d[:, 0] = 1e-3 * xy[:, 1]
+    d[3, 1] = -1e-3
+    res = load_results(write_results(tmp_path / "portal.h5", ids, xy, conn, d, parts=("static",)))
+    assert default_node(res) == 4
+
+
 def test_auto_scale_is_round_and_makes_the_largest_displacement_visible():
     ids, xy, conn, d = cantilever_layout()
     from multicor_post.results import Mesh
