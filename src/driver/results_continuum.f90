@@ -198,7 +198,9 @@ contains
         if (allocated(error)) return
         call file%create_group('/continuum/static', error)
         if (.not. allocated(error)) call file%write_dataset('/continuum/static/displacement', d, error)
+        if (.not. allocated(error)) call file%write_attribute('/continuum/static/displacement', 'units', 'm', error)
         if (.not. allocated(error)) call file%write_dataset('/continuum/static/stress', stress, error)
+        if (.not. allocated(error)) call file%write_attribute('/continuum/static/stress', 'units', 'Pa', error)
         if (.not. allocated(error)) call file%write_attribute('/continuum/static', 'strain_energy', strain_energy, error)
     end subroutine writer_write_static
 
@@ -217,7 +219,11 @@ contains
         call file%create_group('/continuum/modal', error)
         if (.not. allocated(error)) call file%write_dataset('/continuum/modal/omega', omega, error)
         if (.not. allocated(error)) call file%write_dataset('/continuum/modal/frequency', omega/two_pi, error)
+        if (.not. allocated(error)) call file%write_attribute('/continuum/modal/omega', 'units', 'rad/s', error)
+        if (.not. allocated(error)) call file%write_attribute('/continuum/modal/frequency', 'units', 'Hz', error)
         if (.not. allocated(error)) call file%write_dataset('/continuum/modal/shapes', shapes, error)
+        if (.not. allocated(error)) call file%write_attribute('/continuum/modal/shapes', 'units', &
+                                                              'kg^-1/2 (mass-normalised)', error)
     end subroutine writer_write_modal
 
     !> Append one state: time, displacements, velocities (2, n_nodes), stresses (3, n_elements).

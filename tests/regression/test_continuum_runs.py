@@ -325,6 +325,16 @@ def main():
     timed_loads(exe, work)
     h5_dynamic = work / "continuum_cantilever_dynamic" / "continuum_cantilever_dynamic.h5"
     xdmf_paraview(h5_static, h5_dynamic, work)
+    # every dataset with a physical unit carries it (doc/output.md), static and modal too
+    units = {}
+    for h5, names in ((h5_static, ["continuum/static/displacement", "continuum/static/stress"]),
+                      (work / "strip_160x4" / "strip_160x4.h5",
+                       ["continuum/modal/omega", "continuum/modal/frequency", "continuum/modal/shapes"])):
+        with h5py.File(h5, "r") as f:
+            units.update({n: f[n].attrs.get("units", b"").decode() if isinstance(f[n].attrs.get("units", ""), bytes)
+                          else str(f[n].attrs.get("units", "")) for n in names})
+    check("static and modal datasets carry their units",
+          list(units.values()) == ["m", "Pa", "rad/s", "Hz", "kg^-1/2 (mass-normalised)"], str(units))
     # the plots ./run.sh draws after a continuum run: static, dynamic and modal
     plots(src, h5_static, work / "png", ["stress"])
     plots(src, h5_dynamic, work / "png", ["stress", "continuum_energy", "history"])
