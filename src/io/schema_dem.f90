@@ -194,8 +194,9 @@ contains
                            'plain sweeps (the default, 5, is the fastest measured on deposits and tall '// &
                            'packings, doc/performance.md). The '// &
                            'accelerated sweeps run in the fixed contact order; the history restarts when the '// &
-                           'change over a sweep grows. Not used with the Arlequin coupling rows, nor in a step '// &
-                           'with intact bonds among the swept contacts (method = block solves them directly).', &
+                           'change over a sweep grows. With the Arlequin coupling rows too (their multipliers '// &
+                           'follow the mixed reactions exactly). Not used in a step with intact bonds among the '// &
+                           'swept contacts (method = block solves them directly).', &
                            default='5')
         call s%add_keyword('solver', 'anderson_after', [int_field('anderson_after', lower=0)], &
                            'With `anderson` > 0: plain sweeps before the Anderson steps start. A step that '// &
