@@ -221,7 +221,7 @@ contains
                 travel = hypot((p%x(i) - start%x(i)) - 0.5_wp*((w%x1(k) - start%wx1(k)) + (w%x2(k) - start%wx2(k))), &
                                (p%y(i) - start%y(i)) - 0.5_wp*((w%y1(k) - start%wy1(k)) + (w%y2(k) - start%wy2(k))))
                 call make_error(error, when(step, t)//'disk '//to_str(i)//' passed through wall '// &
-                                to_str(k)//' within one step (its centre moved '//num(travel)// &
+                                to_str(k)//one_step(travel)//' (its centre moved '//num(travel)// &
                                 ' m relative to the wall, its radius is '//num(p%radius(i))//' m): '//advice(travel))
                 return
             end do
@@ -244,7 +244,7 @@ contains
             travel = hypot((p%x(j) - p%x(i)) - (start%x(j) - start%x(i)), &
                            (p%y(j) - p%y(i)) - (start%y(j) - start%y(i)))
             call make_error(error, when(step, t)//'disks '//to_str(i)//' and '//to_str(j)// &
-                            ' passed through each other within one step (relative motion '// &
+                            ' passed through each other'//one_step(travel)//' (relative motion '// &
                             num(travel)//' m, radii '//num(p%radius(i))//' and '// &
                             num(p%radius(j))//' m): '//advice(travel))
         end subroutine through_each_other
@@ -355,6 +355,15 @@ contains
         end function passed
 
         !> What to do: a step under which the same motion stays within the alert distance.
+        !> ' within one step' when the step's motion went beyond what the detection sees
+        !> (else the crossing built up over several steps: advice says so).
+        function one_step(travel) result(text)
+            real(wp), intent(in) :: travel
+            character(len=:), allocatable :: text
+            text = ''
+            if (.not. travel <= max(alert, 0.1_wp*minval(p%radius(1:p%n)))) text = ' within one step'
+        end function one_step
+
         function advice(travel) result(text)
             real(wp), intent(in) :: travel
             character(len=:), allocatable :: text
@@ -362,6 +371,16 @@ contains
             reach = max(alert, 0.1_wp*minval(p%radius(1:p%n)))
             if (.not. travel > 0.0_wp) then
                 text = 'the time step is too large for the speed of the bodies; lower [time] step'
+                return
+            end if
+            if (travel <= reach) then
+                ! the step's motion stayed within what the detection sees: the crossing is an
+                ! overlap that grew over several steps, not a step too large for the speed
+                text = 'the motion of this step is within the '//num(reach)//' m the detection sees, so '// &
+                       'the time step is not the cause: the contacts did not hold the disk back and the '// &
+                       'overlap grew over several steps until the centre crossed (steps that did not '// &
+                       'converge: raise [solver] max_sweeps; a wall driven into a jammed packing; a load '// &
+                       'the packing cannot carry)'
                 return
             end if
             text = 'the time step is too large for this speed; lower [time] step to '// &

@@ -166,6 +166,34 @@ def aliased_harmonic(exe, work):
               out.strip()[:300])
 
 
+SQUEEZE = """[run]
+analysis = dynamic
+[particles]
+material = 1 2500
+disk = 0 0.01 0.01 1
+[walls]
+wall = -0.1 0 0.1 0
+wall = 0.1 0.02 -0.1 0.02 1 0 -{v}
+[contacts]
+law = 1 1 0.4 0 0
+[time]
+step = 1e-3
+end = {end}
+[output]
+progress = 0
+"""
+
+
+def squeezed(exe, work):
+    """A disk squeezed between the floor and a ceiling driven down at 1 cm/s (no escape) is
+    pushed through a wall over many steps, 10 um per step: the error said 'within one step'
+    and advised a time step 2.5e-3 m / 1e-5 m = 250 times larger. It now says the step is
+    not the cause; a run stopped before the crossing (the ceiling 5 mm down) is fine."""
+    failing_run(exe, work, "dem_squeezed_disk", SQUEEZE.format(v="0.01", end="3"),
+                r"disk 1 passed through wall \d \(its centre moved 1\.000E-005 m .*the time step is not the "
+                r"cause: the contacts did not hold the disk back", SQUEEZE.format(v="0.01", end="0.5"))
+
+
 def tunnelling(exe, work):
     """A step so large that disks pass through the floor ran to the end with one warning."""
     failing_run(exe, work, "dem_tunnelling_floor", dem_deck(step="0.05", end="1"),
@@ -371,6 +399,7 @@ def main():
     continuum_blow_up_cause(exe, work, src)
     aliased_harmonic(exe, work)
     tunnelling(exe, work)
+    squeezed(exe, work)
     lock(exe, work)
     output_empty(exe, work)
     end_option(exe, work)
