@@ -75,6 +75,9 @@ def main(argv=None):
             raise ResultsError(f"{args.results}: neither /fem/mesh, /continuum nor /dem: not a "
                                "MULTICOR results file")
         paths = []
+        if args.results.endswith(".partial"):
+            print(f"plot_results.py: note: '{args.results}' is the partial file of a run that did not "
+                  "finish: the figures show the outputs stored so far", file=sys.stderr)
         if has_continuum:
             paths += continuum.write_all(continuum.load_continuum(args.results), out,
                                          time=args.time, scale=args.scale, node=args.node)

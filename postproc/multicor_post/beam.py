@@ -15,7 +15,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from .results import THETA, U, W, Mesh, Results, ResultsError
+from .results import THETA, U, W, Mesh, Results, ResultsError, figure_stem
 
 POINTS_PER_ELEMENT = 16
 
@@ -281,7 +281,7 @@ def write_all(res: Results, out_dir, time: Optional[float] = None,
     """Write every plot the results allow as PNG files in ``out_dir``; return their paths."""
     out_dir = os.fspath(out_dir)
     os.makedirs(out_dir, exist_ok=True)
-    stem = os.path.splitext(os.path.basename(res.path))[0]
+    stem = figure_stem(res.path)
     written = []
 
     def save(fig, name):

@@ -24,7 +24,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
 from .beam import _time_unit
-from .results import ResultsError
+from .results import ResultsError, figure_stem
 
 
 @dataclass
@@ -276,7 +276,7 @@ def write_all(res: ContinuumResults, out_dir, time: Optional[float] = None,
     """Write the figures of the module doc as PNG files in ``out_dir``; return their paths."""
     out_dir = os.fspath(out_dir)
     os.makedirs(out_dir, exist_ok=True)
-    stem = os.path.splitext(os.path.basename(res.path))[0]
+    stem = figure_stem(res.path)
     written = []
 
     def save(fig, name):

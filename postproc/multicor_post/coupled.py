@@ -18,7 +18,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import EllipseCollection
 from matplotlib.figure import Figure
 
-from .results import ResultsError, _decode_attrs, _Getter, _open_results
+from .results import ResultsError, _decode_attrs, _Getter, _open_results, figure_stem
 
 #: Columns of the nodal and per-disk arrays: x (u), y (w), rotation.
 X, Y, ROT = 0, 1, 2
@@ -407,7 +407,7 @@ def write_all(res: CoupledResults, out_dir, time: Optional[float] = None,
     the last) and <name>_coupling.png."""
     out_dir = os.fspath(out_dir)
     os.makedirs(out_dir, exist_ok=True)
-    stem = os.path.splitext(os.path.basename(res.path))[0]
+    stem = figure_stem(res.path)
     written = []
     for fig, name in ((plot_profiles(res, time), "profiles"),
                       (plot_configuration(res, time, scale), "configuration"),

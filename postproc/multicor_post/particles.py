@@ -18,7 +18,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from .beam import _time_unit
-from .results import ResultsError, _decode_attrs, _Getter, _open_results
+from .results import ResultsError, _decode_attrs, _Getter, _open_results, figure_stem
 
 #: Columns of the per-disk arrays: x [m], y [m], rotation [rad].
 X, Y, ROT = 0, 1, 2
@@ -426,7 +426,7 @@ def write_all(res: DemResults, out_dir, time: Optional[float] = None,
     <name>_solver.png, and <name>_velocities.png for small systems."""
     out_dir = os.fspath(out_dir)
     os.makedirs(out_dir, exist_ok=True)
-    stem = os.path.splitext(os.path.basename(res.path))[0]
+    stem = figure_stem(res.path)
     written = []
 
     def save(fig, name, resolution=dpi):

@@ -21,6 +21,15 @@ class ResultsError(Exception):
     """A results file is missing, unreadable or does not follow the documented layout."""
 
 
+def figure_stem(path) -> str:
+    """The name the figures of a results file start with: the deck name, also for the
+    partial file of an unfinished run (``deck.h5.partial`` gives ``deck``)."""
+    name = os.path.basename(os.fspath(path))
+    if name.endswith(".partial"):
+        name = name[:-len(".partial")]
+    return os.path.splitext(name)[0]
+
+
 @dataclass
 class Mesh:
     """FE mesh: deck node ids, coordinates [m] and element connectivity (0-based indices)."""
