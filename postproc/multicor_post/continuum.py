@@ -54,6 +54,9 @@ class ContinuumResults:
         return int(np.argmin(np.abs(self.time - t)))
 
 
+#: Relative level below which a stress component is round-off of the largest one.
+ROUNDOFF = 1e-9
+
 ENERGY_TERMS = ("kinetic", "strain", "external_work", "damping", "reaction_work", "balance")
 
 
@@ -169,6 +172,9 @@ def plot_stress(res: ContinuumResults, time: Optional[float] = None,
     panel = float(np.clip(6.5 * extent[1] / max(extent[0], 1e-300) + 0.9, 1.6, 3.5))
     fig = _figure(height=1.0 + 3 * panel)
     axes = fig.subplots(3, 1, sharex=True)
+    # a component below ROUNDOFF times the largest one is round-off (sigma_yy of a bar in
+    # uniaxial tension): drawn white, not as a saturated pattern of noise
+    overall = float(np.max(np.abs(res.stress[k]))) * fs if res.stress[k].size else 0.0
     for c, (ax, name) in enumerate(zip(axes, ("σ_xx", "σ_yy", "σ_xy"))):
         values = res.stress[k, :, c] * fs
         # colour limits at the 99th percentile of |value|, so that a few elements at a corner
@@ -176,6 +182,9 @@ def plot_stress(res: ContinuumResults, time: Optional[float] = None,
         top = float(np.max(np.abs(values)))
         lim = float(np.percentile(np.abs(values), 99)) if values.size else 0.0
         lim = lim if lim > 0 else (top or 1.0)
+        noise = 0.0 < top < ROUNDOFF * overall
+        if noise:
+            lim = ROUNDOFF * overall
         ax.add_collection(PolyCollection(outline, facecolor="none", edgecolor="0.8", lw=0.3))
         pc = PolyCollection(deformed, array=values, cmap="RdBu_r", edgecolor="face", lw=0.2)
         pc.set_clim(-lim, lim)
@@ -185,6 +194,8 @@ def plot_stress(res: ContinuumResults, time: Optional[float] = None,
         ax.set_aspect("equal")
         ax.set_ylabel("y [m]")
         label = f"{name} [{us}]" + (f" (largest {top:.3g})" if top > lim * (1 + 1e-12) else "")
+        if noise:
+            label = f"{name} [{us}] (round-off: at most {top:.1g})"
         fig.colorbar(pc, ax=ax, label=label, extend="both" if top > lim * (1 + 1e-12) else "neither")
     axes[-1].set_xlabel("x [m]")
     when = ""

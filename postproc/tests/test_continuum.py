@@ -171,3 +171,20 @@ def test_partial_file_of_an_unfinished_run(tmp_path, capsys):
     out = capsys.readouterr()
     assert out.out.split() == [str(tmp_path / "png" / "run_stress.png")]
     assert "partial file of a run that did not finish" in out.err
+
+
+def test_round_off_components_are_drawn_white(tmp_path):
+    # a bar in uniaxial tension: sigma_yy and sigma_xy are round-off of sigma_xx (1e-16 of
+    # it); their panels take the limits of 1e-9 of sigma_xx, not their own noise's
+    path = write(tmp_path / "s.h5", "static")
+    with h5py.File(path, "r+") as f:
+        f["continuum/static/stress"][...] = np.array([[1e6, 1e-10, -2e-10], [1e6, -1e-10, 3e-10],
+                                                      [1e6, 2e-10, 1e-10]])
+    fig = continuum.plot_stress(continuum.load_continuum(path))
+    for c in (1, 2):
+        lo, hi = fig.axes[c].collections[1].get_clim()
+        assert hi == pytest.approx(1e-9, rel=1e-12) and lo == -hi      # MPa: 1e-9 of 1 MPa
+        assert "round-off" in fig.axes[3 + c].get_ylabel()
+    # the real component keeps its own limits
+    assert fig.axes[0].collections[1].get_clim()[1] == pytest.approx(1.0, rel=1e-12)
+    assert "round-off" not in fig.axes[3].get_ylabel()
