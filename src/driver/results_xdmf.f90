@@ -8,7 +8,7 @@
 !>   displacement (x, y; ParaView adds z = 0, so that Warp By Vector applies), the rotation,
 !>   and the velocity and acceleration when stored; the node ids;
 !> - a 2D continuum (/continuum/mesh): its mesh "continuum" with displacement, velocity and the
-!>   centre stresses;
+!>   centre stresses as the scalars sigma_xx, sigma_yy, sigma_xy;
 !> - disks (/dem/position): a point grid "disks" (the centres) with radius, material, velocity,
 !>   rotation and angular velocity; walls (/dem/walls/position): segments "walls";
 !> - static: one grid; modal: a temporal collection per part with one grid per mode, at the
@@ -230,7 +230,10 @@ contains
         integer, intent(in) :: k
         !> Name of the part.
         character(len=*), intent(in) :: part
-        integer :: n, e
+        ! the stress components as three scalars (a 3-vector would be coloured by its
+        ! "Magnitude", which is no stress measure)
+        character(len=*), parameter :: stress_names(3) = ['sigma_xx', 'sigma_yy', 'sigma_xy']
+        integer :: n, e, c
         n = s%mesh_nodes
         e = s%mesh_elements
         call begin_part(x, s, part, k)
@@ -239,7 +242,10 @@ contains
         select case (s%analysis)
         case ('static')
             call x%attribute('displacement', 'Vector', 'Node', xdmf_whole('/continuum/static/displacement', [n, 2]))
-            call x%attribute('stress', 'Vector', 'Cell', xdmf_whole('/continuum/static/stress', [e, 3]))
+            do c = 1, 3
+                call x%attribute(stress_names(c), 'Scalar', 'Cell', &
+                                 xdmf_slab('/continuum/static/stress', [e, 3], [0, c - 1], [e, 1]))
+            end do
         case ('modal')
             call x%attribute('mode_shape', 'Vector', 'Node', &
                              xdmf_slab('/continuum/modal/shapes', [s%n_states, n, 2], [k - 1, 0, 0], [1, n, 2]))
@@ -248,8 +254,10 @@ contains
                              xdmf_slab('/continuum/displacement', [s%n_states, n, 2], [k - 1, 0, 0], [1, n, 2]))
             call x%attribute('velocity', 'Vector', 'Node', &
                              xdmf_slab('/continuum/velocity', [s%n_states, n, 2], [k - 1, 0, 0], [1, n, 2]))
-            call x%attribute('stress', 'Vector', 'Cell', &
-                             xdmf_slab('/continuum/stress', [s%n_states, e, 3], [k - 1, 0, 0], [1, e, 3]))
+            do c = 1, 3
+                call x%attribute(stress_names(c), 'Scalar', 'Cell', &
+                                 xdmf_slab('/continuum/stress', [s%n_states, e, 3], [k - 1, 0, c - 1], [1, e, 1]))
+            end do
         end select
         call x%end_grid()
     end subroutine continuum_grid
