@@ -8,7 +8,7 @@ Plots what the file holds: the beam (finite-element) plots of plot_beam.py when 
 walls and contact force network at the stored time nearest to T; default the last, plus
 <name>_particles_start.png at t = 0), <name>_dem_energy.png (energy audit),
 <name>_solver.png (contact solver statistics of every step) and, for up to 50 disks,
-<name>_velocities.png; and, for a coupled run (a /coupling group), both of these and
+<name>_velocities.png; and, for a beam-coupled run (/coupling and /fem/mesh), both of these and
 <name>_profiles.png (displacement and velocity along x of the beam nodes and the disks),
 <name>_configuration.png (deformed beam, disks, overlap) and <name>_coupling.png (constraint
 residuals, multipliers, energy audit). For a 2D continuum (a /continuum group, alone or
