@@ -206,9 +206,9 @@ contains
             ! describes the earlier result, which is left as it was).
             ! ParaView's XDMF 2 reader splits a reference 'file.h5:/dataset' at the first colon
             if (index(basename(path), ':') > 0) call report('warning: the name '//basename(path)// &
-                                                             ' contains a colon, which ParaView''s XDMF reader '// &
-                                                             'cannot open; rename the deck to view '// &
-                                                             basename(xdmf)//' in ParaView')
+                                                            ' contains a colon, which ParaView''s XDMF reader '// &
+                                                            'cannot open; rename the deck to view '// &
+                                                            basename(xdmf)//' in ParaView')
             call write_results_xdmf(out%file, xdmf//'.partial', basename(path), error)
             if (allocated(error)) then
                 call out%abort()
