@@ -19,7 +19,7 @@ from typing import Optional
 import h5py
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.collections import PatchCollection, PolyCollection
+from matplotlib.collections import LineCollection, PatchCollection, PolyCollection
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
@@ -46,6 +46,7 @@ class ContinuumResults:
     disk_position: Optional[np.ndarray] = None   # coupled: (n_out, n_disks, 3)
     disk_radius: Optional[np.ndarray] = None
     disk_time: Optional[np.ndarray] = None
+    walls: Optional[np.ndarray] = None   # coupled: (n_out, n_walls, 4) x1, y1, x2, y2
 
     def nearest_index(self, t: Optional[float]) -> int:
         """The stored state nearest to time t (the last one for None or a static run)."""
@@ -108,6 +109,8 @@ def load_continuum(path) -> ContinuumResults:
             res.disk_position = f["dem/position"][...]
             res.disk_radius = need("dem/particles/radius")
             res.disk_time = need("dem/time")
+            if "dem/walls/position" in f:
+                res.walls = f["dem/walls/position"][...]
     return res
 
 
@@ -143,7 +146,7 @@ def _stress_unit(values) -> tuple[float, str]:
 
 def _draw_disks(ax, res: ContinuumResults, k: int, scale: float):
     """The disks of a coupled run at the DEM output nearest to the continuum's state k, their
-    displacements from the first output magnified by the mesh's `scale`."""
+    displacements from the first output magnified by the mesh's `scale`, and its walls."""
     if res.disk_position is None:
         return
     j = res.disk_position.shape[0] - 1
@@ -153,6 +156,10 @@ def _draw_disks(ax, res: ContinuumResults, k: int, scale: float):
     pos = start + scale * (res.disk_position[j] - start)
     ax.add_collection(PatchCollection([Circle((p[0], p[1]), r) for p, r in zip(pos, res.disk_radius)],
                                       facecolor="none", edgecolor="0.25", lw=0.4))
+    if res.walls is not None and res.walls.shape[1] > 0:
+        # the walls' displacements (driven walls) magnified like everything else
+        walls = res.walls[0] + scale * (res.walls[j] - res.walls[0])
+        ax.add_collection(LineCollection(walls.reshape(-1, 2, 2), colors="0.2", linewidths=2.0))
 
 
 def plot_stress(res: ContinuumResults, time: Optional[float] = None,

@@ -57,6 +57,9 @@ def write(path, analysis="dynamic", disks=False):
                 move = np.stack([np.concatenate([field(k)[[2, 5]], np.zeros((2, 1))], axis=1)
                                  for k in range(N_OUT)])
                 f["dem/position"] = start + move
+                # a floor, and a wall driven along x at 1 m/s
+                f["dem/walls/position"] = np.stack([[[-1.0, -0.5, 4.0, -0.5], [3.5, 0.0 + t[k], 3.5, 1.0 + t[k]]]
+                                                    for k in range(N_OUT)])
                 f["dem/particles/radius"] = np.array([0.1, 0.2])
                 f["dem/time"] = t
     return path
@@ -122,6 +125,10 @@ def test_disks_of_a_coupled_run_move_with_the_same_magnification(tmp_path):
     expected = X[[2, 5]] + s * field(k)[[2, 5]]
     np.testing.assert_allclose(drawn, expected, rtol=0, atol=1e-12)
     np.testing.assert_allclose(radii, [0.1, 0.2], rtol=1e-12)
+    # the walls, their displacements magnified the same way (the driven one moved 4 mm in y)
+    walls = continuum.plot_stress(res, scale=s).axes[0].collections[3].get_segments()
+    np.testing.assert_allclose(walls[1], [[3.5, s * 4e-3], [3.5, 1.0 + s * 4e-3]], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(walls[0], [[-1.0, -0.5], [4.0, -0.5]], rtol=0, atol=0)
 
 
 def test_history_of_the_node_that_moves_most(tmp_path):
