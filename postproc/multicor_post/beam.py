@@ -8,14 +8,13 @@ mesh still gives the true element curve.
 """
 from __future__ import annotations
 
-import os
 from typing import Optional
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from .results import THETA, U, W, Mesh, Results, ResultsError, figure_stem
+from .results import THETA, U, W, FigureFiles, Mesh, Results, ResultsError
 
 POINTS_PER_ELEMENT = 16
 
@@ -279,16 +278,8 @@ def write_all(res: Results, out_dir, time: Optional[float] = None,
               node_id: Optional[int] = None, scale: Optional[float] = None,
               dpi: int = 120) -> list[str]:
     """Write every plot the results allow as PNG files in ``out_dir``; return their paths."""
-    out_dir = os.fspath(out_dir)
-    os.makedirs(out_dir, exist_ok=True)
-    stem = figure_stem(res.path)
-    written = []
-
-    def save(fig, name):
-        path = os.path.join(out_dir, f"{stem}_{name}.png")
-        fig.savefig(path, dpi=dpi)
-        written.append(path)
-
+    files = FigureFiles(res.path, out_dir, dpi)
+    save, written = files.save, files.written
     if res.dynamic is not None:
         fig, _ = plot_deflection(res, time, scale)
         save(fig, "deflection")

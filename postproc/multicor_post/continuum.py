@@ -24,7 +24,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
 from .beam import _time_unit
-from .results import ResultsError, figure_stem
+from .results import FigureFiles, ResultsError
 
 
 @dataclass
@@ -292,21 +292,12 @@ def plot_modes(res: ContinuumResults, max_modes: int = 6,
 def write_all(res: ContinuumResults, out_dir, time: Optional[float] = None,
               scale: Optional[float] = None, node: Optional[int] = None) -> list[str]:
     """Write the figures of the module doc as PNG files in ``out_dir``; return their paths."""
-    out_dir = os.fspath(out_dir)
-    os.makedirs(out_dir, exist_ok=True)
-    stem = figure_stem(res.path)
-    written = []
-
-    def save(fig, name):
-        path = os.path.join(out_dir, f"{stem}_{name}.png")
-        fig.savefig(path, dpi=120)
-        written.append(path)
-
+    files = FigureFiles(res.path, out_dir)
     if res.analysis == "modal":
-        save(plot_modes(res, scale=scale), "modes")
-        return written
-    save(plot_stress(res, time=time, scale=scale), "stress")
+        files.save(plot_modes(res, scale=scale), "modes")
+        return files.written
+    files.save(plot_stress(res, time=time, scale=scale), "stress")
     if res.analysis == "dynamic":
-        save(plot_energy(res), "continuum_energy")
-        save(plot_history(res, node)[0], "history")
-    return written
+        files.save(plot_energy(res), "continuum_energy")
+        files.save(plot_history(res, node)[0], "history")
+    return files.written

@@ -18,7 +18,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import EllipseCollection
 from matplotlib.figure import Figure
 
-from .results import ResultsError, _decode_attrs, _Getter, _open_results, figure_stem
+from .results import FigureFiles, ResultsError, _decode_attrs, _Getter, _open_results
 
 #: Columns of the nodal and per-disk arrays: x (u), y (w), rotation.
 X, Y, ROT = 0, 1, 2
@@ -405,14 +405,8 @@ def write_all(res: CoupledResults, out_dir, time: Optional[float] = None,
     """Write the plots of one coupled run as PNG files in ``out_dir``; return their paths:
     <name>_profiles.png, <name>_configuration.png (at the output nearest to ``time``, default
     the last) and <name>_coupling.png."""
-    out_dir = os.fspath(out_dir)
-    os.makedirs(out_dir, exist_ok=True)
-    stem = figure_stem(res.path)
-    written = []
-    for fig, name in ((plot_profiles(res, time), "profiles"),
-                      (plot_configuration(res, time, scale), "configuration"),
-                      (plot_coupling(res), "coupling")):
-        path = os.path.join(out_dir, f"{stem}_{name}.png")
-        fig.savefig(path, dpi=dpi)
-        written.append(path)
-    return written
+    files = FigureFiles(res.path, out_dir, dpi)
+    files.save(plot_profiles(res, time), "profiles")
+    files.save(plot_configuration(res, time, scale), "configuration")
+    files.save(plot_coupling(res), "coupling")
+    return files.written

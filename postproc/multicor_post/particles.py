@@ -18,7 +18,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from .beam import _time_unit
-from .results import ResultsError, _decode_attrs, _Getter, _open_results, figure_stem
+from .results import FigureFiles, ResultsError, _decode_attrs, _Getter, _open_results
 
 #: Columns of the per-disk arrays: x [m], y [m], rotation [rad].
 X, Y, ROT = 0, 1, 2
@@ -424,16 +424,8 @@ def write_all(res: DemResults, out_dir, time: Optional[float] = None,
     <name>_particles.png (configuration at the output nearest to ``time``, default the last),
     <name>_particles_start.png (at t = 0, when ``time`` is not given), <name>_dem_energy.png,
     <name>_solver.png, and <name>_velocities.png for small systems."""
-    out_dir = os.fspath(out_dir)
-    os.makedirs(out_dir, exist_ok=True)
-    stem = figure_stem(res.path)
-    written = []
-
-    def save(fig, name, resolution=dpi):
-        path = os.path.join(out_dir, f"{stem}_{name}.png")
-        fig.savefig(path, dpi=resolution)
-        written.append(path)
-
+    files = FigureFiles(res.path, out_dir, dpi)
+    save = files.save
     # Thousands of disks need more pixels to be seen one by one.
     dpi_config = dpi if res.n <= 500 else 2 * dpi
     if time is None:
@@ -446,4 +438,4 @@ def write_all(res: DemResults, out_dir, time: Optional[float] = None,
         save(plot_solver(res), "solver")
     if res.n <= SMALL_SYSTEM:
         save(plot_velocities(res), "velocities")
-    return written
+    return files.written

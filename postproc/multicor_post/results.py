@@ -21,6 +21,23 @@ class ResultsError(Exception):
     """A results file is missing, unreadable or does not follow the documented layout."""
 
 
+class FigureFiles:
+    """Writes the PNG figures of one results file into ``out_dir`` as <stem>_<name>.png
+    (`figure_stem`) and keeps their paths, in order, in ``written``."""
+
+    def __init__(self, results_path, out_dir, dpi: int = 120):
+        self.out_dir = os.fspath(out_dir)
+        os.makedirs(self.out_dir, exist_ok=True)
+        self.stem = figure_stem(results_path)
+        self.dpi = dpi
+        self.written: list[str] = []
+
+    def save(self, fig, name: str, dpi: Optional[int] = None) -> None:
+        path = os.path.join(self.out_dir, f"{self.stem}_{name}.png")
+        fig.savefig(path, dpi=self.dpi if dpi is None else dpi)
+        self.written.append(path)
+
+
 def figure_stem(path) -> str:
     """The name the figures of a results file start with: the deck name, also for the
     partial file of an unfinished run (``deck.h5.partial`` gives ``deck``)."""
