@@ -53,12 +53,18 @@ def summary_lines(runs, time):
     """Measured figures of each run (text)."""
     lines = [f"{'case':<15} {'steps':>6} {'max|q-Cu| [m]':>14} {'max|x-Cu| [m]':>14} "
              f"{'max|bal| [J]':>12} {'ext. work [J]':>13} {'wall [s]':>9}"]
+    def of(series, name, value):
+        """value(series[name]), NaN when the file lacks the dataset."""
+        return value(series[name]) if name in series else np.nan
+
     for name, r in runs.items():
         s, e = r.steps, r.energy
         wall = float(r.summary.get("wall_seconds", np.nan))
-        lines.append(f"{name:<15} {s['g_norm'].size:>6d} {s['position_residual'].max():>14.3e} "
-                     f"{s['coordinate_residual'].max():>14.3e} {np.abs(e['balance']).max():>12.3e} "
-                     f"{e['external_work'][-1]:>13.4e} {wall:>9.2f}")
+        n_steps = next((v.size for v in s.values()), 0)
+        lines.append(f"{name:<15} {n_steps:>6d} {of(s, 'position_residual', np.max):>14.3e} "
+                     f"{of(s, 'coordinate_residual', np.max):>14.3e} "
+                     f"{of(e, 'balance', lambda b: np.abs(b).max()):>12.3e} "
+                     f"{of(e, 'external_work', lambda w: w[-1]):>13.4e} {wall:>9.2f}")
     lines.append("")
     lines.append(f"profiles at t = {time:g} s (vertical displacement; rigid fit = straight line "
                  "through the disks beyond the overlap):")

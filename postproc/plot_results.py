@@ -15,8 +15,9 @@ residuals, multipliers, energy audit). For a 2D continuum (a /continuum group, a
 coupled to disks): <name>_stress.png (stress per element on the deformed mesh at the state
 nearest to T), and for a dynamic run <name>_continuum_energy.png and <name>_history.png (the
 node --node, a 1-based mesh index; default the node with the largest displacement), for a modal run
-<name>_modes.png; with disks, their particle plots too. Exit code 1 with a message on a
-missing or invalid file.
+<name>_modes.png; coupled to disks (/coupling), <name>_coupling.png (the same diagnostics as a
+beam-coupled run's) and the particle plots too. Exit code 1 with a message on a missing or
+invalid file.
 """
 import argparse
 import os
@@ -81,6 +82,8 @@ def main(argv=None):
         if has_continuum:
             paths += continuum.write_all(continuum.load_continuum(args.results), out,
                                          time=args.time, scale=args.scale, node=args.node)
+            if is_coupled:
+                paths += coupled.write_coupling(coupled.load_continuum_coupling(args.results), out)
         if is_coupled and has_beam:
             paths += coupled.write_all(coupled.load_coupled(args.results), out, time=args.time,
                                        scale=args.scale)

@@ -4,6 +4,12 @@ experiments (doc/experiments.md): profiles of displacement and velocity along x 
 nodes and the disks on the same axes, the deformed configuration with the overlap shaded,
 the history of a tracked disk in several runs, the profiles of several runs against each
 other, and the coupling diagnostics (constraint residuals, multipliers, energy audit).
+
+The coupling diagnostics are those of either kind of coupled run: the /coupling group is
+written by the same code for a beam (/fem) and for a 2D continuum (/continuum) glued to disks.
+One figure (`plot_coupling`) draws a `CouplingDiagnostics`, which a small loader per kind
+gives: `CoupledResults.coupling` (beam, read by `load_coupled`) and
+`load_continuum_coupling` (continuum).
 Figures use matplotlib's object API and the Agg renderer.
 """
 from __future__ import annotations
@@ -18,12 +24,82 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import EllipseCollection
 from matplotlib.figure import Figure
 
+from .beam import _time_unit
 from .results import FigureFiles, ResultsError, _decode_attrs, _Getter, _open_results
 
 #: Columns of the nodal and per-disk arrays: x (u), y (w), rotation.
 X, Y, ROT = 0, 1, 2
 #: Colours: beam (FE) and disks (DEM), coupled disks, overlap shading.
 FE_COLOUR, DEM_COLOUR, COUPLED_COLOUR, OVERLAP_COLOUR = "C0", "C3", "C2", "0.85"
+#: Per-step datasets of /coupling (entry k: the step ending at t = (k + 1) h).
+STEP_SERIES = ("g_norm", "position_residual", "velocity_residual", "rotation_residual",
+               "coordinate_residual", "lambda_norm", "sweeps", "corrections")
+
+
+@dataclass
+class CouplingDiagnostics:
+    """The /coupling group of a coupled run, beam or 2D continuum (module doc). The per-step
+    series and the energy terms are those the file holds: a figure says which it lacks. With
+    the mediator space (multipliers = nodes, a /coupling/mediator_nodes dataset), lambda_norm
+    is the norm of the multipliers on the FE nodes, and lam still the forces of the rows."""
+
+    path: str
+    title: str
+    body: str                    # the FE side, in the figure's legends: "beam", "continuum"
+    time: np.ndarray             # (n_out,) [s] of the stored outputs
+    lam: np.ndarray              # (n_out, n_rows) [N, N.m]
+    steps: dict                  # STEP_SERIES present, each (n_steps,)
+    energy: dict                 # /coupling/energy/<name> (n_out,) [J] present, with "time"
+    attrs: dict                  # attributes of /coupling (time_step, rotation, ...)
+    mediator: bool = False       # multipliers = nodes
+
+    def step_time(self) -> np.ndarray:
+        """End time of each recorded step [s] (NaN without the time_step attribute)."""
+        n = next((v.size for v in self.steps.values()), 0)
+        return (np.arange(n) + 1) * float(self.attrs.get("time_step", np.nan))
+
+
+def _read_coupling(f, get, path: str, time: np.ndarray, body: str) -> CouplingDiagnostics:
+    """The /coupling group of an open results file whose outputs are at ``time``: the
+    multipliers are required; the per-step series and energy terms are read when present
+    (shapes checked)."""
+    n_rows = int(f["coupling"].attrs.get("n_rows", 0))
+    present = [name for name in STEP_SERIES if f"coupling/{name}" in f]
+    n_steps = f[f"coupling/{present[0]}"].shape[0] if present else 0
+    energy = {}
+    if "coupling/energy" in f:
+        energy = {name: get(f"coupling/energy/{name}", (time.size,))
+                  for name in f["coupling/energy"].keys()}
+    attrs = _decode_attrs(f.attrs)
+    return CouplingDiagnostics(
+        path=path, title=attrs.get("title", "") or os.path.basename(path), body=body, time=time,
+        lam=get("coupling/lambda", (time.size, n_rows)),
+        steps={name: get(f"coupling/{name}", (n_steps,)) for name in present}, energy=energy,
+        attrs=_decode_attrs(f["coupling"].attrs), mediator="coupling/mediator_nodes" in f)
+
+
+def _same_times(path: str, a: np.ndarray, b: np.ndarray, names: str) -> None:
+    """ResultsError unless two time axes of one file agree (to 1e-12 of the largest time)."""
+    if not np.allclose(a, b, rtol=0, atol=1e-12 * max(1.0, float(np.abs(a).max(initial=0.0)))):
+        raise ResultsError(f"{path}: {names} differ")
+
+
+def load_continuum_coupling(path) -> CouplingDiagnostics:
+    """The coupling diagnostics of a 2D continuum coupled to disks (/continuum, /dem and
+    /coupling; the outputs at /coupling/time, which /continuum/time repeats). ResultsError
+    when the file is missing, unreadable, not such a run, or a dataset does not follow the
+    layout."""
+    path = os.fspath(path)
+    f = _open_results(path)
+    with f:
+        if "coupling" not in f or "continuum" not in f:
+            raise ResultsError(f"{path}: a /coupling and a /continuum group are needed (not a "
+                               "continuum coupled to disks)")
+        get = _Getter(f, path, kind="coupled continuum results file")
+        time = get("coupling/time", (None,))
+        _same_times(path, time, get("continuum/time", (time.size,)),
+                    "/coupling/time and /continuum/time")
+        return _read_coupling(f, get, path, time, body="continuum")
 
 
 @dataclass
@@ -44,11 +120,28 @@ class CoupledResults:
     overlap: np.ndarray          # (2,): s_fe, s_particle [m]
     coupled: np.ndarray          # (n_points,) 0-based disk indices
     alpha: np.ndarray            # (n_points,) weight at the coupled disks
-    lam: np.ndarray              # (n_out, n_rows) [N]
-    steps: dict                  # per-step arrays: g_norm, position_residual, ...
-    energy: dict                 # /coupling/energy/<name> (n_out,) [J], with "time"
-    coupling_attrs: dict
+    coupling: CouplingDiagnostics   # multipliers, per-step series, energy audit
     summary: dict                # /summary attributes (steps, wall_seconds, ...) or {}
+
+    @property
+    def lam(self) -> np.ndarray:
+        """Multipliers (n_out, n_rows) [N]."""
+        return self.coupling.lam
+
+    @property
+    def steps(self) -> dict:
+        """Per-step arrays: g_norm, position_residual, ..."""
+        return self.coupling.steps
+
+    @property
+    def energy(self) -> dict:
+        """/coupling/energy/<name> (n_out,) [J], with "time"."""
+        return self.coupling.energy
+
+    @property
+    def coupling_attrs(self) -> dict:
+        """Attributes of /coupling."""
+        return self.coupling.attrs
 
     @property
     def title(self) -> str:
@@ -106,16 +199,7 @@ def load_coupled(path) -> CoupledResults:
         n_out = time.size
         radius = get("dem/particles/radius", (None,))
         n = radius.size
-        dem_time = get("dem/time", (n_out,))
-        if not np.allclose(dem_time, time, rtol=0, atol=1e-12 * max(1.0, abs(time).max())):
-            raise ResultsError(f"{path}: /fem/time and /dem/time differ")
-        n_rows = int(f["coupling"].attrs.get("n_rows", 0))
-        step_names = ("g_norm", "position_residual", "velocity_residual", "rotation_residual",
-                      "coordinate_residual", "lambda_norm", "sweeps", "corrections")
-        n_steps = get("coupling/g_norm", (None,)).size
-        steps = {name: get(f"coupling/{name}", (n_steps,)) for name in step_names}
-        energy = {name: get(f"coupling/energy/{name}", (n_out,))
-                  for name in f["coupling/energy"].keys()}
+        _same_times(path, time, get("dem/time", (n_out,)), "/fem/time and /dem/time")
         return CoupledResults(
             path=path, attrs=_decode_attrs(f.attrs), node_x=xy[:, 0], node_y=xy[:, 1],
             connectivity=get("fem/mesh/connectivity", (None, 2)).astype(int) - 1, time=time,
@@ -126,8 +210,7 @@ def load_coupled(path) -> CoupledResults:
             overlap=get("coupling/overlap", (2,)),
             coupled=get("coupling/particles", (None,)).astype(int) - 1,
             alpha=get("coupling/alpha", (None,)),
-            lam=get("coupling/lambda", (n_out, n_rows)), steps=steps, energy=energy,
-            coupling_attrs=_decode_attrs(f["coupling"].attrs),
+            coupling=_read_coupling(f, get, path, time, body="beam"),
             summary=_decode_attrs(f["summary"].attrs) if "summary" in f else {})
 
 
@@ -367,37 +450,96 @@ def plot_compare_profiles(runs: Sequence[CoupledResults], labels: Sequence[str],
     return fig
 
 
-def plot_coupling(res: CoupledResults) -> Figure:
-    """Coupling diagnostics: constraint residuals and sweeps of every step, multipliers and
-    energy balance at the outputs."""
+#: Per-step residual curves of the coupling figure: dataset, label.
+RESIDUALS = (("position_residual", "|q - C u| [m]"),
+             ("coordinate_residual", "|x - x0 - C(u - u0)| [m]"),
+             ("velocity_residual", "velocity residual [m/s]"),
+             ("g_norm", "‖g‖ before the multipliers [m/s]"))
+#: Curves of the energy panel: the /coupling/energy terms summed, label (the FE side's name
+#: replaces {body}).
+ENERGY_CURVES = ((("fe_kinetic", "fe_strain"), "{body}: kinetic + strain"),
+                 (("dem_kinetic", "dem_potential"), "disks: kinetic + potential"),
+                 (("external_work",), "external work"),
+                 (("contact_dissipation",), "dissipated in contacts"),
+                 (("fe_damping", "numerical_dissipation"), "damping + numerical dissipation"),
+                 (("balance",), "balance (0 = exact)"))
+
+
+def _note_absent(ax, names) -> None:
+    """Say on the axes which datasets the file lacks (nothing is drawn for them)."""
+    if names:
+        ax.text(0.01, 0.02, "not in the file: " + ", ".join(names), transform=ax.transAxes,
+                fontsize="small", color="C3", va="bottom")
+
+
+def _legend(ax) -> None:
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="best", fontsize="small")
+
+
+def plot_coupling(diag: CouplingDiagnostics) -> Figure:
+    """Coupling diagnostics of a coupled run, beam or continuum: constraint residuals and
+    sweeps of every step, multipliers at the outputs and their norm at every step, energy
+    audit at the outputs. A dataset the file lacks is named on its panel, not drawn."""
     fig, (ax_r, ax_l, ax_e) = _new_figure(8.0, 9.0, rows=3)
-    steps = res.steps
-    h = float(res.coupling_attrs.get("time_step", np.nan))
-    t = (np.arange(steps["g_norm"].size) + 1) * h * 1e3
-    for name, label in (("position_residual", "|q - C u| [m]"),
-                        ("coordinate_residual", "|x - x0 - C(u - u0)| [m]"),
-                        ("velocity_residual", "velocity residual [m/s]")):
-        ax_r.semilogy(t, np.maximum(steps[name], 1e-300), label=label)
+    steps, e = diag.steps, diag.energy
+    ft, ut = _time_unit(np.concatenate([diag.time, diag.energy.get("time", [])]))
+    t = diag.step_time() * ft
+    residuals = list(RESIDUALS)
+    if diag.attrs.get("rotation", 0) == 1:
+        residuals.append(("rotation_residual", "rotation residual [rad]"))
+    for name, label in residuals:
+        if name in steps:
+            # a residual of exactly 0 (the first step of a run at rest) has no logarithm: a gap
+            ax_r.semilogy(t, np.where(steps[name] > 0, steps[name], np.nan), label=label)
+    _note_absent(ax_r, [name for name, _ in residuals + [("sweeps", "")] if name not in steps])
     ax_r.set_ylabel("residual")
-    ax_r.legend(loc="best", fontsize="small")
-    ax_s = ax_r.twinx()
-    ax_s.plot(t, steps["sweeps"], color="0.5", lw=0.6)
-    ax_s.set_ylabel("sweeps per step", color="0.4")
-    ax_l.plot(res.time * 1e3, res.lam, lw=0.8)
-    ax_l.set_ylabel("multipliers λ [N]")
-    e = res.energy
-    ax_e.plot(e["time"] * 1e3, e["fe_kinetic"] + e["fe_strain"], label="beam: kinetic + strain")
-    ax_e.plot(e["time"] * 1e3, e["dem_kinetic"] + e["dem_potential"], label="disks: kinetic + potential")
-    ax_e.plot(e["time"] * 1e3, e["external_work"], label="external work")
-    ax_e.plot(e["time"] * 1e3, e["contact_dissipation"], label="dissipated in contacts")
-    ax_e.plot(e["time"] * 1e3, e["balance"], "k", lw=1.5, label="balance (0 = exact)")
+    _legend(ax_r)
+    if "sweeps" in steps:
+        ax_s = ax_r.twinx()
+        ax_s.plot(t, steps["sweeps"], color="0.5", lw=0.6)
+        ax_s.set_ylabel("sweeps per step", color="0.4")
+    n_rows = diag.lam.shape[1]
+    for j in range(n_rows):
+        ax_l.plot(diag.time * ft, diag.lam[:, j], lw=0.8,
+                  label=f"λ: {n_rows} rows on the coupled disks, at the outputs" if j == 0
+                  else None)
+    if "lambda_norm" in steps:
+        # with the mediator space, lambda_norm is the norm of the multipliers on the FE nodes,
+        # not of the rows' forces on the disks
+        ax_l.plot(t, steps["lambda_norm"], "k", lw=1.2,
+                  label="‖λ_m‖ of every step (mediator multipliers on the FE nodes)"
+                  if diag.mediator else "‖λ‖ of every step")
+    _note_absent(ax_l, [] if "lambda_norm" in steps else ["lambda_norm"])
+    ax_l.set_ylabel("multipliers λ [N, N·m]" if diag.attrs.get("rotation", 0) == 1
+                    else "multipliers λ [N]")
+    _legend(ax_l)
+    absent = []
+    for names, label in ENERGY_CURVES:
+        missing = [n for n in names if n not in e]
+        if missing or "time" not in e:
+            absent += missing
+            continue
+        style, what = {}, label.format(body=diag.body)
+        if names == ("balance",):
+            style = {"color": "k", "lw": 1.5}
+            what += f"; largest |balance| {np.abs(e['balance']).max(initial=0.0):.2g} J"
+        ax_e.plot(e["time"] * ft, sum(e[n] for n in names), label=what, **style)
+    _note_absent(ax_e, absent + ([] if "time" in e else ["energy/time"]))
     ax_e.set_ylabel("energy [J]")
-    ax_e.set_xlabel("t [ms]")
-    ax_e.legend(loc="best", fontsize="small")
+    ax_e.set_xlabel(f"t [{ut}]")
+    _legend(ax_e)
     for ax in (ax_r, ax_l, ax_e):
         ax.grid(True, alpha=0.3)
-    ax_r.set_title(f"{res.title}: coupling")
+    ax_r.set_title(f"{diag.title}\ncoupling of the {diag.body} and the disks")
     return fig
+
+
+def write_coupling(diag: CouplingDiagnostics, out_dir, dpi: int = 120) -> list[str]:
+    """Write <name>_coupling.png (`plot_coupling`) in ``out_dir``; return its path in a list."""
+    files = FigureFiles(diag.path, out_dir, dpi)
+    files.save(plot_coupling(diag), "coupling")
+    return files.written
 
 
 def write_all(res: CoupledResults, out_dir, time: Optional[float] = None,
@@ -408,5 +550,5 @@ def write_all(res: CoupledResults, out_dir, time: Optional[float] = None,
     files = FigureFiles(res.path, out_dir, dpi)
     files.save(plot_profiles(res, time), "profiles")
     files.save(plot_configuration(res, time, scale), "configuration")
-    files.save(plot_coupling(res), "coupling")
+    files.save(plot_coupling(res.coupling), "coupling")
     return files.written
