@@ -21,7 +21,8 @@
   same pressure ramped by a time function reaches the same state with about half the work;
 - the energy audit of the coupled system closes on every run;
 - the XDMF file shows the mesh and the disks (ParaView's pvpython when installed);
-- postproc/plot_results.py, as ./run.sh calls it, draws the continuum's and the disks' plots;
+- postproc/plot_results.py, as ./run.sh calls it, draws the continuum's plots, the coupling
+  diagnostics (<name>_coupling.png, as for a beam-coupled run) and the disks' plots;
 - --restart is refused with a clear message for a static continuum deck (no time steps; the
   checkpoints of dynamic continuum and coupled runs are tested in test_restart.py).
 Usage (ctest does this): test_coupled2d_runs.py --exe multicor --work DIR --source REPO
@@ -349,7 +350,8 @@ def main():
     xdmf(work / "rigid_per_disk" / "rigid_per_disk.h5")
     # the plots ./run.sh draws after a continuum-particle run
     plots(src, work / "rigid_per_disk" / "rigid_per_disk.h5", work / "png",
-          ["stress", "continuum_energy", "history", "particles_start", "particles", "dem_energy", "solver"])
+          ["stress", "continuum_energy", "history", "coupling", "particles_start", "particles",
+           "dem_energy", "solver"])
     restart_refused(exe, src, work)
     return summary()
 
