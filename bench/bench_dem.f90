@@ -24,7 +24,7 @@
 !> Options: --sizes N... (the packings to run), --anderson M (Anderson depth; default 5 as in
 !> the decks, 0: plain sweeps), --anderson-after K (plain sweeps before the Anderson steps;
 !> default 10, `[solver] anderson_after`), --anderson-sweeps P (sweeps per Anderson step;
-!> default 3, `[solver] anderson_sweeps`), --relaxation W,
+!> default 2, `[solver] anderson_sweeps`), --relaxation W,
 !> --check-every K (safeguard period of the over-relaxation), --criterion siconos,
 !> --max-sweeps C (cap of the timed steps), --forward (no alternating sweeps), --settle S (steps
 !> before timing, default 10), --settle-anderson M and --settle-sweeps C (solver of those
@@ -98,7 +98,7 @@ program bench_dem
     !> Solver options from the command line (see the header).
     real(wp) :: relaxation = 1.0_wp
     integer :: criterion = criterion_lmgc90, max_sweeps = 200, check_every = 10, settle_sweeps = 0, iarg
-    integer :: anderson = 5, settle_anderson = -1, anderson_after = 10, anderson_sweeps = 3
+    integer :: anderson = 5, settle_anderson = -1, anderson_after = 10, anderson_sweeps = 2
     logical :: convergence = .false., sizes_given = .false., verbose = .false., symmetric = .true.
     logical :: hydrostatic = .false., criterion_given = .false.
     !> Global strategy (`[solver] method`; of the settling steps, -1: the same) and the

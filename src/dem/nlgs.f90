@@ -26,7 +26,7 @@
 !> Acceleration (doc/theory.md 4.4): over-relaxation (`relaxation` omega, off by default;
 !> each update P_K(r0 + omega (r_loc - r0)), back to omega = 1 when the error measured every
 !> `check_every` sweeps rose), and Anderson mixing of the last `anderson` iterates (on by
-!> default, depth 5; the map is `anderson_sweeps` sweeps in the fixed contact order, 3 by
+!> default, depth 5; the map is `anderson_sweeps` sweeps in the fixed contact order, 2 by
 !> default; the history restarts when |G(x) - x| grows), after `anderson_after` plain sweeps
 !> (default 10).
 !> Cold start (`hydrostatic`, off by default): when no contact of the solve carries a
@@ -149,9 +149,9 @@ module dem_nlgs
         integer :: anderson_after = 10
         !> Sweeps per Anderson step: the map G accelerated is that many forward sweeps. An
         !> Anderson step costs about a sweep (its three passes over the contacts); with a map
-        !> of 3 sweeps, a third of that per sweep, for a few per cent more sweeps
-        !> (doc/performance.md, "Anderson over three sweeps").
-        integer :: anderson_sweeps = 3
+        !> of 2 sweeps, half of that per sweep, and about as many sweeps in all
+        !> (doc/performance.md, "Anderson over two sweeps").
+        integer :: anderson_sweeps = 2
         !> Domain split of the sweeps over the OpenMP threads (split_build): fewest contacts
         !> per block (smaller solves, and all solves on one thread, are serial).
         integer :: split_min = 2000

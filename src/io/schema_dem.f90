@@ -204,9 +204,9 @@ contains
                            'a few suffice (doc/performance.md).', default='10')
         call s%add_keyword('solver', 'anderson_sweeps', [int_field('anderson_sweeps', lower=1)], &
                            'With `anderson` > 0: sweeps per Anderson step (the map accelerated is that '// &
-                           'many forward sweeps). An Anderson step costs about one sweep; over 3 sweeps its '// &
-                           'cost per sweep is a third, for a few per cent more sweeps (doc/performance.md). '// &
-                           '1 mixes after every sweep.', default='3')
+                           'many forward sweeps). An Anderson step costs about one sweep; over 2 sweeps its '// &
+                           'cost per sweep is half, for about as many sweeps (doc/performance.md). 1 mixes '// &
+                           'after every sweep.', default='2')
         call s%add_keyword('solver', 'sweep_order', [word_field('sweep_order', 'alternating forward')], &
                            'Order of the plain sweeps: `alternating` (forward, then backward through the '// &
                            'contact list, in turn: symmetric Gauss-Seidel) or `forward` (every sweep in the '// &
