@@ -23,7 +23,8 @@
 !> what limits the solver on tall static packings.
 !> Options: --sizes N... (the packings to run), --anderson M (Anderson depth; default 5 as in
 !> the decks, 0: plain sweeps), --anderson-after K (plain sweeps before the Anderson steps;
-!> default 50, `[solver] anderson_after`), --relaxation W,
+!> default 10, `[solver] anderson_after`), --anderson-sweeps P (sweeps per Anderson step;
+!> default 2, `[solver] anderson_sweeps`), --relaxation W,
 !> --check-every K (safeguard period of the over-relaxation), --criterion siconos,
 !> --max-sweeps C (cap of the timed steps), --forward (no alternating sweeps), --settle S (steps
 !> before timing, default 10), --settle-anderson M and --settle-sweeps C (solver of those
@@ -97,7 +98,7 @@ program bench_dem
     !> Solver options from the command line (see the header).
     real(wp) :: relaxation = 1.0_wp
     integer :: criterion = criterion_lmgc90, max_sweeps = 200, check_every = 10, settle_sweeps = 0, iarg
-    integer :: anderson = 5, settle_anderson = -1, anderson_after = 50
+    integer :: anderson = 5, settle_anderson = -1, anderson_after = 10, anderson_sweeps = 2
     logical :: convergence = .false., sizes_given = .false., verbose = .false., symmetric = .true.
     logical :: hydrostatic = .false., criterion_given = .false.
     !> Global strategy (`[solver] method`; of the settling steps, -1: the same) and the
@@ -138,6 +139,9 @@ program bench_dem
             call read_int_value(arg, val, anderson)
         case ('--anderson-after')
             call read_int_value(arg, val, anderson_after)
+        case ('--anderson-sweeps')
+            call read_int_value(arg, val, anderson_sweeps)
+            if (anderson_sweeps < 1) call usage_error('--anderson-sweeps needs an integer >= 1')
         case ('--siconos')
             call read_int_value(arg, val, siconos_n)
         case ('--seed')
@@ -270,13 +274,13 @@ contains
     subroutine print_usage(unit)
         integer, intent(in) :: unit
         write (unit, '(a)') 'usage: bench_dem [--sizes N...] [--settle S] [--max-sweeps C] [--anderson M] [--anderson-after K]', &
-            '         [--relaxation W --check-every K] [--criterion lmgc90|siconos] [--forward]', &
+            '         [--anderson-sweeps P] [--relaxation W --check-every K] [--criterion lmgc90|siconos] [--forward]', &
             '         [--hydrostatic] [--method nlgs|block|coarse] [--coarse-every K] [--coarse-size M]', &
             '         [--settle-anderson M] [--settle-sweeps C] [--settle-method M] [--scheme multicor|siconos]', &
             '         [--verbose]', &
             '       bench_dem --convergence', &
             '       bench_dem --siconos 200|2000 [--seed S] [--scheme siconos|multicor] [--csv FILE] [--deck FILE]', &
-            '         [--anderson M] [--anderson-after K] [--forward] [--verbose]', &
+            '         [--anderson M] [--anderson-after K] [--anderson-sweeps P] [--forward] [--verbose]', &
             'Options and figures: the header of bench/bench_dem.f90 and doc/performance.md.'
     end subroutine print_usage
 
@@ -308,6 +312,7 @@ contains
         sys%solver%max_sweeps = max_sweeps
         sys%solver%anderson = anderson
         sys%solver%anderson_after = anderson_after
+        sys%solver%anderson_sweeps = anderson_sweeps
         sys%solver%method = method
         allocate (t_det(n_steps), t_sol(n_steps), rate(n_steps))
         sweeps = 0
@@ -465,6 +470,7 @@ contains
         sys%solver%relaxation = relaxation
         sys%solver%anderson = anderson
         sys%solver%anderson_after = anderson_after
+        sys%solver%anderson_sweeps = anderson_sweeps
         sys%solver%hydrostatic = hydrostatic
         sys%solver%symmetric = symmetric
         sys%solver%method = method
@@ -483,9 +489,9 @@ contains
         write (output_unit, '(a, i0, a, i0, a, i0, a, f0.4, a, i0, a)') '# deposit against Siconos: N = ', n, ' (', &
             n_row, ' x ', n_rows, '), box width ', width, ' m, mean radius 1 cm, seed ', layout_seed, &
             ', mu 0.3, e 0, h 2 ms, 500 steps, contact scheme '//trim(scheme_word)
-        write (output_unit, '(a, i0, a, es9.2, a, i0, a, i0, a, l1)') '# criterion ', sys%solver%criterion, &
+        write (output_unit, '(a, i0, a, es9.2, a, i0, a, 3(i0, a), l1)') '# criterion ', sys%solver%criterion, &
             ' (1 lmgc90, 2 siconos), tolerance ', tol, ', cap ', cap, ' sweeps, anderson ', anderson, &
-            ', hydrostatic ', hydrostatic
+            ' after ', anderson_after, ' sweeps, ', anderson_sweeps, ' sweeps per step, hydrostatic ', hydrostatic
         if (verbose) write (output_unit, '(a)') '# step  active  sweeps  conv  siconos_error  step[ms]  top[m]'
         do s = 1, n_steps
             before_sol = sys%time_solver
@@ -648,6 +654,7 @@ contains
         sys%solver%check_every = check_every
         sys%solver%anderson = anderson
         sys%solver%anderson_after = anderson_after
+        sys%solver%anderson_sweeps = anderson_sweeps
         sys%solver%hydrostatic = hydrostatic
         sys%solver%symmetric = symmetric
         sys%solver%method = method

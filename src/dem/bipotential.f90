@@ -266,7 +266,9 @@ contains
         call scaling(wnn, wnt, wtt, mu, sn, st, c, mup)
         call bipotential_predictor(rn*sn, rt*st, un/sn, ut/st, mup, 1.0_wp, taun, taut)
         call coulomb_projection(taun, taut, mup, qn, qt, pcase)
-        res = hypot(rn*sn - qn, rt*st - qt)
+        ! (sqrt rather than hypot: the scaled reactions are far from overflow, and libm's
+        ! hypot was 1.4 % of the 200-disk deposit's time, in the residual of every step)
+        res = sqrt((rn*sn - qn)**2 + (rt*st - qt)**2)
     end function bipotential_residual
 
     !> Scale factors of the frame where W has a unit diagonal (diagonal floored at 1e-12 of

@@ -280,7 +280,7 @@ contains
                 px = det%x0 + (cx + 0.5_wp)*det%cell
                 py = det%y0 + (cy + 0.5_wp)*det%cell
                 call segment_closest_point(x1, y1, x2, y2, px, py, qx, qy)
-                if (hypot(px - qx, py - qy) > lim) cycle
+                if ((px - qx)**2 + (py - qy)**2 > lim**2) cycle
                 c = cx + det%ncx*cy + 1
                 if (present(fill)) det%wall_list(count(c + 1)) = k
                 count(c + 1) = count(c + 1) + 1
@@ -555,7 +555,9 @@ contains
         real(wp), intent(out) :: nx, ny, gap
         real(wp) :: qx, qy, d, e
         call segment_closest_point(x1, y1, x2, y2, xc, yc, qx, qy)
-        d = hypot(xc - qx, yc - qy)
+        ! (sqrt rather than hypot: no overflow at lengths of a disk's size, and libm's hypot
+        ! was 1.5 % of the 200-disk deposit's time)
+        d = sqrt((xc - qx)**2 + (yc - qy)**2)
         hit = d <= r + alert
         gap = d - r
         if (d > 0.0_wp) then

@@ -25,9 +25,10 @@
 !> Sweeps alternate direction when `symmetric` (symmetric Gauss-Seidel).
 !> Acceleration (doc/theory.md 4.4): over-relaxation (`relaxation` omega, off by default;
 !> each update P_K(r0 + omega (r_loc - r0)), back to omega = 1 when the error measured every
-!> `check_every` sweeps rose), and Anderson mixing of the last `anderson` sweeps (on by
-!> default, depth 5; one sweep in the fixed contact order is the map; the history restarts
-!> when |G(x) - x| grows), after `anderson_after` plain sweeps (default 50).
+!> `check_every` sweeps rose), and Anderson mixing of the last `anderson` iterates (on by
+!> default, depth 5; the map is `anderson_sweeps` sweeps in the fixed contact order, 2 by
+!> default; the history restarts when |G(x) - x| grows), after `anderson_after` plain sweeps
+!> (default 10).
 !> Cold start (`hydrostatic`, off by default): when no contact of the solve carries a
 !> reaction yet (a fresh packing), the sweeps start from the hydrostatic estimate of
 !> hydrostatic_guess instead of zero reactions.
@@ -145,7 +146,12 @@ module dem_nlgs
         integer :: anderson = 5
         !> Plain sweeps before the Anderson steps start: a solve that converges within them
         !> is not accelerated (near rest a plain sweep is cheaper, doc/performance.md).
-        integer :: anderson_after = 50
+        integer :: anderson_after = 10
+        !> Sweeps per Anderson step: the map G accelerated is that many forward sweeps. An
+        !> Anderson step costs about a sweep (its three passes over the contacts); with a map
+        !> of 2 sweeps, half of that per sweep, and about as many sweeps in all
+        !> (doc/performance.md, "Anderson over two sweeps").
+        integer :: anderson_sweeps = 2
         !> Domain split of the sweeps over the OpenMP threads (split_build): fewest contacts
         !> per block (smaller solves, and all solves on one thread, are serial).
         integer :: split_min = 2000
@@ -192,7 +198,7 @@ module dem_nlgs
         integer :: depth = 0, used = 0, next = 1
         real(wp), allocatable :: df(:, :), dg(:, :), gram(:, :)
         !> The iterate x (the scaled reactions the next sweep starts from, valid when
-        !> x_valid), the residual f and output g of the last sweep, the scaling D.
+        !> x_valid), the residual f and output g of the last map, the scaling D.
         real(wp), allocatable :: x(:), fprev(:), gprev(:), d(:)
         !> 1/D where D > 0, else 0 (no moment, or W_tt = 0).
         real(wp), allocatable :: dinv(:)
@@ -200,6 +206,8 @@ module dem_nlgs
         real(wp), allocatable :: part(:, :)
         real(wp) :: fnorm_prev = huge(1.0_wp)
         logical :: started = .false., x_valid = .false.
+        !> Sweeps run since x was set (the map's sweeps so far).
+        integer :: swept = 0
     end type anderson_t
 
     !> Domain split of the sweeps (split_build): the contacts of the solve in block order,
@@ -463,12 +471,16 @@ contains
             stats%converged = .false.
             do s = 1, config%max_sweeps
                 if (accelerate .and. s > config%anderson_after) then
-                    ! the map accelerated is one sweep in the fixed (bottom-up) contact order;
-                    ! the history is sized when a step first needs it
+                    ! the map accelerated is anderson_sweeps sweeps in the fixed (bottom-up)
+                    ! contact order, from x; the history is sized when a step first needs it
                     if (aa%depth == 0) call anderson_init(aa, config%anderson, cs, list)
-                    if (.not. aa%x_valid) call gather(cs, list, aa%d, aa%x, split%nb > 1)
-                    aa%x_valid = .true.
+                    if (.not. aa%x_valid) then
+                        call gather(cs, list, aa%d, aa%x, split%nb > 1)
+                        aa%x_valid = .true.
+                        aa%swept = 0
+                    end if
                     call split_sweep(config, omega, cs, im, vel, sc, split, .true., num, den, nloc, bilateral)
+                    aa%swept = aa%swept + 1
                 else
                     call split_sweep(config, omega, cs, im, vel, sc, split, &
                                      .not. (config%symmetric .and. mod(s, 2) == 0), num, den, nloc, bilateral)
@@ -517,8 +529,12 @@ contains
                     if (stats%error > checked) omega = 1.0_wp
                     checked = stats%error
                 end if
-                if (accelerate .and. s > config%anderson_after) call anderson_mix(aa, cs, list, im, vfree, vel, split, &
-                                                                                  bilateral)
+                if (accelerate .and. s > config%anderson_after) then
+                    if (aa%swept == max(config%anderson_sweeps, 1)) then
+                        call anderson_mix(aa, cs, list, im, vfree, vel, split, bilateral)
+                        aa%swept = 0
+                    end if
+                end if
                 if (coarse .and. mod(s, config%coarse_every) == 0) then
                     ! safeguard: no more corrections once the error at one is larger than at
                     ! the previous one
@@ -875,21 +891,33 @@ contains
         real(wp), intent(in) :: d(:)
         real(wp), intent(out) :: x(:)
         logical, intent(in) :: parallel
-        integer :: a, k
-        !$omp parallel do schedule(static) private(k) if (parallel)
-        do a = 1, size(list)
+        integer :: a
+        if (parallel) then
+            !$omp parallel do schedule(static)
+            do a = 1, size(list)
+                call one(a)
+            end do
+            !$omp end parallel do
+        else
+            do a = 1, size(list)
+                call one(a)
+            end do
+        end if
+    contains
+        subroutine one(a)
+            integer, intent(in) :: a
+            integer :: k
             k = list(a)
             x(3*a - 2) = d(3*a - 2)*(cs%r(1, k) + cs%coh(k))
             x(3*a - 1) = d(3*a - 1)*cs%r(2, k)
             x(3*a) = d(3*a)*cs%r(3, k)
-        end do
-        !$omp end parallel do
+        end subroutine one
     end subroutine gather
 
-    !> One Anderson step after a sweep: with x the reactions before the sweep and g after,
+    !> One Anderson step after the map's sweeps: with x the reactions before them and g after,
     !> f = g - x; the new iterate is g - dG gamma, gamma minimising |f - dF gamma| over the
     !> history, projected on the cones, and the velocities are recomputed from it. When |f|
-    !> rose since the last sweep the history is cleared and g is kept (plain NLGS step).
+    !> rose since the last step the history is cleared and g is kept (plain NLGS step).
     !> Three passes over the contacts: g, f, their differences and |f| (pass_residual); the
     !> new row of the Gram matrix and the right-hand side (pass_products); the mixed,
     !> projected iterate, kept in x for the next step (pass_mix). The sums are taken by
@@ -962,72 +990,113 @@ contains
         if (present(bilateral)) call bilateral%restore(vel)
     contains
         ! g = D (r_n + r_cohe h, r_t, M), f = g - x, |f|^2 per chunk in aa%part(1, :); with
-        ! `history`, their differences with the previous ones in column slot
+        ! `history`, their differences with the previous ones in column slot. Like the two
+        ! passes below, on the threads only when the sweeps are split; otherwise no parallel
+        ! region is opened at all: even with `if (.false.)` or one thread, libgomp ends a
+        ! region with a futex system call (100 per step of the 200-disk deposit, 5 % of its time)
         subroutine pass_residual(history)
             logical, intent(in) :: history
-            real(wp) :: g(3*dot_chunk), f(3*dot_chunk)
-            integer :: c, a, k, lo, hi, n
-            !$omp parallel do schedule(static) private(a, k, lo, hi, n, g, f) if (split%nb > 1)
-            do c = 1, nc
-                lo = 3*(c - 1)*dot_chunk + 1
-                hi = 3*min(c*dot_chunk, size(list))
-                n = hi - lo + 1
-                do a = (c - 1)*dot_chunk + 1, min(c*dot_chunk, size(list))
-                    k = list(a)
-                    g(3*a - 2 - lo + 1) = cs%r(1, k) + cs%coh(k)
-                    g(3*a - 1 - lo + 1) = cs%r(2, k)
-                    g(3*a - lo + 1) = cs%r(3, k)
+            integer :: c
+            if (split%nb > 1) then
+                !$omp parallel do schedule(static)
+                do c = 1, nc
+                    call residual_chunk(c, history)
                 end do
-                g(1:n) = aa%d(lo:hi)*g(1:n)
-                f(1:n) = g(1:n) - aa%x(lo:hi)
-                if (history) then
-                    aa%df(lo:hi, slot) = f(1:n) - aa%fprev(lo:hi)
-                    aa%dg(lo:hi, slot) = g(1:n) - aa%gprev(lo:hi)
-                end if
-                aa%fprev(lo:hi) = f(1:n)
-                aa%gprev(lo:hi) = g(1:n)
-                aa%part(1, c) = dot(f(1:n), f(1:n))
-            end do
-            !$omp end parallel do
+                !$omp end parallel do
+            else
+                do c = 1, nc
+                    call residual_chunk(c, history)
+                end do
+            end if
         end subroutine pass_residual
+
+        subroutine residual_chunk(c, history)
+            integer, intent(in) :: c
+            logical, intent(in) :: history
+            real(wp) :: g(3*dot_chunk), f(3*dot_chunk)
+            integer :: a, k, lo, hi, n
+            lo = 3*(c - 1)*dot_chunk + 1
+            hi = 3*min(c*dot_chunk, size(list))
+            n = hi - lo + 1
+            do a = (c - 1)*dot_chunk + 1, min(c*dot_chunk, size(list))
+                k = list(a)
+                g(3*a - 2 - lo + 1) = cs%r(1, k) + cs%coh(k)
+                g(3*a - 1 - lo + 1) = cs%r(2, k)
+                g(3*a - lo + 1) = cs%r(3, k)
+            end do
+            g(1:n) = aa%d(lo:hi)*g(1:n)
+            f(1:n) = g(1:n) - aa%x(lo:hi)
+            if (history) then
+                aa%df(lo:hi, slot) = f(1:n) - aa%fprev(lo:hi)
+                aa%dg(lo:hi, slot) = g(1:n) - aa%gprev(lo:hi)
+            end if
+            aa%fprev(lo:hi) = f(1:n)
+            aa%gprev(lo:hi) = g(1:n)
+            aa%part(1, c) = dot(f(1:n), f(1:n))
+        end subroutine residual_chunk
 
         ! per chunk: df_slot . df_j in aa%part(j, :), df_j . f in aa%part(m + j, :), j = 1..m
         ! (a chunk's columns stay in cache while they are read again)
         subroutine pass_products(m)
             integer, intent(in) :: m
-            integer :: c, j, lo, hi
-            !$omp parallel do schedule(static) private(j, lo, hi) if (split%nb > 1)
-            do c = 1, nc
-                lo = 3*(c - 1)*dot_chunk + 1
-                hi = 3*min(c*dot_chunk, size(list))
-                do j = 1, m
-                    aa%part(j, c) = dot(aa%df(lo:hi, slot), aa%df(lo:hi, j))
-                    aa%part(m + j, c) = dot(aa%df(lo:hi, j), aa%fprev(lo:hi))
+            integer :: c
+            if (split%nb > 1) then
+                !$omp parallel do schedule(static)
+                do c = 1, nc
+                    call products_chunk(c, m)
                 end do
-            end do
-            !$omp end parallel do
+                !$omp end parallel do
+            else
+                do c = 1, nc
+                    call products_chunk(c, m)
+                end do
+            end if
         end subroutine pass_products
 
+        subroutine products_chunk(c, m)
+            integer, intent(in) :: c, m
+            integer :: j, lo, hi
+            lo = 3*(c - 1)*dot_chunk + 1
+            hi = 3*min(c*dot_chunk, size(list))
+            do j = 1, m
+                aa%part(j, c) = dot(aa%df(lo:hi, slot), aa%df(lo:hi, j))
+                aa%part(m + j, c) = dot(aa%df(lo:hi, j), aa%fprev(lo:hi))
+            end do
+        end subroutine products_chunk
+
         ! x = g - dG gamma, back to reactions on the cones, and x = D r of the result; with
-        ! `apply_now`, serially, vel += M^-1 H r of each contact too
+        ! `apply_now` (the serial path), vel += M^-1 H r of each contact too
         subroutine pass_mix(m, apply_now)
             integer, intent(in) :: m
             logical, intent(in) :: apply_now
-            integer :: c, j, lo, hi
-            !$omp parallel do schedule(static) private(j, lo, hi) if (.not. apply_now)
-            do c = 1, nc
-                lo = 3*(c - 1)*dot_chunk + 1
-                hi = 3*min(c*dot_chunk, size(list))
-                aa%x(lo:hi) = aa%gprev(lo:hi)
-                do j = 1, m
-                    aa%x(lo:hi) = aa%x(lo:hi) - gamma(j)*aa%dg(lo:hi, j)
+            integer :: c
+            if (.not. apply_now) then
+                !$omp parallel do schedule(static)
+                do c = 1, nc
+                    call mix_chunk(c, m, apply_now)
                 end do
-                call project_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%erol, cs%mu, cs%coh, cs%r, size(vel, 2), &
-                                      im, vel, size(list), list, (c - 1)*dot_chunk + 1, min(c*dot_chunk, size(list)), &
-                                      aa%x, aa%d, aa%dinv, apply_now)
-            end do
-            !$omp end parallel do
+                !$omp end parallel do
+            else
+                do c = 1, nc
+                    call mix_chunk(c, m, apply_now)
+                end do
+            end if
         end subroutine pass_mix
+
+        subroutine mix_chunk(c, m, apply_now)
+            integer, intent(in) :: c, m
+            logical, intent(in) :: apply_now
+            integer :: j, lo, hi
+            lo = 3*(c - 1)*dot_chunk + 1
+            hi = 3*min(c*dot_chunk, size(list))
+            aa%x(lo:hi) = aa%gprev(lo:hi)
+            do j = 1, m
+                aa%x(lo:hi) = aa%x(lo:hi) - gamma(j)*aa%dg(lo:hi, j)
+            end do
+            call project_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%erol, cs%mu, cs%coh, cs%r, size(vel, 2), &
+                                  im, vel, size(list), list, (c - 1)*dot_chunk + 1, min(c*dot_chunk, size(list)), &
+                                  aa%x, aa%d, aa%dinv, apply_now)
+        end subroutine mix_chunk
     end subroutine anderson_mix
 
     !> The mixed iterate of the contacts list(first:last) back to reactions on their cones:

@@ -771,6 +771,7 @@ contains
             sys%solver%check_every = deck%get_int('solver', 'check_every')
             sys%solver%anderson = deck%get_int('solver', 'anderson')
             sys%solver%anderson_after = deck%get_int('solver', 'anderson_after')
+            sys%solver%anderson_sweeps = deck%get_int('solver', 'anderson_sweeps')
             sys%solver%hydrostatic = deck%get_word('solver', 'cold_start') == 'hydrostatic'
             sys%solver%symmetric = deck%get_word('solver', 'sweep_order') == 'alternating'
             sys%solver%criterion = criterion_lmgc90

@@ -201,7 +201,12 @@ contains
         call s%add_keyword('solver', 'anderson_after', [int_field('anderson_after', lower=0)], &
                            'With `anderson` > 0: plain sweeps before the Anderson steps start. A step that '// &
                            'converges within them is not accelerated: near rest a plain sweep is cheaper and '// &
-                           'a few suffice (doc/performance.md).', default='50')
+                           'a few suffice (doc/performance.md).', default='10')
+        call s%add_keyword('solver', 'anderson_sweeps', [int_field('anderson_sweeps', lower=1)], &
+                           'With `anderson` > 0: sweeps per Anderson step (the map accelerated is that '// &
+                           'many forward sweeps). An Anderson step costs about one sweep; over 2 sweeps its '// &
+                           'cost per sweep is half, for about as many sweeps (doc/performance.md). 1 mixes '// &
+                           'after every sweep.', default='2')
         call s%add_keyword('solver', 'sweep_order', [word_field('sweep_order', 'alternating forward')], &
                            'Order of the plain sweeps: `alternating` (forward, then backward through the '// &
                            'contact list, in turn: symmetric Gauss-Seidel) or `forward` (every sweep in the '// &
