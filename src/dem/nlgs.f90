@@ -929,8 +929,9 @@ contains
     !> One Anderson step after the map's sweeps: with x the reactions before them and g after,
     !> f = g - x; the new iterate is g - dG gamma, gamma minimising |f - dF gamma| over the
     !> history, projected on the cones, and the velocities are recomputed from it. When |f|
-    !> rose since the last step the history is cleared and g is kept (plain NLGS step).
-    !> Three passes over the contacts: g, f, their differences and |f| (pass_residual); the
+    !> rose since the last step, or the extrapolation would exceed anderson_max_step |g|, the
+    !> history is cleared and g is kept (plain NLGS step).
+    !> Three passes over the contacts: g, f, their differences, |f| and |g| (pass_residual); the
     !> new row of the Gram matrix and the right-hand side (pass_products); the mixed,
     !> projected iterate, kept in x for the next step (pass_mix). The sums are taken by
     !> fixed chunks of contacts, in parallel, then over the chunks in order: the same result
