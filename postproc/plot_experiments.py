@@ -58,7 +58,7 @@ def summary_lines(runs, time):
         return value(series[name]) if name in series else np.nan
 
     for name, r in runs.items():
-        s, e = r.steps, r.energy
+        s, e = r.coupling.steps, r.coupling.energy
         wall = float(r.summary.get("wall_seconds", np.nan))
         n_steps = next((v.size for v in s.values()), 0)
         lines.append(f"{name:<15} {n_steps:>6d} {of(s, 'position_residual', np.max):>14.3e} "

@@ -124,26 +124,6 @@ class CoupledResults:
     summary: dict                # /summary attributes (steps, wall_seconds, ...) or {}
 
     @property
-    def lam(self) -> np.ndarray:
-        """Multipliers (n_out, n_rows) [N]."""
-        return self.coupling.lam
-
-    @property
-    def steps(self) -> dict:
-        """Per-step arrays: g_norm, position_residual, ..."""
-        return self.coupling.steps
-
-    @property
-    def energy(self) -> dict:
-        """/coupling/energy/<name> (n_out,) [J], with "time"."""
-        return self.coupling.energy
-
-    @property
-    def coupling_attrs(self) -> dict:
-        """Attributes of /coupling."""
-        return self.coupling.attrs
-
-    @property
     def title(self) -> str:
         return self.attrs.get("title", "") or os.path.basename(self.path)
 

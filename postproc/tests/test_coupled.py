@@ -31,10 +31,10 @@ def test_loader_reads_the_three_parts_with_zero_based_coupled_disks(coupled_file
     assert res.n_disks == DISK_X.size
     assert res.time.shape == (N_OUT,)
     assert res.fe_displacement.shape == (N_OUT, NODE_X.size, 3)
-    assert res.lam.shape == (N_OUT, 2 * COUPLED.size)
+    assert res.coupling.lam.shape == (N_OUT, 2 * COUPLED.size)
     np.testing.assert_array_equal(res.coupled, COUPLED - 1)
     np.testing.assert_allclose(res.overlap, OVERLAP, rtol=0, atol=EXACT)
-    assert res.steps["g_norm"].size == (N_OUT - 1) * STEPS_PER_OUT
+    assert res.coupling.steps["g_norm"].size == (N_OUT - 1) * STEPS_PER_OUT
     assert res.summary["wall_seconds"] == 0.25
     assert res.title == "synthetic coupled"
 
