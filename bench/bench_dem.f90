@@ -25,7 +25,9 @@
 !> the decks, 0: plain sweeps), --anderson-after K (plain sweeps before the Anderson steps;
 !> default 10, `[solver] anderson_after`), --anderson-sweeps P (sweeps per Anderson step;
 !> default 2, `[solver] anderson_sweeps`), --relaxation W,
-!> --check-every K (safeguard period of the over-relaxation), --criterion siconos,
+!> --check-every K (safeguard period of the over-relaxation), --criterion siconos, --tol T
+!> (tolerance of the packings, default 1.666e-4), --settle-tol T (of their settling steps,
+!> default the same),
 !> --max-sweeps C (cap of the timed steps), --forward (no alternating sweeps), --settle S (steps
 !> before timing, default 10), --settle-anderson M and --settle-sweeps C (solver of those
 !> steps, default the timed one), --verbose (sweeps, Siconos error, solver ms of every timed
@@ -97,6 +99,9 @@ program bench_dem
     character(len=256) :: arg, val
     !> Solver options from the command line (see the header).
     real(wp) :: relaxation = 1.0_wp
+    !> Tolerance of the timed steps and of the settling steps (--tol, --settle-tol; 0: the
+    !> timed one).
+    real(wp) :: tol = 1.666e-4_wp, settle_tol = 0.0_wp
     integer :: criterion = criterion_lmgc90, max_sweeps = 200, check_every = 10, settle_sweeps = 0, iarg
     integer :: anderson = 5, settle_anderson = -1, anderson_after = 10, anderson_sweeps = 2
     logical :: convergence = .false., sizes_given = .false., verbose = .false., symmetric = .true.
@@ -127,6 +132,12 @@ program bench_dem
             iarg = iarg - 1
         case ('--relaxation')
             call read_real_value(arg, val, relaxation)
+        case ('--tol')
+            call read_real_value(arg, val, tol)
+            if (.not. tol > 0.0_wp) call usage_error('--tol needs a tolerance > 0')
+        case ('--settle-tol')
+            call read_real_value(arg, val, settle_tol)
+            if (.not. settle_tol > 0.0_wp) call usage_error('--settle-tol needs a tolerance > 0')
         case ('--max-sweeps')
             call read_int_value(arg, val, max_sweeps)
         case ('--forward')
@@ -277,7 +288,7 @@ contains
             '         [--anderson-sweeps P] [--relaxation W --check-every K] [--criterion lmgc90|siconos] [--forward]', &
             '         [--hydrostatic] [--method nlgs|block|coarse] [--coarse-every K] [--coarse-size M]', &
             '         [--settle-anderson M] [--settle-sweeps C] [--settle-method M] [--scheme multicor|siconos]', &
-            '         [--verbose]', &
+            '         [--tol T] [--settle-tol T] [--verbose]', &
             '       bench_dem --convergence', &
             '       bench_dem --siconos 200|2000 [--seed S] [--scheme siconos|multicor] [--csv FILE] [--deck FILE]', &
             '         [--anderson M] [--anderson-after K] [--anderson-sweeps P] [--forward] [--verbose]', &
@@ -304,12 +315,14 @@ contains
         n_steps = max(8, 200000/n)
         call build(sys, n, c)
         if (settle_sweeps > 0) sys%solver%max_sweeps = settle_sweeps
+        if (settle_tol > 0.0_wp) sys%solver%tol = settle_tol
         if (settle_anderson >= 0) sys%solver%anderson = settle_anderson
         if (settle_method >= 0) sys%solver%method = settle_method
         do s = 1, n_settle
             call mj_step(sys)
         end do
         sys%solver%max_sweeps = max_sweeps
+        sys%solver%tol = tol
         sys%solver%anderson = anderson
         sys%solver%anderson_after = anderson_after
         sys%solver%anderson_sweeps = anderson_sweeps
@@ -399,8 +412,8 @@ contains
         integer :: k
         cold_sizes = [250, 1000, 4000, 16000]
         if (sizes_given) cold_sizes = sizes
-        write (output_unit, '(a)') '# first step from rest, no warm start, tolerance 1.666e-4, ' &
-            //'cap 50000 sweeps; height/d: deposit height in mean diameters'
+        write (output_unit, '(a,es10.4,a)') '# first step from rest, no warm start, tolerance ', tol, &
+            ', cap 50000 sweeps; height/d: deposit height in mean diameters'
         write (output_unit, '(a)') '#      N  height/d  active  sweeps  converged  solve[s]  updates/s' &
             //'   v_mean[g h]'
         do k = 1, size(cold_sizes)
@@ -648,7 +661,7 @@ contains
         sys%particles%gravity = [0.0_wp, -gravity]
         sys%scheme%h = step
         sys%scheme%alert = 0.05_wp*radius_mean
-        sys%solver%tol = 1.666e-4_wp
+        sys%solver%tol = tol
         sys%solver%max_sweeps = max_sweeps
         sys%solver%relaxation = relaxation
         sys%solver%check_every = check_every
