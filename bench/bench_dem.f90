@@ -27,7 +27,7 @@
 !> default 2, `[solver] anderson_sweeps`), --relaxation W,
 !> --check-every K (safeguard period of the over-relaxation), --criterion siconos, --tol T
 !> (tolerance of the packings, default 1.666e-4), --settle-tol T (of their settling steps,
-!> default the same),
+!> default the same), --steps K (timed steps; default at least 8 and about 2e5 disk-steps),
 !> --max-sweeps C (cap of the timed steps), --forward (no alternating sweeps), --settle S (steps
 !> before timing, default 10), --settle-anderson M and --settle-sweeps C (solver of those
 !> steps, default the timed one), --verbose (sweeps, Siconos error, solver ms of every timed
@@ -91,6 +91,8 @@ program bench_dem
     integer, allocatable :: sizes(:)
     !> Steps before timing (the warm start fills up).
     integer :: n_settle = 10
+    !> Timed steps of a packing (--steps; 0: at least 8, and about 2e5 disk-steps).
+    integer :: n_timed = 0
     real(wp), parameter :: radius_mean = 1.0e-3_wp, gravity = 9.81_wp, step = 1.0e-3_wp
     !> Rounds of the interleaved detection timing.
     integer, parameter :: n_rounds = 30
@@ -172,6 +174,9 @@ program bench_dem
             call read_int_value(arg, val, settle_anderson)
         case ('--settle')
             call read_int_value(arg, val, n_settle)
+        case ('--steps')
+            call read_int_value(arg, val, n_timed)
+            if (n_timed < 1) call usage_error('--steps needs an integer >= 1')
         case ('--settle-sweeps')
             call read_int_value(arg, val, settle_sweeps)
         case ('--method')
@@ -288,7 +293,7 @@ contains
             '         [--anderson-sweeps P] [--relaxation W --check-every K] [--criterion lmgc90|siconos] [--forward]', &
             '         [--hydrostatic] [--method nlgs|block|coarse] [--coarse-every K] [--coarse-size M]', &
             '         [--settle-anderson M] [--settle-sweeps C] [--settle-method M] [--scheme multicor|siconos]', &
-            '         [--tol T] [--settle-tol T] [--verbose]', &
+            '         [--tol T] [--settle-tol T] [--steps K] [--verbose]', &
             '       bench_dem --convergence', &
             '       bench_dem --siconos 200|2000 [--seed S] [--scheme siconos|multicor] [--csv FILE] [--deck FILE]', &
             '         [--anderson M] [--anderson-after K] [--anderson-sweeps P] [--forward] [--verbose]', &
@@ -311,8 +316,9 @@ contains
         real(wp), allocatable :: t_det(:), t_sol(:), rate(:)
         integer :: s, n_steps, sweeps, n_conv, corrections
         real(wp) :: before_det, before_sol, sic
-        ! at least 8 steps, and ~2e5 disk-steps for the small cases
+        ! at least 8 steps, and ~2e5 disk-steps for the small cases (unless --steps)
         n_steps = max(8, 200000/n)
+        if (n_timed > 0) n_steps = n_timed
         call build(sys, n, c)
         if (settle_sweeps > 0) sys%solver%max_sweeps = settle_sweeps
         if (settle_tol > 0.0_wp) sys%solver%tol = settle_tol
