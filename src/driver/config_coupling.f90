@@ -95,12 +95,6 @@ contains
                                   ' '//to_str(dem%system%particles%gravity(2)))
             return
         end if
-        if (deck%has('solver', 'fclib_step')) then
-            call make_input_error(error, deck%file, deck%line('solver', 'fclib_step'), 'fclib_step', &
-                                  'coupled runs do not export their contact problem yet (the coupling rows '// &
-                                  'are not contacts): remove fclib_step')
-            return
-        end if
         if (deck%has('coupling', 'region')) then
             call make_input_error(error, deck%file, deck%line('coupling', 'region'), 'region', &
                                   'region lines define the overlap of a [continuum]; a beam takes overlap = '// &

@@ -11,8 +11,8 @@
 !> run ([coupling] without both models, [continuum] with [beam], or with only one of
 !> [particles] and [coupling]) and the keywords that
 !> the kind of run would ignore (particle settings in a deck without particles, beam
-!> settings and [initial] in a deck without a beam), each error naming file, line and
-!> keyword.
+!> settings and [initial] in a deck without a beam, the export of the contact problem,
+!> `[solver] fclib_step`, in a coupled run), each error naming file, line and keyword.
 module driver_run_kind
     use core_error, only: error_t, make_input_error
     use io_deck, only: deck_t
@@ -98,6 +98,12 @@ contains
             call check_initial_unused(deck, error)
         case (run_particles)
             call check_beam_keywords_unused(deck, error)
+        case (run_coupled, run_coupled2d)
+            if (deck%has('solver', 'fclib_step')) then
+                call make_input_error(error, deck%file, deck%line('solver', 'fclib_step'), 'fclib_step', &
+                                      'coupled runs do not export their contact problem yet (the coupling rows '// &
+                                      'are not contacts): remove fclib_step')
+            end if
         end select
     end subroutine check_run_kind
 
