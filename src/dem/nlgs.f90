@@ -253,6 +253,13 @@ module dem_nlgs
     !> 64.34 sweeps per step over 24 layouts of 200 disks against 64.33 without the bound
     !> (65.23 with a bound of 1), the 10^4-disk protocol unchanged (doc/performance.md).
     real(wp), parameter :: anderson_max_step = 10.0_wp
+    !> Drift of the sweeps (anderson_mix, drift_length): |f| / |f_prev| between 1 and
+    !> drift_high, 1 - cos(f, f_prev) below drift_cosine; a face of a cone nearer than
+    !> drift_slack times |r| counts as the one the reaction is on; the skip is taken when it is
+    !> at least drift_min maps long.
+    real(wp), parameter :: drift_high = 1.01_wp, drift_cosine = 1.0e-4_wp
+    real(wp), parameter :: drift_slack = 1.0e-9_wp
+    real(wp), parameter :: drift_min = 2.0_wp
 
     !> Linear velocity constraints kept satisfied during the sweeps (see the module header).
     type, abstract :: nlgs_bilateral_t
@@ -883,7 +890,7 @@ contains
         aa%depth = depth
         allocate (aa%df(n, depth), aa%dg(n, depth), aa%gram(depth, depth))
         allocate (aa%x(n), aa%fprev(n), aa%gprev(n), aa%d(n), aa%dinv(n))
-        allocate (aa%part(max(2*depth, 3), (size(list) + dot_chunk - 1)/dot_chunk), aa%dgnorm(depth))
+        allocate (aa%part(max(2*depth, 4), (size(list) + dot_chunk - 1)/dot_chunk), aa%dgnorm(depth))
         do a = 1, size(list)
             k = list(a)
             aa%d(3*a - 2) = sqrt(cs%w(1, k))
@@ -944,14 +951,30 @@ contains
         real(wp), intent(inout) :: vel(:, :)
         type(split_t), intent(in) :: split
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
-        real(wp) :: gamma(aa%depth), rhs(aa%depth), fnorm, gnorm
+        real(wp) :: gamma(aa%depth), rhs(aa%depth), fnorm, gnorm, fnorm_before, dfnorm2, drift
         integer :: slot, m, nc, c, j
         nc = size(aa%part, 2)
         slot = aa%next
         call pass_residual(aa%started)
         fnorm = sqrt(sum(aa%part(1, :)))
         gnorm = sqrt(sum(aa%part(2, :)))
-        if (aa%started) aa%dgnorm(slot) = sqrt(sum(aa%part(3, :)))
+        fnorm_before = aa%fnorm_prev
+        dfnorm2 = huge(1.0_wp)
+        if (aa%started) then
+            aa%dgnorm(slot) = sqrt(sum(aa%part(3, :)))
+            dfnorm2 = sum(aa%part(4, :))
+        end if
+        drift = 0.0_wp
+        if (ieee_is_finite(fnorm)) drift = drift_length()
+        if (drift > 0.0_wp) then
+            ! the sweeps drift: no mixing of the history can follow them (there is no fixed
+            ! point along the drift); skip the drift and restart the history from there
+            aa%used = 0
+            aa%next = 1
+            aa%fnorm_prev = fnorm
+            call rebuild(0)
+            return
+        end if
         if ((aa%started .and. fnorm > aa%fnorm_prev) .or. .not. ieee_is_finite(fnorm)) then
             ! safeguard: the residual rose (or overflowed), restart from the plain sweep's result
             aa%used = 0
@@ -990,28 +1013,90 @@ contains
             aa%x = aa%gprev
             return
         end if
-        if (present(bilateral)) then
-            ! the velocities without the swept contacts' impulses, with the multipliers' share
-            ! as it stands (vfree + that share: the sweeps keep vel = vfree + M^-1 H r + share)
-            do j = 1, size(list)
-                c = list(j)
-                call apply(cs, c, im, vel, -cs%r(1, c), -cs%r(2, c), -cs%r(3, c))
-            end do
-        else
-            vel = vfree
-        end if
-        if (split%nb == 1) then
-            ! one pass: each contact's impulse applied where its reaction is set, in the order
-            ! of split_apply for one block
-            call pass_mix(m, .true.)
-        else
-            call pass_mix(m, .false.)
-            call split_apply(cs, split, im, vel)
-        end if
-        ! the multipliers of the mixed reactions: the constraints hold again (exactly, they are
-        ! linear in the velocities)
-        if (present(bilateral)) call bilateral%restore(vel)
+        call rebuild(m)
     contains
+        ! the iterate x = g - dG gamma(1:m) (+ drift f), projected on the cones, and the
+        ! velocities recomputed from it
+        subroutine rebuild(m)
+            integer, intent(in) :: m
+            integer :: j, c
+            if (present(bilateral)) then
+                ! the velocities without the swept contacts' impulses, with the multipliers'
+                ! share as it stands (vfree + that share: the sweeps keep vel = vfree + M^-1 H r
+                ! + share)
+                do j = 1, size(list)
+                    c = list(j)
+                    call apply(cs, c, im, vel, -cs%r(1, c), -cs%r(2, c), -cs%r(3, c))
+                end do
+            else
+                vel = vfree
+            end if
+            if (split%nb == 1) then
+                ! one pass: each contact's impulse applied where its reaction is set, in the
+                ! order of split_apply for one block
+                call pass_mix(m, .true.)
+            else
+                call pass_mix(m, .false.)
+                call split_apply(cs, split, im, vel)
+            end if
+            ! the multipliers of the mixed reactions: the constraints hold again (exactly, they
+            ! are linear in the velocities)
+            if (present(bilateral)) call bilateral%restore(vel)
+        end subroutine rebuild
+
+        ! The drift of the sweeps, when the map moves the iterate by the same f again and again
+        ! without contracting (1 <= |f| / |f_prev| <= drift_high, 1 - cos(f, f_prev) below
+        ! drift_cosine): the number t of further maps after which the first contact of the drift
+        ! reaches a face of its cone (its status changes there), so that g + t f skips them.
+        ! 0 when there is no drift, no contact reaches a face, t < drift_min, or t |f| >
+        ! anderson_max_step |g|.
+        real(wp) function drift_length() result(t)
+            real(wp) :: cosine, rho
+            integer :: c
+            t = 0.0_wp
+            if (dfnorm2 == huge(1.0_wp) .or. fnorm <= 0.0_wp .or. fnorm_before <= 0.0_wp) return
+            rho = fnorm/fnorm_before
+            if (rho < 1.0_wp .or. rho > drift_high) return
+            cosine = (fnorm**2 + fnorm_before**2 - dfnorm2)/(2.0_wp*fnorm*fnorm_before)
+            if (cosine < 1.0_wp - drift_cosine) return
+            if (split%nb > 1) then
+                !$omp parallel do schedule(static)
+                do c = 1, nc
+                    call bounds_chunk(c)
+                end do
+                !$omp end parallel do
+            else
+                do c = 1, nc
+                    call bounds_chunk(c)
+                end do
+            end if
+            t = minval(aa%part(4, 1:nc))
+            if (t < drift_min .or. t*fnorm > anderson_max_step*gnorm) t = 0.0_wp
+        end function drift_length
+
+        ! per chunk, in aa%part(4, c): the least t > 0 at which a reaction p + t dp of the
+        ! chunk (p = g / D, dp = f / D) leaves a face of its cone it is not on
+        subroutine bounds_chunk(c)
+            integer, intent(in) :: c
+            real(wp) :: p(3), dp(3), t, scale
+            integer :: a, k, i
+            t = huge(1.0_wp)
+            do a = (c - 1)*dot_chunk + 1, min(c*dot_chunk, size(list))
+                k = list(a)
+                i = 3*a - 3
+                p = aa%gprev(i + 1:i + 3)*aa%dinv(i + 1:i + 3)
+                dp = aa%fprev(i + 1:i + 3)*aa%dinv(i + 1:i + 3)
+                scale = drift_slack*(abs(p(1)) + abs(p(2)) + abs(p(3)))
+                t = min(t, time_to_face(p(1), dp(1), scale), &
+                        time_to_face(cs%mu(k)*p(1) - p(2), cs%mu(k)*dp(1) - dp(2), scale), &
+                        time_to_face(cs%mu(k)*p(1) + p(2), cs%mu(k)*dp(1) + dp(2), scale))
+                if (cs%erol(k) > 0.0_wp) &
+                    t = min(t, time_to_face(cs%erol(k)*p(1) - p(3), cs%erol(k)*dp(1) - dp(3), scale), &
+                            time_to_face(cs%erol(k)*p(1) + p(3), cs%erol(k)*dp(1) + dp(3), scale))
+            end do
+            aa%part(4, c) = t
+        end subroutine bounds_chunk
+
         ! g = D (r_n + r_cohe h, r_t, M), f = g - x, |f|^2 and |g|^2 per chunk in aa%part(1:2, :);
         ! with `history`, their differences with the previous ones in column slot, and |dG|^2
         ! of that column in aa%part(3, :). Like the two
@@ -1058,7 +1143,10 @@ contains
             aa%gprev(lo:hi) = g(1:n)
             aa%part(1, c) = dot(f(1:n), f(1:n))
             aa%part(2, c) = dot(g(1:n), g(1:n))
-            if (history) aa%part(3, c) = dot(aa%dg(lo:hi, slot), aa%dg(lo:hi, slot))
+            if (history) then
+                aa%part(3, c) = dot(aa%dg(lo:hi, slot), aa%dg(lo:hi, slot))
+                aa%part(4, c) = dot(aa%df(lo:hi, slot), aa%df(lo:hi, slot))
+            end if
         end subroutine residual_chunk
 
         ! per chunk: df_slot . df_j in aa%part(j, :), df_j . f in aa%part(m + j, :), j = 1..m
@@ -1119,6 +1207,7 @@ contains
             do j = 1, m
                 aa%x(lo:hi) = aa%x(lo:hi) - gamma(j)*aa%dg(lo:hi, j)
             end do
+            if (drift > 0.0_wp) aa%x(lo:hi) = aa%x(lo:hi) + drift*aa%fprev(lo:hi)
             call project_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%erol, cs%mu, cs%coh, cs%r, size(vel, 2), &
                                   im, vel, size(list), list, (c - 1)*dot_chunk + 1, min(c*dot_chunk, size(list)), &
                                   aa%x, aa%d, aa%dinv, apply_now)
@@ -1231,6 +1320,14 @@ contains
         if (a > 0) f = f + vel(1, a)**2 + vel(2, a)**2 + (cs%amoy(k)*vel(3, a))**2
         f = roundoff**2*f
     end function roundoff_floor
+
+    !> Steps t > 0 until v + t dv = 0, for a constraint v >= 0 that holds with more than
+    !> `slack` and decreases (dv < 0); huge otherwise.
+    pure real(wp) function time_to_face(v, dv, slack) result(t)
+        real(wp), intent(in) :: v, dv, slack
+        t = huge(1.0_wp)
+        if (dv < 0.0_wp .and. v > slack) t = v/(-dv)
+    end function time_to_face
 
     !> sqrt(num/den), 0 for 0/0, huge for x/0.
     pure real(wp) function relative(num, den) result(q)
