@@ -259,7 +259,7 @@ module dem_nlgs
     !> at least drift_min maps long.
     real(wp), parameter :: drift_high = 1.01_wp, drift_cosine = 1.0e-4_wp
     real(wp), parameter :: drift_slack = 1.0e-9_wp
-    real(wp), parameter :: drift_min = 2.0_wp
+    real(wp), parameter :: drift_min = 5.0_wp
 
     !> Linear velocity constraints kept satisfied during the sweeps (see the module header).
     type, abstract :: nlgs_bilateral_t
