@@ -27,8 +27,9 @@
 !> each update P_K(r0 + omega (r_loc - r0)), back to omega = 1 when the error measured every
 !> `check_every` sweeps rose), and Anderson mixing of the last `anderson` iterates (on by
 !> default, depth 5; the map is `anderson_sweeps` sweeps in the fixed contact order, 2 by
-!> default; the history restarts when |G(x) - x| grows), after `anderson_after` plain sweeps
-!> (default 10).
+!> default; the history restarts when |G(x) - x| grows; a drift of the sweeps, G(x) - x the
+!> same map after map, is skipped to where its first reaction meets a face of its cone), after
+!> `anderson_after` plain sweeps (default 10).
 !> Cold start (`hydrostatic`, off by default): when no contact of the solve carries a
 !> reaction yet (a fresh packing), the sweeps start from the hydrostatic estimate of
 !> hydrostatic_guess instead of zero reactions.
@@ -937,7 +938,10 @@ contains
     !> f = g - x; the new iterate is g - dG gamma, gamma minimising |f - dF gamma| over the
     !> history, projected on the cones, and the velocities are recomputed from it. When |f|
     !> rose since the last step, or the extrapolation would exceed anderson_max_step |g|, the
-    !> history is cleared and g is kept (plain NLGS step).
+    !> history is cleared and g is kept (plain NLGS step). Before that, a drift (f the same as
+    !> at the last step, not contracting) is skipped: the iterate jumps to g + t f, where the
+    !> first reaction of the drift meets a face of its cone (drift_length), and the history is
+    !> cleared.
     !> Three passes over the contacts: g, f, their differences, |f| and |g| (pass_residual); the
     !> new row of the Gram matrix and the right-hand side (pass_products); the mixed,
     !> projected iterate, kept in x for the next step (pass_mix). The sums are taken by
