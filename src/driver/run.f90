@@ -27,7 +27,7 @@
 module driver_run
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error, make_input_error
-    use core_strings, only: to_str
+    use core_strings, only: string_t, to_str
     use io_lock, only: lock_t, lock_acquire, lock_release
     use io_memory, only: available_memory
     use core_signals, only: caught_signal, signal_name, install_signal_handlers
@@ -40,6 +40,7 @@ module driver_run
     use fem_mesh_generator, only: rectangle_size, check_rectangle_size
     use driver_simulation, only: simulation_t, report_iface
     use driver_simulations, only: select_simulation
+    use driver_run_kind, only: run_kind_warnings
     use driver_config, only: steps_to_end, max_steps
     use driver_checkpoint, only: checkpoint_run_t, checkpoint_name, checkpoint_open
     implicit none
@@ -99,6 +100,7 @@ contains
         kind = sim%checkpoint_kind()
         call apply_end_time(error)
         if (allocated(error)) return
+        call warn_keywords_without_effect()
         call warn_aliased_functions()
         call warn_end_off_the_steps()
         if (opts%check_only) then
@@ -267,8 +269,17 @@ contains
             word = word//"'"
         end function shell_word
 
-        !> Option `--end`: a new end time (the models built by `init` do not depend on it, the step
-        !> count does).
+        !> Settings given in the deck that another setting or the kind of run turns off (the
+        !> deck is valid: a tuning value left in place while it is off).
+        subroutine warn_keywords_without_effect()
+            type(string_t), allocatable :: warnings(:)
+            integer :: i
+            warnings = [deck%ineffective(), run_kind_warnings(deck)]
+            do i = 1, size(warnings)
+                call report(warnings(i)%s)
+            end do
+        end subroutine warn_keywords_without_effect
+
         !> Warn about a harmonic function faster than half the sampling rate of the time step:
         !> the run sees it at fewer than two steps per period, i.e. an alias of another
         !> frequency. Allowed (the deck may mean it), said once per function.
@@ -313,6 +324,8 @@ contains
             end associate
         end subroutine warn_end_off_the_steps
 
+        !> Option `--end`: a new end time (the models built by `init` do not depend on it, the step
+        !> count does).
         subroutine apply_end_time(error)
             type(error_t), allocatable, intent(out) :: error
             real(wp) :: steps

@@ -13,13 +13,17 @@
 !> the kind of run would ignore (particle settings in a deck without particles, beam
 !> settings and [initial] in a deck without a beam, the export of the contact problem,
 !> `[solver] fclib_step`, in a coupled run), each error naming file, line and keyword.
+!> `run_kind_warnings` lists the settings a coupled run accepts but does not use (the coarse
+!> correction and the hydrostatic cold start do not act on the coupling rows: documented
+!> fallbacks, so a warning rather than an error).
 module driver_run_kind
     use core_error, only: error_t, make_input_error
+    use core_strings, only: string_t, to_str
     use io_deck, only: deck_t
     implicit none
     private
     public :: run_beam, run_particles, run_coupled, run_continuum, run_coupled2d
-    public :: run_kind_of, check_run_kind
+    public :: run_kind_of, check_run_kind, run_kind_warnings
 
     !> Kind of run: beam finite elements ([beam] alone).
     integer, parameter :: run_beam = 1
@@ -106,6 +110,29 @@ contains
             end if
         end select
     end subroutine check_run_kind
+
+    !> Warnings for the solver settings that a coupled run accepts and does not use, as
+    !> 'warning: file:line: ...': `method = coarse` (a coupled run sweeps as with `nlgs`) and
+    !> `cold_start = hydrostatic` (its estimate leaves out the coupling rows).
+    function run_kind_warnings(deck) result(warnings)
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        type(string_t), allocatable :: warnings(:)
+        allocate (warnings(0))
+        select case (run_kind_of(deck))
+        case (run_coupled, run_coupled2d)
+            if (deck%has('solver', 'method') .and. deck%get_word('solver', 'method') == 'coarse') &
+                warnings = [warnings, string_t('warning: '//deck%file//':'//to_str(deck%line('solver', 'method'))// &
+                                               ': [solver] method = coarse has no effect in a coupled run: '// &
+                                               'the coarse correction does not act on the coupling rows, and the run '// &
+                                               'sweeps as with method = nlgs')]
+            if (deck%has('solver', 'cold_start') .and. deck%get_word('solver', 'cold_start') == 'hydrostatic') &
+                warnings = [warnings, string_t('warning: '//deck%file//':'//to_str(deck%line('solver', 'cold_start'))// &
+                                               ': [solver] cold_start = hydrostatic has no effect in a coupled run: '// &
+                                               'the hydrostatic estimate leaves out the coupling rows, and a step without '// &
+                                               'reactions starts from zero')]
+        end select
+    end function run_kind_warnings
 
     !> Error for a deck without [particles] that sets particle-only keywords ([walls],
     !> [contacts], [solver], [time] theta and contact_scheme, [output] contacts): they would

@@ -7,7 +7,9 @@
 !> against the schema as it is read (known section and keyword, number of values, types,
 !> ranges, allowed words, duplicates of scalar keywords); then required keywords and
 !> conditional ones (`required_when`, `allowed_when`) are checked. The first problem found
-!> stops the reading with an error `file:line: keyword 'kw': message`.
+!> stops the reading with an error `file:line: keyword 'kw': message`. A keyword given where
+!> another setting turns it off (schema `effective_when`) is valid: `deck%ineffective()` lists
+!> the warnings to print.
 !>
 !> Access after a successful read:
 !> - `deck%has(section, keyword)`, `deck%count(...)`, `deck%line(...)` (first line, 0 if absent);
@@ -107,6 +109,8 @@ module io_deck
         generic :: get_word => deck_get_word, deck_get_word_named
         !> A text value, from the deck or the schema default.
         procedure :: get_text => deck_get_text
+        !> Warnings for the keywords given that have no effect (schema `effective_when`).
+        procedure :: ineffective => deck_ineffective
     end type deck_t
 
 contains
@@ -574,7 +578,7 @@ contains
         do k = 1, size(deck%schema%keywords)
             associate (kw => deck%schema%keywords(k), c => deck%schema%keywords(k)%required_when)
                 if (c%active .and. first_line(k) == 0) then
-                    if (deck%get_word(c%section, c%keyword) == c%word) then
+                    if (condition_holds(deck, c)) then
                         call make_input_error(error, deck%file, deck%line(c%section, c%keyword), &
                                               kw%name, 'missing: ['//kw%section//'] '//kw%name// &
                                               ' is required when '//c%text())
@@ -586,8 +590,8 @@ contains
         do k = 1, size(deck%schema%keywords)
             associate (kw => deck%schema%keywords(k), c => deck%schema%keywords(k)%allowed_when)
                 if (c%active .and. first_line(k) > 0) then
-                    actual = deck%get_word(c%section, c%keyword)
-                    if (actual /= c%word) then
+                    if (.not. condition_holds(deck, c)) then
+                        actual = deck%get_word(c%section, c%keyword)
                         call make_input_error(error, deck%file, first_line(k), kw%name, &
                                               'only allowed when '//c%text()//'; here '//c%keyword// &
                                               ' = '//actual//condition_origin(deck, c)// &
@@ -615,6 +619,55 @@ contains
             end if
         end do
     end function value_hint
+
+    !> Whether a condition holds in the deck: the first field of the keyword tested (or its
+    !> default) is the condition's word, compared by value when both read as numbers.
+    function condition_holds(deck, c) result(holds)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> The condition.
+        type(condition_t), intent(in) :: c
+        logical :: holds
+        character(len=:), allocatable :: actual
+        real(wp) :: x, y
+        logical :: ok_x, ok_y
+        actual = deck%get_word(c%section, c%keyword)
+        call parse_real(actual, x, ok_x)
+        call parse_real(c%word, y, ok_y)
+        if (ok_x .and. ok_y) then
+            holds = x == y
+        else
+            holds = actual == c%word
+        end if
+        if (c%negate) holds = .not. holds
+    end function condition_holds
+
+    !> Warnings for the keywords of the deck that have no effect: those whose schema
+    !> `effective_when` condition does not hold, as 'warning: file:line: ...'.
+    function deck_ineffective(deck) result(warnings)
+        !> The deck.
+        class(deck_t), intent(in) :: deck
+        type(string_t), allocatable :: warnings(:)
+        integer, allocatable :: lines(:)
+        integer :: k, line, i
+        allocate (warnings(0), lines(0))
+        do k = 1, size(deck%schema%keywords)
+            associate (kw => deck%schema%keywords(k), c => deck%schema%keywords(k)%effective_when)
+                if (.not. c%active) cycle
+                line = deck%line(kw%section, kw%name)
+                if (line == 0) cycle
+                if (condition_holds(deck, c)) cycle
+                ! in the order of the deck's lines
+                i = count(lines <= line) + 1
+                lines = [lines(1:i - 1), line, lines(i:)]
+                warnings = [warnings(1:i - 1), string_t('warning: '//deck%file//':'//to_str(line)//': ['// &
+                                                        kw%section//'] '//kw%name//' has no effect: it applies only '// &
+                                                        'when '//c%text()//'; here '//c%keyword//' = '// &
+                                                        deck%get_word(c%section, c%keyword)//condition_origin(deck, c)), &
+                            warnings(i:)]
+            end associate
+        end do
+    end function deck_ineffective
 
     !> " (line N)" or " (default)": where the value tested by a condition comes from.
     function condition_origin(deck, c) result(text)

@@ -25,7 +25,7 @@ module io_deck_schema
     private
     public :: field_spec_t, tail_spec_t, condition_t, keyword_spec_t, section_spec_t, schema_t
     public :: field_int, field_real, field_word, field_text, field_selection
-    public :: int_field, real_field, positive, word_field, text_field, selection_field, tail, when
+    public :: int_field, real_field, positive, word_field, text_field, selection_field, tail, when, unless
     public :: multicor_schema, schema_markdown, type_name, parse_selection
 
     !> Field type: integer.
@@ -88,10 +88,13 @@ module io_deck_schema
         procedure :: usage => tail_usage
     end type tail_spec_t
 
-    !> Condition "[section] keyword = word" on another keyword's first (word) field.
+    !> Condition "[section] keyword = word" (or, negated, "is not word") on another keyword's
+    !> first field; a numeric field is compared by value (`1.0` is `1`).
     type :: condition_t
         !> Whether the condition is in use.
         logical :: active = .false.
+        !> Whether the condition is "keyword is not word".
+        logical :: negate = .false.
         !> Section of the keyword tested.
         character(len=:), allocatable :: section
         !> Keyword tested.
@@ -121,6 +124,9 @@ module io_deck_schema
         type(condition_t) :: required_when
         !> May only appear when this condition holds.
         type(condition_t) :: allowed_when
+        !> Has an effect only when this condition holds: elsewhere it is accepted with a
+        !> warning (a tuning value left in a deck while another setting turns it off).
+        type(condition_t) :: effective_when
         !> May appear several times (a record); scalar keywords appear at most once.
         logical :: repeatable = .false.
         !> Whether a default applies when the keyword is absent.
@@ -385,6 +391,19 @@ contains
         c%word = word
     end function when
 
+    !> Condition "[section] keyword is not word".
+    pure function unless(section, keyword, word) result(c)
+        !> Section of the keyword tested.
+        character(len=*), intent(in) :: section
+        !> Keyword tested.
+        character(len=*), intent(in) :: keyword
+        !> Value of its first field that makes the condition false.
+        character(len=*), intent(in) :: word
+        type(condition_t) :: c
+        c = when(section, keyword, word)
+        c%negate = .true.
+    end function unless
+
     !> Declare a section.
     subroutine schema_add_section(self, name, description)
         !> The schema.
@@ -402,7 +421,7 @@ contains
 
     !> Declare a keyword of an already declared section.
     subroutine schema_add_keyword(self, section, name, fields, description, required, repeatable, &
-                                  default, selector, tails, required_when, allowed_when)
+                                  default, selector, tails, required_when, allowed_when, effective_when)
         !> The schema.
         class(schema_t), intent(inout) :: self
         !> Section.
@@ -427,6 +446,8 @@ contains
         type(condition_t), intent(in), optional :: required_when
         !> Allowed only when this condition holds.
         type(condition_t), intent(in), optional :: allowed_when
+        !> Effective only when this condition holds (a warning elsewhere).
+        type(condition_t), intent(in), optional :: effective_when
         type(keyword_spec_t) :: kw
         if (.not. allocated(self%keywords)) allocate (self%keywords(0))
         kw%section = section
@@ -448,6 +469,7 @@ contains
         end if
         if (present(required_when)) kw%required_when = required_when
         if (present(allowed_when)) kw%allowed_when = allowed_when
+        if (present(effective_when)) kw%effective_when = effective_when
         self%keywords = [self%keywords, kw]
     end subroutine schema_add_keyword
 
@@ -760,7 +782,11 @@ contains
         !> The condition.
         class(condition_t), intent(in) :: self
         character(len=:), allocatable :: text
-        text = '['//self%section//'] '//self%keyword//' = '//self%word
+        if (self%negate) then
+            text = '['//self%section//'] '//self%keyword//' is not '//self%word
+        else
+            text = '['//self%section//'] '//self%keyword//' = '//self%word
+        end if
     end function condition_text
 
     ! ---------------------------------------------------------------------------------------
@@ -815,6 +841,8 @@ contains
         description = kw%description
         if (kw%allowed_when%active) description = description//' Only allowed if '// &
                                                   kw%allowed_when%text()//'.'
+        if (kw%effective_when%active) description = description//' Effective only if '// &
+                                                    kw%effective_when%text()//' (elsewhere accepted with a warning).'
         started = .false.
         do i = 1, size(kw%fields)
             values = '`'//kw%fields(i)%name//'` ('//type_name(kw%fields(i)%value_type)//')'

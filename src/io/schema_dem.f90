@@ -6,7 +6,7 @@
 module io_schema_dem
     use core_kinds, only: wp
     use io_deck_schema, only: schema_t, int_field, real_field, positive, word_field, &
-                              selection_field, tail
+                              selection_field, tail, when, unless
     implicit none
     private
 
@@ -162,7 +162,7 @@ contains
                            'packings away from rest and deposits, doc/performance.md; it changes nothing at a '// &
                            'solution, and a step stops correcting once the error at a correction is larger '// &
                            'than at the previous one; not with the Arlequin coupling rows: a coupled run '// &
-                           'sweeps as with `nlgs`). Every '// &
+                           'sweeps as with `nlgs`, and says so in a warning). Every '// &
                            'unilateral or frictional contact uses the bi-potential local solver in all three.', &
                            default='block')
         call s%add_keyword('solver', 'tolerance', [positive('tolerance', '')], &
@@ -201,12 +201,14 @@ contains
         call s%add_keyword('solver', 'anderson_after', [int_field('anderson_after', lower=0)], &
                            'With `anderson` > 0: plain sweeps before the Anderson steps start. A step that '// &
                            'converges within them is not accelerated: near rest a plain sweep is cheaper and '// &
-                           'a few suffice (doc/performance.md).', default='10')
+                           'a few suffice (doc/performance.md).', default='10', &
+                           effective_when=unless('solver', 'anderson', '0'))
         call s%add_keyword('solver', 'anderson_sweeps', [int_field('anderson_sweeps', lower=1)], &
                            'With `anderson` > 0: sweeps per Anderson step (the map accelerated is that '// &
                            'many forward sweeps). An Anderson step costs about one sweep; over 2 sweeps its '// &
                            'cost per sweep is half, for about as many sweeps (doc/performance.md). 1 mixes '// &
-                           'after every sweep.', default='2')
+                           'after every sweep.', default='2', &
+                           effective_when=unless('solver', 'anderson', '0'))
         call s%add_keyword('solver', 'sweep_order', [word_field('sweep_order', 'alternating forward')], &
                            'Order of the plain sweeps: `alternating` (forward, then backward through the '// &
                            'contact list, in turn: symmetric Gauss-Seidel) or `forward` (every sweep in the '// &
@@ -221,17 +223,20 @@ contains
                            'weight carried down the contact network from the top and split at each disk over '// &
                            'its supports within their friction cones (doc/performance.md). On tall packings '// &
                            'it cuts the sweeps of that step 2 to 6 times. Not used with the Arlequin '// &
-                           'coupling rows, nor in a step where method = block solves intact bonds directly.', &
+                           'coupling rows (a warning), nor in a step where method = block solves intact bonds directly.', &
                            default='zero')
         call s%add_keyword('solver', 'coarse_every', [int_field('coarse_every', lower=1)], &
                            'With `method = coarse`: sweeps between two coarse corrections (one more before '// &
-                           'the first sweep).', default='10')
+                           'the first sweep).', default='10', &
+                           effective_when=when('solver', 'method', 'coarse'))
         call s%add_keyword('solver', 'coarse_size', [int_field('coarse_size', lower=1)], &
                            'With `method = coarse`: contacts per aggregate, consecutive in the contact list '// &
                            '(ordered by disk: disks numbered by layers give horizontal slabs); larger when '// &
-                           'there would be more than 2000 aggregates.', default='400')
+                           'there would be more than 2000 aggregates.', default='400', &
+                           effective_when=when('solver', 'method', 'coarse'))
         call s%add_keyword('solver', 'check_every', [int_field('check_every', lower=1)], &
-                           'Period in sweeps of the safeguard of the over-relaxation.', default='10')
+                           'Period in sweeps of the safeguard of the over-relaxation.', default='10', &
+                           effective_when=unless('solver', 'relaxation', '1'))
         call s%add_keyword('solver', 'fclib_step', [int_field('fclib_step', lower=1)], &
                            'Write the local contact problem of this step (W, q, mu, cohesion, rolling '// &
                            'lengths and the solution found) in FCLIB''s HDF5 format to <output>_fclib_<step>.h5 '// &

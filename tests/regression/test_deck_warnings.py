@@ -1,0 +1,130 @@
+#!/usr/bin/env python3
+"""Settings that another setting or the kind of run turns off: the deck is valid, the run
+goes on, and a warning names the file, the line and the setting that turns it off.
+
+- The example decks of input/ carry no such setting: `--check` prints no warning for any.
+- A solver tuning value where it does nothing (`coarse_size` with the default method,
+  `anderson_sweeps` with `anderson = 0`, `check_every` at relaxation 1.0) is warned about,
+  one line each, in the order of the deck; the same values where they act are not.
+- In a coupled run (beam or continuum: input/bending_hinged_row.dat, input/interface_shear.dat)
+  `method = coarse` and `cold_start = hydrostatic` are warned about, and the warning is true:
+  the run's results are those of `method = nlgs` (and of `cold_start = zero`), bit for bit.
+
+Usage (ctest does this): test_deck_warnings.py --exe multicor --work DIR --source REPO
+"""
+import re
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+from checks import arguments, check, summary
+
+
+def multicor(exe, *args):
+    return subprocess.run([str(exe), *map(str, args)], capture_output=True, text=True, timeout=300)
+
+
+def warnings_of(out):
+    return [line for line in out.splitlines() if line.startswith("warning:")]
+
+
+def with_solver(text, lines):
+    """The deck with `lines` under its [solver] header (added at the end if it has none)."""
+    if re.search(r"^\[solver\]", text, flags=re.M):
+        return re.sub(r"^\[solver\]\n", "[solver]\n" + lines, text, count=1, flags=re.M)
+    return text + "\n[solver]\n" + lines
+
+
+def line_of(text, keyword):
+    """1-based line of the first `keyword =` line of `text`."""
+    for i, line in enumerate(text.splitlines(), start=1):
+        if re.match(rf"\s*{keyword}\s*=", line):
+            return i
+    raise ValueError(keyword)
+
+
+def example_decks_are_quiet(exe, src):
+    for deck in sorted((src / "input").glob("*.dat")):
+        proc = multicor(exe, "--check", deck)
+        check(f"input/{deck.name}: --check exit 0 without warning",
+              proc.returncode == 0 and not warnings_of(proc.stdout + proc.stderr),
+              f"exit {proc.returncode}; " + "; ".join(warnings_of(proc.stdout + proc.stderr))[:300])
+
+
+def solver_values(exe, src, work):
+    base = (src / "input" / "deposit.dat").read_text()
+    base = re.sub(r"^\s*(anderson|method|relaxation|check_every|coarse_\w+)\s*=.*\n", "", base, flags=re.M)
+    text = with_solver(base, "coarse_size = 100\nanderson = 0\nanderson_sweeps = 3\nrelaxation = 1.0\n"
+                       "check_every = 5\n")
+    deck = work / "ineffective.dat"
+    deck.write_text(text)
+    proc = multicor(exe, "--check", deck)
+    said = warnings_of(proc.stdout)
+    expected = [f"warning: {deck}:{line_of(text, 'coarse_size')}: [solver] coarse_size has no effect: it "
+                "applies only when [solver] method = coarse; here method = block (default)",
+                f"warning: {deck}:{line_of(text, 'anderson_sweeps')}: [solver] anderson_sweeps has no effect: it "
+                f"applies only when [solver] anderson is not 0; here anderson = 0 (line {line_of(text, 'anderson')})",
+                f"warning: {deck}:{line_of(text, 'check_every')}: [solver] check_every has no effect: it applies "
+                f"only when [solver] relaxation is not 1; here relaxation = 1.0 (line {line_of(text, 'relaxation')})"]
+    check("solver values without effect: valid deck", proc.returncode == 0, proc.stderr.strip()[:300])
+    check("solver values without effect: one warning each, in the deck's order", said == expected,
+          "\n".join(said))
+    text = with_solver(base, "method = coarse\ncoarse_size = 100\nanderson = 2\nanderson_sweeps = 3\n"
+                       "relaxation = 1.3\ncheck_every = 5\n")
+    deck.write_text(text)
+    proc = multicor(exe, "--check", deck)
+    check("solver values where they act: no warning", proc.returncode == 0 and not warnings_of(proc.stdout),
+          "; ".join(warnings_of(proc.stdout)))
+
+
+def coupled(exe, work, name, deck_path, ends, extra=""):
+    """`deck_path` (ending at `ends`, with the solver lines `extra`) with method = coarse and
+    cold_start = hydrostatic: two warnings, and the results of method = nlgs, cold_start =
+    zero. The sweeps are many (`extra` keeps them at about 100 per step), so that a coarse
+    correction or another start of the first step would show in the results."""
+    base = re.sub(r"^\s*(method|cold_start|tolerance)\s*=.*\n", "", deck_path.read_text(), flags=re.M)
+    base = re.sub(r"^end\s*=.*$", f"end = {ends}", base, count=1, flags=re.M)
+    if "mesh = file " in base:
+        base = base.replace("mesh = file ", f"mesh = file {deck_path.parent}/")
+    results = {}
+    for variant, lines in (("off", "method = coarse\ncold_start = hydrostatic\n"),
+                           ("nlgs", "method = nlgs\ncold_start = zero\n")):
+        text = with_solver(base, lines + extra)
+        deck = work / f"{name}_{variant}.dat"
+        deck.write_text(text)
+        proc = multicor(exe, deck, "--output", work / f"{name}_{variant}", "--quiet")
+        said = warnings_of(proc.stdout)
+        if variant == "off":
+            check(f"{name}: exit 0", proc.returncode == 0, proc.stderr.strip()[:300])
+            check(f"{name}: method = coarse warned about at its line",
+                  any(w.startswith(f"warning: {deck}:{line_of(text, 'method')}: [solver] method = coarse has no "
+                                   "effect in a coupled run") for w in said), "\n".join(said))
+            check(f"{name}: cold_start = hydrostatic warned about at its line",
+                  any(w.startswith(f"warning: {deck}:{line_of(text, 'cold_start')}: [solver] cold_start = "
+                                   "hydrostatic has no effect in a coupled run") for w in said), "\n".join(said))
+        else:
+            check(f"{name}: method = nlgs is not warned about", proc.returncode == 0 and not said, "\n".join(said))
+        with h5py.File(work / f"{name}_{variant}" / f"{name}_{variant}.h5", "r") as f:
+            results[variant] = (f["dem/position"][...], f["dem/velocity"][...], f["dem/solver/sweeps"][...])
+    same = all(np.array_equal(a, b) for a, b in zip(results["off"], results["nlgs"]))
+    check(f"{name}: the results are those of method = nlgs, bit for bit", same,
+          f"sweeps {results['off'][2].sum()} and {results['nlgs'][2].sum()}")
+    check(f"{name}: the contacts are solved by sweeps (not a trivial step)", results["nlgs"][2].mean() > 10,
+          f"sweeps per step {results['nlgs'][2].mean():.1f}")
+
+
+def main():
+    exe, work, src = arguments(fresh=True)
+    example_decks_are_quiet(exe, src)
+    solver_values(exe, src, work)
+    # the hinged row of the reference work (20 steps; with nlgs at 1e-4: 108 to 172 sweeps per
+    # step) and the interface experiment (10 steps: 19 to 47 sweeps per step)
+    coupled(exe, work, "beam", src / "input" / "bending_hinged_row.dat", "2e-4", "tolerance = 1e-4\n")
+    coupled(exe, work, "continuum", src / "input" / "interface_shear.dat", "2e-4")
+    return summary()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
