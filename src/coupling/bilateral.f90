@@ -76,6 +76,8 @@ module coupling_bilateral
         procedure :: gather
         !> See `nlgs_bilateral_t%mobility`: C = (h gamma / t) A^-1 (or B).
         procedure :: mobility
+        !> See `nlgs_bilateral_t%hold`.
+        procedure :: hold
     end type coupling_rows_t
 
 contains
@@ -181,6 +183,22 @@ contains
         end do
         self%corrections = self%corrections + 1
     end subroutine correct
+
+    !> vel corrected as `restore` would (lambda += -A^-1 delta, delta = G vel - target), the
+    !> rows' multipliers and target left as they are.
+    pure subroutine hold(self, vel)
+        !> The rows.
+        class(coupling_rows_t), intent(in) :: self
+        !> Disk velocities (3, n_disks).
+        real(wp), intent(inout) :: vel(:, :)
+        real(wp) :: gv(self%n_rows), dl(self%n_rows)
+        integer :: r
+        call self%gather(vel, gv)
+        dl = -matmul(self%ainv, gv - self%target)
+        do r = 1, self%n_rows
+            vel(self%dof(r), self%owner(r)) = vel(self%dof(r), self%owner(r)) + self%response(r)*dl(r)
+        end do
+    end subroutine hold
 
     !> The rows' share of the disks' mobility (nlgs_bilateral_t): an impulse p followed by
     !> `restore` changes the velocities by M^-1 p - P^T D C D P p with C = (h gamma / t) A^-1

@@ -69,6 +69,7 @@ module coupling_coupled_step
     use fem_dynamic_operator, only: dynamic_operator_t
     use fem_newmark, only: newmark_t
     use dem_particles, only: particles_inverse_mass, dof_x, dof_y, dof_rot
+    use dem_local_problem, only: local_problem_t, local_problem_build
     use dem_moreau_jean, only: dem_system_t, mj_init, mj_free_velocities, mj_detect, mj_solve, &
                                mj_end_step, energies_balance
     use coupling_weights, only: overlap_weight_t
@@ -378,11 +379,15 @@ contains
     end function constraint_norm
 
     !> Advance the coupled system by one time step (see the module description).
-    subroutine arlequin_step(sys, error)
+    subroutine arlequin_step(sys, error, lp)
         !> The coupled system (built).
         type(coupled_system_t), intent(inout) :: sys
         !> Set on failure of the FE solves.
         type(error_t), allocatable, intent(out) :: error
+        !> If present: the local contact problem the step solved, with the coupling rows
+        !> condensed (dem_local_problem; for an FCLIB export).
+        type(local_problem_t), intent(out), optional :: lp
+        real(wp), allocatable :: vfree(:, :)
         real(wp) :: h, gam, th, imp
         integer :: r, i, d
         h = sys%fe%h
@@ -411,7 +416,10 @@ contains
         call sys%rows%restore(sys%dem%vel)
         call mj_detect(sys%dem)
         if (sys%condensed) call sys%rows%condense(sys%dem%contacts, sys%dem%im)
+        ! (the velocities at zero contact impulses with the rows held)
+        if (present(lp)) allocate (vfree, source=sys%dem%vel)
         call mj_solve(sys%dem, sys%rows)
+        if (present(lp)) call local_problem_build(sys%dem%contacts, sys%dem%im, vfree, lp, sys%rows, sys%dem%vel)
         sys%lambda = sys%rows%lambda
         do r = 1, sys%op%n_rows
             i = sys%rows%owner(r)

@@ -7,9 +7,16 @@
 !> reaction (r_n + r_cohe h, r_t, M), so that the cone is the plain one; q is the free term
 !> in that unknown: q = H^T v_free + shift - W (r_cohe h, 0, 0). W = H^T M^-1 H is stored in
 !> compressed sparse columns, 0-based (FCLIB's nz = -1), rows sorted within each column.
+!>
+!> With bilateral constraints kept by the sweeps (the Arlequin coupling rows,
+!> `nlgs_bilateral_t`), the problem is the condensed one the sweeps solve: an impulse moves the
+!> disks by M^-1 - P^T D C D P (`nlgs_bilateral_t%mobility`), so W = H^T (M^-1 - P^T D C D P) H,
+!> dense among the contacts that touch a constrained disk; v_free is then the velocity at zero
+!> contact impulses with the constraints held, and u comes from the velocities of the solve.
 module dem_local_problem
     use core_kinds, only: wp
     use dem_contacts, only: contact_set_t
+    use dem_nlgs, only: nlgs_bilateral_t
     implicit none
     private
     public :: local_problem_t, local_problem_build
@@ -36,19 +43,26 @@ module dem_local_problem
 contains
 
     !> Assemble the local problem of the active contacts of cs.
-    subroutine local_problem_build(cs, im, vfree, lp)
+    subroutine local_problem_build(cs, im, vfree, lp, bilateral, vel)
         !> Contacts after the solve (frames, laws, activity, reactions).
         type(contact_set_t), intent(in) :: cs
         !> Inverse mass per DOF (3, n_disks).
         real(wp), intent(in) :: im(:, :)
-        !> Free velocities of the step (3, n_disks).
+        !> Free velocities of the step (3, n_disks); with `bilateral`, those at zero contact
+        !> impulses with the constraints held.
         real(wp), intent(in) :: vfree(:, :)
         !> The problem.
         type(local_problem_t), intent(out) :: lp
-        integer, allocatable :: pos(:), adj_start(:), adj(:), rows(:)
-        real(wp), allocatable :: vq(:, :), vr(:, :), vals(:)
+        !> Bilateral constraints kept by the solve (their share of the mobility enters W).
+        class(nlgs_bilateral_t), intent(in), optional :: bilateral
+        !> Velocities at the end of the solve (3, n_disks), for u; needed with `bilateral`
+        !> (otherwise u comes from vfree + M^-1 H r).
+        real(wp), intent(in), optional :: vel(:, :)
+        integer, allocatable :: pos(:), adj_start(:), adj(:), rows(:), owner(:), dof(:), tpos(:), trow(:)
+        real(wp), allocatable :: vq(:, :), vr(:, :), vals(:), cmat(:, :), um(:, :), cu(:, :)
         real(wp) :: ga(3, 3), gb(3, 3), s
-        integer :: nd, m, d, k, a, b, c, e, j, side, body, nnz, nrow, other, col
+        integer :: nd, m, d, k, a, b, c, e, j, side, body, nnz, nrow, col, nt, i
+        logical :: condensed
         nd = size(im, 2)
         m = count(cs%active(1:cs%n))
         lp%n = m
@@ -89,8 +103,13 @@ contains
             adj(rows(lp%i2(j))) = j
             rows(lp%i2(j)) = rows(lp%i2(j)) + 1
         end do
+        condensed = present(bilateral)
+        if (condensed) call constraint_share()
         ! W column by column: the block of contact b with itself is cs%w; with another
-        ! contact a it is the term of the one body they share
+        ! contact a it is the term of the one body they share. Condensed: the block of b with
+        ! itself is summed over its bodies as the others (cs%w may hold a condensed block
+        ! already), and the constraints' share -U^T C U is added on the contacts that touch
+        ! a constrained disk.
         allocate (lp%colptr(d*m + 1))
         allocate (lp%rowind(d*d*m*8), lp%values(d*d*m*8))
         deallocate (rows)
@@ -101,14 +120,14 @@ contains
             k = lp%index(b)
             do c = 1, d
                 nrow = 0
-                call add_self(k, c)
+                if (.not. condensed) call add_self(k, c)
                 do side = 1, 2
                     body = merge(lp%i1(b), lp%i2(b), side == 1)
                     if (body <= 0) cycle
                     call directions(cs, lp%index(b), body, gb)
                     do e = adj_start(body), adj_start(body + 1) - 1
                         a = adj(e)
-                        if (a == b) cycle
+                        if (a == b .and. .not. condensed) cycle
                         call directions(cs, lp%index(a), body, ga)
                         do j = 1, d
                             s = sum(ga(:, j)*im(:, body)*gb(:, c))
@@ -116,8 +135,16 @@ contains
                         end do
                     end do
                 end do
-                call sort_rows(rows(1:nrow), vals(1:nrow))
                 col = d*(b - 1) + c
+                if (condensed) then
+                    if (tpos(col) > 0) then
+                        do i = 1, nt
+                            call push(trow(i), -dot_product(um(:, i), cu(:, tpos(col))))
+                        end do
+                    end if
+                end if
+                call sort_rows(rows(1:nrow), vals(1:nrow))
+                if (condensed) call merge_rows(rows, vals, nrow)
                 if (nnz + nrow > size(lp%rowind)) call grow(nnz + nrow)
                 lp%rowind(nnz + 1:nnz + nrow) = rows(1:nrow)
                 lp%values(nnz + 1:nnz + nrow) = vals(1:nrow)
@@ -127,13 +154,16 @@ contains
         end do
         lp%rowind = lp%rowind(1:nnz)
         lp%values = lp%values(1:nnz)
-        ! q from the free velocities shifted by the cohesion, u from vfree + M^-1 H r
+        ! q from the free velocities shifted by the cohesion, u from vfree + M^-1 H r (or the
+        ! velocities of the solve). Condensed, the shift by the cohesion goes through W: the
+        ! constraints respond to the cohesion impulses too.
         allocate (vq, source=vfree)
         allocate (vr, source=vfree)
+        if (present(vel)) vr = vel
         do j = 1, m
             k = lp%index(j)
-            call impulse(cs, k, im, vq, [-cs%coh(k), 0.0_wp, 0.0_wp])
-            call impulse(cs, k, im, vr, cs%r(:, k))
+            if (.not. condensed) call impulse(cs, k, im, vq, [-cs%coh(k), 0.0_wp, 0.0_wp])
+            if (.not. present(vel)) call impulse(cs, k, im, vr, cs%r(:, k))
         end do
         allocate (lp%q(d*m), lp%u(d*m), lp%r(d*m))
         do j = 1, m
@@ -144,7 +174,58 @@ contains
             lp%r(d*(j - 1) + 2) = cs%r(2, k)
             if (d == 3) lp%r(d*j) = cs%r(3, k)
         end do
+        if (condensed) then
+            ! q -= W (r_cohe h, 0, 0): the normal columns of the cohesive contacts
+            do j = 1, m
+                if (lp%cohesion(j) == 0.0_wp) cycle
+                col = d*(j - 1) + 1
+                do e = lp%colptr(col) + 1, lp%colptr(col + 1)
+                    lp%q(lp%rowind(e) + 1) = lp%q(lp%rowind(e) + 1) - lp%values(e)*lp%cohesion(j)
+                end do
+            end do
+        end if
     contains
+        ! U = D P H on the unknowns of the contacts that touch a constrained disk (um, one
+        ! column per such unknown; tpos: the column of an unknown, 0 for the others; trow:
+        ! the 0-based unknown of a column) and C U (cu)
+        subroutine constraint_share()
+            logical, allocatable :: constrained(:), touches(:)
+            integer :: r, nr
+            call bilateral%mobility(owner, dof, cmat)
+            nr = size(owner)
+            allocate (constrained(nd), touches(m), tpos(d*m))
+            constrained = .false.
+            if (nr > 0) constrained(owner) = .true.
+            do j = 1, m
+                touches(j) = constrained(lp%i2(j))
+                if (lp%i1(j) > 0) touches(j) = touches(j) .or. constrained(lp%i1(j))
+            end do
+            nt = d*count(touches)
+            allocate (um(nr, nt), trow(nt))
+            um = 0.0_wp
+            tpos = 0
+            i = 0
+            do j = 1, m
+                if (.not. touches(j)) cycle
+                do c = 1, d
+                    i = i + 1
+                    tpos(d*(j - 1) + c) = i
+                    trow(i) = d*(j - 1) + c - 1
+                    do side = 1, 2
+                        body = merge(lp%i1(j), lp%i2(j), side == 1)
+                        if (body <= 0) cycle
+                        if (.not. constrained(body)) cycle
+                        call directions(cs, lp%index(j), body, gb)
+                        do r = 1, nr
+                            if (owner(r) /= body) cycle
+                            um(r, i) = um(r, i) + im(dof(r), body)*gb(dof(r), c)
+                        end do
+                    end do
+                end do
+            end do
+            cu = matmul(cmat, um)
+        end subroutine constraint_share
+
         ! the diagonal block from cs%w (sum over both bodies)
         subroutine add_self(k, c)
             integer, intent(in) :: k, c
@@ -229,6 +310,26 @@ contains
         w(1:2) = w(1:2) + cs%shift(:, k)
         u = w(1:size(u))
     end subroutine velocity
+
+    !> Sum the values of equal rows of the sorted (rows(1:n), vals(1:n)); n becomes the
+    !> number of distinct rows.
+    pure subroutine merge_rows(rows, vals, n)
+        integer, intent(inout) :: rows(:), n
+        real(wp), intent(inout) :: vals(:)
+        integer :: i, k
+        if (n == 0) return
+        k = 1
+        do i = 2, n
+            if (rows(i) == rows(k)) then
+                vals(k) = vals(k) + vals(i)
+            else
+                k = k + 1
+                rows(k) = rows(i)
+                vals(k) = vals(i)
+            end if
+        end do
+        n = k
+    end subroutine merge_rows
 
     !> Sort (rows, vals) by row (insertion sort: a column has a few entries).
     pure subroutine sort_rows(rows, vals)

@@ -271,6 +271,8 @@ module dem_nlgs
         procedure(bilateral_update), deferred :: update
         !> The constraints' share of the disks' mobility (used by a block solve).
         procedure(bilateral_mobility), deferred :: mobility
+        !> Correct a velocity field so that the constraints hold, the constraints unchanged.
+        procedure(bilateral_hold), deferred :: hold
     end type nlgs_bilateral_t
 
     abstract interface
@@ -293,6 +295,17 @@ module dem_nlgs
             !> Disk velocities (3, n_disks).
             real(wp), intent(inout) :: vel(:, :)
         end subroutine bilateral_update
+
+        !> Correct vel as `restore` would, without changing the constraints' state (their
+        !> multipliers): vel is a velocity field of the same multipliers as the one the
+        !> constraints last held for (e.g. that one with other contact impulses).
+        subroutine bilateral_hold(self, vel)
+            import :: nlgs_bilateral_t, wp
+            !> The constraints.
+            class(nlgs_bilateral_t), intent(in) :: self
+            !> Disk velocities (3, n_disks).
+            real(wp), intent(inout) :: vel(:, :)
+        end subroutine bilateral_hold
 
         !> Mobility of the constrained disks: an impulse p (3, n_disks) applied to the disks
         !> and followed by `restore` changes the velocities by M^-1 p - P^T D C D P p, with P
@@ -421,11 +434,11 @@ contains
         allocate (list(n_swept), sc(rolling_n_scaling, n_swept))
         allocate (vfree, source=vel)
         allocate (vwork, mold=vel)
-        nq = 0.0_wp
+        ! |q|^2 of the Siconos error, for the criterion and the final error
+        nq = siconos_free_norm2(cs, im, vfree, bilateral)
         if (config%criterion == criterion_siconos) then
             ! the active contacts, in increasing order: the running criterion runs over them
             act = pack([(k, k=1, cs%n)], cs%active(1:cs%n))
-            nq = siconos_free_norm2(cs, im, vfree)
         end if
         per_norm = 0.0_wp
         norm_evaluated = huge(1.0_wp)
@@ -533,7 +546,7 @@ contains
                         if (norm > 0.0_wp) per_norm = stats%error/norm
                         last_evaluation = s
                         if (stats%error <= config%tol) stats%error = siconos_error(cs, im, vfree, vel, vwork, &
-                                                                                   present(bilateral))
+                                                                                   present(bilateral), nq)
                     else
                         ! an estimate, which does not stop the sweeps
                         stats%error = stats%error*per_norm
@@ -576,7 +589,7 @@ contains
             ! the last error of the sweeps, computed in full
             stats%siconos_error = stats%error
         else
-            stats%siconos_error = siconos_error(cs, im, vfree, vel, vwork, present(bilateral))
+            stats%siconos_error = siconos_error(cs, im, vfree, vel, vwork, present(bilateral), nq)
         end if
     end subroutine nlgs_solve
 
@@ -1690,19 +1703,21 @@ contains
 
     !> Siconos error of the current reactions (doc/theory.md, "Siconos error"), u computed in
     !> full from the free velocities: vwork = vfree + M^-1 H r (or vel itself when bilateral
-    !> constraints changed the velocities: their impulses are not contacts).
-    real(wp) function siconos_error(cs, im, vfree, vel, vwork, bilateral) result(err)
+    !> constraints changed the velocities: their impulses are not contacts); nq = |q|^2
+    !> (siconos_free_norm2).
+    real(wp) function siconos_error(cs, im, vfree, vel, vwork, bilateral, nq) result(err)
         type(contact_set_t), intent(in) :: cs
-        real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :)
+        real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :), nq
         real(wp), intent(inout) :: vwork(:, :)
         logical, intent(in) :: bilateral
+        integer :: k
         if (bilateral) then
             vwork = vel
         else
             vwork = vfree
             call nlgs_apply_reactions(cs, im, vwork)
         end if
-        err = nlgs_siconos_error(cs, im, vfree, vwork)
+        err = siconos_ratio(cs, pack([(k, k=1, cs%n)], cs%active(1:cs%n)), vwork, nq)
     end function siconos_error
 
     !> Siconos error of the contact problem u = W r + q over the active contacts:
@@ -1727,10 +1742,12 @@ contains
     end function nlgs_siconos_error
 
     !> |q|^2 over the active contacts: q = H^T vq + shift, vq the velocities of the free
-    !> term in the shifted unknown (the free motion minus the cohesion impulses).
-    real(wp) function siconos_free_norm2(cs, im, vfree) result(nq)
+    !> term in the shifted unknown (the free motion minus the cohesion impulses; with
+    !> bilateral constraints, held by them: the problem is the condensed one).
+    real(wp) function siconos_free_norm2(cs, im, vfree, bilateral) result(nq)
         type(contact_set_t), intent(in) :: cs
         real(wp), intent(in) :: im(:, :), vfree(:, :)
+        class(nlgs_bilateral_t), intent(in), optional :: bilateral
         real(wp), allocatable :: vq(:, :)
         real(wp) :: q(3)
         integer :: k
@@ -1739,6 +1756,7 @@ contains
             if (.not. cs%active(k)) cycle
             if (cs%coh(k) /= 0.0_wp) call apply(cs, k, im, vq, -cs%coh(k), 0.0_wp, 0.0_wp)
         end do
+        if (present(bilateral)) call bilateral%hold(vq)
         nq = 0.0_wp
         do k = 1, cs%n
             if (.not. cs%active(k)) cycle

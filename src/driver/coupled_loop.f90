@@ -28,7 +28,10 @@ module driver_coupled_loop
     use driver_results, only: results_writer_t
     use driver_results_dem, only: dem_writer_t
     use driver_results_coupled, only: coupled_writer_t
-    use driver_run_dem, only: max_warnings, speed_warning, last_unconverged_warning
+    use driver_run_dem, only: max_warnings, speed_warning, last_unconverged_warning, fclib_path, &
+                              fclib_after_end_warning
+    use driver_results_dem, only: write_fclib_local
+    use dem_local_problem, only: local_problem_t
     use dem_contacts, only: status_cohesive
     use driver_guards, only: check_disks_state, step_start_t, take_step_start, check_tunnelling
     use driver_checkpoint, only: checkpoint_run_t, end_of_step, step_end_t, loop_state_t, checkpoint_create, &
@@ -48,6 +51,9 @@ module driver_coupled_loop
         type(dem_writer_t) :: dem_out
         !> Writer of /coupling (its maxima of the residuals feed the summary).
         type(coupled_writer_t) :: cpl_out
+        !> Step whose local contact problem (coupling rows condensed) is written in FCLIB's
+        !> format (`[solver] fclib_step`; 0: none), set by `init`.
+        integer :: fclib_step = 0
     contains
         !> See `simulation_t%run`: the coupled time loop.
         procedure :: run => arlequin_run
@@ -195,11 +201,16 @@ contains
             call store(error)
             if (allocated(error)) return
         end if
+        if (self%fclib_step > n_steps) call report(fclib_after_end_warning(self%fclib_step, n_steps))
         call progress%start(n_steps, self%settings%t_end, self%settings%progress_seconds)
         call ck%schedule%start()
         do k = k0 + 1, n_steps
             call take_step_start(start, self%sys%dem%particles, self%sys%dem%walls)
-            call arlequin_step(self%sys, error)
+            if (k == self%fclib_step) then
+                call step_with_export(error)
+            else
+                call arlequin_step(self%sys, error)
+            end if
             if (allocated(error)) return
             call self%after_step()
             call check_step(error)
@@ -236,6 +247,17 @@ contains
         call self%finish(out, error)
 
     contains
+
+        !> One step (as arlequin_step) that writes its local contact problem, the coupling
+        !> rows condensed, in FCLIB's format to <results without .h5>_fclib_<step>.h5.
+        subroutine step_with_export(error)
+            type(error_t), allocatable, intent(out) :: error
+            type(local_problem_t) :: lp
+            call arlequin_step(self%sys, error, lp)
+            if (allocated(error)) return
+            call write_fclib_local(fclib_path(out%final_path, int(k)), self%settings%title, lp, int(k), &
+                                   self%sys%fe%t, self%sys%dem%stats%siconos_error, error)
+        end subroutine step_with_export
 
         !> Restart: state, writer counters and results file from the checkpoint `ck%source`.
         subroutine restore(error)

@@ -28,6 +28,7 @@ module driver_run_dem
     implicit none
     private
     public :: run_dem, max_warnings, report_line_iface, speed_warning, last_unconverged_warning
+    public :: fclib_path, fclib_after_end_warning
 
     !> Unconverged steps reported one by one; later ones are only counted.
     integer, parameter :: max_warnings = 5
@@ -92,9 +93,7 @@ contains
             if (allocated(error)) return
         end if
         ! An export the run never reaches would pass unnoticed (the deck's end or --end).
-        if (cfg%fclib_step > n_steps) call report('warning: [solver] fclib_step = '// &
-                                                  to_str(cfg%fclib_step)//' is after the last step of the '// &
-                                                  'run ('//to_str(n_steps)//'): no FCLIB problem written')
+        if (cfg%fclib_step > n_steps) call report(fclib_after_end_warning(cfg%fclib_step, n_steps))
         call progress%start(n_steps, run%t_end, run%progress_seconds)
         call ck%schedule%start()
         do k = k0 + 1, n_steps
@@ -175,20 +174,13 @@ contains
             type(error_t), allocatable, intent(out) :: error
             type(local_problem_t) :: lp
             real(wp), allocatable :: vfree(:, :)
-            character(len=:), allocatable :: path
-            character(len=32) :: tag
             associate (sys => cfg%system)
                 call mj_free_velocities(sys)
                 call mj_detect(sys)
                 allocate (vfree, source=sys%vel)
                 call mj_solve(sys)
                 call local_problem_build(sys%contacts, sys%im, vfree, lp)
-                write (tag, '(a, i0, a)') '_fclib_', sys%step + 1, '.h5'
-                path = out%final_path
-                if (len(path) > 3) then
-                    if (path(len(path) - 2:) == '.h5') path = path(:len(path) - 3)
-                end if
-                call write_fclib_local(path//trim(tag), run%title, lp, sys%step + 1, &
+                call write_fclib_local(fclib_path(out%final_path, sys%step + 1), run%title, lp, sys%step + 1, &
                                        sys%time + sys%scheme%h, sys%stats%siconos_error, error)
                 if (allocated(error)) return
                 call mj_end_step(sys)
@@ -287,4 +279,30 @@ contains
         line = 'warning: further unconverged steps are only counted (total in the summary); '// &
                'raise [solver] max_sweeps or the tolerance, or lower [time] step'
     end function last_unconverged_warning
+
+    !> File of the FCLIB export of step `step`: the results file without '.h5', then
+    !> '_fclib_<step>.h5'.
+    function fclib_path(results_path, step) result(path)
+        !> Final path of the results file.
+        character(len=*), intent(in) :: results_path
+        !> The step exported.
+        integer, intent(in) :: step
+        character(len=:), allocatable :: path
+        path = results_path
+        if (len(path) > 3) then
+            if (path(len(path) - 2:) == '.h5') path = path(:len(path) - 3)
+        end if
+        path = path//'_fclib_'//to_str(step)//'.h5'
+    end function fclib_path
+
+    !> Warning for an FCLIB export after the last step (it would pass unnoticed).
+    function fclib_after_end_warning(step, n_steps) result(line)
+        !> `[solver] fclib_step`.
+        integer, intent(in) :: step
+        !> Steps of the run.
+        integer(i8), intent(in) :: n_steps
+        character(len=:), allocatable :: line
+        line = 'warning: [solver] fclib_step = '//to_str(step)//' is after the last step of the run ('// &
+               to_str(n_steps)//'): no FCLIB problem written'
+    end function fclib_after_end_warning
 end module driver_run_dem

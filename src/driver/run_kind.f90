@@ -11,8 +11,7 @@
 !> run ([coupling] without both models, [continuum] with [beam], or with only one of
 !> [particles] and [coupling]) and the keywords that
 !> the kind of run would ignore (particle settings in a deck without particles, beam
-!> settings and [initial] in a deck without a beam, the export of the contact problem,
-!> `[solver] fclib_step`, in a coupled run), each error naming file, line and keyword.
+!> settings and [initial] in a deck without a beam), each error naming file, line and keyword.
 !> `run_kind_warnings` lists the settings a coupled run accepts but does not use (the coarse
 !> correction and the hydrostatic cold start do not act on the coupling rows: documented
 !> fallbacks, so a warning rather than an error).
@@ -102,12 +101,6 @@ contains
             call check_initial_unused(deck, error)
         case (run_particles)
             call check_beam_keywords_unused(deck, error)
-        case (run_coupled, run_coupled2d)
-            if (deck%has('solver', 'fclib_step')) then
-                call make_input_error(error, deck%file, deck%line('solver', 'fclib_step'), 'fclib_step', &
-                                      'coupled runs do not export their contact problem yet (the coupling rows '// &
-                                      'are not contacts): remove fclib_step')
-            end if
         end select
     end subroutine check_run_kind
 

@@ -92,6 +92,7 @@ contains
             return
         end if
         self%model = coupled_beam(self%sys)
+        self%fclib_step = self%dem%fclib_step
     end subroutine coupled_init
 
     !> Build the coupled system of a deck (weighted beam, weighted disks, coupling operator,

@@ -131,7 +131,9 @@ contains
             else
                 call make_input_error(error, deck%file, self%coupling%region_line, 'region', message)
             end if
+            return
         end if
+        self%fclib_step = self%particles%dem%fclib_step
     end subroutine coupled2d_init
 
     !> The deck without the entries of the given sections or 'section keyword' pairs.

@@ -240,7 +240,8 @@ contains
         call s%add_keyword('solver', 'fclib_step', [int_field('fclib_step', lower=1)], &
                            'Write the local contact problem of this step (W, q, mu, cohesion, rolling '// &
                            'lengths and the solution found) in FCLIB''s HDF5 format to <output>_fclib_<step>.h5 '// &
-                           '(doc/theory.md, "Siconos error"). Runs of particles alone: a coupled run refuses it '// &
-                           '(its coupling rows are not contacts). Default: none.')
+                           '(doc/theory.md, "Siconos error"). In a coupled run: the problem the contacts see, '// &
+                           'the coupling rows condensed (W dense among the contacts on coupled disks). '// &
+                           'Default: none.')
     end subroutine add_solver
 end module io_schema_dem

@@ -6,8 +6,15 @@ FCLIB export ([solver] fclib_step, doc/theory.md "Siconos error").
 The code computes the error from velocities (u = H^T (v_free + M^-1 H r) + shift); here W is
 the exported sparse matrix and u = W r + q. Two decks: a frictional deposit (2 components per
 contact, no cohesion) and the cohesive hanging row (bonds: cohesion and moments, 3 components).
+And two coupled runs, whose export is the contact problem with the Arlequin coupling rows
+condensed (W = H^T (M^-1 - P^T D C D P) H, dense among the contacts on coupled disks): the
+interface experiment (continuum, rolling resistance: 3 components) and the bonded hinged row
+of the reference work (beam, bonds with cohesion). There u comes from the velocities of the
+joint solve, which keeps the rows satisfied at every contact update: u = W r + q checks the
+condensed W and the free term with the rows held against the solver's own motion.
 Usage (ctest does this): test_fclib_export.py --exe multicor --work DIR --source REPO
 """
+import re
 import subprocess
 import sys
 
@@ -91,8 +98,14 @@ def siconos_error(W, q, r, mu, rolling, dim):
     return np.sqrt(num) / np.sqrt(max(nq, nr, nu)), u
 
 
-def case(exe, deck, step, work, expect_dim, extra=(), replace=None, name=None):
+def case(exe, deck, step, work, expect_dim, extra=(), replace=None, name=None, end=None):
+    """Export step `step` of `deck` (run to `end` if given) and check it (see the module)."""
+    folder = deck.parent
     deck = with_export(deck, step, work, extra, replace, name)
+    if end is not None:
+        # a shorter run, with the mesh file of the deck's folder
+        text = re.sub(r"^end\s*=.*$", f"end = {end}", deck.read_text(), count=1, flags=re.M)
+        deck.write_text(text.replace("mesh = file ", f"mesh = file {folder}/"))
     results = run(exe, deck, work)
     fclib = results.parent / f"{deck.stem}_fclib_{step}.h5"
     with h5py.File(results, "r") as f:
@@ -116,7 +129,9 @@ def case(exe, deck, step, work, expect_dim, extra=(), replace=None, name=None):
     for col in range(n):
         W[i[p[col]:p[col + 1]], col] = x[p[col]:p[col + 1]]
     # W = H^T M^-1 H is symmetric positive semi-definite; 1e-12 relative: the entries of both
-    # triangles are the same products in another order.
+    # triangles are the same products in another order. Condensed, the share of the rows
+    # -U^T C U keeps both (C symmetric, M^-1 - P^T D C D P the mobility of the disks with the
+    # rows held); its entries are sums in another order too.
     sym = np.max(np.abs(W - W.T)) / np.max(np.abs(W))
     eig = np.linalg.eigvalsh(0.5 * (W + W.T)).min() / np.max(np.abs(W))
     check(f"{name}: W symmetric, positive semi-definite", sym < 1e-12 and eig > -1e-12,
@@ -137,6 +152,7 @@ def case(exe, deck, step, work, expect_dim, extra=(), replace=None, name=None):
 
 def main():
     exe, work, src = arguments()
+    src_input = src / "input"
     decks = src / "tests" / "regression" / "decks"
     # a loose tolerance, so that the error compared is well above round-off
     case(exe, decks / "dem_small_deposit.dat", 276, work, 2, ("tolerance = 1e-3",))
@@ -150,6 +166,16 @@ def main():
                               ["law = 1 1 0.3 0 2.0e4", "bond = 1 1 0.3 0.0025"]), "bonded_row.dat")
     check("bonded_row: bonds exported with cohesion and moment length",
           np.all(cohesion > 0) and np.all(rolling > 0), f"{len(cohesion)} contacts")
+    # Coupled runs (the rows condensed). The interface experiment at its 12th step (the layer
+    # under the rising pressure, every disk in contact) and the hinged row of the reference
+    # work, bonded and glued to the beam at both ends, solved by plain sweeps to a loose
+    # tolerance so that the error compared is well above round-off.
+    _, rolling = case(exe, src_input / "interface_shear.dat", 12, work, 3, name="interface.dat", end="4e-4")
+    check("interface: contacts with a moment (rolling resistance)", np.all(rolling > 0), f"{len(rolling)} contacts")
+    cohesion, _ = case(exe, src_input / "bending_hinged_row.dat", 12, work, 2,
+                       ("method = nlgs", "tolerance = 1e-4"), name="hinged_row.dat", end="2e-4",
+                       replace=("tolerance  = 1.0e-8", []))
+    check("hinged_row: bonds exported with their cohesion", np.all(cohesion > 0), f"{len(cohesion)} contacts")
     # The criterion chosen by the deck stops the sweeps: with criterion = siconos every
     # converged step has a stored Siconos error at most the tolerance.
     deck = with_export(src / "tests" / "regression" / "decks" / "dem_small_deposit.dat", 250, work,
