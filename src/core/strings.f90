@@ -8,6 +8,7 @@ module core_strings
     private
     public :: string_t, to_lower, strip, is_blank_char, split_words, join_words
     public :: levenshtein, closest_match, parse_real, parse_int, to_str, shorten, max_echo, is_real_syntax
+    public :: gib
 
     !> Longest token echoed whole in a message (see `shorten`).
     integer, parameter :: max_echo = 40
@@ -409,4 +410,16 @@ contains
             text = mantissa//'e'//int_to_str(expo)
         end if
     end function real_to_str
+
+    !> A number of bytes in GiB with two decimals, e.g. '1.50 GiB', '0.25 GiB'.
+    function gib(bytes) result(text)
+        !> Bytes.
+        integer(i8), intent(in) :: bytes
+        character(len=:), allocatable :: text
+        character(len=32) :: buf
+        write (buf, '(f0.2)') real(bytes, wp)/1024.0_wp**3
+        text = trim(buf)
+        if (text(1:1) == '.') text = '0'//text
+        text = text//' GiB'
+    end function gib
 end module core_strings

@@ -19,7 +19,7 @@
 !> `coupled_beam` and `coupled_beam_operator` give back the beam and its C from a system built
 !> here.
 module coupling_arlequin
-    use core_kinds, only: wp
+    use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error, make_internal_error
     use fem_beam_config, only: beam_config_t
     use fem_beam_model, only: beam_model_t, build_beam_model
@@ -59,6 +59,9 @@ module coupling_arlequin
         logical :: condensed_contacts = .true.
         !> Multiplier space: multipliers_particles or multipliers_nodes.
         integer :: multipliers = multipliers_particles
+        !> Bytes the dense multiplier matrices may take (coupled_step's multiplier_bytes; the
+        !> memory available; < 0: no limit).
+        integer(i8) :: memory_limit = -1_i8
     end type coupling_config_t
 
 contains
@@ -132,7 +135,7 @@ contains
         if (allocated(error)) return
         allocate (sys%model, source=model)
         allocate (sys%op, source=op)
-        call complete_coupled_system(sys, space, u0, v0, error, beta, gamma)
+        call complete_coupled_system(sys, space, u0, v0, error, beta, gamma, config%memory_limit)
     end subroutine build_coupled_system
 
     !> The multiplier space chosen by config%multipliers: per coupled DOF, or the mediator

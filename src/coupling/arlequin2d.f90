@@ -18,7 +18,7 @@
 !> - the multiplier space: per coupled DOF, or the mediator space on the FE nodes whose shape
 !>   functions carry coupled centres, with the L2 or H1 pairing (`build_mediator2d`).
 module coupling_arlequin2d
-    use core_kinds, only: wp
+    use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
     use fem_continuum_model, only: continuum_model_t
     use fem_continuum_dynamics, only: continuum_dynamics_t
@@ -61,6 +61,9 @@ module coupling_arlequin2d
         real(wp) :: gravity(2) = 0.0_wp
         !> Gauss points per direction in the elements that meet the overlap.
         integer :: order = 4
+        !> Bytes the dense multiplier matrices may take (coupled_step's multiplier_bytes; the
+        !> memory available; < 0: no limit).
+        integer(i8) :: memory_limit = -1_i8
     end type coupling2d_config_t
 
 contains
@@ -143,7 +146,7 @@ contains
         if (present(v0)) vf = v0
         allocate (sys%model, source=ops)
         allocate (sys%op, source=op)
-        call complete_coupled_system(sys, space, uf, vf, error, beta, gamma)
+        call complete_coupled_system(sys, space, uf, vf, error, beta, gamma, config%memory_limit)
 
     contains
 

@@ -64,8 +64,9 @@
 !> above; a first-step impulse that removes inconsistent initial velocities dissipates energy
 !> like a plastic impact).
 module coupling_coupled_step
-    use core_kinds, only: wp
-    use core_error, only: error_t
+    use core_kinds, only: wp, i8
+    use core_error, only: error_t, make_error
+    use core_strings, only: to_str, gib
     use fem_dynamic_operator, only: dynamic_operator_t
     use fem_newmark, only: newmark_t
     use dem_particles, only: particles_inverse_mass, dof_x, dof_y, dof_rot
@@ -212,7 +213,7 @@ contains
     !> factor A = h gamma (W + C S^-1 C^T), take the multiplier space and form its B, and set
     !> the initial residuals. The initial configuration is taken as consistent: the constraint
     !> is q - q_0 = C (u - u_0).
-    subroutine complete_coupled_system(sys, space, u0, v0, error, beta, gamma)
+    subroutine complete_coupled_system(sys, space, u0, v0, error, beta, gamma, memory_limit)
         !> The coupled system (see above).
         type(coupled_system_t), intent(inout) :: sys
         !> The multiplier space over the rows of C (moved into `sys`).
@@ -224,6 +225,9 @@ contains
         !> Newmark beta and gamma (default 1/4, 1/2: average acceleration, which makes the
         !> coupled energy balance exact with theta = 1/2).
         real(wp), intent(in), optional :: beta, gamma
+        !> Bytes the dense multiplier matrices may take (multiplier_bytes; < 0: no limit):
+        !> beyond it, an error instead of an allocation that fails or exhausts the machine.
+        integer(i8), intent(in), optional :: memory_limit
         real(wp), allocatable :: im(:, :), iw(:)
         real(wp) :: h
         integer :: n, r
@@ -237,6 +241,17 @@ contains
         if (present(gamma)) sys%fe%gamma = gamma
         call sys%fe%init(sys%model, h, sys%dem%time, u0, v0, error)
         if (allocated(error)) return
+        if (present(memory_limit)) then
+            if (memory_limit >= 0 .and. multiplier_bytes(sys%op%n_rows) > memory_limit) then
+                call make_error(error, 'coupling: '//to_str(sys%op%n_rows)//' rows ('// &
+                                to_str(sys%op%n_points)//' coupled disks, '//to_str(sys%op%rows_per_point)// &
+                                ' rows each): the dense multiplier matrices ('//to_str(sys%op%n_rows)//' x '// &
+                                to_str(sys%op%n_rows)//') need about '//gib(multiplier_bytes(sys%op%n_rows))// &
+                                ' of memory and '//gib(memory_limit)//' are available: couple fewer disks (a '// &
+                                'smaller overlap), or run on a machine with more memory')
+                return
+            end if
+        end if
         ! Rows: owner disk and DOF, weighted inverse masses per unit thickness.
         call init_rows(sys)
         allocate (im(3, n))
@@ -377,6 +392,21 @@ contains
         logical, intent(in) :: rotation
         nrm = sys%space%constraint_norm(v, rotation)
     end function constraint_norm
+
+    !> Bytes of the dense multiplier matrices of a coupled system of n_rows rows at their
+    !> peak, while the system is built: A (factored), A^-1 or B, and a work matrix of the
+    !> same size (each n_rows x n_rows reals).
+    pure integer(i8) function multiplier_bytes(n_rows) result(bytes)
+        !> Rows of the coupling (multipliers on the coupled DOFs).
+        integer, intent(in) :: n_rows
+        real(wp) :: total
+        total = 3.0_wp*real(storage_size(1.0_wp)/8, wp)*real(n_rows, wp)**2
+        if (total < 2.0_wp**62) then
+            bytes = int(total, i8)
+        else
+            bytes = huge(0_i8)
+        end if
+    end function multiplier_bytes
 
     !> Advance the coupled system by one time step (see the module description).
     subroutine arlequin_step(sys, error, lp)

@@ -23,6 +23,7 @@ module driver_config_coupling
     use core_constants, only: relative_roundoff
     use core_error, only: error_t, make_input_error
     use core_strings, only: string_t, to_str
+    use io_memory, only: available_memory
     use io_deck, only: deck_t, deck_entry_t
     use io_deck_schema, only: parse_selection
     use fem_beam_config, only: beam_config_t
@@ -114,6 +115,7 @@ contains
                                        alpha_min=deck%get_real('coupling', 'alpha_min'), &
                                        constant=deck%get_real('coupling', 'constant'))
             c%thickness = deck%get_real('coupling', 'thickness')
+            c%memory_limit = available_memory()
             c%rotation_row = deck%get_word('coupling', 'rotation') == 'on'
             c%max_offset = deck%get_real('coupling', 'max_offset')
             c%multipliers = merge(multipliers_nodes, multipliers_particles, &

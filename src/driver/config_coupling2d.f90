@@ -14,6 +14,7 @@ module driver_config_coupling2d
     use core_kinds, only: wp
     use core_error, only: error_t, make_input_error
     use core_strings, only: string_t, to_str
+    use io_memory, only: available_memory
     use io_deck, only: deck_t, deck_entry_t
     use coupling_weights, only: weight_config_t
     use coupling_overlap2d, only: overlap2d_t, overlap_set_t, make_box_overlap, make_polygon_overlap, &
@@ -115,6 +116,7 @@ contains
         end if
         associate (c => setup%config)
             c%thickness = deck%get_real('coupling', 'thickness')
+            c%memory_limit = available_memory()
             c%rotation_row = deck%get_word('coupling', 'rotation') == 'on'
             c%multipliers = merge(multipliers_nodes, multipliers_particles, &
                                   deck%get_word('coupling', 'multipliers') == 'nodes')

@@ -18,7 +18,7 @@ module driver_guards
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
-    use core_strings, only: to_str
+    use core_strings, only: to_str, gib
     use dem_particles, only: particles_t
     use dem_walls, only: walls_t
     use dem_contacts, only: contact_set_t
@@ -426,16 +426,6 @@ contains
                         gib(available)//' are available (MemAvailable in /proc/meminfo): make the model '// &
                         'smaller, or run it on a machine with more memory')
     contains
-        function gib(b) result(text)
-            integer(i8), intent(in) :: b
-            character(len=:), allocatable :: text
-            character(len=32) :: buf
-            write (buf, '(f0.2)') real(b, wp)/1024.0_wp**3
-            text = trim(buf)
-            if (text(1:1) == '.') text = '0'//text
-            text = text//' GiB'
-        end function gib
-
         !> 'n continuum elements', or 'n Q4 and m T3 continuum elements' when both kinds are there.
         function continuum() result(text)
             character(len=:), allocatable :: text
