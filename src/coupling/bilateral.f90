@@ -164,25 +164,43 @@ contains
         real(wp), intent(inout) :: vel(:, :)
         integer, intent(in), optional :: rows(:)
         real(wp) :: dl(self%n_rows)
-        integer :: k, r, i, d
         if (.not. present(rows)) then
             dl = -matmul(self%ainv, self%delta)
         else
-            dl = 0.0_wp
-            do k = 1, size(rows)
-                r = rows(k)
-                dl = dl - self%ainv(:, r)*self%delta(r)
-            end do
+            call columns_times_delta(self%n_rows, size(rows), rows, self%ainv, self%delta, dl)
         end if
-        self%lambda = self%lambda + dl
-        do r = 1, self%n_rows
-            d = self%dof(r)
-            i = self%owner(r)
-            vel(d, i) = vel(d, i) + self%response(r)*dl(r)
-            self%target(r) = vel(d, i)
-        end do
+        call apply_correction(self%n_rows, size(vel, 2), self%dof, self%owner, self%response, dl, self%lambda, &
+                              self%target, vel)
         self%corrections = self%corrections + 1
     end subroutine correct
+
+    !> dl = -sum_k A^-1(:, rows(k)) delta(rows(k)), in the order of rows (the hot loop of a
+    !> coupled solve: explicit shapes, so that the columns are read as contiguous vectors).
+    pure subroutine columns_times_delta(m, n, rows, ainv, delta, dl)
+        integer, intent(in) :: m, n, rows(n)
+        real(wp), intent(in) :: ainv(m, m), delta(m)
+        real(wp), intent(out) :: dl(m)
+        integer :: k
+        real(wp) :: d
+        dl = 0.0_wp
+        do k = 1, n
+            d = delta(rows(k))
+            dl = dl - ainv(:, rows(k))*d
+        end do
+    end subroutine columns_times_delta
+
+    !> lambda += dl; the velocity of each row's DOF += response dl, and target = that velocity.
+    pure subroutine apply_correction(m, nd, dof, owner, response, dl, lambda, target, vel)
+        integer, intent(in) :: m, nd, dof(m), owner(m)
+        real(wp), intent(in) :: response(m), dl(m)
+        real(wp), intent(inout) :: lambda(m), target(m), vel(3, nd)
+        integer :: r
+        lambda = lambda + dl
+        do r = 1, m
+            vel(dof(r), owner(r)) = vel(dof(r), owner(r)) + response(r)*dl(r)
+            target(r) = vel(dof(r), owner(r))
+        end do
+    end subroutine apply_correction
 
     !> vel corrected as `restore` would (lambda += -A^-1 delta, delta = G vel - target), the
     !> rows' multipliers and target left as they are.
