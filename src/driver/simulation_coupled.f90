@@ -88,7 +88,12 @@ contains
         call build_coupled(self%settings, self%beam, self%dem, self%coupling, self%sys, error)
         if (allocated(error)) then
             message = error%message
-            call make_input_error(error, deck%file, self%coupling%overlap_line, 'overlap', message)
+            if (index(message, 'omega_max h') > 0) then
+                ! The beam's Newmark step refused (fem_newmark, round-off of the implicit step).
+                call make_input_error(error, deck%file, deck%line('time', 'step'), 'step', message)
+            else
+                call make_input_error(error, deck%file, self%coupling%overlap_line, 'overlap', message)
+            end if
             return
         end if
         self%model = coupled_beam(self%sys)
