@@ -128,6 +128,8 @@ module coupling_coupled_step
         real(wp) :: translation_scale = 0.0_wp, rotation_scale = 0.0_wp
         !> The disk of the row with the largest |G v - C v_c| (0: no row).
         integer :: disk = 0
+        !> Largest radius of the coupled disks [m]: turns the rotation rows into velocities.
+        real(wp) :: radius = 0.0_wp
     end type velocity_mismatch_t
 
     !> Energy audit of the coupled system [J] (DEM terms already multiplied by the thickness).
@@ -374,6 +376,7 @@ contains
         if (sys%op%n_rows == 0) return
         r = maxloc(abs(gv - cv), 1)
         m%disk = sys%rows%owner(r)
+        m%radius = maxval(sys%dem%particles%radius(sys%rows%owner))
     end function velocity_mismatch
 
     !> Velocities of the coupled DOFs from the disks' state (n_rows).

@@ -316,7 +316,9 @@ contains
         end subroutine warn_unconverged
 
         !> Warning when the initial velocities of the coupled disks differ from the FE model's
-        !> at their centres (beyond round-off: 1e-8 of the velocities). The first step's
+        !> at their centres (beyond round-off: 1e-8 of the velocities, the rotation rows times
+        !> the largest coupled radius, so that a rotation mismatch of rounding next to zero
+        !> rotations does not count). The first step's
         !> multipliers remove the difference with an impulse that dissipates its energy like a
         !> plastic impact: the run goes on, but /coupling/energy/balance shows that loss (5 % to
         !> 30 % of the energy for disks given initial_velocity over a block at rest).
@@ -324,7 +326,8 @@ contains
             real(wp), parameter :: relative = 1.0e-8_wp
             type(velocity_mismatch_t) :: m
             m = velocity_mismatch(self%sys)
-            if (m%translation <= relative*m%translation_scale .and. m%rotation <= relative*m%rotation_scale) return
+            if (hypot(m%translation, m%radius*m%rotation) <= &
+                relative*hypot(m%translation_scale, m%radius*m%rotation_scale)) return
             write (buf, '(a,es10.3e3,a,es10.3e3,a,es10.3e3,a,es10.3e3,a,i0,a)') &
                 'warning: the initial velocities of the coupled disks differ from the finite-element '// &
                 'model''s at their centres (|G v - C v| = ', m%translation, ' m/s against ', &
