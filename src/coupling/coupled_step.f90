@@ -83,6 +83,7 @@ module coupling_coupled_step
     public :: coupled_system_t, coupled_stats_t, coupled_energies_t
     public :: complete_coupled_system, disk_space, arlequin_step, coupled_energies, coordinate_residual
     public :: multipliers_particles, multipliers_nodes
+    public :: velocity_mismatch_t, velocity_mismatch
 
     !> One multiplier per coupled DOF (the reference work).
     integer, parameter :: multipliers_particles = 1
@@ -118,6 +119,20 @@ module coupling_coupled_step
         !> ||lambda|| over all multipliers (mediator ones with multipliers_nodes) [N, N.m].
         real(wp) :: lambda_norm = 0.0_wp
     end type coupled_stats_t
+
+    !> How far the velocities of the coupled disks are from the FE field at their points, in the
+    !> current state (before the first step: the initial velocities of the deck).
+    type :: velocity_mismatch_t
+        !> ||G v - C v_c|| over the translation rows [m/s] and the rotation rows [rad/s]
+        !> (||Pi (...)|| with the mediator space: what the multipliers impose).
+        real(wp) :: translation = 0.0_wp, rotation = 0.0_wp
+        !> The larger of ||G v|| and ||C v_c|| over the same rows (their scale).
+        real(wp) :: translation_scale = 0.0_wp, rotation_scale = 0.0_wp
+        !> The disk of the row with the largest |G v - C v_c| (0: no row).
+        integer :: disk = 0
+        !> Largest radius of the coupled disks [m]: turns the rotation rows into velocities.
+        real(wp) :: radius = 0.0_wp
+    end type velocity_mismatch_t
 
     !> Energy audit of the coupled system [J] (DEM terms already multiplied by the thickness).
     type :: coupled_energies_t
@@ -355,6 +370,30 @@ contains
         sys%stats%velocity_residual = sys%stats%free_residual
         sys%step = 0
     end subroutine init_state
+
+    !> The velocity mismatch of the coupled disks with the FE field in the current state. Before
+    !> the first step it is that of the initial velocities: the first step's multipliers remove
+    !> it with an impulse that dissipates its energy like a plastic impact (the balance of
+    !> coupled_energies shows it).
+    function velocity_mismatch(sys) result(m)
+        !> The coupled system (built).
+        type(coupled_system_t), intent(in) :: sys
+        type(velocity_mismatch_t) :: m
+        real(wp), allocatable :: gv(:), cv(:)
+        integer :: r
+        allocate (gv(sys%op%n_rows), cv(sys%op%n_rows))
+        call disk_velocities(sys, gv)
+        call sys%op%apply(sys%fe%v, cv)
+        call sys%op%add_prescribed(sys%fe%t, 1, cv)
+        m%translation = constraint_norm(sys, gv - cv, .false.)
+        m%rotation = constraint_norm(sys, gv - cv, .true.)
+        m%translation_scale = max(constraint_norm(sys, gv, .false.), constraint_norm(sys, cv, .false.))
+        m%rotation_scale = max(constraint_norm(sys, gv, .true.), constraint_norm(sys, cv, .true.))
+        if (sys%op%n_rows == 0) return
+        r = maxloc(abs(gv - cv), 1)
+        m%disk = sys%rows%owner(r)
+        m%radius = maxval(sys%dem%particles%radius(sys%rows%owner))
+    end function velocity_mismatch
 
     !> Velocities of the coupled DOFs from the disks' state (n_rows).
     pure subroutine disk_velocities(sys, gv)

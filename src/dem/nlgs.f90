@@ -434,8 +434,8 @@ contains
         allocate (list(n_swept), sc(rolling_n_scaling, n_swept))
         allocate (vfree, source=vel)
         allocate (vwork, mold=vel)
-        ! |q|^2 of the Siconos error, for the criterion and the final error
-        nq = siconos_free_norm2(cs, im, vfree, bilateral)
+        ! |q| of the Siconos error, for the criterion and the final error
+        nq = siconos_free_norm(cs, im, vfree, bilateral)
         if (config%criterion == criterion_siconos) then
             ! the active contacts, in increasing order: the running criterion runs over them
             act = pack([(k, k=1, cs%n)], cs%active(1:cs%n))
@@ -1703,8 +1703,8 @@ contains
 
     !> Siconos error of the current reactions (doc/theory.md, "Siconos error"), u computed in
     !> full from the free velocities: vwork = vfree + M^-1 H r (or vel itself when bilateral
-    !> constraints changed the velocities: their impulses are not contacts); nq = |q|^2
-    !> (siconos_free_norm2).
+    !> constraints changed the velocities: their impulses are not contacts); nq = |q|
+    !> (siconos_free_norm).
     real(wp) function siconos_error(cs, im, vfree, vel, vwork, bilateral, nq) result(err)
         type(contact_set_t), intent(in) :: cs
         real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :), nq
@@ -1738,18 +1738,19 @@ contains
         real(wp), intent(in) :: vel(:, :)
         real(wp) :: err
         integer :: k
-        err = siconos_ratio(cs, pack([(k, k=1, cs%n)], cs%active(1:cs%n)), vel, siconos_free_norm2(cs, im, vfree))
+        err = siconos_ratio(cs, pack([(k, k=1, cs%n)], cs%active(1:cs%n)), vel, siconos_free_norm(cs, im, vfree))
     end function nlgs_siconos_error
 
-    !> |q|^2 over the active contacts: q = H^T vq + shift, vq the velocities of the free
-    !> term in the shifted unknown (the free motion minus the cohesion impulses; with
-    !> bilateral constraints, held by them: the problem is the condensed one).
-    real(wp) function siconos_free_norm2(cs, im, vfree, bilateral) result(nq)
+    !> |q| over the active contacts: q = H^T vq + shift, vq the velocities of the free term in
+    !> the shifted unknown (the free motion minus the cohesion impulses; with bilateral
+    !> constraints, held by them: the problem is the condensed one). The square root of the
+    !> sum of squares (with the max in siconos_quotient, bitwise the error computed from the
+    !> squares), or norm2 where the squares overflow.
+    real(wp) function siconos_free_norm(cs, im, vfree, bilateral) result(nq)
         type(contact_set_t), intent(in) :: cs
         real(wp), intent(in) :: im(:, :), vfree(:, :)
         class(nlgs_bilateral_t), intent(in), optional :: bilateral
-        real(wp), allocatable :: vq(:, :)
-        real(wp) :: q(3)
+        real(wp), allocatable :: vq(:, :), q(:, :)
         integer :: k
         allocate (vq, source=vfree)
         do k = 1, cs%n
@@ -1757,42 +1758,77 @@ contains
             if (cs%coh(k) /= 0.0_wp) call apply(cs, k, im, vq, -cs%coh(k), 0.0_wp, 0.0_wp)
         end do
         if (present(bilateral)) call bilateral%hold(vq)
+        allocate (q(3, cs%n), source=0.0_wp)
         nq = 0.0_wp
         do k = 1, cs%n
             if (.not. cs%active(k)) cycle
-            call local_velocity(cs, k, vq, q)
-            if (cs%erol(k) <= 0.0_wp) q(3) = 0.0_wp
-            nq = nq + sum(q**2)
+            call local_velocity(cs, k, vq, q(:, k))
+            if (cs%erol(k) <= 0.0_wp) q(3, k) = 0.0_wp
+            nq = nq + sum(q(:, k)**2)
         end do
-    end function siconos_free_norm2
+        if (ieee_is_finite(nq)) then
+            nq = sqrt(nq)
+        else
+            nq = norm2(q)
+        end if
+    end function siconos_free_norm
 
-    !> The ratio of nlgs_siconos_error for the velocities vel, with nq = |q|^2
-    !> (siconos_free_norm2), over the active contacts act (in increasing order).
+    !> The ratio of nlgs_siconos_error for the velocities vel, with nq = |q|
+    !> (siconos_free_norm), over the active contacts act (in increasing order).
     pure real(wp) function siconos_ratio(cs, act, vel, nq) result(err)
         type(contact_set_t), intent(in) :: cs
         integer, intent(in) :: act(:)
         real(wp), intent(in) :: vel(:, :), nq
+        real(wp) :: num, nr, nu, amax, c
         err = 0.0_wp
         ! (no contact arrays to pass before the first contact)
         if (size(act) == 0) return
-        err = siconos_ratio_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%shift, cs%r, cs%coh, cs%erol, cs%mu, &
-                                     size(vel, 2), vel, size(act), act, nq)
+        call siconos_ratio_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%shift, cs%r, cs%coh, cs%erol, cs%mu, &
+                                    size(vel, 2), vel, size(act), act, 1.0_wp, num, nr, nu, amax)
+        if ((ieee_is_finite(num) .and. ieee_is_finite(nr) .and. ieee_is_finite(nu)) .or. &
+            .not. (amax > 0.0_wp .and. amax <= huge(amax))) then
+            err = siconos_quotient(num, nr, nu, nq)
+            return
+        end if
+        ! Finite values whose squares overflow (reactions beyond 1e154: disks of density 1e300
+        ! gave a NaN error, inf/inf). The projections on the cones are positively homogeneous:
+        ! r and u scaled by the power of 2 c ~ 1/amax (exact) give the same ratio.
+        c = scale(1.0_wp, -exponent(amax))
+        call siconos_ratio_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%shift, cs%r, cs%coh, cs%erol, &
+                                    cs%mu, size(vel, 2), vel, size(act), act, c, num, nr, nu, amax)
+        err = siconos_quotient(num, nr, nu, nq*c)
     end function siconos_ratio
+
+    !> sqrt(num) / max(nq, sqrt(nr), sqrt(nu)), 0 when the denominator vanishes.
+    pure real(wp) function siconos_quotient(num, nr, nu, nq) result(err)
+        real(wp), intent(in) :: num, nr, nu, nq
+        real(wp) :: den
+        den = max(nq, sqrt(nr), sqrt(nu))
+        err = 0.0_wp
+        if (den > 0.0_wp) err = sqrt(num)/den
+    end function siconos_quotient
 
     !> siconos_ratio on the arrays of the contact set (explicit shapes, as sweep_contacts; the
     !> local velocity written out as there: this runs after most sweeps of a long solve, and a
     !> shared procedure for it was not inlined, 3 % more time on the 200-disk deposit).
-    pure real(wp) function siconos_ratio_contacts(n, i1s, i2s, nrm, lever, shift, rc, coh, erol, mu, nd, vel, na, &
-                                                  act, nq) result(err)
+    pure subroutine siconos_ratio_contacts(n, i1s, i2s, nrm, lever, shift, rc, coh, erol, mu, nd, vel, na, &
+                                           act, c, num, nr, nu, amax)
         integer, intent(in) :: n, nd, na
         integer, intent(in) :: i1s(n), i2s(n), act(na)
         real(wp), intent(in) :: nrm(2, n), lever(2, n), shift(2, n), rc(3, n), coh(n), erol(n), mu(n)
-        real(wp), intent(in) :: vel(3, nd), nq
-        real(wp) :: u(3), r(3), t(3), p(3), num, nr, nu, den, dvx, dvy, nx, ny
+        real(wp), intent(in) :: vel(3, nd)
+        !> Scale of r and u (1, or 1/amax of a first pass whose squares overflowed).
+        real(wp), intent(in) :: c
+        !> Sums of |r - P_K(r - u_hat)|^2, |r|^2 and |u|^2 of the scaled values.
+        real(wp), intent(out) :: num, nr, nu
+        !> Largest |component| of the scaled r and u.
+        real(wp), intent(out) :: amax
+        real(wp) :: u(3), r(3), t(3), p(3), dvx, dvy, nx, ny
         integer :: a, k, i1, i2, pcase
         num = 0.0_wp
         nr = 0.0_wp
         nu = 0.0_wp
+        amax = 0.0_wp
         do a = 1, na
             k = act(a)
             i1 = i1s(k)
@@ -1811,7 +1847,9 @@ contains
             ny = nrm(2, k)
             u(1) = nx*dvx + ny*dvy + shift(1, k)
             u(2) = u(2) - ny*dvx + nx*dvy
-            r = [rc(1, k) + coh(k), rc(2, k), rc(3, k)]
+            r = c*[rc(1, k) + coh(k), rc(2, k), rc(3, k)]
+            u = c*u
+            amax = max(amax, maxval(abs(r)), maxval(abs(u)))
             if (erol(k) > 0.0_wp) then
                 t = r - [u(1) + mu(k)*abs(u(2)) + erol(k)*abs(u(3)), u(2), u(3)]
                 call rolling_projection(t(1), t(2), t(3), mu(k), erol(k), p(1), p(2), p(3), pcase)
@@ -1826,10 +1864,7 @@ contains
             nr = nr + sum(r**2)
             nu = nu + sum(u**2)
         end do
-        den = sqrt(max(nq, nr, nu))
-        err = 0.0_wp
-        if (den > 0.0_wp) err = sqrt(num)/den
-    end function siconos_ratio_contacts
+    end subroutine siconos_ratio_contacts
 
     !> Relative residual of the contact laws in the current state:
     !> sqrt(sum res_a^2) / sqrt(sum |r'_a|^2) over active contacts, with res_a from

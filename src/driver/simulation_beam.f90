@@ -12,7 +12,7 @@ module driver_simulation_beam
     use fem_beam_model, only: beam_model_t, build_beam_model
     use fem_static, only: solve_static
     use fem_modal, only: solve_modal, mode_axial_fraction, mode_kind, dominant_fraction
-    use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
+    use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t, model_out_of_range
     use driver_config, only: run_config_t, build_config
     use driver_results, only: results_writer_t
     use driver_checkpoint, only: end_of_step, step_end_t, checkpoint_run_t, loop_state_t, checkpoint_create, &
@@ -86,10 +86,14 @@ contains
         if (self%settings%analysis == 'dynamic') then
             call make_integrator(self%settings, self%model, self%integ, error)
             if (allocated(error)) then
-                ! The integrator only refuses a time step (stability limit).
+                ! The integrator refuses a time step (stability limit, round-off), or a model
+                ! whose highest frequency no step resolves (its sections).
                 message = error%message
-                call make_input_error(error, deck%file, deck%line('time', 'step'), 'step', &
-                                      message)
+                if (index(message, model_out_of_range) == 1) then
+                    call make_input_error(error, deck%file, deck%line('beam', 'section'), 'section', message)
+                else
+                    call make_input_error(error, deck%file, deck%line('time', 'step'), 'step', message)
+                end if
             end if
         end if
     end subroutine beam_init

@@ -23,7 +23,7 @@ module driver_simulation_continuum
     use fem_continuum_model, only: continuum_model_t
     use fem_continuum_dynamics, only: continuum_dynamics_t, continuum_audit_t
     use fem_dynamic_operator, only: spd_factor_t
-    use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
+    use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t, model_out_of_range
     use driver_config, only: run_config_t, build_run_settings, build_time_functions
     use driver_results, only: results_writer_t
     use io_hdf5_file, only: h5_file_t
@@ -402,7 +402,13 @@ contains
                 end select
             end select
             call self%integ%init(self%ops, self%settings%h, 0.0_wp, u0, v0, error)
-            if (allocated(error)) call fail_at(error, deck%line('time', 'step'), 'step')
+            if (.not. allocated(error)) return
+            if (index(error%message, model_out_of_range) == 1) then
+                ! no time step resolves the model: its materials
+                call fail_at(error, deck%line('continuum', 'material'), 'material')
+            else
+                call fail_at(error, deck%line('time', 'step'), 'step')
+            end if
         end subroutine make_integrator
     end subroutine continuum_init
 

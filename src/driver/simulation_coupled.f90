@@ -12,6 +12,7 @@ module driver_simulation_coupled
     use io_deck, only: deck_t
     use fem_beam_config, only: beam_config_t
     use fem_beam_model, only: beam_model_t
+    use fem_newmark, only: model_out_of_range
     use coupling_arlequin, only: coupled_system_t, build_coupled_system, coupled_beam
     use driver_config, only: run_config_t, build_config
     use driver_config_dem, only: dem_config_t, build_dem_config
@@ -88,7 +89,15 @@ contains
         call build_coupled(self%settings, self%beam, self%dem, self%coupling, self%sys, error)
         if (allocated(error)) then
             message = error%message
-            call make_input_error(error, deck%file, self%coupling%overlap_line, 'overlap', message)
+            if (index(message, model_out_of_range) == 1) then
+                ! The beam's Newmark step refused (fem_newmark): no step resolves the beam.
+                call make_input_error(error, deck%file, deck%line('beam', 'section'), 'section', message)
+            else if (index(message, 'omega_max h') > 0) then
+                ! The beam's Newmark step refused (fem_newmark, round-off of the implicit step).
+                call make_input_error(error, deck%file, deck%line('time', 'step'), 'step', message)
+            else
+                call make_input_error(error, deck%file, self%coupling%overlap_line, 'overlap', message)
+            end if
             return
         end if
         self%model = coupled_beam(self%sys)
