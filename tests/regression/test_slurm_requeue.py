@@ -2,8 +2,9 @@
 """A sweep point stopped before its time limit requeues itself on a real Slurm and completes
 from its checkpoint (scripts/multicor-sweep, tests/regression/slurm_local.py).
 
-A 2-point sweep of input/incline.dat over the time step (1e-3 s: 500 steps; 1e-5 s: 50000
-steps, a few seconds on the Debug build; outputs every 100 steps). While the long point runs, the test sends it
+A 2-point sweep of input/incline.dat over the time step (1e-3 s: 500 steps; the long point
+as many steps as this build runs in about 3 s, from a timed run of 20 000 steps, at least
+50 000 and at most 500 000; outputs every 100 steps). While the long point runs, the test sends it
 SIGUSR1 with `scancel --signal=USR1 <job>_2`: the signal that `#SBATCH --signal=USR1@<s>`
 makes slurmctld send to the job steps <s> seconds before the time limit, by the same route
 (slurmctld -> slurmd -> the step's tasks), only sent now instead of at the clock's time (a
@@ -45,6 +46,24 @@ def sweep_tool(src, args, env=None):
     return proc
 
 
+def steps_lasting(exe, src, work, seconds):
+    """Steps of input/incline.dat (outputs every 100) that `exe` runs in about `seconds`, from a
+    timed local run of 20 000 steps; a multiple of 10 000, at least 50 000 and at most 500 000.
+    A Release build runs 50 000 steps in about 0.6 s: the signal, sent 0.5 s after the point
+    started, then arrived after its end (the point finished once, never stopped)."""
+    n = 20000
+    text = (src / "input" / "incline.dat").read_text()
+    text = re.sub(r"^step\s*=.*$", f"step = {0.5 / n!r}", text, count=1, flags=re.M)
+    text = re.sub(r"^interval\s*=.*$", "interval = 100", text, count=1, flags=re.M)
+    deck = work / "timing.dat"
+    deck.write_text(text)
+    t0 = time.monotonic()
+    subprocess.run([str(exe), "--quiet", str(deck), "--output", str(work / "timing")], check=True,
+                   capture_output=True)
+    elapsed = time.monotonic() - t0
+    return int(min(max(round(n * seconds / elapsed, -4), 50000), 500000))
+
+
 def wait_for(what, test, timeout, cluster):
     t0 = time.monotonic()
     while time.monotonic() - t0 < timeout:
@@ -66,7 +85,6 @@ def main():
                     "time-limit warning stops it, once or several times")
     args = ap.parse_args()
     real = args.real_time_limit
-    steps = 3000000 if real else 50000
     exe = pathlib.Path(args.exe).resolve()
     src = pathlib.Path(args.source).resolve()
     work = pathlib.Path(args.work).resolve()
@@ -84,6 +102,8 @@ def main():
         print(f"skipped: {reason}")
         return 77
 
+    steps = 3000000 if real else steps_lasting(exe, src, work, 3.0)
+    print(f"the long point: {steps} steps")
     folder = work / "sweep"
     limits = ["--time", "1", "--signal-seconds", "50"] if real else ["--time", "00:05:00"]
     sweep_tool(src, ["create", src / "input" / "incline.dat", "--exe", exe,
