@@ -10,6 +10,7 @@ from synthetic_dem import write_dem
 import plot_beam
 import plot_experiments
 import plot_results
+import run_interface_experiment
 
 
 @pytest.mark.parametrize("script", [plot_results, plot_beam])
@@ -97,3 +98,55 @@ def test_plot_experiments_output_folder_that_is_a_file(tmp_path, capsys):
         write_coupled(tmp_path / case / f"{case}.h5", title=case)
     assert plot_experiments.main(["--results", str(tmp_path), "--out", str(blocker)]) == 1
     assert f"the folder of the figures '{blocker}' is a file" in capsys.readouterr().err
+
+
+@pytest.fixture
+def fake_exe(tmp_path):
+    exe = tmp_path / "multicor"
+    exe.write_text("#!/bin/sh\nexit 0\n")
+    exe.chmod(0o755)
+    return exe
+
+
+def test_run_interface_experiment_keeps_a_folder_it_did_not_write(fake_exe, tmp_path, capsys):
+    # --out is emptied first: a folder of other results (a typo such as --out results) was
+    # deleted whole before anything ran
+    out = tmp_path / "results"
+    out.mkdir()
+    (out / "precious.h5").write_bytes(b"x")
+    assert run_interface_experiment.main(["--exe", str(fake_exe), "--out", str(out)]) == 1
+    assert "holds precious.h5, which this script did not write" in capsys.readouterr().err
+    assert (out / "precious.h5").read_bytes() == b"x"
+
+
+@pytest.mark.parametrize("case, message", [
+    ("exe", "not an executable file"), ("deck", "no such deck"), ("out", "a file, not a folder")])
+def test_run_interface_experiment_checks_its_arguments_first(case, message, fake_exe, tmp_path,
+                                                             capsys):
+    # each was a traceback (PermissionError in a thread, FileNotFoundError, NotADirectoryError)
+    blocker = tmp_path / "blocker"
+    blocker.write_text("keep")
+    args = {"exe": str(fake_exe), "deck": run_interface_experiment.ROOT / "input" /
+            "interface_shear.dat", "out": str(tmp_path / "new")}
+    args[case] = {"exe": str(blocker), "deck": str(tmp_path / "none.dat"),
+                  "out": str(blocker)}[case]
+    argv = [f"--{k}={v}" for k, v in args.items()]
+    assert run_interface_experiment.main(argv) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err
+    assert blocker.read_text() == "keep" and not (tmp_path / "new").exists()
+
+
+def test_run_interface_experiment_empties_an_earlier_experiment(fake_exe, tmp_path):
+    # the folder of an earlier experiment is still emptied (the fake executable prints no
+    # deck reference, so multicor-sweep refuses to create the sweeps: exit 1 after the folder
+    # was emptied and the base deck written)
+    out = tmp_path / "interface"
+    for name in ("mu", "cohesion", "width"):
+        (out / name / "runs").mkdir(parents=True)
+    (out / "mu" / "old.txt").write_text("old")
+    (out / "interface_shear.dat").write_text("old")
+    assert run_interface_experiment.main(["--exe", str(fake_exe), "--out", str(out),
+                                          "-j", "1"]) == 1
+    assert not (out / "mu" / "old.txt").exists()
+    assert "mesh = file " in (out / "interface_shear.dat").read_text()
