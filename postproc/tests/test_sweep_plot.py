@@ -1,5 +1,6 @@
 """results.png of `scripts/multicor-sweep collect` (its plot function on rows as collect builds
-them from results.csv): a word-valued swept key and a sweep without any value yet."""
+them from results.csv): a word-valued swept key and a sweep without any value yet; the grid
+file of `create --grid`."""
 import importlib.machinery
 import importlib.util
 import math
@@ -90,3 +91,27 @@ def test_a_scalar_without_values_says_so_on_its_axis(sweep_tool, saved, tmp_path
     assert texts == ["no point has a value of missing"]
     assert not fig.axes[0].texts
     assert all(math.isfinite(y) for y in fig.axes[0].get_lines()[0].get_ydata())
+
+
+@pytest.mark.parametrize("case, reason", [("missing", "No such file or directory"),
+                                          ("folder", "Is a directory"),
+                                          ("binary", "can't decode byte 0xff")])
+def test_a_grid_file_that_cannot_be_read_is_a_sweep_error(case, reason, sweep_tool, tmp_path):
+    # create --grid FILE: each was a traceback (FileNotFoundError, IsADirectoryError,
+    # UnicodeDecodeError)
+    path = tmp_path / case
+    if case == "folder":
+        path.mkdir()
+    elif case == "binary":
+        path.write_bytes(b"\xff\xfe time.step = 1")
+    with pytest.raises(sweep_tool.SweepError) as err:
+        sweep_tool.read_grid_file(path)
+    assert str(err.value).startswith(f"--grid {path}: cannot read it (")
+    assert reason in str(err.value)
+
+
+def test_a_grid_file_gives_its_keys_and_values(sweep_tool, tmp_path):
+    path = tmp_path / "grid.txt"
+    path.write_text("# comment\ntime.step = 1e-4, 2e-4\n\nsolver.method = block  # end\n")
+    assert sweep_tool.read_grid_file(path) == [("time.step", ["1e-4", "2e-4"]),
+                                               ("solver.method", ["block"])]
