@@ -149,11 +149,11 @@ def main(argv=None):
     out = args.out or args.results
     written = []
     try:
-        make_out_dir(out)
         runs = {}
         for name in CASES:
             path = os.path.join(args.results, name, f"{name}.h5")
             runs[name] = coupled.load_coupled(path)
+        make_out_dir(out)  # once the runs load: a mistyped --results creates no folder
         for name, r in runs.items():
             save(coupled.plot_profiles(r, args.time), out, f"{name}_profiles", written)
             save(coupled.plot_configuration(r, args.time), out, f"{name}_configuration", written)

@@ -90,6 +90,14 @@ def test_plot_experiments_refuses_a_tracked_disk_the_runs_do_not_have(disk, tmp_
     assert not list(tmp_path.glob("history_*"))
 
 
+def test_plot_experiments_creates_no_folder_for_results_it_cannot_load(tmp_path, capsys):
+    # a mistyped --results (the default --out) was created as an empty folder
+    missing = tmp_path / "typo"
+    assert plot_experiments.main(["--results", str(missing)]) == 1
+    assert "does not exist" in capsys.readouterr().err
+    assert not missing.exists()
+
+
 def test_plot_experiments_output_folder_that_is_a_file(tmp_path, capsys):
     blocker = tmp_path / "blocker"
     blocker.write_text("")
