@@ -16,24 +16,30 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from multicor_post.beam import write_all  # noqa: E402
-from multicor_post.results import ResultsError, load_results  # noqa: E402
+from multicor_post.results import (ResultsError, file_contents, finite_float,  # noqa: E402
+                                   load_results, scale_factor)
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="plot_beam.py", description=__doc__.split("\n")[0])
     parser.add_argument("results", help="results file (.h5) written by multicor")
-    parser.add_argument("--time", type=float, default=None,
+    parser.add_argument("--time", type=finite_float, default=None,
                         help="time [s] of the deflection plot (nearest stored output; "
                              "default: the last one)")
     parser.add_argument("--node", type=int, default=None,
                         help="deck id of the node whose history is plotted (default: the tip)")
     parser.add_argument("--out", default=None,
                         help="folder for the PNG files (default: the results file's folder)")
-    parser.add_argument("--scale", type=float, default=None,
+    parser.add_argument("--scale", type=scale_factor, default=None,
                         help="displacement scale factor of deformed-shape plots (default: auto)")
     args = parser.parse_args(argv)
     out = args.out if args.out is not None else (os.path.dirname(args.results) or ".")
     try:
+        has_beam, has_particles, _, has_continuum = file_contents(args.results)
+        if not has_beam and (has_particles or has_continuum):
+            what = "particles (/dem)" if has_particles else "a 2D continuum (/continuum)"
+            raise ResultsError(f"'{args.results}' holds no beam (/fem/mesh) but {what}: plot it "
+                               "with plot_results.py")
         res = load_results(args.results)
         paths = write_all(res, out, time=args.time, node_id=args.node, scale=args.scale)
     except ResultsError as exc:

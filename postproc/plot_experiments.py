@@ -33,7 +33,8 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from multicor_post import coupled, interface  # noqa: E402
-from multicor_post.results import ResultsError  # noqa: E402
+from multicor_post.results import (ResultsError, finite_float, make_out_dir,  # noqa: E402
+                                   save_figure)
 
 CASES = ("bending_case1", "bending_case2", "bending_stack")
 LABELS = {"bending_case1": "case 1 (overlap 6 layers)",
@@ -45,7 +46,7 @@ def save(fig, out, name, written):
     """Save a figure as PNG and PDF."""
     for ext in ("png", "pdf"):
         path = os.path.join(out, f"{name}.{ext}")
-        fig.savefig(path, dpi=150)
+        save_figure(fig, path, 150)
         written.append(path)
 
 
@@ -135,7 +136,7 @@ def main(argv=None):
     parser.add_argument("--results", default="results/experiments",
                         help="folder holding <case>/<case>.h5 (default results/experiments)")
     parser.add_argument("--out", default=None, help="folder of the figures (default: --results)")
-    parser.add_argument("--time", type=float, default=5e-3,
+    parser.add_argument("--time", type=finite_float, default=5e-3,
                         help="time of the snapshots [s] (nearest stored output; default 5e-3)")
     parser.add_argument("--track", type=int, nargs="+", default=[7, 11, 17],
                         help="disks (1-based) whose histories are compared (default 7 11 17: "
@@ -146,13 +147,13 @@ def main(argv=None):
                              "when absent)")
     args = parser.parse_args(argv)
     out = args.out or args.results
-    os.makedirs(out, exist_ok=True)
     written = []
     try:
         runs = {}
         for name in CASES:
             path = os.path.join(args.results, name, f"{name}.h5")
             runs[name] = coupled.load_coupled(path)
+        make_out_dir(out)  # once the runs load: a mistyped --results creates no folder
         for name, r in runs.items():
             save(coupled.plot_profiles(r, args.time), out, f"{name}_profiles", written)
             save(coupled.plot_configuration(r, args.time), out, f"{name}_configuration", written)

@@ -23,40 +23,23 @@ import argparse
 import os
 import sys
 
-import h5py
-
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from multicor_post import beam, continuum, coupled, particles  # noqa: E402
-from multicor_post.results import ResultsError, load_results  # noqa: E402
+from multicor_post.results import (ResultsError, file_contents, finite_float,  # noqa: E402
+                                   load_results, scale_factor)
 
 
 def contents(path):
     """(has beam results, has particle results, is a coupled run, has a 2D continuum) of a
-    results file."""
-    if not os.path.exists(path):
-        hint = ""
-        if os.path.exists(path + ".partial"):
-            hint = f" ('{path}.partial' exists: the run did not finish)"
-        raise ResultsError(f"results file '{path}' does not exist{hint}")
-    try:
-        with h5py.File(path, "r") as f:
-            # the other HDF5 files multicor writes: say what they are and where the results are
-            if str(f.attrs.get("format", "")).startswith("MULTICOR checkpoint"):
-                raise ResultsError(f"'{path}' is a MULTICOR checkpoint (for --restart), not a "
-                                   "results file: plot the <deck name>.h5 next to it")
-            if "fclib_local" in f:
-                raise ResultsError(f"'{path}' is a contact problem exported in FCLIB's format "
-                                   "([solver] fclib_step), not a results file")
-            return "fem/mesh" in f, "dem" in f, "coupling" in f, "continuum/mesh" in f
-    except OSError as exc:
-        raise ResultsError(f"'{path}' is not a readable HDF5 file ({exc})") from None
+    results file (multicor_post.results.file_contents)."""
+    return file_contents(path)
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="plot_results.py", description=__doc__.split("\n")[0])
     parser.add_argument("results", help="results file (.h5) written by multicor")
-    parser.add_argument("--time", type=float, default=None,
+    parser.add_argument("--time", type=finite_float, default=None,
                         help="time [s] of the snapshot plots (nearest stored output; default: "
                              "the last one)")
     parser.add_argument("--out", default=None,
@@ -65,7 +48,7 @@ def main(argv=None):
                         help="beam: deck id of the node whose history is plotted (default: the "
                              "tip); continuum: 1-based mesh node (default: the largest "
                              "displacement)")
-    parser.add_argument("--scale", type=float, default=None,
+    parser.add_argument("--scale", type=scale_factor, default=None,
                         help="beam and continuum: displacement scale factor of deformed shapes "
                              "(default: auto)")
     args = parser.parse_args(argv)

@@ -4,8 +4,9 @@ doc/experiments.md.
 
     run_interface_experiment.py --exe EXE [--out DIR] [--deck DECK] [-j N]
 
-Writes DIR (default results/experiments/interface, emptied first): the base deck with the
-absolute path of its mesh (interface_shear.dat), and three sweeps made from it by
+Writes DIR (default results/experiments/interface, emptied first: refused, like an --exe or
+--deck that is not a file, when it holds anything this script does not write): the base deck
+with the absolute path of its mesh (interface_shear.dat), and three sweeps made from it by
 scripts/multicor-sweep (`create`, then `run`), each point in <sweep>/runs/<point>/<point>.h5:
 - mu: the local friction of the disks, contacts.law[1].mu = 0.1, 0.3, 0.5 (0.3: the base);
 - cohesion: contacts.law[1].cohesion = 1e7 Pa (the base has 0; 1e6 Pa bonds break under the
@@ -18,6 +19,7 @@ The two lanes (mu; cohesion then width) run side by side (-j 2, the default) or 
 other (-j 1). plot_experiments.py draws the figures from DIR. Exit code 1 when a run fails.
 """
 import argparse
+import os
 import pathlib
 import shutil
 import subprocess
@@ -29,6 +31,8 @@ SWEEPS = {
     "mu": ["contacts.law[1].mu=0.1,0.3,0.5"],
     "cohesion": ["contacts.law[1].cohesion=1e7"],
 }
+#: What the script writes into --out (besides the base deck): the only entries it deletes.
+OWN = set(SWEEPS) | {"width"}
 REGIONS = [("region = box 0 0.5 0.175 0.2 bottom top", "region = box 0 0.5 0.15 0.2 bottom top"),
            ("region = box 0 0.5 0.25 0.275 top bottom", "region = box 0 0.5 0.25 0.3 top bottom")]
 
@@ -66,6 +70,27 @@ def width_point(exe, base, folder):
     return None
 
 
+def check_arguments(exe, deck, out):
+    """What is wrong with the command line before anything is deleted or run, or None: the
+    executable and the deck must be files, and the folder --out, emptied first, must be new or
+    hold only what this script writes (an earlier experiment): a typo such as --out results
+    must not delete other runs."""
+    if not (exe.is_file() and os.access(exe, os.X_OK)):
+        return f"--exe {exe}: not an executable file"
+    if not deck.is_file():
+        return f"--deck {deck}: no such deck"
+    if out.exists():
+        if not out.is_dir():
+            return f"--out {out}: a file, not a folder"
+        strangers = sorted(p.name for p in out.iterdir() if p.name not in OWN | {deck.name})
+        if strangers:
+            return (f"--out {out}: holds {', '.join(strangers[:5])}"
+                    f"{' ...' if len(strangers) > 5 else ''}, which this script did not write "
+                    "(it empties the folder first): give a new folder or an earlier "
+                    "experiment's")
+    return None
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="run_interface_experiment.py", description=__doc__.split("\n")[0])
     ap.add_argument("--exe", required=True, help="multicor executable")
@@ -76,6 +101,10 @@ def main(argv=None):
     deck = pathlib.Path(args.deck).resolve()
     out = pathlib.Path(args.out).resolve()
     exe = pathlib.Path(args.exe).resolve()
+    problem = check_arguments(exe, deck, out)
+    if problem:
+        print(f"run_interface_experiment.py: error: {problem}", file=sys.stderr)
+        return 1
     if out.exists():
         shutil.rmtree(out)
     out.mkdir(parents=True)

@@ -284,15 +284,20 @@ def main():
     ap.add_argument("--work", required=True, help="folder for the decks and results")
     ap.add_argument("--refine", action="store_true", help="also the 20 mm band at dx = 5, 2.5, 1.25 mm")
     args = ap.parse_args()
+    exe, work = pathlib.Path(args.exe).resolve(), pathlib.Path(args.work).resolve()
+    if not (exe.is_file() and os.access(exe, os.X_OK)):
+        raise SystemExit(f"wave_reflection_2d.py: error: --exe {exe}: not an executable file")
+    if work.exists() and not work.is_dir():
+        raise SystemExit(f"wave_reflection_2d.py: error: --work {work}: a file, not a folder")
     start = time.perf_counter()
-    rows = study(pathlib.Path(args.exe).resolve(), pathlib.Path(args.work).resolve())
+    rows = study(exe, work)
     print(f"Z = {Z:.2f} kg/s, c = {C_BAR:.1f} m/s, T = {T_PULSE * 1e6:.0f} us, t_a = {S_FE / C_BAR * 1e6:.2f} us, "
           f"m_d t = {M_DISK * 1e3:.4f} g; {len(rows)} runs in {time.perf_counter() - start:.1f} s")
     print(table(rows))
     worst = max(max(m["energy_check"], m["balance"]) for _, _, m in rows)
     print(f"Q4 energies against the stored ones before the band, and energy audit: worst {worst:.1e}")
     if args.refine:
-        print(refine(pathlib.Path(args.exe).resolve(), pathlib.Path(args.work).resolve()))
+        print(refine(exe, work))
     return 0
 
 

@@ -356,7 +356,12 @@ def plot_configuration(res: CoupledResults, time: Optional[float] = None,
 def plot_histories(runs: Sequence[CoupledResults], disk: int, labels: Sequence[str],
                    component: int = Y) -> Figure:
     """Displacement (top) and velocity (bottom) history of one disk (0-based index; the same
-    disk at the same abscissa) in several runs."""
+    disk at the same abscissa) in several runs. ResultsError when a run has no such disk (a
+    negative index would silently draw a disk counted from the end under the wrong number)."""
+    for r in runs:
+        n = r.velocity.shape[1]
+        if not 0 <= disk < n:
+            raise ResultsError(f"{r.path}: no disk {disk + 1} (the run has disks 1..{n})")
     fig, (ax_d, ax_v) = _new_figure(8.0, 6.5, rows=2)
     d_all = np.concatenate([history(r, disk)[1][:, component] for r in runs])
     v_all = np.concatenate([r.velocity[:, disk, component] for r in runs])

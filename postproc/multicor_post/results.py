@@ -6,6 +6,8 @@ a first axis, one entry per stored output.
 """
 from __future__ import annotations
 
+import argparse
+import math
 import os
 from dataclasses import dataclass, field
 from typing import Optional
@@ -27,15 +29,82 @@ class FigureFiles:
 
     def __init__(self, results_path, out_dir, dpi: int = 120):
         self.out_dir = os.fspath(out_dir)
-        os.makedirs(self.out_dir, exist_ok=True)
+        make_out_dir(self.out_dir)
         self.stem = figure_stem(results_path)
         self.dpi = dpi
         self.written: list[str] = []
 
     def save(self, fig, name: str, dpi: Optional[int] = None) -> None:
         path = os.path.join(self.out_dir, f"{self.stem}_{name}.png")
-        fig.savefig(path, dpi=self.dpi if dpi is None else dpi)
+        save_figure(fig, path, self.dpi if dpi is None else dpi)
         self.written.append(path)
+
+
+def make_out_dir(out_dir) -> None:
+    """Create the folder of the figures (and its parents); ResultsError naming it when that
+    fails (a file of that name, no permission, a read-only file system)."""
+    if os.path.exists(out_dir) and not os.path.isdir(out_dir):
+        raise ResultsError(f"the folder of the figures '{os.fspath(out_dir)}' is a file")
+    try:
+        os.makedirs(out_dir, exist_ok=True)
+    except OSError as exc:
+        raise ResultsError(f"cannot create the folder of the figures '{os.fspath(out_dir)}' "
+                           f"({exc.strerror or exc})") from None
+
+
+def save_figure(fig, path, dpi: int) -> None:
+    """fig.savefig(path); ResultsError naming the file when it cannot be written."""
+    try:
+        fig.savefig(path, dpi=dpi)
+    except OSError as exc:
+        raise ResultsError(f"cannot write the figure '{os.fspath(path)}' "
+                           f"({exc.strerror or exc})") from None
+
+
+def finite_float(text: str) -> float:
+    """argparse type of a time or scale option: a finite real number (nan and inf are
+    refused as a usage error: no stored output is 'nearest' to nan, and a nan or infinite
+    scale draws nothing or fails inside matplotlib)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a real number, got '{text}'") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite real number, got '{text}'")
+    return value
+
+
+def scale_factor(text: str) -> float:
+    """argparse type of --scale: a finite real number > 0 (0 would draw the undeformed shape
+    labelled as deformed, a negative factor the displacements the wrong way round)."""
+    value = finite_float(text)
+    if value <= 0.0:
+        raise argparse.ArgumentTypeError(f"expected a scale factor > 0, got '{text}'")
+    return value
+
+
+def file_contents(path) -> tuple[bool, bool, bool, bool]:
+    """(has beam results, has particle results, is a coupled run, has a 2D continuum) of a
+    results file; ResultsError saying what the file is when it is missing, not HDF5, a
+    checkpoint or an FCLIB export."""
+    path = os.fspath(path)
+    if not os.path.exists(path):
+        hint = ""
+        if os.path.exists(path + ".partial"):
+            hint = f" ('{path}.partial' exists: the run did not finish)"
+        raise ResultsError(f"results file '{path}' does not exist{hint}")
+    try:
+        with h5py.File(path, "r") as f:
+            # the other HDF5 files multicor writes: say what they are and where the results are
+            if str(f.attrs.get("format", "")).startswith("MULTICOR checkpoint"):
+                raise ResultsError(f"'{path}' is a MULTICOR checkpoint (for --restart), not a "
+                                   "results file: plot the <deck name>.h5 next to it")
+            if "fclib_local" in f:
+                raise ResultsError(f"'{path}' is a contact problem exported in FCLIB's format "
+                                   "([solver] fclib_step), not a results file")
+            return "fem/mesh" in f, "dem" in f, "coupling" in f, "continuum/mesh" in f
+    except OSError as exc:
+        raise ResultsError(f"'{path}' is not a readable HDF5 file ({exc})") from None
 
 
 def figure_stem(path) -> str:
