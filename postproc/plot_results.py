@@ -78,6 +78,9 @@ def main(argv=None):
     except ResultsError as exc:
         print(f"plot_results.py: error: {exc}", file=sys.stderr)
         return 1
+    if args.node is not None and not any("_history" in os.path.basename(p) for p in paths):
+        print(f"plot_results.py: note: --node {args.node} is not used: '{args.results}' has no node "
+              "history to plot (dynamic beam and continuum runs have one)", file=sys.stderr)
     for path in paths:
         print(path)
     return 0

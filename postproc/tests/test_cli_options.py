@@ -158,3 +158,18 @@ def test_run_interface_experiment_empties_an_earlier_experiment(fake_exe, tmp_pa
                                           "-j", "1"]) == 1
     assert not (out / "mu" / "old.txt").exists()
     assert "mesh = file " in (out / "interface_shear.dat").read_text()
+
+
+def test_a_node_without_a_history_to_plot_is_said_to_be_unused(cantilever_file, tmp_path, capsys):
+    # --node was silently ignored where no node history is drawn (static, modal, particles)
+    static = cantilever_file("static.h5", parts=("static",))
+    assert plot_results.main([str(static), "--node", "3", "--out", str(tmp_path / "a")]) == 0
+    err = capsys.readouterr().err
+    assert "--node 3 is not used" in err and "static.h5" in err
+    dem = write_dem(tmp_path / "dem.h5")
+    assert plot_results.main([str(dem), "--node", "3", "--out", str(tmp_path / "b")]) == 0
+    assert "--node 3 is not used" in capsys.readouterr().err
+    # where the history is drawn, no note
+    dynamic = cantilever_file("dynamic.h5")
+    assert plot_results.main([str(dynamic), "--node", "50", "--out", str(tmp_path / "c")]) == 0
+    assert "not used" not in capsys.readouterr().err
