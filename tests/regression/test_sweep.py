@@ -67,6 +67,14 @@ def refused_keys(src, exe, work):
                             work / "refused"], expect=None)
     check("refuses two keys naming the same value", proc.returncode == 1
           and "name the same value" in proc.stderr, proc.stderr.strip())
+    # a value listed twice, as the same text or as the same number written otherwise
+    for values, said in (("1e-4,2e-4,1e-4", "('1e-4' would"),
+                         ("1e-4,1E-4", "'1e-4' and '1E-4', the same number")):
+        proc = sweep_tool(src, ["create", deck, "--exe", exe, "--set", f"time.step={values}",
+                                "--dir", work / "refused"], expect=None)
+        check(f"refuses a value listed twice ({values})", proc.returncode == 1
+              and "key 'time.step': a value is listed twice" in proc.stderr and said in proc.stderr
+              and not (work / "refused").exists(), proc.stderr.strip())
     # a value that the deck check refuses (mu < 0): the message of multicor, naming the line
     proc = sweep_tool(src, ["create", deck, "--exe", exe, "--set", "contacts.law[2].mu=0.1,-1",
                             "--dir", work / "bad_value"], expect=None)
