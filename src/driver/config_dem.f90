@@ -68,6 +68,8 @@ module driver_config_dem
         logical :: default_alert = .true.
         !> Step whose local contact problem is written in FCLIB's format (0: none).
         integer :: fclib_step = 0
+        !> Warnings about the model, 'warning: file:line: ...' (printed by the simulation).
+        type(string_t), allocatable :: warnings(:)
     end type dem_config_t
 
 contains
@@ -636,6 +638,7 @@ contains
         allocate (list, source=deck%records('contacts', 'law'))
         allocate (law_line(size(cfg%material_id), size(cfg%material_id)))
         law_line = 0
+        if (.not. allocated(cfg%warnings)) allocate (cfg%warnings(0))
         do i = 1, size(list)
             associate (e => list(i))
                 call material_pair(deck, cfg, e, 'law', law_line, a, b, error)
@@ -652,9 +655,31 @@ contains
                     call make_input_error(error, deck%file, e%line, 'law', message)
                     return
                 end if
+                if (e%has('rolling')) call warn_rolling_length(e, a, b)
             end associate
         end do
         call build_bonds(deck, cfg, law_line, error)
+    contains
+        !> A rolling length beyond the radius of the largest disk of the pair's materials: the
+        !> moment |M| <= e_r r_n then has an arm longer than the disk (e_r is a fraction of the
+        !> radius in rolling-resistance models), and the sweeps may stop converging.
+        subroutine warn_rolling_length(e, a, b)
+            type(deck_entry_t), intent(in) :: e
+            integer, intent(in) :: a, b
+            real(wp) :: r_max
+            associate (p => cfg%system%particles)
+                if (p%n == 0) return
+                r_max = maxval(p%radius(1:p%n), mask=p%mat(1:p%n) == a .or. p%mat(1:p%n) == b)
+                if (.not. any(p%mat(1:p%n) == a .or. p%mat(1:p%n) == b)) return
+            end associate
+            if (e%real('rolling') <= r_max) return
+            cfg%warnings = [cfg%warnings, string_t('warning: '//deck%file//':'//to_str(e%line)//': [contacts] law: '// &
+                                                   'the rolling length e_r = '//e%word('rolling')//' m exceeds the radius of '// &
+                                                   'the largest disk of materials '//e%word('material1')//' and '// &
+                                                   e%word('material2')//' ('//to_str(r_max)//' m): the moment''s arm is '// &
+                                                   'longer than the disk (e_r is usually a fraction of the radius), and '// &
+                                                   'the sweeps may not converge')]
+        end subroutine warn_rolling_length
     end subroutine build_laws
 
     !> Materials (a, b) of a `law` or `bond` record: both defined, the pair given once (its

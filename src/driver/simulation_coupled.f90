@@ -80,6 +80,9 @@ contains
         if (allocated(error)) return
         call check_dem_coordinates(deck, self%dem, error)
         if (allocated(error)) return
+        do i = 1, size(self%dem%warnings)
+            call report(self%dem%warnings(i)%s)
+        end do
         call build_coupling_config(deck, self%settings, self%beam, self%dem, self%coupling, error)
         if (allocated(error)) return
         do i = 1, size(self%coupling%warnings)

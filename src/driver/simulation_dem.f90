@@ -45,11 +45,16 @@ contains
         procedure(report_iface) :: report
         !> Set on any input error.
         type(error_t), allocatable, intent(out) :: error
+        integer :: i
         call build_config(deck, self%settings, self%beam, error)
         if (allocated(error)) return
         call build_dem_config(deck, self%settings, self%beam%functions, self%dem, error)
         if (allocated(error)) return
         call check_dem_coordinates(deck, self%dem, error)
+        if (allocated(error)) return
+        do i = 1, size(self%dem%warnings)
+            call report(self%dem%warnings(i)%s)
+        end do
     end subroutine dem_init
 
     !> 'dynamic analysis, 40 disks, 2 walls'.

@@ -127,7 +127,8 @@ contains
                            'sigma_cohe times the mean radius of the pair per unit thickness; bonds form '// &
                            'between touching disks at t = 0 and break for good once a bound of their law is '// &
                            'reached), and optionally the rolling resistance length e_r (default 0: none; '// &
-                           '|M| <= e_r r_n). Without a `bond` record the bonds of the pair keep mu and e_r: '// &
+                           '|M| <= e_r r_n; a warning when it exceeds the radius of the largest disk of the '// &
+                           'two materials). Without a `bond` record the bonds of the pair keep mu and e_r: '// &
                            'with both 0 they hold opening only (a hinge).', &
                            tails=[tail([real_field('rolling', 'm', lower=0.0_wp)], 0, 1)], repeatable=.true.)
         call s%add_keyword('contacts', 'bond', [int_field('material1', lower=1), &

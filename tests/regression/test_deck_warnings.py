@@ -6,6 +6,8 @@ goes on, and a warning names the file, the line and the setting that turns it of
 - A solver tuning value where it does nothing (`coarse_size` with the default method,
   `anderson_sweeps` with `anderson = 0`, `check_every` at relaxation 1.0) is warned about,
   one line each, in the order of the deck; the same values where they act are not.
+- A rolling length beyond the radius of the largest disk of its law's materials is warned
+  about at the law's line (the moment's arm would be longer than the disk).
 - In a coupled run (beam or continuum: input/bending_hinged_row.dat, input/interface_shear.dat)
   `method = coarse` and `cold_start = hydrostatic` are warned about, and the warning is true:
   the run's results are those of `method = nlgs` (and of `cold_start = zero`), bit for bit.
@@ -79,6 +81,24 @@ def solver_values(exe, src, work):
           "; ".join(warnings_of(proc.stdout)))
 
 
+def rolling_length(exe, src, work):
+    """A rolling length beyond the radius of the largest disk of the law's materials (the
+    deposit's disks: radii 2.0 to 2.5 mm) is warned about at the law's line; one below is not."""
+    base = (src / "input" / "deposit.dat").read_text()
+    for e_r, warned in (("10", True), ("0.002", False)):
+        text = re.sub(r"^law\s*=.*$", f"law = 1 1 0.4 0.1 0 {e_r}", base, count=1, flags=re.M)
+        deck = work / f"rolling_{e_r}.dat"
+        deck.write_text(text)
+        proc = multicor(exe, "--check", deck)
+        said = warnings_of(proc.stdout)
+        expected = (f"warning: {deck}:{line_of(text, 'law')}: [contacts] law: the rolling length "
+                    f"e_r = {e_r} m exceeds the radius of the largest disk of materials 1 and 1")
+        check(f"rolling length {e_r} m on disks of 2.5 mm: {'warned' if warned else 'no warning'}",
+              proc.returncode == 0
+              and (len(said) == 1 and said[0].startswith(expected) if warned else not said),
+              "\n".join(said) or proc.stderr.strip()[:300])
+
+
 def coupled(exe, work, name, deck_path, ends, extra=""):
     """`deck_path` (ending at `ends`, with the solver lines `extra`) with method = coarse and
     cold_start = hydrostatic: two warnings, and the results of method = nlgs, cold_start =
@@ -119,6 +139,7 @@ def main():
     exe, work, src = arguments(fresh=True)
     example_decks_are_quiet(exe, src)
     solver_values(exe, src, work)
+    rolling_length(exe, src, work)
     # the hinged row of the reference work (20 steps; with nlgs at 1e-4: 108 to 172 sweeps per
     # step) and the interface experiment (10 steps: 19 to 47 sweeps per step)
     coupled(exe, work, "beam", src / "input" / "bending_hinged_row.dat", "2e-4", "tolerance = 1e-4\n")
