@@ -88,23 +88,15 @@ def file_contents(path) -> tuple[bool, bool, bool, bool]:
     results file; ResultsError saying what the file is when it is missing, not HDF5, a
     checkpoint or an FCLIB export."""
     path = os.fspath(path)
-    if not os.path.exists(path):
-        hint = ""
-        if os.path.exists(path + ".partial"):
-            hint = f" ('{path}.partial' exists: the run did not finish)"
-        raise ResultsError(f"results file '{path}' does not exist{hint}")
-    try:
-        with h5py.File(path, "r") as f:
-            # the other HDF5 files multicor writes: say what they are and where the results are
-            if str(f.attrs.get("format", "")).startswith("MULTICOR checkpoint"):
-                raise ResultsError(f"'{path}' is a MULTICOR checkpoint (for --restart), not a "
-                                   "results file: plot the <deck name>.h5 next to it")
-            if "fclib_local" in f:
-                raise ResultsError(f"'{path}' is a contact problem exported in FCLIB's format "
-                                   "([solver] fclib_step), not a results file")
-            return "fem/mesh" in f, "dem" in f, "coupling" in f, "continuum/mesh" in f
-    except OSError as exc:
-        raise ResultsError(f"'{path}' is not a readable HDF5 file ({exc})") from None
+    with _open_results(path) as f:
+        # the other HDF5 files multicor writes: say what they are and where the results are
+        if str(f.attrs.get("format", "")).startswith("MULTICOR checkpoint"):
+            raise ResultsError(f"'{path}' is a MULTICOR checkpoint (for --restart), not a "
+                               "results file: plot the <deck name>.h5 next to it")
+        if "fclib_local" in f:
+            raise ResultsError(f"'{path}' is a contact problem exported in FCLIB's format "
+                               "([solver] fclib_step), not a results file")
+        return "fem/mesh" in f, "dem" in f, "coupling" in f, "continuum/mesh" in f
 
 
 def figure_stem(path) -> str:
