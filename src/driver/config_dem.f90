@@ -668,9 +668,9 @@ contains
             integer, intent(in) :: a, b
             real(wp) :: r_max
             associate (p => cfg%system%particles)
-                if (p%n == 0) return
-                r_max = maxval(p%radius(1:p%n), mask=p%mat(1:p%n) == a .or. p%mat(1:p%n) == b)
+                ! (no disk of these materials: no radius to compare with)
                 if (.not. any(p%mat(1:p%n) == a .or. p%mat(1:p%n) == b)) return
+                r_max = maxval(p%radius(1:p%n), mask=p%mat(1:p%n) == a .or. p%mat(1:p%n) == b)
             end associate
             if (e%real('rolling') <= r_max) return
             cfg%warnings = [cfg%warnings, string_t('warning: '//deck%file//':'//to_str(e%line)//': [contacts] law: '// &
