@@ -1750,27 +1750,37 @@ contains
         type(contact_set_t), intent(in) :: cs
         real(wp), intent(in) :: im(:, :), vfree(:, :)
         class(nlgs_bilateral_t), intent(in), optional :: bilateral
-        real(wp), allocatable :: vq(:, :), q(:, :)
-        integer :: k
+        real(wp), allocatable :: vq(:, :)
+        real(wp) :: q(3), qmax
+        integer :: k, pass
         allocate (vq, source=vfree)
         do k = 1, cs%n
             if (.not. cs%active(k)) cycle
             if (cs%coh(k) /= 0.0_wp) call apply(cs, k, im, vq, -cs%coh(k), 0.0_wp, 0.0_wp)
         end do
         if (present(bilateral)) call bilateral%hold(vq)
-        allocate (q(3, cs%n), source=0.0_wp)
-        nq = 0.0_wp
-        do k = 1, cs%n
-            if (.not. cs%active(k)) cycle
-            call local_velocity(cs, k, vq, q(:, k))
-            if (cs%erol(k) <= 0.0_wp) q(3, k) = 0.0_wp
-            nq = nq + sum(q(:, k)**2)
+        ! pass 1: the sum of squares; where it overflows, pass 2 finds the largest component
+        ! and pass 3 sums the squares scaled by it
+        qmax = 1.0_wp
+        do pass = 1, 3
+            nq = 0.0_wp
+            do k = 1, cs%n
+                if (.not. cs%active(k)) cycle
+                call local_velocity(cs, k, vq, q)
+                if (cs%erol(k) <= 0.0_wp) q(3) = 0.0_wp
+                select case (pass)
+                case (1)
+                    nq = nq + sum(q**2)
+                case (2)
+                    nq = max(nq, maxval(abs(q)))
+                case default
+                    nq = nq + sum((q/qmax)**2)
+                end select
+            end do
+            if (pass == 1 .and. ieee_is_finite(nq)) exit
+            if (pass == 2) qmax = nq
         end do
-        if (ieee_is_finite(nq)) then
-            nq = sqrt(nq)
-        else
-            nq = norm2(q)
-        end if
+        nq = qmax*sqrt(nq)
     end function siconos_free_norm
 
     !> The ratio of nlgs_siconos_error for the velocities vel, with nq = |q|
@@ -1784,9 +1794,15 @@ contains
         ! (no contact arrays to pass before the first contact)
         if (size(act) == 0) return
         call siconos_ratio_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%shift, cs%r, cs%coh, cs%erol, cs%mu, &
-                                    size(vel, 2), vel, size(act), act, 1.0_wp, num, nr, nu, amax)
-        if ((ieee_is_finite(num) .and. ieee_is_finite(nr) .and. ieee_is_finite(nu)) .or. &
-            .not. (amax > 0.0_wp .and. amax <= huge(amax))) then
+                                    size(vel, 2), vel, size(act), act, .false., 1.0_wp, num, nr, nu, amax)
+        if (ieee_is_finite(num) .and. ieee_is_finite(nr) .and. ieee_is_finite(nu)) then
+            err = siconos_quotient(num, nr, nu, nq)
+            return
+        end if
+        ! (a second pass measures the largest component; non-finite values stay as they are)
+        call siconos_ratio_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%shift, cs%r, cs%coh, cs%erol, cs%mu, &
+                                    size(vel, 2), vel, size(act), act, .true., 1.0_wp, num, nr, nu, amax)
+        if (.not. (amax > 0.0_wp .and. amax <= huge(amax))) then
             err = siconos_quotient(num, nr, nu, nq)
             return
         end if
@@ -1795,7 +1811,7 @@ contains
         ! r and u scaled by the power of 2 c ~ 1/amax (exact) give the same ratio.
         c = scale(1.0_wp, -exponent(amax))
         call siconos_ratio_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%shift, cs%r, cs%coh, cs%erol, &
-                                    cs%mu, size(vel, 2), vel, size(act), act, c, num, nr, nu, amax)
+                                    cs%mu, size(vel, 2), vel, size(act), act, .true., c, num, nr, nu, amax)
         err = siconos_quotient(num, nr, nu, nq*c)
     end function siconos_ratio
 
@@ -1812,16 +1828,19 @@ contains
     !> local velocity written out as there: this runs after most sweeps of a long solve, and a
     !> shared procedure for it was not inlined, 3 % more time on the 200-disk deposit).
     pure subroutine siconos_ratio_contacts(n, i1s, i2s, nrm, lever, shift, rc, coh, erol, mu, nd, vel, na, &
-                                           act, c, num, nr, nu, amax)
+                                           act, scaled, c, num, nr, nu, amax)
         integer, intent(in) :: n, nd, na
         integer, intent(in) :: i1s(n), i2s(n), act(na)
         real(wp), intent(in) :: nrm(2, n), lever(2, n), shift(2, n), rc(3, n), coh(n), erol(n), mu(n)
         real(wp), intent(in) :: vel(3, nd)
+        !> Whether r and u are scaled by c and amax measured (only after squares overflowed:
+        !> the usual pass does neither).
+        logical, intent(in) :: scaled
         !> Scale of r and u (1, or 1/amax of a first pass whose squares overflowed).
         real(wp), intent(in) :: c
         !> Sums of |r - P_K(r - u_hat)|^2, |r|^2 and |u|^2 of the scaled values.
         real(wp), intent(out) :: num, nr, nu
-        !> Largest |component| of the scaled r and u.
+        !> Largest |component| of the scaled r and u (0 when not `scaled`).
         real(wp), intent(out) :: amax
         real(wp) :: u(3), r(3), t(3), p(3), dvx, dvy, nx, ny
         integer :: a, k, i1, i2, pcase
@@ -1847,9 +1866,12 @@ contains
             ny = nrm(2, k)
             u(1) = nx*dvx + ny*dvy + shift(1, k)
             u(2) = u(2) - ny*dvx + nx*dvy
-            r = c*[rc(1, k) + coh(k), rc(2, k), rc(3, k)]
-            u = c*u
-            amax = max(amax, maxval(abs(r)), maxval(abs(u)))
+            r = [rc(1, k) + coh(k), rc(2, k), rc(3, k)]
+            if (scaled) then
+                r = c*r
+                u = c*u
+                amax = max(amax, maxval(abs(r)), maxval(abs(u)))
+            end if
             if (erol(k) > 0.0_wp) then
                 t = r - [u(1) + mu(k)*abs(u(2)) + erol(k)*abs(u(3)), u(2), u(3)]
                 call rolling_projection(t(1), t(2), t(3), mu(k), erol(k), p(1), p(2), p(3), pcase)
