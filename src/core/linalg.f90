@@ -8,6 +8,7 @@
 !> - `band_generalized_eigen`: selected eigenpairs of A x = lambda B x for band A, B (dsbgvx),
 !>   eigenvectors B-normalised; `largest_generalized_eigenvalue` for the critical time step.
 !>
+!> - `symmetrize`: A = factor (A + A^T)/2 in place (no n^2 temporary).
 !> - `dot`: the dot product of two contiguous vectors (ddot; vectorised, where a Fortran
 !>   loop must add in order).
 !>
@@ -18,7 +19,7 @@ module core_linalg
     use core_error, only: error_t, make_error, make_internal_error
     implicit none
     private
-    public :: band_spd_t, dense_spd_t, band_generalized_eigen, largest_generalized_eigenvalue, dot
+    public :: band_spd_t, dense_spd_t, band_generalized_eigen, largest_generalized_eigenvalue, dot, symmetrize
 
     !> Symmetric positive-definite band matrix (upper band storage) and its Cholesky factor.
     type :: band_spd_t
@@ -82,6 +83,9 @@ module core_linalg
         procedure, private :: dense_solve_vec, dense_solve_mat
         !> Solve A x = b in place, one or several right-hand sides (dpotrs).
         generic :: solve => dense_solve_vec, dense_solve_mat
+        !> The inverse of the factored matrix, both triangles (dpotri: n^3 flops, against
+        !> 2 n^3 for dpotrs on the identity).
+        procedure :: inverse => dense_inverse
     end type dense_spd_t
 
     interface
@@ -137,6 +141,13 @@ module core_linalg
             real(wp), intent(inout) :: work(*)
             real(wp) :: value
         end function dlansy
+        subroutine dpotri(uplo, n, a, lda, info)
+            import :: wp
+            character, intent(in) :: uplo
+            integer, intent(in) :: n, lda
+            real(wp), intent(inout) :: a(lda, *)
+            integer, intent(out) :: info
+        end subroutine dpotri
         subroutine dpotrs(uplo, n, nrhs, a, lda, b, ldb, info)
             import :: wp
             character(len=1), intent(in) :: uplo
@@ -466,6 +477,55 @@ contains
         call dpotrs('U', self%n, size(b, 2), self%fac, self%n, b, self%n, info)
         if (info /= 0) call make_internal_error(error, 'dense Cholesky solve', 'dpotrs: invalid argument')
     end subroutine dense_solve_mat
+
+    !> A = factor (A + A^T)/2 in place, factor = 1 by default; each pair of entries is computed
+    !> once, so the result is exactly symmetric (the same values as the array expression).
+    pure subroutine symmetrize(a, factor)
+        !> Square matrix.
+        real(wp), intent(inout) :: a(:, :)
+        !> Scale applied with the average.
+        real(wp), intent(in), optional :: factor
+        real(wp) :: c, v
+        integer :: i, j
+        c = 0.5_wp
+        if (present(factor)) c = factor*0.5_wp
+        do j = 1, size(a, 2)
+            do i = 1, j
+                v = c*(a(i, j) + a(j, i))
+                a(i, j) = v
+                a(j, i) = v
+            end do
+        end do
+    end subroutine symmetrize
+
+    !> B = A^-1 from the Cholesky factor (dpotri), the lower triangle copied from the upper one
+    !> (B is exactly symmetric).
+    subroutine dense_inverse(self, b, error)
+        !> The factored matrix.
+        class(dense_spd_t), intent(in) :: self
+        !> The inverse (n, n).
+        real(wp), allocatable, intent(out) :: b(:, :)
+        !> Set when the matrix is not factored or its factor is singular.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: info, j
+        character(len=160) :: buf
+        call check_solve(self%factored, self%n, self%n, 'dense', error)
+        if (allocated(error)) return
+        b = self%fac
+        call dpotri('U', self%n, b, self%n, info)
+        if (info < 0) then
+            call make_internal_error(error, 'dense Cholesky inverse', 'dpotri: invalid argument')
+            return
+        else if (info > 0) then
+            write (buf, '(a,i0,a)') 'dense Cholesky inverse (dpotri): the factor is singular (diagonal entry ', &
+                info, ' is zero)'
+            call make_error(error, trim(buf))
+            return
+        end if
+        do j = 1, self%n - 1
+            b(j + 1:, j) = b(j, j + 1:)
+        end do
+    end subroutine dense_inverse
 
     !> Eigenvalues il..iu (ascending) of A x = lambda B x, A symmetric and B symmetric
     !> positive definite, both band (dsbgvx). Eigenvectors, if asked, satisfy X^T B X = I.

@@ -29,7 +29,7 @@ module coupling_arlequin
                                  build_mediator
     use coupling_multiplier_space, only: multiplier_space_t, mediator_space_t, make_mediator_space
     use coupling_coupled_step, only: coupled_system_t, coupled_stats_t, coupled_energies_t, &
-                                     complete_coupled_system, disk_space, arlequin_step, &
+                                     complete_coupled_system, disk_space, arlequin_step, notice_iface, &
                                      coupled_energies, coordinate_residual, multipliers_particles, &
                                      multipliers_nodes
     implicit none
@@ -71,7 +71,7 @@ contains
     !> physical masses and loads, materials, walls and settings (mj_init not called); the
     !> common time step is dem%scheme%h. The initial configuration is taken as consistent:
     !> the constraint is q - q_0 = C (u - u_0).
-    subroutine build_coupled_system(config, beam, dem, sys, error, beta, gamma, fe_u0, fe_v0)
+    subroutine build_coupled_system(config, beam, dem, sys, error, beta, gamma, fe_u0, fe_v0, notice)
         !> The coupling.
         type(coupling_config_t), intent(in) :: config
         !> The beam (unweighted description).
@@ -88,6 +88,8 @@ contains
         real(wp), intent(in), optional :: beta, gamma
         !> FE initial displacements and velocities per node (3, n_nodes) (default 0).
         real(wp), intent(in), optional :: fe_u0(:, :), fe_v0(:, :)
+        !> Where a long set-up of the multiplier matrices is announced (default: silent).
+        procedure(notice_iface), optional :: notice
         type(beam_model_t) :: model
         type(coupling_operator_t) :: op
         class(multiplier_space_t), allocatable :: space
@@ -135,7 +137,7 @@ contains
         if (allocated(error)) return
         allocate (sys%model, source=model)
         allocate (sys%op, source=op)
-        call complete_coupled_system(sys, space, u0, v0, error, beta, gamma, config%memory_limit)
+        call complete_coupled_system(sys, space, u0, v0, error, beta, gamma, config%memory_limit, notice)
     end subroutine build_coupled_system
 
     !> The multiplier space chosen by config%multipliers: per coupled DOF, or the mediator

@@ -31,7 +31,7 @@ module coupling_arlequin2d
     use coupling_operator2d, only: continuum_operator_t, build_continuum_operator, build_mediator2d, &
                                    pairing_l2
     use coupling_multiplier_space, only: multiplier_space_t, mediator_space_t
-    use coupling_coupled_step, only: coupled_system_t, complete_coupled_system, disk_space, &
+    use coupling_coupled_step, only: coupled_system_t, complete_coupled_system, disk_space, notice_iface, &
                                      multipliers_particles, multipliers_nodes
     implicit none
     private
@@ -69,7 +69,7 @@ module coupling_arlequin2d
 contains
 
     !> Build the coupled system of a continuum and disks (see the module description).
-    subroutine build_coupled2d(config, model, dem, sys, error, beta, gamma, u0, v0)
+    subroutine build_coupled2d(config, model, dem, sys, error, beta, gamma, u0, v0, notice)
         !> The coupling.
         type(coupling2d_config_t), intent(in) :: config
         !> The continuum (materials, supports and loads set; no body force: `config%gravity`).
@@ -85,6 +85,8 @@ contains
         real(wp), intent(in), optional :: beta, gamma
         !> Initial displacements and velocities of the free dofs (default 0).
         real(wp), intent(in), optional :: u0(:), v0(:)
+        !> Where a long set-up of the multiplier matrices is announced (default: silent).
+        procedure(notice_iface), optional :: notice
         type(fem_triplets_t) :: k_all, m_all
         type(continuum_dynamics_t) :: ops
         type(element_grid_t) :: grid
@@ -146,7 +148,7 @@ contains
         if (present(v0)) vf = v0
         allocate (sys%model, source=ops)
         allocate (sys%op, source=op)
-        call complete_coupled_system(sys, space, uf, vf, error, beta, gamma, config%memory_limit)
+        call complete_coupled_system(sys, space, uf, vf, error, beta, gamma, config%memory_limit, notice)
 
     contains
 

@@ -67,6 +67,7 @@ module coupling_coupled_step
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
     use core_strings, only: to_str, gib
+    use core_linalg, only: symmetrize
     use fem_dynamic_operator, only: dynamic_operator_t
     use fem_newmark, only: newmark_t
     use dem_particles, only: particles_inverse_mass, dof_x, dof_y, dof_rot
@@ -81,6 +82,7 @@ module coupling_coupled_step
     implicit none
     private
     public :: coupled_system_t, coupled_stats_t, coupled_energies_t
+    public :: notice_iface
     public :: complete_coupled_system, disk_space, arlequin_step, coupled_energies, coordinate_residual
     public :: multipliers_particles, multipliers_nodes
     public :: velocity_mismatch_t, velocity_mismatch
@@ -219,6 +221,19 @@ module coupling_coupled_step
         real(wp) :: prescribed_coupling_work = 0.0_wp
     end type coupled_system_t
 
+    abstract interface
+        !> Receives one line telling what a long set-up is doing.
+        subroutine notice_iface(line)
+            !> The line.
+            character(len=*), intent(in) :: line
+        end subroutine notice_iface
+    end interface
+
+    !> Rows from which the set-up of the dense multiplier matrices is announced: it grows as
+    !> the rows cubed, about 2 s for 4 000 rows and 13 s for 7 680 on the 2-core machine of
+    !> doc/performance.md (the seconds before the first step of a run or the line of --check).
+    integer, parameter :: notice_rows = 4000
+
 contains
 
     !> Finish a coupled system whose builder set the weighted FE model (`model`), C (`op`),
@@ -228,7 +243,7 @@ contains
     !> factor A = h gamma (W + C S^-1 C^T), take the multiplier space and form its B, and set
     !> the initial residuals. The initial configuration is taken as consistent: the constraint
     !> is q - q_0 = C (u - u_0).
-    subroutine complete_coupled_system(sys, space, u0, v0, error, beta, gamma, memory_limit)
+    subroutine complete_coupled_system(sys, space, u0, v0, error, beta, gamma, memory_limit, notice)
         !> The coupled system (see above).
         type(coupled_system_t), intent(inout) :: sys
         !> The multiplier space over the rows of C (moved into `sys`).
@@ -243,6 +258,8 @@ contains
         !> Bytes the dense multiplier matrices may take (multiplier_bytes; < 0: no limit):
         !> beyond it, an error instead of an allocation that fails or exhausts the machine.
         integer(i8), intent(in), optional :: memory_limit
+        !> Where to announce a set-up of notice_rows rows or more (default: silent).
+        procedure(notice_iface), optional :: notice
         real(wp), allocatable :: im(:, :), iw(:)
         real(wp) :: h
         integer :: n, r
@@ -267,6 +284,11 @@ contains
                 return
             end if
         end if
+        if (present(notice) .and. sys%op%n_rows >= notice_rows) then
+            call notice('coupling: '//to_str(sys%op%n_rows)//' rows ('//to_str(sys%op%n_points)// &
+                        ' coupled disks): setting up the dense multiplier matrices ('// &
+                        gib(multiplier_bytes(sys%op%n_rows))//'); the time grows as the rows cubed')
+        end if
         ! Rows: owner disk and DOF, weighted inverse masses per unit thickness.
         call init_rows(sys)
         allocate (im(3, n))
@@ -282,7 +304,7 @@ contains
         if (allocated(error)) return
         sys%on_nodes = sys%space%projected()
         if (.not. allocated(sys%mediator_nodes)) allocate (sys%mediator_nodes(0))
-        sys%rows%ainv = 0.5_wp*(sys%rows%ainv + transpose(sys%rows%ainv))
+        call symmetrize(sys%rows%ainv)
         sys%rows%response = h*sys%fe%gamma*iw
         sys%rows%scale = h*sys%fe%gamma/sys%thickness
         call init_state(sys)

@@ -15,7 +15,7 @@ module coupling_lambda
     use core_kinds, only: wp
     use core_error, only: error_t, make_error, make_internal_error
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-    use core_linalg, only: dense_spd_t
+    use core_linalg, only: dense_spd_t, symmetrize
     use fem_newmark, only: newmark_t
     use coupling_map, only: coupling_map_t
     implicit none
@@ -146,7 +146,7 @@ contains
             end do
         end if
         ! Symmetric up to the rounding of the solves; keep it exactly symmetric.
-        self%a%a = self%h*0.5_wp*(self%a%a + transpose(self%a%a))
+        call symmetrize(self%a%a, self%h)
         call self%a%factor(error)
         if (allocated(error)) then
             error%message = 'coupling multipliers: A = h (W + gamma C S^-1 C^T) is singular: '// &

@@ -19,7 +19,7 @@ module coupling_multiplier_space
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
-    use core_linalg, only: dense_spd_t
+    use core_linalg, only: dense_spd_t, symmetrize
     implicit none
     private
     public :: multiplier_space_t, disk_space_t, mediator_space_t, make_mediator_space
@@ -174,18 +174,13 @@ contains
         nrm = norm2(merge(self%project(v), 0.0_wp, (self%comp == comp_rotation) .eqv. rotation))
     end function space_constraint_norm
 
-    !> B = A^-1 (identity solved with the factor).
+    !> B = A^-1 (from the factor).
     subroutine disk_inverse(self, a, b, error)
         class(disk_space_t), intent(inout) :: self
         type(dense_spd_t), intent(in) :: a
         real(wp), allocatable, intent(out) :: b(:, :)
         type(error_t), allocatable, intent(out) :: error
-        integer :: i
-        allocate (b(self%n_rows, self%n_rows), source=0.0_wp)
-        do i = 1, self%n_rows
-            b(i, i) = 1.0_wp
-        end do
-        call a%solve(b, error)
+        call a%inverse(b, error)
     end subroutine disk_inverse
 
     !> lambda = mu.
@@ -223,7 +218,7 @@ contains
         associate (pi => self%pi)
             call am%init(self%n_mult)
             am%a = matmul(pi, matmul(a%a, transpose(pi)))
-            am%a = 0.5_wp*(am%a + transpose(am%a))
+            call symmetrize(am%a)
             call am%factor(error)
             if (allocated(error)) then
                 error%message = 'coupling: multipliers = nodes: A_m = Pi A Pi^T is singular; '// &

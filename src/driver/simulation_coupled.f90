@@ -89,7 +89,7 @@ contains
             call report(self%coupling%warnings(i)%s)
         end do
         allocate (self%sys)
-        call build_coupled(self%settings, self%beam, self%dem, self%coupling, self%sys, error)
+        call build_coupled(self%settings, self%beam, self%dem, self%coupling, self%sys, report, error)
         if (allocated(error)) then
             message = error%message
             if (index(message, model_out_of_range) == 1) then
@@ -110,7 +110,7 @@ contains
     !> Build the coupled system of a deck (weighted beam, weighted disks, coupling operator,
     !> factored multiplier matrix). Errors come from the coupling library, without a deck
     !> line (the caller attaches one).
-    subroutine build_coupled(run, beam, dem, setup, sys, error)
+    subroutine build_coupled(run, beam, dem, setup, sys, report, error)
         !> Run settings (time step, Newmark beta and gamma, initial beam state).
         type(run_config_t), intent(in) :: run
         !> The beam (unweighted).
@@ -121,14 +121,16 @@ contains
         type(coupled_setup_t), intent(in) :: setup
         !> The coupled system.
         type(coupled_system_t), intent(out) :: sys
+        !> Where a long set-up is announced.
+        procedure(report_iface) :: report
         !> Set when the library refuses the model.
         type(error_t), allocatable, intent(out) :: error
         if (allocated(run%u0) .and. allocated(run%v0)) then
             call build_coupled_system(setup%config, beam, dem%system, sys, error, &
-                                      beta=run%beta, gamma=run%gamma, fe_u0=run%u0, fe_v0=run%v0)
+                                      beta=run%beta, gamma=run%gamma, fe_u0=run%u0, fe_v0=run%v0, notice=report)
         else
             call build_coupled_system(setup%config, beam, dem%system, sys, error, &
-                                      beta=run%beta, gamma=run%gamma)
+                                      beta=run%beta, gamma=run%gamma, notice=report)
         end if
     end subroutine build_coupled
 

@@ -119,7 +119,7 @@ contains
         allocate (self%sys)
         call build_coupled2d(self%coupling%config, self%continuum%model, self%particles%dem%system, self%sys, error, &
                              beta=self%settings%beta, gamma=self%settings%gamma, u0=self%continuum%integ%u, &
-                             v0=self%continuum%integ%v)
+                             v0=self%continuum%integ%v, notice=report)
         if (allocated(error)) then
             message = error%message
             if (index(message, 'A_m = Pi A Pi^T') > 0 .and. deck%has('coupling', 'h1_length')) then

@@ -24,6 +24,8 @@
 - the XDMF file shows the mesh and the disks (ParaView's pvpython when installed);
 - postproc/plot_results.py, as ./run.sh calls it, draws the continuum's plots, the coupling
   diagnostics (<name>_coupling.png, as for a beam-coupled run) and the disks' plots;
+- a coupling of 4 000 rows or more is announced before its dense matrices are set up (the
+  interface with disks of R/6: 4 320 rows), a smaller one is not;
 - --restart is refused with a clear message for a static continuum deck (no time steps; the
   checkpoints of dynamic continuum and coupled runs are tested in test_restart.py).
 Usage (ctest does this): test_coupled2d_runs.py --exe multicor --work DIR --source REPO
@@ -374,6 +376,30 @@ def xdmf(h5):
           f"{disks['points'][0][:2]} vs {last[0, :2]}")
 
 
+def large_coupling_announced(exe, src, work):
+    """The set-up of the dense multiplier matrices grows as the rows cubed (seconds from about
+    4 000 rows on): --check of such a deck says what it is doing before it is silent for them."""
+    text = (src / "input" / "interface_shear.dat").read_text()
+    text = text.replace("mesh = file interface_shear.msh", f"mesh = file {src / 'input' / 'interface_shear.msh'}")
+    notice = "setting up the dense multiplier matrices"
+    small = subprocess.run([str(exe), str(write_deck(work, "interface_check", text)), "--check"],
+                           capture_output=True, text=True)
+    check("coupling set-up: 120 rows are not announced", small.returncode == 0 and notice not in small.stdout,
+          small.stdout.strip()[-300:])
+    # Disks of R/6 filling the same layer (120 x 24, touching), the rolling length R/6 as the
+    # deck's R: 1 440 of the 2 880 disks in the two bands, 3 rows each.
+    r = 0.0125 / 6
+    text = text.replace("square_lattice = 20 4 0.0125 0.1875 0.0125 1",
+                        f"square_lattice = 120 24 {r!r} {0.175 + r!r} {r!r} 1")
+    text = text.replace("law = 1 1 0.3 0 0 0.0125", f"law = 1 1 0.3 0 0 {r!r}")
+    large = subprocess.run([str(exe), str(write_deck(work, "interface_fine_check", text)), "--check"],
+                           capture_output=True, text=True)
+    lines = [line for line in large.stdout.splitlines() if notice in line]
+    check("coupling set-up: 4 320 rows are announced once, with the counts, before the deck is valid",
+          large.returncode == 0 and len(lines) == 1 and "4320 rows (1440 coupled disks)" in lines[0]
+          and large.stdout.index(notice) < large.stdout.index("deck is valid"), large.stdout.strip()[-400:])
+
+
 def restart_refused(exe, src, work):
     deck = src / "input" / "continuum_cantilever.dat"
     proc = subprocess.run([str(exe), str(deck), "--output", str(work / "restart"), "--restart",
@@ -396,6 +422,7 @@ def main():
     plots(src, work / "rigid_per_disk" / "rigid_per_disk.h5", work / "png",
           ["stress", "continuum_energy", "history", "coupling", "particles_start", "particles",
            "dem_energy", "solver"])
+    large_coupling_announced(exe, src, work)
     restart_refused(exe, src, work)
     return summary()
 
