@@ -92,11 +92,15 @@ def check_arguments(exe, deck, out):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="run_interface_experiment.py", description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(prog="run_interface_experiment.py",
+                                 description=" ".join(__doc__.split("\n\n")[0].split()))
     ap.add_argument("--exe", required=True, help="multicor executable")
-    ap.add_argument("--out", default="results/experiments/interface")
-    ap.add_argument("--deck", default=str(ROOT / "input" / "interface_shear.dat"))
-    ap.add_argument("-j", "--jobs", type=int, default=2, choices=(1, 2))
+    ap.add_argument("--out", default="results/experiments/interface",
+                    help="folder of the runs, replaced (default results/experiments/interface)")
+    ap.add_argument("--deck", default=str(ROOT / "input" / "interface_shear.dat"),
+                    help="the base deck (default input/interface_shear.dat)")
+    ap.add_argument("-j", "--jobs", type=int, default=2, choices=(1, 2),
+                    help="runs at a time (default 2)")
     args = ap.parse_args(argv)
     deck = pathlib.Path(args.deck).resolve()
     out = pathlib.Path(args.out).resolve()
