@@ -47,7 +47,9 @@ def sweep(python, exe, deck, folder, sets):
         if proc.returncode != 0:
             sys.stderr.write(proc.stdout + proc.stderr)
             return f"{' '.join(cmd)}: exit {proc.returncode}"
-        sys.stdout.write(proc.stdout)
+        # the points run here: create's hints about the Slurm job array would mislead
+        sys.stdout.writelines(line for line in proc.stdout.splitlines(keepends=True)
+                              if not line.startswith(("Slurm job array:", "next: multicor-sweep")))
     return None
 
 
