@@ -21,7 +21,8 @@ from multicor_post.results import (ResultsError, file_contents, finite_float,  #
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="plot_beam.py", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="plot_beam.py",
+                                     description=" ".join(__doc__.split("\n\n")[0].split()))
     parser.add_argument("results", help="results file (.h5) written by multicor")
     parser.add_argument("--time", type=finite_float, default=None,
                         help="time [s] of the deflection plot (nearest stored output; "

@@ -132,7 +132,7 @@ def interface_figures(folder, out, written):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="plot_experiments.py",
-                                     description=__doc__.split("\n")[0])
+                                     description=" ".join(__doc__.split("\n\n")[0].split()))
     parser.add_argument("--results", default="results/experiments",
                         help="folder holding <case>/<case>.h5 (default results/experiments)")
     parser.add_argument("--out", default=None, help="folder of the figures (default: --results)")

@@ -37,7 +37,8 @@ def contents(path):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="plot_results.py", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="plot_results.py",
+                                     description=" ".join(__doc__.split("\n\n")[0].split()))
     parser.add_argument("results", help="results file (.h5) written by multicor")
     parser.add_argument("--time", type=finite_float, default=None,
                         help="time [s] of the snapshot plots (nearest stored output; default: "

@@ -47,7 +47,9 @@ def sweep(python, exe, deck, folder, sets):
         if proc.returncode != 0:
             sys.stderr.write(proc.stdout + proc.stderr)
             return f"{' '.join(cmd)}: exit {proc.returncode}"
-        sys.stdout.write(proc.stdout)
+        # the points run here: create's hints about the Slurm job array would mislead
+        sys.stdout.writelines(line for line in proc.stdout.splitlines(keepends=True)
+                              if not line.startswith(("Slurm job array:", "next: multicor-sweep")))
     return None
 
 
@@ -92,11 +94,15 @@ def check_arguments(exe, deck, out):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="run_interface_experiment.py", description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(prog="run_interface_experiment.py",
+                                 description=" ".join(__doc__.split("\n\n")[0].split()))
     ap.add_argument("--exe", required=True, help="multicor executable")
-    ap.add_argument("--out", default="results/experiments/interface")
-    ap.add_argument("--deck", default=str(ROOT / "input" / "interface_shear.dat"))
-    ap.add_argument("-j", "--jobs", type=int, default=2, choices=(1, 2))
+    ap.add_argument("--out", default="results/experiments/interface",
+                    help="folder of the runs, replaced (default results/experiments/interface)")
+    ap.add_argument("--deck", default=str(ROOT / "input" / "interface_shear.dat"),
+                    help="the base deck (default input/interface_shear.dat)")
+    ap.add_argument("-j", "--jobs", type=int, default=2, choices=(1, 2),
+                    help="runs at a time (default 2)")
     args = ap.parse_args(argv)
     deck = pathlib.Path(args.deck).resolve()
     out = pathlib.Path(args.out).resolve()

@@ -279,7 +279,7 @@ def refine(exe, work):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
     ap.add_argument("--exe", required=True, help="the multicor executable")
     ap.add_argument("--work", required=True, help="folder for the decks and results")
     ap.add_argument("--refine", action="store_true", help="also the 20 mm band at dx = 5, 2.5, 1.25 mm")
