@@ -412,7 +412,7 @@ contains
                 ' J (max over the outputs ', self%cpl_out%max_balance, ' J; external work ', &
                 en%fe_external_work + en%dem_external_work + en%dem_drive_work, ' J)'
             call report(trim(buf))
-            call report(progress%summary_line(n_steps, self%sys%fe%t))
+            call report(progress%summary_line(n_steps, self%sys%fe%t, out%stopped()))
         end subroutine summary
     end subroutine arlequin_run
 

@@ -245,7 +245,7 @@ contains
                     sys%energies%contact_dissipation, ' J/m)'
                 call report(trim(buf))
             end associate
-            call report(progress%summary_line(n_steps, cfg%system%time))
+            call report(progress%summary_line(n_steps, cfg%system%time, out%stopped()))
         end subroutine summary
     end subroutine run_dem
     !> Warning text when the fastest disk moves farther than the alert distance in one step

@@ -264,7 +264,7 @@ contains
         write (buf, '(a,i0,a,es13.5e3,a,es11.3e3)') 'dynamic run: ', n_steps, ' steps to t = ', &
             integ%t, ' s; energy balance residual ', integ%energy_balance()
         call report(trim(buf))
-        call report(progress%summary_line(n_steps))
+        call report(progress%summary_line(n_steps, stopped=out%stopped()))
         ! n_steps <= max_steps = huge(0) (driver_config)
         call out%write_summary(int(n_steps), progress%elapsed(), error)
     contains

@@ -579,7 +579,7 @@ contains
             write (buf, '(a,i0,a,es13.5e3,a,es11.3e3,a)') 'dynamic run: ', n_steps, ' steps to t = ', &
                 self%integ%t, ' s; energy balance residual ', self%audit%balance(), ' J'
             call report(trim(buf))
-            call report(progress%summary_line(n_steps))
+            call report(progress%summary_line(n_steps, stopped=out%stopped()))
             call out%write_summary(int(n_steps), progress%elapsed(), error)
         end subroutine run_dynamic
 

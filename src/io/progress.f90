@@ -94,17 +94,19 @@ contains
     end function progress_line
 
     !> Closing line of a run, e.g. `done: 5000 steps, t = 5.0000E-03 s, wall 00:01:40
-    !> (20.000 ms/step)`.
-    impure function progress_summary_line(self, steps, t) result(text)
+    !> (20.000 ms/step)`, or `stopped after 2400 steps, ...` for a run stopped early.
+    impure function progress_summary_line(self, steps, t, stopped) result(text)
         !> The progress object.
         class(progress_t), intent(in) :: self
         !> Steps done.
         integer(i8), intent(in) :: steps
         !> Simulated time reached [s] (not shown when absent).
         real(wp), intent(in), optional :: t
+        !> Whether the run was stopped before its end (default: it ran to its end).
+        logical, intent(in), optional :: stopped
         !> The line.
         character(len=:), allocatable :: text
-        text = format_summary_line(steps, self%elapsed(), t)
+        text = format_summary_line(steps, self%elapsed(), t, stopped)
     end function progress_summary_line
 
     !> Estimated remaining wall time [s] after `step` of `total_steps` steps took `elapsed`
@@ -156,18 +158,28 @@ contains
     end function format_progress_line
 
     !> Summary line built from explicit values (see `progress_t%summary_line`).
-    pure function format_summary_line(steps, elapsed, t) result(text)
+    pure function format_summary_line(steps, elapsed, t, stopped) result(text)
         !> Steps done.
         integer(i8), intent(in) :: steps
         !> Wall time of the run [s].
         real(wp), intent(in) :: elapsed
         !> Simulated time reached [s] (not shown when absent).
         real(wp), intent(in), optional :: t
+        !> Whether the run was stopped before its end: 'stopped after N steps' instead of
+        !> 'done: N steps' (default .false.).
+        logical, intent(in), optional :: stopped
         !> The line.
         character(len=:), allocatable :: text
         character(len=64) :: buf
+        logical :: early
+        early = .false.
+        if (present(stopped)) early = stopped
         write (buf, '(i0)') steps
-        text = 'done: '//trim(buf)//' steps'
+        if (early) then
+            text = 'stopped after '//trim(buf)//' steps'
+        else
+            text = 'done: '//trim(buf)//' steps'
+        end if
         if (present(t)) then
             write (buf, '(es12.4e3)') t
             text = text//', t = '//trim(adjustl(buf))//' s'

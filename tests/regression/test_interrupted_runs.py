@@ -205,6 +205,10 @@ def stop_by_signal(exe, src, work, deck_name, sig, name):
           f"{proc.returncode} ({delay:.2f} s after the signal)")
     m = re.search(rf"stopped: signal {signame} at step (\d+), t = (\S+) s", out)
     check(f"{name}: says at which step it stopped", m is not None, out.strip()[-300:])
+    closing = [line for line in out.splitlines() if line.startswith(("done:", "stopped after "))]
+    check(f"{name}: its closing line says it stopped (not 'done:'), after the step of the stop",
+          m is not None and closing == [line for line in closing if line.startswith(f"stopped after {m.group(1)} steps")]
+          and len(closing) == 1, "; ".join(closing))
     check(f"{name}: says what was saved", "saved: every output up to t = " in out and
           str(partial) in out, "")
     check(f"{name}: error line names the signal", f"run stopped by {signame}" in err,
