@@ -116,6 +116,21 @@ def on_slurm(src, exe, work):
         done = wait_idle(cluster, 120)
         print(f"array and collect job done in {time.monotonic() - t1:.1f} s")
         check("all jobs ended within 120 s", done, cluster.query(["squeue"]))
+        # The same job submitted again once the run finished (its final checkpoint is in the
+        # folder): a fresh run, not a restart with nothing to do (exit 1).
+        first = (single / "incline.h5").stat().st_mtime_ns if (single / "incline.h5").exists() else None
+        again = subprocess.run(["sbatch", "--parsable", "--time=5", f"--output={work / 'again.out'}",
+                                str(src / "scripts" / "multicor.slurm"),
+                                str(src / "input" / "incline.dat"), str(single)],
+                               capture_output=True, text=True, env=env, cwd=src)
+        check("scripts/multicor.slurm submitted again", again.returncode == 0, again.stderr.strip())
+        done = wait_idle(cluster, 60)
+        log = (work / "again.out").read_text() if (work / "again.out").exists() else "no job output"
+        starts = [line for line in log.splitlines() if " start (restart count" in line]
+        check("scripts/multicor.slurm again after the end: a fresh run (no --restart), exit 0, new results",
+              done and "multicor exit 0" in log and len(starts) == 1 and "--restart" not in starts[0]
+              and first is not None
+              and (single / "incline.h5").stat().st_mtime_ns > first, log[-400:])
     finally:
         cluster.stop()
     try:
