@@ -56,7 +56,7 @@ module dem_bonded_block
     use core_error, only: error_t
     use core_sparse, only: sparse_matrix_t, sparse_solver_t, sparse_cholesky
     use dem_contacts, only: contact_set_t, status_cohesive
-    use dem_bipotential, only: case_stick, case_slip, case_roll, case_slip_roll
+    use dem_bipotential, only: case_stick
     use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_apply_reactions, nlgs_block_t, &
                         nlgs_bilateral_t
     implicit none
@@ -74,10 +74,6 @@ module dem_bonded_block
     !> Relative resolution of a relative velocity (64 machine epsilons of the velocities of
     !> the two bodies, as in dem_nlgs): the refinement stops below it.
     real(wp), parameter :: roundoff = 64.0_wp*epsilon(1.0_wp)
-    !> A reaction of the block within this fraction of a bound is on it (bound_case): the
-    !> direct solve rounds at about 1e-12 of the reactions, the sweeps of a released
-    !> neighbour stop at local_tolerance (1e-10 by default).
-    real(wp), parameter :: on_bound = 1.0e-9_wp
 
     !> Counts since the block was created (for statistics and benchmarks).
     type :: bonded_block_counts_t
@@ -233,14 +229,7 @@ contains
                     end if
                 end if
             end do
-            if (worst == 0) then
-                ! bonds of the block whose reaction lies on a bound have reached it: judged
-                ! as the sweeps judge a bond projected onto it (contacts_finish breaks them)
-                do k = 1, cs%n
-                    if (block%member(k)) cs%pcase(k) = bound_case(cs, k)
-                end do
-                exit
-            end if
+            if (worst == 0) exit
             block%excluded(worst) = .true.
             released = 1
             block%counts%releases = block%counts%releases + released
@@ -289,32 +278,6 @@ contains
         if (cs%erol(k) > 0.0_wp .and. abs(cs%r(3, k)) > cs%erol(k)*rn) &
             excess = max(excess, abs(cs%r(3, k))/max(cs%erol(k)*rn, tiny(1.0_wp)) - 1.0_wp)
     end function cone_excess
-
-    !> Case of the reaction of bond k of the block, which lies inside its cone: on a bound
-    !> (within on_bound of it, relative) case_slip, case_roll or case_slip_roll, else
-    !> case_stick. A bond of the block carries exactly a bound when a released neighbour
-    !> yields at its own and the two take the same load (two bonds of a row in shear: both
-    !> reached the bound, and the plain sweeps break both).
-    pure integer function bound_case(cs, k) result(c)
-        type(contact_set_t), intent(in) :: cs
-        integer, intent(in) :: k
-        real(wp) :: rn
-        logical :: shear, moment
-        rn = cs%r(1, k) + cs%coh(k)
-        shear = cs%mu(k) > 0.0_wp .and. abs(cs%r(2, k)) >= (1.0_wp - on_bound)*cs%mu(k)*rn
-        moment = cs%erol(k) > 0.0_wp .and. abs(cs%r(3, k)) >= (1.0_wp - on_bound)*cs%erol(k)*rn
-        if (rn <= 0.0_wp) then
-            c = case_stick
-        else if (shear .and. moment) then
-            c = case_slip_roll
-        else if (shear) then
-            c = case_slip
-        else if (moment) then
-            c = case_roll
-        else
-            c = case_stick
-        end if
-    end function bound_case
 
     !> Choose B (active intact bonds not excluded), assemble W_BB + eps I, analyse when the
     !> bond graph changed, factor when a value changed.
