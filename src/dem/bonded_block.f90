@@ -44,12 +44,9 @@
 !>
 !> Outer check (`bonded_block_solve`): after a converged solve every bond of B is checked
 !> against its cone, r_n + r_cohe h >= 0, |r_t| <= mu_b (r_n + r_cohe h), |M| <= e_b (r_n +
-!> r_cohe h). A bond outside it cannot hold as a bilateral constraint: the one farthest
-!> outside (cone_excess) leaves B for the rest of the step, joins the sweeps with its own
-!> (cohesive) law, and the step is solved again from the current reactions, one bond per
-!> pass (released together, the overloaded bonds of a clamped bonded row were swept against
-!> the rigid rest of the block and never converged; once the root yields the others are back
-!> inside their cones). This is the problem the plain NLGS solves, so the
+!> r_cohe h). A bond outside it cannot hold as a bilateral constraint: it leaves B for the
+!> rest of the step, joins the sweeps with its own (cohesive) law, and the step is solved
+!> again from the current reactions. This is the problem the plain NLGS solves, so the
 !> judgement of dem_contacts (contacts_finish) then breaks it exactly as after the NLGS.
 module dem_bonded_block
     use core_kinds, only: wp, i8
@@ -196,8 +193,7 @@ contains
         !> Bilateral constraints kept satisfied (default: none).
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         type(nlgs_stats_t) :: pass
-        integer :: k, released, n_blocked, sweeps, worst
-        real(wp) :: excess
+        integer :: k, released, n_blocked, sweeps
         integer(i8) :: updates, local
         if (allocated(block%excluded)) then
             if (size(block%excluded) < cs%n) deallocate (block%excluded)
@@ -215,23 +211,15 @@ contains
             updates = updates + pass%updates
             local = local + pass%local_iterations
             if (.not. pass%converged) exit
-            ! release only the bond farthest outside its cone: the others may come back inside
-            ! once it yields, and bonds released together are swept against the rigid rest of
-            ! the block, whose Gauss-Seidel converges too slowly to judge them (module header)
-            worst = 0
-            excess = 0.0_wp
+            released = 0
             do k = 1, cs%n
                 if (.not. block%member(k)) cycle
                 if (outside_cone(cs, k)) then
-                    if (worst == 0 .or. cone_excess(cs, k) > excess) then
-                        worst = k
-                        excess = cone_excess(cs, k)
-                    end if
+                    block%excluded(k) = .true.
+                    released = released + 1
                 end if
             end do
-            if (worst == 0) exit
-            block%excluded(worst) = .true.
-            released = 1
+            if (released == 0) exit
             block%counts%releases = block%counts%releases + released
             block%counts%resolves = block%counts%resolves + 1
             ! back to the velocities without the contact impulses (nlgs_solve applies the
@@ -258,26 +246,6 @@ contains
         if (cs%mu(k) > 0.0_wp) out = out .or. abs(cs%r(2, k)) > cs%mu(k)*rn
         if (cs%erol(k) > 0.0_wp) out = out .or. abs(cs%r(3, k)) > cs%erol(k)*rn
     end function outside_cone
-
-    !> How far the reaction of bond k lies outside its cone, relative to the bound it exceeds
-    !> (largest ratio of a component to its bound, minus 1; a tension beyond the cohesion
-    !> ranks first, by its excess over r_cohe h).
-    pure real(wp) function cone_excess(cs, k) result(excess)
-        type(contact_set_t), intent(in) :: cs
-        integer, intent(in) :: k
-        real(wp) :: rn
-        rn = cs%r(1, k) + cs%coh(k)
-        if (rn < 0.0_wp) then
-            excess = huge(1.0_wp)
-            if (cs%coh(k) > 0.0_wp) excess = min(huge(1.0_wp), 1.0e10_wp*(1.0_wp - rn/cs%coh(k)))
-            return
-        end if
-        excess = 0.0_wp
-        if (cs%mu(k) > 0.0_wp .and. abs(cs%r(2, k)) > cs%mu(k)*rn) &
-            excess = max(excess, abs(cs%r(2, k))/max(cs%mu(k)*rn, tiny(1.0_wp)) - 1.0_wp)
-        if (cs%erol(k) > 0.0_wp .and. abs(cs%r(3, k)) > cs%erol(k)*rn) &
-            excess = max(excess, abs(cs%r(3, k))/max(cs%erol(k)*rn, tiny(1.0_wp)) - 1.0_wp)
-    end function cone_excess
 
     !> Choose B (active intact bonds not excluded), assemble W_BB + eps I, analyse when the
     !> bond graph changed, factor when a value changed.
