@@ -120,6 +120,29 @@ def hanging(exe, decks, work):
           f"first stored status {status[:1].tolist()}")
 
 
+def bonded_shear_pair(exe, decks, work):
+    """dem_bonded_shear_pair.dat: both bonds of a clamped 3-disk row break in shear."""
+    radius, rho, load, cap, h = 0.01, 2500.0, 210.0, 200.0, 1e-4
+    f, _ = run(exe, decks / "dem_bonded_shear_pair.dat", work)
+    with f:
+        converged = f["dem/solver/converged"][...]
+        broken = sorted((int(i), int(j), int(s), int(mode)) for i, j, s, mode in
+                        zip(*(f[f"dem/bonds/{k}"][...] for k in ("i", "j", "step", "mode"))))
+        v = f["dem/velocity"][1]
+    m = rho * np.pi * radius**2
+    check("bonded shear pair: converged, both bonds broken at step 1 in shear",
+          bool(np.all(converged == 1)) and broken == [(2, 1, 1, 2), (3, 2, 1, 2)],
+          f"converged {converged.tolist()}, broken (i, j, step, mode) {broken}")
+    v3 = (load - cap) * h / m
+    # Each bond carries its bound exactly; the solve stops at 1e-10 of W r (a few sweeps of
+    # two contacts), and the local solver at 1e-10 of the reactions: 1e-8 of v3, whose
+    # impulse is 5 % of the load's (rotations as R omega, measured 7.5e-9 of v3).
+    err = max(abs(v[2, 1] - v3), abs(v[1, 0]), abs(v[1, 1]), abs(v[2, 0]),
+              radius * abs(v[1, 2]), radius * abs(v[2, 2])) / v3
+    check("bonded shear pair: disk 2 held, disk 3 at (P - mu_b r_cohe) h / m", err < 1e-8,
+          f"v3 = {v[2, 1]:.10e} vs {v3:.10e} m/s; max error {err:.1e} of v3")
+
+
 def cohesive_row(exe, src, work):
     """input/cohesive_row.dat: top bond breaks at t = 0.08711 s, the bottom one at 0.15 s."""
     f, _ = run(exe, src / "input" / "cohesive_row.dat", work)
@@ -360,6 +383,7 @@ def main():
     incline(exe, src, work)
     column(exe, decks, work)
     hanging(exe, decks, work)
+    bonded_shear_pair(exe, decks, work)
     cohesive_row(exe, src, work)
     small_deposit(exe, decks, work)
     unconverged(exe, decks, work)
