@@ -6,6 +6,8 @@
 !> - s_fe) the weight is
 !> - alpha = 1 for xi < 0 (FE only), alpha = 0 for xi > 1 (particles only);
 !> - inside the closed overlap 0 <= xi <= 1: alpha = clip(r(xi), alpha_min, 1 - alpha_min),
+!>   the ends widened by relative_roundoff times the larger end's abscissa (a disk centred on
+!>   an end has an abscissa rounded to either side of it: it is coupled either way),
 !>   with the ramp r(xi) = c (constant), 1 - xi (linear) or 1 - (3 xi^2 - 2 xi^3) (cubic,
 !>   zero slope at both ends).
 !> The floor keeps every coupled point (placed inside the overlap) away from 0 and 1, where
@@ -20,6 +22,7 @@ module coupling_weights
     use core_error, only: error_t, make_error
     use core_sort, only: sort_in_place
     use core_weight, only: weight_function_t
+    use core_constants, only: relative_roundoff
     implicit none
     private
     public :: weight_config_t, overlap_weight_t, make_weight
@@ -114,13 +117,18 @@ contains
         class(overlap_weight_t), intent(in) :: self
         !> Curvilinear abscissa [m].
         real(wp), intent(in) :: s
-        real(wp) :: xi
+        real(wp) :: xi, slack
         xi = (s - self%s_fe)/(self%s_particle - self%s_fe)
-        if (xi < 0) then
+        ! the abscissa of a point placed on an end (a disk centred on s_fe or s_particle, as
+        ! written in the deck) comes out of the node coordinates and element lengths rounded:
+        ! within relative_roundoff of the larger end it is on that end, inside the overlap
+        slack = relative_roundoff*max(abs(self%s_fe), abs(self%s_particle))/abs(self%s_particle - self%s_fe)
+        if (xi < -slack) then
             alpha = 1.0_wp
-        else if (xi > 1) then
+        else if (xi > 1 + slack) then
             alpha = 0.0_wp
         else
+            xi = min(max(xi, 0.0_wp), 1.0_wp)
             alpha = min(max(self%ramp(xi), self%alpha_min), 1.0_wp - self%alpha_min)
         end if
     end function overlap_value

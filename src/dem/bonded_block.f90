@@ -44,16 +44,21 @@
 !>
 !> Outer check (`bonded_block_solve`): after a converged solve every bond of B is checked
 !> against its cone, r_n + r_cohe h >= 0, |r_t| <= mu_b (r_n + r_cohe h), |M| <= e_b (r_n +
-!> r_cohe h). A bond outside it cannot hold as a bilateral constraint: it leaves B for the
-!> rest of the step, joins the sweeps with its own (cohesive) law, and the step is solved
-!> again from the current reactions. This is the problem the plain NLGS solves, so the
+!> r_cohe h). A bond outside it cannot hold as a bilateral constraint: the one farthest
+!> outside (cone_excess) leaves B for the rest of the step, joins the sweeps with its own
+!> (cohesive) law, and the step is solved again from the current reactions, one bond per
+!> pass (released together, the overloaded bonds of a clamped bonded row were swept against
+!> the rigid rest of the block and never converged; once the root yields the others are back
+!> inside their cones). When the block's equalities have no solution (`consistent`), every
+!> bond outside its cone is released at once. A bond left in B on a bound is judged at it
+!> (bound_case). This is the problem the plain NLGS solves, so the
 !> judgement of dem_contacts (contacts_finish) then breaks it exactly as after the NLGS.
 module dem_bonded_block
     use core_kinds, only: wp, i8
     use core_error, only: error_t
     use core_sparse, only: sparse_matrix_t, sparse_solver_t, sparse_cholesky
     use dem_contacts, only: contact_set_t, status_cohesive
-    use dem_bipotential, only: case_stick
+    use dem_bipotential, only: case_stick, case_slip, case_roll, case_slip_roll
     use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_apply_reactions, nlgs_block_t, &
                         nlgs_bilateral_t
     implicit none
@@ -71,6 +76,14 @@ module dem_bonded_block
     !> Relative resolution of a relative velocity (64 machine epsilons of the velocities of
     !> the two bodies, as in dem_nlgs): the refinement stops below it.
     real(wp), parameter :: roundoff = 64.0_wp*epsilon(1.0_wp)
+    !> A reaction of the block within this fraction of a bound is on it (bound_case): the
+    !> direct solve rounds at about 1e-12 of the reactions, the sweeps of a released
+    !> neighbour stop at local_tolerance (1e-10 by default).
+    real(wp), parameter :: on_bound = 1.0e-9_wp
+    !> The bonds' equalities are met when their residual is below this fraction of the
+    !> velocities (a consistent system refines down to roundoff, an inconsistent one keeps a
+    !> residual of the order of the velocities).
+    real(wp), parameter :: consistent_ratio = 1.0e-6_wp
 
     !> Counts since the block was created (for statistics and benchmarks).
     type :: bonded_block_counts_t
@@ -117,6 +130,11 @@ module dem_bonded_block
         logical :: stale = .false.
         !> A refactorisation failed during this solve: the block is not solved.
         logical :: lost = .false.
+        !> The last solve met the bonds' equalities (residual within `consistent_ratio` of
+        !> the velocities): false when they have no solution, e.g. bonds between bodies
+        !> whose velocities are imposed apart (the regularised solve then leaves a residual
+        !> of the order of the velocities, with reactions of order 1/eps).
+        logical :: consistent = .true.
         !> W_BB + eps I (lower triangle).
         type(sparse_matrix_t) :: mat
         !> Its factorisation.
@@ -193,7 +211,8 @@ contains
         !> Bilateral constraints kept satisfied (default: none).
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         type(nlgs_stats_t) :: pass
-        integer :: k, released, n_blocked, sweeps
+        integer :: k, released, n_blocked, sweeps, worst
+        real(wp) :: excess
         integer(i8) :: updates, local
         if (allocated(block%excluded)) then
             if (size(block%excluded) < cs%n) deallocate (block%excluded)
@@ -211,15 +230,39 @@ contains
             updates = updates + pass%updates
             local = local + pass%local_iterations
             if (.not. pass%converged) exit
+            ! release only the bond farthest outside its cone: the others may come back inside
+            ! once it yields, and bonds released together are swept against the rigid rest of
+            ! the block, whose Gauss-Seidel converges too slowly to judge them (module header)
+            worst = 0
+            excess = 0.0_wp
             released = 0
             do k = 1, cs%n
                 if (.not. block%member(k)) cycle
                 if (outside_cone(cs, k)) then
-                    block%excluded(k) = .true.
-                    released = released + 1
+                    if (.not. block%consistent) then
+                        ! no solution with every bond held: its reactions are of order 1/eps
+                        ! and tell nothing of which bond yields first; release them all
+                        block%excluded(k) = .true.
+                        released = released + 1
+                    else if (worst == 0 .or. cone_excess(cs, k) > excess) then
+                        worst = k
+                        excess = cone_excess(cs, k)
+                    end if
                 end if
             end do
-            if (released == 0) exit
+            if (released > 0) worst = -1
+            if (worst == 0) then
+                ! bonds of the block whose reaction lies on a bound have reached it: judged
+                ! as the sweeps judge a bond projected onto it (contacts_finish breaks them)
+                do k = 1, cs%n
+                    if (block%member(k)) cs%pcase(k) = bound_case(cs, k)
+                end do
+                exit
+            end if
+            if (worst > 0) then
+                block%excluded(worst) = .true.
+                released = 1
+            end if
             block%counts%releases = block%counts%releases + released
             block%counts%resolves = block%counts%resolves + 1
             ! back to the velocities without the contact impulses (nlgs_solve applies the
@@ -246,6 +289,52 @@ contains
         if (cs%mu(k) > 0.0_wp) out = out .or. abs(cs%r(2, k)) > cs%mu(k)*rn
         if (cs%erol(k) > 0.0_wp) out = out .or. abs(cs%r(3, k)) > cs%erol(k)*rn
     end function outside_cone
+
+    !> How far the reaction of bond k lies outside its cone, relative to the bound it exceeds
+    !> (largest ratio of a component to its bound, minus 1; a tension beyond the cohesion
+    !> ranks first, by its excess over r_cohe h).
+    pure real(wp) function cone_excess(cs, k) result(excess)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: k
+        real(wp) :: rn
+        rn = cs%r(1, k) + cs%coh(k)
+        if (rn < 0.0_wp) then
+            excess = huge(1.0_wp)
+            if (cs%coh(k) > 0.0_wp) excess = min(huge(1.0_wp), 1.0e10_wp*(1.0_wp - rn/cs%coh(k)))
+            return
+        end if
+        excess = 0.0_wp
+        if (cs%mu(k) > 0.0_wp .and. abs(cs%r(2, k)) > cs%mu(k)*rn) &
+            excess = max(excess, abs(cs%r(2, k))/max(cs%mu(k)*rn, tiny(1.0_wp)) - 1.0_wp)
+        if (cs%erol(k) > 0.0_wp .and. abs(cs%r(3, k)) > cs%erol(k)*rn) &
+            excess = max(excess, abs(cs%r(3, k))/max(cs%erol(k)*rn, tiny(1.0_wp)) - 1.0_wp)
+    end function cone_excess
+
+    !> Case of the reaction of bond k of the block, which lies inside its cone: on a bound
+    !> (within on_bound of it, relative) case_slip, case_roll or case_slip_roll, else
+    !> case_stick. A bond of the block carries exactly a bound when a released neighbour
+    !> yields at its own and the two take the same load (two bonds of a row in shear: both
+    !> reached the bound, and the plain sweeps break both).
+    pure integer function bound_case(cs, k) result(c)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: k
+        real(wp) :: rn
+        logical :: shear, moment
+        rn = cs%r(1, k) + cs%coh(k)
+        shear = cs%mu(k) > 0.0_wp .and. abs(cs%r(2, k)) >= (1.0_wp - on_bound)*cs%mu(k)*rn
+        moment = cs%erol(k) > 0.0_wp .and. abs(cs%r(3, k)) >= (1.0_wp - on_bound)*cs%erol(k)*rn
+        if (rn <= 0.0_wp) then
+            c = case_stick
+        else if (shear .and. moment) then
+            c = case_slip_roll
+        else if (shear) then
+            c = case_slip
+        else if (moment) then
+            c = case_roll
+        else
+            c = case_stick
+        end if
+    end function bound_case
 
     !> Choose B (active intact bonds not excluded), assemble W_BB + eps I, analyse when the
     !> bond graph changed, factor when a value changed.
@@ -675,6 +764,7 @@ contains
         noise = roundoff*sqrt(noise)
         prev = huge(1.0_wp)
         it = 0
+        self%consistent = .true.
         do
             ! the residual of the bonds, -u_B, from the velocities themselves
             do b = 1, self%nb
@@ -685,6 +775,7 @@ contains
                 end do
             end do
             rnorm = norm2(self%rhs)
+            self%consistent = rnorm <= max(noise, consistent_ratio*noise/roundoff)
             if (rnorm <= noise) exit
             if (rnorm > stale_contraction*prev) then
                 if (self%stale) then
