@@ -439,6 +439,7 @@ contains
         if (sc(1) <= 0.0_wp) return
         bp = b*sc(4:6)
         rp = r*sc(1:3)
+        done = .false.
         do n_iter = 1, max_iter
             up = scaled_velocity(sc, bp, rp)
             tau(1) = rp(1) - sc(18)*(up(1) + sc(10)*abs(up(2)) + sc(11)*abs(up(3)))
@@ -446,14 +447,61 @@ contains
             call rolling_projection(tau(1), tau(2), tau(3), sc(10), sc(11), q(1), q(2), q(3), pcase)
             change = sum(abs(q - rp))
             rp = q
-            if (change <= tol*sum(abs(rp))) exit
+            if (change <= tol*sum(abs(rp))) then
+                done = .true.
+                exit
+            end if
             if (pcase == case_separation) cycle
             call branch(sc, bp, pcase, rp, done)
             if (done) exit
         end do
         n_iter = min(n_iter, max_iter)
+        ! The iterations stopped at the cap: the branch they were heading for may be one the
+        ! projections keep missing (a strong coupling of t and M with a wide cone contracts at
+        ! a rate close to 1). Every branch solved exactly, and the one satisfying the law kept.
+        if (.not. done) call exact_branches(sc, bp, rp, pcase)
         r = rp*sc(4:6)
     end subroutine rolling_local_solve_scaled
+
+    !> Every branch of the three-component law solved exactly (`branch`): separation (valid
+    !> when b'_n >= 0), stick, slip with either sign, roll with either sign, slip and roll with
+    !> the four; rp becomes the candidate that satisfies the whole law nearest to it (in the
+    !> scaled frame), pcase its case. Unchanged when no candidate does (a singular block).
+    pure subroutine exact_branches(sc, bp, rp, pcase)
+        real(wp), intent(in) :: sc(rolling_n_scaling), bp(3)
+        real(wp), intent(inout) :: rp(3)
+        integer, intent(inout) :: pcase
+        integer, parameter :: n_cand = 9
+        integer, parameter :: cases(n_cand) = [case_stick, case_slip, case_slip, case_roll, case_roll, &
+                                               case_slip_roll, case_slip_roll, case_slip_roll, case_slip_roll]
+        ! signs of r'_t and M' that `branch` takes for each candidate (unused where irrelevant)
+        real(wp), parameter :: st(n_cand) = [1.0_wp, 1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp, 1.0_wp, -1.0_wp]
+        real(wp), parameter :: sm(n_cand) = [1.0_wp, 1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp, -1.0_wp]
+        real(wp) :: q(3), best(3), dist, best_dist
+        integer :: k, best_case
+        logical :: done
+        best_dist = huge(1.0_wp)
+        best_case = 0
+        if (bp(1) >= 0.0_wp) then
+            best = 0.0_wp
+            best_dist = sum((rp - best)**2)
+            best_case = case_separation
+        end if
+        do k = 1, n_cand
+            q = [0.0_wp, st(k), sm(k)]
+            call branch(sc, bp, cases(k), q, done)
+            if (.not. done) cycle
+            dist = sum((rp - q)**2)
+            if (dist < best_dist) then
+                best = q
+                best_dist = dist
+                best_case = cases(k)
+            end if
+        end do
+        if (best_case == 0) return
+        rp = best
+        pcase = best_case
+    end subroutine exact_branches
 
     !> u' = b' + W' r' in the scaled frame.
     pure function scaled_velocity(sc, bp, rp) result(up)

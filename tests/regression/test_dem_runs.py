@@ -156,26 +156,37 @@ def bonded_row_break(exe, decks, work):
 
 
 def bonded_shear_pair(exe, decks, work):
-    """dem_bonded_shear_pair.dat: both bonds of a clamped 3-disk row break in shear."""
+    """dem_bonded_shear_pair.dat: both bonds of a clamped 3-disk row break in shear, with the
+    default solver (the bonded block) and with plain sweeps (`method = nlgs`, the default 8
+    local iterations: the bonds' local law, with e_b = 7R and t and M strongly coupled, is
+    solved exactly by its branches at the cap; before that no sweep converged in 20 000)."""
     radius, rho, load, cap, h = 0.01, 2500.0, 210.0, 200.0, 1e-4
-    f, _ = run(exe, decks / "dem_bonded_shear_pair.dat", work)
-    with f:
-        converged = f["dem/solver/converged"][...]
-        broken = sorted((int(i), int(j), int(s), int(mode)) for i, j, s, mode in
-                        zip(*(f[f"dem/bonds/{k}"][...] for k in ("i", "j", "step", "mode"))))
-        v = f["dem/velocity"][1]
-    m = rho * np.pi * radius**2
-    check("bonded shear pair: converged, both bonds broken at step 1 in shear",
-          bool(np.all(converged == 1)) and broken == [(2, 1, 1, 2), (3, 2, 1, 2)],
-          f"converged {converged.tolist()}, broken (i, j, step, mode) {broken}")
-    v3 = (load - cap) * h / m
-    # Each bond carries its bound exactly; the solve stops at 1e-10 of W r (a few sweeps of
-    # two contacts), and the local solver at 1e-10 of the reactions: 1e-8 of v3, whose
-    # impulse is 5 % of the load's (rotations as R omega, measured 7.5e-9 of v3).
-    err = max(abs(v[2, 1] - v3), abs(v[1, 0]), abs(v[1, 1]), abs(v[2, 0]),
-              radius * abs(v[1, 2]), radius * abs(v[2, 2])) / v3
-    check("bonded shear pair: disk 2 held, disk 3 at (P - mu_b r_cohe) h / m", err < 1e-8,
-          f"v3 = {v[2, 1]:.10e} vs {v3:.10e} m/s; max error {err:.1e} of v3")
+    deck = decks / "dem_bonded_shear_pair.dat"
+    sweeps_deck = work / "dem_bonded_shear_pair_nlgs.dat"
+    sweeps_deck.write_text(deck.read_text().replace("[solver]\n", "[solver]\nmethod = nlgs\n"))
+    for name, path in (("block", deck), ("nlgs", sweeps_deck)):
+        f, _ = run(exe, path, work)
+        with f:
+            converged = f["dem/solver/converged"][...]
+            broken = sorted((int(i), int(j), int(s), int(mode)) for i, j, s, mode in
+                            zip(*(f[f"dem/bonds/{k}"][...] for k in ("i", "j", "step", "mode"))))
+            v = f["dem/velocity"][1]
+        m = rho * np.pi * radius**2
+        check(f"bonded shear pair ({name}): converged, both bonds broken at step 1 in shear",
+              bool(np.all(converged == 1)) and broken == [(2, 1, 1, 2), (3, 2, 1, 2)],
+              f"converged {converged.tolist()}, broken (i, j, step, mode) {broken}")
+        v3 = (load - cap) * h / m
+        # Each bond carries its bound exactly; the solve stops at 1e-10 of W r (a few sweeps
+        # of two contacts), and the local solver at 1e-10 of the reactions: 1e-8 of v3, whose
+        # impulse is 5 % of the load's (rotations as R omega; measured 3.7e-9 of v3 with the
+        # block). The sweeps (112 of them) stop on the change of one sweep, which a
+        # contraction near 1 leaves below the distance to the solution: measured 1.1e-8,
+        # asserted at 1e-7 for them.
+        err = max(abs(v[2, 1] - v3), abs(v[1, 0]), abs(v[1, 1]), abs(v[2, 0]),
+                  radius * abs(v[1, 2]), radius * abs(v[2, 2])) / v3
+        bound = 1e-8 if name == "block" else 1e-7
+        check(f"bonded shear pair ({name}): disk 2 held, disk 3 at (P - mu_b r_cohe) h / m", err < bound,
+              f"v3 = {v[2, 1]:.10e} vs {v3:.10e} m/s; max error {err:.1e} of v3")
 
 
 def cohesive_row(exe, src, work):
