@@ -67,7 +67,6 @@ module coupling_coupled_step
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
     use core_strings, only: to_str, gib
-    use core_linalg, only: symmetrize
     use fem_dynamic_operator, only: dynamic_operator_t
     use fem_newmark, only: newmark_t
     use dem_particles, only: particles_inverse_mass, dof_x, dof_y, dof_rot
@@ -230,7 +229,7 @@ module coupling_coupled_step
     end interface
 
     !> Rows from which the set-up of the dense multiplier matrices is announced: it grows as
-    !> the rows cubed, about 2 s for 4 000 rows and 13 s for 7 680 on the 2-core machine of
+    !> the rows cubed, about 3 s of CPU for 4 320 rows and 11 s for 7 680 on the machine of
     !> doc/performance.md (the seconds before the first step of a run or the line of --check).
     integer, parameter :: notice_rows = 4000
 
@@ -304,7 +303,6 @@ contains
         if (allocated(error)) return
         sys%on_nodes = sys%space%projected()
         if (.not. allocated(sys%mediator_nodes)) allocate (sys%mediator_nodes(0))
-        call symmetrize(sys%rows%ainv)
         sys%rows%response = h*sys%fe%gamma*iw
         sys%rows%scale = h*sys%fe%gamma/sys%thickness
         call init_state(sys)

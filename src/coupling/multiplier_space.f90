@@ -60,7 +60,7 @@ module coupling_multiplier_space
             class(multiplier_space_t), intent(inout) :: self
             !> Row matrix A (n_rows, n_rows), factored.
             type(dense_spd_t), intent(in) :: a
-            !> B (n_rows, n_rows).
+            !> B (n_rows, n_rows), exactly symmetric.
             real(wp), allocatable, intent(out) :: b(:, :)
             !> Set when A_m is singular or a solve fails.
             type(error_t), allocatable, intent(out) :: error
@@ -244,6 +244,7 @@ contains
             call am%solve(p, error)
             if (allocated(error)) return
             b = matmul(transpose(pi), p)
+            call symmetrize(b)
             self%recovery = matmul(p, a%a)
             ! A factor can succeed on entries out of scale and still give an overflowing inverse
             if (.not. (all(ieee_is_finite(b)) .and. all(ieee_is_finite(self%recovery)))) then
