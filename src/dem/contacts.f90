@@ -40,6 +40,10 @@ module dem_contacts
     integer, parameter :: status_cohesive = 3
     !> Contact status, cohesive bond broken for good (now a plain frictional contact).
     integer, parameter :: status_broken = 4
+    !> Fewest contacts for which the frames and the laws are set on the OpenMP threads: where
+    !> the sweeps split (2 blocks of 2000 contacts, dem_nlgs). Below it a parallel region costs
+    !> more than the loop, and far more on a loaded machine (doc/performance.md, OpenMP).
+    integer, parameter :: parallel_min = 4000
 
     !> Parameters of the step needed to set the contact laws.
     type :: contact_law_t
@@ -388,7 +392,7 @@ contains
         real(wp), intent(in) :: im(:, :)
         integer :: k, a, b
         real(wp) :: nx, ny
-        !$omp parallel do schedule(static) private(k, a, b, nx, ny)
+        !$omp parallel do schedule(static) private(k, a, b, nx, ny) if (cs%n >= parallel_min)
         do k = 1, cs%n
             a = cs%i1(k)
             b = cs%i2(k)
@@ -490,7 +494,8 @@ contains
         real(wp) :: ub(3), uf(3), uw(2), amoy, target, e
         logical :: active
         ! contacts are independent: the loop runs over the OpenMP threads (same result)
-        !$omp parallel do schedule(static) private(k, ma, mb, ub, uf, uw, amoy, target, e, active)
+        !$omp parallel do schedule(static) private(k, ma, mb, ub, uf, uw, amoy, target, e, active) &
+        !$omp if (cs%n >= parallel_min)
         do k = 1, cs%n
             mb = mat(cs%i2(k))
             if (cs%i1(k) > 0) then
