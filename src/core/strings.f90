@@ -8,7 +8,7 @@ module core_strings
     private
     public :: string_t, to_lower, strip, is_blank_char, split_words, join_words
     public :: levenshtein, closest_match, parse_real, parse_int, to_str, shorten, max_echo, is_real_syntax
-    public :: gib
+    public :: gib, counted
 
     !> Longest token echoed whole in a message (see `shorten`).
     integer, parameter :: max_echo = 40
@@ -25,6 +25,12 @@ module core_strings
     interface to_str
         module procedure int_to_str, int8_to_str, real_to_str
     end interface to_str
+
+    !> A count with its noun, singular for one: `counted(1, 'disk')` is '1 disk',
+    !> `counted(3, 'disk')` '3 disks'.
+    interface counted
+        module procedure int_counted, int8_counted
+    end interface counted
 
     character(len=*), parameter :: digits = '0123456789'
     !> Significant digits kept by `to_str` for reals: well above what a deck value needs, well
@@ -334,6 +340,28 @@ contains
         write (buf, '(i0)') i
         text = trim(buf)
     end function int_to_str
+
+    !> Count and noun (see `counted`).
+    pure function int_counted(n, noun) result(text)
+        !> The count.
+        integer, intent(in) :: n
+        !> The noun, singular; its plural adds an s.
+        character(len=*), intent(in) :: noun
+        character(len=:), allocatable :: text
+        text = int_to_str(n)//' '//noun
+        if (n /= 1) text = text//'s'
+    end function int_counted
+
+    !> Count and noun, 64-bit count (see `counted`).
+    pure function int8_counted(n, noun) result(text)
+        !> The count.
+        integer(i8), intent(in) :: n
+        !> The noun, singular; its plural adds an s.
+        character(len=*), intent(in) :: noun
+        character(len=:), allocatable :: text
+        text = int8_to_str(n)//' '//noun
+        if (n /= 1_i8) text = text//'s'
+    end function int8_counted
 
     !> 64-bit integer as text (`i0`).
     pure function int8_to_str(i) result(text)

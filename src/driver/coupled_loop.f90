@@ -23,6 +23,7 @@ module driver_coupled_loop
     use core_error, only: error_t
     use core_signals, only: caught_signal, signal_name
     use io_progress, only: progress_t
+    use core_strings, only: counted, to_str
     use io_hdf5_file, only: h5_file_t
     use coupling_coupled_step, only: coupled_system_t, coupled_energies_t, arlequin_step, coupled_energies, &
                                      velocity_mismatch_t, velocity_mismatch
@@ -427,9 +428,10 @@ contains
         !> The line.
         character(len=:), allocatable :: line
         character(len=512) :: buf
-        write (buf, '(a,i0,a,i0,a,i0,a,es13.5e3,a)') 'coupled run: '//model//', ', self%sys%dem%particles%n, &
-            ' disks (', self%sys%op%n_points, ' coupled), ', n_steps, ' steps to t = ', self%sys%fe%t, ' s'
-        line = trim(buf)
+        write (buf, '(es13.5e3)') self%sys%fe%t
+        line = 'coupled run: '//model//', '//counted(self%sys%dem%particles%n, 'disk')//' ('// &
+               to_str(self%sys%op%n_points)//' coupled), '//counted(n_steps, 'step')//' to t = '//trim(buf)//' s'
+
     end function run_line
 
     !> '<residual> = P m (<coordinates> C m), max velocity residual V m/s': the largest

@@ -10,7 +10,7 @@
 module driver_run_dem
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
-    use core_strings, only: to_str
+    use core_strings, only: counted, to_str
     use core_signals, only: caught_signal, signal_name
     use io_progress, only: progress_t
     use dem_particles, only: particles_t
@@ -230,9 +230,9 @@ contains
         !> Closing lines: contacts, solver effort, unconverged steps, energy balance, times.
         subroutine summary()
             associate (sys => cfg%system)
-                write (buf, '(a,i0,a,i0,a,i0,a,es13.5e3,a)') 'particles: ', sys%particles%n, &
-                    ' disks, ', sys%walls%n, ' walls, ', n_steps, ' steps to t = ', sys%time, ' s'
-                call report(trim(buf))
+                write (buf, '(es13.5e3)') sys%time
+                call report('particles: '//counted(sys%particles%n, 'disk')//', '//counted(sys%walls%n, 'wall')// &
+                            ', '//counted(n_steps, 'step')//' to t = '//trim(buf)//' s')
                 write (buf, '(a,i0,a,i0,a,es11.3e3,a,es11.3e3,a)') 'contacts at the end: ', &
                     sys%contacts%n, ' (', sys%stats%n_active, ' active); time in detection ', &
                     sys%time_detection, ' s, in the solver ', sys%time_solver, ' s'

@@ -8,7 +8,7 @@
 module driver_simulation_coupled
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_input_error
-    use core_strings, only: to_str
+    use core_strings, only: counted, to_str
     use io_deck, only: deck_t
     use fem_beam_config, only: beam_config_t
     use fem_beam_model, only: beam_model_t
@@ -140,8 +140,8 @@ contains
         class(coupled_simulation_t), intent(in) :: self
         !> Summary.
         character(len=:), allocatable :: text
-        text = 'coupled '//self%settings%analysis//' analysis, '//to_str(size(self%beam%x))//' beam nodes, '// &
-               to_str(self%dem%system%particles%n)//' disks, '//to_str(self%sys%op%n_points)//' coupled'
+        text = 'coupled '//self%settings%analysis//' analysis, '//counted(size(self%beam%x), 'beam node')//', '// &
+               counted(self%dem%system%particles%n, 'disk')//', '//to_str(self%sys%op%n_points)//' coupled'
     end function coupled_describe
 
     !> 'coupled'.
@@ -239,7 +239,7 @@ contains
         integer, intent(in) :: unconverged
         !> Where the lines go.
         procedure(report_iface) :: report
-        call report(self%run_line(to_str(self%model%n_nodes)//' beam nodes', n_steps))
+        call report(self%run_line(counted(self%model%n_nodes, 'beam node'), n_steps))
         if (self%sys%on_nodes) then
             ! Only the projection on the mediator space is imposed: the per-disk residual from
             ! the coordinates is free in the kernel of Pi.

@@ -19,7 +19,7 @@ module driver_simulation_coupled2d
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error, make_input_error
-    use core_strings, only: to_str
+    use core_strings, only: counted, to_str
     use io_deck, only: deck_t
     use io_hdf5_file, only: h5_file_t
     use fem_continuum_dynamics, only: continuum_dynamics_t
@@ -160,8 +160,8 @@ contains
         !> Summary.
         character(len=:), allocatable :: text
         text = 'coupled '//self%settings%analysis//' analysis of a continuum, '// &
-               to_str(self%continuum%model%mesh%element_count())//' elements, '// &
-               to_str(self%sys%dem%particles%n)//' disks, '//to_str(self%sys%op%n_points)//' coupled'
+               counted(self%continuum%model%mesh%element_count(), 'element')//', '// &
+               counted(self%sys%dem%particles%n, 'disk')//', '//to_str(self%sys%op%n_points)//' coupled'
     end function coupled2d_describe
 
     !> 'coupled2d'.
@@ -299,7 +299,7 @@ contains
         integer, intent(in) :: unconverged
         !> Where the lines go.
         procedure(report_iface) :: report
-        call report(self%run_line(to_str(self%continuum%model%mesh%element_count())//' elements', n_steps))
+        call report(self%run_line(counted(self%continuum%model%mesh%element_count(), 'element'), n_steps))
         call report(self%constraint_line('constraint: max |Pi (q - C u)|', 'per disk, from the coordinates'))
         call report('unconverged steps: '//to_str(unconverged)//' of '//to_str(n_steps))
     end subroutine coupled2d_summary_lines

@@ -2,7 +2,7 @@
 module driver_simulation_dem
     use core_kinds, only: wp
     use core_error, only: error_t, make_input_error
-    use core_strings, only: to_str
+    use core_strings, only: counted, to_str
     use io_deck, only: deck_t
     use fem_beam_config, only: beam_config_t
     use dem_detection, only: coordinate_limit
@@ -63,8 +63,8 @@ contains
         class(dem_simulation_t), intent(in) :: self
         !> Summary.
         character(len=:), allocatable :: text
-        text = self%settings%analysis//' analysis, '//to_str(self%dem%system%particles%n)//' disks, '// &
-               to_str(self%dem%system%walls%n)//' walls'
+        text = self%settings%analysis//' analysis, '//counted(self%dem%system%particles%n, 'disk')//', '// &
+               counted(self%dem%system%walls%n, 'wall')
     end function dem_describe
 
     !> Integrate the particles; results into `out`.

@@ -6,6 +6,7 @@
 !> formatting and the ETA are testable without a clock.
 module io_progress
     use core_kinds, only: wp, i8
+    use core_strings, only: counted
     implicit none
     private
     public :: progress_t, format_progress_line, format_summary_line, format_hms, eta_seconds
@@ -174,11 +175,10 @@ contains
         logical :: early
         early = .false.
         if (present(stopped)) early = stopped
-        write (buf, '(i0)') steps
         if (early) then
-            text = 'stopped after '//trim(buf)//' steps'
+            text = 'stopped after '//counted(steps, 'step')
         else
-            text = 'done: '//trim(buf)//' steps'
+            text = 'done: '//counted(steps, 'step')
         end if
         if (present(t)) then
             write (buf, '(es12.4e3)') t
