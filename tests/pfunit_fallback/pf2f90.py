@@ -12,9 +12,9 @@ generation time what real pFUnit would refuse, at generation or at compile time:
   arguments as pFUnit requires for the variant;
 * the line after ``@before``/``@after`` (comments aside) must be the ``subroutine``
   statement, as pFUnit reads it;
-* test procedure names <= 63 characters (Fortran), module name = file name (pFUnit's
-  registry calls ``<file name>_suite``) and <= 57 characters (pFUnit generates
-  ``<module>_suite`` and ``Wrap<module>``);
+* test procedure names <= 63 characters (Fortran), module name = file name, spelled
+  exactly (pFUnit's registry calls ``<file name>_suite``) and <= 57 characters (pFUnit
+  generates ``<module>_suite`` and ``Wrap<module>``);
 * no code line longer than 132 characters in what pFUnit generates (gfortran's default
   free-form limit: ``add_pfunit_ctest`` adds no line-length flag); for an assert, the line
   ``  call assert<Variant>(<arguments>, &`` that pFUnit writes.
@@ -26,7 +26,9 @@ Supported asserts: ``@assertEqual``, ``@assertTrue``, ``@assertFalse``, ``@asser
 (funit.f90) exports pFUnit's public names, so a helper named like one of them (``run``...)
 fails to compile as under pFUnit. After the module, a ``<module>_suite`` subroutine uses the
 test module and ``funit`` unrestricted and declares ``suite`` and ``t``, as pFUnit's
-generated suite function does, so the same name clashes fail.
+generated suite function does, so the same name clashes fail. Each test runs as pFUnit's
+``TestCase%runBare`` runs it: the ``@before`` procedure, then, only if it raised nothing, the
+test and the ``@after`` procedure (also after a failed test, never after a failed set-up).
 
 Line numbers are preserved (annotations become blank lines, asserts stay on their line),
 so compiler messages and failure reports point into the ``.pf`` file.
@@ -175,9 +177,11 @@ def parse(path):
         raise PfError(f"{base}: @test not followed by a subroutine statement")
     if module is None:
         raise PfError(f"{base}: no module found")
-    if module.lower() != stem.lower():
-        raise PfError(f"{base}: module '{module}' must be named like the file ('{stem}'): "
-                      f"pFUnit's registry calls {stem}_suite")
+    if module != stem:
+        # exact spelling: pFUnit (>= 4.7) refuses a module not named like its file, and the
+        # case rule of that check could not be read in 4.12's source (see the report)
+        raise PfError(f"{base}: module '{module}' must be named exactly like the file "
+                      f"('{stem}'): pFUnit's registry calls {stem}_suite")
     if len(module) > MAX_MODULE:
         raise PfError(f"{base}: module name longer than {MAX_MODULE} characters (pFUnit "
                       f"generates '{module}_suite')")
@@ -201,13 +205,17 @@ def suite_lines(module, tests, befores, afters):
             "    ! as in pFUnit's generated suite function (name clashes fail the same way)",
             "    type(TestSuite) :: suite",
             "    class(Test), allocatable :: t"]
+    # pFUnit's TestCase%runBare: set-up; then, only if the set-up raised nothing, the test
+    # and the tear-down (which runs after a failed test too, never after a failed set-up)
     for name in tests:
         text.append(f"    call fallback_start_test('{module}', '{name}')")
         if befores:
             text.append(f"    call {befores[0]}()")
-        text.append(f"    if (.not. anyExceptions()) call {name}()")
+        text.append("    if (.not. anyExceptions()) then")
+        text.append(f"        call {name}()")
         if afters:
-            text.append(f"    call {afters[0]}()")
+            text.append(f"        call {afters[0]}()")
+        text.append("    end if")
         text.append("    call fallback_end_test()")
     text.append(f"end subroutine {module}_suite")
     return text
