@@ -16,8 +16,8 @@ generation time what real pFUnit would refuse, at generation or at compile time:
   exactly (pFUnit's registry calls ``<file name>_suite``) and <= 57 characters (pFUnit
   generates ``<module>_suite`` and ``Wrap<module>``);
 * no code line longer than 132 characters in what pFUnit generates (gfortran's default
-  free-form limit: ``add_pfunit_ctest`` adds no line-length flag); for an assert, the line
-  ``  call assert<Variant>(<arguments>, &`` that pFUnit writes.
+  free-form limit, counted in bytes as gfortran does: ``add_pfunit_ctest`` adds no line-length
+  flag); for an assert, the line ``  call assert<Variant>(<arguments>, &`` that pFUnit writes.
 
 Supported asserts: ``@assertEqual``, ``@assertTrue``, ``@assertFalse``, ``@assertLessThan``,
 ``@assertGreaterThan``, ``@assertRelativelyEqual`` (tolerance required, as in pFUnit),
@@ -74,6 +74,11 @@ class PfError(Exception):
 
 def fortran_string(text):
     return "'" + text.replace("'", "''") + "'"
+
+
+def columns(line):
+    """Line length as gfortran counts it: bytes (a UTF-8 'e' with an accent counts 2)."""
+    return len(line.encode('utf-8'))
 
 
 def check_arguments(args, where):
@@ -136,8 +141,8 @@ def parse(path):
                     raise PfError(f"{where}: @assert{variant} is not supported by the fallback")
                 check_arguments(args, where)
                 generated = f"  call assert{variant}({args}, &"
-                if len(generated) > MAX_LINE:
-                    raise PfError(f"{where}: pFUnit would generate a {len(generated)}-character "
+                if columns(generated) > MAX_LINE:
+                    raise PfError(f"{where}: pFUnit would generate a {columns(generated)}-character "
                                   f"line ('  call assert{variant}(..., &'), more than gfortran's "
                                   f"default {MAX_LINE}: shorten the assert")
                 indent = line[:len(line) - len(line.lstrip())]
@@ -159,8 +164,8 @@ def parse(path):
             continue
         if '@assert' in line.lower().split('!')[0]:
             raise PfError(f"{where}: an @assert must stand alone on its line")
-        if len(line) > MAX_LINE:
-            raise PfError(f"{where}: line of {len(line)} characters, more than gfortran's "
+        if columns(line) > MAX_LINE:
+            raise PfError(f"{where}: line of {columns(line)} characters, more than gfortran's "
                           f"default {MAX_LINE} (pFUnit copies it unchanged)")
         m = MODULE.match(line)
         if m and m.group(1).lower() != 'procedure':
@@ -204,7 +209,9 @@ def suite_lines(module, tests, befores, afters):
             "    implicit none",
             "    ! as in pFUnit's generated suite function (name clashes fail the same way)",
             "    type(TestSuite) :: suite",
-            "    class(Test), allocatable :: t"]
+            "    class(Test), allocatable :: t",
+            "    ! pFUnit builds each test with the TestMethod constructor",
+            "    type(TestMethod), allocatable :: method"]
     # pFUnit's TestCase%runBare: set-up; then, only if the set-up raised nothing, the test
     # and the tear-down (which runs after a failed test too, never after a failed set-up)
     for name in tests:

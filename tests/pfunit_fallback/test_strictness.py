@@ -56,6 +56,10 @@ GENERATION = [
         'test_one', 't' * 64), r'longer than 63'),
     ('strict_long_line', module('strict_long_line', "        call sleep(0)" + ' ' * 120 + '; continue'),
      r'more than gfortran'),
+    # gfortran counts bytes: 131 characters, 221 bytes
+    ('strict_long_bytes', module('strict_long_bytes', "    character(len=*), parameter :: s = '"
+                                 + '\u00e9' * 90 + "'\n        @assertTrue(.true.)"),
+     r'more than gfortran'),
     ('strict_long_assert', module('strict_long_assert', "        @assertTrue(" + '.true. .and. ' * 10
                                   + ".true.)"), r'would generate a 1[0-9][0-9]-character line'),
     ('strict_before_args', module('strict_before_args', "        @assertTrue(.true.)",
@@ -83,6 +87,11 @@ COMPILE = [
     ('strict_relative_no_tol', module('strict_relative_no_tol',
                                       "        @assertRelativelyEqual(1.0_real64, 1.0_real64)"),
      r"no specific subroutine for the generic .assertrelativelyequal."),
+    # pFUnit's suite function names TestMethod (its constructor) next to `use <module>`
+    ('strict_suite_testmethod', module('strict_suite_testmethod', "        @assertTrue(.true.)")
+     .replace('    use funit\n', '    use funit, only: SourceLocation, anyExceptions, assertTrue\n')
+     .replace('contains\n', '    type, public :: TestMethod\n    end type TestMethod\ncontains\n'),
+     r"(ambiguous|TestMethod)"),
     # pFUnit's integer comparisons put a KeywordEnforcer third: the message goes by keyword
     ('strict_int_message', module('strict_int_message', "        @assertLessThan(1, 2, '1 < 2')"),
      r"no specific subroutine for the generic .assertlessthan."),
@@ -144,7 +153,7 @@ class Case:
         self.dir.mkdir(parents=True)
         self.name = name
         self.pf = self.dir / f'{name}.pf'
-        self.pf.write_text(text)
+        self.pf.write_text(text, encoding='utf-8')
 
     def generate(self):
         rc, out = run([sys.executable, str(PF2F90), 'module', str(self.pf),
