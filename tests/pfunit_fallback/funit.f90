@@ -390,7 +390,7 @@ module funit
     public :: less_than_or_equal_to, near, relatively_near, every_item, any_of, all_of
     public :: contains_string, starts_with, ends_with, array_with_size, empty_array
     public :: Is, IsNot, not, IsTrueOrFalse, true, false, AbstractMatcher, MatcherDescription
-    public :: StringDescription
+    public :: StringDescription, IsEqual, IsGreater
 
     !> pFUnit's whitespace option type for string comparisons.
     type :: WhitespaceOptions
@@ -470,6 +470,10 @@ module funit
     end type MatcherDescription
     type :: StringDescription
     end type StringDescription
+    type :: IsEqual
+    end type IsEqual
+    type :: IsGreater
+    end type IsGreater
 
     abstract interface
         subroutine LoadTests_interface()
