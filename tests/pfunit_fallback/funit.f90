@@ -9,10 +9,16 @@
 !>   under pFUnit. The assertions MULTICOR uses are real; the other names are placeholders
 !>   that stop the run if called.
 !>
-!> Assertions follow pFUnit's argument names and rules: `assertRelativelyEqual` needs a
-!> tolerance and fails with 'Zero denominator detected in AssertRelativelyEqual.' when an
-!> expected value is zero; `assertIsFinite` takes a scalar. A failed assertion prints file,
-!> line, expected and actual values, marks the running test as failed, and the test returns.
+!> Assertions follow pFUnit's argument names and rules (src/funit/asserts): `assertRelativelyEqual`
+!> needs a tolerance and fails with 'Zero denominator detected in AssertRelativelyEqual.' when an
+!> expected value is zero; `assertIsFinite` takes a scalar; the integer `assertLessThan` and
+!> `assertGreaterThan` take the message by keyword only (pFUnit's KeywordEnforcer dummy comes
+!> third); the string `assertEqual` names its second argument `found` and ignores leading and
+!> trailing blanks and tabs (pFUnit's default TRIM_ALL); `assertTrue`/`assertFalse` take a
+!> scalar or a rank-1 array (all elements). The fallback is narrower than pFUnit elsewhere (real64
+!> and default integers only, ranks 0 and 1, no mixed kinds), never wider. A failed assertion
+!> prints file, line, expected and actual values, marks the running test as failed, and the test
+!> returns.
 !> `fallback_finish` prints 'N passed, N failed' and stops with a non-zero exit code when a
 !> test failed. The state below is the test harness's own, not physics.
 module funit_fallback_runner
@@ -26,16 +32,30 @@ module funit_fallback_runner
     public :: assertRelativelyEqual, assertIsFinite
 
     integer, parameter :: dp = real64
+    integer, parameter :: tab = 9, blank = 32
     integer :: n_passed = 0
     integer :: n_failed = 0
     logical :: current_failed = .false.
     character(len=:), allocatable :: current_name
+
+    !> pFUnit's KeywordEnforcer: a dummy no caller can pass, placed before the optional
+    !> arguments that pFUnit wants by keyword.
+    type :: keyword_enforcer_t
+    end type keyword_enforcer_t
 
     !> Where an assertion is (pFUnit's `SourceLocation(file, line)`).
     type :: SourceLocation
         character(len=256) :: fileName = '<unknown file>'
         integer :: lineNumber = -1
     end type SourceLocation
+
+    interface assertTrue
+        module procedure true_scalar, true_1d
+    end interface assertTrue
+
+    interface assertFalse
+        module procedure false_scalar, false_1d
+    end interface assertFalse
 
     interface assertEqual
         module procedure equal_real, equal_real_1d, equal_int, equal_int_1d, equal_string
@@ -127,17 +147,21 @@ contains
         real(dp), intent(in), optional :: tolerance
         character(len=*), intent(in), optional :: message
         type(SourceLocation), intent(in), optional :: location
+        real(dp) :: tol
         integer :: i
         if (size(expected) /= size(actual)) then
             call fail(location, 'nonconforming arrays (sizes differ)', message)
             return
         end if
+        tol = 0.0_dp
+        if (present(tolerance)) tol = tolerance
+        ! as pFUnit: exact equality first (Inf == Inf), then |diff| <= tolerance (NaN fails)
         do i = 1, size(expected)
-            call equal_real(expected(i), actual(i), tolerance, message, location)
-            if (current_failed) then
-                write (error_unit, '(4x,a,i0)') 'at index ', i
-                return
-            end if
+            if (actual(i) == expected(i)) cycle
+            if (abs(actual(i) - expected(i)) <= tol) cycle
+            call equal_real(expected(i), actual(i), tol, message, location)
+            write (error_unit, '(4x,a,i0)') 'at index ', i
+            return
         end do
     end subroutine equal_real_1d
 
@@ -162,20 +186,46 @@ contains
             return
         end if
         do i = 1, size(expected)
+            if (expected(i) == actual(i)) cycle
             call equal_int(expected(i), actual(i), message, location)
-            if (current_failed) then
-                write (error_unit, '(4x,a,i0)') 'at index ', i
-                return
-            end if
+            write (error_unit, '(4x,a,i0)') 'at index ', i
+            return
         end do
     end subroutine equal_int_1d
 
-    subroutine equal_string(expected, actual, message, location)
-        character(len=*), intent(in) :: expected, actual
+    !> pFUnit's default (TRIM_ALL): leading and trailing blanks and tabs do not count, the rest
+    !> must be identical (length included). The second argument is `found`, as in pFUnit.
+    subroutine equal_string(expected, found, message, location)
+        character(len=*), intent(in) :: expected, found
         character(len=*), intent(in), optional :: message
         type(SourceLocation), intent(in), optional :: location
-        if (expected /= actual) call fail(location, 'expected "'//expected//'" actual "'//actual//'"', message)
+        character(len=:), allocatable :: e, f
+        e = trim_all(expected)
+        f = trim_all(found)
+        if (len(e) /= len(f)) then
+            call fail(location, 'expected "'//e//'" found "'//f//'"', message)
+        else if (e /= f) then
+            call fail(location, 'expected "'//e//'" found "'//f//'"', message)
+        end if
     end subroutine equal_string
+
+    !> `s` without its leading and trailing blanks and tabs (pFUnit's trimAll).
+    pure function trim_all(s) result(t)
+        character(len=*), intent(in) :: s
+        character(len=:), allocatable :: t
+        integer :: first, last
+        first = 1
+        do while (first <= len(s))
+            if (iachar(s(first:first)) /= blank .and. iachar(s(first:first)) /= tab) exit
+            first = first + 1
+        end do
+        last = len(s)
+        do while (last >= first)
+            if (iachar(s(last:last)) /= blank .and. iachar(s(last:last)) /= tab) exit
+            last = last - 1
+        end do
+        t = s(first:last)
+    end function trim_all
 
     !> pFUnit's rule: no zero expected value (the relative error has no meaning there).
     subroutine rel_equal_real(expected, actual, tolerance, message, location)
@@ -212,27 +262,42 @@ contains
             return
         end if
         do i = 1, size(expected)
+            if (abs(actual(i) - expected(i)) <= tolerance*abs(expected(i))) cycle
             call rel_equal_real(expected(i), actual(i), tolerance, message, location)
-            if (current_failed) then
-                write (error_unit, '(4x,a,i0)') 'at index ', i
-                return
-            end if
+            write (error_unit, '(4x,a,i0)') 'at index ', i
+            return
         end do
     end subroutine rel_equal_real_1d
 
-    subroutine assertTrue(condition, message, location)
+    subroutine true_scalar(condition, message, location)
         logical, intent(in) :: condition
         character(len=*), intent(in), optional :: message
         type(SourceLocation), intent(in), optional :: location
         if (.not. condition) call fail(location, 'expected .true.', message)
-    end subroutine assertTrue
+    end subroutine true_scalar
 
-    subroutine assertFalse(condition, message, location)
+    !> As pFUnit's assertTrue_1d_: fails unless all elements are true.
+    subroutine true_1d(condition, message, location)
+        logical, intent(in) :: condition(:)
+        character(len=*), intent(in), optional :: message
+        type(SourceLocation), intent(in), optional :: location
+        if (.not. all(condition)) call fail(location, 'expected all elements .true.', message)
+    end subroutine true_1d
+
+    subroutine false_scalar(condition, message, location)
         logical, intent(in) :: condition
         character(len=*), intent(in), optional :: message
         type(SourceLocation), intent(in), optional :: location
         if (condition) call fail(location, 'expected .false.', message)
-    end subroutine assertFalse
+    end subroutine false_scalar
+
+    !> As pFUnit's assertFalse_1d_ (assertTrue of .not. condition): fails unless all are false.
+    subroutine false_1d(condition, message, location)
+        logical, intent(in) :: condition(:)
+        character(len=*), intent(in), optional :: message
+        type(SourceLocation), intent(in), optional :: location
+        if (any(condition)) call fail(location, 'expected all elements .false.', message)
+    end subroutine false_1d
 
     subroutine less_real(lhs, rhs, message, location)
         real(dp), intent(in) :: lhs, rhs
@@ -245,8 +310,10 @@ contains
         end if
     end subroutine less_real
 
-    subroutine less_int(lhs, rhs, message, location)
+    !> `unused` is pFUnit's KeywordEnforcer: the message goes by keyword (integers only).
+    subroutine less_int(lhs, rhs, unused, message, location)
         integer, intent(in) :: lhs, rhs
+        type(keyword_enforcer_t), intent(in), optional :: unused
         character(len=*), intent(in), optional :: message
         type(SourceLocation), intent(in), optional :: location
         character(len=100) :: buf
@@ -267,8 +334,10 @@ contains
         end if
     end subroutine greater_real
 
-    subroutine greater_int(lhs, rhs, message, location)
+    !> `unused` is pFUnit's KeywordEnforcer: the message goes by keyword (integers only).
+    subroutine greater_int(lhs, rhs, unused, message, location)
         integer, intent(in) :: lhs, rhs
+        type(keyword_enforcer_t), intent(in), optional :: unused
         character(len=*), intent(in), optional :: message
         type(SourceLocation), intent(in), optional :: location
         character(len=100) :: buf
@@ -287,7 +356,8 @@ contains
 end module funit_fallback_runner
 
 !> What `use funit` gives a test module: pFUnit 4.12's public names (FUnit, its PF_Assert and
-!> FUnit_Core parts, fHamcrest matchers). Names the fallback does not implement are
+!> FUnit_Core parts, the fHamcrest matchers and the types and functions they export, such as
+!> `is`, `not`, `true`, `false`). Names the fallback does not implement are
 !> placeholders (stop the run if called): they are here so that a clash with user code is a
 !> compile error as under pFUnit. `output_unit` is re-exported as pFUnit's FUnit does.
 module funit
@@ -311,11 +381,16 @@ module funit
     ! FUnit_Core
     public :: throw, catchNext, catch, Test, TestSuite, TestMethod, TestCase, TestResult
     public :: TestRunner, ParameterizedTestCase, Expectation, wasCalled, wasNotCalled
-    public :: wasCalledOnce, Disable
+    public :: wasCalledOnce, Disable, BaseTestRunner, RemoteRunner, RobustRunner, TestListener
+    public :: TestListenerVector, ListenerPointer, ResultPrinter, XmlPrinter, DebugListener
+    public :: NameFilter, AbstractTestParameter, ParallelContext, SerialContext, Subject
+    public :: Predicate, TestAnnotation, StringTestAnnotationMap, TimeoutAnnotation, TapListener
     ! fHamcrest
     public :: assert_that, equal_to, greater_than, greater_than_or_equal_to, less_than
     public :: less_than_or_equal_to, near, relatively_near, every_item, any_of, all_of
     public :: contains_string, starts_with, ends_with, array_with_size, empty_array
+    public :: Is, IsNot, not, IsTrueOrFalse, true, false, AbstractMatcher, MatcherDescription
+    public :: StringDescription, IsEqual, IsGreater
 
     !> pFUnit's whitespace option type for string comparisons.
     type :: WhitespaceOptions
@@ -345,6 +420,60 @@ module funit
     end type Expectation
     type :: Disable
     end type Disable
+    type :: BaseTestRunner
+    end type BaseTestRunner
+    type :: RemoteRunner
+    end type RemoteRunner
+    type :: RobustRunner
+    end type RobustRunner
+    type :: TestListener
+    end type TestListener
+    type :: TestListenerVector
+    end type TestListenerVector
+    type :: ListenerPointer
+    end type ListenerPointer
+    type :: ResultPrinter
+    end type ResultPrinter
+    type :: XmlPrinter
+    end type XmlPrinter
+    type :: DebugListener
+    end type DebugListener
+    type :: NameFilter
+    end type NameFilter
+    type :: AbstractTestParameter
+    end type AbstractTestParameter
+    type :: ParallelContext
+    end type ParallelContext
+    type :: SerialContext
+    end type SerialContext
+    type :: Subject
+    end type Subject
+    type :: Predicate
+    end type Predicate
+    type :: TestAnnotation
+    end type TestAnnotation
+    type :: StringTestAnnotationMap
+    end type StringTestAnnotationMap
+    type :: TimeoutAnnotation
+    end type TimeoutAnnotation
+    type :: TapListener
+    end type TapListener
+    type :: Is
+    end type Is
+    type :: IsNot
+    end type IsNot
+    type :: IsTrueOrFalse
+    end type IsTrueOrFalse
+    type :: AbstractMatcher
+    end type AbstractMatcher
+    type :: MatcherDescription
+    end type MatcherDescription
+    type :: StringDescription
+    end type StringDescription
+    type :: IsEqual
+    end type IsEqual
+    type :: IsGreater
+    end type IsGreater
 
     abstract interface
         subroutine LoadTests_interface()
@@ -448,6 +577,18 @@ contains
     subroutine wasCalledOnce()
         call fallback_unsupported('wasCalledOnce')
     end subroutine wasCalledOnce
+
+    subroutine not()
+        call fallback_unsupported('not')
+    end subroutine not
+
+    subroutine true()
+        call fallback_unsupported('true')
+    end subroutine true
+
+    subroutine false()
+        call fallback_unsupported('false')
+    end subroutine false
 
     subroutine assert_that()
         call fallback_unsupported('assert_that')

@@ -12,12 +12,12 @@ generation time what real pFUnit would refuse, at generation or at compile time:
   arguments as pFUnit requires for the variant;
 * the line after ``@before``/``@after`` (comments aside) must be the ``subroutine``
   statement, as pFUnit reads it;
-* test procedure names <= 63 characters (Fortran), module name = file name (pFUnit's
-  registry calls ``<file name>_suite``) and <= 57 characters (pFUnit generates
-  ``<module>_suite`` and ``Wrap<module>``);
+* test procedure names <= 63 characters (Fortran), module name = file name, spelled
+  exactly (pFUnit's registry calls ``<file name>_suite``) and <= 57 characters (pFUnit
+  generates ``<module>_suite`` and ``Wrap<module>``);
 * no code line longer than 132 characters in what pFUnit generates (gfortran's default
-  free-form limit: ``add_pfunit_ctest`` adds no line-length flag); for an assert, the line
-  ``  call assert<Variant>(<arguments>, &`` that pFUnit writes.
+  free-form limit, counted in bytes as gfortran does: ``add_pfunit_ctest`` adds no line-length
+  flag); for an assert, the line ``  call assert<Variant>(<arguments>, &`` that pFUnit writes.
 
 Supported asserts: ``@assertEqual``, ``@assertTrue``, ``@assertFalse``, ``@assertLessThan``,
 ``@assertGreaterThan``, ``@assertRelativelyEqual`` (tolerance required, as in pFUnit),
@@ -26,7 +26,9 @@ Supported asserts: ``@assertEqual``, ``@assertTrue``, ``@assertFalse``, ``@asser
 (funit.f90) exports pFUnit's public names, so a helper named like one of them (``run``...)
 fails to compile as under pFUnit. After the module, a ``<module>_suite`` subroutine uses the
 test module and ``funit`` unrestricted and declares ``suite`` and ``t``, as pFUnit's
-generated suite function does, so the same name clashes fail.
+generated suite function does, so the same name clashes fail. Each test runs as pFUnit's
+``TestCase%runBare`` runs it: the ``@before`` procedure, then, only if it raised nothing, the
+test and the ``@after`` procedure (also after a failed test, never after a failed set-up).
 
 Line numbers are preserved (annotations become blank lines, asserts stay on their line),
 so compiler messages and failure reports point into the ``.pf`` file.
@@ -72,6 +74,11 @@ class PfError(Exception):
 
 def fortran_string(text):
     return "'" + text.replace("'", "''") + "'"
+
+
+def columns(line):
+    """Line length as gfortran counts it: bytes (a UTF-8 'e' with an accent counts 2)."""
+    return len(line.encode('utf-8'))
 
 
 def check_arguments(args, where):
@@ -134,8 +141,8 @@ def parse(path):
                     raise PfError(f"{where}: @assert{variant} is not supported by the fallback")
                 check_arguments(args, where)
                 generated = f"  call assert{variant}({args}, &"
-                if len(generated) > MAX_LINE:
-                    raise PfError(f"{where}: pFUnit would generate a {len(generated)}-character "
+                if columns(generated) > MAX_LINE:
+                    raise PfError(f"{where}: pFUnit would generate a {columns(generated)}-character "
                                   f"line ('  call assert{variant}(..., &'), more than gfortran's "
                                   f"default {MAX_LINE}: shorten the assert")
                 indent = line[:len(line) - len(line.lstrip())]
@@ -157,8 +164,8 @@ def parse(path):
             continue
         if '@assert' in line.lower().split('!')[0]:
             raise PfError(f"{where}: an @assert must stand alone on its line")
-        if len(line) > MAX_LINE:
-            raise PfError(f"{where}: line of {len(line)} characters, more than gfortran's "
+        if columns(line) > MAX_LINE:
+            raise PfError(f"{where}: line of {columns(line)} characters, more than gfortran's "
                           f"default {MAX_LINE} (pFUnit copies it unchanged)")
         m = MODULE.match(line)
         if m and m.group(1).lower() != 'procedure':
@@ -175,9 +182,11 @@ def parse(path):
         raise PfError(f"{base}: @test not followed by a subroutine statement")
     if module is None:
         raise PfError(f"{base}: no module found")
-    if module.lower() != stem.lower():
-        raise PfError(f"{base}: module '{module}' must be named like the file ('{stem}'): "
-                      f"pFUnit's registry calls {stem}_suite")
+    if module != stem:
+        # exact spelling: pFUnit (>= 4.7) refuses a module not named like its file, and the
+        # case rule of that check could not be read in 4.12's source (see the report)
+        raise PfError(f"{base}: module '{module}' must be named exactly like the file "
+                      f"('{stem}'): pFUnit's registry calls {stem}_suite")
     if len(module) > MAX_MODULE:
         raise PfError(f"{base}: module name longer than {MAX_MODULE} characters (pFUnit "
                       f"generates '{module}_suite')")
@@ -200,14 +209,20 @@ def suite_lines(module, tests, befores, afters):
             "    implicit none",
             "    ! as in pFUnit's generated suite function (name clashes fail the same way)",
             "    type(TestSuite) :: suite",
-            "    class(Test), allocatable :: t"]
+            "    class(Test), allocatable :: t",
+            "    ! pFUnit builds each test with the TestMethod constructor",
+            "    type(TestMethod), allocatable :: method"]
+    # pFUnit's TestCase%runBare: set-up; then, only if the set-up raised nothing, the test
+    # and the tear-down (which runs after a failed test too, never after a failed set-up)
     for name in tests:
         text.append(f"    call fallback_start_test('{module}', '{name}')")
         if befores:
             text.append(f"    call {befores[0]}()")
-        text.append(f"    if (.not. anyExceptions()) call {name}()")
+        text.append("    if (.not. anyExceptions()) then")
+        text.append(f"        call {name}()")
         if afters:
-            text.append(f"    call {afters[0]}()")
+            text.append(f"        call {afters[0]}()")
+        text.append("    end if")
         text.append("    call fallback_end_test()")
     text.append(f"end subroutine {module}_suite")
     return text

@@ -31,7 +31,14 @@ def module(name, body, helpers=''):
 GOOD = module('strict_good', "        real(real64) :: x\n        x = 2.0_real64\n"
               "        @assertEqual(2.0_real64, x, tolerance=0.0_real64)\n"
               "        @assertRelativelyEqual(2.0_real64, x, tolerance=1.0e-15_real64)\n"
-              "        @assertTrue(x > 1.0_real64, message='x > 1')")
+              "        @assertTrue(x > 1.0_real64, message='x > 1')\n"
+              # pFUnit accepts these too: logical arrays, the integer comparisons with the
+              # message by keyword, strings compared without leading/trailing blanks and tabs
+              "        @assertTrue([x > 1.0_real64, x < 3.0_real64])\n"
+              "        @assertFalse([x < 1.0_real64, x > 3.0_real64])\n"
+              "        @assertLessThan(1, 2, message='1 < 2')\n"
+              "        @assertGreaterThan(2, 1, message='2 > 1')\n"
+              "        @assertEqual('abc', '  abc ' // achar(9))")
 
 # (name, .pf text, regex the pf2f90 error must match)
 GENERATION = [
@@ -49,6 +56,10 @@ GENERATION = [
         'test_one', 't' * 64), r'longer than 63'),
     ('strict_long_line', module('strict_long_line', "        call sleep(0)" + ' ' * 120 + '; continue'),
      r'more than gfortran'),
+    # gfortran counts bytes: 131 characters, 221 bytes
+    ('strict_long_bytes', module('strict_long_bytes', "    character(len=*), parameter :: s = '"
+                                 + '\u00e9' * 90 + "'\n        @assertTrue(.true.)"),
+     r'more than gfortran'),
     ('strict_long_assert', module('strict_long_assert', "        @assertTrue(" + '.true. .and. ' * 10
                                   + ".true.)"), r'would generate a 1[0-9][0-9]-character line'),
     ('strict_before_args', module('strict_before_args', "        @assertTrue(.true.)",
@@ -59,7 +70,9 @@ GENERATION = [
                                   "    end subroutine set_up\n"),
      r'must be followed by its subroutine statement'),
     ('strict_module_name', module('other_name', "        @assertTrue(.true.)"),
-     r'must be named like the file'),
+     r'must be named exactly like the file'),
+    ('strict_module_case', module('Strict_Module_Case', "        @assertTrue(.true.)"),
+     r'must be named exactly like the file'),
 ]
 
 # (name, .pf text, regex the compiler output must match)
@@ -74,6 +87,26 @@ COMPILE = [
     ('strict_relative_no_tol', module('strict_relative_no_tol',
                                       "        @assertRelativelyEqual(1.0_real64, 1.0_real64)"),
      r"no specific subroutine for the generic .assertrelativelyequal."),
+    # pFUnit's suite function names TestMethod (its constructor) next to `use <module>`
+    ('strict_suite_testmethod', module('strict_suite_testmethod', "        @assertTrue(.true.)")
+     .replace('    use funit\n', '    use funit, only: SourceLocation, anyExceptions, assertTrue\n')
+     .replace('contains\n', '    type, public :: TestMethod\n    end type TestMethod\ncontains\n'),
+     r"(ambiguous|TestMethod)"),
+    # pFUnit's integer comparisons put a KeywordEnforcer third: the message goes by keyword
+    ('strict_int_message', module('strict_int_message', "        @assertLessThan(1, 2, '1 < 2')"),
+     r"no specific subroutine for the generic .assertlessthan."),
+    ('strict_int_message_gt', module('strict_int_message_gt',
+                                     "        @assertGreaterThan(2, 1, '2 > 1')"),
+     r"no specific subroutine for the generic .assertgreaterthan."),
+    # pFUnit's string assertEqual calls its second argument `found`
+    ('strict_string_keyword', module('strict_string_keyword',
+                                     "        @assertEqual('a', actual='a')"),
+     r"no specific subroutine for the generic .assertequal."),
+    # fHamcrest's `true` is public in pFUnit's FUnit module
+    ('strict_helper_true', module('strict_helper_true', "        @assertTrue(true())",
+                                  "    logical function true()\n        true = .true.\n"
+                                  "    end function true\n"),
+     r"(already defined|USE-associated)"),
 ]
 
 # (name, .pf text, regex the run output must match)
@@ -86,6 +119,24 @@ RUN = [
                                        "        @assertRelativelyEqual([1.0_real64, 0.0_real64], "
                                        "[1.0_real64, 0.0_real64], tolerance=1.0e-12_real64)"),
      r'Zero denominator detected in AssertRelativelyEqual\.'),
+    # pFUnit's TestCase%runBare: no tear-down after a failed set-up (the error stop would cut
+    # the summary line; stdout and stderr are joined, hence the order-free look-aheads)
+    ('strict_before_fails', module('strict_before_fails', "        @assertTrue(.true.)",
+                                   "    @before\n    subroutine set_up()\n"
+                                   "        @assertTrue(.false., message='set-up fails')\n"
+                                   "    end subroutine set_up\n"
+                                   "    @after\n    subroutine tear_down()\n"
+                                   "        error stop 3\n    end subroutine tear_down\n"),
+     r'(?=[\s\S]*set-up fails)(?=[\s\S]*0 passed, 1 failed)'),
+    # ... but a tear-down after a failed test
+    ('strict_after_runs', module('strict_after_runs', "        @assertTrue(.false., message='test fails')",
+                                 "    @after\n    subroutine tear_down()\n"
+                                 "        @assertTrue(.false., message='tear-down ran')\n"
+                                 "    end subroutine tear_down\n"),
+     r'(?=[\s\S]*test fails[\s\S]*tear-down ran)(?=[\s\S]*0 passed, 1 failed)'),
+    # TRIM_ALL ignores the ends only: inner blanks count
+    ('strict_string_inner', module('strict_string_inner', "        @assertEqual('a b', 'a  b')"),
+     r'expected "a b" found "a  b"'),
 ]
 
 
@@ -102,7 +153,7 @@ class Case:
         self.dir.mkdir(parents=True)
         self.name = name
         self.pf = self.dir / f'{name}.pf'
-        self.pf.write_text(text)
+        self.pf.write_text(text, encoding='utf-8')
 
     def generate(self):
         rc, out = run([sys.executable, str(PF2F90), 'module', str(self.pf),
