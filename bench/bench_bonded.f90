@@ -135,7 +135,7 @@ contains
         dem%system%solver%max_sweeps = 100000
         dem%system%solver%method = method
         allocate (sys)
-        call build_coupled(run, beam, dem, setup, sys, error)
+        call build_coupled(run, beam, dem, setup, sys, report_line, error)
         if (allocated(error)) then
             write (output_unit, '(a)') 'bench_bonded: '//error%message
             error stop 1
@@ -169,6 +169,13 @@ contains
                 t_total, cpu1 - cpu0
         end if
     end subroutine reference_stack
+
+    !> Lines the set-up announces (a long one), printed as they come.
+    subroutine report_line(line)
+        !> The line.
+        character(len=*), intent(in) :: line
+        write (output_unit, '(a)') line
+    end subroutine report_line
 
     !> Name of a method.
     pure function name(method) result(s)
