@@ -5,7 +5,9 @@
 # where everything runs but the long-horizon unit suites (ctest label long: thousands of
 # coupled steps each, ~20x faster without the run-time checks), which run on the Release
 # build in build/ (the one run.sh uses), with the malformed-deck tests (label baddeck) again,
-# so that the messages do not depend on the build type. Exit code is non-zero on any failure.
+# so that the messages do not depend on the build type. The Release build also compiles the
+# benchmark programs of bench/ (not part of `all`), so that a change of an interface they call
+# cannot leave them broken. Exit code is non-zero on any failure.
 set -uo pipefail
 source "$(cd "$(dirname "$0")" && pwd)/scripts/bootstrap.sh"
 cd "$MULTICOR_ROOT"
@@ -20,6 +22,6 @@ say "Python tests (postproc)"
 say "CTest suites"
 ctest --test-dir build-debug --output-on-failure -j "$(nproc)" -LE long || status=1
 say "Long-horizon unit suites and malformed decks on the Release build (build/)"
-MULTICOR_BUILD_TARGET="multicor long_tests" configure_and_build build Release
+MULTICOR_BUILD_TARGET="multicor long_tests bench" configure_and_build build Release
 ctest --test-dir build --output-on-failure -j "$(nproc)" -L 'baddeck|long' || status=1
 exit $status
