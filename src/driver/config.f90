@@ -11,14 +11,16 @@
 !> (|dx|, |dy| <= 1e-9 line length), otherwise it is an error. Node ids are mapped to
 !> indices 1..n in increasing id order (`beam%node_id(i)` is the deck id of node i).
 module driver_config
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp, i8
     use core_constants, only: relative_roundoff, deg_to_rad
     use core_error, only: error_t, make_input_error
     use core_strings, only: string_t, to_str
     use core_sort, only: sort_index
     use core_timefunc, only: time_function_t, tf_constant, tf_ramp, tf_step, tf_table, tf_harmonic
-    use fem_beam_config, only: beam_config_t, dof_u, dof_w, dof_theta, beam_element_load_t, &
+    use fem_beam_config, only: beam_config_t, beam_section_t, dof_u, dof_w, dof_theta, beam_element_load_t, &
                                load_x, load_y, load_axial, load_transverse
+    use fem_beam_element, only: element_stiffness, element_mass_consistent, element_mass_lumped
     use io_deck, only: deck_t, deck_entry_t
     use driver_run_kind, only: run_kind_of, run_particles
     implicit none
@@ -464,6 +466,7 @@ contains
         integer, allocatable :: order(:)
         integer(i8), allocatable :: keys(:)
         logical, allocatable :: connected(:)
+        type(deck_entry_t), allocatable :: section_list(:)
         integer :: i, k, ne, a, b
         real(wp) :: size_model, length
         ne = size(elements)
@@ -497,6 +500,17 @@ contains
                                           'zero-length element: '// &
                                           'nodes '//to_str(c%node(1))//' and '//to_str(c%node(2))// &
                                           ' are at the same place')
+                    return
+                end if
+                if (.not. representable_element(beam%sections(beam%elem_section(i)), length)) then
+                    section_list = deck%records('beam', 'section')
+                    call make_input_error(error, deck%file, c%line, trim(kw), &
+                                          'element between nodes '//to_str(c%node(1))//' and '// &
+                                          to_str(c%node(2))//' (length '//to_str(length)//' m, section '// &
+                                          to_str(c%section)//'): its stiffness or mass (E A / L, 12 E I / L^3, '// &
+                                          'rho A L, rho A L^3 / 105) overflows or vanishes in double precision '// &
+                                          '(beyond 1.8e308 or below 2.2e-308); check the coordinates and the '// &
+                                          '[beam] section on line '//to_str(section_list(beam%elem_section(i))%line))
                     return
                 end if
                 keys(i) = int(min(a, b), i8)*int(size(beam%x) + 1, i8) + int(max(a, b), i8)
@@ -541,6 +555,25 @@ contains
             end if
         end do
     end subroutine resolve_elements
+
+    !> True when the stiffness and mass matrices of an element of this section and length are
+    !> finite and their diagonal entries above the smallest normal number: a product such as
+    !> E A (area 1e300) or rho A L^3 (coordinates of 1e300) that overflows gives infinite
+    !> entries and a run that stops at step 0 on a NaN acceleration; one that underflows, a
+    !> singular matrix.
+    logical function representable_element(s, length) result(ok)
+        type(beam_section_t), intent(in) :: s
+        real(wp), intent(in) :: length
+        real(wp) :: k(6, 6), m(6, 6), ml(6)
+        integer :: j
+        k = element_stiffness(s%young*s%area, s%young*s%inertia, length)
+        m = element_mass_consistent(s%density*s%area, length)
+        ml = element_mass_lumped(s%density*s%area, length)
+        ok = all(ieee_is_finite(k)) .and. all(ieee_is_finite(m)) .and. all(ieee_is_finite(ml))
+        do j = 1, 3
+            ok = ok .and. k(j, j) >= tiny(1.0_wp) .and. m(j, j) >= tiny(1.0_wp) .and. ml(j) >= tiny(1.0_wp)
+        end do
+    end function representable_element
 
     !> The deck's [functions] (for models other than the beam, e.g. the continuum): the
     !> functions in file order and their deck ids, checked as for the beam's loads.
