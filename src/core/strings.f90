@@ -8,7 +8,7 @@ module core_strings
     private
     public :: string_t, to_lower, strip, is_blank_char, split_words, join_words
     public :: levenshtein, closest_match, parse_real, parse_int, to_str, shorten, max_echo, is_real_syntax
-    public :: gib, counted
+    public :: gib, counted, sci_to_str
 
     !> Longest token echoed whole in a message (see `shorten`).
     integer, parameter :: max_echo = 40
@@ -438,6 +438,29 @@ contains
             text = mantissa//'e'//int_to_str(expo)
         end if
     end function real_to_str
+
+    !> Real in scientific notation with `decimals` digits after the point and a two-digit
+    !> exponent, or three digits where the exponent needs them: '5.000E-03', '1.000E+300'.
+    !> (A plain `esw.d` edit descriptor drops the letter E of a three-digit exponent and
+    !> writes '1.000+300'.)
+    function sci_to_str(x, decimals) result(text)
+        !> The real.
+        real(wp), intent(in) :: x
+        !> Digits after the decimal point.
+        integer, intent(in) :: decimals
+        character(len=:), allocatable :: text
+        character(len=60) :: buf, fmt
+        integer :: e_pos
+        if (.not. ieee_is_finite(x)) then
+            text = real_to_str(x)
+            return
+        end if
+        write (fmt, '(a,i0,a,i0,a)') '(es', decimals + 10, '.', decimals, 'e3)'
+        write (buf, fmt) x
+        text = trim(adjustl(buf))
+        e_pos = index(text, 'E')
+        if (text(e_pos + 2:e_pos + 2) == '0') text = text(:e_pos + 1)//text(e_pos + 3:)
+    end function sci_to_str
 
     !> A number of bytes in GiB with two decimals, e.g. '1.50 GiB', '0.25 GiB'.
     function gib(bytes) result(text)

@@ -19,6 +19,7 @@ module coupling_multiplier_space
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
+    use core_strings, only: sci_to_str
     use core_linalg, only: dense_spd_t, symmetrize
     implicit none
     private
@@ -214,7 +215,6 @@ contains
         type(dense_spd_t) :: am
         real(wp), allocatable :: p(:, :)
         real(wp) :: rcond
-        character(len=32) :: buf, limit
         associate (pi => self%pi)
             call am%init(self%n_mult)
             am%a = matmul(pi, matmul(a%a, transpose(pi)))
@@ -233,11 +233,9 @@ contains
             ! 2.7e-9 m/s, 1000 m (1.3e-20) blows up (disks through each other at step 15).
             rcond = am%rcond()
             if (rcond < epsilon(1.0_wp)) then
-                write (buf, '(es9.2)') rcond
-                write (limit, '(es9.2)') epsilon(1.0_wp)
                 call make_error(error, 'coupling: multipliers = nodes: A_m = Pi A Pi^T is singular to '// &
-                                'working precision (reciprocal condition number '//trim(adjustl(buf))// &
-                                ', below machine epsilon '//trim(adjustl(limit))//')')
+                                'working precision (reciprocal condition number '//sci_to_str(rcond, 2)// &
+                                ', below machine epsilon '//sci_to_str(epsilon(1.0_wp), 2)//')')
                 return
             end if
             p = pi

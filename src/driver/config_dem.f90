@@ -16,7 +16,7 @@ module driver_config_dem
     use core_kinds, only: wp, i8
     use core_constants, only: deg_to_rad, pi
     use core_error, only: error_t, make_input_error
-    use core_strings, only: string_t, to_str
+    use core_strings, only: string_t, to_str, sci_to_str
     use core_timefunc, only: time_function_t
     use io_deck, only: deck_t, deck_entry_t
     use io_deck_schema, only: parse_selection
@@ -850,14 +850,12 @@ contains
         end associate
     end subroutine check_overlaps
 
-    !> A length with 4 significant digits, e.g. '5.000E-03'.
-    pure function length_text(x) result(text)
+    !> A length with 4 significant digits, e.g. '5.000E-03' ('1.000E+300').
+    function length_text(x) result(text)
         !> The length [m].
         real(wp), intent(in) :: x
         character(len=:), allocatable :: text
-        character(len=16) :: buf
-        write (buf, '(es10.3)') x
-        text = trim(adjustl(buf))
+        text = sci_to_str(x, 3)
     end function length_text
 
     !> Error for a record whose `function` value is the id of no time function.
