@@ -30,7 +30,7 @@ module driver_config_dem
     use dem_walls, only: walls_add
     use dem_materials, only: materials_init, materials_set_pair, materials_set_bond, bond_e_default
     use dem_contacts, only: contact_set_t
-    use dem_detection, only: detector_t, detect_contacts
+    use dem_detection, only: detector_t, detect_contacts, coordinate_limit
     use dem_moreau_jean, only: dem_system_t
     use dem_nlgs, only: nlgs_method_nlgs, nlgs_method_block, nlgs_method_coarse, criterion_lmgc90, criterion_siconos
     use driver_config, only: run_config_t, repeated_dof
@@ -99,6 +99,8 @@ contains
         call build_materials(deck, cfg, density, error)
         if (allocated(error)) return
         call build_disks(deck, density, cfg, error)
+        if (allocated(error)) return
+        call check_disk_coordinates(deck, cfg, error)
         if (allocated(error)) return
         cfg%system%particles%functions = functions
         cfg%system%walls%functions = functions
@@ -347,7 +349,44 @@ contains
         end subroutine generate
     end subroutine build_disks
 
-    !> Walls: 4, 5, 7 or 8 values; known material and function; non-zero length.
+    !> Disk centres must lie in the box the contact detection can represent
+    !> (dem_detection::coordinate_limit); checked before anything else uses them (the walls'
+    !> lengths are compared with the size of the model).
+    subroutine check_disk_coordinates(deck, cfg, error)
+        !> The deck (for messages).
+        type(deck_t), intent(in) :: deck
+        !> The model (disks and disk_line filled).
+        type(dem_config_t), intent(in) :: cfg
+        !> Set when a disk lies beyond the box.
+        type(error_t), allocatable, intent(out) :: error
+        real(wp) :: limit
+        integer :: k
+        associate (p => cfg%system%particles)
+            if (p%n == 0) return
+            limit = coordinate_limit(minval(p%radius(1:p%n)))
+            do k = 1, p%n
+                if (max(abs(p%x(k)), abs(p%y(k))) <= limit) cycle
+                call make_input_error(error, deck%file, cfg%disk_line(k), '', 'disk '// &
+                                      to_str(k)//' at ('//num(p%x(k))//', '//num(p%y(k))// &
+                                      ') m lies beyond the box the run can represent: |x|, |y| <= '// &
+                                      num(limit)//' m (4.5e9 times the smallest radius, at most '// &
+                                      '1e100 m; coordinates are then known to 1e-6 of the radius)')
+                return
+            end do
+        end associate
+    end subroutine check_disk_coordinates
+
+    !> A real with 3 significant digits and a three-digit exponent, e.g. '4.500E+009'.
+    function num(x) result(text)
+        real(wp), intent(in) :: x
+        character(len=:), allocatable :: text
+        character(len=24) :: buf
+        write (buf, '(es11.3e3)') x
+        text = trim(adjustl(buf))
+    end function num
+
+    !> The walls, each of 4, 5, 7 or 8 values, with a known material and function, inside the
+    !> box the contact detection can represent, and of non-zero length.
     subroutine build_walls(deck, function_ids, cfg, error)
         !> The deck.
         type(deck_t), intent(in) :: deck
@@ -358,12 +397,13 @@ contains
         !> Error, if any.
         type(error_t), allocatable, intent(out) :: error
         type(deck_entry_t), allocatable :: list(:)
-        real(wp) :: vx, vy, length, size_model
+        real(wp) :: vx, vy, length, size_model, limit
         character(len=:), allocatable :: message
         integer :: i, mat, func
         allocate (list, source=deck%records('walls', 'wall'))
         allocate (cfg%wall_line(size(list)))
         size_model = model_size(cfg, list)
+        limit = coordinate_limit(minval(cfg%system%particles%radius(1:cfg%system%particles%n)))
         do i = 1, size(list)
             associate (e => list(i))
                 cfg%wall_line(i) = e%line
@@ -392,6 +432,15 @@ contains
                         call unknown_function(deck, e, error)
                         return
                     end if
+                end if
+                ! Before the length: an end far out makes the model so large that the other
+                ! walls would be blamed for their length.
+                if (max(abs(e%real('x1')), abs(e%real('y1')), abs(e%real('x2')), abs(e%real('y2'))) > limit) then
+                    call make_input_error(error, deck%file, e%line, 'wall', 'wall '// &
+                                          to_str(i)//' has an end beyond the box the run can represent: '// &
+                                          '|x|, |y| <= '//num(limit)//' m (4.5e9 times the smallest '// &
+                                          'disk radius, at most 1e100 m): shorten it')
+                    return
                 end if
                 length = hypot(e%real('x2') - e%real('x1'), e%real('y2') - e%real('y1'))
                 if (length <= 1.0e-9_wp*size_model) then

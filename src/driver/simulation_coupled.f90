@@ -21,7 +21,6 @@ module driver_simulation_coupled
     use driver_results_coupled, only: write_beam_overlap
     use driver_guards, only: check_beam_state
     use driver_simulation, only: report_iface
-    use driver_simulation_dem, only: check_dem_coordinates
     use driver_coupled_loop, only: arlequin_simulation_t
     implicit none
     private
@@ -77,8 +76,6 @@ contains
         call build_config(deck, self%settings, self%beam, error)
         if (allocated(error)) return
         call build_dem_config(deck, self%settings, self%beam%functions, self%dem, error)
-        if (allocated(error)) return
-        call check_dem_coordinates(deck, self%dem, error)
         if (allocated(error)) return
         do i = 1, size(self%dem%warnings)
             call report(self%dem%warnings(i)%s)

@@ -1,11 +1,9 @@
 !> Particle (Contact Dynamics) runs: a [particles] deck without [beam].
 module driver_simulation_dem
-    use core_kinds, only: wp
-    use core_error, only: error_t, make_input_error
+    use core_error, only: error_t
     use core_strings, only: counted, to_str
     use io_deck, only: deck_t
     use fem_beam_config, only: beam_config_t
-    use dem_detection, only: coordinate_limit
     use driver_config, only: run_config_t, build_config
     use driver_config_dem, only: dem_config_t, build_dem_config
     use driver_run_dem, only: run_dem
@@ -14,7 +12,7 @@ module driver_simulation_dem
     use driver_simulation, only: simulation_t, report_iface
     implicit none
     private
-    public :: dem_simulation_t, check_dem_coordinates
+    public :: dem_simulation_t
 
     !> A run of rigid disks and walls.
     type, extends(simulation_t) :: dem_simulation_t
@@ -50,8 +48,6 @@ contains
         if (allocated(error)) return
         call build_dem_config(deck, self%settings, self%beam%functions, self%dem, error)
         if (allocated(error)) return
-        call check_dem_coordinates(deck, self%dem, error)
-        if (allocated(error)) return
         do i = 1, size(self%dem%warnings)
             call report(self%dem%warnings(i)%s)
         end do
@@ -83,48 +79,6 @@ contains
         type(error_t), allocatable, intent(out) :: error
         call run_dem(self%settings, self%dem, out, quiet, report, ck, error)
     end subroutine dem_run
-
-    !> Disks and walls must lie in the box the contact detection can represent.
-    subroutine check_dem_coordinates(deck, dem, error)
-        !> The deck (for messages).
-        type(deck_t), intent(in) :: deck
-        !> The particle configuration.
-        type(dem_config_t), intent(in) :: dem
-        !> Set when a disk or a wall end lies beyond the box.
-        type(error_t), allocatable, intent(out) :: error
-        real(wp) :: limit
-        integer :: k
-        associate (p => dem%system%particles, w => dem%system%walls)
-            if (p%n == 0) return
-            limit = coordinate_limit(minval(p%radius(1:p%n)))
-            do k = 1, p%n
-                if (max(abs(p%x(k)), abs(p%y(k))) <= limit) cycle
-                call make_input_error(error, deck%file, dem%disk_line(k), '', 'disk '// &
-                                      to_str(k)//' at ('//num(p%x(k))//', '//num(p%y(k))// &
-                                      ') m lies beyond the box the run can represent: |x|, |y| <= '// &
-                                      num(limit)//' m (4.5e9 times the smallest radius, at most '// &
-                                      '1e100 m; coordinates are then known to 1e-6 of the radius)')
-                return
-            end do
-            do k = 1, w%n
-                if (max(abs(w%x1(k)), abs(w%y1(k)), abs(w%x2(k)), abs(w%y2(k))) <= limit) cycle
-                call make_input_error(error, deck%file, dem%wall_line(k), 'wall', 'wall '// &
-                                      to_str(k)//' has an end beyond the box the run can represent: '// &
-                                      '|x|, |y| <= '//num(limit)//' m (4.5e9 times the smallest '// &
-                                      'disk radius, at most 1e100 m): shorten it')
-                return
-            end do
-        end associate
-    end subroutine check_dem_coordinates
-
-    !> A real with 3 significant digits.
-    function num(x) result(text)
-        real(wp), intent(in) :: x
-        character(len=:), allocatable :: text
-        character(len=24) :: buf
-        write (buf, '(es11.3e3)') x
-        text = trim(adjustl(buf))
-    end function num
 
     !> 'particles'.
     function dem_checkpoint_kind(self) result(kind)
