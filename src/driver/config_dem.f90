@@ -13,6 +13,7 @@
 !> The model types of the DEM library (particles_t, walls_t, materials_t) are plain data, so
 !> they are filled directly: `dem_config_t%system` is ready for `mj_init`.
 module driver_config_dem
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp, i8
     use core_constants, only: deg_to_rad, pi
     use core_error, only: error_t, make_input_error
@@ -498,13 +499,14 @@ contains
         type(dem_config_t), intent(inout) :: cfg
         !> Error, if any.
         type(error_t), allocatable, intent(out) :: error
-        integer, allocatable :: state(:, :), line(:, :)
+        integer, allocatable :: state(:, :), line(:, :), velocity_line(:)
         integer :: i, pass
         associate (n => cfg%system%particles%n)
-            allocate (state(3, n), line(3, n))
+            allocate (state(3, n), line(3, n), velocity_line(n))
         end associate
         state = free
         line = 0
+        velocity_line = 0
         do pass = 1, 2
             do i = 1, size(deck%entries)
                 associate (e => deck%entries(i))
@@ -521,8 +523,42 @@ contains
                 end associate
             end do
         end do
+        call check_kinetic_energy()
 
     contains
+
+        !> The initial velocities' kinetic energy, disk by disk and in total, must be finite:
+        !> a speed of 1e160 m/s (or a finite speed with a huge density) stopped the run at its
+        !> initial state on an energy account that is not finite, blaming the forces or the time
+        !> step. The error names the record that set the velocity of the disk with the largest
+        !> energy.
+        subroutine check_kinetic_energy()
+            real(wp), allocatable :: energy(:)
+            integer :: j
+            associate (p => cfg%system%particles)
+                if (p%n == 0) return
+                energy = 0.5_wp*(p%mass(1:p%n)*(p%vx(1:p%n)**2 + p%vy(1:p%n)**2) + p%inertia(1:p%n)*p%w(1:p%n)**2)
+                if (ieee_is_finite(sum(energy))) return
+                j = maxloc(energy, dim=1, mask=.not. ieee_is_finite(energy))
+                if (j == 0) j = maxloc(energy, dim=1)
+                call make_input_error(error, deck%file, velocity_line(j), deck_keyword_at(velocity_line(j)), &
+                                      'the kinetic energy of the initial velocities is beyond the range of '// &
+                                      'double precision: disk '//to_str(j)//' (mass '//to_str(p%mass(j))// &
+                                      ' kg/m) starts at ('//to_str(p%vx(j))//', '//to_str(p%vy(j))//') m/s and '// &
+                                      to_str(p%w(j))//' rad/s; check the velocities (and the densities)')
+            end associate
+        end subroutine check_kinetic_energy
+
+        !> Keyword of the [particles] record on a deck line.
+        function deck_keyword_at(at) result(keyword)
+            integer, intent(in) :: at
+            character(len=:), allocatable :: keyword
+            integer :: k
+            keyword = ''
+            do k = 1, size(deck%entries)
+                if (deck%entries(k)%line == at) keyword = deck%entries(k)%keyword
+            end do
+        end function deck_keyword_at
 
         !> Selected disks of a record, as a range; error set when the selection is invalid.
         subroutine select_disks(e, first, last)
@@ -616,6 +652,7 @@ contains
                     call particles_add_load(cfg%system%particles, j, dof, e%real('value'), error, func)
                     if (allocated(error)) return
                 else
+                    velocity_line(j) = e%line
                     select case (dof)
                     case (dof_x)
                         cfg%system%particles%vx(j) = e%real('value')
@@ -648,6 +685,7 @@ contains
                             return
                         end if
                     end do
+                    velocity_line(j) = e%line
                     if (state(dof_x, j) == free) p%vx(j) = v(1)
                     if (state(dof_y, j) == free) p%vy(j) = v(2)
                     if (state(dof_rot, j) == free) p%w(j) = v(3)

@@ -6,6 +6,7 @@ module driver_simulation_beam
     use core_constants, only: two_pi
     use core_error, only: error_t, make_error, make_input_error
     use core_signals, only: caught_signal, signal_name
+    use core_strings, only: to_str
     use io_deck, only: deck_t
     use io_progress, only: progress_t
     use fem_beam_config, only: beam_config_t
@@ -22,7 +23,7 @@ module driver_simulation_beam
     use driver_simulation, only: simulation_t, report_iface
     implicit none
     private
-    public :: beam_simulation_t
+    public :: beam_simulation_t, check_initial_energy
 
     !> A planar frame run.
     type, extends(simulation_t) :: beam_simulation_t
@@ -84,6 +85,8 @@ contains
             end if
         end if
         if (self%settings%analysis == 'dynamic') then
+            call check_initial_energy(deck, self%settings, self%model, error)
+            if (allocated(error)) return
             call make_integrator(self%settings, self%model, self%integ, error)
             if (allocated(error)) then
                 ! The integrator refuses a time step (stability limit, round-off), or a model
@@ -133,6 +136,43 @@ contains
                              error)
         end select
     end subroutine beam_run
+
+    !> The kinetic energy 1/2 v.M v of the [initial] velocities and the strain energy
+    !> 1/2 u.K u of the [initial] displacements must be finite: a velocity of 1e300 m/s or a
+    !> displacement of 1e300 m stopped the run at step 0 on a value that is not finite.
+    subroutine check_initial_energy(deck, run, model, error)
+        !> The deck (for messages).
+        type(deck_t), intent(in) :: deck
+        !> Run settings (initial displacements and velocities).
+        type(run_config_t), intent(in) :: run
+        !> The beam model (weighted in a coupled run).
+        type(beam_model_t), intent(in) :: model
+        !> Set when an energy is not finite.
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: u0(:), v0(:)
+        character(len=:), allocatable :: keyword
+        integer :: at
+        call model%restrict(run%v0, v0)
+        if (.not. ieee_is_finite(model%kinetic_energy(v0))) then
+            keyword = 'velocity'
+            at = deck%line('initial', 'velocity')
+            if (at == 0) then
+                keyword = 'rigid'
+                at = deck%line('initial', 'rigid')
+            end if
+            call make_input_error(error, deck%file, at, keyword, 'the kinetic energy 1/2 v.M v of the [initial] '// &
+                                  'velocities is beyond the range of double precision (largest velocity '// &
+                                  to_str(maxval(abs(v0)))//'): check their values (and the sections'' densities)')
+            return
+        end if
+        call model%restrict(run%u0, u0)
+        if (.not. ieee_is_finite(model%strain_energy(u0))) then
+            call make_input_error(error, deck%file, deck%line('initial', 'displacement'), 'displacement', &
+                                  'the strain energy 1/2 u.K u of the [initial] displacements is beyond the range '// &
+                                  'of double precision (largest displacement '//to_str(maxval(abs(u0)))// &
+                                  '): check their values (and the sections'' stiffness)')
+        end if
+    end subroutine check_initial_energy
 
     !> Build the time integrator the deck asks for (refuses an unstable explicit step).
     subroutine make_integrator(run, model, integ, error)

@@ -390,6 +390,15 @@ contains
             do c = 1, size(eq)
                 if (eq(c) > 0) v0(eq(c)) = v_all(c)
             end do
+            ! A speed whose kinetic energy overflows would stop the run at its initial state,
+            ! on an energy that is not finite, blaming loads or moduli.
+            if (.not. ieee_is_finite(self%ops%kinetic_energy(v0))) then
+                call make_input_error(error, deck%file, e%line, 'initial_velocity', 'the kinetic energy '// &
+                                      '1/2 v.M v of this initial velocity is beyond the range of double precision '// &
+                                      '(largest nodal speed '//to_str(maxval(abs(v_all)))//' m/s): check vx, vy '// &
+                                      'and omega, and the densities of [continuum] material')
+                return
+            end if
             select case (self%settings%scheme)
             case ('central_difference')
                 allocate (central_difference_t :: self%integ)

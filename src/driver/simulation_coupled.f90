@@ -21,6 +21,7 @@ module driver_simulation_coupled
     use driver_results_coupled, only: write_beam_overlap
     use driver_guards, only: check_beam_state
     use driver_simulation, only: report_iface
+    use driver_simulation_beam, only: check_initial_energy
     use driver_coupled_loop, only: arlequin_simulation_t
     implicit none
     private
@@ -101,6 +102,8 @@ contains
             return
         end if
         self%model = coupled_beam(self%sys)
+        call check_initial_energy(deck, self%settings, self%model, error)
+        if (allocated(error)) return
         self%fclib_step = self%dem%fclib_step
     end subroutine coupled_init
 
