@@ -171,7 +171,13 @@ contains
         integer, allocatable :: first_line(:), section_line(:)
         character(len=:), allocatable :: current, text
         integer :: n, line_no, start, lf
+        ! Line of the last header while no keyword has followed it, and the first header
+        ! found with no keyword before the next header or the end (0: none).
+        integer :: open_header, empty_header
+        character(len=:), allocatable :: open_name, empty_name
         text = normalized_text(raw_text)
+        open_header = 0
+        empty_header = 0
         deck%file = file
         deck%text = text
         deck%schema = schema
@@ -195,6 +201,7 @@ contains
             if (allocated(error)) return
             start = lf + 1
         end do
+        call close_header()
         deck%entries = entries(:n)
         if (n == 0) then
             call make_input_error(error, file, 0, '', 'the deck is empty (no keyword found); '// &
@@ -203,9 +210,23 @@ contains
         end if
         call check_required(deck, first_line, section_line, error)
         if (allocated(error)) return
-        call check_empty_sections(deck, section_line, error)
+        ! A header followed by no keyword would have no effect (a deck of beams with an empty
+        ! [particles] is still a deck of beams, a second [beam] header with nothing under it
+        ! adds nothing), and is most likely what is left of a section the user meant to fill.
+        if (empty_header > 0) call make_input_error(error, file, empty_header, '', '['//empty_name// &
+                                                    '] has no keyword: give its keywords or remove the header')
 
     contains
+
+        !> A new header or the end of the deck: the previous header, if no keyword followed it,
+        !> is empty.
+        subroutine close_header()
+            if (open_header > 0 .and. empty_header == 0) then
+                empty_header = open_header
+                empty_name = open_name
+            end if
+            open_header = 0
+        end subroutine close_header
 
         !> A control character (other than a tab, or the CR of CR LF) outside a comment is an error: a terminal
         !> would not show it in the message, and it means a binary or damaged file.
@@ -292,6 +313,7 @@ contains
             call check_values(schema%keywords(k), tokens, file, line_no, error)
             if (allocated(error)) return
             if (first_line(k) == 0) first_line(k) = line_no
+            open_header = 0
             if (n == size(entries)) then
                 allocate (grown(2*n))
                 grown(:n) = entries
@@ -336,6 +358,9 @@ contains
             end if
             current = name
             if (section_line(k) == 0) section_line(k) = line_no
+            call close_header()
+            open_header = line_no
+            open_name = name
         end subroutine parse_header
     end subroutine read_deck_text
 
@@ -533,26 +558,6 @@ contains
     end subroutine check_values
 
     !> Check required and conditional keywords once the whole deck is read.
-    !> Error for a section header followed by no keyword: the header would have no effect
-    !> (a deck of beams with an empty [particles] is still a deck of beams), and is most
-    !> likely what is left of a section the user meant to fill.
-    subroutine check_empty_sections(deck, section_line, error)
-        !> The deck (entries filled).
-        type(deck_t), intent(in) :: deck
-        !> First header line of each schema section (0 if absent).
-        integer, intent(in) :: section_line(:)
-        !> Error naming the header's line, if any.
-        type(error_t), allocatable, intent(out) :: error
-        integer :: k
-        do k = 1, size(deck%schema%sections)
-            if (section_line(k) == 0) cycle
-            if (deck%has_section(deck%schema%sections(k)%name)) cycle
-            call make_input_error(error, deck%file, section_line(k), '', '['//deck%schema%sections(k)%name// &
-                                  '] has no keyword: give its keywords or remove the header')
-            return
-        end do
-    end subroutine check_empty_sections
-
     subroutine check_required(deck, first_line, section_line, error)
         !> The deck (entries filled).
         type(deck_t), intent(in) :: deck
