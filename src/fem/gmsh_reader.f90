@@ -21,7 +21,7 @@
 module fem_gmsh_reader
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_input_error
-    use core_strings, only: string_t, split_words, parse_real
+    use core_strings, only: string_t, split_words, parse_real, to_str
     use core_sort, only: sort_index, sort_in_place
     use fem_mesh2d, only: mesh2d_t, element_t3, element_q4
     implicit none
@@ -448,7 +448,9 @@ contains
 
     !> $Nodes: blocks of tags then coordinates; xtag(:, tag - min_tag + 1) = (x, y), -huge when
     !> the tag is unused. The header's node count must be the blocks' total, a tag must appear
-    !> once, and coordinates must be finite numbers.
+    !> once, and coordinates must be finite numbers. The mesh is planar in (x, y): every node
+    !> has the z of the first within 1e-9 of the extent in (x, y) (z is dropped; a mesh drawn
+    !> in another plane, or a node moved out of the plane, would be silently flattened).
     subroutine read_nodes(cur, xtag, min_tag, error)
         type(cursor_t), intent(inout) :: cur
         real(wp), allocatable, intent(out) :: xtag(:, :)
@@ -459,9 +461,15 @@ contains
         type(cursor_t) :: header
         integer :: head(4), bh(4), b, k, i, total, n_words
         integer, allocatable :: tags(:)
-        real(wp) :: xyz(3), value
-        logical :: ok
+        real(wp) :: xyz(3), value, z0, z_off, lo(2), hi(2)
+        type(cursor_t) :: off_plane
+        logical :: ok, have_z0
         character(len=64) :: buf
+        z_off = 0.0_wp
+        z0 = 0.0_wp
+        have_z0 = .false.
+        lo = huge(1.0_wp)
+        hi = -huge(1.0_wp)
         call section_line(cur, text, error)
         if (allocated(error)) return
         call read_ints(cur, text, 4, head, error)
@@ -542,12 +550,26 @@ contains
                     return
                 end if
                 xtag(:, tags(k) - min_tag + 1) = xyz(1:2)
+                lo = min(lo, xyz(1:2))
+                hi = max(hi, xyz(1:2))
+                if (.not. have_z0) z0 = xyz(3)
+                have_z0 = .true.
+                if (abs(xyz(3) - z0) > z_off) then
+                    z_off = abs(xyz(3) - z0)
+                    off_plane = cur
+                end if
             end do
             deallocate (tags)
         end do
         if (total /= head(2)) then
             write (buf, '(i0,a,i0)') head(2), ' nodes, its blocks hold ', total
             call fail(header, error, 'the header gives '//trim(buf))
+            return
+        end if
+        if (z_off > 1.0e-9_wp*hypot(hi(1) - lo(1), hi(2) - lo(2))) then
+            call fail(off_plane, error, 'this node lies off the plane z = '//to_str(z0)// &
+                      ' of the first node (by '//to_str(z_off)//'): a 2D mesh lies in a plane parallel '// &
+                      'to (x, y), its z is dropped')
         end if
     end subroutine read_nodes
 
