@@ -89,6 +89,11 @@ contains
                 if (rc == 0 .and. len(created) == 0) created = path(:i - 1)
             end if
         end do
+        ! A file of that name is in the way (its '.' does not exist): the lock file or the
+        ! results inside it would fail with a less telling 'Not a directory'.
+        if (.not. file_exists(trim(path)//'/.')) &
+            call make_error(error, "cannot use '"//trim(path)//"' as the results folder: it exists and is not a "// &
+                            'folder (give --output another name, or move that file)')
     end subroutine mkdir_p
 
     !> Undo `mkdir_p` where nothing was put in the folders it created: remove `path` and its

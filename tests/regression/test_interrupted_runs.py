@@ -9,7 +9,7 @@ killed or signalled. The '.partial' file must open in h5py and h5dump, say finis
 at the same steps; an earlier finished result in the same folder must stay untouched. A file
 size limit (RLIMIT_FSIZE, as `ulimit -f`, unprivileged) and, where root can mount one, a
 full 512 KiB tmpfs: the run must stop with a clear error at the write and exit code 1, not
-crash.
+crash. An --output that names a file: exit 1 saying so, the file untouched.
 Usage (ctest does this): test_interrupted_runs.py --exe multicor --work DIR --source REPO
 """
 import argparse
@@ -279,6 +279,21 @@ def full_disk(exe, src, work):
         subprocess.run(["umount", str(mnt)], capture_output=True)
 
 
+def output_is_a_file(exe, src, work):
+    """--output naming an existing regular file: exit 1 with a message saying so (it was
+    'cannot create the lock file ...: Not a directory'), the file untouched."""
+    path = work / "a_file"
+    path.write_text("not a folder\n")
+    deck = deck_with_end(src / "input" / "cantilever.dat", work / "file_beam.dat", 0.001)
+    proc = subprocess.run([str(exe), str(deck), "--output", str(path), "--quiet"],
+                          capture_output=True, text=True, timeout=300)
+    check("output is a file: exit code 1", proc.returncode == 1,
+          f"exit {proc.returncode}: {proc.stderr.strip()[-300:]}")
+    check("output is a file: the message says so", "it exists and is not a folder" in proc.stderr,
+          proc.stderr.strip()[-300:])
+    check("output is a file: the file untouched", path.read_text() == "not a folder\n", "")
+
+
 def write_failure_checks(name, proc):
     err = proc.stderr
     check(f"{name}: exit code 1 (no crash)", proc.returncode == 1,
@@ -305,6 +320,7 @@ def main():
     stop_by_signal(exe, src, work, "bending_case2.dat", signal.SIGINT, "int_coupled")
     write_error(exe, src, work)
     full_disk(exe, src, work)
+    output_is_a_file(exe, src, work)
     sys.exit(summary())
 
 
