@@ -549,8 +549,8 @@ contains
             if (.not. ok) then
                 message = "expected a real number, got '"//shorten(token)//"'"
                 ! a number of the right form out of the range read (parse_real)
-                if (is_real_syntax(token)) message = "expected a real number between 1e-307 and 1e308 in "// &
-                                                     "magnitude (or 0), got '"//shorten(token)//"'"
+                if (is_real_syntax(token)) message = "expected a real number with 1e-307 <= |x| < 1e308 "// &
+                                                     "(or 0), got '"//shorten(token)//"'"
                 return
             end if
         case (field_word)
