@@ -166,14 +166,17 @@ contains
                            'sweeps as with `nlgs`, and says so in a warning). Every '// &
                            'unilateral or frictional contact uses the bi-potential local solver in all three.', &
                            default='block')
-        call s%add_keyword('solver', 'tolerance', [positive('tolerance', '')], &
+        call s%add_keyword('solver', 'tolerance', [real_field('tolerance', '', lower=0.0_wp, upper=1.0_wp, &
+                                                              lower_strict=.true., upper_strict=.true.)], &
                            'Convergence of the sweeps: change of the local velocities over a sweep relative '// &
                            'to W r (quadratic mean over the active contacts).', default='1.666e-4')
         call s%add_keyword('solver', 'max_sweeps', [int_field('max_sweeps', lower=1)], &
                            'Largest number of sweeps per step (with `method = block`: block iterations, each a '// &
                            'direct solve of the bonds and a sweep over the other contacts); a step that reaches '// &
                            'it without converging is reported (warning) and counted.', default='1000')
-        call s%add_keyword('solver', 'local_tolerance', [positive('local_tolerance', '')], &
+        call s%add_keyword('solver', 'local_tolerance', [real_field('local_tolerance', '', lower=0.0_wp, &
+                                                                    upper=1.0_wp, lower_strict=.true., &
+                                                                    upper_strict=.true.)], &
                            'Relative tolerance of the local prediction-correction iterations of one contact.', &
                            default='1e-10')
         call s%add_keyword('solver', 'local_iterations', [int_field('local_iterations', lower=1)], &
