@@ -128,6 +128,8 @@ contains
         call build_element_grid(model%mesh, grid)
         call check_fe_zone(error)
         if (allocated(error)) return
+        call check_particle_sides(error)
+        if (allocated(error)) return
         if (size(sys%coupled) == 0) then
             call make_error(error, 'coupling: no disk centre lies in the overlap: nothing to couple; check the '// &
                             'overlap region against the positions of the disks')
@@ -170,6 +172,64 @@ contains
                 return
             end do
         end subroutine check_fe_zone
+
+        !> Error for a particle-side edge along which the continuum goes on outside every
+        !> region: alpha would jump there from alpha_min to 1 (the FE-only zone), the disks'
+        !> weight from 1 - alpha_min to 0. The FE and particle sides swapped (a box with
+        !> `right left` for `left right`) gave such a jump and was accepted. Probes at 9 points
+        !> along each particle edge, just outside the region (beyond its boundary tolerance).
+        subroutine check_particle_sides(error)
+            type(error_t), allocatable, intent(out) :: error
+            integer :: r
+            select type (field => config%region)
+            type is (overlap2d_t)
+                call check_region(field, 0, error)
+            type is (overlap_set_t)
+                do r = 1, size(field%regions)
+                    call check_region(field%regions(r), r, error)
+                    if (allocated(error)) return
+                end do
+            end select
+        end subroutine check_particle_sides
+
+        subroutine check_region(region, number, error)
+            type(overlap2d_t), intent(in) :: region
+            integer, intent(in) :: number
+            type(error_t), allocatable, intent(out) :: error
+            real(wp) :: a(2), b(2), t(2), normal(2), p(2), q(2), length, offset, xi(2)
+            integer :: k, n, j, e
+            character(len=400) :: buf
+            n = size(region%vertex, 2)
+            do k = 1, n
+                if (.not. region%particle_edge(k)) cycle
+                a = region%vertex(:, k)
+                b = region%vertex(:, modulo(k, n) + 1)
+                length = norm2(b - a)
+                if (.not. (length > 0)) cycle
+                t = (b - a)/length
+                normal = [t(2), -t(1)]
+                offset = max(4*region%tol, 1.0e-6_wp*length)
+                do j = 1, 9
+                    p = a + (real(j, wp)/10)*(b - a)
+                    q = p + offset*normal
+                    if (region%contains(q(1), q(2))) q = p - offset*normal
+                    if (region%contains(q(1), q(2))) cycle
+                    if (config%region%alpha_fe(q(1), q(2)) < 1.0_wp) cycle
+                    call grid%locate(model%mesh, q(1), q(2), e, xi)
+                    if (e == 0) cycle
+                    write (buf, '(a,i0,a,es13.5e3,a,es13.5e3,a,i0,a)') 'the particle side (edge ', k, &
+                        ') of this region borders the continuum outside the overlap (at (', q(1), ', ', q(2), &
+                        ') m, element ', e, '), where alpha = 1: the weight would jump there from alpha_min to 1; '// &
+                        'the particle side faces the particles only (no continuum beyond it): are the FE and '// &
+                        'particle sides swapped?'
+                    if (number > 0) then
+                        write (buf, '(a,i0,a)') 'region ', number, ': '//trim(buf)
+                    end if
+                    call make_error(error, 'coupling: '//trim(buf))
+                    return
+                end do
+            end do
+        end subroutine check_region
     end subroutine build_coupled2d
 
     !> The ramp (shape and floor) of a weight field: that of the region, or of the first
