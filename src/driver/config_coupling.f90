@@ -250,9 +250,9 @@ contains
             if (weight%value(s(i)) < 1) cycle
             call make_input_error(error, deck%file, setup%overlap_line, 'overlap', 'disk '// &
                                   to_str(i)//' (line '//to_str(dem%disk_line(i))//', abscissa '//to_str(s(i))// &
-                                  ' m along the beam) lies in the FE-only zone before s_fe = '// &
-                                  to_str(weight%s_fe)//' m, where alpha = 1 would leave it no mass: start the '// &
-                                  'overlap at or before it, or remove the disk')
+                                  ' m along the beam) lies in the FE-only zone, on the FE side of s_fe = '// &
+                                  to_str(weight%s_fe)//' m, where alpha = 1 would leave it no mass: move s_fe '// &
+                                  'past it, or remove the disk')
             return
         end do
     end subroutine check_fe_zone

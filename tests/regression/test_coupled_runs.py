@@ -309,7 +309,7 @@ def overlap_ends(exe, work):
     The overlaps [0.04, 0.08] m (8 elements of 1 cm) and [0.05, 0.09] m (9) start and end
     on the centres of the row's disks. The abscissas of those centres come out of the node
     coordinates rounded to either side of the ends: the first deck was refused (its disk 1
-    'in the FE-only zone before s_fe = 0.04 m'), the second coupled disks 1..4 only (disk 5,
+    'in the FE-only zone, on the FE side of s_fe = 0.04 m'), the second coupled disks 1..4 only (disk 5,
     at s_particle, got alpha = 0: left unglued, with its full mass)."""
     for s_fe, s_p in ((0.04, 0.08), (0.05, 0.09)):
         n_el, n_ov = round(s_p / PITCH), round((s_p - s_fe) / PITCH)
