@@ -228,7 +228,8 @@ contains
                            'a packing built at rest): `zero` reactions, or the `hydrostatic` estimate, the '// &
                            'weight carried down the contact network from the top and split at each disk over '// &
                            'its supports within their friction cones (doc/performance.md). On tall packings '// &
-                           'it cuts the sweeps of that step 2 to 6 times. Not used with the Arlequin '// &
+                           'it cuts the sweeps of that step 2 to 6 times; on hexagonal lattices the steps that '// &
+                           'follow can need several times more (doc/performance.md). Not used with the Arlequin '// &
                            'coupling rows (a warning), nor in a step where method = block solves intact bonds directly.', &
                            default='zero')
         call s%add_keyword('solver', 'coarse_every', [int_field('coarse_every', lower=1)], &
