@@ -472,7 +472,10 @@ contains
         end do
         !$omp end parallel do
         if (config%hydrostatic .and. .not. present(bilateral) .and. stats%n_block == 0) then
-            if (all(cs%r(:, list) == 0.0_wp)) call hydrostatic_guess(cs, list, im, vfree)
+            ! not on a step without active contacts: the estimate's O(N) pass would find nothing
+            if (size(list) > 0) then
+                if (all(cs%r(:, list) == 0.0_wp)) call hydrostatic_guess(cs, list, im, vfree)
+            end if
         end if
         call nlgs_apply_reactions(cs, im, vel)
         do k = 1, cs%n
