@@ -71,7 +71,7 @@ module dem_bonded_block
     use core_kinds, only: wp, i8
     use core_error, only: error_t
     use core_sparse, only: sparse_matrix_t, sparse_solver_t, sparse_cholesky
-    use dem_contacts, only: contact_set_t, status_cohesive
+    use dem_contacts, only: contact_set_t, status_cohesive, bond_on_bound
     use dem_bipotential, only: case_stick, case_slip, case_roll, case_slip_roll, rolling_local_solve, &
                                bipotential_local_solve
     use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_apply_reactions, nlgs_block_t, &
@@ -91,10 +91,9 @@ module dem_bonded_block
     !> Relative resolution of a relative velocity (64 machine epsilons of the velocities of
     !> the two bodies, as in dem_nlgs): the refinement stops below it.
     real(wp), parameter :: roundoff = 64.0_wp*epsilon(1.0_wp)
-    !> A reaction of the block within this fraction of a bound is on it (bound_case): the
-    !> direct solve rounds at about 1e-12 of the reactions, the sweeps of a released
-    !> neighbour stop at local_tolerance (1e-10 by default).
-    real(wp), parameter :: on_bound = 1.0e-9_wp
+    !> A reaction of the block within this fraction of a bound is on it (bound_case), as for
+    !> the rupture judgement of dem_contacts.
+    real(wp), parameter :: on_bound = bond_on_bound
     !> The bonds' equalities are met when their residual is below this fraction of the
     !> velocities (a consistent system refines down to roundoff, an inconsistent one keeps a
     !> residual of the order of the velocities).

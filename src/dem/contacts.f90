@@ -44,6 +44,11 @@ module dem_contacts
     !> the sweeps split (2 blocks of 2000 contacts, dem_nlgs). Below it a parallel region costs
     !> more than the loop, and far more on a loaded machine (doc/performance.md, OpenMP).
     integer, parameter :: parallel_min = 4000
+    !> A bond's reaction within this fraction of a bound of its cone is on it, for the rupture
+    !> judgement (bond_break_mode) and the bonded block (dem_bonded_block): a direct solve
+    !> rounds at about 1e-12 of the reactions, a local solve stops at local_tolerance (1e-10
+    !> by default).
+    real(wp), parameter, public :: bond_on_bound = 1.0e-9_wp
 
     !> Parameters of the step needed to set the contact laws.
     type :: contact_law_t
@@ -615,13 +620,19 @@ contains
         type(contact_set_t), intent(in) :: cs
         integer, intent(in) :: k
         logical :: shear, moment
+        real(wp) :: rn
         mode = break_none
         if (cs%r(1, k) + cs%coh(k) <= 0.0_wp) then
             if (cs%u(1, k) > 0.0_wp) mode = break_tension
             return
         end if
-        shear = cs%mu(k) > 0.0_wp .and. (cs%pcase(k) == case_slip .or. cs%pcase(k) == case_slip_roll)
-        moment = cs%erol(k) > 0.0_wp .and. (cs%pcase(k) == case_roll .or. cs%pcase(k) == case_slip_roll)
+        ! the case of the last local solve, or the reaction on the bound: a bond on its bound
+        ! with zero slip is a tie of the law that either case solves (doc/theory.md 7.6)
+        rn = cs%r(1, k) + cs%coh(k)
+        shear = cs%mu(k) > 0.0_wp .and. (cs%pcase(k) == case_slip .or. cs%pcase(k) == case_slip_roll &
+                                         .or. abs(cs%r(2, k)) >= (1.0_wp - bond_on_bound)*cs%mu(k)*rn)
+        moment = cs%erol(k) > 0.0_wp .and. (cs%pcase(k) == case_roll .or. cs%pcase(k) == case_slip_roll &
+                                            .or. abs(cs%r(3, k)) >= (1.0_wp - bond_on_bound)*cs%erol(k)*rn)
         if (shear .and. moment) then
             mode = break_shear_moment
         else if (shear) then
