@@ -431,7 +431,6 @@ contains
         write (buf, '(es13.5e3)') self%sys%fe%t
         line = 'coupled run: '//model//', '//counted(self%sys%dem%particles%n, 'disk')//' ('// &
                to_str(self%sys%op%n_points)//' coupled), '//counted(n_steps, 'step')//' to t = '//trim(buf)//' s'
-
     end function run_line
 
     !> '<residual> = P m (<coordinates> C m), max velocity residual V m/s': the largest
