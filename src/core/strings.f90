@@ -8,7 +8,7 @@ module core_strings
     private
     public :: string_t, to_lower, strip, is_blank_char, split_words, join_words
     public :: levenshtein, closest_match, parse_real, parse_int, to_str, shorten, max_echo, is_real_syntax
-    public :: gib, counted, sci_to_str
+    public :: gib, counted, sci_to_str, sci_text
 
     !> Longest token echoed whole in a message (see `shorten`).
     integer, parameter :: max_echo = 40
@@ -461,6 +461,17 @@ contains
         e_pos = index(text, 'E')
         if (text(e_pos + 2:e_pos + 2) == '0') text = text(:e_pos + 1)//text(e_pos + 3:)
     end function sci_to_str
+
+    !> A real with 4 significant digits and a three-digit exponent, as messages print
+    !> coordinates, times and rates: '4.500E+009', '1.226E-002'.
+    function sci_text(x) result(text)
+        !> The real.
+        real(wp), intent(in) :: x
+        character(len=:), allocatable :: text
+        character(len=24) :: buf
+        write (buf, '(es11.3e3)') x
+        text = trim(adjustl(buf))
+    end function sci_text
 
     !> A number of bytes in GiB with two decimals, e.g. '1.50 GiB', '0.25 GiB'.
     function gib(bytes) result(text)

@@ -17,7 +17,7 @@ module driver_config_dem
     use core_kinds, only: wp, i8
     use core_constants, only: deg_to_rad, pi
     use core_error, only: error_t, make_input_error
-    use core_strings, only: string_t, to_str, sci_to_str
+    use core_strings, only: string_t, to_str, sci_to_str, num => sci_text
     use core_timefunc, only: time_function_t
     use io_deck, only: deck_t, deck_entry_t
     use io_deck_schema, only: parse_selection
@@ -376,15 +376,6 @@ contains
             end do
         end associate
     end subroutine check_disk_coordinates
-
-    !> A real with 3 significant digits and a three-digit exponent, e.g. '4.500E+009'.
-    function num(x) result(text)
-        real(wp), intent(in) :: x
-        character(len=:), allocatable :: text
-        character(len=24) :: buf
-        write (buf, '(es11.3e3)') x
-        text = trim(adjustl(buf))
-    end function num
 
     !> The walls, each of 4, 5, 7 or 8 values, with a known material and function, inside the
     !> box the contact detection can represent, and of non-zero length.

@@ -18,7 +18,7 @@ module driver_guards
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
-    use core_strings, only: to_str, gib
+    use core_strings, only: to_str, gib, num => sci_text
     use dem_particles, only: particles_t
     use dem_walls, only: walls_t
     use dem_contacts, only: contact_set_t
@@ -446,15 +446,6 @@ contains
         write (buf, '(es12.5e3)') t
         text = 'step '//to_str(step)//' (t = '//trim(adjustl(buf))//' s): '
     end function when
-
-    !> A real with 3 significant digits ('1.226E-002').
-    function num(x) result(text)
-        real(wp), intent(in) :: x
-        character(len=:), allocatable :: text
-        character(len=24) :: buf
-        write (buf, '(es11.3e3)') x
-        text = trim(adjustl(buf))
-    end function num
 
     !> 'NaN', 'infinite'.
     pure function kind_of(x) result(text)

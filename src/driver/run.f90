@@ -27,7 +27,7 @@
 module driver_run
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error, make_input_error
-    use core_strings, only: string_t, to_str
+    use core_strings, only: string_t, to_str, num => sci_text
     use io_lock, only: lock_t, lock_acquire, lock_release
     use io_memory, only: available_memory
     use core_signals, only: caught_signal, signal_name, install_signal_handlers
@@ -375,15 +375,6 @@ contains
             ck%restart = .true.
             call report('restart from '//opts%restart//' at step '//to_str(ck%start%step))
         end subroutine open_checkpoint
-
-        !> A real with 4 significant digits.
-        function num(x) result(text)
-            real(wp), intent(in) :: x
-            character(len=:), allocatable :: text
-            character(len=24) :: buf
-            write (buf, '(es11.3e3)') x
-            text = trim(adjustl(buf))
-        end function num
 
         !> Title of the run ([run] title).
         function sim_title() result(text)
