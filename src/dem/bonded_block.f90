@@ -845,8 +845,8 @@ contains
         type(error_t), allocatable :: error
         real(wp), allocatable :: dv(:, :)
         integer, allocatable :: parent(:)
-        real(wp) :: sm(3, 3), dr(3), g(3, 3), u(3), ratio
-        integer :: k, j, c, s, d, b, p, n, kept
+        real(wp) :: sm(3, 3), dr(3), u(3), ratio
+        integer :: k, j, c, d, b, p, n, kept
         kept = 0
         self%condensed_ready = .true.
         self%n_released = 0
@@ -878,12 +878,7 @@ contains
                 dv = 0.0_wp
                 dr = 0.0_wp
                 dr(c) = 1.0_wp
-                do s = 1, 2
-                    d = body(cs, k, s)
-                    if (d <= 0) cycle
-                    g = directions(cs, k, s)
-                    dv(:, d) = dv(:, d) + im(:, d)*matmul(g, dr)
-                end do
+                call add_impulse(cs, k, dr, im, dv)
                 do b = 1, self%nb
                     u = local_change(cs, self%bond(b), dv)
                     do p = self%first(b), self%first(b + 1) - 1
@@ -903,12 +898,7 @@ contains
                     do p = self%first(b), self%first(b + 1) - 1
                         dr(self%comp(p)) = self%x(p)
                     end do
-                    do s = 1, 2
-                        d = body(cs, self%bond(b), s)
-                        if (d <= 0) cycle
-                        g = directions(cs, self%bond(b), s)
-                        dv(:, d) = dv(:, d) + im(:, d)*matmul(g, dr)
-                    end do
+                    call add_impulse(cs, self%bond(b), dr, im, dv)
                 end do
                 sm(:, c) = local_change(cs, k, dv)
             end do
@@ -964,8 +954,8 @@ contains
         real(wp), intent(in) :: im(:, :)
         real(wp), intent(inout) :: vel(:, :)
         integer, intent(in) :: j
-        real(wp) :: u(3), r0(3), r(3), dr(3), sw(6), g(3, 3)
-        integer :: k, it, pcase, s, d
+        real(wp) :: u(3), r0(3), r(3), dr(3), sw(6)
+        integer :: k, it, pcase
         k = self%released(j)
         sw = self%condensed(:, j)
         u = relative_velocity(cs, k, vel)
@@ -983,12 +973,7 @@ contains
         dr = r - r0
         cs%r(1, k) = r(1) - cs%coh(k)
         cs%r(2:3, k) = r(2:3)
-        do s = 1, 2
-            d = body(cs, k, s)
-            if (d <= 0) cycle
-            g = directions(cs, k, s)
-            vel(:, d) = vel(:, d) + im(:, d)*matmul(g, dr)
-        end do
+        call add_impulse(cs, k, dr, im, vel)
     end subroutine condensed_step
 
     !> The direct solve of `solve`, without the released bonds' steps.
@@ -1072,18 +1057,13 @@ contains
             integer, intent(in) :: k, b
             real(wp), intent(in) :: im(:, :)
             real(wp), intent(inout) :: vel(:, :)
-            real(wp) :: dr(3), g(3, 3)
-            integer :: s, d, pp
+            real(wp) :: dr(3)
+            integer :: pp
             dr = 0.0_wp
             do pp = self%first(b), self%first(b + 1) - 1
                 dr(self%comp(pp)) = self%x(pp)
             end do
-            do s = 1, 2
-                d = body(cs, k, s)
-                if (d <= 0) cycle
-                g = directions(cs, k, s)
-                vel(:, d) = vel(:, d) + im(:, d)*matmul(g, dr)
-            end do
+            call add_impulse(cs, k, dr, im, vel)
         end subroutine apply_change
     end subroutine solve_direct
 
@@ -1116,6 +1096,24 @@ contains
             u = u + matmul(transpose(g), vel(:, d))
         end do
     end function relative_velocity
+
+    !> v += M^-1 H dr for contact k: the change of the velocities of its bodies for an impulse
+    !> dr in its frame (the transpose of `local_change`).
+    pure subroutine add_impulse(cs, k, dr, im, v)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: k
+        real(wp), intent(in) :: dr(3)
+        real(wp), intent(in) :: im(:, :)
+        real(wp), intent(inout) :: v(:, :)
+        real(wp) :: g(3, 3)
+        integer :: s, d
+        do s = 1, 2
+            d = body(cs, k, s)
+            if (d <= 0) cycle
+            g = directions(cs, k, s)
+            v(:, d) = v(:, d) + im(:, d)*matmul(g, dr)
+        end do
+    end subroutine add_impulse
 
     !> H^T dv of contact k (the change of its relative velocity for a change dv of the
     !> velocities, without the shift).
