@@ -159,11 +159,13 @@ contains
 
     !> Half-side of the box of representable coordinates [m]: 1e-6 r_min/epsilon (about 4.5e9
     !> r_min), where the rounding of a coordinate is a millionth of the smallest radius r_min,
-    !> and at most 1e100 m (squares of distances stay finite).
+    !> and at most 1e100 m (squares of distances stay finite), also for r_min = huge (no disks:
+    !> the minimum of an empty set) without overflow.
     pure real(wp) function coordinate_limit(r_min) result(limit)
         !> Smallest disk radius [m].
         real(wp), intent(in) :: r_min
-        limit = min(1.0e-6_wp*(r_min/epsilon(1.0_wp)), 1.0e100_wp)
+        limit = 1.0e100_wp
+        if (r_min < limit*(epsilon(1.0_wp)/1.0e-6_wp)) limit = 1.0e-6_wp*(r_min/epsilon(1.0_wp))
     end function coordinate_limit
 
     !> Grid geometry and counting sort of the disks by cell.

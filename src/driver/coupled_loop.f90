@@ -35,7 +35,7 @@ module driver_coupled_loop
     use driver_results_dem, only: write_fclib_local
     use dem_local_problem, only: local_problem_t
     use dem_contacts, only: status_cohesive
-    use driver_guards, only: check_disks_state, step_start_t, take_step_start, check_tunnelling
+    use driver_guards, only: check_disks_state, check_walls_state, step_start_t, take_step_start, check_tunnelling
     use driver_checkpoint, only: checkpoint_run_t, end_of_step, step_end_t, loop_state_t, checkpoint_create, &
                                  save_coupled, load_coupled, &
                                  save_results, load_results, save_dem_writer, load_dem_writer, &
@@ -309,6 +309,8 @@ contains
             if (allocated(error)) return
             associate (sys => self%sys)
                 call check_disks_state(k, sys%fe%t, sys%dem%particles, sys%dem%energies, error)
+                if (allocated(error)) return
+                call check_walls_state(k, sys%fe%t, sys%dem%particles, sys%dem%walls, error)
                 if (allocated(error)) return
                 if (k == 0) return
                 call check_tunnelling(k, sys%fe%t, self%settings%h, sys%dem%scheme%alert, start, &

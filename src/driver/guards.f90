@@ -7,6 +7,8 @@
 !> - `check_disks_state`: positions, rotations and velocities of the disks are finite and the
 !>   centres stay in the box the detection can represent (dem_detection::coordinate_limit);
 !>   energy accounts are finite.
+!> - `check_walls_state`: the end points of the walls are finite and in the same box (a
+!>   driven wall leaves it when its velocity times the time run is too large).
 !> - Tunnelling (`step_start_t`, `check_tunnelling`): a disk whose centre crossed a wall
 !>   within the step, or two candidate disks (pairs found by the detection of the step) whose
 !>   centres passed each other while overlapping by more than half their radii, stop the run
@@ -27,7 +29,7 @@ module driver_guards
     use core_sort, only: sort_index
     implicit none
     private
-    public :: check_beam_state, check_disks_state, step_start_t, take_step_start, check_tunnelling
+    public :: check_beam_state, check_disks_state, check_walls_state, step_start_t, take_step_start, check_tunnelling
     public :: model_size_t, model_memory_bytes, check_memory
     public :: bytes_per_disk, bytes_per_node, bytes_per_element, bytes_per_q4, bytes_per_t3
 
@@ -166,6 +168,38 @@ contains
             call make_error(error, when(step, t)//'particles: an energy account is not finite; '//cause)
         end if
     end subroutine check_disks_state
+
+    !> Error at the first wall with an end point that is not finite or lies beyond the box
+    !> of check_disks_state (the box of the deck's walls, dem_detection::coordinate_limit):
+    !> a driven wall moves there when its velocity times the time run is too large.
+    subroutine check_walls_state(step, t, p, w, error)
+        !> Steps done.
+        integer(i8), intent(in) :: step
+        !> Time reached [s].
+        real(wp), intent(in) :: t
+        !> The disks (their smallest radius sets the box).
+        type(particles_t), intent(in) :: p
+        !> The walls.
+        type(walls_t), intent(in) :: w
+        !> Set at the first problem found.
+        type(error_t), allocatable, intent(out) :: error
+        real(wp) :: limit, ends(4)
+        integer :: i
+        if (w%n == 0) return
+        limit = coordinate_limit(minval(p%radius(1:p%n)))
+        do i = 1, w%n
+            ends = [w%x1(i), w%y1(i), w%x2(i), w%y2(i)]
+            if (all(ieee_is_finite(ends))) then
+                if (maxval(abs(ends)) <= limit) cycle
+            end if
+            call make_error(error, when(step, t)//'wall '//to_str(i)//' has moved to ('//num(ends(1))// &
+                            ', '//num(ends(2))//') - ('//num(ends(3))//', '//num(ends(4))// &
+                            ') m, beyond the box the run can represent (|x|, |y| <= '//num(limit)// &
+                            ' m); likely cause: its velocity (vx, vy times its function) far too large '// &
+                            'for the time run (check the wall record in [particles] and [time] end)')
+            return
+        end do
+    end subroutine check_walls_state
 
     !> Record the disk centres and wall end points at the start of a step.
     subroutine take_step_start(start, p, w)

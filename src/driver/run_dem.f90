@@ -21,7 +21,7 @@ module driver_run_dem
     use driver_config_dem, only: dem_config_t
     use driver_results, only: results_writer_t
     use driver_results_dem, only: dem_writer_t, write_fclib_local
-    use driver_guards, only: check_disks_state, step_start_t, take_step_start, check_tunnelling
+    use driver_guards, only: check_disks_state, check_walls_state, step_start_t, take_step_start, check_tunnelling
     use io_hdf5_file, only: h5_file_t
     use driver_checkpoint, only: end_of_step, step_end_t, checkpoint_run_t, loop_state_t, checkpoint_create, &
                                  save_dem, load_dem, save_results, load_results, save_dem_writer, load_dem_writer
@@ -192,6 +192,8 @@ contains
             type(error_t), allocatable, intent(out) :: error
             associate (sys => cfg%system)
                 call check_disks_state(k, sys%time, sys%particles, sys%energies, error)
+                if (allocated(error)) return
+                call check_walls_state(k, sys%time, sys%particles, sys%walls, error)
                 if (allocated(error)) return
                 call check_tunnelling(k, sys%time, run%h, sys%scheme%alert, start, sys%particles, &
                                       sys%walls, sys%contacts, error)

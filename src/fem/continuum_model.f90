@@ -11,6 +11,7 @@
 !> ones to the right-hand side; the timed ones enter the loads of the free dofs at each time
 !> (fem_continuum_dynamics), and `prescribed_at` gives u_p(t), its rate and its acceleration.
 module fem_continuum_model
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp
     use core_constants, only: singular_ratio
     use core_error, only: error_t, make_error
@@ -83,6 +84,8 @@ module fem_continuum_model
         procedure :: add_traction_parabolic => model_add_traction_parabolic
         !> Check that every element has a material.
         procedure :: check => model_check
+        !> First element whose matrices overflow or vanish in double precision (0: none).
+        procedure :: unrepresentable_element => model_unrepresentable_element
         !> Global stiffness (all dofs) as triplets.
         procedure :: assemble_stiffness => model_assemble_stiffness
         !> Global mass (all dofs), consistent or row-sum lumped, as triplets.
@@ -448,6 +451,36 @@ contains
             end if
         end do
     end subroutine model_check
+
+    !> First element whose stiffness or mass matrix cannot be represented (0: none): an entry
+    !> that overflows (a thickness or modulus of 1e300 gives E t beyond 1.8e308) or a diagonal
+    !> entry below the smallest normal number (a singular matrix); the mass only for a density
+    !> > 0 (a static analysis may have none). Every element must have a material (check).
+    integer function model_unrepresentable_element(self) result(bad)
+        !> The model.
+        class(continuum_model_t), intent(in) :: self
+        real(wp), allocatable :: k(:, :), m(:, :), ml(:)
+        integer :: e, a
+        logical :: ok
+        bad = 0
+        do e = 1, self%mesh%element_count()
+            associate (el => self%family(self%mesh%kind(e))%element, &
+                       xe => self%mesh%element_coordinates(e), mat => self%materials(self%element_material(e)))
+                k = el%stiffness(xe, mat)
+                m = el%mass_consistent(xe, mat)
+                ml = el%mass_lumped(xe, mat)
+                ok = all(ieee_is_finite(k)) .and. all(ieee_is_finite(m)) .and. all(ieee_is_finite(ml))
+                do a = 1, size(ml)
+                    ok = ok .and. k(a, a) >= tiny(1.0_wp)
+                    if (mat%density > 0.0_wp) ok = ok .and. m(a, a) >= tiny(1.0_wp) .and. ml(a) >= tiny(1.0_wp)
+                end do
+            end associate
+            if (.not. ok) then
+                bad = e
+                return
+            end if
+        end do
+    end function model_unrepresentable_element
 
     !> Global stiffness over all dofs.
     subroutine model_assemble_stiffness(self, k, error)

@@ -99,6 +99,12 @@ def non_finite(exe, work):
                 r"step 1 \(t = 2\.00000E-004 s\): beam", beam_deck())
     failing_run(exe, work, "dem_gravity_1e300", dem_deck(gravity="0 -1e300"),
                 r"step 1 \(t = 1\.00000E-003 s\): disk \d+ is at .* beyond the box", dem_deck())
+    # a floor sliding along itself at 1e300 m/s: finite, but 1e297 m away after a step (the
+    # run ended with exit 0, its walls beyond the box; at 9e307 m/s and a longer run they
+    # were written as Inf)
+    fast_wall = dem_deck().replace("wall = 0 0 0.2 0\n", "wall = 0 0 0.2 0 1 1e300 0\n", 1)
+    failing_run(exe, work, "dem_wall_velocity_1e300", fast_wall,
+                r"step 1 \(t = 1\.00000E-003 s\): wall 1 has moved to .* beyond the box", dem_deck())
 
 
 def coupled_non_finite(exe, work, decks):
