@@ -572,16 +572,17 @@ contains
                 end if
                 mix_now = accelerate .and. s > config%anderson_after
                 if (mix_now) mix_now = aa%swept == max(config%anderson_sweeps, 1)
-                if (present(block) .and. .not. mix_now) call block%solve(cs, im, vel, bilateral)
+                ! with members, the block is solved after the Anderson step, for the mixed reactions
+                if (present(block) .and. .not. (mix_now .and. stats%n_block > 0)) call block%solve(cs, im, vel, bilateral)
                 ! safeguard of the over-relaxation
                 if (omega /= 1.0_wp .and. mod(s, config%check_every) == 0) then
                     if (stats%error > checked) omega = 1.0_wp
                     checked = stats%error
                 end if
                 if (mix_now) then
-                    call anderson_mix(aa, cs, list, im, vfree, vel, split, bilateral, present(block))
+                    call anderson_mix(aa, cs, list, im, vfree, vel, split, bilateral, stats%n_block > 0)
                     aa%swept = 0
-                    if (present(block)) then
+                    if (stats%n_block > 0) then
                         call block%solve(cs, im, vel, bilateral)
                         call gather(cs, list, aa%d, aa%x, .false.)
                     end if
@@ -978,8 +979,8 @@ contains
     !> projected iterate, kept in x for the next step (pass_mix). The sums are taken by
     !> fixed chunks of contacts, in parallel, then over the chunks in order: the same result
     !> for any number of threads. f and g of the step are kept in fprev and gprev. With
-    !> `others` (a block) vel holds impulses of contacts outside the list: the velocities are
-    !> rebuilt by removing the swept contacts' impulses, not from vfree.
+    !> `others` (a block with members) vel holds impulses of contacts outside the list: the
+    !> velocities are rebuilt by removing the swept contacts' impulses, not from vfree.
     subroutine anderson_mix(aa, cs, list, im, vfree, vel, split, bilateral, others)
         type(anderson_t), intent(inout) :: aa
         type(contact_set_t), intent(inout) :: cs
