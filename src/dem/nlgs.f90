@@ -61,7 +61,16 @@
 !> taken out; `solve` is called once after the warm start and after every sweep that did not
 !> converge; after each sweep `measure` gives the block's share of the convergence norm (the
 !> change of the members' local velocities the next solve would make, and their |W r|), so
-!> that `sweeps` counts block iterations.
+!> that `sweeps` counts block iterations. The Anderson steps mix the swept contacts'
+!> reactions as without a block: with the members fixed within a solve and the block solved
+!> exactly for the others' reactions, the velocities are a function of the swept reactions
+!> alone, so the step removes the swept contacts' impulses, applies the mixed ones, restores
+!> the bilateral constraints and solves the block again (instead of the solve after the
+!> sweep); the map accelerated is block Gauss-Seidel. Released bonds (cohesive, swept) are
+!> mixed too: with them kept at the sweeps' output and the others mixed, the interface
+!> experiment's onset at 1e-6 diverged (a disk at 1e140 m by step 64); mixed, 1 of its 70
+!> steps stops at the cap of 20 000 iterations instead of 12 (doc/performance.md, "Anderson
+!> with the bonded block").
 !>
 !> Coarse correction (`method = coarse`, coarse_correct): before the first sweep and after
 !> every `coarse_every` sweeps, the reactions of aggregates of consecutive contacts are
@@ -142,8 +151,8 @@ module dem_nlgs
         !> Stopping criterion: criterion_lmgc90 or criterion_siconos.
         integer :: criterion = criterion_lmgc90
         !> Anderson acceleration of the sweeps (module header): depth (number of previous
-        !> sweeps mixed); 0: none. Not used with a block, or intact bonds among the swept
-        !> contacts.
+        !> sweeps mixed); 0: none. Not used when intact bonds are swept without a block
+        !> (nlgs_solve).
         integer :: anderson = 5
         !> Plain sweeps before the Anderson steps start: a solve that converges within them
         !> is not accelerated (near rest a plain sweep is cheaper, doc/performance.md).
@@ -421,6 +430,7 @@ contains
         type(split_t) :: split
         logical :: accelerate, coarse
         real(wp) :: error_corrected
+        logical :: mix_now
         integer :: s, k, n_swept, nb
         stats%n_contacts = cs%n
         call skip_blocked(cs, stats%n_blocked)
@@ -488,12 +498,13 @@ contains
         omega = config%relaxation
         checked = huge(1.0_wp)
         ! the Anderson steps rebuild the velocities from the swept contacts (and the bilateral
-        ! constraints' exact correction): not with members of a block, whose impulses are not
-        ! among them; nor over
-        ! intact bonds (method = block solves them; on a bonded row the mixed iterates stop 4e-10
-        ! of the load away at a tolerance of 1e-14, plain sweeps within 1e-10)
-        accelerate = config%anderson > 0 .and. stats%n_block == 0 .and. n_swept > 0
-        if (accelerate) accelerate = all(cs%coh(list) == 0.0_wp)
+        ! constraints' exact correction, and with a block its solve for the mixed reactions:
+        ! the map is then block Gauss-Seidel, its reactions those of the swept contacts,
+        ! released bonds included); not when intact bonds are swept with no block (on a bonded
+        ! row the mixed iterates stop 4e-10 of the load away at a tolerance of 1e-14, plain
+        ! sweeps within 1e-10; method = block solves them)
+        accelerate = config%anderson > 0 .and. n_swept > 0
+        if (accelerate .and. stats%n_block == 0) accelerate = all(cs%coh(list) == 0.0_wp)
         ! the coarse correction scales swept contacts only: not with a block or bilateral rows
         coarse = config%method == nlgs_method_coarse .and. .not. present(bilateral) .and. stats%n_block == 0 &
                  .and. n_swept > 0
@@ -559,16 +570,21 @@ contains
                     stats%converged = .true.
                     exit
                 end if
-                if (present(block)) call block%solve(cs, im, vel, bilateral)
+                mix_now = accelerate .and. s > config%anderson_after
+                if (mix_now) mix_now = aa%swept == max(config%anderson_sweeps, 1)
+                ! with members, the block is solved after the Anderson step, for the mixed reactions
+                if (present(block) .and. .not. (mix_now .and. stats%n_block > 0)) call block%solve(cs, im, vel, bilateral)
                 ! safeguard of the over-relaxation
                 if (omega /= 1.0_wp .and. mod(s, config%check_every) == 0) then
                     if (stats%error > checked) omega = 1.0_wp
                     checked = stats%error
                 end if
-                if (accelerate .and. s > config%anderson_after) then
-                    if (aa%swept == max(config%anderson_sweeps, 1)) then
-                        call anderson_mix(aa, cs, list, im, vfree, vel, split, bilateral)
-                        aa%swept = 0
+                if (mix_now) then
+                    call anderson_mix(aa, cs, list, im, vfree, vel, split, bilateral, stats%n_block > 0)
+                    aa%swept = 0
+                    if (stats%n_block > 0) then
+                        call block%solve(cs, im, vel, bilateral)
+                        call gather(cs, list, aa%d, aa%x, .false.)
                     end if
                 end if
                 if (coarse .and. mod(s, config%coarse_every) == 0) then
@@ -962,8 +978,10 @@ contains
     !> new row of the Gram matrix and the right-hand side (pass_products); the mixed,
     !> projected iterate, kept in x for the next step (pass_mix). The sums are taken by
     !> fixed chunks of contacts, in parallel, then over the chunks in order: the same result
-    !> for any number of threads. f and g of the step are kept in fprev and gprev.
-    subroutine anderson_mix(aa, cs, list, im, vfree, vel, split, bilateral)
+    !> for any number of threads. f and g of the step are kept in fprev and gprev. With
+    !> `others` (a block with members) vel holds impulses of contacts outside the list: the
+    !> velocities are rebuilt by removing the swept contacts' impulses, not from vfree.
+    subroutine anderson_mix(aa, cs, list, im, vfree, vel, split, bilateral, others)
         type(anderson_t), intent(inout) :: aa
         type(contact_set_t), intent(inout) :: cs
         integer, intent(in) :: list(:)
@@ -971,6 +989,7 @@ contains
         real(wp), intent(inout) :: vel(:, :)
         type(split_t), intent(in) :: split
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
+        logical, intent(in) :: others
         real(wp) :: gamma(aa%depth), rhs(aa%depth), fnorm, gnorm, fnorm_before, dfnorm2, drift
         integer :: slot, m, nc, c, j
         nc = size(aa%part, 2)
@@ -1040,7 +1059,7 @@ contains
         subroutine rebuild(m)
             integer, intent(in) :: m
             integer :: j, c
-            if (present(bilateral)) then
+            if (present(bilateral) .or. others) then
                 ! the velocities without the swept contacts' impulses, with the multipliers'
                 ! share as it stands (vfree + that share: the sweeps keep vel = vfree + M^-1 H r
                 ! + share)

@@ -201,8 +201,9 @@ contains
                            'packings, doc/performance.md). The '// &
                            'accelerated sweeps run in the fixed contact order; the history restarts when the '// &
                            'change over a sweep grows. With the Arlequin coupling rows too (their multipliers '// &
-                           'follow the mixed reactions exactly). Not used in a step with intact bonds among the '// &
-                           'swept contacts (method = block solves them directly).', &
+                           'follow the mixed reactions exactly). With method = block, the block is solved '// &
+                           'again for the mixed reactions (the bonds it released are mixed too). Not used in '// &
+                           'a step whose intact bonds are all swept (method = nlgs).', &
                            default='5')
         call s%add_keyword('solver', 'anderson_after', [int_field('anderson_after', lower=0)], &
                            'With `anderson` > 0: plain sweeps before the Anderson steps start. A step that '// &
