@@ -255,6 +255,56 @@ def bonded_shear_row(exe, decks, work):
           f"R |omega| = {spin:.2e} m/s, bound {bound:.2e} m/s")
 
 
+def bonded_pull_lattice(exe, decks, work):
+    """dem_bonded_pull_lattice.dat: a bonded hexagonal lattice torn by imposed velocities;
+    its block has no solution and releases every bond at step 1. Every step converges within
+    the default cap (the released bonds are then mixed by Anderson's method: 340 iterations
+    at step 1, where the plain sweeps needed 1 564 and the step ended unconverged with no
+    bond broken), bonds break at step 1, each on the bound of its mode, and the bonds that
+    hold lie inside their cones."""
+    radius, r_cohe, mu_b = 0.01, 200.0, 0.5
+    e_b = radius / 2
+    f, _ = run(exe, decks / "dem_bonded_pull_lattice.dat", work)
+    with f:
+        converged = f["dem/solver/converged"][...]
+        sweeps = f["dem/solver/sweeps"][...]
+        bi, bj, bstep, bmode = (f[f"dem/bonds/{k}"][...] for k in ("i", "j", "step", "mode"))
+        o = f["dem/contacts/offset"][...]
+        c = {k: f[f"dem/contacts/{k}"][...] for k in ("i", "j", "rn", "rt", "m", "status")}
+    check("bonded pull lattice: every step converged within the default cap, bonds broken at step 1",
+          bool(np.all(converged == 1)) and int(np.sum(bstep == 1)) > 0,
+          f"converged {converged.tolist()} in {sweeps.tolist()} iterations, {int(np.sum(bstep == 1))} "
+          f"bonds broken at step 1")
+    # A bond breaks when its reaction reaches the bound of its mode (1 tension: r_n + r_cohe =
+    # 0; 2 shear: |r_t| = mu_b (r_n + r_cohe); 3 moment: |M| = e_b (r_n + r_cohe); 4 both),
+    # read from the contacts written after the step of its rupture (output k = step k). The
+    # judgement takes a reaction within 1e-9 of its bound as on it; the measured gaps are
+    # 4e-12, so 1e-9 of r_cohe, as forces, moments over e_b.
+    worst = 0.0
+    for i, j, step, mode in zip(bi, bj, bstep, bmode):
+        s = slice(int(o[step]), int(o[step + 1]))
+        k = np.flatnonzero(((c["i"][s] == i) & (c["j"][s] == j)) | ((c["i"][s] == j) & (c["j"][s] == i)))
+        if len(k) != 1:
+            worst = np.inf
+            break
+        k = int(k[0]) + s.start
+        cap = c["rn"][k] + r_cohe
+        gaps = {1: abs(cap), 2: abs(abs(c["rt"][k]) - mu_b * cap), 3: abs(abs(c["m"][k]) / e_b - cap),
+                4: min(abs(abs(c["rt"][k]) - mu_b * cap), abs(abs(c["m"][k]) / e_b - cap))}
+        worst = max(worst, gaps[int(mode)] / r_cohe)
+    check("bonded pull lattice: every broken bond on its bound at its rupture", worst < 1e-9,
+          f"largest distance to the bound {worst:.1e} of r_cohe over {len(bi)} ruptures")
+    # The bonds intact after step 1 (status 3) inside their cones, to the same 1e-9.
+    s = slice(int(o[1]), int(o[2]))
+    intact = c["status"][s] == 3
+    cap = c["rn"][s][intact] + r_cohe
+    excess = np.concatenate([-cap, np.abs(c["rt"][s][intact]) - mu_b * cap,
+                             np.abs(c["m"][s][intact]) / e_b - cap]) / r_cohe
+    check("bonded pull lattice: intact bonds inside their cones after step 1",
+          int(np.sum(intact)) > 0 and float(np.max(excess)) < 1e-9,
+          f"{int(np.sum(intact))} intact, largest excess {float(np.max(excess)):.1e} of r_cohe")
+
+
 def cohesive_row(exe, src, work):
     """input/cohesive_row.dat: top bond breaks at t = 0.08711 s, the bottom one at 0.15 s."""
     f, _ = run(exe, src / "input" / "cohesive_row.dat", work)
@@ -498,6 +548,7 @@ def main():
     bonded_row_break(exe, decks, work)
     bonded_shear_pair(exe, decks, work)
     bonded_shear_row(exe, decks, work)
+    bonded_pull_lattice(exe, decks, work)
     cohesive_row(exe, src, work)
     small_deposit(exe, decks, work)
     unconverged(exe, decks, work)
