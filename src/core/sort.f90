@@ -70,18 +70,38 @@ contains
     end function sort_index_i8
 
     !> Permutation sorting real `keys` in increasing order, as `sort_index_i8` (stable; keys
-    !> that are NaN are not ordered): the keys' IEEE bits, read as integers, order the
-    !> non-negative values; the negative ones have their magnitude bits flipped, so that a
-    !> larger magnitude gives a smaller integer.
+    !> that are NaN are not ordered).
     pure function sort_index_real(keys) result(order)
         !> Keys.
         real(wp), intent(in) :: keys(:)
         !> Positions in `keys`, in increasing key order.
         integer, allocatable :: order(:)
-        integer(i8), allocatable :: bits(:)
-        integer :: i
-        bits = [(transfer(keys(i), 0_i8), i=1, size(keys))]
-        where (bits < 0_i8) bits = ieor(bits, huge(0_i8))
-        order = sort_index_i8(bits)
+        integer, allocatable :: buffer(:)
+        integer :: n, width, lo, mid, hi, i, j, k
+        n = size(keys)
+        order = [(i, i=1, n)]
+        allocate (buffer(n))
+        width = 1
+        do while (width < n)
+            do lo = 1, n, 2*width
+                mid = min(lo + width, n + 1)
+                hi = min(lo + 2*width, n + 1)
+                i = lo
+                j = mid
+                do k = lo, hi - 1
+                    ! min() keeps the indices valid: Fortran does not short-circuit .or.
+                    if (i < mid .and. (j >= hi .or. &
+                                       keys(order(min(i, n))) <= keys(order(min(j, n))))) then
+                        buffer(k) = order(i)
+                        i = i + 1
+                    else
+                        buffer(k) = order(j)
+                        j = j + 1
+                    end if
+                end do
+            end do
+            order = buffer
+            width = 2*width
+        end do
     end function sort_index_real
 end module core_sort
