@@ -1,16 +1,10 @@
 !> Sorting of small real arrays in place (breakpoint lists, timing samples), and the
-!> permutation that sorts integer keys (deck ids, node pairs) or real keys (bonds ranked by
-!> how far they lie outside their cones), stable, in O(n log n).
+!> permutation that sorts integer keys (deck ids, node pairs), stable, in O(n log n).
 module core_sort
     use core_kinds, only: wp, i8
     implicit none
     private
     public :: sort_in_place, sort_index
-
-    !> Permutation sorting integer or real keys in increasing order (stable).
-    interface sort_index
-        module procedure sort_index_i8, sort_index_real
-    end interface sort_index
 
 contains
 
@@ -35,7 +29,7 @@ contains
 
     !> Permutation sorting `keys` in increasing order: keys(order) is non-decreasing, and
     !> equal keys keep their input order (stable; bottom-up merge sort, O(n log n)).
-    pure function sort_index_i8(keys) result(order)
+    pure function sort_index(keys) result(order)
         !> Keys.
         integer(i8), intent(in) :: keys(:)
         !> Positions in `keys`, in increasing key order.
@@ -67,41 +61,5 @@ contains
             order = buffer
             width = 2*width
         end do
-    end function sort_index_i8
-
-    !> Permutation sorting real `keys` in increasing order, as `sort_index_i8` (stable; keys
-    !> that are NaN are not ordered).
-    pure function sort_index_real(keys) result(order)
-        !> Keys.
-        real(wp), intent(in) :: keys(:)
-        !> Positions in `keys`, in increasing key order.
-        integer, allocatable :: order(:)
-        integer, allocatable :: buffer(:)
-        integer :: n, width, lo, mid, hi, i, j, k
-        n = size(keys)
-        order = [(i, i=1, n)]
-        allocate (buffer(n))
-        width = 1
-        do while (width < n)
-            do lo = 1, n, 2*width
-                mid = min(lo + width, n + 1)
-                hi = min(lo + 2*width, n + 1)
-                i = lo
-                j = mid
-                do k = lo, hi - 1
-                    ! min() keeps the indices valid: Fortran does not short-circuit .or.
-                    if (i < mid .and. (j >= hi .or. &
-                                       keys(order(min(i, n))) <= keys(order(min(j, n))))) then
-                        buffer(k) = order(i)
-                        i = i + 1
-                    else
-                        buffer(k) = order(j)
-                        j = j + 1
-                    end if
-                end do
-            end do
-            order = buffer
-            width = 2*width
-        end do
-    end function sort_index_real
+    end function sort_index
 end module core_sort

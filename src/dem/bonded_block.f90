@@ -44,22 +44,15 @@
 !>
 !> Outer check (`bonded_block_solve`): after a converged solve every bond of B is checked
 !> against its cone, r_n + r_cohe h >= 0, |r_t| <= mu_b (r_n + r_cohe h), |M| <= e_b (r_n +
-!> r_cohe h). A bond outside it cannot hold as a bilateral constraint: the bonds farthest
-!> outside (cone_excess) leave B for the rest of the step, join the sweeps with their own
-!> (cohesive) law, and the step is solved again from the current reactions. The first pass
-!> of a step that finds bonds outside releases one, the farthest; each later one releases
-!> twice as many as the one before (1, 2, 4, ...), the farthest first. One at first: released
-!> together, the overloaded bonds of a clamped bonded row were swept against the rigid rest of
-!> the block and never converged, and once the root yields the others are back inside their
-!> cones. Doubling after: a lattice torn apart releases hundreds of bonds in a step, which
-!> one per pass took hundreds of passes (each a few block iterations and a new analysis and
-!> factorisation of the block), doubling about log2 of that; a bond released beyond need is
-!> swept with its own law, which keeps it intact while it holds (doc/performance.md, "Bonds
-!> breaking: batches that double").
-!> When the block's equalities have no solution (`consistent`), every bond outside its cone is
-!> released at once. A bond left in B on a bound is judged at it (bound_case). This is the
-!> problem the plain NLGS solves, so the judgement of dem_contacts (contacts_finish) then
-!> breaks it exactly as after the NLGS.
+!> r_cohe h). A bond outside it cannot hold as a bilateral constraint: the one farthest
+!> outside (cone_excess) leaves B for the rest of the step, joins the sweeps with its own
+!> (cohesive) law, and the step is solved again from the current reactions, one bond per
+!> pass (released together, the overloaded bonds of a clamped bonded row were swept against
+!> the rigid rest of the block and never converged; once the root yields the others are back
+!> inside their cones). When the block's equalities have no solution (`consistent`), every
+!> bond outside its cone is released at once. A bond left in B on a bound is judged at it
+!> (bound_case). This is the problem the plain NLGS solves, so the
+!> judgement of dem_contacts (contacts_finish) then breaks it exactly as after the NLGS.
 !>
 !> Released bonds that hold a part alone (`condense`): a released bond whose two bodies are
 !> not connected through B carries the part beyond it by itself, a rigid body or a structure
@@ -78,7 +71,6 @@ module dem_bonded_block
     use core_kinds, only: wp, i8
     use core_error, only: error_t
     use core_sparse, only: sparse_matrix_t, sparse_solver_t, sparse_cholesky
-    use core_sort, only: sort_index
     use dem_contacts, only: contact_set_t, status_cohesive, bond_on_bound
     use dem_bipotential, only: case_stick, case_slip, case_roll, case_slip_roll, rolling_local_solve, &
                                bipotential_local_solve
@@ -93,10 +85,6 @@ module dem_bonded_block
     real(wp), parameter :: bonded_block_eps_ratio = 1.0e-12_wp
     !> Largest number of passes (solve and refinements) per block solve.
     integer, parameter :: max_passes = 6
-    !> Cap of the number of bonds the outer check releases in one pass (it doubles from 1 at
-    !> each pass of a step that finds bonds outside their cones; the cap only keeps the
-    !> doubling from overflowing).
-    integer, parameter :: max_batch = 2**30
     !> A kept factor of older values is refactored when a pass reduces the residual by less
     !> than this factor.
     real(wp), parameter :: stale_contraction = 1.0e-2_wp
@@ -270,9 +258,8 @@ contains
         !> Bilateral constraints kept satisfied (default: none).
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         type(nlgs_stats_t) :: pass
-        integer :: k, released, n_blocked, sweeps, n_out, batch
-        integer, allocatable :: outside(:), order(:)
-        real(wp), allocatable :: excess(:)
+        integer :: k, released, n_blocked, sweeps, worst
+        real(wp) :: excess
         integer(i8) :: updates, local
         if (allocated(block%excluded)) then
             if (size(block%excluded) < cs%n) deallocate (block%excluded)
@@ -281,12 +268,10 @@ contains
         block%excluded = .false.
         block%local_tol = config%local_tol
         block%local_max_iter = config%local_max_iter
-        allocate (outside(max(cs%n, 1)))
         sweeps = 0
         updates = 0_i8
         local = 0_i8
         n_blocked = -1
-        batch = 1
         do
             call nlgs_solve(config, cs, im, vel, pass, bilateral, block)
             if (n_blocked < 0) n_blocked = pass%n_blocked
@@ -294,14 +279,28 @@ contains
             updates = updates + pass%updates
             local = local + pass%local_iterations
             if (.not. pass%converged) exit
-            n_out = 0
+            ! release only the bond farthest outside its cone: the others may come back inside
+            ! once it yields, and bonds released together are swept against the rigid rest of
+            ! the block, whose Gauss-Seidel converges too slowly to judge them (module header)
+            worst = 0
+            excess = 0.0_wp
+            released = 0
             do k = 1, cs%n
                 if (.not. block%member(k)) cycle
-                if (.not. outside_cone(cs, k)) cycle
-                n_out = n_out + 1
-                outside(n_out) = k
+                if (outside_cone(cs, k)) then
+                    if (.not. block%consistent) then
+                        ! no solution with every bond held: its reactions are of order 1/eps
+                        ! and tell nothing of which bond yields first; release them all
+                        block%excluded(k) = .true.
+                        released = released + 1
+                    else if (worst == 0 .or. cone_excess(cs, k) > excess) then
+                        worst = k
+                        excess = cone_excess(cs, k)
+                    end if
+                end if
             end do
-            if (n_out == 0) then
+            if (released > 0) worst = -1
+            if (worst == 0) then
                 ! bonds of the block whose reaction lies on a bound have reached it: judged
                 ! as the sweeps judge a bond projected onto it (contacts_finish breaks them)
                 do k = 1, cs%n
@@ -309,22 +308,9 @@ contains
                 end do
                 exit
             end if
-            if (block%consistent) then
-                ! release the `batch` bonds farthest outside their cones (ties in contact
-                ! order), 1 at the first ranked release of the step, then twice as many at each
-                ! pass that still finds bonds outside: the others may come back inside once
-                ! the first yield, and bonds released together are swept against the rigid
-                ! rest of the block (module header)
-                excess = [(cone_excess(cs, outside(k)), k=1, n_out)]
-                order = sort_index(-excess)
-                released = min(batch, n_out)
-                block%excluded(outside(order(1:released))) = .true.
-                if (batch < max_batch) batch = 2*batch
-            else
-                ! no solution with every bond held: its reactions are of order 1/eps and tell
-                ! nothing of which bond yields first; release them all
-                released = n_out
-                block%excluded(outside(1:n_out)) = .true.
+            if (worst > 0) then
+                block%excluded(worst) = .true.
+                released = 1
             end if
             block%counts%releases = block%counts%releases + released
             block%counts%resolves = block%counts%resolves + 1
