@@ -278,8 +278,9 @@ def bonded_pull_lattice(exe, decks, work):
     # A bond breaks when its reaction reaches the bound of its mode (1 tension: r_n + r_cohe =
     # 0; 2 shear: |r_t| = mu_b (r_n + r_cohe); 3 moment: |M| = e_b (r_n + r_cohe); 4 both),
     # read from the contacts written after the step of its rupture (output k = step k). The
-    # judgement takes a reaction within 1e-9 of its bound as on it; the measured gaps are
-    # 4e-12, so 1e-9 of r_cohe, as forces, moments over e_b.
+    # judgement takes a reaction within 1e-6 of its bound as on it (dem_contacts::
+    # bond_on_bound); the measured gaps are below 1e-11, so 1e-9 of r_cohe, as forces,
+    # moments over e_b.
     worst = 0.0
     for i, j, step, mode in zip(bi, bj, bstep, bmode):
         s = slice(int(o[step]), int(o[step + 1]))
