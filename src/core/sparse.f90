@@ -11,6 +11,9 @@
 !> - `sparse_solver_t`: `analyse` (fill-reducing ordering and symbolic factorisation, once per
 !>   pattern), `factor` (numerical factorisation, each time the values change), `solve` (one
 !>   or several right-hand sides), `stats` (nonzeros and flops of the factor, ordering used).
+!>   `delete_rows` modifies the factor in place so that it solves the matrix with some rows
+!>   and columns replaced by those of the identity (CHOLMOD's row deletion, without a new
+!>   analysis or factorisation; the factor becomes simplicial L D L^T).
 !>   Two kinds: `sparse_cholesky`, A = L L^T for symmetric positive-definite matrices
 !>   (supernodal or simplicial as CHOLMOD judges faster; a pivot <= 0 is an error naming the
 !>   column), and `sparse_ldlt`, A = L D L^T without pivoting (simplicial), for
@@ -145,6 +148,9 @@ module core_sparse
         procedure, private :: solver_solve_vec, solver_solve_mat
         !> Solve A x = b for one or several right-hand sides.
         generic :: solve => solver_solve_vec, solver_solve_mat
+        !> Replace rows and columns of the factored matrix by those of the identity,
+        !> modifying the factor.
+        procedure :: delete_rows => solver_delete_rows
         !> Figures of the analysis and factorisation.
         procedure :: stats => solver_stats
         !> True after a successful `factor`.
@@ -198,6 +204,13 @@ module core_sparse
             real(c_double), intent(inout) :: x(*)
             integer(c_int) :: status
         end function mc_sparse_solve
+        function mc_sparse_delete(handle, nrows, rows) bind(c, name='mc_sparse_delete') result(status)
+            import :: c_ptr, c_int, c_int64_t
+            type(c_ptr), value :: handle
+            integer(c_int64_t), value :: nrows
+            integer(c_int64_t), intent(in) :: rows(*)
+            integer(c_int) :: status
+        end function mc_sparse_delete
         subroutine mc_sparse_info(handle, lnz, flops, ordering, supernodal, is_ll, negative_pivots, &
                                   rcond, memory_peak) bind(c, name='mc_sparse_info')
             import :: c_ptr, c_int, c_int64_t, c_double
@@ -618,6 +631,40 @@ contains
         status = mc_sparse_solve(self%handle, int(self%n, c_int64_t), nrhs, b, x)
         if (status < cholmod_ok) call status_error(status, 'sparse solve (cholmod_solve2)', error)
     end subroutine solve_common
+
+    !> Replace rows and columns `rows` of the factored matrix A by those of the identity: the
+    !> factor is modified in place (cholmod_rowdel on each row, in the given order) and
+    !> then solves the matrix equal to A but for A(r, :) = A(:, r) = e_r for every deleted
+    !> r, whose other rows are exact without a new analysis or factorisation; a right-hand
+    !> side zero on the deleted rows has a solution zero there. The cost of a deletion
+    !> is that of the columns of the factor it changes, a small part of a factorisation.
+    !> CHOLMOD modifies only a simplicial L D L^T factor: a supernodal or L L^T one is
+    !> converted to it first (once; `factor` then refactors in that form, and `stats`
+    !> reports it). Deleting a row already deleted changes nothing.
+    subroutine solver_delete_rows(self, rows, error)
+        !> The factored solver.
+        class(sparse_solver_t), intent(inout) :: self
+        !> Rows (1-based, original numbering, 1..n) to delete, in order.
+        integer, intent(in) :: rows(:)
+        !> Set when not factored, a row is outside 1..n, or CHOLMOD fails (out of memory: the
+        !> factor is then no longer usable and `factor` must be called again).
+        type(error_t), allocatable, intent(out) :: error
+        integer(c_int) :: status
+        if (.not. self%factored) then
+            call make_error(error, 'sparse delete_rows: the matrix is not factored (call factor first)')
+            return
+        end if
+        if (size(rows) == 0) return
+        if (any(rows < 1) .or. any(rows > self%n)) then
+            call make_internal_error(error, 'sparse delete_rows', 'row outside 1..n')
+            return
+        end if
+        status = mc_sparse_delete(self%handle, size(rows, kind=c_int64_t), int(rows - 1, c_int64_t))
+        if (status < cholmod_ok) then
+            self%factored = .false.
+            call status_error(status, 'sparse row deletion (cholmod_rowdel)', error)
+        end if
+    end subroutine solver_delete_rows
 
     !> Figures of the last analysis and factorisation (zeros and 'none' before `analyse`).
     function solver_stats(self) result(stats)

@@ -191,6 +191,36 @@ int mc_sparse_solve(void *handle, int64_t n, int64_t nrhs, double *b, double *x)
     return s->c.status;
 }
 
+/* Replace rows and columns rows[0..nrows-1] (0-based, original numbering) of the factored
+ * matrix by those of the identity: cholmod_l_rowdel on each, in the given order, with the
+ * row's position in the factor (L holds the factor of P A P'). CHOLMOD modifies only a
+ * simplicial LDL' factor and converts any other (supernodal, or LL') to one first. */
+int mc_sparse_delete(void *handle, int64_t nrows, int64_t *rows)
+{
+    mc_solver *s = handle;
+    int64_t n, *where;
+    const int64_t *perm;
+    if (s == NULL || s->L == NULL) return MC_NO_HANDLE;
+    if (s->L->xtype == CHOLMOD_PATTERN) return MC_NO_HANDLE;
+    n = (int64_t)s->L->n;
+    where = malloc(sizeof(int64_t) * (size_t)(n > 0 ? n : 1));
+    if (where == NULL) return CHOLMOD_OUT_OF_MEMORY;
+    perm = s->L->Perm;
+    for (int64_t j = 0; j < n; j++) where[perm != NULL ? perm[j] : j] = j;
+    for (int64_t r = 0; r < nrows; r++) {
+        if (rows[r] < 0 || rows[r] >= n) {
+            free(where);
+            return CHOLMOD_INVALID;
+        }
+        if (!cholmod_l_rowdel((size_t)where[rows[r]], NULL, s->L, &s->c)) {
+            free(where);
+            return s->c.status < CHOLMOD_OK ? s->c.status : CHOLMOD_INVALID;
+        }
+    }
+    free(where);
+    return s->c.status;
+}
+
 /* Figures of the last analysis and factorisation. lnz and flops come from the analysis
  * (nonzeros of L including the diagonal; floating-point operations of the factorisation);
  * negative_pivots counts D(j,j) < 0 of a simplicial LDL' factor (0 otherwise); rcond is

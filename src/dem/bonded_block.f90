@@ -14,7 +14,8 @@
 !> Arlequin coupling rows, `nlgs_bilateral_t%mobility`): the rows join the block exactly, and
 !> `restore` then applies their multipliers. W_BB is sparse (one 3x3 block per pair of bonds
 !> that share a disk; a dense corner among the bonds on coupled disks) and is factored by
-!> CHOLMOD (core_sparse) with L L^T.
+!> CHOLMOD (core_sparse) as a simplicial L D L^T, the form whose rows CHOLMOD can delete
+!> (below); on the reference stack its solves cost no more than the supernodal L L^T's.
 !>
 !> Regularisation: eps = 1e-12 max diag(W_BB). Redundant bonds (a closed loop, e.g. a
 !> triangle of a hexagonal stack) make W_BB singular: its kernel holds the self-stresses,
@@ -42,14 +43,32 @@
 !> step, against one factorisation per step for a refactor at every step, which cost 40 %
 !> of the block's time.
 !>
+!> Released bonds leave the factor (`delete_slots`): the unknowns of the analysed pattern
+!> are those of its slots, one per bond of B at the analysis. When a bond leaves B (released
+!> by the outer check, or broken at the end of a step) its slot dies: its rows and columns of
+!> W_BB + eps I become those of the identity, and the factor is modified accordingly
+!> (CHOLMOD's row deletion, `sparse_solver_t%delete_rows`) instead of a new analysis and
+!> factorisation of B without it; its right-hand side is zero, so its change is zero, and
+!> the factor solves the other slots exactly as a new one would (to rounding). Its reaction
+!> then comes from the sweeps, as before. B is matched against the live slots: the same
+!> bonds (a reuse as above), or the same but some (deleted), or else (a new or returning
+!> bond) the pattern of B is analysed afresh, as it is when the dead rows would exceed
+!> max_dead_fraction of the unknowns (their fill stays in the factor and every solve pays for
+!> it). A dead slot's entries are zeros and its diagonal 1 in the values, so a refactor with
+!> the current values (stale factor) keeps it dead, and the stale test compares the live
+!> entries only. Within a step the values do not change: the passes after a release keep
+!> those of the first (and its eps). A checkpoint holds the values of the last factorisation,
+!> the dead slots and the slots deleted since, in order; the restart factors those values and
+!> deletes them again, so that the factor, and the run, stay bitwise the same.
+!>
 !> Outer check (`bonded_block_solve`): after a converged solve every bond of B is checked
 !> against its cone, r_n + r_cohe h >= 0, |r_t| <= mu_b (r_n + r_cohe h), |M| <= e_b (r_n +
 !> r_cohe h). A bond outside it cannot hold as a bilateral constraint: the one farthest
 !> outside (cone_excess) leaves B for the rest of the step, joins the sweeps with its own
-!> (cohesive) law, and the step is solved again from the current reactions, one bond per
-!> pass (released together, the overloaded bonds of a clamped bonded row were swept against
-!> the rigid rest of the block and never converged; once the root yields the others are back
-!> inside their cones). When the block's equalities have no solution (`consistent`), every
+!> (cohesive) law, and the step is solved again from the current reactions (its slot deleted
+!> from the factor, above), one bond per pass (released together, the overloaded bonds of a
+!> clamped bonded row were swept against the rigid rest of the block and never converged;
+!> once the root yields the others are back inside their cones). When the block's equalities have no solution (`consistent`), every
 !> bond outside its cone is released at once. A bond left in B on a bound is judged at it
 !> (bound_case). This is the problem the plain NLGS solves, so the
 !> judgement of dem_contacts (contacts_finish) then breaks it exactly as after the NLGS.
@@ -70,7 +89,7 @@
 module dem_bonded_block
     use core_kinds, only: wp, i8
     use core_error, only: error_t
-    use core_sparse, only: sparse_matrix_t, sparse_solver_t, sparse_cholesky
+    use core_sparse, only: sparse_matrix_t, sparse_solver_t, sparse_ldlt
     use dem_contacts, only: contact_set_t, status_cohesive, bond_on_bound
     use dem_bipotential, only: case_stick, case_slip, case_roll, case_slip_roll, rolling_local_solve, &
                                bipotential_local_solve
@@ -98,6 +117,11 @@ module dem_bonded_block
     !> velocities (a consistent system refines down to roundoff, an inconsistent one keeps a
     !> residual of the order of the velocities).
     real(wp), parameter :: consistent_ratio = 1.0e-6_wp
+
+    !> A kept factor whose dead rows (bonds that left B, deleted from it) would exceed this
+    !> fraction of its unknowns is replaced by the analysis and factorisation of B alone: the
+    !> dead rows keep their share of the factor's fill, which every solve pays for.
+    real(wp), parameter :: max_dead_fraction = 0.25_wp
 
     !> Block iterations of a solve (its warm start included) before the released bonds take
     !> condensed steps (`solve`). A condensed step costs a block solve where a plain update
@@ -133,6 +157,8 @@ module dem_bonded_block
         integer(i8) :: releases = 0
         !> Steps solved again after a release.
         integer(i8) :: resolves = 0
+        !> Bonds deleted from a kept factor (identity rows) as they left B.
+        integer(i8) :: deletions = 0
         !> Set-ups whose factorisation failed (the bonds were then swept as by the NLGS).
         integer(i8) :: failures = 0
     end type bonded_block_counts_t
@@ -143,16 +169,29 @@ module dem_bonded_block
         type(bonded_block_counts_t) :: counts
         !> Contact k left the block at this step (outer check); set by bonded_block_solve.
         logical, allocatable :: excluded(:)
-        !> Number of bonds in the block and of unknowns.
+        !> Number of slots (the bonds of the analysed pattern) and of their unknowns.
         integer :: nb = 0, nu = 0
-        !> Contact index of each bond of the block (nb).
+        !> Number of bonds in B (the live slots).
+        integer :: n_live = 0
+        !> Contact index of the bond of each slot in B, 0 for a dead slot (nb).
         integer, allocatable :: bond(:)
-        !> First unknown of each bond (nb + 1).
+        !> First unknown of each slot (nb + 1).
         integer, allocatable :: first(:)
         !> Component (1 = r_n, 2 = r_t, 3 = M) of each unknown (nu).
         integer, allocatable :: comp(:)
-        !> Bond graph of the analysed pattern: pairs and locked components (bitmask).
+        !> Bond graph of the analysed pattern: pairs and locked components (bitmask) of each
+        !> slot.
         integer, allocatable :: key_i1(:), key_i2(:), key_rows(:)
+        !> The slot's bond has left B: its rows are those of the identity in the factor (nb).
+        logical, allocatable :: dead(:)
+        !> Slots deleted from the factor since its numerical factorisation, in order (the
+        !> others dead were identity rows of the values factored).
+        integer, allocatable :: deleted(:)
+        !> Number of entries of `deleted` in use.
+        integer :: n_deleted = 0
+        !> The step is being solved again after a release (set by bonded_block_solve): the
+        !> values of W_BB are those of the pass before.
+        logical :: resolving = .false.
         !> A pattern is analysed.
         logical :: analysed = .false.
         !> A factor of the current pattern is held.
@@ -205,8 +244,11 @@ module dem_bonded_block
         !> See `local_tol`.
         integer :: local_max_iter = 8
         !> Restart (`bonded_block_restore`): values of the factor in use at the checkpoint,
-        !> factored at the next `prepare` when its bond graph is the restored key.
+        !> factored at the next `prepare` when its bond graph is the restored key, and the
+        !> slots then deleted from it, in order.
         real(wp), allocatable :: restore_values(:)
+        !> See `restore_values`.
+        integer, allocatable :: restore_deleted(:)
     contains
         !> See `nlgs_block_t%prepare`.
         procedure :: prepare
@@ -223,17 +265,24 @@ contains
     !> whose bond graph is that one factors these values instead of the current ones, so
     !> that the same (possibly stale) factor is used as in the uninterrupted run and the
     !> results stay bitwise the same; otherwise it proceeds as usual.
-    subroutine bonded_block_restore(block, key_i1, key_i2, key_rows, values)
+    subroutine bonded_block_restore(block, key_i1, key_i2, key_rows, values, dead, deleted)
         !> The block (new).
         type(bonded_block_t), intent(inout) :: block
-        !> Bond graph of the factor: pairs and locked components (bitmask) of each bond.
+        !> Bond graph of the factor: pairs and locked components (bitmask) of each slot.
         integer, intent(in) :: key_i1(:), key_i2(:), key_rows(:)
         !> Values of the factor.
         real(wp), intent(in) :: values(:)
+        !> Dead slots (identity rows in the factor), and those of them deleted from it after
+        !> its factorisation, in order.
+        logical, intent(in) :: dead(:)
+        !> See `dead`.
+        integer, intent(in) :: deleted(:)
         block%key_i1 = key_i1
         block%key_i2 = key_i2
         block%key_rows = key_rows
+        block%dead = dead
         block%restore_values = values
+        block%restore_deleted = deleted
         block%analysed = .false.
         block%factored = .false.
     end subroutine bonded_block_restore
@@ -272,6 +321,7 @@ contains
         updates = 0_i8
         local = 0_i8
         n_blocked = -1
+        block%resolving = .false.
         do
             call nlgs_solve(config, cs, im, vel, pass, bilateral, block)
             if (n_blocked < 0) n_blocked = pass%n_blocked
@@ -314,12 +364,14 @@ contains
             end if
             block%counts%releases = block%counts%releases + released
             block%counts%resolves = block%counts%resolves + 1
+            block%resolving = .true.
             ! back to the velocities without the contact impulses (nlgs_solve applies the
             ! current reactions again: the warm start of the next pass)
             cs%r(:, 1:cs%n) = -cs%r(:, 1:cs%n)
             call nlgs_apply_reactions(cs, im, vel)
             cs%r(:, 1:cs%n) = -cs%r(:, 1:cs%n)
         end do
+        block%resolving = .false.
         stats = pass
         stats%n_blocked = n_blocked
         stats%sweeps = sweeps
@@ -385,8 +437,11 @@ contains
         end if
     end function bound_case
 
-    !> Choose B (active intact bonds not excluded), assemble W_BB + eps I, analyse when the
-    !> bond graph changed, factor when a value changed.
+    !> Choose B (active intact bonds not excluded) and set up the factor of W_BB + eps I
+    !> (module header, "Reuse" and "Released bonds"): when B is the live slots of the
+    !> analysed pattern, or some of them, the bonds that left are deleted from the factor
+    !> (identity rows) and the factor is kept; otherwise the pattern of B is analysed and
+    !> factored afresh.
     subroutine prepare(self, cs, im, bilateral)
         !> The block.
         class(bonded_block_t), intent(inout) :: self
@@ -397,8 +452,9 @@ contains
         !> Bilateral constraints of the solve, if any.
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         type(error_t), allocatable :: error
-        integer :: k, b, u, mask, i
-        logical :: same, excl, restoring
+        integer :: k, b, u, i, nc
+        integer, allocatable :: cur(:), newly(:)
+        logical :: match, excl, restoring, fresh, reassemble
         real(wp), allocatable :: current(:)
         if (allocated(self%member)) then
             if (size(self%member) < cs%n) deallocate (self%member)
@@ -416,95 +472,117 @@ contains
             end if
             self%member(k) = cs%active(k) .and. cs%status(k) == status_cohesive .and. .not. excl
         end do
-        self%nb = count(self%member(1:cs%n))
-        if (allocated(self%bond)) deallocate (self%bond, self%first)
-        allocate (self%bond(self%nb), self%first(self%nb + 1))
-        b = 0
-        u = 1
+        nc = count(self%member(1:cs%n))
+        allocate (cur(nc))
+        i = 0
         do k = 1, cs%n
             if (.not. self%member(k)) cycle
-            b = b + 1
-            self%bond(b) = k
-            self%first(b) = u
-            u = u + popcnt(rows_mask(cs, k))
+            i = i + 1
+            cur(i) = k
             ! components that are not locked carry no reaction (see contacts_set_laws)
             if (cs%mu(k) <= 0.0_wp) cs%r(2, k) = 0.0_wp
             if (cs%erol(k) <= 0.0_wp) cs%r(3, k) = 0.0_wp
         end do
-        self%first(self%nb + 1) = u
-        self%nu = u - 1
-        if (allocated(self%comp)) deallocate (self%comp)
-        allocate (self%comp(self%nu))
-        do b = 1, self%nb
-            mask = rows_mask(cs, self%bond(b))
-            u = self%first(b)
-            do k = 1, 3
-                if (.not. btest(mask, k - 1)) cycle
-                self%comp(u) = k
-                u = u + 1
-            end do
-        end do
-        if (self%nb == 0) then
+        self%n_live = nc
+        if (nc == 0) then
+            ! no bond in B: the slots stay (the factor is kept for a later step)
+            if (allocated(self%bond)) self%bond = 0
             if (allocated(self%restore_values)) deallocate (self%restore_values)
             return
         end if
-        ! same bond graph as the analysed pattern (or as the restored factor)?
+        ! B among the live slots of the analysed pattern (or of the restored factor)?
         restoring = allocated(self%restore_values)
-        same = self%analysed .or. restoring
-        if (same) same = size(self%key_i1) == self%nb
-        if (same) then
+        match = self%analysed .or. restoring
+        if (match) call match_slots(self, cs, cur, match, newly)
+        if (match) then
+            ! too many dead rows: the factor carries their fill for nothing, start afresh
+            u = 0
             do b = 1, self%nb
-                k = self%bond(b)
-                if (self%key_i1(b) /= cs%i1(k) .or. self%key_i2(b) /= cs%i2(k) .or. &
-                    self%key_rows(b) /= rows_mask(cs, k)) then
-                    same = .false.
-                    exit
-                end if
+                if (self%dead(b) .or. any(newly == b)) u = u + popcnt(self%key_rows(b))
             end do
+            match = real(u, wp) <= max_dead_fraction*real(self%nu, wp)
         end if
-        if (restoring) then
-            restoring = same
-            same = .false.
-        end if
-        self%nt = 0
-        call assemble(self, cs, im, bilateral)
-        if (same) then
-            self%mat%values = 0.0_wp
-            do i = 1, self%nt
-                self%mat%values(self%pos(i)) = self%mat%values(self%pos(i)) + self%tv(i)
-            end do
-        else
+        fresh = .not. match
+        if (fresh) then
+            ! the pattern of B: every slot live
+            restoring = .false.
+            if (allocated(self%restore_values)) deallocate (self%restore_values)
             self%analysed = .false.
             self%factored = .false.
-            self%key_i1 = cs%i1(self%bond)
-            self%key_i2 = cs%i2(self%bond)
-            self%key_rows = [(rows_mask(cs, self%bond(b)), b=1, self%nb)]
-            call self%mat%init(self%nu, int(self%nt, i8))
-            do i = 1, self%nt
-                call self%mat%add(self%ti(i), self%tj(i), self%tv(i))
+            self%nb = nc
+            self%key_i1 = cs%i1(cur)
+            self%key_i2 = cs%i2(cur)
+            self%key_rows = [(rows_mask(cs, cur(b)), b=1, nc)]
+            self%bond = cur
+            if (allocated(self%dead)) deallocate (self%dead)
+            allocate (self%dead(nc))
+            self%dead = .false.
+            self%n_deleted = 0
+            call set_unknowns(self)
+        else if (restoring) then
+            call set_unknowns(self)
+        end if
+        if (.not. fresh) then
+            do i = 1, size(newly)
+                self%dead(newly(i)) = .true.
             end do
-            call self%mat%finalize(error)
-            if (allocated(error)) then
+        end if
+        ! the values: the live slots' entries of this step (unchanged within a step, so kept
+        ! when the step is solved again after a release), zero rows and columns for the dead
+        ! slots with 1 on their diagonal
+        reassemble = fresh .or. restoring .or. .not. self%resolving .or. present(bilateral)
+        if (reassemble) then
+            self%nt = 0
+            call assemble(self, cs, im, bilateral)
+            if (fresh .or. restoring) then
+                call self%mat%init(self%nu, int(self%nt, i8))
+                do i = 1, self%nt
+                    call self%mat%add(self%ti(i), self%tj(i), self%tv(i))
+                end do
+                call self%mat%finalize(error)
+                if (allocated(error)) then
+                    call give_up(self)
+                    return
+                end if
+                if (allocated(self%pos)) deallocate (self%pos, self%diag)
+                allocate (self%pos(self%nt), self%diag(self%nu))
+                do i = 1, self%nt
+                    self%pos(i) = self%mat%position(self%ti(i), self%tj(i))
+                end do
+                do u = 1, self%nu
+                    self%diag(u) = self%mat%position(u, u)
+                end do
+            else
+                self%mat%values = 0.0_wp
+                do i = 1, self%nt
+                    self%mat%values(self%pos(i)) = self%mat%values(self%pos(i)) + self%tv(i)
+                end do
+            end if
+            self%eps = 0.0_wp
+            do b = 1, self%nb
+                if (self%dead(b)) cycle
+                do u = self%first(b), self%first(b + 1) - 1
+                    self%eps = max(self%eps, self%mat%values(self%diag(u)))
+                end do
+            end do
+            self%eps = bonded_block_eps_ratio*self%eps
+            if (self%eps <= 0.0_wp) then
                 call give_up(self)
                 return
             end if
-            if (allocated(self%pos)) deallocate (self%pos, self%diag)
-            allocate (self%pos(self%nt), self%diag(self%nu))
-            do i = 1, self%nt
-                self%pos(i) = self%mat%position(self%ti(i), self%tj(i))
-            end do
-            do u = 1, self%nu
-                self%diag(u) = self%mat%position(u, u)
+        end if
+        if (reassemble) then
+            do b = 1, self%nb
+                if (self%dead(b)) cycle
+                do u = self%first(b), self%first(b + 1) - 1
+                    self%mat%values(self%diag(u)) = self%mat%values(self%diag(u)) + self%eps
+                end do
             end do
         end if
-        self%eps = bonded_block_eps_ratio*maxval(self%mat%values(self%diag))
-        if (self%eps <= 0.0_wp) then
-            call give_up(self)
-            return
-        end if
-        self%mat%values(self%diag) = self%mat%values(self%diag) + self%eps
-        if (.not. same) then
-            call self%solver%analyse(self%mat, error, kind=sparse_cholesky)
+        call clear_dead(self)
+        call size_work(self)
+        if (fresh .or. restoring) then
+            call self%solver%analyse(self%mat, error, kind=sparse_ldlt)
             if (allocated(error)) then
                 call give_up(self)
                 return
@@ -512,31 +590,197 @@ contains
             self%analysed = .true.
             self%counts%analyses = self%counts%analyses + 1
         end if
-        call size_work(self)
+        if (restoring) then
+            if (size(self%restore_values) == size(self%mat%values)) then
+                ! the factor of the checkpoint with its deletions, then the current values as
+                ! after a reuse
+                current = self%mat%values
+                self%mat%values = self%restore_values
+                deallocate (self%restore_values)
+                call refactor(self)
+                self%mat%values = current
+                if (self%factored) call delete_slots(self, self%restore_deleted)
+                if (self%factored) call delete_slots(self, newly)
+                if (.not. self%factored) call give_up(self)
+                if (.not. self%factored) return
+                self%stale = live_values_differ(self)
+                return
+            end if
+            deallocate (self%restore_values)
+            call refactor(self)
+            if (.not. self%factored) call give_up(self)
+            return
+        end if
         if (self%factored) then
-            ! keep the factor; `solve` refactors if it no longer contracts well
-            self%stale = any(self%mat%values /= self%values_factored)
+            ! keep the factor, without the bonds that left B; `solve` refactors if it no
+            ! longer contracts well
+            call delete_slots(self, newly)
+            if (.not. self%factored) then
+                call give_up(self)
+                return
+            end if
+            self%stale = live_values_differ(self)
             self%counts%reuses = self%counts%reuses + 1
             return
         end if
-        if (restoring) then
-            if (size(self%restore_values) == size(self%mat%values)) then
-                ! the factor of the checkpoint, then the current values as after a reuse
-                current = self%mat%values
-                self%mat%values = self%restore_values
-                call refactor(self)
-                self%mat%values = current
-                deallocate (self%restore_values)
-                if (.not. self%factored) call give_up(self)
-                if (.not. self%factored) return
-                self%stale = any(self%mat%values /= self%values_factored)
-                return
-            end if
-        end if
-        if (allocated(self%restore_values)) deallocate (self%restore_values)
         call refactor(self)
         if (.not. self%factored) call give_up(self)
     end subroutine prepare
+
+    !> Match B (contacts `cur`, in order) with the live slots of the analysed pattern: B is
+    !> those slots, or those slots but some (`newly`, which leave B and are deleted from the
+    !> factor). Sets bond(b) to the contact of each slot in B, 0 for the others.
+    subroutine match_slots(self, cs, cur, match, newly)
+        type(bonded_block_t), intent(inout) :: self
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: cur(:)
+        logical, intent(out) :: match
+        integer, allocatable, intent(out) :: newly(:)
+        integer :: b, i, k, n
+        allocate (newly(size(self%key_i1)))
+        n = 0
+        match = allocated(self%dead)
+        if (match) match = size(self%dead) == size(self%key_i1)
+        if (.not. match) return
+        if (allocated(self%bond)) then
+            if (size(self%bond) /= size(self%key_i1)) deallocate (self%bond)
+        end if
+        if (.not. allocated(self%bond)) allocate (self%bond(size(self%key_i1)))
+        self%bond = 0
+        i = 1
+        do b = 1, size(self%key_i1)
+            if (self%dead(b)) cycle
+            if (i <= size(cur)) then
+                k = cur(i)
+                if (self%key_i1(b) == cs%i1(k) .and. self%key_i2(b) == cs%i2(k) .and. &
+                    self%key_rows(b) == rows_mask(cs, k)) then
+                    self%bond(b) = k
+                    i = i + 1
+                    cycle
+                end if
+            end if
+            n = n + 1
+            newly(n) = b
+        end do
+        match = i == size(cur) + 1
+        newly = newly(1:n)
+    end subroutine match_slots
+
+    !> Unknowns of the slots (first, comp; nb, nu) from the locked components of the key.
+    subroutine set_unknowns(self)
+        type(bonded_block_t), intent(inout) :: self
+        integer :: b, c, u
+        self%nb = size(self%key_rows)
+        if (allocated(self%first)) deallocate (self%first)
+        allocate (self%first(self%nb + 1))
+        u = 1
+        do b = 1, self%nb
+            self%first(b) = u
+            u = u + popcnt(self%key_rows(b))
+        end do
+        self%first(self%nb + 1) = u
+        self%nu = u - 1
+        if (allocated(self%comp)) deallocate (self%comp)
+        allocate (self%comp(self%nu))
+        u = 1
+        do b = 1, self%nb
+            do c = 1, 3
+                if (.not. btest(self%key_rows(b), c - 1)) cycle
+                self%comp(u) = c
+                u = u + 1
+            end do
+        end do
+    end subroutine set_unknowns
+
+    !> Delete the unknowns of the slots `slots` from the factor (identity rows: the factor
+    !> then solves W_BB + eps I of the other slots exactly) and note them in `deleted`
+    !> (factored = .false. on failure).
+    subroutine delete_slots(self, slots)
+        type(bonded_block_t), intent(inout) :: self
+        integer, intent(in) :: slots(:)
+        type(error_t), allocatable :: error
+        integer, allocatable :: rows(:)
+        integer :: i, u
+        if (size(slots) == 0) return
+        rows = [((u, u=self%first(slots(i)), self%first(slots(i) + 1) - 1), i=1, size(slots))]
+        call self%solver%delete_rows(rows, error)
+        if (allocated(error)) then
+            self%factored = .false.
+            return
+        end if
+        if (.not. allocated(self%deleted)) allocate (self%deleted(self%nb))
+        if (size(self%deleted) < self%nb) then
+            rows = self%deleted(1:self%n_deleted)
+            deallocate (self%deleted)
+            allocate (self%deleted(self%nb))
+            self%deleted(1:self%n_deleted) = rows
+        end if
+        do i = 1, size(slots)
+            self%n_deleted = self%n_deleted + 1
+            self%deleted(self%n_deleted) = slots(i)
+        end do
+        self%counts%deletions = self%counts%deletions + size(slots)
+    end subroutine delete_slots
+
+    !> The unknowns of the dead slots.
+    pure function dead_unknowns(self) result(d)
+        type(bonded_block_t), intent(in) :: self
+        logical :: d(self%nu)
+        integer :: b
+        do b = 1, self%nb
+            d(self%first(b):self%first(b + 1) - 1) = self%dead(b)
+        end do
+    end function dead_unknowns
+
+    !> Rows and columns of the dead slots set to those of the identity in mat%values.
+    subroutine clear_dead(self)
+        type(bonded_block_t), intent(inout) :: self
+        logical :: d(self%nu)
+        integer(i8) :: p
+        integer :: i, j
+        d = dead_unknowns(self)
+        if (.not. any(d)) return
+        do j = 1, self%nu
+            do p = self%mat%colptr(j) + 1, self%mat%colptr(j + 1)
+                i = int(self%mat%rowind(p)) + 1
+                if (d(i) .or. d(j)) self%mat%values(p) = merge(1.0_wp, 0.0_wp, i == j)
+            end do
+        end do
+    end subroutine clear_dead
+
+    !> The current values differ from those of the factor on the live slots (the dead ones
+    !> are identity rows in both: deleted from the factor, or already so when factored).
+    pure logical function live_values_differ(self) result(differ)
+        type(bonded_block_t), intent(in) :: self
+        logical :: d(self%nu)
+        integer(i8) :: p
+        integer :: i, j
+        d = dead_unknowns(self)
+        differ = .false.
+        do j = 1, self%nu
+            if (d(j)) cycle
+            do p = self%mat%colptr(j) + 1, self%mat%colptr(j + 1)
+                i = int(self%mat%rowind(p)) + 1
+                if (d(i)) cycle
+                if (self%mat%values(p) /= self%values_factored(p)) then
+                    differ = .true.
+                    return
+                end if
+            end do
+        end do
+    end function live_values_differ
+
+    !> Disk of side s (1: i1, 2: i2) of slot b, <= 0 for a wall (from the key: the same for
+    !> a dead slot, whose contact may be gone).
+    pure integer function slot_body(self, b, s)
+        type(bonded_block_t), intent(in) :: self
+        integer, intent(in) :: b, s
+        if (s == 1) then
+            slot_body = self%key_i1(b)
+        else
+            slot_body = self%key_i2(b)
+        end if
+    end function slot_body
 
     !> Numerical factorisation of the current values (factored = .false. on failure).
     subroutine refactor(self)
@@ -548,6 +792,7 @@ contains
         self%factored = .true.
         self%stale = .false.
         self%values_factored = self%mat%values
+        self%n_deleted = 0
         self%counts%factorisations = self%counts%factorisations + 1
     end subroutine refactor
 
@@ -558,6 +803,7 @@ contains
         self%member = .false.
         self%nb = 0
         self%nu = 0
+        self%n_live = 0
         self%analysed = .false.
         self%factored = .false.
         self%counts%failures = self%counts%failures + 1
@@ -600,7 +846,8 @@ contains
 
     !> Assemble W_BB = H_B^T M_eff^-1 H_B as entries (push): one product per pair of
     !> bonds that share a disk, then the bilateral constraints' share. Every entry of a block
-    !> is added, zero or not, so that the pattern depends on the graph only.
+    !> is added, zero or not, so that the pattern depends on the graph only; the entries of
+    !> a dead slot are zeros (its contact may be gone: its disks come from the key).
     subroutine assemble(self, cs, im, bilateral)
         type(bonded_block_t), intent(inout) :: self
         type(contact_set_t), intent(in) :: cs
@@ -615,7 +862,7 @@ contains
         start = 0
         do b = 1, self%nb
             do s = 1, 2
-                d = body(cs, self%bond(b), s)
+                d = slot_body(self, b, s)
                 if (d > 0) start(d + 1) = start(d + 1) + 1
             end do
         end do
@@ -626,7 +873,7 @@ contains
         fill = start(1:nd)
         do b = 1, self%nb
             do s = 1, 2
-                d = body(cs, self%bond(b), s)
+                d = slot_body(self, b, s)
                 if (d <= 0) cycle
                 inc_b(fill(d)) = b
                 inc_s(fill(d)) = s
@@ -637,11 +884,13 @@ contains
             do e1 = start(d), start(d + 1) - 1
                 b1 = inc_b(e1)
                 s1 = inc_s(e1)
-                g1 = directions(cs, self%bond(b1), s1)
+                g1 = 0.0_wp
+                if (self%bond(b1) > 0) g1 = directions(cs, self%bond(b1), s1)
                 do e2 = e1, start(d + 1) - 1
                     b2 = inc_b(e2)
                     s2 = inc_s(e2)
-                    g2 = directions(cs, self%bond(b2), s2)
+                    g2 = 0.0_wp
+                    if (self%bond(b2) > 0) g2 = directions(cs, self%bond(b2), s2)
                     do p = self%first(b1), self%first(b1 + 1) - 1
                         do q = self%first(b2), self%first(b2 + 1) - 1
                             if (b1 == b2 .and. q > p) cycle
@@ -715,9 +964,10 @@ contains
         do i = 1, nt
             p = touched(i)
             b = bond_of(p)
+            if (self%bond(b) <= 0) cycle
             do s = 1, 2
                 if (.not. touches(b, s)) cycle
-                d = body(cs, self%bond(b), s)
+                d = slot_body(self, b, s)
                 g = directions(cs, self%bond(b), s)
                 do r = 1, nr
                     if (owner(r) /= d) cycle
@@ -735,7 +985,7 @@ contains
         pure logical function touches(bb, ss)
             integer, intent(in) :: bb, ss
             integer :: dd
-            dd = body(cs, self%bond(bb), ss)
+            dd = slot_body(self, bb, ss)
             touches = .false.
             if (dd > 0) touches = constrained(dd)
         end function touches
@@ -782,6 +1032,7 @@ contains
         end if
         do b = 1, self%nb
             k = self%bond(b)
+            if (k <= 0) cycle
             u = relative_velocity(cs, k, vel)
             u(3) = cs%amoy(k)*u(3)
             do p = self%first(b), self%first(b + 1) - 1
@@ -813,7 +1064,7 @@ contains
         call solve_direct(self, cs, im, vel, bilateral)
         ! not with bilateral constraints: their share of the cross terms W_kB is not in the
         ! condensed block, and the plain sweeps handle the released bonds as before
-        if (present(bilateral) .or. self%nb == 0 .or. self%lost) return
+        if (present(bilateral) .or. self%n_live == 0 .or. self%lost) return
         self%iterations = self%iterations + 1
         if (self%iterations <= condense_after) return
         if (.not. self%condensed_ready) call condense(self, cs, im)
@@ -857,7 +1108,7 @@ contains
         allocate (parent(0:size(im, 2)))
         parent = [(d, d=0, size(im, 2))]
         do b = 1, self%nb
-            call join(node(self%bond(b), 1), node(self%bond(b), 2))
+            if (self%bond(b) > 0) call join(node(self%bond(b), 1), node(self%bond(b), 2))
         end do
         if (allocated(self%released)) deallocate (self%released)
         allocate (self%released(count(self%excluded(1:n))))
@@ -880,7 +1131,8 @@ contains
                 dr(c) = 1.0_wp
                 call add_impulse(cs, k, dr, im, dv)
                 do b = 1, self%nb
-                    u = local_change(cs, self%bond(b), dv)
+                    u = 0.0_wp
+                    if (self%bond(b) > 0) u = local_change(cs, self%bond(b), dv)
                     do p = self%first(b), self%first(b + 1) - 1
                         self%rhs(p) = -u(self%comp(p))
                     end do
@@ -894,6 +1146,7 @@ contains
                     return
                 end if
                 do b = 1, self%nb
+                    if (self%bond(b) <= 0) cycle
                     dr = 0.0_wp
                     do p = self%first(b), self%first(b + 1) - 1
                         dr(self%comp(p)) = self%x(p)
@@ -991,10 +1244,10 @@ contains
         type(error_t), allocatable :: error
         real(wp) :: u(3), rnorm, prev, noise
         integer :: b, k, p, it
-        if (self%nb == 0 .or. self%lost) return
+        if (self%n_live == 0 .or. self%lost) return
         noise = 0.0_wp
         do b = 1, self%nb
-            noise = noise + velocity_scale2(cs, self%bond(b), vel)
+            if (self%bond(b) > 0) noise = noise + velocity_scale2(cs, self%bond(b), vel)
         end do
         noise = roundoff*sqrt(noise)
         prev = huge(1.0_wp)
@@ -1004,7 +1257,9 @@ contains
             ! the residual of the bonds, -u_B, from the velocities themselves
             do b = 1, self%nb
                 k = self%bond(b)
-                u = relative_velocity(cs, k, vel)
+                ! a dead slot: an identity row with a zero right-hand side, a zero change
+                u = 0.0_wp
+                if (k > 0) u = relative_velocity(cs, k, vel)
                 do p = self%first(b), self%first(b + 1) - 1
                     self%rhs(p) = -u(self%comp(p))
                 end do
@@ -1042,6 +1297,7 @@ contains
             end if
             do b = 1, self%nb
                 k = self%bond(b)
+                if (k <= 0) cycle
                 do p = self%first(b), self%first(b + 1) - 1
                     cs%r(self%comp(p), k) = cs%r(self%comp(p), k) + self%x(p)
                 end do

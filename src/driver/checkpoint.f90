@@ -620,6 +620,12 @@ contains
             if (.not. allocated(error)) call file%write_dataset(g//'/key_i2', sys%block%key_i2, error)
             if (.not. allocated(error)) call file%write_dataset(g//'/key_rows', sys%block%key_rows, error)
             if (.not. allocated(error)) call file%write_dataset(g//'/values', sys%block%values_factored, error)
+            ! slots whose bonds left the block: identity rows, some deleted from the factor
+            ! after its factorisation (replayed in order at the restart)
+            if (.not. any(sys%block%dead)) return
+            if (.not. allocated(error)) call file%write_dataset(g//'/dead', merge(1, 0, sys%block%dead), error)
+            if (.not. allocated(error) .and. sys%block%n_deleted > 0) &
+                call file%write_dataset(g//'/deleted', sys%block%deleted(1:sys%block%n_deleted), error)
         end subroutine save_block
 
         subroutine save_contacts(error)
@@ -770,7 +776,7 @@ contains
         subroutine load_block(error)
             type(error_t), allocatable, intent(out) :: error
             character(len=:), allocatable :: g
-            integer, allocatable :: k1(:), k2(:), kr(:)
+            integer, allocatable :: k1(:), k2(:), kr(:), dead(:), deleted(:)
             real(wp), allocatable :: v(:)
             if (allocated(sys%block)) deallocate (sys%block)
             g = group//'/block'
@@ -784,12 +790,31 @@ contains
                 call damaged(error, g//': key_i1, key_i2 and key_rows differ in size')
                 return
             end if
+            allocate (dead(size(k1)), deleted(0))
+            dead = 0
+            if (file%exists(g//'/dead')) call file%read_dataset(g//'/dead', dead, error)
+            if (.not. allocated(error) .and. file%exists(g//'/deleted')) &
+                call file%read_dataset(g//'/deleted', deleted, error)
+            if (allocated(error)) return
+            if (size(dead) /= size(k1)) then
+                call damaged(error, g//': dead and key_i1 differ in size')
+                return
+            end if
+            call require_range(dead, 0, 1, g//'/dead', error)
+            if (.not. allocated(error)) call require_range(deleted, 1, size(k1), g//'/deleted', error)
+            if (allocated(error)) return
+            if (size(deleted) > 0) then
+                if (any(dead(deleted) == 0)) then
+                    call damaged(error, g//': a slot of deleted is not dead')
+                    return
+                end if
+            end if
             call require_range(k1, -sys%walls%n, sys%particles%n, g//'/key_i1', error)
             if (.not. allocated(error)) call require_range(k2, 1, sys%particles%n, g//'/key_i2', error)
             if (.not. allocated(error)) call require_finite(v, g//'/values', error)
             if (allocated(error)) return
             allocate (sys%block)
-            call bonded_block_restore(sys%block, k1, k2, kr, v)
+            call bonded_block_restore(sys%block, k1, k2, kr, v, dead == 1, deleted)
         end subroutine load_block
 
         !> Read the first n values of a per-body array (the array keeps its size).

@@ -666,7 +666,9 @@ def main():
     check("bonds_end: the checkpoint holds intact bonds (status 3)", intact == 8,
           f"{intact} intact bonds")
     # The same row with the bonds solved as a direct block ([solver] method = block): the
-    # block's factor, kept from step to step, is restored from the checkpoint.
+    # block's factor, kept from step to step, is restored from the checkpoint, with the row
+    # of the bond broken before the stop deleted from it again (/dem/block/deleted; without
+    # that the contacts' reactions differ from the uninterrupted run's).
     block = work / "cohesive_row_block.dat"
     block.write_text(re.sub(r"^\[solver\]\s*$", "[solver]\nmethod = block",
                             (src / "input" / "cohesive_row.dat").read_text(), count=1, flags=re.M))
