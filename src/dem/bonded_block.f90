@@ -89,7 +89,7 @@
 module dem_bonded_block
     use core_kinds, only: wp, i8
     use core_error, only: error_t
-    use core_sparse, only: sparse_matrix_t, sparse_solver_t, sparse_ldlt
+    use core_sparse, only: sparse_matrix_t, sparse_solver_t, sparse_ldlt, sparse_stats_t
     use dem_contacts, only: contact_set_t, status_cohesive, bond_on_bound
     use dem_bipotential, only: case_stick, case_slip, case_roll, case_slip_roll, rolling_local_solve, &
                                bipotential_local_solve
@@ -782,13 +782,19 @@ contains
         end if
     end function slot_body
 
-    !> Numerical factorisation of the current values (factored = .false. on failure).
+    !> Numerical factorisation of the current values (factored = .false. on failure). W_BB +
+    !> eps I is positive definite, so a pivot D(j) < 0 of the L D L^T factor (which CHOLMOD
+    !> accepts: it stops only on a zero pivot) is a breakdown of the factorisation, treated
+    !> as a failure as the L L^T factor's pivot <= 0 was.
     subroutine refactor(self)
         type(bonded_block_t), intent(inout) :: self
         type(error_t), allocatable :: error
+        type(sparse_stats_t) :: figures
         self%factored = .false.
         call self%solver%factor(self%mat, error)
         if (allocated(error)) return
+        figures = self%solver%stats()
+        if (figures%negative_pivots > 0) return
         self%factored = .true.
         self%stale = .false.
         self%values_factored = self%mat%values
