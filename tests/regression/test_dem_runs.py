@@ -265,11 +265,11 @@ def bonded_shear_row(exe, decks, work, n=8):
 
 def bonded_pull_lattice(exe, decks, work):
     """dem_bonded_pull_lattice.dat: a bonded hexagonal lattice torn by imposed velocities;
-    its block has no solution and releases every bond at step 1. Every step converges within
-    the default cap (the released bonds are then mixed by Anderson's method: 340 iterations
-    at step 1, where the plain sweeps needed 1 564 and the step ended unconverged with no
-    bond broken), bonds break at step 1, each on the bound of its mode, and the bonds that
-    hold lie inside their cones."""
+    its block has no solution and releases every bond at step 1, in one pass. Every step
+    converges within the default cap (the released bonds are then mixed by Anderson's method:
+    340 iterations at step 1, where the plain sweeps needed 1 564 and the step ended
+    unconverged with no bond broken), step 1 within one cap over all its passes, bonds break
+    at step 1, each on the bound of its mode, and the bonds that hold lie inside their cones."""
     radius, r_cohe, mu_b = 0.01, 200.0, 0.5
     e_b = radius / 2
     f, _ = run(exe, decks / "dem_bonded_pull_lattice.dat", work)
@@ -283,6 +283,12 @@ def bonded_pull_lattice(exe, decks, work):
           bool(np.all(converged == 1)) and int(np.sum(bstep == 1)) > 0,
           f"converged {converged.tolist()} in {sweeps.tolist()} iterations, {int(np.sum(bstep == 1))} "
           f"bonds broken at step 1")
+    # The cap applies to each pass of the outer check; the block without a solution releases
+    # every bond in one pass, so step 1 stays within one cap over all its passes (measured 330
+    # iterations; released one at a time, by the order of reactions of size 1/eps, the bonds
+    # took 1 081 iterations over their passes and broke another set).
+    check("bonded pull lattice: step 1 within one cap of iterations over all its passes",
+          int(sweeps[0]) < 1000, f"{int(sweeps[0])} iterations at step 1")
     # A bond breaks when its reaction reaches the bound of its mode (1 tension: r_n + r_cohe =
     # 0; 2 shear: |r_t| = mu_b (r_n + r_cohe); 3 moment: |M| = e_b (r_n + r_cohe); 4 both),
     # read from the contacts written after the step of its rupture (output k = step k). The

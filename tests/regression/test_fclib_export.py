@@ -5,7 +5,8 @@ FCLIB export ([solver] fclib_step, doc/theory.md "Siconos error").
 
 The code computes the error from velocities (u = H^T (v_free + M^-1 H r) + shift); here W is
 the exported sparse matrix and u = W r + q. Two decks: a frictional deposit (2 components per
-contact, no cohesion) and the cohesive hanging row (bonds: cohesion and moments, 3 components).
+contact, no cohesion; also at a step where |q| is the largest term of the denominator) and the
+cohesive hanging row (bonds: cohesion and moments, 3 components).
 And two coupled runs, whose export is the contact problem with the Arlequin coupling rows
 condensed (W = H^T (M^-1 - P^T D C D P) H, dense among the contacts on coupled disks): the
 interface experiment (continuum, rolling resistance: 3 components) and the bonded hinged row
@@ -98,8 +99,9 @@ def siconos_error(W, q, r, mu, rolling, dim):
     return np.sqrt(num) / np.sqrt(max(nq, nr, nu)), u
 
 
-def case(exe, deck, step, work, expect_dim, extra=(), replace=None, name=None, end=None):
-    """Export step `step` of `deck` (run to `end` if given) and check it (see the module)."""
+def case(exe, deck, step, work, expect_dim, extra=(), replace=None, name=None, end=None, q_largest=False):
+    """Export step `step` of `deck` (run to `end` if given) and check it (see the module); with
+    q_largest, check too that |q| is the largest term of the error's denominator."""
     folder = deck.parent
     deck = with_export(deck, step, work, extra, replace, name)
     if end is not None:
@@ -137,6 +139,10 @@ def case(exe, deck, step, work, expect_dim, extra=(), replace=None, name=None, e
     check(f"{name}: W symmetric, positive semi-definite", sym < 1e-12 and eig > -1e-12,
           f"asymmetry {sym:.1e}, smallest eigenvalue / max|W| {eig:.1e}")
     err, u = siconos_error(W, q, r, mu, rolling, dim)
+    if q_largest:
+        nq, nr, nu = np.linalg.norm(q), np.linalg.norm(r), np.linalg.norm(u)
+        check(f"{name}: |q| the largest of |q|, |r|, |u|", nq > 1.1 * max(nr, nu),
+              f"|q| {nq:.3e}, |r| {nr:.3e}, |u| {nu:.3e}")
     # u from W r + q against the code's u (from the body velocities): the same sum in another
     # order; both are sums of terms of size |q|, so they agree to a few eps * |q|.
     du = np.max(np.abs(u - u_code)) / np.linalg.norm(q)
@@ -156,6 +162,11 @@ def main():
     decks = src / "tests" / "regression" / "decks"
     # a loose tolerance, so that the error compared is well above round-off
     case(exe, decks / "dem_small_deposit.dat", 276, work, 2, ("tolerance = 1e-3",))
+    # a step where the free term is the largest of |q|, |r|, |u| (the other cases have |r| or |u|
+    # larger): the denominator max(|q|, |r|, |u|) is checked with |q| in it. |q| is 1.2 times the
+    # next (measured |q| 0.289, |u| 0.237, |r| 0.074); 1.1 keeps the case meaningful against round-off.
+    case(exe, decks / "dem_small_deposit.dat", 250, work, 2, ("tolerance = 1e-3",), name="deposit_free_term.dat",
+         q_largest=True)
     # rolling resistance (e_r = 1 mm) on the pair 1-1, the one of every contact of that step
     _, rolling = case(exe, decks / "dem_small_deposit.dat", 291, work, 3, ("tolerance = 1e-3",),
                       ("law = 1 1 0.4 0.2 0", ["law = 1 1 0.4 0.2 0 0.001"]), "deposit_rolling.dat")
