@@ -107,6 +107,7 @@ module dem_nlgs
     !> by aggregates of contacts every `coarse_every` sweeps (coarse_correct).
     integer, parameter :: nlgs_method_coarse = 3
     public :: nlgs_siconos_error
+    public :: nlgs_split_t, nlgs_split_build
     public :: criterion_lmgc90, criterion_siconos, criterion_names
 
     !> Stopping criterion: the LMGC90-like norm of the sweeps (module header).
@@ -162,7 +163,7 @@ module dem_nlgs
         !> of 2 sweeps, half of that per sweep, and about as many sweeps in all
         !> (doc/performance.md, "Anderson over two sweeps").
         integer :: anderson_sweeps = 2
-        !> Domain split of the sweeps over the OpenMP threads (split_build): fewest contacts
+        !> Domain split of the sweeps over the OpenMP threads (nlgs_split_build): fewest contacts
         !> per block (smaller solves, and all solves on one thread, are serial).
         integer :: split_min = 2000
         !> Cold start from the hydrostatic estimate (hydrostatic_guess): when every contact of
@@ -222,14 +223,14 @@ module dem_nlgs
         real(wp), allocatable :: dgnorm(:)
     end type anderson_t
 
-    !> Domain split of the sweeps (split_build): the contacts of the solve in block order,
+    !> Domain split of the sweeps (nlgs_split_build): the contacts of the solve in block order,
     !> order(start(b):start(b + 1) - 1) for block b (swept in parallel), then the interface,
     !> order(start(nb + 1):), swept after them. The scaled frames of the solve are stored in the
     !> same order, so that a block is swept over contiguous memory like the serial sweep.
-    type :: split_t
+    type :: nlgs_split_t
         integer :: nb = 1
         integer, allocatable :: start(:), order(:)
-    end type split_t
+    end type nlgs_split_t
 
     !> Largest number of aggregates of the coarse correction (its system is factored dense:
     !> 2000^3/3 flops, about 1 s; larger aggregates are used beyond).
@@ -427,7 +428,7 @@ contains
         logical :: evaluated
         real(wp) :: floor, omega, checked
         type(anderson_t) :: aa
-        type(split_t) :: split
+        type(nlgs_split_t) :: split
         logical :: accelerate, coarse
         real(wp) :: error_corrected
         logical :: mix_now
@@ -467,7 +468,7 @@ contains
 !$      nb = omp_get_max_threads()
         if (present(bilateral) .or. stats%n_block > 0) nb = 1
         nb = max(1, min(nb, n_swept/max(config%split_min, 1)))
-        call split_build(split, cs, list, size(vel, 2), nb)
+        call nlgs_split_build(split, cs, list, size(vel, 2), nb)
         ! the scaled frames in the order of the sweeps (split%order); like every loop of the
         ! solve, on the threads only when the sweeps are split (below, waking the threads costs
         ! more than the loop)
@@ -989,7 +990,7 @@ contains
         integer, intent(in) :: list(:)
         real(wp), intent(in) :: im(:, :), vfree(:, :)
         real(wp), intent(inout) :: vel(:, :)
-        type(split_t), intent(in) :: split
+        type(nlgs_split_t), intent(in) :: split
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         logical, intent(in) :: others
         real(wp) :: gamma(aa%depth), rhs(aa%depth), fnorm, gnorm, fnorm_before, dfnorm2, drift
@@ -1300,7 +1301,7 @@ contains
     !> parallel, then the interface (serial order for one block).
     subroutine split_apply(cs, split, im, vel)
         type(contact_set_t), intent(in) :: cs
-        type(split_t), intent(in) :: split
+        type(nlgs_split_t), intent(in) :: split
         real(wp), intent(in) :: im(:, :)
         real(wp), intent(inout) :: vel(:, :)
         integer :: b, j, k
@@ -1594,8 +1595,8 @@ contains
     !> are swept after them, serially. nb = the number of OpenMP threads (1 without OpenMP or
     !> below split_min contacts per block, or with bilateral constraints): with nb = 1 the
     !> sweep is the serial one, and for a fixed nb the result does not depend on timing.
-    subroutine split_build(split, cs, list, n_disks, nb)
-        type(split_t), intent(out) :: split
+    subroutine nlgs_split_build(split, cs, list, n_disks, nb)
+        type(nlgs_split_t), intent(out) :: split
         type(contact_set_t), intent(in) :: cs
         integer, intent(in) :: list(:), n_disks, nb
         integer, allocatable :: owner(:)
@@ -1649,9 +1650,9 @@ contains
                 owner(d) = -1
             end if
         end subroutine mark
-    end subroutine split_build
+    end subroutine nlgs_split_build
 
-    !> One sweep with the domain split (split_build), forward or backward: the blocks in
+    !> One sweep with the domain split (nlgs_split_build), forward or backward: the blocks in
     !> parallel (each a plain sweep over its contiguous part of split%order and sc), the
     !> interface serially, after the blocks when forward, before them when backward.
     subroutine split_sweep(config, omega, cs, im, vel, sc, split, forward, num, den, nloc, bilateral)
@@ -1661,7 +1662,7 @@ contains
         real(wp), intent(in) :: im(:, :)
         real(wp), intent(inout) :: vel(:, :)
         real(wp), intent(in), contiguous :: sc(:, :)
-        type(split_t), intent(in) :: split
+        type(nlgs_split_t), intent(in) :: split
         logical, intent(in) :: forward
         real(wp), intent(out) :: num, den
         integer(i8), intent(out) :: nloc
