@@ -228,8 +228,12 @@ module dem_nlgs
     !> order(start(nb + 1):), swept after them. The scaled frames of the solve are stored in the
     !> same order, so that a block is swept over contiguous memory like the serial sweep.
     type :: nlgs_split_t
+        !> Number of blocks (1: the serial sweep).
         integer :: nb = 1
-        integer, allocatable :: start(:), order(:)
+        !> First position in `order` of each block, and of the interface (nb + 1).
+        integer, allocatable :: start(:)
+        !> The contacts of the solve, block after block, then the interface.
+        integer, allocatable :: order(:)
     end type nlgs_split_t
 
     !> Largest number of aggregates of the coarse correction (its system is factored dense:
@@ -1596,9 +1600,16 @@ contains
     !> below split_min contacts per block, or with bilateral constraints): with nb = 1 the
     !> sweep is the serial one, and for a fixed nb the result does not depend on timing.
     subroutine nlgs_split_build(split, cs, list, n_disks, nb)
+        !> The split.
         type(nlgs_split_t), intent(out) :: split
+        !> Contacts.
         type(contact_set_t), intent(in) :: cs
-        integer, intent(in) :: list(:), n_disks, nb
+        !> Contacts of the solve, in sweep order.
+        integer, intent(in) :: list(:)
+        !> Number of disks.
+        integer, intent(in) :: n_disks
+        !> Number of blocks (OpenMP threads).
+        integer, intent(in) :: nb
         integer, allocatable :: owner(:)
         integer :: n, b, a, k, lo, hi, nint, m
         logical, allocatable :: inter(:)
