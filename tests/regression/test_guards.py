@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Scenarios that used to run to NaN with exit 0, crash, or misbehave, and must now stop
 cleanly: guards on the initial state and after every step (non-finite state, disks beyond
-the representable box, tunnelling), one writer per results folder (lock file), --output '',
+the representable box, a driven wall with one end beyond it, tunnelling), the warning of a
+disk moving farther than the alert distance in one step, one writer per results folder (lock file), --output '',
 --end 1e999, no empty folder left by a failed run, three-digit exponents in messages, decks
 with a UTF-8 byte-order mark or CR-only line endings.
 
@@ -404,6 +405,72 @@ def end_off_the_steps(exe, work):
         check(f"{name}: {steps} steps done", done == steps, f"{done}")
 
 
+def speed_warning(exe, work):
+    """A disk that moves farther than the alert distance in one step (its contacts may be
+    found late) is reported once, with the distance |v| h of the fastest disk, |v| from both
+    components of its velocity."""
+    deck_text = """[run]
+analysis = dynamic
+[particles]
+material = 1 2500
+disk = 0 0 0.01 1
+disk = 1 0 0.01 1
+initial_velocity = 1 x {vx}
+initial_velocity = 1 y {vy}
+[contacts]
+law = 1 1 0.4 0 0
+alert = 1e-3
+[time]
+step = 1e-3
+end = 5e-3
+[output]
+progress = 0
+"""
+    # |v| h against the alert distance 1 mm: 3 mm straight down, 5 mm along (3, 4) m/s,
+    # 0.5 mm along (0.3, 0.4) m/s (below it: no warning). No force acts: |v| stays.
+    for name, vx, vy, moved, speed in (("speed_down", "0", "-3", "3.00E-003", "3.00E+000"),
+                                       ("speed_oblique", "3", "4", "5.00E-003", "5.00E+000"),
+                                       ("speed_slow", "0.3", "0.4", None, None)):
+        deck = work / f"{name}.dat"
+        deck.write_text(deck_text.format(vx=vx, vy=vy))
+        proc = multicor(exe, deck, "--output", work / name, "--quiet")
+        check(f"{name}: exit 0", proc.returncode == 0, proc.stderr.strip()[:300])
+        said = [ln for ln in proc.stdout.splitlines() if "more than the alert distance" in ln]
+        if moved is None:
+            check(f"{name}: no speed warning", not said, "; ".join(said))
+        else:
+            expect = rf"a disk moves\s+{re.escape(moved)} m in one step \(speed\s+{re.escape(speed)} m/s\)"
+            check(f"{name}: one speed warning, {moved} m in one step", len(said) == 1
+                  and re.search(expect, said[0]) is not None, "; ".join(said) or "none")
+
+
+def wall_end_beyond_box(exe, work):
+    """A driven wall whose second end point leaves the box the run can represent, while its
+    first one is still inside, stops the run like a wall that leaves it whole."""
+    # The box: |x|, |y| <= 1e-6 r_min / eps (dem_detection::coordinate_limit), r_min = 0.01 m.
+    limit = 1.0e-6 * (0.01 / float(np.finfo(float).eps))
+    # A floor ending 5 cm inside the box, driven along itself at 100 m/s: 10 cm per step of
+    # 1 ms, so its second end is beyond the box after step 1 and its first at x = 0.1 m.
+    text = f"""[run]
+analysis = dynamic
+[particles]
+material = 1 2500
+disk = 1 0.011 0.01 1
+[walls]
+wall = 0 0 {limit - 0.05!r} 0 1 {{v}} 0
+[contacts]
+law = 1 1 0.4 0 0
+[time]
+step = 1e-3
+end = 5e-3
+[output]
+progress = 0
+"""
+    failing_run(exe, work, "dem_wall_end_beyond_box", text.format(v="100"),
+                r"step 1 \(t = 1\.00000E-003 s\): wall 1 has moved to \(1\.0+E-0*1, 0\.0+E\+0+\) - .* beyond the box",
+                text.format(v="1"))
+
+
 def main():
     exe, work, src = arguments()
     non_finite(exe, work)
@@ -418,6 +485,8 @@ def main():
     end_option(exe, work)
     no_empty_folder(exe, work)
     exponents(exe, work)
+    speed_warning(exe, work)
+    wall_end_beyond_box(exe, work)
     line_endings(exe, work)
     end_off_the_steps(exe, work)
     return summary()

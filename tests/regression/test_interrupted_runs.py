@@ -9,7 +9,9 @@ killed or signalled. The '.partial' file must open in h5py and h5dump, say finis
 at the same steps; an earlier finished result in the same folder must stay untouched. A file
 size limit (RLIMIT_FSIZE, as `ulimit -f`, unprivileged) and, where root can mount one, a
 full 512 KiB tmpfs: the run must stop with a clear error at the write and exit code 1, not
-crash. An --output that names a file: exit 1 saying so, the file untouched.
+crash. An --output that names a file: exit 1 saying so, the file untouched. A particle run
+(input/incline.dat) and a coupled run (input/bending_case2.dat) killed with -9: the same
+for their partial files.
 Usage (ctest does this): test_interrupted_runs.py --exe multicor --work DIR --source REPO
 """
 import argparse
@@ -182,6 +184,51 @@ def kill_9(exe, src, work):
     check("kill -9: earlier finished result untouched", digest(earlier) == before, str(earlier))
 
 
+def kill_9_loop(exe, src, work, deck_name, label, min_step=300):
+    """kill -9 a particle run or a coupled run at three moments: the partial file opens and
+    holds the outputs so far, equal to those of an uninterrupted run (every time loop
+    flushes the file after each output, as the beam loop does). Outputs every 10 steps."""
+    deck_src = src / "input" / deck_name
+    stem = f"long_{deck_src.stem}"
+    folder = work / f"kill9_{deck_src.stem}"
+    deck = deck_with_end(deck_src, work / f"{stem}.dat", 1000.0, progress=0.02)
+    partial = folder / f"{stem}.h5.partial"
+    counts, failures, short = [], [], []
+    for i, extra in enumerate([0.0, 0.07, 0.19]):
+        partial.unlink(missing_ok=True)
+        proc = start(exe, deck, folder)
+        # Past step min_step (outputs every 10 steps, and the initial state).
+        lines = []
+        if not wait_for_step(proc, min_step, lines):
+            check(f"kill -9 ({label}): run reached a few outputs", False, proc.communicate()[1][-300:])
+            return
+        time.sleep(extra)
+        proc.send_signal(signal.SIGKILL)
+        out, _ = proc.communicate()
+        # A progress line comes after the outputs of its step are flushed: the file holds
+        # every output up to the last step printed before the kill, and the initial state.
+        printed = [int(m.group(1)) for m in re.finditer(r"^step (\d+)/", "".join(lines) + out, flags=re.M)]
+        n_out, summary = readable(f"kill -9 {label} #{i + 1}", partial, failures)
+        if n_out == 0:
+            continue
+        counts.append(n_out)
+        if n_out < max(printed) // 10 + 1:
+            short.append(f"#{i + 1}: {n_out} outputs, step {max(printed)} printed")
+        if len(counts) == 1:
+            check(f"kill -9 ({label}): /summary finished = 0", int(summary.get("finished", -1)) == 0,
+                  f"{summary}")
+            with h5py.File(partial, "r") as f:
+                t_last = float(f[series_key(f)][-1])
+            h = float(re.search(r"^step\s*=\s*(\S+)", deck_src.read_text(), flags=re.M).group(1))
+            ref = reference_run(exe, deck_src, t_last, 10 * h, work, f"ref_kill9_{deck_src.stem}")
+            compare_prefix(f"kill -9 ({label}): outputs equal an uninterrupted run", partial, ref, False)
+    # The in-flush window of kill_9 (p <= 1/300 per kill): one unreadable file of three is
+    # tolerated; every readable one holds the outputs of every step printed.
+    check(f"kill -9 ({label}): partial files readable and holding the outputs of every step printed",
+          len(failures) <= 1 and len(counts) >= 2 and not short,
+          f"{len(counts)} readable, unreadable: {failures}, outputs held {counts}; short: {short}")
+
+
 def stop_by_signal(exe, src, work, deck_name, sig, name):
     """Send `sig` to a long run: exit 128 + sig, message, partial closed with finished = 0
     and every output up to the step of the stop, equal to an uninterrupted run."""
@@ -315,6 +362,8 @@ def main():
     shutil.rmtree(work, ignore_errors=True)
     work.mkdir(parents=True)
     kill_9(exe, src, work)
+    kill_9_loop(exe, src, work, "incline.dat", "particles")
+    kill_9_loop(exe, src, work, "bending_case2.dat", "coupled", min_step=100)
     stop_by_signal(exe, src, work, "cantilever.dat", signal.SIGTERM, "term_beam")
     stop_by_signal(exe, src, work, "incline.dat", signal.SIGUSR1, "usr1_dem")
     stop_by_signal(exe, src, work, "bending_case2.dat", signal.SIGINT, "int_coupled")

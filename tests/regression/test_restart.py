@@ -4,7 +4,8 @@ continued from its checkpoint gives BITWISE the results of the uninterrupted run
 
 For a beam deck (input/cantilever.dat), a particle deck with contacts and bonds that break
 (input/cohesive_row.dat: bonded row, two ruptures, one before and one after the stop; also
-with [solver] method = block, whose factor is kept from step to step) and
+with [solver] method = block, whose factor is kept from step to step; a deposit under a
+driven wall with unconverged steps before and after the stop) and
 coupled decks (input/bending_stack.dat, tests/regression/decks/coupled_rigid_translation.dat),
 a 2D continuum deck (input/continuum_cantilever_dynamic.dat) and continuum-disk coupled decks
 (tests/regression/decks/coupled2d_pushed.dat with one multiplier per disk and with the
@@ -43,6 +44,32 @@ from checks import check, summary
 # Attributes that measure wall-clock time or dates: they differ between any two runs.
 CLOCK_ATTRIBUTES = {"created", "ended", "wall_seconds", "detection_seconds", "solver_seconds",
                     "run_id"}
+
+# Disks settling under a piston (the fourth wall, driven down at 0.2 m/s) with at most 3
+# sweeps per step: most steps end unconverged.
+PISTON = """[run]
+title    = Deposit under a piston
+analysis = dynamic
+[particles]
+material = 1 2500
+deposit  = 60 0 0.1 0 0.004 0.005 1 7
+gravity  = 0 -9.81
+[walls]
+wall = 0 0 0.1 0
+wall = 0 0 0 0.3
+wall = 0.1 0 0.1 0.3
+wall = 0.1 0.1 0 0.1 1 0 -0.2
+[contacts]
+law = 1 1 0.4 0.1 0
+[solver]
+max_sweeps = 3
+[time]
+step = 1e-3
+end  = 0.2
+[output]
+interval = 10
+progress = 0
+"""
 
 
 def edit_deck(src, dst, end=None, extra_output=None, progress=None):
@@ -673,6 +700,21 @@ def main():
     block.write_text(re.sub(r"^\[solver\]\s*$", "[solver]\nmethod = block",
                             (src / "input" / "cohesive_row.dat").read_text(), count=1, flags=re.M))
     by_end_time(exe, block, work, "block_end", 0.1)
+    # A driven wall and unconverged steps: the walls' end points and the count of unconverged
+    # steps (/dem/solver@unconverged_steps) come back from the checkpoint. Stopped at step
+    # 125, not an output step.
+    piston = work / "piston.dat"
+    piston.write_text(PISTON)
+    ref = by_end_time(exe, piston, work, "piston_end", 0.125)
+    with h5py.File(ref, "r") as f, h5py.File(work / "piston_end_first_checkpoint.h5", "r") as c:
+        total = int(f["dem/solver"].attrs["unconverged_steps"])
+        before = int(c["loop"].attrs["unconverged"])
+        ceiling = (float(c["dem/walls/y1"][3]), float(c["dem/walls/y2"][3]))
+    check("piston_end: unconverged steps before and after the stop", 0 < before < total,
+          f"{before} before the stop, {total} in all")
+    # 0.2 m/s for 0.125 s: both ends at 0.1 - 0.025 m (to round-off)
+    check("piston_end: the piston moved down 25 mm before the stop",
+          all(abs(y - 0.075) < 1e-12 for y in ceiling), f"ends at y = {ceiling} m")
     # The deposit compared with Siconos, with Siconos' rule of activation ([time] contact_scheme
     # = siconos): the rule reads the outputs of the previous step's contacts, which the
     # checkpoint keeps (dem/contacts/y). Stopped at step 85, while the pile forms.
