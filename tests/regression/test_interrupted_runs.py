@@ -10,8 +10,9 @@ at the same steps; an earlier finished result in the same folder must stay untou
 size limit (RLIMIT_FSIZE, as `ulimit -f`, unprivileged) and, where root can mount one, a
 full 512 KiB tmpfs: the run must stop with a clear error at the write and exit code 1, not
 crash. An --output that names a file: exit 1 saying so, the file untouched. A particle run
-(input/incline.dat) and a coupled run (input/bending_case2.dat) killed with -9: the same
-for their partial files.
+(input/incline.dat), a coupled run (input/bending_case2.dat), a continuum run
+(input/continuum_cantilever_dynamic.dat) and a continuum-disk run (input/coupled2d_block.dat)
+killed with -9: the same for their partial files.
 Usage (ctest does this): test_interrupted_runs.py --exe multicor --work DIR --source REPO
 """
 import argparse
@@ -64,7 +65,8 @@ def wait_for_step(proc, min_step, lines):
 
 
 def series_key(f):
-    return "fem/time" if "fem/time" in f else "dem/time"
+    """The time axis of the outputs: the beam's, the continuum's, or the disks'."""
+    return next(k for k in ("fem/time", "continuum/time", "dem/time") if k in f)
 
 
 def compare_prefix(name, partial, reference, complete):
@@ -185,7 +187,7 @@ def kill_9(exe, src, work):
 
 
 def kill_9_loop(exe, src, work, deck_name, label, min_step=300):
-    """kill -9 a particle run or a coupled run at three moments: the partial file opens and
+    """kill -9 a particle, coupled, continuum or continuum-disk run at three moments: the partial file opens and
     holds the outputs so far, equal to those of an uninterrupted run (every time loop
     flushes the file after each output, as the beam loop does). Outputs every 10 steps."""
     deck_src = src / "input" / deck_name
@@ -364,6 +366,8 @@ def main():
     kill_9(exe, src, work)
     kill_9_loop(exe, src, work, "incline.dat", "particles")
     kill_9_loop(exe, src, work, "bending_case2.dat", "coupled", min_step=100)
+    kill_9_loop(exe, src, work, "continuum_cantilever_dynamic.dat", "continuum", min_step=100)
+    kill_9_loop(exe, src, work, "coupled2d_block.dat", "continuum and disks", min_step=100)
     stop_by_signal(exe, src, work, "cantilever.dat", signal.SIGTERM, "term_beam")
     stop_by_signal(exe, src, work, "incline.dat", signal.SIGUSR1, "usr1_dem")
     stop_by_signal(exe, src, work, "bending_case2.dat", signal.SIGINT, "int_coupled")
