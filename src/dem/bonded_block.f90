@@ -570,8 +570,6 @@ contains
                 call give_up(self)
                 return
             end if
-        end if
-        if (reassemble) then
             do b = 1, self%nb
                 if (self%dead(b)) cycle
                 do u = self%first(b), self%first(b + 1) - 1
