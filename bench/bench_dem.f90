@@ -1,7 +1,8 @@
 !> Speed and memory of the discrete-element kernel (issue 3, "Speed").
 !>
 !> For N = 1e3, 1e4, 1e5 disks: a dense random packing at rest in a box under gravity
-!> (bench_packing: sequential deposition with rolling, radii uniform in [0.8, 1.2] mm, seed 42,
+!> (bench_packing: sequential deposition with rolling, radii uniform in [0.8, 1.2] mm, seed 42
+!> or --packing-seed S,
 !> box about as high as wide, floor and two side walls; radii then enlarged by 1e-6 so that
 !> every contact of the deposit starts closed), density 2500 kg/m^3, mu = 0.5, e = 0,
 !> h = 1 ms, theta = 1/2, alert 5 % of the mean radius, NLGS tolerance
@@ -117,6 +118,9 @@ program bench_dem
     !> Seed of the deposit's radii (--seed; 8 is the layout of the decks and of the CSV compared
     !> with Siconos).
     integer :: layout_seed = 8
+    !> Seed of the random packings' deposition (--packing-seed; 42 is the packing of the
+    !> tables of doc/performance.md).
+    integer :: packing_seed = 42
     character(len=256) :: csv_path = '', deck_path = ''
     !> Rule of activation (--scheme, `[time] contact_scheme`): multicor or siconos; '' for the
     !> default of the mode (siconos for --siconos, the deposit compared with Siconos 4.4 on
@@ -159,6 +163,8 @@ program bench_dem
             call read_int_value(arg, val, siconos_n)
         case ('--seed')
             call read_int_value(arg, val, layout_seed)
+        case ('--packing-seed')
+            call read_int_value(arg, val, packing_seed)
         case ('--scheme')
             if (val /= 'multicor' .and. val /= 'siconos') &
                 call usage_error('--scheme takes multicor or siconos, got '''//trim(val)//'''')
@@ -293,7 +299,7 @@ contains
             '         [--anderson-sweeps P] [--relaxation W --check-every K] [--criterion lmgc90|siconos] [--forward]', &
             '         [--hydrostatic] [--method nlgs|block|coarse] [--coarse-every K] [--coarse-size M]', &
             '         [--settle-anderson M] [--settle-sweeps C] [--settle-method M] [--scheme multicor|siconos]', &
-            '         [--tol T] [--settle-tol T] [--steps K] [--verbose]', &
+            '         [--tol T] [--settle-tol T] [--steps K] [--packing-seed S] [--verbose]', &
             '       bench_dem --convergence', &
             '       bench_dem --siconos 200|2000 [--seed S] [--scheme siconos|multicor] [--csv FILE] [--deck FILE]', &
             '         [--anderson M] [--anderson-after K] [--anderson-sweeps P] [--forward] [--verbose]', &
@@ -645,7 +651,7 @@ contains
         real(wp) :: width, top
         call system_clock(t0, clock_rate)
         width = deposit_width(n, rmin, rmax, 1.0_wp)
-        call deposit_disks(n, width, rmin, rmax, 42, x, y, radius, c%stuck)
+        call deposit_disks(n, width, rmin, rmax, packing_seed, x, y, radius, c%stuck)
         call system_clock(t1)
         c%n = n
         c%t_build = real(t1 - t0, wp)/real(clock_rate, wp)
