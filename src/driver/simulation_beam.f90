@@ -62,14 +62,23 @@ contains
         !> Set on any input error.
         type(error_t), allocatable, intent(out) :: error
         character(len=:), allocatable :: message
+        integer :: line
         call build_config(deck, self%settings, self%beam, error)
         if (allocated(error)) return
         call build_beam_model(self%beam, self%model, error)
-        ! A static solve needs supports that stop every rigid-body motion.
-        if (.not. allocated(error) .and. self%settings%analysis == 'static') &
-            call self%model%check_supports(error)
         if (allocated(error)) then
             error%message = deck%file//': '//error%message
+            return
+        end if
+        ! A static solve needs supports that stop every rigid-body motion: the error names the
+        ! first `fix` of the deck (the supports as a whole; the message names the part), or
+        ! the first `line` when there is none.
+        if (self%settings%analysis == 'static') call self%model%check_supports(error)
+        if (allocated(error)) then
+            message = error%message
+            line = deck%line('beam', 'fix')
+            if (line == 0) line = deck%line('beam', 'line')
+            call make_input_error(error, deck%file, line, 'fix', message)
             return
         end if
         if (self%settings%analysis == 'modal') then
