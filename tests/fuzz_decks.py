@@ -121,8 +121,9 @@ def check(job):
                 return f"{where}: run exit {code}: {last}", None
             if any(s in text for s in CRASH):
                 return f"{where}: the run crashed: {last}", None
-            if code == 0 and non_finite(out):
-                return f"{where}: non-finite results with exit 0: {non_finite(out)[:3]}", None
+            bad = non_finite(out) if code == 0 else []
+            if bad:
+                return f"{where}: non-finite results with exit 0: {bad[:3]}", None
         finally:
             shutil.rmtree(out, ignore_errors=True)
         return None, None
