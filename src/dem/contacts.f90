@@ -165,8 +165,11 @@ contains
         call grow_int(cs%status, cs%capacity, 0)
         call grow_real2(cs%r, 3, cs%capacity, 0)
         call grow_real2(cs%y, 2, cs%capacity, 0)
-        ! the new list is usually about as long as the previous one
-        call ensure_capacity(cs, cs%n_prev + cs%n_prev/8)
+        ! the new list is usually about as long as the previous one; the slack beyond it is
+        ! memory of every per-contact array (of the current and the previous list), so it is
+        ! kept small: 1/16 here, growth by eighths below (with 1/8 and quarters, 1 039 bytes
+        ! per disk at 10^4 disks against 926; doc/performance.md, issue 3's 1 KB per particle)
+        call ensure_capacity(cs, cs%n_prev + cs%n_prev/16)
     end subroutine contacts_begin_detection
 
     !> Append a pair (in contact order) with its geometry; its reaction and status are carried
@@ -217,11 +220,11 @@ contains
         !> Number of slots to add (>= 0).
         integer, intent(in) :: m
         integer :: cap
-        ! grow by quarters, as appending the contacts owner by owner does: the capacity, hence
+        ! grow by eighths, as appending the contacts owner by owner does: the capacity, hence
         ! the memory, does not depend on how the list was cut (number of threads)
         cap = cs%capacity
         do while (cap < cs%n + m)
-            cap = max(cap + cap/4, 64)
+            cap = max(cap + cap/8, 64)
         end do
         if (cap > cs%capacity) call ensure_capacity(cs, cap)
         cs%n = cs%n + m
@@ -325,7 +328,7 @@ contains
         integer, intent(in) :: m
         integer :: cap
         if (m <= cs%capacity) return
-        cap = max(cs%capacity + cs%capacity/4, m, 64)
+        cap = max(cs%capacity + cs%capacity/8, m, 64)
         call grow_int(cs%i1, cap, cs%n)
         call grow_int(cs%i2, cap, cs%n)
         call grow_real2(cs%nrm, 2, cap, cs%n)
