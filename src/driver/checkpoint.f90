@@ -793,8 +793,8 @@ contains
             allocate (dead(size(k1)), deleted(0))
             dead = 0
             if (file%exists(g//'/dead')) call file%read_dataset(g//'/dead', dead, error)
-            if (.not. allocated(error) .and. file%exists(g//'/deleted')) &
-                call file%read_dataset(g//'/deleted', deleted, error)
+            if (allocated(error)) return
+            if (file%exists(g//'/deleted')) call file%read_dataset(g//'/deleted', deleted, error)
             if (allocated(error)) return
             if (size(dead) /= size(k1)) then
                 call damaged(error, g//': dead and key_i1 differ in size')
@@ -1482,8 +1482,11 @@ contains
         !> The actions due, in the order of their components.
         type(step_end_t) :: act
         act%store_first = mod(k, int(output_interval, i8)) == 0
-        act%stop = k < n_steps .and. caught_signal() /= 0
-        act%checkpoint = k == n_steps .or. act%stop .or. schedule%due(k)
+        ! each impure call on its own: in an .and./.or. expression gfortran may skip it
+        act%stop = .false.
+        if (k < n_steps) act%stop = caught_signal() /= 0
+        act%checkpoint = k == n_steps .or. act%stop
+        if (.not. act%checkpoint) act%checkpoint = schedule%due(k)
         act%store_last = (k == n_steps .or. act%stop) .and. .not. act%store_first
     end function end_of_step
 end module driver_checkpoint

@@ -208,19 +208,17 @@ contains
         type(node_candidate_t), allocatable :: nodes(:)
         type(element_candidate_t), allocatable :: elements(:)
         integer, allocatable :: def_line(:)
-        logical, allocatable :: def_generated(:)
         integer :: n_nodes, n_elements
         call collect_candidates(deck, nodes, n_nodes, elements, n_elements, error)
         if (allocated(error)) return
-        call merge_nodes(deck, nodes(:n_nodes), beam, def_line, def_generated, error)
+        call merge_nodes(deck, nodes(:n_nodes), beam, def_line, error)
         if (allocated(error)) return
         if (n_elements == 0) then
             call make_input_error(error, deck%file, 0, '', 'the model has no element: '// &
                                   'add [beam] line or element records')
             return
         end if
-        call resolve_elements(deck, elements(:n_elements), section_ids, def_line, &
-                              def_generated, beam, error)
+        call resolve_elements(deck, elements(:n_elements), section_ids, def_line, beam, error)
     end subroutine build_mesh
 
     !> Walk the [beam] entries in file order; list node and element candidates.
@@ -378,7 +376,7 @@ contains
 
     !> Merge candidates with the same id (generated nodes reuse coincident existing ones),
     !> number the nodes in increasing id order, fill x, y and node_id.
-    subroutine merge_nodes(deck, nodes, beam, def_line, def_generated, error)
+    subroutine merge_nodes(deck, nodes, beam, def_line, error)
         !> The deck.
         type(deck_t), intent(in) :: deck
         !> Node candidates in file order.
@@ -387,15 +385,13 @@ contains
         type(beam_config_t), intent(inout) :: beam
         !> Deck line defining each node.
         integer, allocatable, intent(out) :: def_line(:)
-        !> Whether each node was defined by a generator.
-        logical, allocatable, intent(out) :: def_generated(:)
         !> Error, if any.
         type(error_t), allocatable, intent(out) :: error
         integer :: order(size(nodes))
         integer :: i, n, ref
         order = sort_index([(int(nodes(i)%id, i8), i=1, size(nodes))])
         allocate (beam%x(size(nodes)), beam%y(size(nodes)), beam%node_id(size(nodes)))
-        allocate (def_line(size(nodes)), def_generated(size(nodes)))
+        allocate (def_line(size(nodes)))
         n = 0
         ref = 0
         do i = 1, size(nodes)
@@ -413,14 +409,12 @@ contains
                 beam%x(n) = c%x
                 beam%y(n) = c%y
                 def_line(n) = c%line
-                def_generated(n) = c%generated
             end associate
         end do
         beam%x = beam%x(:n)
         beam%y = beam%y(:n)
         beam%node_id = beam%node_id(:n)
         def_line = def_line(:n)
-        def_generated = def_generated(:n)
 
     contains
 
@@ -448,7 +442,7 @@ contains
 
     !> Node indices and section indices of elements; checks unknown ids, duplicate element
     !> ids, zero-length and duplicate elements, nodes connected to no element.
-    subroutine resolve_elements(deck, elements, section_ids, def_line, def_generated, beam, error)
+    subroutine resolve_elements(deck, elements, section_ids, def_line, beam, error)
         !> The deck.
         type(deck_t), intent(in) :: deck
         !> Element candidates in file order.
@@ -457,8 +451,6 @@ contains
         integer, intent(in) :: section_ids(:)
         !> Deck line defining each node.
         integer, intent(in) :: def_line(:)
-        !> Whether each node was defined by a generator.
-        logical, intent(in) :: def_generated(:)
         !> Beam configuration (conn, elem_section filled).
         type(beam_config_t), intent(inout) :: beam
         !> Error, if any.

@@ -392,6 +392,7 @@ contains
         real(wp) :: vx, vy, length, size_model, limit
         character(len=:), allocatable :: message
         integer :: i, mat, func
+        logical :: has_vx, has_vy
         allocate (list, source=deck%records('walls', 'wall'))
         allocate (cfg%wall_line(size(list)))
         size_model = model_size(cfg, list)
@@ -399,7 +400,9 @@ contains
         do i = 1, size(list)
             associate (e => list(i))
                 cfg%wall_line(i) = e%line
-                if (e%has('vx') .and. .not. e%has('vy')) then
+                has_vx = e%has('vx')
+                has_vy = e%has('vy')
+                if (has_vx .and. .not. has_vy) then
                     call make_input_error(error, deck%file, e%line, 'wall', 'the wall velocity '// &
                                           "needs both vx and vy: expected 'x1 y1 x2 y2 [material] [vx vy "// &
                                           "[function]]', got 6 values")

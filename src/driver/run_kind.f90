@@ -114,17 +114,24 @@ contains
         allocate (warnings(0))
         select case (run_kind_of(deck))
         case (run_coupled, run_coupled2d)
-            if (deck%has('solver', 'method') .and. deck%get_word('solver', 'method') == 'coarse') &
+            if (set_to('method', 'coarse')) &
                 warnings = [warnings, string_t('warning: '//deck%file//':'//to_str(deck%line('solver', 'method'))// &
                                                ': [solver] method = coarse has no effect in a coupled run: '// &
                                                'the coarse correction does not act on the coupling rows, and the run '// &
                                                'sweeps as with method = nlgs')]
-            if (deck%has('solver', 'cold_start') .and. deck%get_word('solver', 'cold_start') == 'hydrostatic') &
+            if (set_to('cold_start', 'hydrostatic')) &
                 warnings = [warnings, string_t('warning: '//deck%file//':'//to_str(deck%line('solver', 'cold_start'))// &
                                                ': [solver] cold_start = hydrostatic has no effect in a coupled run: '// &
                                                'the hydrostatic estimate leaves out the coupling rows, and a step without '// &
                                                'reactions starts from zero')]
         end select
+    contains
+        ! whether the deck itself sets [solver] keyword to value
+        logical function set_to(keyword, value)
+            character(len=*), intent(in) :: keyword, value
+            set_to = .false.
+            if (deck%has('solver', keyword)) set_to = deck%get_word('solver', keyword) == value
+        end function set_to
     end function run_kind_warnings
 
     !> Error for a deck without [particles] that sets particle-only keywords ([walls],

@@ -308,7 +308,9 @@ contains
                 n_steps = k
                 exit
             end if
-            if (.not. quiet .and. progress%due()) call report(progress%line(k, integ%t))
+            if (.not. quiet) then
+                if (progress%due()) call report(progress%line(k, integ%t))
+            end if
         end do
         write (buf, '(a,i0,a,es13.5e3,a,es11.3e3)') 'dynamic run: ', n_steps, ' steps to t = ', &
             integ%t, ' s; energy balance residual ', integ%energy_balance()

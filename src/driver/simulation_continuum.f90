@@ -287,6 +287,7 @@ contains
             type(error_t), allocatable, intent(out) :: error
             integer, allocatable :: ids(:)
             integer :: i, j, func
+            real(wp) :: gravity(2)
             deallocate (self%model%timed_load)
             allocate (self%model%timed_load(self%model%dof_count(), size(function_ids)), source=0.0_wp)
             list = deck%records('continuum', 'load')
@@ -316,9 +317,9 @@ contains
                 if (allocated(error)) return
                 call end_load(func)
             end do
-            if (deck%get_real('continuum', 'gravity', 'gx') /= 0 .or. deck%get_real('continuum', 'gravity', 'gy') /= 0) then
-                call self%model%add_body_force([deck%get_real('continuum', 'gravity', 'gx'), &
-                                                deck%get_real('continuum', 'gravity', 'gy')], error)
+            gravity = [deck%get_real('continuum', 'gravity', 'gx'), deck%get_real('continuum', 'gravity', 'gy')]
+            if (any(gravity /= 0)) then
+                call self%model%add_body_force(gravity, error)
                 if (allocated(error)) call fail_at(error, deck%line('continuum', 'gravity'), 'gravity')
                 if (allocated(error)) return
             end if
@@ -589,7 +590,9 @@ contains
                     n_steps = k
                     exit
                 end if
-                if (.not. quiet .and. progress%due()) call report(progress%line(k, self%integ%t))
+                if (.not. quiet) then
+                    if (progress%due()) call report(progress%line(k, self%integ%t))
+                end if
             end do
             write (buf, '(a,i0,a,es13.5e3,a,es11.3e3,a)') 'dynamic run: ', n_steps, ' steps to t = ', &
                 self%integ%t, ' s; energy balance residual ', self%audit%balance(), ' J'

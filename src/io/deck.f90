@@ -370,7 +370,8 @@ contains
         !> The file's bytes.
         character(len=*), intent(in) :: raw
         character(len=:), allocatable :: text
-        character(len=*), parameter :: bom = achar(239)//achar(187)//achar(191)
+        ! the UTF-8 byte order mark, bytes EF BB BF (char: achar is for ASCII codes only)
+        character(len=*), parameter :: bom = char(int(z'EF'))//char(int(z'BB'))//char(int(z'BF'))
         integer :: i
         if (len(raw) >= 3) then
             if (raw(1:3) == bom) then

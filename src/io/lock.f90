@@ -66,7 +66,8 @@ contains
                 return
             end if
             owner = read_owner(lock%path)
-            if (attempt == 2 .or. lock_owner_alive(owner, host_name())) exit
+            if (attempt == 2) exit
+            if (lock_owner_alive(owner, host_name())) exit
             warning = "warning: taking over the stale lock '"//lock%path//"' of a run that no longer "// &
                       'runs (host pid start: '//owner//')'
             call remove_file(lock%path)

@@ -81,7 +81,8 @@ contains
             end if
             if (file_exists(path(:i - 1))) cycle
             rc = c_mkdir(path(:i - 1)//c_null_char, int(o'755', c_int))
-            if (rc /= 0 .and. .not. file_exists(path(:i - 1))) then
+            if (rc /= 0) then
+                if (file_exists(path(:i - 1))) cycle
                 call make_error(error, "cannot create folder '"//path(:i - 1)//"'")
                 return
             end if
