@@ -5,7 +5,8 @@
 # where everything runs but the long-horizon unit suites (ctest label long: thousands of
 # coupled steps each, ~20x faster without the run-time checks), which run on the Release
 # build in build/ (the one run.sh uses), with the malformed-deck tests (label baddeck) again,
-# so that the messages do not depend on the build type. The Release build also compiles the
+# so that the messages do not depend on the build type, and the check that the Release sweep
+# inlines its local solver (label build). The Release build also compiles the
 # benchmark programs of bench/ (not part of `all`), so that a change of an interface they call
 # cannot leave them broken. Exit code is non-zero on any failure.
 set -uo pipefail
@@ -21,7 +22,7 @@ say "Python tests (postproc)"
 .venv/bin/python -m pytest -q postproc/tests || status=1
 say "CTest suites"
 ctest --test-dir build-debug --output-on-failure -j "$(nproc)" -LE long || status=1
-say "Long-horizon unit suites and malformed decks on the Release build (build/)"
+say "Long-horizon unit suites, malformed decks and the inlined sweep on the Release build (build/)"
 MULTICOR_BUILD_TARGET="multicor long_tests bench" configure_and_build build Release
-ctest --test-dir build --output-on-failure -j "$(nproc)" -L 'baddeck|long' || status=1
+ctest --test-dir build --output-on-failure -j "$(nproc)" -L 'baddeck|long|build' || status=1
 exit $status
