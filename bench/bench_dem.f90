@@ -168,7 +168,7 @@ program bench_dem
         case ('--scheme')
             if (val /= 'multicor' .and. val /= 'siconos') &
                 call usage_error('--scheme takes multicor or siconos, got '''//trim(val)//'''')
-            scheme_word = val
+            scheme_word = trim(val)
         case ('--csv')
             csv_path = val
         case ('--deck')
