@@ -2,8 +2,8 @@
 """The Release build's sweep calls no local solver: gfortran must have inlined
 bipotential_local_solve_scaled (dem_bipotential) into the sweeps of dem_nlgs at link time.
 
-The local solver runs once per contact and sweep; called instead of inlined, it costs 15 % of
-the 200-disk deposit's time (0.487 against 0.414 ms per step, doc/performance.md). gfortran
+The local solver runs once per contact and sweep; called instead of inlined, it costs 16 % of
+the 200-disk deposit's time (0.492 against 0.414 ms per step, doc/performance.md). gfortran
 decides the inlining by a size limit (src/CMakeLists.txt), so the solver growing by a few
 lines loses it silently, with the same results: only the machine code tells. This script
 disassembles the executable (objdump) and fails when a procedure of dem_nlgs calls the local
