@@ -28,6 +28,7 @@ module dem_contacts
     public :: contacts_extend, contacts_fill
     public :: contacts_set_frames, contacts_set_laws, contacts_finish, contacts_impulses
     public :: contacts_local_velocity, contacts_count_status, contacts_bytes, contacts_moments_active
+    public :: contacts_apply_impulse, contacts_solver_velocity
     public :: contacts_list_problem
 
     !> Contact status, no reaction (separated or not active this step).
@@ -466,6 +467,65 @@ contains
         u(1) = nx*dv(1) + ny*dv(2)
         u(2) = u(2) - ny*dv(1) + nx*dv(2) + cs%lever(2, k)*vel(3, b)
     end function contacts_local_velocity
+
+    !> The impulse (drn, drt, drm) of contact k in its frame applied to the disks:
+    !> vel += M^-1 H (drn, drt, drm). A wall (i1 <= 0) takes nothing.
+    pure subroutine contacts_apply_impulse(cs, k, im, vel, drn, drt, drm)
+        !> Contacts (frames and levers).
+        type(contact_set_t), intent(in) :: cs
+        !> Contact index.
+        integer, intent(in) :: k
+        !> Inverse mass per DOF (3, n_disks).
+        real(wp), intent(in) :: im(:, :)
+        !> Disk velocities (vx, vy, w) (3, n_disks), updated.
+        real(wp), intent(inout) :: vel(:, :)
+        !> Normal and tangential impulse and moment impulse.
+        real(wp), intent(in) :: drn, drt, drm
+        real(wp) :: px, py
+        integer :: a, b
+        a = cs%i1(k)
+        b = cs%i2(k)
+        px = drn*cs%nrm(1, k) - drt*cs%nrm(2, k)
+        py = drn*cs%nrm(2, k) + drt*cs%nrm(1, k)
+        vel(1, b) = vel(1, b) + im(1, b)*px
+        vel(2, b) = vel(2, b) + im(2, b)*py
+        vel(3, b) = vel(3, b) + im(3, b)*(cs%lever(2, k)*drt + drm)
+        if (a > 0) then
+            vel(1, a) = vel(1, a) - im(1, a)*px
+            vel(2, a) = vel(2, a) - im(2, a)*py
+            vel(3, a) = vel(3, a) + im(3, a)*(cs%lever(1, k)*drt - drm)
+        end if
+    end subroutine contacts_apply_impulse
+
+    !> Relative velocity of contact k as the contact solver sees it, H^T v + shift:
+    !> (u_n, u_t, w_r). A wall's motion is in the shift (contacts_set_laws), unlike
+    !> contacts_local_velocity.
+    pure subroutine contacts_solver_velocity(cs, k, vel, u)
+        !> Contacts (frames, levers and shifts).
+        type(contact_set_t), intent(in) :: cs
+        !> Contact index.
+        integer, intent(in) :: k
+        !> Disk velocities (vx, vy, w) (3, n_disks).
+        real(wp), intent(in) :: vel(:, :)
+        !> (u_n, u_t, w_r).
+        real(wp), intent(out) :: u(3)
+        real(wp) :: dvx, dvy, ut
+        integer :: a, b
+        a = cs%i1(k)
+        b = cs%i2(k)
+        dvx = vel(1, b)
+        dvy = vel(2, b)
+        ut = cs%lever(2, k)*vel(3, b) + cs%shift(2, k)
+        u(3) = vel(3, b)
+        if (a > 0) then
+            dvx = dvx - vel(1, a)
+            dvy = dvy - vel(2, a)
+            ut = ut + cs%lever(1, k)*vel(3, a)
+            u(3) = u(3) - vel(3, a)
+        end if
+        u(1) = cs%nrm(1, k)*dvx + cs%nrm(2, k)*dvy + cs%shift(1, k)
+        u(2) = ut - cs%nrm(2, k)*dvx + cs%nrm(1, k)*dvy
+    end subroutine contacts_solver_velocity
 
     !> Material law, bonds, solver shifts and activation of every contact for the step.
     !> Intact bonds are always active, with Newton restitution: target = e max(-u_n(begin), 0)

@@ -32,7 +32,7 @@
 !> `anderson_after` plain sweeps (default 10).
 !> Cold start (`hydrostatic`, off by default): when no contact of the solve carries a
 !> reaction yet (a fresh packing), the sweeps start from the hydrostatic estimate of
-!> hydrostatic_guess instead of zero reactions.
+!> hydrostatic_guess (dem_cold_start) instead of zero reactions.
 !> The Siconos error (nlgs_siconos_error, doc/theory.md 4.5) of the final state is always
 !> computed, from u = H^T (v_free + M^-1 H r) + shift in full; `criterion` chooses which
 !> error stops the sweeps. As a stopping test it is evaluated from the velocities the sweeps
@@ -81,13 +81,19 @@
 !> sweeps between them did), the step goes on without corrections: on the impacts of a
 !> deposit every correction raised the error tenfold and 13 to 16 % of the steps never
 !> converged.
+!>
+!> Files: this one holds the solve, the sweeps and their domain split; the submodules
+!> dem_nlgs_anderson (nlgs_anderson.f90), dem_nlgs_coarse (nlgs_coarse.f90) and
+!> dem_nlgs_siconos (nlgs_siconos.f90) the Anderson step, the coarse correction and the
+!> Siconos error.
 module dem_nlgs
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp, i8
     use core_constants, only: diagonal_floor
     use core_error, only: error_t
     use core_linalg, only: dense_spd_t, dot
-    use dem_contacts, only: contact_set_t
+    use dem_contacts, only: contact_set_t, contacts_apply_impulse, contacts_solver_velocity
+    use dem_cold_start, only: hydrostatic_guess
 !$  use omp_lib, only: omp_get_max_threads
     use dem_bipotential, only: bipotential_residual, bipotential_scaling, bipotential_local_solve_scaled, &
                                bipotential_n_scaling, rolling_scaling, rolling_local_solve_scaled, rolling_residual, &
@@ -397,6 +403,95 @@ module dem_nlgs
         end subroutine block_measure
     end interface
 
+    ! The procedures of the submodules (module header) that this file calls. The submodules
+    ! repeat the arguments (`module subroutine`; the compiler checks them against these)
+    ! rather than use `module procedure`, whose body fprettify does not indent.
+    interface
+        !> Coarse correction of the reactions of the contacts list (nlgs_method_coarse): scale
+        !> the reactions of aggregates of size_agg consecutive contacts by the Galerkin solution
+        !> of a small system, and update vel (submodule dem_nlgs_coarse).
+        module subroutine coarse_correct(cs, list, im, vel, size_agg)
+            type(contact_set_t), intent(inout) :: cs
+            integer, intent(in) :: list(:)
+            real(wp), intent(in) :: im(:, :)
+            real(wp), intent(inout) :: vel(:, :)
+            integer, intent(in) :: size_agg
+        end subroutine coarse_correct
+
+        !> Forget the history of the Anderson acceleration (submodule dem_nlgs_anderson).
+        pure module subroutine anderson_restart(aa)
+            type(anderson_t), intent(inout) :: aa
+        end subroutine anderson_restart
+
+        !> Size the history and the scaling of the Anderson acceleration (dem_nlgs_anderson).
+        module subroutine anderson_init(aa, depth, cs, list)
+            type(anderson_t), intent(inout) :: aa
+            integer, intent(in) :: depth
+            type(contact_set_t), intent(in) :: cs
+            integer, intent(in) :: list(:)
+        end subroutine anderson_init
+
+        !> The scaled reactions x = D r of the contacts list (dem_nlgs_anderson).
+        module subroutine gather(cs, list, d, x, parallel)
+            type(contact_set_t), intent(in) :: cs
+            integer, intent(in) :: list(:)
+            real(wp), intent(in) :: d(:)
+            real(wp), intent(out) :: x(:)
+            logical, intent(in) :: parallel
+        end subroutine gather
+
+        !> One Anderson step after the map's sweeps (dem_nlgs_anderson).
+        module subroutine anderson_mix(aa, cs, list, im, vfree, vel, split, bilateral, others)
+            type(anderson_t), intent(inout) :: aa
+            type(contact_set_t), intent(inout) :: cs
+            integer, intent(in) :: list(:)
+            real(wp), intent(in) :: im(:, :), vfree(:, :)
+            real(wp), intent(inout) :: vel(:, :)
+            type(nlgs_split_t), intent(in) :: split
+            class(nlgs_bilateral_t), intent(inout), optional :: bilateral
+            logical, intent(in) :: others
+        end subroutine anderson_mix
+
+        !> Siconos error of the current reactions, u computed in full (submodule
+        !> dem_nlgs_siconos).
+        real(wp) module function siconos_error(cs, im, vfree, vel, vwork, bilateral, nq) result(err)
+            type(contact_set_t), intent(in) :: cs
+            real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :), nq
+            real(wp), intent(inout) :: vwork(:, :)
+            logical, intent(in) :: bilateral
+        end function siconos_error
+
+        !> Siconos error of the contact problem u = W r + q over the active contacts,
+        !> sqrt(sum_a |r_a - P_K(r_a - u_hat_a)|^2) / max(|q|, |r|, |u|) (doc/theory.md 4.5;
+        !> submodule dem_nlgs_siconos).
+        module function nlgs_siconos_error(cs, im, vfree, vel) result(err)
+            !> Contacts (reactions r).
+            type(contact_set_t), intent(in) :: cs
+            !> Inverse mass per DOF (3, n_disks).
+            real(wp), intent(in) :: im(:, :)
+            !> Free velocities (3, n_disks).
+            real(wp), intent(in) :: vfree(:, :)
+            !> Velocities (3, n_disks) of the reactions (vfree + M^-1 H r).
+            real(wp), intent(in) :: vel(:, :)
+            real(wp) :: err
+        end function nlgs_siconos_error
+
+        !> |q| over the active contacts (dem_nlgs_siconos).
+        real(wp) module function siconos_free_norm(cs, im, vfree, bilateral) result(nq)
+            type(contact_set_t), intent(in) :: cs
+            real(wp), intent(in) :: im(:, :), vfree(:, :)
+            class(nlgs_bilateral_t), intent(in), optional :: bilateral
+        end function siconos_free_norm
+
+        !> Siconos error of the contacts act from the velocities vel, |q| = nq
+        !> (dem_nlgs_siconos).
+        pure real(wp) module function siconos_ratio(cs, act, vel, nq) result(err)
+            type(contact_set_t), intent(in) :: cs
+            integer, intent(in) :: act(:)
+            real(wp), intent(in) :: vel(:, :), nq
+        end function siconos_ratio
+    end interface
+
 contains
 
     !> Solve the contact problem of one step. On entry vel holds the free velocities, on
@@ -619,740 +714,6 @@ contains
         end if
     end subroutine nlgs_solve
 
-    !> Hydrostatic estimate of the reactions of a cold solve (config%hydrostatic): the
-    !> impulses that bring every disk to rest, -M v_free, carried down the contact network
-    !> from the top. "Down" is the direction of the total free momentum sum M v_free (gravity
-    !> for a packing at rest). A contact supports its upper body: the other disk lies below
-    !> along "down" (|n.down| > level), or the other body is a wall that is not above the
-    !> disk. The disks are taken from the top (Kahn's order on the support graph, FIFO from
-    !> the disks nothing rests on, in index order: deterministic and serial). Each needs the
-    !> impulse S = -M v_free - (impulses of the contacts above it) from its supports. Every
-    !> support offers three generators, its normal e (from the support to the disk) and the
-    !> two edges e +- mu t of its friction cone; S is written as f_1 g_1 + f_2 g_2 with
-    !> f >= 0 over the pairs of generators, keeping the pair with the least f_1 + f_2, so
-    !> that every impulse set is in its cone (r_n = f, r_t = +-mu f). When no pair holds the
-    !> disk, the best aligned generator alone takes max(S.g, 0). Moments start at zero and
-    !> the torques of the tangential impulses are left to the sweeps. With two supports
-    !> holding every disk without friction (a frictionless pyramid, test_nlgs) this is the
-    !> solution of the step; elsewhere it is a start that already carries the weight to the
-    !> floor.
-    subroutine hydrostatic_guess(cs, list, im, vfree)
-        type(contact_set_t), intent(inout) :: cs
-        integer, intent(in) :: list(:)
-        real(wp), intent(in) :: im(:, :), vfree(:, :)
-        ! a contact is horizontal when |n.down| <= level (then only a wall supports)
-        real(wp), parameter :: level = 1.0e-9_wp
-        integer, allocatable :: upper(:), lower(:), first(:), sup(:), n_above(:), queue(:)
-        real(wp), allocatable :: e(:, :), acc(:, :)
-        real(wp) :: down(2), dn, s(2), det, f1, f2, best, fbest(2), gj(2), gl(2)
-        integer :: nd, n, a, k, i, c, head, tail, j, l, jb, lb, u, m
-        nd = size(vfree, 2)
-        n = size(list)
-        down = 0.0_wp
-        do i = 1, nd
-            do c = 1, 2
-                if (im(c, i) > 0.0_wp) down(c) = down(c) + vfree(c, i)/im(c, i)
-            end do
-        end do
-        if (norm2(down) <= 0.0_wp) return
-        down = down/norm2(down)
-        allocate (upper(n), lower(n), e(2, n))
-        allocate (first(nd + 1), source=0)
-        allocate (n_above(nd), source=0)
-        do a = 1, n
-            k = list(a)
-            dn = cs%nrm(1, k)*down(1) + cs%nrm(2, k)*down(2)
-            upper(a) = 0
-            lower(a) = 0
-            e(:, a) = cs%nrm(:, k)
-            if (dn < -level .or. (cs%i1(k) <= 0 .and. dn <= level)) then
-                ! i2 rests on i1 (a disk below, or a floor or side wall)
-                upper(a) = cs%i2(k)
-                lower(a) = cs%i1(k)
-            else if (dn > level .and. cs%i1(k) > 0) then
-                upper(a) = cs%i1(k)
-                lower(a) = cs%i2(k)
-                e(:, a) = -cs%nrm(:, k)
-            end if
-            if (upper(a) > 0) first(upper(a)) = first(upper(a)) + 1
-            if (lower(a) > 0) n_above(lower(a)) = n_above(lower(a)) + 1
-        end do
-        ! supports of disk u: sup(first(u) : first(u + 1) - 1), positions in list
-        do i = nd, 1, -1
-            first(i + 1) = first(i)
-        end do
-        first(1) = 1
-        do i = 1, nd
-            first(i + 1) = first(i + 1) + first(i)
-        end do
-        allocate (sup(n))
-        block
-            integer, allocatable :: fill(:)
-            allocate (fill, source=first(1:nd))
-            do a = 1, n
-                if (upper(a) <= 0) cycle
-                sup(fill(upper(a))) = a
-                fill(upper(a)) = fill(upper(a)) + 1
-            end do
-        end block
-        allocate (acc(2, nd), source=0.0_wp)
-        allocate (queue(nd))
-        tail = 0
-        do i = 1, nd
-            if (n_above(i) == 0) then
-                tail = tail + 1
-                queue(tail) = i
-            end if
-        end do
-        head = 0
-        do while (head < tail)
-            head = head + 1
-            u = queue(head)
-            m = first(u + 1) - first(u)
-            if (m > 0 .and. all(im(1:2, u) > 0.0_wp)) then
-                s = -vfree(1:2, u)/im(1:2, u) - acc(:, u)
-                ! generators: the normal and the two edges of the friction cone of each support
-                best = huge(1.0_wp)
-                jb = 0
-                lb = 0
-                do j = 3*first(u) - 2, 3*first(u + 1) - 3
-                    gj = generator(j)
-                    do l = j + 1, 3*first(u + 1) - 3
-                        gl = generator(l)
-                        det = gj(1)*gl(2) - gj(2)*gl(1)
-                        if (abs(det) <= level) cycle
-                        f1 = (s(1)*gl(2) - s(2)*gl(1))/det
-                        f2 = (gj(1)*s(2) - gj(2)*s(1))/det
-                        if (f1 >= 0.0_wp .and. f2 >= 0.0_wp .and. f1 + f2 < best) then
-                            best = f1 + f2
-                            jb = j
-                            lb = l
-                            fbest = [f1, f2]
-                        end if
-                    end do
-                end do
-                if (jb == 0) then
-                    ! no pair holds the disk: the best aligned support alone
-                    jb = 3*first(u) - 1
-                    do j = 3*first(u) - 2, 3*first(u + 1) - 3
-                        if (dot_product(s, generator(j)) > dot_product(s, generator(jb))) jb = j
-                    end do
-                    call set(jb, max(dot_product(s, generator(jb)), 0.0_wp))
-                else
-                    call set(jb, fbest(1))
-                    call set(lb, fbest(2))
-                end if
-            end if
-            do j = first(u), first(u + 1) - 1
-                l = lower(sup(j))
-                if (l <= 0) cycle
-                n_above(l) = n_above(l) - 1
-                if (n_above(l) == 0) then
-                    tail = tail + 1
-                    queue(tail) = l
-                end if
-            end do
-        end do
-    contains
-        ! generator q: 3 per support, support sup((q + 2)/3), sigma = mod(q + 2, 3) - 1 (0: the normal)
-        pure function generator(q) result(v)
-            integer, intent(in) :: q
-            real(wp) :: v(2)
-            integer :: p
-            p = sup((q + 2)/3)
-            v = e(:, p) + (mod(q + 2, 3) - 1)*cs%mu(list(p))*[-e(2, p), e(1, p)]
-        end function generator
-
-        ! impulse f times generator q on its contact (r_n = f, r_t = sigma mu f)
-        subroutine set(q, f)
-            integer, intent(in) :: q
-            real(wp), intent(in) :: f
-            integer :: p
-            real(wp) :: sigma
-            p = sup((q + 2)/3)
-            sigma = real(mod(q + 2, 3) - 1, wp)
-            cs%r(1, list(p)) = cs%r(1, list(p)) + f
-            cs%r(2, list(p)) = cs%r(2, list(p)) + sigma*cs%mu(list(p))*f
-            if (lower(p) > 0) acc(:, lower(p)) = acc(:, lower(p)) - f*generator(q)
-        end subroutine set
-    end subroutine hydrostatic_guess
-
-    !> Coarse correction of the reactions (nlgs_method_coarse; doc/theory.md 4.6). The
-    !> contacts of the solve, in their order (bottom-up for a packing numbered by rows), are
-    !> cut into aggregates A of `size_agg` consecutive contacts (at most max_aggregates
-    !> aggregates). Each contact with r_n > 0 and
-    !> no cohesion has a pattern p: its reaction when strictly inside its cone (sticking),
-    !> (r_n, 0, 0) otherwise (sliding). The correction is r <- r + a_A p on the contacts of
-    !> each aggregate, with a the Galerkin solution of
-    !>     sum_{k in A} p_k . u_k(a) = 0   for every A,
-    !> u the shifted relative velocities the sweeps see: C a = b with
-    !> C_AB = (H P_A)^T M^-1 (H P_B) (symmetric, nonzero between aggregates that share a disk;
-    !> factored dense) and b_A = -sum_{k in A} p_k . u_k. At a solution of the sweeps a
-    !> sticking contact has u = 0 and a sliding one u_n = 0, so b = 0 and the correction does
-    !> nothing: the fixed point is that of the plain sweeps. Away from it the correction moves
-    !> the weight between layers in one step, where a sweep moves it by one layer. a_A is
-    !> bounded below by -1/2 (the reactions keep their sign); the next sweep projects any
-    !> reaction left outside its cone.
-    subroutine coarse_correct(cs, list, im, vel, size_agg)
-        type(contact_set_t), intent(inout) :: cs
-        integer, intent(in) :: list(:)
-        real(wp), intent(in) :: im(:, :)
-        real(wp), intent(inout) :: vel(:, :)
-        integer, intent(in) :: size_agg
-        type(dense_spd_t) :: c
-        type(error_t), allocatable :: error
-        integer, allocatable :: start(:), inc(:), fill(:)
-        real(wp), allocatable :: b(:), pat(:, :)
-        real(wp) :: u(3), dmax, dr, rn, ga_imp(3), gb_imp(3)
-        integer :: n, na, nd, a, k, e, f, d, ga, gb, af, m
-        n = size(list)
-        if (n == 0) return
-        ! at most max_aggregates aggregates (the coarse system is dense)
-        m = max(size_agg, 1, (n + max_aggregates - 1)/max_aggregates)
-        na = (n + m - 1)/m
-        nd = size(vel, 2)
-        ! pattern of each position (the reaction it scales) and the incidence of the disks
-        allocate (pat(3, n), b(na), start(nd + 1), fill(nd), inc(2*n))
-        b = 0.0_wp
-        start = 0
-        do a = 1, n
-            k = list(a)
-            pat(:, a) = 0.0_wp
-            rn = cs%r(1, k)
-            if (cs%coh(k) <= 0.0_wp .and. rn > 0.0_wp) then
-                pat(1, a) = rn
-                ! a contact strictly inside its cone (sticking) scales as a whole; a sliding one
-                ! by its normal reaction only
-                if (abs(cs%r(2, k)) < cs%mu(k)*rn .and. &
-                    (cs%erol(k) <= 0.0_wp .or. abs(cs%r(3, k)) < cs%erol(k)*rn)) pat(2:3, a) = cs%r(2:3, k)
-            end if
-            call local_velocity(cs, k, vel, u)
-            ga = (a - 1)/m + 1
-            b(ga) = b(ga) - dot_product(pat(:, a), u)
-            start(cs%i2(k) + 1) = start(cs%i2(k) + 1) + 1
-            if (cs%i1(k) > 0) start(cs%i1(k) + 1) = start(cs%i1(k) + 1) + 1
-        end do
-        start(1) = 1
-        do d = 1, nd
-            start(d + 1) = start(d + 1) + start(d)
-        end do
-        fill = start(1:nd)
-        do a = 1, n
-            k = list(a)
-            inc(fill(cs%i2(k))) = a
-            fill(cs%i2(k)) = fill(cs%i2(k)) + 1
-            if (cs%i1(k) > 0) then
-                inc(fill(cs%i1(k))) = -a
-                fill(cs%i1(k)) = fill(cs%i1(k)) + 1
-            end if
-        end do
-        call c%init(na)
-        do d = 1, nd
-            do e = start(d), start(d + 1) - 1
-                a = abs(inc(e))
-                if (pat(1, a) == 0.0_wp) cycle
-                ga = (a - 1)/m + 1
-                ga_imp = impulse(a, inc(e) > 0)
-                do f = start(d), start(d + 1) - 1
-                    af = abs(inc(f))
-                    if (pat(1, af) == 0.0_wp) cycle
-                    gb = (af - 1)/m + 1
-                    if (gb < ga) cycle
-                    ! the diagonal block (ga == gb) sums both orders of a pair
-                    if (ga == gb .and. af < a) cycle
-                    gb_imp = impulse(af, inc(f) > 0)
-                    dr = sum(ga_imp*im(:, d)*gb_imp)
-                    if (ga == gb .and. af /= a) dr = 2.0_wp*dr
-                    c%a(ga, gb) = c%a(ga, gb) + dr
-                end do
-            end do
-        end do
-        dmax = 0.0_wp
-        do ga = 1, na
-            dmax = max(dmax, c%a(ga, ga))
-        end do
-        if (dmax <= 0.0_wp) return
-        do ga = 1, na
-            if (c%a(ga, ga) <= 0.0_wp) then
-                c%a(ga, ga) = dmax
-                b(ga) = 0.0_wp
-            end if
-            c%a(ga, ga) = c%a(ga, ga)*(1.0_wp + anderson_regularisation)
-        end do
-        call c%factor(error)
-        if (allocated(error)) return
-        call c%solve(b, error)
-        if (allocated(error)) return
-        do a = 1, n
-            if (pat(1, a) == 0.0_wp) cycle
-            k = list(a)
-            dr = max(b((a - 1)/m + 1), -0.5_wp)
-            cs%r(:, k) = cs%r(:, k) + dr*pat(:, a)
-            call apply(cs, k, im, vel, dr*pat(1, a), dr*pat(2, a), dr*pat(3, a))
-        end do
-    contains
-        ! impulse (x, y, moment) of the pattern of position q on its body i2 (plus) or i1
-        pure function impulse(q, plus) result(g)
-            integer, intent(in) :: q
-            logical, intent(in) :: plus
-            real(wp) :: g(3)
-            integer :: kk
-            kk = list(q)
-            g(1) = pat(1, q)*cs%nrm(1, kk) - pat(2, q)*cs%nrm(2, kk)
-            g(2) = pat(1, q)*cs%nrm(2, kk) + pat(2, q)*cs%nrm(1, kk)
-            if (plus) then
-                g(3) = cs%lever(2, kk)*pat(2, q) + pat(3, q)
-            else
-                g(1:2) = -g(1:2)
-                g(3) = cs%lever(1, kk)*pat(2, q) - pat(3, q)
-            end if
-        end function impulse
-    end subroutine coarse_correct
-
-    !> Forget the history of the Anderson acceleration (the iterate changed outside the map).
-    pure subroutine anderson_restart(aa)
-        type(anderson_t), intent(inout) :: aa
-        aa%used = 0
-        aa%next = 1
-        aa%started = .false.
-        aa%fnorm_prev = huge(1.0_wp)
-        aa%x_valid = .false.
-    end subroutine anderson_restart
-
-    !> Size the history and the scaling D = sqrt(diag W) of the Anderson acceleration.
-    subroutine anderson_init(aa, depth, cs, list)
-        type(anderson_t), intent(inout) :: aa
-        integer, intent(in) :: depth
-        type(contact_set_t), intent(in) :: cs
-        integer, intent(in) :: list(:)
-        integer :: n, a, k
-        n = 3*size(list)
-        aa%depth = depth
-        allocate (aa%df(n, depth), aa%dg(n, depth), aa%gram(depth, depth))
-        allocate (aa%x(n), aa%fprev(n), aa%gprev(n), aa%d(n), aa%dinv(n))
-        allocate (aa%part(max(2*depth, 4), (size(list) + dot_chunk - 1)/dot_chunk), aa%dgnorm(depth))
-        do a = 1, size(list)
-            k = list(a)
-            aa%d(3*a - 2) = sqrt(cs%w(1, k))
-            aa%d(3*a - 1) = sqrt(max(cs%w(3, k), 0.0_wp))
-            ! no moment: the third component stays 0
-            aa%d(3*a) = merge(sqrt(max(cs%w(6, k), 0.0_wp)), 0.0_wp, cs%erol(k) > 0.0_wp)
-        end do
-        ! (no division by zero even where a vectorised merge evaluates both branches)
-        aa%dinv = merge(1.0_wp/max(aa%d, tiny(1.0_wp)), 0.0_wp, aa%d > 0.0_wp)
-    end subroutine anderson_init
-
-    !> Scaled shifted reactions x = D (r_n + r_cohe h, r_t, M) of the contacts of the solve
-    !> (on the OpenMP threads when `parallel`).
-    subroutine gather(cs, list, d, x, parallel)
-        type(contact_set_t), intent(in) :: cs
-        integer, intent(in) :: list(:)
-        real(wp), intent(in) :: d(:)
-        real(wp), intent(out) :: x(:)
-        logical, intent(in) :: parallel
-        integer :: a
-        if (parallel) then
-            !$omp parallel do schedule(static)
-            do a = 1, size(list)
-                call one(a)
-            end do
-            !$omp end parallel do
-        else
-            do a = 1, size(list)
-                call one(a)
-            end do
-        end if
-    contains
-        subroutine one(a)
-            integer, intent(in) :: a
-            integer :: k
-            k = list(a)
-            x(3*a - 2) = d(3*a - 2)*(cs%r(1, k) + cs%coh(k))
-            x(3*a - 1) = d(3*a - 1)*cs%r(2, k)
-            x(3*a) = d(3*a)*cs%r(3, k)
-        end subroutine one
-    end subroutine gather
-
-    !> One Anderson step after the map's sweeps: with x the reactions before them and g after,
-    !> f = g - x; the new iterate is g - dG gamma, gamma minimising |f - dF gamma| over the
-    !> history, projected on the cones, and the velocities are recomputed from it. When |f|
-    !> rose since the last step, or the extrapolation would exceed anderson_max_step |g|, the
-    !> history is cleared and g is kept (plain NLGS step). Before that, a drift (f the same as
-    !> at the last step, not contracting) is skipped: the iterate jumps to g + t f, where the
-    !> first reaction of the drift meets a face of its cone (drift_length), and the history is
-    !> cleared.
-    !> Three passes over the contacts: g, f, their differences, |f| and |g| (pass_residual); the
-    !> new row of the Gram matrix and the right-hand side (pass_products); the mixed,
-    !> projected iterate, kept in x for the next step (pass_mix). The sums are taken by
-    !> fixed chunks of contacts, in parallel, then over the chunks in order: the same result
-    !> for any number of threads. f and g of the step are kept in fprev and gprev. With
-    !> `others` (a block with members) vel holds impulses of contacts outside the list: the
-    !> velocities are rebuilt by removing the swept contacts' impulses, not from vfree.
-    subroutine anderson_mix(aa, cs, list, im, vfree, vel, split, bilateral, others)
-        type(anderson_t), intent(inout) :: aa
-        type(contact_set_t), intent(inout) :: cs
-        integer, intent(in) :: list(:)
-        real(wp), intent(in) :: im(:, :), vfree(:, :)
-        real(wp), intent(inout) :: vel(:, :)
-        type(nlgs_split_t), intent(in) :: split
-        class(nlgs_bilateral_t), intent(inout), optional :: bilateral
-        logical, intent(in) :: others
-        real(wp) :: gamma(aa%depth), rhs(aa%depth), fnorm, gnorm, fnorm_before, dfnorm2, drift
-        integer :: slot, m, nc, c, j
-        nc = size(aa%part, 2)
-        slot = aa%next
-        call pass_residual(aa%started)
-        fnorm = sqrt(sum(aa%part(1, :)))
-        gnorm = sqrt(sum(aa%part(2, :)))
-        fnorm_before = aa%fnorm_prev
-        dfnorm2 = huge(1.0_wp)
-        if (aa%started) then
-            aa%dgnorm(slot) = sqrt(sum(aa%part(3, :)))
-            dfnorm2 = sum(aa%part(4, :))
-        end if
-        drift = 0.0_wp
-        if (ieee_is_finite(fnorm)) drift = drift_length()
-        if (drift > 0.0_wp) then
-            ! the sweeps drift: no mixing of the history can follow them (there is no fixed
-            ! point along the drift); skip the drift and restart the history from there
-            aa%used = 0
-            aa%next = 1
-            aa%fnorm_prev = fnorm
-            call rebuild(0)
-            return
-        end if
-        if ((aa%started .and. fnorm > aa%fnorm_prev) .or. .not. ieee_is_finite(fnorm)) then
-            ! safeguard: the residual rose (or overflowed), restart from the plain sweep's result
-            aa%used = 0
-            aa%next = 1
-            aa%fnorm_prev = fnorm
-            aa%x = aa%gprev
-            return
-        end if
-        if (aa%started) then
-            aa%used = min(aa%used + 1, aa%depth)
-            aa%next = mod(slot, aa%depth) + 1
-        end if
-        aa%started = .true.
-        aa%fnorm_prev = fnorm
-        m = aa%used
-        if (m == 0) then
-            aa%x = aa%gprev
-            return
-        end if
-        call pass_products(m)
-        do j = 1, m
-            aa%gram(slot, j) = 0.0_wp
-            rhs(j) = 0.0_wp
-            do c = 1, nc
-                aa%gram(slot, j) = aa%gram(slot, j) + aa%part(j, c)
-                rhs(j) = rhs(j) + aa%part(m + j, c)
-            end do
-            aa%gram(j, slot) = aa%gram(slot, j)
-        end do
-        call solve_small(aa%gram(1:m, 1:m), rhs(1:m), gamma(1:m))
-        if (sum(abs(gamma(1:m))*aa%dgnorm(1:m)) > anderson_max_step*gnorm) then
-            ! safeguard: an extrapolation larger than anderson_max_step |g|; restart from the
-            ! plain sweeps' result, as when the residual rose (the velocities are those of g)
-            aa%used = 0
-            aa%next = 1
-            aa%x = aa%gprev
-            return
-        end if
-        call rebuild(m)
-    contains
-        ! the iterate x = g - dG gamma(1:m) (+ drift f), projected on the cones, and the
-        ! velocities recomputed from it
-        subroutine rebuild(m)
-            integer, intent(in) :: m
-            integer :: j, c
-            if (present(bilateral) .or. others) then
-                ! the velocities without the swept contacts' impulses, with the multipliers'
-                ! share as it stands (vfree + that share: the sweeps keep vel = vfree + M^-1 H r
-                ! + share)
-                do j = 1, size(list)
-                    c = list(j)
-                    call apply(cs, c, im, vel, -cs%r(1, c), -cs%r(2, c), -cs%r(3, c))
-                end do
-            else
-                vel = vfree
-            end if
-            if (split%nb == 1) then
-                ! one pass: each contact's impulse applied where its reaction is set, in the
-                ! order of split_apply for one block
-                call pass_mix(m, .true.)
-            else
-                call pass_mix(m, .false.)
-                call split_apply(cs, split, im, vel)
-            end if
-            ! the multipliers of the mixed reactions: the constraints hold again (exactly, they
-            ! are linear in the velocities)
-            if (present(bilateral)) call bilateral%restore(vel)
-        end subroutine rebuild
-
-        ! The drift of the sweeps, when the map moves the iterate by the same f again and again
-        ! without contracting (1 <= |f| / |f_prev| <= drift_high, 1 - cos(f, f_prev) below
-        ! drift_cosine): the number t of further maps after which the first contact of the drift
-        ! reaches a face of its cone (its status changes there), so that g + t f skips them.
-        ! 0 when there is no drift, no contact reaches a face, t < drift_min, or t |f| >
-        ! anderson_max_step |g|.
-        real(wp) function drift_length() result(t)
-            real(wp) :: cosine, rho
-            integer :: c
-            t = 0.0_wp
-            if (dfnorm2 == huge(1.0_wp) .or. fnorm <= 0.0_wp .or. fnorm_before <= 0.0_wp) return
-            rho = fnorm/fnorm_before
-            if (rho < 1.0_wp .or. rho > drift_high) return
-            cosine = (fnorm**2 + fnorm_before**2 - dfnorm2)/(2.0_wp*fnorm*fnorm_before)
-            if (cosine < 1.0_wp - drift_cosine) return
-            if (split%nb > 1) then
-                !$omp parallel do schedule(static)
-                do c = 1, nc
-                    call bounds_chunk(c)
-                end do
-                !$omp end parallel do
-            else
-                do c = 1, nc
-                    call bounds_chunk(c)
-                end do
-            end if
-            t = minval(aa%part(4, 1:nc))
-            if (t < drift_min .or. t*fnorm > anderson_max_step*gnorm) t = 0.0_wp
-        end function drift_length
-
-        ! per chunk, in aa%part(4, c): the least t > 0 at which a reaction p + t dp of the
-        ! chunk (p = g / D, dp = f / D) leaves a face of its cone it is not on
-        subroutine bounds_chunk(c)
-            integer, intent(in) :: c
-            real(wp) :: p(3), dp(3), t, scale
-            integer :: a, k, i
-            t = huge(1.0_wp)
-            do a = (c - 1)*dot_chunk + 1, min(c*dot_chunk, size(list))
-                k = list(a)
-                i = 3*a - 3
-                p = aa%gprev(i + 1:i + 3)*aa%dinv(i + 1:i + 3)
-                dp = aa%fprev(i + 1:i + 3)*aa%dinv(i + 1:i + 3)
-                scale = drift_slack*(abs(p(1)) + abs(p(2)) + abs(p(3)))
-                t = min(t, time_to_face(p(1), dp(1), scale), &
-                        time_to_face(cs%mu(k)*p(1) - p(2), cs%mu(k)*dp(1) - dp(2), scale), &
-                        time_to_face(cs%mu(k)*p(1) + p(2), cs%mu(k)*dp(1) + dp(2), scale))
-                if (cs%erol(k) > 0.0_wp) &
-                    t = min(t, time_to_face(cs%erol(k)*p(1) - p(3), cs%erol(k)*dp(1) - dp(3), scale), &
-                            time_to_face(cs%erol(k)*p(1) + p(3), cs%erol(k)*dp(1) + dp(3), scale))
-            end do
-            aa%part(4, c) = t
-        end subroutine bounds_chunk
-
-        ! g = D (r_n + r_cohe h, r_t, M), f = g - x, |f|^2 and |g|^2 per chunk in aa%part(1:2, :);
-        ! with `history`, their differences with the previous ones in column slot, and |dG|^2
-        ! of that column in aa%part(3, :). Like the two
-        ! passes below, on the threads only when the sweeps are split; otherwise no parallel
-        ! region is opened at all: even with `if (.false.)` or one thread, libgomp ends a
-        ! region with a futex system call (100 per step of the 200-disk deposit, 5 % of its time)
-        subroutine pass_residual(history)
-            logical, intent(in) :: history
-            integer :: c
-            if (split%nb > 1) then
-                !$omp parallel do schedule(static)
-                do c = 1, nc
-                    call residual_chunk(c, history)
-                end do
-                !$omp end parallel do
-            else
-                do c = 1, nc
-                    call residual_chunk(c, history)
-                end do
-            end if
-        end subroutine pass_residual
-
-        subroutine residual_chunk(c, history)
-            integer, intent(in) :: c
-            logical, intent(in) :: history
-            real(wp) :: g(3*dot_chunk), f(3*dot_chunk)
-            integer :: a, k, lo, hi, n
-            lo = 3*(c - 1)*dot_chunk + 1
-            hi = 3*min(c*dot_chunk, size(list))
-            n = hi - lo + 1
-            do a = (c - 1)*dot_chunk + 1, min(c*dot_chunk, size(list))
-                k = list(a)
-                g(3*a - 2 - lo + 1) = cs%r(1, k) + cs%coh(k)
-                g(3*a - 1 - lo + 1) = cs%r(2, k)
-                g(3*a - lo + 1) = cs%r(3, k)
-            end do
-            g(1:n) = aa%d(lo:hi)*g(1:n)
-            f(1:n) = g(1:n) - aa%x(lo:hi)
-            if (history) then
-                aa%df(lo:hi, slot) = f(1:n) - aa%fprev(lo:hi)
-                aa%dg(lo:hi, slot) = g(1:n) - aa%gprev(lo:hi)
-            end if
-            aa%fprev(lo:hi) = f(1:n)
-            aa%gprev(lo:hi) = g(1:n)
-            aa%part(1, c) = dot(f(1:n), f(1:n))
-            aa%part(2, c) = dot(g(1:n), g(1:n))
-            if (history) then
-                aa%part(3, c) = dot(aa%dg(lo:hi, slot), aa%dg(lo:hi, slot))
-                aa%part(4, c) = dot(aa%df(lo:hi, slot), aa%df(lo:hi, slot))
-            end if
-        end subroutine residual_chunk
-
-        ! per chunk: df_slot . df_j in aa%part(j, :), df_j . f in aa%part(m + j, :), j = 1..m
-        ! (a chunk's columns stay in cache while they are read again)
-        subroutine pass_products(m)
-            integer, intent(in) :: m
-            integer :: c
-            if (split%nb > 1) then
-                !$omp parallel do schedule(static)
-                do c = 1, nc
-                    call products_chunk(c, m)
-                end do
-                !$omp end parallel do
-            else
-                do c = 1, nc
-                    call products_chunk(c, m)
-                end do
-            end if
-        end subroutine pass_products
-
-        subroutine products_chunk(c, m)
-            integer, intent(in) :: c, m
-            integer :: j, lo, hi
-            lo = 3*(c - 1)*dot_chunk + 1
-            hi = 3*min(c*dot_chunk, size(list))
-            do j = 1, m
-                aa%part(j, c) = dot(aa%df(lo:hi, slot), aa%df(lo:hi, j))
-                aa%part(m + j, c) = dot(aa%df(lo:hi, j), aa%fprev(lo:hi))
-            end do
-        end subroutine products_chunk
-
-        ! x = g - dG gamma, back to reactions on the cones, and x = D r of the result; with
-        ! `apply_now` (the serial path), vel += M^-1 H r of each contact too
-        subroutine pass_mix(m, apply_now)
-            integer, intent(in) :: m
-            logical, intent(in) :: apply_now
-            integer :: c
-            if (.not. apply_now) then
-                !$omp parallel do schedule(static)
-                do c = 1, nc
-                    call mix_chunk(c, m, apply_now)
-                end do
-                !$omp end parallel do
-            else
-                do c = 1, nc
-                    call mix_chunk(c, m, apply_now)
-                end do
-            end if
-        end subroutine pass_mix
-
-        subroutine mix_chunk(c, m, apply_now)
-            integer, intent(in) :: c, m
-            logical, intent(in) :: apply_now
-            integer :: j, lo, hi
-            lo = 3*(c - 1)*dot_chunk + 1
-            hi = 3*min(c*dot_chunk, size(list))
-            aa%x(lo:hi) = aa%gprev(lo:hi)
-            do j = 1, m
-                aa%x(lo:hi) = aa%x(lo:hi) - gamma(j)*aa%dg(lo:hi, j)
-            end do
-            if (drift > 0.0_wp) aa%x(lo:hi) = aa%x(lo:hi) + drift*aa%fprev(lo:hi)
-            call project_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%erol, cs%mu, cs%coh, cs%r, size(vel, 2), &
-                                  im, vel, size(list), list, (c - 1)*dot_chunk + 1, min(c*dot_chunk, size(list)), &
-                                  aa%x, aa%d, aa%dinv, apply_now)
-        end subroutine mix_chunk
-    end subroutine anderson_mix
-
-    !> The mixed iterate of the contacts list(first:last) back to reactions on their cones:
-    !> r = P_K(x / D), x = D r, on the arrays of the contact set (explicit shapes, as
-    !> sweep_contacts); with apply_now, vel += M^-1 H r of each contact too (apply, written out).
-    subroutine project_contacts(n, i1s, i2s, nrm, lever, erol, mu, coh, rc, nd, im, vel, nl, list, first, last, x, d, &
-                                dinv, apply_now)
-        integer, intent(in) :: n, nd, nl, first, last
-        integer, intent(in) :: i1s(n), i2s(n), list(nl)
-        real(wp), intent(in) :: nrm(2, n), lever(2, n), erol(n), mu(n), coh(n), im(3, nd), d(3*nl), dinv(3*nl)
-        real(wp), intent(inout) :: rc(3, n), vel(3, nd), x(3*nl)
-        logical, intent(in) :: apply_now
-        real(wp) :: t(3), p(3), px, py
-        integer :: a, k, i, i1, i2, pcase
-        do a = first, last
-            k = list(a)
-            i = 3*a - 3
-            t = x(i + 1:i + 3)*dinv(i + 1:i + 3)
-            if (erol(k) > 0.0_wp) then
-                call rolling_projection(t(1), t(2), t(3), mu(k), erol(k), p(1), p(2), p(3), pcase)
-            else
-                call coulomb_projection(t(1), t(2), mu(k), p(1), p(2), pcase)
-                p(3) = 0.0_wp
-            end if
-            rc(1, k) = p(1) - coh(k)
-            rc(2:3, k) = p(2:3)
-            x(i + 1:i + 3) = d(i + 1:i + 3)*p
-            if (.not. apply_now) cycle
-            i1 = i1s(k)
-            i2 = i2s(k)
-            px = rc(1, k)*nrm(1, k) - rc(2, k)*nrm(2, k)
-            py = rc(1, k)*nrm(2, k) + rc(2, k)*nrm(1, k)
-            vel(1, i2) = vel(1, i2) + im(1, i2)*px
-            vel(2, i2) = vel(2, i2) + im(2, i2)*py
-            vel(3, i2) = vel(3, i2) + im(3, i2)*(lever(2, k)*rc(2, k) + rc(3, k))
-            if (i1 > 0) then
-                vel(1, i1) = vel(1, i1) - im(1, i1)*px
-                vel(2, i1) = vel(2, i1) - im(2, i1)*py
-                vel(3, i1) = vel(3, i1) + im(3, i1)*(lever(1, k)*rc(2, k) - rc(3, k))
-            end if
-        end do
-    end subroutine project_contacts
-
-    !> vel += M^-1 H r over the contacts of the solve, with the domain split: the blocks in
-    !> parallel, then the interface (serial order for one block).
-    subroutine split_apply(cs, split, im, vel)
-        type(contact_set_t), intent(in) :: cs
-        type(nlgs_split_t), intent(in) :: split
-        real(wp), intent(in) :: im(:, :)
-        real(wp), intent(inout) :: vel(:, :)
-        integer :: b, j, k
-        if (split%nb == 1) then
-            do j = 1, size(split%order)
-                k = split%order(j)
-                call apply(cs, k, im, vel, cs%r(1, k), cs%r(2, k), cs%r(3, k))
-            end do
-            return
-        end if
-        !$omp parallel do schedule(static, 1) num_threads(split%nb) private(j, k)
-        do b = 1, split%nb
-            do j = split%start(b), split%start(b + 1) - 1
-                k = split%order(j)
-                call apply(cs, k, im, vel, cs%r(1, k), cs%r(2, k), cs%r(3, k))
-            end do
-        end do
-        !$omp end parallel do
-        do j = split%start(split%nb + 1), size(split%order)
-            k = split%order(j)
-            call apply(cs, k, im, vel, cs%r(1, k), cs%r(2, k), cs%r(3, k))
-        end do
-    end subroutine split_apply
-
-    !> Solve the small symmetric system (a + lambda I) x = b (Cholesky, core_linalg), with
-    !> lambda = anderson_regularisation trace(a): the differences of the history may be nearly
-    !> dependent. x = 0 (a plain sweep) if the regularised system is still not positive definite.
-    subroutine solve_small(a, b, x)
-        real(wp), intent(in) :: a(:, :), b(:)
-        real(wp), intent(out), contiguous :: x(:)
-        type(dense_spd_t) :: g
-        type(error_t), allocatable :: error
-        real(wp) :: lambda
-        integer :: i
-        lambda = anderson_regularisation*sum([(a(i, i), i=1, size(b))])
-        call g%init(size(b))
-        g%a = a
-        do i = 1, size(b)
-            g%a(i, i) = g%a(i, i) + lambda
-        end do
-        call g%factor(error)
-        x = b
-        if (.not. allocated(error)) call g%solve(x, error)
-        if (allocated(error)) x = 0.0_wp
-        if (.not. all(ieee_is_finite(x))) x = 0.0_wp
-    end subroutine solve_small
-
     !> Round-off floor of the convergence norm's denominator for contact k (module header).
     pure real(wp) function roundoff_floor(cs, k, vel) result(f)
         type(contact_set_t), intent(in) :: cs
@@ -1366,14 +727,6 @@ contains
         if (a > 0) f = f + vel(1, a)**2 + vel(2, a)**2 + (cs%amoy(k)*vel(3, a))**2
         f = roundoff**2*f
     end function roundoff_floor
-
-    !> Steps t > 0 until v + t dv = 0, for a constraint v >= 0 that holds with more than
-    !> `slack` and decreases (dv < 0); huge otherwise.
-    pure real(wp) function time_to_face(v, dv, slack) result(t)
-        real(wp), intent(in) :: v, dv, slack
-        t = huge(1.0_wp)
-        if (dv < 0.0_wp .and. v > slack) t = v/(-dv)
-    end function time_to_face
 
     !> sqrt(num/den), 0 for 0/0, huge for x/0.
     pure real(wp) function relative(num, den) result(q)
@@ -1418,56 +771,9 @@ contains
         integer :: k
         do k = 1, cs%n
             if (.not. cs%active(k)) cycle
-            call apply(cs, k, im, vel, cs%r(1, k), cs%r(2, k), cs%r(3, k))
+            call contacts_apply_impulse(cs, k, im, vel, cs%r(1, k), cs%r(2, k), cs%r(3, k))
         end do
     end subroutine nlgs_apply_reactions
-
-    !> vel += M^-1 H (drn, drt, drm) for contact k.
-    pure subroutine apply(cs, k, im, vel, drn, drt, drm)
-        type(contact_set_t), intent(in) :: cs
-        integer, intent(in) :: k
-        real(wp), intent(in) :: im(:, :)
-        real(wp), intent(inout) :: vel(:, :)
-        real(wp), intent(in) :: drn, drt, drm
-        real(wp) :: px, py
-        integer :: a, b
-        a = cs%i1(k)
-        b = cs%i2(k)
-        px = drn*cs%nrm(1, k) - drt*cs%nrm(2, k)
-        py = drn*cs%nrm(2, k) + drt*cs%nrm(1, k)
-        vel(1, b) = vel(1, b) + im(1, b)*px
-        vel(2, b) = vel(2, b) + im(2, b)*py
-        vel(3, b) = vel(3, b) + im(3, b)*(cs%lever(2, k)*drt + drm)
-        if (a > 0) then
-            vel(1, a) = vel(1, a) - im(1, a)*px
-            vel(2, a) = vel(2, a) - im(2, a)*py
-            vel(3, a) = vel(3, a) + im(3, a)*(cs%lever(1, k)*drt - drm)
-        end if
-    end subroutine apply
-
-    !> Relative velocity H^T v + shift of contact k: (u_n, u_t, w_r).
-    pure subroutine local_velocity(cs, k, vel, u)
-        type(contact_set_t), intent(in) :: cs
-        integer, intent(in) :: k
-        real(wp), intent(in) :: vel(:, :)
-        real(wp), intent(out) :: u(3)
-        real(wp) :: dvx, dvy, ut
-        integer :: a, b
-        a = cs%i1(k)
-        b = cs%i2(k)
-        dvx = vel(1, b)
-        dvy = vel(2, b)
-        ut = cs%lever(2, k)*vel(3, b) + cs%shift(2, k)
-        u(3) = vel(3, b)
-        if (a > 0) then
-            dvx = dvx - vel(1, a)
-            dvy = dvy - vel(2, a)
-            ut = ut + cs%lever(1, k)*vel(3, a)
-            u(3) = u(3) - vel(3, a)
-        end if
-        u(1) = cs%nrm(1, k)*dvx + cs%nrm(2, k)*dvy + cs%shift(1, k)
-        u(2) = ut - cs%nrm(2, k)*dvx + cs%nrm(1, k)*dvy
-    end subroutine local_velocity
 
     !> W r for the 3x3 block w = (nn, nt, tt, nm, tm, mm).
     pure function wmul(w, r) result(v)
@@ -1542,7 +848,7 @@ contains
         nloc = 0_i8
         do a = first, last, step
             k = list(a)
-            ! u = H^T v + shift (local_velocity, written out)
+            ! u = H^T v + shift (contacts_solver_velocity, written out)
             i1 = i1s(k)
             i2 = i2s(k)
             dvx = vel(1, i2)
@@ -1576,7 +882,7 @@ contains
             dr = r - r0
             rc(1, k) = r(1) - coh(k)
             rc(2:3, k) = r(2:3)
-            ! v += M^-1 H dr (apply, written out)
+            ! v += M^-1 H dr (contacts_apply_impulse, written out)
             px = dr(1)*nx - dr(2)*ny
             py = dr(1)*ny + dr(2)*nx
             vel(1, i2) = vel(1, i2) + im(1, i2)*px
@@ -1737,193 +1043,6 @@ contains
         end if
     end subroutine relax
 
-    !> Siconos error of the current reactions (doc/theory.md, "Siconos error"), u computed in
-    !> full from the free velocities: vwork = vfree + M^-1 H r (or vel itself when bilateral
-    !> constraints changed the velocities: their impulses are not contacts); nq = |q|
-    !> (siconos_free_norm).
-    real(wp) function siconos_error(cs, im, vfree, vel, vwork, bilateral, nq) result(err)
-        type(contact_set_t), intent(in) :: cs
-        real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :), nq
-        real(wp), intent(inout) :: vwork(:, :)
-        logical, intent(in) :: bilateral
-        integer :: k
-        if (bilateral) then
-            vwork = vel
-        else
-            vwork = vfree
-            call nlgs_apply_reactions(cs, im, vwork)
-        end if
-        err = siconos_ratio(cs, pack([(k, k=1, cs%n)], cs%active(1:cs%n)), vwork, nq)
-    end function siconos_error
-
-    !> Siconos error of the contact problem u = W r + q over the active contacts:
-    !>     sqrt(sum_a |r_a - P_K(r_a - u_hat_a)|^2) / max(|q|, |r|, |u|),
-    !> with r the shifted reaction (r_n + r_cohe h, r_t, M), u_hat = (u_n + mu |u_t| + e |w_r|,
-    !> u_t, w_r) (e |w_r| and the third component only for a law with moments), q = u - W r
-    !> the free term in the shifted unknown (H^T v_free + shift - W (r_cohe h, 0, 0)) and u
-    !> the local velocities of `vel` (doc/theory.md, "Siconos error"). 0 without active
-    !> contacts.
-    function nlgs_siconos_error(cs, im, vfree, vel) result(err)
-        !> Contacts (reactions r).
-        type(contact_set_t), intent(in) :: cs
-        !> Inverse mass per DOF (3, n_disks).
-        real(wp), intent(in) :: im(:, :)
-        !> Free velocities (3, n_disks).
-        real(wp), intent(in) :: vfree(:, :)
-        !> Velocities (3, n_disks) of the reactions (vfree + M^-1 H r).
-        real(wp), intent(in) :: vel(:, :)
-        real(wp) :: err
-        integer :: k
-        err = siconos_ratio(cs, pack([(k, k=1, cs%n)], cs%active(1:cs%n)), vel, siconos_free_norm(cs, im, vfree))
-    end function nlgs_siconos_error
-
-    !> |q| over the active contacts: q = H^T vq + shift, vq the velocities of the free term in
-    !> the shifted unknown (the free motion minus the cohesion impulses; with bilateral
-    !> constraints, held by them: the problem is the condensed one). The square root of the
-    !> sum of squares (with the max in siconos_quotient, bitwise the error computed from the
-    !> squares), or norm2 where the squares overflow.
-    real(wp) function siconos_free_norm(cs, im, vfree, bilateral) result(nq)
-        type(contact_set_t), intent(in) :: cs
-        real(wp), intent(in) :: im(:, :), vfree(:, :)
-        class(nlgs_bilateral_t), intent(in), optional :: bilateral
-        real(wp), allocatable :: vq(:, :)
-        real(wp) :: q(3), qmax
-        integer :: k, pass
-        allocate (vq, source=vfree)
-        do k = 1, cs%n
-            if (.not. cs%active(k)) cycle
-            if (cs%coh(k) /= 0.0_wp) call apply(cs, k, im, vq, -cs%coh(k), 0.0_wp, 0.0_wp)
-        end do
-        if (present(bilateral)) call bilateral%hold(vq)
-        ! pass 1: the sum of squares; where it overflows, pass 2 finds the largest component
-        ! and pass 3 sums the squares scaled by it
-        qmax = 1.0_wp
-        do pass = 1, 3
-            nq = 0.0_wp
-            do k = 1, cs%n
-                if (.not. cs%active(k)) cycle
-                call local_velocity(cs, k, vq, q)
-                if (cs%erol(k) <= 0.0_wp) q(3) = 0.0_wp
-                select case (pass)
-                case (1)
-                    nq = nq + sum(q**2)
-                case (2)
-                    nq = max(nq, maxval(abs(q)))
-                case default
-                    nq = nq + sum((q/qmax)**2)
-                end select
-            end do
-            if (pass == 1 .and. ieee_is_finite(nq)) exit
-            if (pass == 2) qmax = nq
-        end do
-        nq = qmax*sqrt(nq)
-    end function siconos_free_norm
-
-    !> The ratio of nlgs_siconos_error for the velocities vel, with nq = |q|
-    !> (siconos_free_norm), over the active contacts act (in increasing order).
-    pure real(wp) function siconos_ratio(cs, act, vel, nq) result(err)
-        type(contact_set_t), intent(in) :: cs
-        integer, intent(in) :: act(:)
-        real(wp), intent(in) :: vel(:, :), nq
-        real(wp) :: num, nr, nu, amax, c
-        err = 0.0_wp
-        ! (no contact arrays to pass before the first contact)
-        if (size(act) == 0) return
-        call siconos_ratio_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%shift, cs%r, cs%coh, cs%erol, cs%mu, &
-                                    size(vel, 2), vel, size(act), act, .false., 1.0_wp, num, nr, nu, amax)
-        if (ieee_is_finite(num) .and. ieee_is_finite(nr) .and. ieee_is_finite(nu)) then
-            err = siconos_quotient(num, nr, nu, nq)
-            return
-        end if
-        ! (a second pass measures the largest component; non-finite values stay as they are)
-        call siconos_ratio_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%shift, cs%r, cs%coh, cs%erol, cs%mu, &
-                                    size(vel, 2), vel, size(act), act, .true., 1.0_wp, num, nr, nu, amax)
-        if (.not. (amax > 0.0_wp .and. amax <= huge(amax))) then
-            err = siconos_quotient(num, nr, nu, nq)
-            return
-        end if
-        ! Finite values whose squares overflow (reactions beyond 1e154: disks of density 1e300
-        ! gave a NaN error, inf/inf). The projections on the cones are positively homogeneous:
-        ! r and u scaled by the power of 2 c ~ 1/amax (exact) give the same ratio.
-        c = scale(1.0_wp, -exponent(amax))
-        call siconos_ratio_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%shift, cs%r, cs%coh, cs%erol, &
-                                    cs%mu, size(vel, 2), vel, size(act), act, .true., c, num, nr, nu, amax)
-        err = siconos_quotient(num, nr, nu, nq*c)
-    end function siconos_ratio
-
-    !> sqrt(num) / max(nq, sqrt(nr), sqrt(nu)), 0 when the denominator vanishes.
-    pure real(wp) function siconos_quotient(num, nr, nu, nq) result(err)
-        real(wp), intent(in) :: num, nr, nu, nq
-        real(wp) :: den
-        den = max(nq, sqrt(nr), sqrt(nu))
-        err = 0.0_wp
-        if (den > 0.0_wp) err = sqrt(num)/den
-    end function siconos_quotient
-
-    !> siconos_ratio on the arrays of the contact set (explicit shapes, as sweep_contacts; the
-    !> local velocity written out as there: this runs after most sweeps of a long solve, and a
-    !> shared procedure for it was not inlined, 3 % more time on the 200-disk deposit).
-    pure subroutine siconos_ratio_contacts(n, i1s, i2s, nrm, lever, shift, rc, coh, erol, mu, nd, vel, na, &
-                                           act, scaled, c, num, nr, nu, amax)
-        integer, intent(in) :: n, nd, na
-        integer, intent(in) :: i1s(n), i2s(n), act(na)
-        real(wp), intent(in) :: nrm(2, n), lever(2, n), shift(2, n), rc(3, n), coh(n), erol(n), mu(n)
-        real(wp), intent(in) :: vel(3, nd)
-        !> Whether r and u are scaled by c and amax measured (only after squares overflowed:
-        !> the usual pass does neither).
-        logical, intent(in) :: scaled
-        !> Scale of r and u (1, or 1/amax of a first pass whose squares overflowed).
-        real(wp), intent(in) :: c
-        !> Sums of |r - P_K(r - u_hat)|^2, |r|^2 and |u|^2 of the scaled values.
-        real(wp), intent(out) :: num, nr, nu
-        !> Largest |component| of the scaled r and u (0 when not `scaled`).
-        real(wp), intent(out) :: amax
-        real(wp) :: u(3), r(3), t(3), p(3), dvx, dvy, nx, ny
-        integer :: a, k, i1, i2, pcase
-        num = 0.0_wp
-        nr = 0.0_wp
-        nu = 0.0_wp
-        amax = 0.0_wp
-        do a = 1, na
-            k = act(a)
-            i1 = i1s(k)
-            i2 = i2s(k)
-            dvx = vel(1, i2)
-            dvy = vel(2, i2)
-            u(2) = lever(2, k)*vel(3, i2) + shift(2, k)
-            u(3) = vel(3, i2)
-            if (i1 > 0) then
-                dvx = dvx - vel(1, i1)
-                dvy = dvy - vel(2, i1)
-                u(2) = u(2) + lever(1, k)*vel(3, i1)
-                u(3) = u(3) - vel(3, i1)
-            end if
-            nx = nrm(1, k)
-            ny = nrm(2, k)
-            u(1) = nx*dvx + ny*dvy + shift(1, k)
-            u(2) = u(2) - ny*dvx + nx*dvy
-            r = [rc(1, k) + coh(k), rc(2, k), rc(3, k)]
-            if (scaled) then
-                r = c*r
-                u = c*u
-                amax = max(amax, maxval(abs(r)), maxval(abs(u)))
-            end if
-            if (erol(k) > 0.0_wp) then
-                t = r - [u(1) + mu(k)*abs(u(2)) + erol(k)*abs(u(3)), u(2), u(3)]
-                call rolling_projection(t(1), t(2), t(3), mu(k), erol(k), p(1), p(2), p(3), pcase)
-            else
-                u(3) = 0.0_wp
-                r(3) = 0.0_wp
-                t = [r(1) - (u(1) + mu(k)*abs(u(2))), r(2) - u(2), 0.0_wp]
-                call coulomb_projection(t(1), t(2), mu(k), p(1), p(2), pcase)
-                p(3) = 0.0_wp
-            end if
-            num = num + sum((r - p)**2)
-            nr = nr + sum(r**2)
-            nu = nu + sum(u**2)
-        end do
-    end subroutine siconos_ratio_contacts
-
     !> Relative residual of the contact laws in the current state:
     !> sqrt(sum res_a^2) / sqrt(sum |r'_a|^2) over active contacts, with res_a from
     !> bipotential_residual or rolling_residual (scaled frame, shifted reaction) and r' the
@@ -1942,7 +1061,7 @@ contains
         noise = 0.0_wp
         do k = 1, cs%n
             if (.not. cs%active(k)) cycle
-            call local_velocity(cs, k, vel, u)
+            call contacts_solver_velocity(cs, k, vel, u)
             r = [cs%r(1, k) + cs%coh(k), cs%r(2, k), cs%r(3, k)]
             if (cs%erol(k) > 0.0_wp) then
                 num = num + rolling_residual(cs%w(:, k), u, cs%mu(k), cs%erol(k), r)**2
