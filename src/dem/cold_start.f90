@@ -1,6 +1,7 @@
 !> Cold start of a contact solve (`[solver] cold_start = hydrostatic`): the hydrostatic
 !> estimate of the reactions, from which dem_nlgs starts the sweeps when no contact of the
-!> solve carries a reaction yet (doc/performance.md, "Cold start").
+!> solve carries a reaction yet (doc/theory.md section 4.7; figures in doc/performance.md,
+!> "Cold start").
 module dem_cold_start
     use core_kinds, only: wp
     use dem_contacts, only: contact_set_t

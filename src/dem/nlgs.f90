@@ -32,7 +32,7 @@
 !> `anderson_after` plain sweeps (default 10).
 !> Cold start (`hydrostatic`, off by default): when no contact of the solve carries a
 !> reaction yet (a fresh packing), the sweeps start from the hydrostatic estimate of
-!> hydrostatic_guess (dem_cold_start) instead of zero reactions.
+!> hydrostatic_guess (dem_cold_start, doc/theory.md 4.7) instead of zero reactions.
 !> The Siconos error (nlgs_siconos_error, doc/theory.md 4.5) of the final state is always
 !> computed, from u = H^T (v_free + M^-1 H r) + shift in full; `criterion` chooses which
 !> error stops the sweeps. As a stopping test it is evaluated from the velocities the sweeps
