@@ -131,23 +131,34 @@ def check(job):
         path.unlink()
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+def parser_for(description):
+    """The command line shared by the scripts that run many decks: decks, --exe, --jobs."""
+    parser = argparse.ArgumentParser(description=description)
     parser.add_argument("decks", nargs="*", type=pathlib.Path)
     parser.add_argument("--exe", default=str(ROOT / "build" / "src" / "multicor"))
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
-    opts = parser.parse_args()
+    return parser
+
+
+def copy_auxiliaries(decks, scratch):
+    """Copy the mesh and data files next to each deck into scratch/<its folder's name>, where
+    the variants of the decks are written, so that their relative paths still resolve."""
+    for folder in {d.parent for d in decks}:
+        target = scratch / folder.name
+        target.mkdir(exist_ok=True)
+        for aux in folder.iterdir():
+            if aux.is_file() and aux.suffix != ".dat":
+                shutil.copy(aux, target)
+
+
+def main():
+    opts = parser_for(__doc__.split("\n")[0]).parse_args()
     decks = opts.decks or sorted((ROOT / "input").glob("*.dat")) + \
         sorted((ROOT / "tests" / "regression" / "decks").glob("*.dat"))
     decks = [d.resolve() for d in decks]
     with tempfile.TemporaryDirectory() as tmp:
         scratch = pathlib.Path(tmp)
-        for folder in {d.parent for d in decks}:
-            target = scratch / folder.name
-            target.mkdir(exist_ok=True)
-            for aux in folder.iterdir():
-                if aux.is_file() and aux.suffix != ".dat":
-                    shutil.copy(aux, target)
+        copy_auxiliaries(decks, scratch)
         jobs = [(opts.exe, scratch, n, deck, i, what, new)
                 for n, (deck, (i, what, new)) in enumerate(
                     (deck, m) for deck in decks for m in mutants(deck))]

@@ -16,10 +16,8 @@ ctest (about 30 s on 2 cores for the decks of the repository):
     .venv/bin/python tests/solver_combinations.py [--exe build/src/multicor] [--jobs 2] [--verbose]
         [deck.dat ...]
 """
-import argparse
 import concurrent.futures
 import itertools
-import os
 import pathlib
 import re
 import shutil
@@ -30,7 +28,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from fuzz_decks import CRASH, ROOT, non_finite, run  # noqa: E402
+from fuzz_decks import CRASH, ROOT, copy_auxiliaries, non_finite, parser_for, run  # noqa: E402
 
 SETTINGS = {"method": ["nlgs", "block", "coarse"], "criterion": ["lmgc90", "siconos"],
             "cold_start": ["zero", "hydrostatic"], "anderson": ["0", "5"],
@@ -96,10 +94,7 @@ def check(job):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("decks", nargs="*", type=pathlib.Path)
-    parser.add_argument("--exe", default=str(ROOT / "build" / "src" / "multicor"))
-    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    parser = parser_for(__doc__.split("\n")[0])
     parser.add_argument("--verbose", action="store_true", help="list the runs with steps at the cap")
     opts = parser.parse_args()
     decks = opts.decks or [d for d in sorted((ROOT / "input").glob("*.dat"))
@@ -108,12 +103,7 @@ def main():
     combinations = [dict(zip(SETTINGS, v)) for v in itertools.product(*SETTINGS.values())]
     with tempfile.TemporaryDirectory() as tmp:
         scratch = pathlib.Path(tmp)
-        for folder in {d.parent for d in decks}:
-            target = scratch / folder.name
-            target.mkdir(exist_ok=True)
-            for aux in folder.iterdir():
-                if aux.is_file() and aux.suffix != ".dat":
-                    shutil.copy(aux, target)
+        copy_auxiliaries(decks, scratch)
         jobs = [(opts.exe, scratch / deck.parent.name, n, deck, values)
                 for n, (deck, values) in enumerate(itertools.product(decks, combinations))]
         with concurrent.futures.ThreadPoolExecutor(opts.jobs) as pool:
