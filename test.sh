@@ -2,8 +2,9 @@
 # Run every MULTICOR test suite: Fortran unit tests (pFUnit or its fallback), malformed-deck
 # errors, regression runs of the executable, and the Python post-processing tests.
 # Installs what is missing and builds a Debug build with run-time checks in build-debug/,
-# where everything runs but the long-horizon unit suites (ctest label long: thousands of
-# coupled steps each, ~20x faster without the run-time checks), which run on the Release
+# where everything runs but the long suites (ctest label long: the long-horizon unit suites,
+# thousands of coupled steps each, ~20x faster without the run-time checks, and every
+# combination of the solver's settings on every particle deck), which run on the Release
 # build in build/ (the one run.sh uses), with the malformed-deck tests (label baddeck) again,
 # so that the messages do not depend on the build type, and the check that the Release sweep
 # inlines its local solver (label build). The Release build also compiles the
@@ -22,7 +23,7 @@ say "Python tests (postproc)"
 .venv/bin/python -m pytest -q postproc/tests || status=1
 say "CTest suites"
 ctest --test-dir build-debug --output-on-failure -j "$(nproc)" -LE long || status=1
-say "Long-horizon unit suites, malformed decks and the inlined sweep on the Release build (build/)"
+say "Long suites, malformed decks and the inlined sweep on the Release build (build/)"
 MULTICOR_BUILD_TARGET="multicor long_tests bench" configure_and_build build Release
 ctest --test-dir build --output-on-failure -j "$(nproc)" -L 'baddeck|long|build' || status=1
 exit $status
