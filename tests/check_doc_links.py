@@ -6,7 +6,7 @@ cannot leave a dangling pointer behind:
   -1, -2 ... for repeated headings);
 - references written as text anywhere in the sources, decks, tests and scripts:
   `doc/NAME.md, "Title"` names a heading of that file or a paragraph that opens with
-  **Title**, and `doc/NAME.md section 6.2` a heading numbered 6.2.
+  **Title**, and `doc/NAME.md section 6.2` (or `doc/NAME.md 6.2`) a heading numbered 6.2.
 Usage (ctest does this): check_doc_links.py ROOT. Exit 1 with the file and the reference of
 each one that does not resolve."""
 import pathlib
@@ -16,7 +16,7 @@ import sys
 FOLDERS = ["doc", "src", "tests", "bench", "postproc", "scripts", "input", ".ci"]
 SUFFIXES = {".md", ".f90", ".fypp", ".pf", ".py", ".dat", ".cmake", ".txt", ".sh", ".slurm"}
 TEXT_REF = re.compile(
-    r'doc/([a-z_]+\.md),?\s+(?:"([^"]+)"|section\s+([0-9]+(?:\.[0-9]+)*))')
+    r'doc/([a-z_]+\.md),?\s+(?:"([^"]+)"|(?:section\s+)?([0-9]+(?:\.[0-9]+)*)\b)')
 # a line break inside a reference, with the comment marker of the next line
 BREAK = re.compile(r"[ \t]*\n[ \t]*(?:!>?|#|//)?[ \t]*")
 

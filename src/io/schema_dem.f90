@@ -228,7 +228,7 @@ contains
                            'Start of a step in which no contact carries a reaction yet (the first step of '// &
                            'a packing built at rest): `zero` reactions, or the `hydrostatic` estimate, the '// &
                            'weight carried down the contact network from the top and split at each disk over '// &
-                           'its supports within their friction cones (doc/performance.md). On tall packings '// &
+                           'its supports within their friction cones (doc/theory.md 4.7). On tall packings '// &
                            'it cuts the sweeps of that step 2 to 6 times; on hexagonal lattices the steps that '// &
                            'follow can need several times more (doc/performance.md). Not used with the Arlequin '// &
                            'coupling rows (a warning), nor in a step where method = block solves intact bonds directly.', &
