@@ -61,8 +61,9 @@ program bench_dem
     use dem_detection, only: detect_contacts
     use dem_moreau_jean, only: dem_system_t, mj_init, mj_step, dem_system_bytes
     use dem_activation, only: activation_siconos_t, activation_predicted_t
-    use dem_nlgs, only: criterion_lmgc90, criterion_siconos, nlgs_method_nlgs, nlgs_method_block, &
-                        nlgs_method_coarse
+    use dem_nlgs, only: criterion_lmgc90, criterion_siconos, nlgs_method_nlgs, nlgs_method_block, nlgs_config_t
+    use dem_coarse, only: coarse_correction_t
+    use dem_cold_start, only: hydrostatic_start_t
     use bench_packing, only: deposit_disks, deposit_width, staggered_layout
     implicit none
 
@@ -111,6 +112,8 @@ program bench_dem
     logical :: hydrostatic = .false., criterion_given = .false.
     !> Global strategy (`[solver] method`; of the settling steps, -1: the same) and the
     !> coarse correction (`coarse_every`, `coarse_size`).
+    !> `--method coarse`: the sweeps (nlgs_method_nlgs) with dem_coarse's correction.
+    integer, parameter :: method_coarse = 3
     integer :: method = nlgs_method_nlgs, settle_method = -1
     integer :: coarse_every = 10, coarse_size = 400
     !> Siconos deposit (--siconos N): disks, and the files of the layout (empty: not written).
@@ -268,11 +271,25 @@ contains
         case ('block')
             code = nlgs_method_block
         case ('coarse')
-            code = nlgs_method_coarse
+            code = method_coarse
         case default
             call usage_error('--method takes nlgs, block or coarse, got '''//trim(word)//'''')
         end select
     end function method_code
+
+    !> The strategy of a method code: nlgs_method_nlgs, nlgs_method_block, or method_coarse,
+    !> the sweeps with the coarse correction of --coarse-every and --coarse-size.
+    subroutine set_method(solver, code)
+        type(nlgs_config_t), intent(inout) :: solver
+        integer, intent(in) :: code
+        if (allocated(solver%correction)) deallocate (solver%correction)
+        if (code == method_coarse) then
+            solver%method = nlgs_method_nlgs
+            allocate (solver%correction, source=coarse_correction_t(every=coarse_every, aggregate=coarse_size))
+        else
+            solver%method = code
+        end if
+    end subroutine set_method
 
     !> The integer value of option `option`.
     subroutine read_int_value(option, text, value)
@@ -329,7 +346,7 @@ contains
         if (settle_sweeps > 0) sys%solver%max_sweeps = settle_sweeps
         if (settle_tol > 0.0_wp) sys%solver%tol = settle_tol
         if (settle_anderson >= 0) sys%solver%anderson = settle_anderson
-        if (settle_method >= 0) sys%solver%method = settle_method
+        if (settle_method >= 0) call set_method(sys%solver, settle_method)
         do s = 1, n_settle
             call mj_step(sys)
         end do
@@ -338,7 +355,7 @@ contains
         sys%solver%anderson = anderson
         sys%solver%anderson_after = anderson_after
         sys%solver%anderson_sweeps = anderson_sweeps
-        sys%solver%method = method
+        call set_method(sys%solver, method)
         allocate (t_det(n_steps), t_sol(n_steps), rate(n_steps))
         sweeps = 0
         n_conv = 0
@@ -496,11 +513,9 @@ contains
         sys%solver%anderson = anderson
         sys%solver%anderson_after = anderson_after
         sys%solver%anderson_sweeps = anderson_sweeps
-        sys%solver%hydrostatic = hydrostatic
+        if (hydrostatic) allocate (hydrostatic_start_t :: sys%solver%start)
         sys%solver%symmetric = symmetric
-        sys%solver%method = method
-        sys%solver%coarse_every = coarse_every
-        sys%solver%coarse_size = coarse_size
+        call set_method(sys%solver, method)
         call set_scheme(sys)
         call mj_init(sys, error)
         if (allocated(error)) error stop 'bench_dem: invalid setup'
@@ -683,11 +698,9 @@ contains
         sys%solver%anderson = anderson
         sys%solver%anderson_after = anderson_after
         sys%solver%anderson_sweeps = anderson_sweeps
-        sys%solver%hydrostatic = hydrostatic
+        if (hydrostatic) allocate (hydrostatic_start_t :: sys%solver%start)
         sys%solver%symmetric = symmetric
-        sys%solver%method = method
-        sys%solver%coarse_every = coarse_every
-        sys%solver%coarse_size = coarse_size
+        call set_method(sys%solver, method)
         sys%solver%criterion = criterion
         call set_scheme(sys)
         call mj_init(sys, error)

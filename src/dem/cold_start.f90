@@ -1,17 +1,25 @@
 !> Cold start of a contact solve (`[solver] cold_start = hydrostatic`): the hydrostatic
-!> estimate of the reactions, from which dem_nlgs starts the sweeps when no contact of the
-!> solve carries a reaction yet (doc/theory.md section 4.7; figures in doc/performance.md,
-!> "Cold start").
+!> estimate of the reactions, an extension of nlgs_start_t from which dem_nlgs starts the
+!> sweeps when no contact of the solve carries a reaction yet (doc/theory.md section 4.7;
+!> figures in doc/performance.md, "Cold start").
 module dem_cold_start
     use core_kinds, only: wp
     use dem_contacts, only: contact_set_t
+    use dem_nlgs, only: nlgs_start_t
     implicit none
     private
-    public :: hydrostatic_guess
+    public :: hydrostatic_start_t
+
+    !> The hydrostatic estimate (hydrostatic_guess).
+    type, extends(nlgs_start_t) :: hydrostatic_start_t
+    contains
+        !> The weight carried down the contact network from the top.
+        procedure :: guess => hydrostatic_guess
+    end type hydrostatic_start_t
 
 contains
 
-    !> Hydrostatic estimate of the reactions of a cold solve (config%hydrostatic): the
+    !> Hydrostatic estimate of the reactions of a cold solve (nlgs_config_t%start): the
     !> impulses that bring every disk to rest, -M v_free, carried down the contact network
     !> from the top. "Down" is the direction of the total free momentum sum M v_free (gravity
     !> for a packing at rest). A contact supports its upper body: the other disk lies below
@@ -28,7 +36,9 @@ contains
     !> holding every disk without friction (a frictionless pyramid, test_nlgs) this is the
     !> solution of the step; elsewhere it is a start that already carries the weight to the
     !> floor.
-    subroutine hydrostatic_guess(cs, list, im, vfree)
+    subroutine hydrostatic_guess(self, cs, list, im, vfree)
+        !> The estimate (no settings).
+        class(hydrostatic_start_t), intent(in) :: self
         !> Contacts (frames, friction); the reactions of list are set.
         type(contact_set_t), intent(inout) :: cs
         !> The contacts of the solve, all with zero reactions.

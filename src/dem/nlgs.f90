@@ -30,9 +30,10 @@
 !> default; the history restarts when |G(x) - x| grows; a drift of the sweeps, G(x) - x the
 !> same map after map, is skipped to where its first reaction meets a face of its cone), after
 !> `anderson_after` plain sweeps (default 10).
-!> Cold start (`hydrostatic`, off by default): when no contact of the solve carries a
-!> reaction yet (a fresh packing), the sweeps start from the hydrostatic estimate of
-!> hydrostatic_guess (dem_cold_start, doc/theory.md 4.7) instead of zero reactions.
+!> Cold start (`start`, an extension of `nlgs_start_t`; none by default): when no contact of
+!> the solve carries a reaction yet (a fresh packing), the sweeps start from its estimate
+!> instead of zero reactions, e.g. the hydrostatic estimate of dem_cold_start (doc/theory.md
+!> 4.7).
 !> The Siconos error (nlgs_siconos_error, doc/theory.md 4.5) of the final state is always
 !> computed, from u = H^T (v_free + M^-1 H r) + shift in full; `criterion` chooses which
 !> error stops the sweeps. As a stopping test it is evaluated from the velocities the sweeps
@@ -72,20 +73,21 @@
 !> steps stops at the cap of 20 000 iterations instead of 12 (doc/performance.md, "Anderson
 !> with the bonded block").
 !>
-!> Coarse correction (`method = coarse`, coarse_correct): before the first sweep and after
-!> every `coarse_every` sweeps, the reactions of aggregates of consecutive contacts are
-!> scaled by the Galerkin solution of a small system (one unknown per aggregate), which
-!> moves the weight through the whole height of a packing at once. It does nothing at a
-!> solution of the sweeps, and the sweeps alone decide convergence. Safeguard: when the
+!> Correction (`correction`, an extension of `nlgs_correction_t`; none by default): before
+!> the first sweep and after every `correction%every` sweeps it changes the reactions of the
+!> swept contacts, e.g. the coarse correction of dem_coarse (`[solver] method = coarse`),
+!> which scales the reactions of aggregates of consecutive contacts by the Galerkin solution
+!> of a small system and so moves the weight through the whole height of a packing at once.
+!> A correction must do nothing at a solution of the sweeps, so that the sweeps alone decide
+!> convergence. Safeguard: when the
 !> error at a correction is larger than at the previous one (the corrections undo what the
 !> sweeps between them did), the step goes on without corrections: on the impacts of a
 !> deposit every correction raised the error tenfold and 13 to 16 % of the steps never
 !> converged.
 !>
 !> Files: this one holds the solve, the sweeps and their domain split; the submodules
-!> dem_nlgs_anderson (nlgs_anderson.f90), dem_nlgs_coarse (nlgs_coarse.f90) and
-!> dem_nlgs_siconos (nlgs_siconos.f90) the Anderson step, the coarse correction and the
-!> Siconos error.
+!> dem_nlgs_anderson (nlgs_anderson.f90) and dem_nlgs_siconos (nlgs_siconos.f90) the
+!> Anderson step and the Siconos error.
 module dem_nlgs
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp, i8
@@ -93,7 +95,6 @@ module dem_nlgs
     use core_error, only: error_t
     use core_linalg, only: dense_spd_t, dot
     use dem_contacts, only: contact_set_t, contacts_apply_impulse, contacts_solver_velocity
-    use dem_cold_start, only: hydrostatic_guess
 !$  use omp_lib, only: omp_get_max_threads
     use dem_bipotential, only: bipotential_residual, bipotential_scaling, bipotential_local_solve_scaled, &
                                bipotential_n_scaling, rolling_scaling, rolling_local_solve_scaled, rolling_residual, &
@@ -102,16 +103,13 @@ module dem_nlgs
     private
     public :: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_apply_reactions, nlgs_residual
     public :: nlgs_bilateral_t, nlgs_block_t
-    public :: nlgs_method_nlgs, nlgs_method_block, nlgs_method_coarse
+    public :: nlgs_method_nlgs, nlgs_method_block, nlgs_correction_t, nlgs_start_t
 
     !> Global strategy: Gauss-Seidel sweeps over every contact.
     integer, parameter :: nlgs_method_nlgs = 1
     !> Global strategy: intact bonds solved directly as one block, sweeps over the others
     !> (dem_bonded_block).
     integer, parameter :: nlgs_method_block = 2
-    !> Global strategy: sweeps over every contact with a coarse correction of the reactions
-    !> by aggregates of contacts every `coarse_every` sweeps (coarse_correct).
-    integer, parameter :: nlgs_method_coarse = 3
     public :: nlgs_siconos_error
     public :: nlgs_split_t, nlgs_split_build
     public :: criterion_lmgc90, criterion_siconos, criterion_names
@@ -130,6 +128,56 @@ module dem_nlgs
     !> machine epsilons.
     real(wp), parameter :: roundoff = 64.0_wp*epsilon(1.0_wp)
 
+    !> A correction of the swept contacts' reactions between sweeps (module header). It must
+    !> change nothing at a solution of the sweeps.
+    type, abstract :: nlgs_correction_t
+        !> Sweeps between two corrections (one runs before the first sweep).
+        integer :: every = 10
+    contains
+        !> Change the reactions of the contacts list and the velocities with them.
+        procedure(correction_correct), deferred :: correct
+    end type nlgs_correction_t
+
+    !> The reactions a solve starts from when none of its contacts carries one yet (module
+    !> header).
+    type, abstract :: nlgs_start_t
+    contains
+        !> Set the reactions of the contacts list (all zero on entry).
+        procedure(start_guess), deferred :: guess
+    end type nlgs_start_t
+
+    abstract interface
+        !> Change the reactions of the contacts list, and vel by the impulses of the change.
+        subroutine correction_correct(self, cs, list, im, vel)
+            import :: nlgs_correction_t, contact_set_t, wp
+            !> The correction.
+            class(nlgs_correction_t), intent(in) :: self
+            !> Contacts (reactions r).
+            type(contact_set_t), intent(inout) :: cs
+            !> The swept contacts, in the order of the sweeps.
+            integer, intent(in) :: list(:)
+            !> Inverse mass per DOF (3, n_disks).
+            real(wp), intent(in) :: im(:, :)
+            !> Disk velocities (3, n_disks), updated.
+            real(wp), intent(inout) :: vel(:, :)
+        end subroutine correction_correct
+
+        !> Set the reactions of the contacts list, which are all zero.
+        subroutine start_guess(self, cs, list, im, vfree)
+            import :: nlgs_start_t, contact_set_t, wp
+            !> The start.
+            class(nlgs_start_t), intent(in) :: self
+            !> Contacts (frames, friction); the reactions of list are set.
+            type(contact_set_t), intent(inout) :: cs
+            !> The contacts of the solve.
+            integer, intent(in) :: list(:)
+            !> Inverse mass per DOF (3, n_disks).
+            real(wp), intent(in) :: im(:, :)
+            !> Free velocities (3, n_disks).
+            real(wp), intent(in) :: vfree(:, :)
+        end subroutine start_guess
+    end interface
+
     !> Solver settings.
     type :: nlgs_config_t
         !> Tolerance of the convergence norm.
@@ -142,12 +190,15 @@ module dem_nlgs
         integer :: local_max_iter = 8
         !> Alternate the sweep direction.
         logical :: symmetric = .true.
-        !> Global strategy (nlgs_method_nlgs, nlgs_method_block or nlgs_method_coarse),
-        !> chosen by the caller.
+        !> Global strategy (nlgs_method_nlgs or nlgs_method_block), chosen by the caller.
         integer :: method = nlgs_method_nlgs
-        !> Coarse correction (nlgs_method_coarse): sweeps between two corrections, and
-        !> contacts per aggregate (consecutive contacts of the solve).
-        integer :: coarse_every = 10, coarse_size = 400
+        !> Correction of the reactions between sweeps (module header; e.g. dem_coarse's);
+        !> none when not allocated.
+        class(nlgs_correction_t), allocatable :: correction
+        !> Start of a solve in which no contact carries a reaction yet (module header; e.g.
+        !> dem_cold_start's hydrostatic estimate); zero reactions when not allocated. Not used
+        !> with bilateral constraints or a block.
+        class(nlgs_start_t), allocatable :: start
         !> Over-relaxation factor omega in (0, 2): each contact update becomes
         !> P_K(r0 + omega (r_loc - r0)) (module header); 1 is plain NLGS.
         real(wp) :: relaxation = 1.0_wp
@@ -172,11 +223,6 @@ module dem_nlgs
         !> Domain split of the sweeps over the OpenMP threads (nlgs_split_build): fewest contacts
         !> per block (smaller solves, and all solves on one thread, are serial).
         integer :: split_min = 2000
-        !> Cold start from the hydrostatic estimate (hydrostatic_guess): when every contact of
-        !> the solve starts from a zero reaction (a fresh packing), the weight is first carried
-        !> down the contact network from the top, then the sweeps start from there. Not used
-        !> with bilateral constraints or a block.
-        logical :: hydrostatic = .false.
     end type nlgs_config_t
 
     !> Statistics of one solve.
@@ -204,7 +250,7 @@ module dem_nlgs
         logical :: converged = .true.
         !> Active contacts solved as a block (nlgs_block_t members), not swept.
         integer :: n_block = 0
-        !> Coarse corrections done (nlgs_method_coarse).
+        !> Corrections done (config%correction).
         integer :: corrections = 0
     end type nlgs_stats_t
 
@@ -242,9 +288,6 @@ module dem_nlgs
         integer, allocatable :: order(:)
     end type nlgs_split_t
 
-    !> Largest number of aggregates of the coarse correction (its system is factored dense:
-    !> 2000^3/3 flops, about 1 s; larger aggregates are used beyond).
-    integer, parameter :: max_aggregates = 2000
     !> Contacts per chunk of the deterministic parallel sums of the Anderson step.
     integer, parameter :: dot_chunk = 1024
     !> Siconos criterion: the error is evaluated at least every siconos_period sweeps, and at
@@ -407,17 +450,6 @@ module dem_nlgs
     ! repeat the arguments (`module subroutine`; the compiler checks them against these)
     ! rather than use `module procedure`, whose body fprettify does not indent.
     interface
-        !> Coarse correction of the reactions of the contacts list (nlgs_method_coarse): scale
-        !> the reactions of aggregates of size_agg consecutive contacts by the Galerkin solution
-        !> of a small system, and update vel (submodule dem_nlgs_coarse).
-        module subroutine coarse_correct(cs, list, im, vel, size_agg)
-            type(contact_set_t), intent(inout) :: cs
-            integer, intent(in) :: list(:)
-            real(wp), intent(in) :: im(:, :)
-            real(wp), intent(inout) :: vel(:, :)
-            integer, intent(in) :: size_agg
-        end subroutine coarse_correct
-
         !> Forget the history of the Anderson acceleration (submodule dem_nlgs_anderson).
         pure module subroutine anderson_restart(aa)
             type(anderson_t), intent(inout) :: aa
@@ -528,7 +560,8 @@ contains
         real(wp) :: floor, omega, checked
         type(anderson_t) :: aa
         type(nlgs_split_t) :: split
-        logical :: accelerate, coarse
+        logical :: accelerate, correcting
+        integer :: every
         real(wp) :: error_corrected
         logical :: mix_now
         integer :: s, k, n_swept, nb
@@ -581,10 +614,10 @@ contains
             end if
         end do
         !$omp end parallel do
-        if (config%hydrostatic .and. .not. present(bilateral) .and. stats%n_block == 0) then
+        if (allocated(config%start) .and. .not. present(bilateral) .and. stats%n_block == 0) then
             ! not on a step without active contacts: the estimate's O(N) pass would find nothing
             if (size(list) > 0) then
-                if (all(cs%r(:, list) == 0.0_wp)) call hydrostatic_guess(cs, list, im, vfree)
+                if (all(cs%r(:, list) == 0.0_wp)) call config%start%guess(cs, list, im, vfree)
             end if
         end if
         call nlgs_apply_reactions(cs, im, vel)
@@ -607,13 +640,16 @@ contains
         ! at a tolerance of 1e-14, plain sweeps within 1e-10; method = block solves them)
         accelerate = config%anderson > 0 .and. n_swept > 0
         if (accelerate .and. .not. present(block)) accelerate = all(cs%coh(list) == 0.0_wp)
-        ! the coarse correction scales swept contacts only: not with a block or bilateral rows
-        coarse = config%method == nlgs_method_coarse .and. .not. present(bilateral) .and. stats%n_block == 0 &
-                 .and. n_swept > 0
+        ! the correction changes swept contacts only: not with a block or bilateral rows
+        correcting = allocated(config%correction) .and. .not. present(bilateral) .and. stats%n_block == 0 &
+                     .and. n_swept > 0
         stats%corrections = 0
         error_corrected = huge(1.0_wp)
-        if (coarse) then
-            call coarse_correct(cs, list, im, vel, config%coarse_size)
+        ! (the period read only where there is a correction: .and. does not short-circuit)
+        every = huge(1)
+        if (correcting) every = config%correction%every
+        if (correcting) then
+            call config%correction%correct(cs, list, im, vel)
             stats%corrections = 1
         end if
         if (stats%n_active > 0) then
@@ -653,7 +689,7 @@ contains
                                 .or. (stats%error*per_norm <= siconos_margin*config%tol &
                                       .and. stats%error < norm_evaluated) &
                                 .or. (omega /= 1.0_wp .and. mod(s, config%check_every) == 0) &
-                                .or. (coarse .and. mod(s, config%coarse_every) == 0)
+                                .or. (correcting .and. mod(s, every) == 0)
                     if (evaluated) then
                         norm = stats%error
                         norm_evaluated = norm
@@ -689,13 +725,13 @@ contains
                         call gather(cs, list, aa%d, aa%x, .false.)
                     end if
                 end if
-                if (coarse .and. mod(s, config%coarse_every) == 0) then
+                if (correcting .and. mod(s, every) == 0) then
                     ! safeguard: no more corrections once the error at one is larger than at
                     ! the previous one
-                    coarse = stats%error <= error_corrected
-                    if (coarse) then
+                    correcting = stats%error <= error_corrected
+                    if (correcting) then
                         error_corrected = stats%error
-                        call coarse_correct(cs, list, im, vel, config%coarse_size)
+                        call config%correction%correct(cs, list, im, vel)
                         stats%corrections = stats%corrections + 1
                         ! the correction is not a sweep: the history of the sweep map restarts
                         if (accelerate) call anderson_restart(aa)

@@ -10,11 +10,11 @@ set(MULTICOR_DEM_SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/detection.f90
     ${CMAKE_CURRENT_LIST_DIR}/bipotential.f90
     ${CMAKE_CURRENT_LIST_DIR}/bonds.f90
-    ${CMAKE_CURRENT_LIST_DIR}/cold_start.f90
     ${CMAKE_CURRENT_LIST_DIR}/nlgs.f90
     ${CMAKE_CURRENT_LIST_DIR}/nlgs_anderson.f90
-    ${CMAKE_CURRENT_LIST_DIR}/nlgs_coarse.f90
     ${CMAKE_CURRENT_LIST_DIR}/nlgs_siconos.f90
+    ${CMAKE_CURRENT_LIST_DIR}/cold_start.f90
+    ${CMAKE_CURRENT_LIST_DIR}/coarse.f90
     ${CMAKE_CURRENT_LIST_DIR}/bonded_block.f90
     ${CMAKE_CURRENT_LIST_DIR}/local_problem.f90
     ${CMAKE_CURRENT_LIST_DIR}/moreau_jean.f90)

@@ -33,7 +33,9 @@ module driver_config_dem
     use dem_contacts, only: contact_set_t
     use dem_detection, only: detector_t, detect_contacts, coordinate_limit
     use dem_moreau_jean, only: dem_system_t
-    use dem_nlgs, only: nlgs_method_nlgs, nlgs_method_block, nlgs_method_coarse, criterion_lmgc90, criterion_siconos
+    use dem_nlgs, only: nlgs_method_nlgs, nlgs_method_block, criterion_lmgc90, criterion_siconos
+    use dem_coarse, only: coarse_correction_t
+    use dem_cold_start, only: hydrostatic_start_t
     use driver_config, only: run_config_t, repeated_dof
     implicit none
     private
@@ -870,15 +872,16 @@ contains
             sys%solver%local_max_iter = deck%get_int('solver', 'local_iterations')
             sys%solver%method = nlgs_method_nlgs
             if (deck%get_word('solver', 'method') == 'block') sys%solver%method = nlgs_method_block
-            if (deck%get_word('solver', 'method') == 'coarse') sys%solver%method = nlgs_method_coarse
-            sys%solver%coarse_every = deck%get_int('solver', 'coarse_every')
-            sys%solver%coarse_size = deck%get_int('solver', 'coarse_size')
+            ! method = coarse: the sweeps (nlgs) with the coarse correction
+            if (deck%get_word('solver', 'method') == 'coarse') &
+                allocate (sys%solver%correction, source=coarse_correction_t(every=deck%get_int('solver', 'coarse_every'), &
+                                                                            aggregate=deck%get_int('solver', 'coarse_size')))
             sys%solver%relaxation = deck%get_real('solver', 'relaxation')
             sys%solver%check_every = deck%get_int('solver', 'check_every')
             sys%solver%anderson = deck%get_int('solver', 'anderson')
             sys%solver%anderson_after = deck%get_int('solver', 'anderson_after')
             sys%solver%anderson_sweeps = deck%get_int('solver', 'anderson_sweeps')
-            sys%solver%hydrostatic = deck%get_word('solver', 'cold_start') == 'hydrostatic'
+            if (deck%get_word('solver', 'cold_start') == 'hydrostatic') allocate (hydrostatic_start_t :: sys%solver%start)
             sys%solver%symmetric = deck%get_word('solver', 'sweep_order') == 'alternating'
             sys%solver%criterion = criterion_lmgc90
             if (deck%get_word('solver', 'criterion') == 'siconos') sys%solver%criterion = criterion_siconos

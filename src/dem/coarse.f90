@@ -1,14 +1,38 @@
-!> Coarse correction of the NLGS (`[solver] method = coarse`, doc/theory.md 4.6): the
-!> reactions of aggregates of consecutive contacts scaled at once. Part of dem_nlgs (its
-!> module header); the interface is declared there.
-submodule(dem_nlgs) dem_nlgs_coarse
+!> Coarse correction of the NLGS sweeps (`[solver] method = coarse`, doc/theory.md 4.6): an
+!> extension of nlgs_correction_t that scales the reactions of aggregates of consecutive
+!> contacts at once, by the Galerkin solution of a small system, one unknown per aggregate.
+module dem_coarse
+    use core_kinds, only: wp
+    use core_error, only: error_t
+    use core_linalg, only: dense_spd_t
+    use dem_contacts, only: contact_set_t, contacts_apply_impulse, contacts_solver_velocity
+    use dem_nlgs, only: nlgs_correction_t
     implicit none
+    private
+    public :: coarse_correction_t
+
+    !> The coarse correction: every `every` sweeps (nlgs_correction_t), aggregates of
+    !> `aggregate` consecutive contacts of the solve.
+    type, extends(nlgs_correction_t) :: coarse_correction_t
+        !> Contacts per aggregate (`[solver] coarse_size`).
+        integer :: aggregate = 400
+    contains
+        !> Scale the reactions of each aggregate (coarse_correct).
+        procedure :: correct => coarse_correct
+    end type coarse_correction_t
+
+    !> Largest number of aggregates (the system is factored dense: 2000^3/3 flops, about 1 s;
+    !> larger aggregates are used beyond).
+    integer, parameter :: max_aggregates = 2000
+    !> Tikhonov term of the coarse system, relative to its diagonal: far above the rounding of
+    !> its entries (1e-16), far below their size (the value of the Anderson step's).
+    real(wp), parameter :: regularisation = 1.0e-12_wp
 
 contains
 
-    !> Coarse correction of the reactions (nlgs_method_coarse; doc/theory.md 4.6). The
+    !> Coarse correction of the reactions (doc/theory.md 4.6). The
     !> contacts of the solve, in their order (bottom-up for a packing numbered by rows), are
-    !> cut into aggregates A of `size_agg` consecutive contacts (at most max_aggregates
+    !> cut into aggregates A of `self%aggregate` consecutive contacts (at most max_aggregates
     !> aggregates). Each contact with r_n > 0 and
     !> no cohesion has a pattern p: its reaction when strictly inside its cone (sticking),
     !> (r_n, 0, 0) otherwise (sliding). The correction is r <- r + a_A p on the contacts of
@@ -22,12 +46,17 @@ contains
     !> the weight between layers in one step, where a sweep moves it by one layer. a_A is
     !> bounded below by -1/2 (the reactions keep their sign); the next sweep projects any
     !> reaction left outside its cone.
-    module subroutine coarse_correct(cs, list, im, vel, size_agg)
+    subroutine coarse_correct(self, cs, list, im, vel)
+        !> The correction (its aggregate size).
+        class(coarse_correction_t), intent(in) :: self
+        !> Contacts (reactions r).
         type(contact_set_t), intent(inout) :: cs
+        !> The swept contacts, in the order of the sweeps.
         integer, intent(in) :: list(:)
+        !> Inverse mass per DOF (3, n_disks).
         real(wp), intent(in) :: im(:, :)
+        !> Disk velocities (3, n_disks), updated.
         real(wp), intent(inout) :: vel(:, :)
-        integer, intent(in) :: size_agg
         type(dense_spd_t) :: c
         type(error_t), allocatable :: error
         integer, allocatable :: start(:), inc(:), fill(:)
@@ -37,7 +66,7 @@ contains
         n = size(list)
         if (n == 0) return
         ! at most max_aggregates aggregates (the coarse system is dense)
-        m = max(size_agg, 1, (n + max_aggregates - 1)/max_aggregates)
+        m = max(self%aggregate, 1, (n + max_aggregates - 1)/max_aggregates)
         na = (n + m - 1)/m
         nd = size(vel, 2)
         ! pattern of each position (the reaction it scales) and the incidence of the disks
@@ -106,7 +135,7 @@ contains
                 c%a(ga, ga) = dmax
                 b(ga) = 0.0_wp
             end if
-            c%a(ga, ga) = c%a(ga, ga)*(1.0_wp + anderson_regularisation)
+            c%a(ga, ga) = c%a(ga, ga)*(1.0_wp + regularisation)
         end do
         call c%factor(error)
         if (allocated(error)) return
@@ -138,4 +167,4 @@ contains
         end function impulse
     end subroutine coarse_correct
 
-end submodule dem_nlgs_coarse
+end module dem_coarse
