@@ -79,11 +79,10 @@
 !> which scales the reactions of aggregates of consecutive contacts by the Galerkin solution
 !> of a small system and so moves the weight through the whole height of a packing at once.
 !> A correction must do nothing at a solution of the sweeps, so that the sweeps alone decide
-!> convergence. Safeguard: when the
-!> error at a correction is larger than at the previous one (the corrections undo what the
-!> sweeps between them did), the step goes on without corrections: on the impacts of a
-!> deposit every correction raised the error tenfold and 13 to 16 % of the steps never
-!> converged.
+!> convergence. Safeguard: when the error at a correction is larger than at the previous one
+!> (the corrections undo what the sweeps between them did), the step goes on without
+!> corrections: on the impacts of a deposit every coarse correction raised the error tenfold
+!> and 13 to 16 % of the steps never converged.
 !>
 !> Files: this one holds the solve, the sweeps and their domain split; the submodules
 !> dem_nlgs_anderson (nlgs_anderson.f90) and dem_nlgs_siconos (nlgs_siconos.f90) the
