@@ -27,7 +27,8 @@ program bench_bonded
     use dem_particles, only: particles_add_disks, particles_fix, particles_add_load, dof_x, dof_y, dof_rot
     use dem_materials, only: materials_init, materials_set_pair, materials_set_bond, bond_e_default
     use dem_moreau_jean, only: dem_system_t, mj_init, mj_step
-    use dem_nlgs, only: nlgs_method_nlgs, nlgs_method_block
+    use dem_solve_method, only: solve_method_t, sweeps_method_t
+    use dem_bonded_block, only: bonded_block_method_t
     use driver_config, only: run_config_t, build_config
     use driver_config_dem, only: dem_config_t, build_dem_config
     use driver_config_coupling, only: coupled_setup_t, build_coupling_config
@@ -57,19 +58,19 @@ program bench_bonded
     end if
     write (output_unit, '(a)') '# clamped bonded row, 50 disks, tip load, one step from rest, tol 1e-10'
     write (output_unit, '(a)') '# method  iterations  converged  time[s]  err_rn/Ph  err_rt/Ph  err_M/(PR(2N-1)h)'
-    call clamped_row(nlgs_method_block)
-    if (nlgs_steps > 0) call clamped_row(nlgs_method_nlgs)
+    call clamped_row(bonded_block_method_t())
+    if (nlgs_steps > 0) call clamped_row(sweeps_method_t())
     write (output_unit, '(a)') '# reference stack '//deck_path//', tol 1e-10, cap 1e5 sweeps'
     write (output_unit, '(a)') '# method  steps  iter_mean  iter_max  converged  step[ms]  dem_solver[ms]  '// &
         'total[s]  cpu[s]  analyses  factorisations  kept  refinements  releases'
-    call reference_stack(deck_path, nlgs_method_block, 1000)
-    if (nlgs_steps > 0) call reference_stack(deck_path, nlgs_method_nlgs, nlgs_steps)
+    call reference_stack(deck_path, bonded_block_method_t(), 1000)
+    if (nlgs_steps > 0) call reference_stack(deck_path, sweeps_method_t(), nlgs_steps)
 
 contains
 
     !> Case 1 with the given method.
     subroutine clamped_row(method)
-        integer, intent(in) :: method
+        class(solve_method_t), intent(in) :: method
         integer, parameter :: n = 50
         real(wp), parameter :: r = 0.01_wp, p = 3.0_wp, h = 1.0e-4_wp, rho = 2500.0_wp
         type(dem_system_t) :: sys
@@ -84,7 +85,7 @@ contains
         sys%scheme%alert = 0.25_wp*r
         sys%solver%tol = 1.0e-10_wp
         sys%solver%max_sweeps = 1000000
-        sys%solver%method = method
+        allocate (sys%method, source=method)
         call particles_add_disks(sys%particles, [(2.0_wp*r*(k - 1), k=1, n)], spread(0.0_wp, 1, n), &
                                  spread(r, 1, n), [rho], error)
         do d = dof_x, dof_rot
@@ -112,7 +113,8 @@ contains
     !> Case 2 with the given method, `steps` steps.
     subroutine reference_stack(path, method, steps)
         character(len=*), intent(in) :: path
-        integer, intent(in) :: method, steps
+        class(solve_method_t), intent(in) :: method
+        integer, intent(in) :: steps
         type(deck_t) :: deck
         type(run_config_t) :: run
         type(beam_config_t) :: beam
@@ -133,7 +135,8 @@ contains
         end if
         dem%system%solver%tol = 1.0e-10_wp
         dem%system%solver%max_sweeps = 100000
-        dem%system%solver%method = method
+        deallocate (dem%system%method)
+        allocate (dem%system%method, source=method)
         allocate (sys)
         call build_coupled(run, beam, dem, setup, sys, report_line, error)
         if (allocated(error)) then
@@ -156,18 +159,19 @@ contains
         call system_clock(c1)
         call cpu_time(cpu1)
         t_total = real(c1 - c0, wp)/real(rate, wp)
-        if (allocated(sys%dem%block)) then
-            associate (c => sys%dem%block%counts)
+        select type (m => sys%dem%method)
+        type is (bonded_block_method_t)
+            associate (c => m%block%counts)
                 write (output_unit, '(a6,i7,f11.1,i10,f11.3,2f10.3,2f10.3,5i8)') name(method), steps, it_sum/steps, &
                     it_max, real(n_conv, wp)/steps, 1.0e3_wp*t_total/steps, &
                     1.0e3_wp*(sys%dem%time_solver - t_solver0)/steps, t_total, cpu1 - cpu0, c%analyses, &
                     c%factorisations, c%reuses, c%refinements, c%releases
             end associate
-        else
+        class default
             write (output_unit, '(a6,i7,f11.1,i10,f11.3,2f10.3,2f10.3)') name(method), steps, it_sum/steps, it_max, &
                 real(n_conv, wp)/steps, 1.0e3_wp*t_total/steps, 1.0e3_wp*(sys%dem%time_solver - t_solver0)/steps, &
                 t_total, cpu1 - cpu0
-        end if
+        end select
     end subroutine reference_stack
 
     !> Lines the set-up announces (a long one), printed as they come.
@@ -179,8 +183,13 @@ contains
 
     !> Name of a method.
     pure function name(method) result(s)
-        integer, intent(in) :: method
+        class(solve_method_t), intent(in) :: method
         character(len=6) :: s
-        s = merge('block ', 'nlgs  ', method == nlgs_method_block)
+        select type (method)
+        type is (bonded_block_method_t)
+            s = 'block'
+        class default
+            s = 'nlgs'
+        end select
     end function name
 end program bench_bonded

@@ -61,7 +61,9 @@ program bench_dem
     use dem_detection, only: detect_contacts
     use dem_moreau_jean, only: dem_system_t, mj_init, mj_step, dem_system_bytes
     use dem_activation, only: activation_siconos_t, activation_predicted_t
-    use dem_nlgs, only: criterion_lmgc90, criterion_siconos, nlgs_method_nlgs, nlgs_method_block, nlgs_config_t
+    use dem_nlgs, only: criterion_lmgc90, criterion_siconos
+    use dem_solve_method, only: sweeps_method_t
+    use dem_bonded_block, only: bonded_block_method_t
     use dem_coarse, only: coarse_correction_t
     use dem_cold_start, only: hydrostatic_start_t
     use bench_packing, only: deposit_disks, deposit_width, staggered_layout
@@ -112,9 +114,9 @@ program bench_dem
     logical :: hydrostatic = .false., criterion_given = .false.
     !> Global strategy (`[solver] method`; of the settling steps, -1: the same) and the
     !> coarse correction (`coarse_every`, `coarse_size`).
-    !> `--method coarse`: the sweeps (nlgs_method_nlgs) with dem_coarse's correction.
-    integer, parameter :: method_coarse = 3
-    integer :: method = nlgs_method_nlgs, settle_method = -1
+    !> Codes of `--method`: nlgs, block, and coarse, the sweeps with dem_coarse's correction.
+    integer, parameter :: method_nlgs = 1, method_block = 2, method_coarse = 3
+    integer :: method = method_nlgs, settle_method = -1
     integer :: coarse_every = 10, coarse_size = 400
     !> Siconos deposit (--siconos N): disks, and the files of the layout (empty: not written).
     integer :: siconos_n = 0
@@ -267,9 +269,9 @@ contains
         character(len=*), intent(in) :: word
         select case (word)
         case ('nlgs')
-            code = nlgs_method_nlgs
+            code = method_nlgs
         case ('block')
-            code = nlgs_method_block
+            code = method_block
         case ('coarse')
             code = method_coarse
         case default
@@ -277,17 +279,28 @@ contains
         end select
     end function method_code
 
-    !> The strategy of a method code: nlgs_method_nlgs, nlgs_method_block, or method_coarse,
-    !> the sweeps with the coarse correction of --coarse-every and --coarse-size.
-    subroutine set_method(solver, code)
-        type(nlgs_config_t), intent(inout) :: solver
+    !> The strategy of a method code: the sweeps (method_nlgs), the bonded block
+    !> (method_block; a block in use keeps its factor), or the sweeps with the coarse
+    !> correction of --coarse-every and --coarse-size (method_coarse).
+    subroutine set_method(sys, code)
+        type(dem_system_t), intent(inout) :: sys
         integer, intent(in) :: code
-        if (allocated(solver%correction)) deallocate (solver%correction)
-        if (code == method_coarse) then
-            solver%method = nlgs_method_nlgs
-            allocate (solver%correction, source=coarse_correction_t(every=coarse_every, aggregate=coarse_size))
+        if (allocated(sys%solver%correction)) deallocate (sys%solver%correction)
+        if (code == method_coarse) &
+            allocate (sys%solver%correction, source=coarse_correction_t(every=coarse_every, aggregate=coarse_size))
+        if (allocated(sys%method)) then
+            if (code == method_block) then
+                select type (m => sys%method)
+                type is (bonded_block_method_t)
+                    return
+                end select
+            end if
+            deallocate (sys%method)
+        end if
+        if (code == method_block) then
+            allocate (bonded_block_method_t :: sys%method)
         else
-            solver%method = code
+            allocate (sweeps_method_t :: sys%method)
         end if
     end subroutine set_method
 
@@ -346,7 +359,7 @@ contains
         if (settle_sweeps > 0) sys%solver%max_sweeps = settle_sweeps
         if (settle_tol > 0.0_wp) sys%solver%tol = settle_tol
         if (settle_anderson >= 0) sys%solver%anderson = settle_anderson
-        if (settle_method >= 0) call set_method(sys%solver, settle_method)
+        if (settle_method >= 0) call set_method(sys, settle_method)
         do s = 1, n_settle
             call mj_step(sys)
         end do
@@ -355,7 +368,7 @@ contains
         sys%solver%anderson = anderson
         sys%solver%anderson_after = anderson_after
         sys%solver%anderson_sweeps = anderson_sweeps
-        call set_method(sys%solver, method)
+        call set_method(sys, method)
         allocate (t_det(n_steps), t_sol(n_steps), rate(n_steps))
         sweeps = 0
         n_conv = 0
@@ -515,7 +528,7 @@ contains
         sys%solver%anderson_sweeps = anderson_sweeps
         if (hydrostatic) allocate (hydrostatic_start_t :: sys%solver%start)
         sys%solver%symmetric = symmetric
-        call set_method(sys%solver, method)
+        call set_method(sys, method)
         call set_scheme(sys)
         call mj_init(sys, error)
         if (allocated(error)) error stop 'bench_dem: invalid setup'
@@ -700,7 +713,7 @@ contains
         sys%solver%anderson_sweeps = anderson_sweeps
         if (hydrostatic) allocate (hydrostatic_start_t :: sys%solver%start)
         sys%solver%symmetric = symmetric
-        call set_method(sys%solver, method)
+        call set_method(sys, method)
         sys%solver%criterion = criterion
         call set_scheme(sys)
         call mj_init(sys, error)

@@ -95,9 +95,10 @@ module dem_bonded_block
                                bipotential_local_solve
     use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_apply_reactions, nlgs_block_t, &
                         nlgs_bilateral_t
+    use dem_solve_method, only: solve_method_t
     implicit none
     private
-    public :: bonded_block_t, bonded_block_counts_t, bonded_block_solve, bonded_block_eps_ratio, &
+    public :: bonded_block_t, bonded_block_counts_t, bonded_block_method_t, bonded_block_eps_ratio, &
               bonded_block_restore
 
     !> Regularisation eps relative to the largest diagonal entry of W_BB (module header).
@@ -258,6 +259,16 @@ module dem_bonded_block
         procedure :: measure
     end type bonded_block_t
 
+    !> The global strategy `[solver] method = block` (dem_solve_method): the bonded block,
+    !> kept from step to step, and the sweeps over the other contacts (bonded_block_solve).
+    type, extends(solve_method_t) :: bonded_block_method_t
+        !> The block and its factor.
+        type(bonded_block_t) :: block
+    contains
+        !> See `solve_method_t%solve`.
+        procedure :: solve => bonded_block_solve
+    end type bonded_block_method_t
+
 contains
 
     !> Restart from a checkpoint: the block had a factor of `values` (mat%values with eps,
@@ -291,11 +302,11 @@ contains
     !> the NLGS sweeps over the other contacts (block Gauss-Seidel), then the outer check of
     !> the bonds' cones (module header). Arguments as nlgs_solve; stats%sweeps counts the
     !> block iterations of every pass, and the sweep limit applies to each pass.
-    subroutine bonded_block_solve(config, block, cs, im, vel, stats, bilateral)
+    subroutine bonded_block_solve(self, config, cs, im, vel, stats, bilateral)
+        !> The strategy and its block (kept between steps).
+        class(bonded_block_method_t), intent(inout) :: self
         !> Settings.
         type(nlgs_config_t), intent(in) :: config
-        !> The block (kept between steps).
-        type(bonded_block_t), intent(inout) :: block
         !> Contacts (frames, laws and activity set).
         type(contact_set_t), intent(inout) :: cs
         !> Inverse mass per DOF (3, n_disks).
@@ -310,73 +321,75 @@ contains
         integer :: k, released, n_blocked, sweeps, worst
         real(wp) :: excess
         integer(i8) :: updates, local
-        if (allocated(block%excluded)) then
-            if (size(block%excluded) < cs%n) deallocate (block%excluded)
-        end if
-        if (.not. allocated(block%excluded)) allocate (block%excluded(max(cs%n, 1)))
-        block%excluded = .false.
-        block%local_tol = config%local_tol
-        block%local_max_iter = config%local_max_iter
-        sweeps = 0
-        updates = 0_i8
-        local = 0_i8
-        n_blocked = -1
-        block%resolving = .false.
-        do
-            call nlgs_solve(config, cs, im, vel, pass, bilateral, block)
-            if (n_blocked < 0) n_blocked = pass%n_blocked
-            sweeps = sweeps + pass%sweeps
-            updates = updates + pass%updates
-            local = local + pass%local_iterations
-            if (.not. pass%converged) exit
-            ! release only the bond farthest outside its cone: the others may come back inside
-            ! once it yields, and bonds released together are swept against the rigid rest of
-            ! the block, whose Gauss-Seidel converges too slowly to judge them (module header)
-            worst = 0
-            excess = 0.0_wp
-            released = 0
-            do k = 1, cs%n
-                if (.not. block%member(k)) cycle
-                if (outside_cone(cs, k)) then
-                    if (.not. block%consistent) then
-                        ! no solution with every bond held: its reactions are of order 1/eps
-                        ! and tell nothing of which bond yields first; release them all
-                        block%excluded(k) = .true.
-                        released = released + 1
-                    else if (worst == 0 .or. cone_excess(cs, k) > excess) then
-                        worst = k
-                        excess = cone_excess(cs, k)
-                    end if
-                end if
-            end do
-            if (released > 0) worst = -1
-            if (worst == 0) then
-                ! bonds of the block whose reaction lies on a bound have reached it: judged
-                ! as the sweeps judge a bond projected onto it (contacts_finish breaks them)
+        associate (block => self%block)
+            if (allocated(block%excluded)) then
+                if (size(block%excluded) < cs%n) deallocate (block%excluded)
+            end if
+            if (.not. allocated(block%excluded)) allocate (block%excluded(max(cs%n, 1)))
+            block%excluded = .false.
+            block%local_tol = config%local_tol
+            block%local_max_iter = config%local_max_iter
+            sweeps = 0
+            updates = 0_i8
+            local = 0_i8
+            n_blocked = -1
+            block%resolving = .false.
+            do
+                call nlgs_solve(config, cs, im, vel, pass, bilateral, block)
+                if (n_blocked < 0) n_blocked = pass%n_blocked
+                sweeps = sweeps + pass%sweeps
+                updates = updates + pass%updates
+                local = local + pass%local_iterations
+                if (.not. pass%converged) exit
+                ! release only the bond farthest outside its cone: the others may come back inside
+                ! once it yields, and bonds released together are swept against the rigid rest of
+                ! the block, whose Gauss-Seidel converges too slowly to judge them (module header)
+                worst = 0
+                excess = 0.0_wp
+                released = 0
                 do k = 1, cs%n
-                    if (block%member(k)) cs%pcase(k) = bound_case(cs, k)
+                    if (.not. block%member(k)) cycle
+                    if (outside_cone(cs, k)) then
+                        if (.not. block%consistent) then
+                            ! no solution with every bond held: its reactions are of order 1/eps
+                            ! and tell nothing of which bond yields first; release them all
+                            block%excluded(k) = .true.
+                            released = released + 1
+                        else if (worst == 0 .or. cone_excess(cs, k) > excess) then
+                            worst = k
+                            excess = cone_excess(cs, k)
+                        end if
+                    end if
                 end do
-                exit
-            end if
-            if (worst > 0) then
-                block%excluded(worst) = .true.
-                released = 1
-            end if
-            block%counts%releases = block%counts%releases + released
-            block%counts%resolves = block%counts%resolves + 1
-            block%resolving = .true.
-            ! back to the velocities without the contact impulses (nlgs_solve applies the
-            ! current reactions again: the warm start of the next pass)
-            cs%r(:, 1:cs%n) = -cs%r(:, 1:cs%n)
-            call nlgs_apply_reactions(cs, im, vel)
-            cs%r(:, 1:cs%n) = -cs%r(:, 1:cs%n)
-        end do
-        block%resolving = .false.
-        stats = pass
-        stats%n_blocked = n_blocked
-        stats%sweeps = sweeps
-        stats%updates = updates
-        stats%local_iterations = local
+                if (released > 0) worst = -1
+                if (worst == 0) then
+                    ! bonds of the block whose reaction lies on a bound have reached it: judged
+                    ! as the sweeps judge a bond projected onto it (contacts_finish breaks them)
+                    do k = 1, cs%n
+                        if (block%member(k)) cs%pcase(k) = bound_case(cs, k)
+                    end do
+                    exit
+                end if
+                if (worst > 0) then
+                    block%excluded(worst) = .true.
+                    released = 1
+                end if
+                block%counts%releases = block%counts%releases + released
+                block%counts%resolves = block%counts%resolves + 1
+                block%resolving = .true.
+                ! back to the velocities without the contact impulses (nlgs_solve applies the
+                ! current reactions again: the warm start of the next pass)
+                cs%r(:, 1:cs%n) = -cs%r(:, 1:cs%n)
+                call nlgs_apply_reactions(cs, im, vel)
+                cs%r(:, 1:cs%n) = -cs%r(:, 1:cs%n)
+            end do
+            block%resolving = .false.
+            stats = pass
+            stats%n_blocked = n_blocked
+            stats%sweeps = sweeps
+            stats%updates = updates
+            stats%local_iterations = local
+        end associate
     end subroutine bonded_block_solve
 
     !> The reaction of bond k lies outside its cone (a bound with a zero coefficient locks

@@ -40,8 +40,8 @@ module dem_moreau_jean
                             contacts_set_laws, contacts_finish, contacts_impulses, contacts_local_velocity, &
                             contacts_bytes
     use dem_detection, only: detector_t, detect_contacts, detector_bytes
-    use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_bilateral_t, nlgs_method_block
-    use dem_bonded_block, only: bonded_block_t, bonded_block_solve
+    use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_bilateral_t
+    use dem_solve_method, only: solve_method_t, sweeps_method_t
     use dem_bonds, only: rupture_log_t, break_none
     use dem_activation, only: activation_t, activation_predicted_t
     implicit none
@@ -104,10 +104,11 @@ module dem_moreau_jean
         type(mj_config_t) :: scheme
         !> Solver settings.
         type(nlgs_config_t) :: solver
-        !> Intact bonds solved directly (solver%method = nlgs_method_block): the factor is
-        !> kept from step to step. Allocated at the first block solve (so that copies of a
-        !> system that has not run yet carry no CHOLMOD object).
-        type(bonded_block_t), allocatable :: block
+        !> Global strategy of the contact solve (`[solver] method`, dem_solve_method), with
+        !> its state kept from step to step (the bonded block's factor,
+        !> dem_bonded_block::bonded_block_method_t). mj_init sets the NLGS sweeps
+        !> (sweeps_method_t) when none is given.
+        class(solve_method_t), allocatable :: method
         !> Contact list.
         type(contact_set_t) :: contacts
         !> Detection workspace.
@@ -152,6 +153,7 @@ contains
         call check_settings(sys, error)
         if (allocated(error)) return
         if (.not. allocated(sys%scheme%activation)) allocate (activation_predicted_t :: sys%scheme%activation)
+        if (.not. allocated(sys%method)) allocate (sweeps_method_t :: sys%method)
         n = sys%particles%n
         nw = sys%walls%n
         if (allocated(sys%vel0)) deallocate (sys%vel0, sys%vel, sys%im, sys%load, sys%impulse, sys%xm, &
@@ -245,9 +247,9 @@ contains
         sys%time_solver = sys%time_solver + real(c2 - c1, wp)/real(rate, wp)
     end subroutine mj_detect
 
-    !> Part 3 of a step: the contact solve (NLGS, or with solver%method = nlgs_method_block
-    !> the intact bonds as a direct block, dem_bonded_block) from the velocities in `vel`;
-    !> end-of-step velocities in `vel`.
+    !> Part 3 of a step: the contact solve by the system's strategy (`method`: the NLGS
+    !> sweeps, or the intact bonds as a direct block with sweeps over the others) from the
+    !> velocities in `vel`; end-of-step velocities in `vel`.
     subroutine mj_solve(sys, bilateral)
         !> System, after `mj_detect`.
         type(dem_system_t), intent(inout) :: sys
@@ -255,12 +257,7 @@ contains
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         integer(i8) :: c0, c1, rate
         call system_clock(c0, rate)
-        if (sys%solver%method == nlgs_method_block) then
-            if (.not. allocated(sys%block)) allocate (sys%block)
-            call bonded_block_solve(sys%solver, sys%block, sys%contacts, sys%im, sys%vel, sys%stats, bilateral)
-        else
-            call nlgs_solve(sys%solver, sys%contacts, sys%im, sys%vel, sys%stats, bilateral)
-        end if
+        call sys%method%solve(sys%solver, sys%contacts, sys%im, sys%vel, sys%stats, bilateral)
         call system_clock(c1)
         sys%time_solver = sys%time_solver + real(c1 - c0, wp)/real(rate, wp)
     end subroutine mj_solve

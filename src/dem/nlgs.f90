@@ -102,13 +102,7 @@ module dem_nlgs
     private
     public :: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_apply_reactions, nlgs_residual
     public :: nlgs_bilateral_t, nlgs_block_t
-    public :: nlgs_method_nlgs, nlgs_method_block, nlgs_correction_t, nlgs_start_t
-
-    !> Global strategy: Gauss-Seidel sweeps over every contact.
-    integer, parameter :: nlgs_method_nlgs = 1
-    !> Global strategy: intact bonds solved directly as one block, sweeps over the others
-    !> (dem_bonded_block).
-    integer, parameter :: nlgs_method_block = 2
+    public :: nlgs_correction_t, nlgs_start_t
     public :: nlgs_siconos_error
     public :: nlgs_split_t, nlgs_split_build
     public :: criterion_lmgc90, criterion_siconos, criterion_names
@@ -189,8 +183,6 @@ module dem_nlgs
         integer :: local_max_iter = 8
         !> Alternate the sweep direction.
         logical :: symmetric = .true.
-        !> Global strategy (nlgs_method_nlgs or nlgs_method_block), chosen by the caller.
-        integer :: method = nlgs_method_nlgs
         !> Correction of the reactions between sweeps (module header; e.g. dem_coarse's);
         !> none when not allocated.
         class(nlgs_correction_t), allocatable :: correction

@@ -15,6 +15,7 @@ set(MULTICOR_DEM_SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/nlgs_siconos.f90
     ${CMAKE_CURRENT_LIST_DIR}/cold_start.f90
     ${CMAKE_CURRENT_LIST_DIR}/coarse.f90
+    ${CMAKE_CURRENT_LIST_DIR}/solve_method.f90
     ${CMAKE_CURRENT_LIST_DIR}/bonded_block.f90
     ${CMAKE_CURRENT_LIST_DIR}/local_problem.f90
     ${CMAKE_CURRENT_LIST_DIR}/moreau_jean.f90)

@@ -35,7 +35,7 @@ module driver_checkpoint
     use dem_contacts, only: contacts_list_problem
     use dem_moreau_jean, only: dem_system_t
     use dem_nlgs, only: nlgs_stats_t
-    use dem_bonded_block, only: bonded_block_restore
+    use dem_bonded_block, only: bonded_block_method_t, bonded_block_restore
     use coupling_arlequin, only: coupled_system_t
     use driver_results, only: results_writer_t
     use driver_results_dem, only: dem_writer_t
@@ -612,20 +612,25 @@ contains
         subroutine save_block(error)
             type(error_t), allocatable, intent(out) :: error
             character(len=:), allocatable :: g
-            if (.not. allocated(sys%block)) return
-            if (.not. (sys%block%factored .and. allocated(sys%block%values_factored))) return
-            if (size(sys%block%key_i1) == 0) return
-            g = group//'/block'
-            call file%write_dataset(g//'/key_i1', sys%block%key_i1, error)
-            if (.not. allocated(error)) call file%write_dataset(g//'/key_i2', sys%block%key_i2, error)
-            if (.not. allocated(error)) call file%write_dataset(g//'/key_rows', sys%block%key_rows, error)
-            if (.not. allocated(error)) call file%write_dataset(g//'/values', sys%block%values_factored, error)
-            ! slots whose bonds left the block: identity rows, some deleted from the factor
-            ! after its factorisation (replayed in order at the restart)
-            if (.not. any(sys%block%dead)) return
-            if (.not. allocated(error)) call file%write_dataset(g//'/dead', merge(1, 0, sys%block%dead), error)
-            if (.not. allocated(error) .and. sys%block%n_deleted > 0) &
-                call file%write_dataset(g//'/deleted', sys%block%deleted(1:sys%block%n_deleted), error)
+            if (.not. allocated(sys%method)) return
+            select type (m => sys%method)
+            type is (bonded_block_method_t)
+                associate (b => m%block)
+                    if (.not. (b%factored .and. allocated(b%values_factored))) return
+                    if (size(b%key_i1) == 0) return
+                    g = group//'/block'
+                    call file%write_dataset(g//'/key_i1', b%key_i1, error)
+                    if (.not. allocated(error)) call file%write_dataset(g//'/key_i2', b%key_i2, error)
+                    if (.not. allocated(error)) call file%write_dataset(g//'/key_rows', b%key_rows, error)
+                    if (.not. allocated(error)) call file%write_dataset(g//'/values', b%values_factored, error)
+                    ! slots whose bonds left the block: identity rows, some deleted from the factor
+                    ! after its factorisation (replayed in order at the restart)
+                    if (.not. any(b%dead)) return
+                    if (.not. allocated(error)) call file%write_dataset(g//'/dead', merge(1, 0, b%dead), error)
+                    if (.not. allocated(error) .and. b%n_deleted > 0) &
+                        call file%write_dataset(g//'/deleted', b%deleted(1:b%n_deleted), error)
+                end associate
+            end select
         end subroutine save_block
 
         subroutine save_contacts(error)
@@ -778,7 +783,6 @@ contains
             character(len=:), allocatable :: g
             integer, allocatable :: k1(:), k2(:), kr(:), dead(:), deleted(:)
             real(wp), allocatable :: v(:)
-            if (allocated(sys%block)) deallocate (sys%block)
             g = group//'/block'
             if (.not. file%exists(g//'/values')) return
             call file%read_dataset(g//'/key_i1', k1, error)
@@ -813,8 +817,18 @@ contains
             if (.not. allocated(error)) call require_range(k2, 1, sys%particles%n, g//'/key_i2', error)
             if (.not. allocated(error)) call require_finite(v, g//'/values', error)
             if (allocated(error)) return
-            allocate (sys%block)
-            call bonded_block_restore(sys%block, k1, k2, kr, v, dead == 1, deleted)
+            ! the deck (whose hash the checkpoint matches) chose the strategy: only the
+            ! bonded block has a factor to restore
+            if (.not. allocated(sys%method)) then
+                call damaged(error, g//': the deck solves no bonded block ([solver] method)')
+                return
+            end if
+            select type (m => sys%method)
+            type is (bonded_block_method_t)
+                call bonded_block_restore(m%block, k1, k2, kr, v, dead == 1, deleted)
+            class default
+                call damaged(error, g//': the deck solves no bonded block ([solver] method)')
+            end select
         end subroutine load_block
 
         !> Read the first n values of a per-body array (the array keeps its size).

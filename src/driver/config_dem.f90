@@ -33,7 +33,9 @@ module driver_config_dem
     use dem_contacts, only: contact_set_t
     use dem_detection, only: detector_t, detect_contacts, coordinate_limit
     use dem_moreau_jean, only: dem_system_t
-    use dem_nlgs, only: nlgs_method_nlgs, nlgs_method_block, criterion_lmgc90, criterion_siconos
+    use dem_nlgs, only: criterion_lmgc90, criterion_siconos
+    use dem_solve_method, only: sweeps_method_t
+    use dem_bonded_block, only: bonded_block_method_t
     use dem_coarse, only: coarse_correction_t
     use dem_cold_start, only: hydrostatic_start_t
     use driver_config, only: run_config_t, repeated_dof
@@ -870,12 +872,18 @@ contains
             sys%solver%max_sweeps = deck%get_int('solver', 'max_sweeps')
             sys%solver%local_tol = deck%get_real('solver', 'local_tolerance')
             sys%solver%local_max_iter = deck%get_int('solver', 'local_iterations')
-            sys%solver%method = nlgs_method_nlgs
-            if (deck%get_word('solver', 'method') == 'block') sys%solver%method = nlgs_method_block
-            ! method = coarse: the sweeps (nlgs) with the coarse correction
-            if (deck%get_word('solver', 'method') == 'coarse') &
+            if (allocated(sys%method)) deallocate (sys%method)
+            select case (deck%get_word('solver', 'method'))
+            case ('block')
+                allocate (bonded_block_method_t :: sys%method)
+            case ('coarse')
+                ! the sweeps (nlgs) with the coarse correction
+                allocate (sweeps_method_t :: sys%method)
                 allocate (sys%solver%correction, source=coarse_correction_t(every=deck%get_int('solver', 'coarse_every'), &
                                                                             aggregate=deck%get_int('solver', 'coarse_size')))
+            case default
+                allocate (sweeps_method_t :: sys%method)
+            end select
             sys%solver%relaxation = deck%get_real('solver', 'relaxation')
             sys%solver%check_every = deck%get_int('solver', 'check_every')
             sys%solver%anderson = deck%get_int('solver', 'anderson')

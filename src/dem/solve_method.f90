@@ -1,0 +1,74 @@
+!> The global strategy of a step's contact solve (`[solver] method`; doc/theory.md
+!> sections 4.1 and 7.10): an abstract type whose `solve` takes the settings, the contacts and the free velocities
+!> and gives the reactions and the end-of-step velocities, and its plain kind, the NLGS
+!> sweeps over every contact (`method = nlgs`, and `method = coarse`, the sweeps with the
+!> coarse correction that the settings hold). The intact bonds solved directly as one
+!> block (`method = block`) extend it in dem_bonded_block (bonded_block_method_t). The
+!> strategy is state: the block keeps its factor from step to step, so the system holds
+!> it (dem_moreau_jean, `dem_system_t%method`), next to the settings.
+module dem_solve_method
+    use core_kinds, only: wp
+    use dem_contacts, only: contact_set_t
+    use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_bilateral_t, nlgs_solve
+    implicit none
+    private
+    public :: solve_method_t, sweeps_method_t
+
+    !> A global strategy of the contact solve.
+    type, abstract :: solve_method_t
+    contains
+        !> Solve the contact problem of one step (arguments as nlgs_solve).
+        procedure(method_solve), deferred :: solve
+    end type solve_method_t
+
+    abstract interface
+        !> Solve the contact problem of one step: on entry vel holds the free velocities and
+        !> cs%r the warm start, on exit the end-of-step velocities and the reactions.
+        subroutine method_solve(self, config, cs, im, vel, stats, bilateral)
+            import :: solve_method_t, nlgs_config_t, contact_set_t, wp, nlgs_stats_t, nlgs_bilateral_t
+            !> The strategy (and its state kept between steps).
+            class(solve_method_t), intent(inout) :: self
+            !> Settings.
+            type(nlgs_config_t), intent(in) :: config
+            !> Contacts (frames, laws and activity set).
+            type(contact_set_t), intent(inout) :: cs
+            !> Inverse mass per DOF (3, n_disks).
+            real(wp), intent(in) :: im(:, :)
+            !> Velocities (3, n_disks).
+            real(wp), intent(inout) :: vel(:, :)
+            !> Statistics.
+            type(nlgs_stats_t), intent(out) :: stats
+            !> Bilateral constraints kept satisfied (default: none).
+            class(nlgs_bilateral_t), intent(inout), optional :: bilateral
+        end subroutine method_solve
+    end interface
+
+    !> NLGS sweeps over every contact (`method = nlgs`; `coarse` with the settings'
+    !> correction). No state.
+    type, extends(solve_method_t) :: sweeps_method_t
+    contains
+        !> dem_nlgs's solve.
+        procedure :: solve => sweeps_solve
+    end type sweeps_method_t
+
+contains
+
+    !> The NLGS sweeps (nlgs_solve).
+    subroutine sweeps_solve(self, config, cs, im, vel, stats, bilateral)
+        !> The strategy (no state).
+        class(sweeps_method_t), intent(inout) :: self
+        !> Settings.
+        type(nlgs_config_t), intent(in) :: config
+        !> Contacts (frames, laws and activity set).
+        type(contact_set_t), intent(inout) :: cs
+        !> Inverse mass per DOF (3, n_disks).
+        real(wp), intent(in) :: im(:, :)
+        !> Velocities (3, n_disks).
+        real(wp), intent(inout) :: vel(:, :)
+        !> Statistics.
+        type(nlgs_stats_t), intent(out) :: stats
+        !> Bilateral constraints kept satisfied (default: none).
+        class(nlgs_bilateral_t), intent(inout), optional :: bilateral
+        call nlgs_solve(config, cs, im, vel, stats, bilateral)
+    end subroutine sweeps_solve
+end module dem_solve_method
