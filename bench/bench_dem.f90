@@ -61,7 +61,7 @@ program bench_dem
     use dem_detection, only: detect_contacts
     use dem_moreau_jean, only: dem_system_t, mj_init, mj_step, dem_system_bytes
     use dem_activation, only: activation_siconos_t, activation_predicted_t
-    use dem_nlgs, only: criterion_lmgc90, criterion_siconos
+    use dem_nlgs, only: nlgs_config_t, lmgc90_criterion_t, siconos_criterion_t
     use dem_solve_method, only: sweeps_method_t
     use dem_bonded_block, only: bonded_block_method_t
     use dem_coarse, only: coarse_correction_t
@@ -108,7 +108,9 @@ program bench_dem
     !> Tolerance of the timed steps and of the settling steps (--tol, --settle-tol; 0: the
     !> timed one).
     real(wp) :: tol = 1.666e-4_wp, settle_tol = 0.0_wp
-    integer :: criterion = criterion_lmgc90, max_sweeps = 200, check_every = 10, settle_sweeps = 0, iarg
+    !> Stopping criterion (--criterion; the Siconos deposit's default is siconos).
+    character(len=7) :: criterion = 'lmgc90'
+    integer :: max_sweeps = 200, check_every = 10, settle_sweeps = 0, iarg
     integer :: anderson = 5, settle_anderson = -1, anderson_after = 10, anderson_sweeps = 2
     logical :: convergence = .false., sizes_given = .false., verbose = .false., symmetric = .true.
     logical :: hydrostatic = .false., criterion_given = .false.
@@ -202,14 +204,9 @@ program bench_dem
             call read_int_value(arg, val, check_every)
         case ('--criterion')
             criterion_given = .true.
-            select case (val)
-            case ('siconos')
-                criterion = criterion_siconos
-            case ('lmgc90')
-                criterion = criterion_lmgc90
-            case default
+            if (val /= 'siconos' .and. val /= 'lmgc90') &
                 call usage_error('--criterion takes lmgc90 or siconos, got '''//trim(val)//'''')
-            end select
+            criterion = trim(val)
         case ('--sizes')
             sizes = [integer ::]
             sizes_given = .true.
@@ -238,8 +235,8 @@ program bench_dem
     write (output_unit, '(a)') '# DEM kernel benchmark, 1 core: dense random packing in a box under gravity'
     write (output_unit, '(a)') '# compiler: '//compiler_version()
     write (output_unit, '(a)') '# options:  '//compiler_options()
-    write (output_unit, '(a, f0.3, a, i0, a, i0, a)') '# solver: relaxation ', relaxation, &
-        ', criterion ', criterion, ' (1 lmgc90, 2 siconos), cap ', max_sweeps, ' sweeps'
+    write (output_unit, '(a, f0.3, a, i0, a)') '# solver: relaxation ', relaxation, &
+        ', criterion '//trim(criterion)//', cap ', max_sweeps, ' sweeps'
     if (convergence) then
         call cold_start_sweeps()
     else
@@ -303,6 +300,18 @@ contains
             allocate (sweeps_method_t :: sys%method)
         end if
     end subroutine set_method
+
+    !> The stopping criterion named `word` (lmgc90 or siconos).
+    subroutine set_criterion(solver, word)
+        type(nlgs_config_t), intent(inout) :: solver
+        character(len=*), intent(in) :: word
+        if (allocated(solver%criterion)) deallocate (solver%criterion)
+        if (word == 'siconos') then
+            allocate (siconos_criterion_t :: solver%criterion)
+        else
+            allocate (lmgc90_criterion_t :: solver%criterion)
+        end if
+    end subroutine set_criterion
 
     !> The integer value of option `option`.
     subroutine read_int_value(option, text, value)
@@ -520,8 +529,11 @@ contains
         sys%scheme%alert = alert
         sys%solver%tol = tol
         sys%solver%max_sweeps = cap
-        sys%solver%criterion = criterion_siconos
-        if (criterion_given) sys%solver%criterion = criterion
+        if (criterion_given) then
+            call set_criterion(sys%solver, criterion)
+        else
+            call set_criterion(sys%solver, 'siconos')
+        end if
         sys%solver%relaxation = relaxation
         sys%solver%anderson = anderson
         sys%solver%anderson_after = anderson_after
@@ -542,8 +554,8 @@ contains
         write (output_unit, '(a, i0, a, i0, a, i0, a, f0.4, a, i0, a)') '# deposit against Siconos: N = ', n, ' (', &
             n_row, ' x ', n_rows, '), box width ', width, ' m, mean radius 1 cm, seed ', layout_seed, &
             ', mu 0.3, e 0, h 2 ms, 500 steps, contact scheme '//trim(scheme_word)
-        write (output_unit, '(a, i0, a, es9.2, a, i0, a, 3(i0, a), l1)') '# criterion ', sys%solver%criterion, &
-            ' (1 lmgc90, 2 siconos), tolerance ', tol, ', cap ', cap, ' sweeps, anderson ', anderson, &
+        write (output_unit, '(a, es9.2, a, i0, a, 3(i0, a), l1)') '# criterion '//sys%solver%criterion%name()// &
+            ', tolerance ', tol, ', cap ', cap, ' sweeps, anderson ', anderson, &
             ' after ', anderson_after, ' sweeps, ', anderson_sweeps, ' sweeps per step, hydrostatic ', hydrostatic
         if (verbose) write (output_unit, '(a)') '# step  active  sweeps  conv  siconos_error  step[ms]  top[m]'
         do s = 1, n_steps
@@ -714,7 +726,7 @@ contains
         if (hydrostatic) allocate (hydrostatic_start_t :: sys%solver%start)
         sys%solver%symmetric = symmetric
         call set_method(sys, method)
-        sys%solver%criterion = criterion
+        call set_criterion(sys%solver, criterion)
         call set_scheme(sys)
         call mj_init(sys, error)
         if (allocated(error)) error stop 'bench_dem: invalid setup'

@@ -35,8 +35,9 @@
 !> instead of zero reactions, e.g. the hydrostatic estimate of dem_cold_start (doc/theory.md
 !> 4.7).
 !> The Siconos error (nlgs_siconos_error, doc/theory.md 4.5) of the final state is always
-!> computed, from u = H^T (v_free + M^-1 H r) + shift in full; `criterion` chooses which
-!> error stops the sweeps. As a stopping test it is evaluated from the velocities the sweeps
+!> computed, from u = H^T (v_free + M^-1 H r) + shift in full; `criterion` (an extension of
+!> `nlgs_criterion_t`: lmgc90_criterion_t, the default, or siconos_criterion_t) chooses which
+!> error stops the sweeps. As a stopping test the Siconos error is evaluated from the velocities the sweeps
 !> keep up to date (the same up to round-off, and one pass over the contacts instead of
 !> three), only after the sweeps where it may be near the tolerance (siconos_period,
 !> siconos_margin); once that is below the tolerance it is computed again in full, and only
@@ -105,14 +106,7 @@ module dem_nlgs
     public :: nlgs_correction_t, nlgs_start_t
     public :: nlgs_siconos_error
     public :: nlgs_split_t, nlgs_split_build
-    public :: criterion_lmgc90, criterion_siconos, criterion_names
-
-    !> Stopping criterion: the LMGC90-like norm of the sweeps (module header).
-    integer, parameter :: criterion_lmgc90 = 1
-    !> Stopping criterion: the Siconos error (nlgs_siconos_error).
-    integer, parameter :: criterion_siconos = 2
-    !> Names of the criteria (deck keyword `[solver] criterion`), by code.
-    character(len=*), parameter :: criterion_names(2) = [character(len=7) :: 'lmgc90', 'siconos']
+    public :: nlgs_criterion_t, lmgc90_criterion_t, siconos_criterion_t, nlgs_criterion_name
 
     !> A contact is blocked when W_nn <= blocked_ratio (W_nn + W_tt) (the floor of the scaled
     !> frame in dem_bipotential: below it the normal reaction would be unbounded).
@@ -197,8 +191,8 @@ module dem_nlgs
         !> with the one check_every sweeps earlier, and omega falls back to 1 for the rest of
         !> the solve when it rose.
         integer :: check_every = 10
-        !> Stopping criterion: criterion_lmgc90 or criterion_siconos.
-        integer :: criterion = criterion_lmgc90
+        !> Stopping criterion (module header); lmgc90_criterion_t when not allocated.
+        class(nlgs_criterion_t), allocatable :: criterion
         !> Anderson acceleration of the sweeps (module header): depth (number of previous
         !> sweeps mixed); 0: none. Not used when intact bonds are swept without a block
         !> (nlgs_solve).
@@ -315,6 +309,102 @@ module dem_nlgs
     real(wp), parameter :: drift_high = 1.01_wp, drift_cosine = 1.0e-4_wp
     real(wp), parameter :: drift_slack = 1.0e-9_wp
     real(wp), parameter :: drift_min = 5.0_wp
+
+    !> Stopping test of the sweeps (`[solver] criterion`, module header): the error of the
+    !> iterate that is compared with the tolerance. The settings hold the choice; each solve
+    !> works on a copy, which keeps the state of that solve.
+    type, abstract :: nlgs_criterion_t
+    contains
+        !> Name (the value of `[solver] criterion`, /dem/solver@criterion).
+        procedure(criterion_name), deferred :: name
+        !> Start of a solve, the contacts' activity set.
+        procedure(criterion_begin), deferred :: begin
+        !> The error after a sweep, from the norm of the sweeps.
+        procedure(criterion_measure), deferred :: measure
+        !> The error that stops the sweeps is the Siconos error of the final state (then not
+        !> computed again).
+        procedure :: is_siconos_error => criterion_not_siconos
+    end type nlgs_criterion_t
+
+    abstract interface
+        !> Name of a criterion.
+        pure function criterion_name(self) result(name)
+            import :: nlgs_criterion_t
+            !> The criterion.
+            class(nlgs_criterion_t), intent(in) :: self
+            character(len=:), allocatable :: name
+        end function criterion_name
+
+        !> Start of a solve (contacts of the solve: the active ones).
+        subroutine criterion_begin(self, cs)
+            import :: nlgs_criterion_t, contact_set_t
+            !> The criterion (the copy of a solve).
+            class(nlgs_criterion_t), intent(inout) :: self
+            !> Contacts (activity set).
+            type(contact_set_t), intent(in) :: cs
+        end subroutine criterion_begin
+
+        !> The error after sweep s: on entry the convergence norm of the sweeps, on exit the
+        !> criterion's error, `evaluated` when it is exact (only an exact error below the
+        !> tolerance stops the sweeps; otherwise an estimate).
+        subroutine criterion_measure(self, s, needed, tol, cs, im, vfree, vel, vwork, bilateral, nq, error, evaluated)
+            import :: nlgs_criterion_t, contact_set_t, wp
+            !> The criterion (the copy of a solve).
+            class(nlgs_criterion_t), intent(inout) :: self
+            !> Sweeps done.
+            integer, intent(in) :: s
+            !> The solve needs the exact error after this sweep (the cap, a safeguard).
+            logical, intent(in) :: needed
+            !> Tolerance.
+            real(wp), intent(in) :: tol
+            !> Contacts (reactions).
+            type(contact_set_t), intent(in) :: cs
+            !> Inverse mass per DOF, free velocities and velocities (3, n_disks).
+            real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :)
+            !> Work array (3, n_disks).
+            real(wp), intent(inout) :: vwork(:, :)
+            !> Bilateral constraints changed the velocities (their impulses are not contacts).
+            logical, intent(in) :: bilateral
+            !> |q| of the Siconos error (siconos_free_norm).
+            real(wp), intent(in) :: nq
+            !> The convergence norm in, the criterion's error out.
+            real(wp), intent(inout) :: error
+            !> The error is exact.
+            logical, intent(out) :: evaluated
+        end subroutine criterion_measure
+    end interface
+
+    !> The LMGC90-like convergence norm of the sweeps (module header), the default.
+    type, extends(nlgs_criterion_t) :: lmgc90_criterion_t
+    contains
+        !> 'lmgc90'.
+        procedure :: name => lmgc90_name
+        !> Nothing to set up.
+        procedure :: begin => lmgc90_begin
+        !> The norm itself, always exact.
+        procedure :: measure => lmgc90_measure
+    end type lmgc90_criterion_t
+
+    !> The Siconos error (nlgs_siconos_error), evaluated only where it may be near the
+    !> tolerance (module header; siconos_period, siconos_margin; submodule dem_nlgs_siconos).
+    type, extends(nlgs_criterion_t) :: siconos_criterion_t
+        !> The active contacts of the solve, in increasing order.
+        integer, allocatable, private :: act(:)
+        !> Ratio of the Siconos error to the norm of the sweeps at its last evaluation, that
+        !> norm, and that sweep.
+        real(wp), private :: per_norm = 0.0_wp, norm_evaluated = huge(1.0_wp)
+        !> See `per_norm`.
+        integer, private :: last_evaluation = 0
+    contains
+        !> 'siconos'.
+        procedure :: name => siconos_name
+        !> The active contacts, no evaluation yet.
+        procedure :: begin => siconos_begin
+        !> The error where it may be near the tolerance, an estimate elsewhere.
+        procedure :: measure => siconos_measure
+        !> True.
+        procedure :: is_siconos_error => siconos_is_siconos_error
+    end type siconos_criterion_t
 
     !> Linear velocity constraints kept satisfied during the sweeps (see the module header).
     type, abstract :: nlgs_bilateral_t
@@ -506,6 +596,39 @@ module dem_nlgs
             class(nlgs_bilateral_t), intent(in), optional :: bilateral
         end function siconos_free_norm
 
+        !> 'siconos' (dem_nlgs_siconos).
+        pure module function siconos_name(self) result(name)
+            class(siconos_criterion_t), intent(in) :: self
+            character(len=:), allocatable :: name
+        end function siconos_name
+
+        !> Start of a solve of the Siconos criterion (dem_nlgs_siconos).
+        module subroutine siconos_begin(self, cs)
+            class(siconos_criterion_t), intent(inout) :: self
+            type(contact_set_t), intent(in) :: cs
+        end subroutine siconos_begin
+
+        !> The Siconos criterion's error after a sweep (dem_nlgs_siconos).
+        module subroutine siconos_measure(self, s, needed, tol, cs, im, vfree, vel, vwork, bilateral, nq, error, evaluated)
+            class(siconos_criterion_t), intent(inout) :: self
+            integer, intent(in) :: s
+            logical, intent(in) :: needed
+            real(wp), intent(in) :: tol
+            type(contact_set_t), intent(in) :: cs
+            real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :)
+            real(wp), intent(inout) :: vwork(:, :)
+            logical, intent(in) :: bilateral
+            real(wp), intent(in) :: nq
+            real(wp), intent(inout) :: error
+            logical, intent(out) :: evaluated
+        end subroutine siconos_measure
+
+        !> True (dem_nlgs_siconos).
+        pure module function siconos_is_siconos_error(self) result(yes)
+            class(siconos_criterion_t), intent(in) :: self
+            logical :: yes
+        end function siconos_is_siconos_error
+
         !> Siconos error of the contacts act from the velocities vel, |q| = nq
         !> (dem_nlgs_siconos).
         pure real(wp) module function siconos_ratio(cs, act, vel, nq) result(err)
@@ -536,17 +659,17 @@ contains
         class(nlgs_block_t), intent(inout), optional :: block
         real(wp) :: num, den, num_b, den_b
         integer(i8) :: nloc
-        integer, allocatable :: list(:), act(:)
+        integer, allocatable :: list(:)
         ! per contact of the solve, constant over the solve: the scaled frame of its local
         ! problem (bipotential_scaling, or rolling_scaling for a law with moments)
         real(wp), allocatable :: sc(:, :)
         ! free velocities (the Siconos error is computed from them in full) and a work copy
         real(wp), allocatable :: vfree(:, :), vwork(:, :)
-        ! with the Siconos criterion: |q|^2 (constant over the solve), the ratio of the
-        ! Siconos error to the norm of the sweeps at its last evaluation, that norm, and that
-        ! sweep
-        real(wp) :: nq, per_norm, norm, norm_evaluated
-        integer :: last_evaluation
+        ! |q| of the Siconos error (constant over the solve)
+        real(wp) :: nq
+        ! the stopping test of this solve (a copy of the settings' criterion) and whether its
+        ! error after the sweep is exact
+        class(nlgs_criterion_t), allocatable :: criterion
         logical :: evaluated
         real(wp) :: floor, omega, checked
         type(anderson_t) :: aa
@@ -570,13 +693,12 @@ contains
         allocate (vwork, mold=vel)
         ! |q| of the Siconos error, for the criterion and the final error
         nq = siconos_free_norm(cs, im, vfree, bilateral)
-        if (config%criterion == criterion_siconos) then
-            ! the active contacts, in increasing order: the running criterion runs over them
-            act = pack([(k, k=1, cs%n)], cs%active(1:cs%n))
+        if (allocated(config%criterion)) then
+            allocate (criterion, source=config%criterion)
+        else
+            allocate (lmgc90_criterion_t :: criterion)
         end if
-        per_norm = 0.0_wp
-        norm_evaluated = huge(1.0_wp)
-        last_evaluation = 0
+        call criterion%begin(cs)
         s = 0
         floor = 0.0_wp
         do k = 1, cs%n
@@ -669,32 +791,11 @@ contains
                 stats%sweeps = s
                 stats%local_iterations = stats%local_iterations + nloc
                 stats%error = relative(max(num - floor, 0.0_wp), den)
-                evaluated = .true.
-                if (config%criterion == criterion_siconos) then
-                    ! evaluated when it may be near the tolerance (the norm of the sweeps times
-                    ! their last measured ratio), every siconos_period sweeps, and where a
-                    ! safeguard or the cap needs it; from the velocities the sweeps keep up to
-                    ! date, and below the tolerance again from u = W r + q in full, which alone
-                    ! stops the sweeps
-                    evaluated = s - last_evaluation >= siconos_period .or. s == config%max_sweeps &
-                                .or. (stats%error*per_norm <= siconos_margin*config%tol &
-                                      .and. stats%error < norm_evaluated) &
-                                .or. (omega /= 1.0_wp .and. mod(s, config%check_every) == 0) &
-                                .or. (correcting .and. mod(s, every) == 0)
-                    if (evaluated) then
-                        norm = stats%error
-                        norm_evaluated = norm
-                        stats%error = siconos_ratio(cs, act, vel, nq)
-                        per_norm = 0.0_wp
-                        if (norm > 0.0_wp) per_norm = stats%error/norm
-                        last_evaluation = s
-                        if (stats%error <= config%tol) stats%error = siconos_error(cs, im, vfree, vel, vwork, &
-                                                                                   present(bilateral), nq)
-                    else
-                        ! an estimate, which does not stop the sweeps
-                        stats%error = stats%error*per_norm
-                    end if
-                end if
+                ! the exact error is needed at the cap, by the safeguard of the over-relaxation
+                ! and by the correction's
+                call criterion%measure(s, s == config%max_sweeps .or. (omega /= 1.0_wp .and. mod(s, config%check_every) == 0) &
+                                       .or. (correcting .and. mod(s, every) == 0), config%tol, cs, im, vfree, vel, vwork, &
+                                       present(bilateral), nq, stats%error, evaluated)
                 if (evaluated .and. stats%error <= config%tol) then
                     stats%converged = .true.
                     exit
@@ -733,13 +834,75 @@ contains
         stats%relaxation = omega
         stats%updates = int(n_swept, i8)*stats%sweeps
         stats%residual = nlgs_residual(cs, vel)
-        if (config%criterion == criterion_siconos .and. stats%converged) then
+        if (criterion%is_siconos_error() .and. stats%converged) then
             ! the last error of the sweeps, computed in full
             stats%siconos_error = stats%error
         else
             stats%siconos_error = siconos_error(cs, im, vfree, vel, vwork, present(bilateral), nq)
         end if
     end subroutine nlgs_solve
+
+    !> Name of the settings' stopping criterion (lmgc90 when none is set).
+    pure function nlgs_criterion_name(config) result(name)
+        !> Settings.
+        type(nlgs_config_t), intent(in) :: config
+        character(len=:), allocatable :: name
+        if (allocated(config%criterion)) then
+            name = config%criterion%name()
+        else
+            name = 'lmgc90'
+        end if
+    end function nlgs_criterion_name
+
+    !> 'lmgc90'.
+    pure function lmgc90_name(self) result(name)
+        !> The criterion.
+        class(lmgc90_criterion_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = 'lmgc90'
+    end function lmgc90_name
+
+    !> Nothing to set up.
+    subroutine lmgc90_begin(self, cs)
+        !> The criterion.
+        class(lmgc90_criterion_t), intent(inout) :: self
+        !> Contacts.
+        type(contact_set_t), intent(in) :: cs
+    end subroutine lmgc90_begin
+
+    !> The convergence norm of the sweeps is the error, exact.
+    subroutine lmgc90_measure(self, s, needed, tol, cs, im, vfree, vel, vwork, bilateral, nq, error, evaluated)
+        !> The criterion.
+        class(lmgc90_criterion_t), intent(inout) :: self
+        !> Sweeps done.
+        integer, intent(in) :: s
+        !> The exact error is needed.
+        logical, intent(in) :: needed
+        !> Tolerance.
+        real(wp), intent(in) :: tol
+        !> Contacts.
+        type(contact_set_t), intent(in) :: cs
+        !> Inverse mass, free velocities and velocities (3, n_disks).
+        real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :)
+        !> Work array (3, n_disks).
+        real(wp), intent(inout) :: vwork(:, :)
+        !> Bilateral constraints changed the velocities.
+        logical, intent(in) :: bilateral
+        !> |q| of the Siconos error.
+        real(wp), intent(in) :: nq
+        !> The convergence norm, kept.
+        real(wp), intent(inout) :: error
+        !> True.
+        logical, intent(out) :: evaluated
+        evaluated = .true.
+    end subroutine lmgc90_measure
+
+    !> No: the error that stops the sweeps is not the Siconos error.
+    pure logical function criterion_not_siconos(self) result(yes)
+        !> The criterion.
+        class(nlgs_criterion_t), intent(in) :: self
+        yes = .false.
+    end function criterion_not_siconos
 
     !> Round-off floor of the convergence norm's denominator for contact k (module header).
     pure real(wp) function roundoff_floor(cs, k, vel) result(f)

@@ -33,7 +33,7 @@ module driver_config_dem
     use dem_contacts, only: contact_set_t
     use dem_detection, only: detector_t, detect_contacts, coordinate_limit
     use dem_moreau_jean, only: dem_system_t
-    use dem_nlgs, only: criterion_lmgc90, criterion_siconos
+    use dem_nlgs, only: lmgc90_criterion_t, siconos_criterion_t
     use dem_solve_method, only: sweeps_method_t
     use dem_bonded_block, only: bonded_block_method_t
     use dem_coarse, only: coarse_correction_t
@@ -891,8 +891,12 @@ contains
             sys%solver%anderson_sweeps = deck%get_int('solver', 'anderson_sweeps')
             if (deck%get_word('solver', 'cold_start') == 'hydrostatic') allocate (hydrostatic_start_t :: sys%solver%start)
             sys%solver%symmetric = deck%get_word('solver', 'sweep_order') == 'alternating'
-            sys%solver%criterion = criterion_lmgc90
-            if (deck%get_word('solver', 'criterion') == 'siconos') sys%solver%criterion = criterion_siconos
+            if (allocated(sys%solver%criterion)) deallocate (sys%solver%criterion)
+            if (deck%get_word('solver', 'criterion') == 'siconos') then
+                allocate (siconos_criterion_t :: sys%solver%criterion)
+            else
+                allocate (lmgc90_criterion_t :: sys%solver%criterion)
+            end if
             if (deck%has('solver', 'fclib_step')) cfg%fclib_step = deck%get_int('solver', 'fclib_step')
         end associate
         cfg%store_contacts = deck%get_word('output', 'contacts') == 'yes'

@@ -16,7 +16,7 @@ module driver_results_dem
     use core_strings, only: to_str
     use core_version, only: multicor_name, multicor_version
     use io_hdf5_file, only: h5_file_t
-    use dem_nlgs, only: nlgs_stats_t, criterion_names
+    use dem_nlgs, only: nlgs_stats_t, nlgs_criterion_name
     use dem_moreau_jean, only: dem_system_t, energies_balance
     use dem_local_problem, only: local_problem_t
     implicit none
@@ -142,7 +142,7 @@ contains
             if (allocated(error)) return
             call file%write_attribute('/dem/solver', 'relaxation', sys%solver%relaxation, error)
             if (allocated(error)) return
-            call file%write_attribute('/dem/solver', 'criterion', trim(criterion_names(sys%solver%criterion)), error)
+            call file%write_attribute('/dem/solver', 'criterion', nlgs_criterion_name(sys%solver), error)
         end subroutine settings
 
         subroutine series(error)
