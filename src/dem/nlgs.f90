@@ -386,7 +386,7 @@ module dem_nlgs
     end type lmgc90_criterion_t
 
     !> The Siconos error (nlgs_siconos_error), evaluated only where it may be near the
-    !> tolerance (module header; siconos_period, siconos_margin; submodule dem_nlgs_siconos).
+    !> tolerance (module header; siconos_period, siconos_margin).
     type, extends(nlgs_criterion_t) :: siconos_criterion_t
         !> The active contacts of the solve, in increasing order.
         integer, allocatable, private :: act(:)
@@ -595,39 +595,6 @@ module dem_nlgs
             real(wp), intent(in) :: im(:, :), vfree(:, :)
             class(nlgs_bilateral_t), intent(in), optional :: bilateral
         end function siconos_free_norm
-
-        !> 'siconos' (dem_nlgs_siconos).
-        pure module function siconos_name(self) result(name)
-            class(siconos_criterion_t), intent(in) :: self
-            character(len=:), allocatable :: name
-        end function siconos_name
-
-        !> Start of a solve of the Siconos criterion (dem_nlgs_siconos).
-        module subroutine siconos_begin(self, cs)
-            class(siconos_criterion_t), intent(inout) :: self
-            type(contact_set_t), intent(in) :: cs
-        end subroutine siconos_begin
-
-        !> The Siconos criterion's error after a sweep (dem_nlgs_siconos).
-        module subroutine siconos_measure(self, s, needed, tol, cs, im, vfree, vel, vwork, bilateral, nq, error, evaluated)
-            class(siconos_criterion_t), intent(inout) :: self
-            integer, intent(in) :: s
-            logical, intent(in) :: needed
-            real(wp), intent(in) :: tol
-            type(contact_set_t), intent(in) :: cs
-            real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :)
-            real(wp), intent(inout) :: vwork(:, :)
-            logical, intent(in) :: bilateral
-            real(wp), intent(in) :: nq
-            real(wp), intent(inout) :: error
-            logical, intent(out) :: evaluated
-        end subroutine siconos_measure
-
-        !> True (dem_nlgs_siconos).
-        pure module function siconos_is_siconos_error(self) result(yes)
-            class(siconos_criterion_t), intent(in) :: self
-            logical :: yes
-        end function siconos_is_siconos_error
 
         !> Siconos error of the contacts act from the velocities vel, |q| = nq
         !> (dem_nlgs_siconos).
@@ -896,6 +863,80 @@ contains
         logical, intent(out) :: evaluated
         evaluated = .true.
     end subroutine lmgc90_measure
+
+    !> 'siconos'.
+    pure function siconos_name(self) result(name)
+        !> The criterion.
+        class(siconos_criterion_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = 'siconos'
+    end function siconos_name
+
+    !> The active contacts, in increasing order (the running error runs over them); no
+    !> evaluation yet.
+    subroutine siconos_begin(self, cs)
+        !> The criterion (the copy of a solve).
+        class(siconos_criterion_t), intent(inout) :: self
+        !> Contacts (activity set).
+        type(contact_set_t), intent(in) :: cs
+        integer :: k
+        self%act = pack([(k, k=1, cs%n)], cs%active(1:cs%n))
+        self%per_norm = 0.0_wp
+        self%norm_evaluated = huge(1.0_wp)
+        self%last_evaluation = 0
+    end subroutine siconos_begin
+
+    !> The Siconos error after sweep s, evaluated when it may be near the tolerance (the norm
+    !> of the sweeps times their last measured ratio), every siconos_period sweeps, and where
+    !> the solve needs it (the cap, a safeguard); from the velocities the sweeps keep up to
+    !> date, and below the tolerance again from u = W r + q in full, which alone stops the
+    !> sweeps. Elsewhere an estimate (the norm times the last ratio), which does not stop
+    !> them.
+    subroutine siconos_measure(self, s, needed, tol, cs, im, vfree, vel, vwork, bilateral, nq, error, evaluated)
+        !> The criterion (the copy of a solve).
+        class(siconos_criterion_t), intent(inout) :: self
+        !> Sweeps done.
+        integer, intent(in) :: s
+        !> The solve needs the exact error (the cap, a safeguard).
+        logical, intent(in) :: needed
+        !> Tolerance.
+        real(wp), intent(in) :: tol
+        !> Contacts (reactions).
+        type(contact_set_t), intent(in) :: cs
+        !> Inverse mass, free velocities and velocities (3, n_disks).
+        real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :)
+        !> Work array (3, n_disks).
+        real(wp), intent(inout) :: vwork(:, :)
+        !> Bilateral constraints changed the velocities.
+        logical, intent(in) :: bilateral
+        !> |q| of the Siconos error.
+        real(wp), intent(in) :: nq
+        !> The norm of the sweeps in, the Siconos error (or its estimate) out.
+        real(wp), intent(inout) :: error
+        !> The error is exact.
+        logical, intent(out) :: evaluated
+        real(wp) :: norm
+        evaluated = s - self%last_evaluation >= siconos_period .or. needed &
+                    .or. (error*self%per_norm <= siconos_margin*tol .and. error < self%norm_evaluated)
+        if (evaluated) then
+            norm = error
+            self%norm_evaluated = norm
+            error = siconos_ratio(cs, self%act, vel, nq)
+            self%per_norm = 0.0_wp
+            if (norm > 0.0_wp) self%per_norm = error/norm
+            self%last_evaluation = s
+            if (error <= tol) error = siconos_error(cs, im, vfree, vel, vwork, bilateral, nq)
+        else
+            error = error*self%per_norm
+        end if
+    end subroutine siconos_measure
+
+    !> True: the error that stops the sweeps is the Siconos error of the final state.
+    pure logical function siconos_is_siconos_error(self) result(yes)
+        !> The criterion.
+        class(siconos_criterion_t), intent(in) :: self
+        yes = .true.
+    end function siconos_is_siconos_error
 
     !> No: the error that stops the sweeps is not the Siconos error.
     pure logical function criterion_not_siconos(self) result(yes)

@@ -1,70 +1,10 @@
 !> Siconos error of the contact problem (doc/theory.md 4.5): the final error of every
-!> solve, the stopping test of `[solver] criterion = siconos` and |q|. Part of dem_nlgs (its
+!> solve, the error the stopping test siconos_criterion_t evaluates, and |q|. Part of dem_nlgs (its
 !> module header); the interfaces are declared there.
 submodule(dem_nlgs) dem_nlgs_siconos
     implicit none
 
 contains
-
-    !> 'siconos'.
-    pure module function siconos_name(self) result(name)
-        class(siconos_criterion_t), intent(in) :: self
-        character(len=:), allocatable :: name
-        name = 'siconos'
-    end function siconos_name
-
-    !> The active contacts, in increasing order (the running error runs over them); no
-    !> evaluation yet.
-    module subroutine siconos_begin(self, cs)
-        class(siconos_criterion_t), intent(inout) :: self
-        type(contact_set_t), intent(in) :: cs
-        integer :: k
-        self%act = pack([(k, k=1, cs%n)], cs%active(1:cs%n))
-        self%per_norm = 0.0_wp
-        self%norm_evaluated = huge(1.0_wp)
-        self%last_evaluation = 0
-    end subroutine siconos_begin
-
-    !> The Siconos error after sweep s, evaluated when it may be near the tolerance (the norm
-    !> of the sweeps times their last measured ratio), every siconos_period sweeps, and where
-    !> the solve needs it (the cap, a safeguard); from the velocities the sweeps keep up to
-    !> date, and below the tolerance again from u = W r + q in full, which alone stops the
-    !> sweeps. Elsewhere an estimate (the norm times the last ratio), which does not stop
-    !> them.
-    module subroutine siconos_measure(self, s, needed, tol, cs, im, vfree, vel, vwork, bilateral, nq, error, evaluated)
-        class(siconos_criterion_t), intent(inout) :: self
-        integer, intent(in) :: s
-        logical, intent(in) :: needed
-        real(wp), intent(in) :: tol
-        type(contact_set_t), intent(in) :: cs
-        real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :)
-        real(wp), intent(inout) :: vwork(:, :)
-        logical, intent(in) :: bilateral
-        real(wp), intent(in) :: nq
-        real(wp), intent(inout) :: error
-        logical, intent(out) :: evaluated
-        real(wp) :: norm
-        evaluated = s - self%last_evaluation >= siconos_period .or. needed &
-                    .or. (error*self%per_norm <= siconos_margin*tol .and. error < self%norm_evaluated)
-        if (evaluated) then
-            norm = error
-            self%norm_evaluated = norm
-            error = siconos_ratio(cs, self%act, vel, nq)
-            self%per_norm = 0.0_wp
-            if (norm > 0.0_wp) self%per_norm = error/norm
-            self%last_evaluation = s
-            if (error <= tol) error = siconos_error(cs, im, vfree, vel, vwork, bilateral, nq)
-        else
-            error = error*self%per_norm
-        end if
-    end subroutine siconos_measure
-
-    !> True: the error that stops the sweeps is the Siconos error of the final state.
-    pure module function siconos_is_siconos_error(self) result(yes)
-        class(siconos_criterion_t), intent(in) :: self
-        logical :: yes
-        yes = .true.
-    end function siconos_is_siconos_error
 
     !> Siconos error of the current reactions (doc/theory.md, "Siconos error"), u computed in
     !> full from the free velocities: vwork = vfree + M^-1 H r (or vel itself when bilateral
