@@ -90,7 +90,7 @@ module dem_bonded_block
     use core_kinds, only: wp, i8
     use core_error, only: error_t
     use core_sparse, only: sparse_matrix_t, sparse_solver_t, sparse_ldlt, sparse_stats_t
-    use dem_contacts, only: contact_set_t, status_cohesive, bond_on_bound
+    use dem_contacts, only: contact_set_t, status_cohesive, bond_on_bound, contacts_directions
     use dem_bipotential, only: case_stick, case_slip, case_roll, case_slip_roll, rolling_local_solve, &
                                bipotential_local_solve
     use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_apply_reactions, nlgs_block_t, &
@@ -846,21 +846,6 @@ contains
         if (cs%erol(k) > 0.0_wp) mask = ibset(mask, 2)
     end function rows_mask
 
-    !> Generalised directions of the reaction components of contact k on its body of side
-    !> s (1: i1, with sign -1; 2: i2, with sign +1): g(dof, component).
-    pure function directions(cs, k, s) result(g)
-        type(contact_set_t), intent(in) :: cs
-        integer, intent(in) :: k, s
-        real(wp) :: g(3, 3)
-        real(wp) :: sg, nx, ny
-        sg = merge(1.0_wp, -1.0_wp, s == 2)
-        nx = cs%nrm(1, k)
-        ny = cs%nrm(2, k)
-        g(:, 1) = [sg*nx, sg*ny, 0.0_wp]
-        g(:, 2) = [-sg*ny, sg*nx, cs%lever(s, k)]
-        g(:, 3) = [0.0_wp, 0.0_wp, sg]
-    end function directions
-
     !> Assemble W_BB = H_B^T M_eff^-1 H_B as entries (push): one product per pair of
     !> bonds that share a disk, then the bilateral constraints' share. Every entry of a block
     !> is added, zero or not, so that the pattern depends on the graph only; the entries of
@@ -902,12 +887,12 @@ contains
                 b1 = inc_b(e1)
                 s1 = inc_s(e1)
                 g1 = 0.0_wp
-                if (self%bond(b1) > 0) g1 = directions(cs, self%bond(b1), s1)
+                if (self%bond(b1) > 0) g1 = contacts_directions(cs, self%bond(b1), s1)
                 do e2 = e1, start(d + 1) - 1
                     b2 = inc_b(e2)
                     s2 = inc_s(e2)
                     g2 = 0.0_wp
-                    if (self%bond(b2) > 0) g2 = directions(cs, self%bond(b2), s2)
+                    if (self%bond(b2) > 0) g2 = contacts_directions(cs, self%bond(b2), s2)
                     do p = self%first(b1), self%first(b1 + 1) - 1
                         do q = self%first(b2), self%first(b2 + 1) - 1
                             if (b1 == b2 .and. q > p) cycle
@@ -985,7 +970,7 @@ contains
             do s = 1, 2
                 if (.not. touches(b, s)) cycle
                 d = slot_body(self, b, s)
-                g = directions(cs, self%bond(b), s)
+                g = contacts_directions(cs, self%bond(b), s)
                 do r = 1, nr
                     if (owner(r) /= d) cycle
                     um(r, i) = um(r, i) + im(dof(r), d)*g(dof(r), self%comp(p))
@@ -1365,7 +1350,7 @@ contains
         do s = 1, 2
             d = body(cs, k, s)
             if (d <= 0) cycle
-            g = directions(cs, k, s)
+            g = contacts_directions(cs, k, s)
             u = u + matmul(transpose(g), vel(:, d))
         end do
     end function relative_velocity
@@ -1383,7 +1368,7 @@ contains
         do s = 1, 2
             d = body(cs, k, s)
             if (d <= 0) cycle
-            g = directions(cs, k, s)
+            g = contacts_directions(cs, k, s)
             v(:, d) = v(:, d) + im(:, d)*matmul(g, dr)
         end do
     end subroutine add_impulse
@@ -1401,7 +1386,7 @@ contains
         do s = 1, 2
             d = body(cs, k, s)
             if (d <= 0) cycle
-            g = directions(cs, k, s)
+            g = contacts_directions(cs, k, s)
             u = u + matmul(transpose(g), dv(:, d))
         end do
     end function local_change

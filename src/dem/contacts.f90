@@ -28,7 +28,7 @@ module dem_contacts
     public :: contacts_extend, contacts_fill
     public :: contacts_set_frames, contacts_set_laws, contacts_finish, contacts_impulses
     public :: contacts_local_velocity, contacts_count_status, contacts_bytes, contacts_moments_active
-    public :: contacts_apply_impulse, contacts_solver_velocity
+    public :: contacts_apply_impulse, contacts_solver_velocity, contacts_directions
     public :: contacts_list_problem
 
     !> Contact status, no reaction (separated or not active this step).
@@ -467,6 +467,25 @@ contains
         u(1) = nx*dv(1) + ny*dv(2)
         u(2) = u(2) - ny*dv(1) + nx*dv(2) + cs%lever(2, k)*vel(3, b)
     end function contacts_local_velocity
+
+    !> Generalised directions (vx, vy, w) of the unit reaction components r_n, r_t, M of
+    !> contact k (columns) on its body of side s (1: i1, sign -1; 2: i2, sign +1): g(dof,
+    !> component). A body's share of H is g, its velocity's contribution to (u_n, u_t, w_r)
+    !> is g^T v (the velocity map is the transpose of the impulse map).
+    pure function contacts_directions(cs, k, s) result(g)
+        !> Contacts (frames and levers).
+        type(contact_set_t), intent(in) :: cs
+        !> Contact index and side.
+        integer, intent(in) :: k, s
+        real(wp) :: g(3, 3)
+        real(wp) :: sg, nx, ny
+        sg = merge(1.0_wp, -1.0_wp, s == 2)
+        nx = cs%nrm(1, k)
+        ny = cs%nrm(2, k)
+        g(:, 1) = [sg*nx, sg*ny, 0.0_wp]
+        g(:, 2) = [-sg*ny, sg*nx, cs%lever(s, k)]
+        g(:, 3) = [0.0_wp, 0.0_wp, sg]
+    end function contacts_directions
 
     !> The impulse (drn, drt, drm) of contact k in its frame applied to the disks:
     !> vel += M^-1 H (drn, drt, drm). A wall (i1 <= 0) takes nothing.

@@ -15,7 +15,7 @@
 !> contact impulses with the constraints held, and u comes from the velocities of the solve.
 module dem_local_problem
     use core_kinds, only: wp
-    use dem_contacts, only: contact_set_t
+    use dem_contacts, only: contact_set_t, contacts_directions
     use dem_nlgs, only: nlgs_bilateral_t
     implicit none
     private
@@ -124,11 +124,11 @@ contains
                 do side = 1, 2
                     body = merge(lp%i1(b), lp%i2(b), side == 1)
                     if (body <= 0) cycle
-                    call directions(cs, lp%index(b), body, gb)
+                    gb = contacts_directions(cs, lp%index(b), side)
                     do e = adj_start(body), adj_start(body + 1) - 1
                         a = adj(e)
                         if (a == b .and. .not. condensed) cycle
-                        call directions(cs, lp%index(a), body, ga)
+                        ga = contacts_directions(cs, lp%index(a), merge(2, 1, body == cs%i2(lp%index(a))))
                         do j = 1, d
                             s = sum(ga(:, j)*im(:, body)*gb(:, c))
                             call push(d*(a - 1) + j - 1, s)
@@ -215,7 +215,7 @@ contains
                         body = merge(lp%i1(j), lp%i2(j), side == 1)
                         if (body <= 0) cycle
                         if (.not. constrained(body)) cycle
-                        call directions(cs, lp%index(j), body, gb)
+                        gb = contacts_directions(cs, lp%index(j), side)
                         do r = 1, nr
                             if (owner(r) /= body) cycle
                             um(r, i) = um(r, i) + im(dof(r), body)*gb(dof(r), c)
@@ -260,26 +260,6 @@ contains
         end subroutine grow
     end subroutine local_problem_build
 
-    !> Generalised directions (vx, vy, w) on disk `body` of the unit components r_n, r_t, M
-    !> of contact k (columns); the velocity components of the contact are their dot products
-    !> with the body's velocity (H^T is the transpose of the impulse map).
-    pure subroutine directions(cs, k, body, g)
-        type(contact_set_t), intent(in) :: cs
-        integer, intent(in) :: k, body
-        real(wp), intent(out) :: g(3, 3)
-        real(wp) :: s, lever
-        if (body == cs%i2(k)) then
-            s = 1.0_wp
-            lever = cs%lever(2, k)
-        else
-            s = -1.0_wp
-            lever = cs%lever(1, k)
-        end if
-        g(:, 1) = [s*cs%nrm(1, k), s*cs%nrm(2, k), 0.0_wp]
-        g(:, 2) = [-s*cs%nrm(2, k), s*cs%nrm(1, k), lever]
-        g(:, 3) = [0.0_wp, 0.0_wp, s]
-    end subroutine directions
-
     !> vel += M^-1 H dr for contact k.
     pure subroutine impulse(cs, k, im, vel, dr)
         type(contact_set_t), intent(in) :: cs
@@ -287,10 +267,10 @@ contains
         real(wp), intent(in) :: im(:, :), dr(3)
         real(wp), intent(inout) :: vel(:, :)
         real(wp) :: g(3, 3)
-        call directions(cs, k, cs%i2(k), g)
+        g = contacts_directions(cs, k, 2)
         vel(:, cs%i2(k)) = vel(:, cs%i2(k)) + im(:, cs%i2(k))*matmul(g, dr)
         if (cs%i1(k) <= 0) return
-        call directions(cs, k, cs%i1(k), g)
+        g = contacts_directions(cs, k, 1)
         vel(:, cs%i1(k)) = vel(:, cs%i1(k)) + im(:, cs%i1(k))*matmul(g, dr)
     end subroutine impulse
 
@@ -301,10 +281,10 @@ contains
         real(wp), intent(in) :: vel(:, :)
         real(wp), intent(out) :: u(:)
         real(wp) :: g(3, 3), w(3)
-        call directions(cs, k, cs%i2(k), g)
+        g = contacts_directions(cs, k, 2)
         w = matmul(vel(:, cs%i2(k)), g)
         if (cs%i1(k) > 0) then
-            call directions(cs, k, cs%i1(k), g)
+            g = contacts_directions(cs, k, 1)
             w = w + matmul(vel(:, cs%i1(k)), g)
         end if
         w(1:2) = w(1:2) + cs%shift(:, k)
