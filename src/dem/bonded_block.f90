@@ -267,9 +267,21 @@ module dem_bonded_block
     contains
         !> See `solve_method_t%solve`.
         procedure :: solve => bonded_block_solve
+        !> 'block'.
+        procedure :: name => bonded_block_name
     end type bonded_block_method_t
 
 contains
+
+    !> 'block'.
+    pure function bonded_block_name(self, config) result(name)
+        !> The strategy.
+        class(bonded_block_method_t), intent(in) :: self
+        !> Settings.
+        type(nlgs_config_t), intent(in) :: config
+        character(len=:), allocatable :: name
+        name = 'block'
+    end function bonded_block_name
 
     !> Restart from a checkpoint: the block had a factor of `values` (mat%values with eps,
     !> values_factored) for the bond graph (key_i1, key_i2, key_rows). The next `prepare`

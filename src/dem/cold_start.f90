@@ -15,9 +15,19 @@ module dem_cold_start
     contains
         !> The weight carried down the contact network from the top.
         procedure :: guess => hydrostatic_guess
+        !> 'hydrostatic'.
+        procedure :: name => hydrostatic_name
     end type hydrostatic_start_t
 
 contains
+
+    !> 'hydrostatic'.
+    pure function hydrostatic_name(self) result(name)
+        !> The estimate.
+        class(hydrostatic_start_t), intent(in) :: self
+        character(len=:), allocatable :: name
+        name = 'hydrostatic'
+    end function hydrostatic_name
 
     !> Hydrostatic estimate of the reactions of a cold solve (nlgs_config_t%start): the
     !> impulses that bring every disk to rest, -M v_free, carried down the contact network

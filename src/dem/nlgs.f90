@@ -106,7 +106,7 @@ module dem_nlgs
     public :: nlgs_correction_t, nlgs_start_t
     public :: nlgs_siconos_error
     public :: nlgs_split_t, nlgs_split_build
-    public :: nlgs_criterion_t, lmgc90_criterion_t, siconos_criterion_t, nlgs_criterion_name
+    public :: nlgs_criterion_t, lmgc90_criterion_t, siconos_criterion_t, nlgs_criterion_name, nlgs_start_name
 
     !> A contact is blocked when W_nn <= blocked_ratio (W_nn + W_tt) (the floor of the scaled
     !> frame in dem_bipotential: below it the normal reaction would be unbounded).
@@ -131,9 +131,19 @@ module dem_nlgs
     contains
         !> Set the reactions of the contacts list (all zero on entry).
         procedure(start_guess), deferred :: guess
+        !> Name (the value of `[solver] cold_start`).
+        procedure(start_name), deferred :: name
     end type nlgs_start_t
 
     abstract interface
+        !> Name of a cold start.
+        pure function start_name(self) result(name)
+            import :: nlgs_start_t
+            !> The start.
+            class(nlgs_start_t), intent(in) :: self
+            character(len=:), allocatable :: name
+        end function start_name
+
         !> Change the reactions of the contacts list, and vel by the impulses of the change.
         subroutine correction_correct(self, cs, list, im, vel)
             import :: nlgs_correction_t, contact_set_t, wp
@@ -820,6 +830,19 @@ contains
             name = 'lmgc90'
         end if
     end function nlgs_criterion_name
+
+    !> Name of the settings' cold start (zero when none is set: the sweeps start from zero
+    !> reactions).
+    pure function nlgs_start_name(config) result(name)
+        !> Settings.
+        type(nlgs_config_t), intent(in) :: config
+        character(len=:), allocatable :: name
+        if (allocated(config%start)) then
+            name = config%start%name()
+        else
+            name = 'zero'
+        end if
+    end function nlgs_start_name
 
     !> 'lmgc90'.
     pure function lmgc90_name(self) result(name)

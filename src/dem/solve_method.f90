@@ -19,9 +19,21 @@ module dem_solve_method
     contains
         !> Solve the contact problem of one step (arguments as nlgs_solve).
         procedure(method_solve), deferred :: solve
+        !> Name, with the settings (the value of `[solver] method`).
+        procedure(method_name), deferred :: name
     end type solve_method_t
 
     abstract interface
+        !> Name of a strategy with the settings.
+        pure function method_name(self, config) result(name)
+            import :: solve_method_t, nlgs_config_t
+            !> The strategy.
+            class(solve_method_t), intent(in) :: self
+            !> Settings.
+            type(nlgs_config_t), intent(in) :: config
+            character(len=:), allocatable :: name
+        end function method_name
+
         !> Solve the contact problem of one step: on entry vel holds the free velocities and
         !> cs%r the warm start, on exit the end-of-step velocities and the reactions.
         subroutine method_solve(self, config, cs, im, vel, stats, bilateral)
@@ -49,9 +61,25 @@ module dem_solve_method
     contains
         !> dem_nlgs's solve.
         procedure :: solve => sweeps_solve
+        !> 'nlgs', or 'coarse' with the settings' correction.
+        procedure :: name => sweeps_name
     end type sweeps_method_t
 
 contains
+
+    !> 'nlgs', or 'coarse' when the settings hold a correction (the only one is dem_coarse's).
+    pure function sweeps_name(self, config) result(name)
+        !> The strategy.
+        class(sweeps_method_t), intent(in) :: self
+        !> Settings.
+        type(nlgs_config_t), intent(in) :: config
+        character(len=:), allocatable :: name
+        if (allocated(config%correction)) then
+            name = 'coarse'
+        else
+            name = 'nlgs'
+        end if
+    end function sweeps_name
 
     !> The NLGS sweeps (nlgs_solve).
     subroutine sweeps_solve(self, config, cs, im, vel, stats, bilateral)

@@ -16,7 +16,7 @@ module driver_results_dem
     use core_strings, only: to_str
     use core_version, only: multicor_name, multicor_version
     use io_hdf5_file, only: h5_file_t
-    use dem_nlgs, only: nlgs_stats_t, nlgs_criterion_name
+    use dem_nlgs, only: nlgs_stats_t, nlgs_criterion_name, nlgs_start_name
     use dem_moreau_jean, only: dem_system_t, energies_balance
     use dem_local_problem, only: local_problem_t
     implicit none
@@ -143,6 +143,19 @@ contains
             call file%write_attribute('/dem/solver', 'relaxation', sys%solver%relaxation, error)
             if (allocated(error)) return
             call file%write_attribute('/dem/solver', 'criterion', nlgs_criterion_name(sys%solver), error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem/solver', 'method', sys%method%name(sys%solver), error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem/solver', 'cold_start', nlgs_start_name(sys%solver), error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem/solver', 'sweep_order', trim(merge('alternating', 'forward    ', &
+                                                                               sys%solver%symmetric)), error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem/solver', 'anderson', sys%solver%anderson, error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem/solver', 'anderson_after', sys%solver%anderson_after, error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem/solver', 'anderson_sweeps', sys%solver%anderson_sweeps, error)
         end subroutine settings
 
         subroutine series(error)

@@ -128,6 +128,12 @@ def coupled(exe, work, name, deck_path, ends, extra=""):
             check(f"{name}: method = nlgs is not warned about", proc.returncode == 0 and not said, "\n".join(said))
         with h5py.File(work / f"{name}_{variant}" / f"{name}_{variant}.h5", "r") as f:
             results[variant] = (f["dem/position"][...], f["dem/velocity"][...], f["dem/solver/sweeps"][...])
+            named = tuple(f["dem/solver"].attrs[key] for key in ("method", "cold_start"))
+        named = tuple(value.decode() if isinstance(value, bytes) else value for value in named)
+        # the results name the deck's settings, as the warnings do
+        expected = ("coarse", "hydrostatic") if variant == "off" else ("nlgs", "zero")
+        check(f"{name}: /dem/solver names method and cold_start as the deck does ({variant})", named == expected,
+              f"{named}, expected {expected}")
     same = all(np.array_equal(a, b) for a, b in zip(results["off"], results["nlgs"]))
     check(f"{name}: the results are those of method = nlgs, bit for bit", same,
           f"sweeps {results['off'][2].sum()} and {results['nlgs'][2].sum()}")

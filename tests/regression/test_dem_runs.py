@@ -426,6 +426,17 @@ def deposit_strategies(exe, decks, work):
         f, _ = run(exe, deck, work)
         with f:
             res[method] = (f["dem/position"][...], f["dem/solver/sweeps"][...], f["dem/solver/converged"][...])
+            attrs = dict(f["dem/solver"].attrs)
+        # the results name the settings the run used, the defaults included (method = block,
+        # Anderson depth 5 after 10 sweeps, 2 sweeps per step)
+        expected = {"method": method if method in ("nlgs", "block", "coarse") else "block",
+                    "sweep_order": order, "cold_start": "zero",
+                    "anderson": 5 if method in ("anderson", "default") else 0,
+                    "anderson_after": 0 if method == "anderson" else 10, "anderson_sweeps": 2}
+        found = {key: attrs.get(key) for key in expected}
+        found = {key: value.decode() if isinstance(value, bytes) else value for key, value in found.items()}
+        check(f"deposit strategies: /dem/solver names the settings of {method}",
+              all(found[key] == expected[key] for key in expected), f"{found}, expected {expected}")
     (pa, na, ca) = res["nlgs"]
     drop = np.abs(pa - pa[0])[..., :2].max()
     for method in variants[1:]:
