@@ -37,11 +37,11 @@
 !> The Siconos error (nlgs_siconos_error, doc/theory.md 4.5) of the final state is always
 !> computed, from u = H^T (v_free + M^-1 H r) + shift in full; `criterion` (an extension of
 !> `nlgs_criterion_t`: lmgc90_criterion_t, the default, or siconos_criterion_t) chooses which
-!> error stops the sweeps. As a stopping test the Siconos error is evaluated from the velocities the sweeps
-!> keep up to date (the same up to round-off, and one pass over the contacts instead of
-!> three), only after the sweeps where it may be near the tolerance (siconos_period,
-!> siconos_margin); once that is below the tolerance it is computed again in full, and only
-!> that value stops the sweeps (Siconos' "light, full final" evaluation).
+!> error stops the sweeps. As a stopping test the Siconos error is evaluated from the
+!> velocities the sweeps keep up to date (the same up to round-off, and one pass over the
+!> contacts instead of three), only after the sweeps where it may be near the tolerance
+!> (siconos_period, siconos_margin); once that is below the tolerance it is computed again in
+!> full, and only that value stops the sweeps (Siconos' "light, full final" evaluation).
 !> Blocked contacts (both bodies immobile along the normal: W_nn = 0) are taken out of the
 !> solve with r = 0 and counted in the statistics (`nlgs_stats_t%n_blocked`).
 !> The constants of each contact's scaled frame (bipotential_scaling) are computed once per
@@ -647,7 +647,7 @@ contains
         ! the stopping test of this solve (a copy of the settings' criterion) and whether its
         ! error after the sweep is exact
         class(nlgs_criterion_t), allocatable :: criterion
-        logical :: evaluated
+        logical :: evaluated, needed
         real(wp) :: floor, omega, checked
         type(anderson_t) :: aa
         type(nlgs_split_t) :: split
@@ -770,9 +770,10 @@ contains
                 stats%error = relative(max(num - floor, 0.0_wp), den)
                 ! the exact error is needed at the cap, by the safeguard of the over-relaxation
                 ! and by the correction's
-                call criterion%measure(s, s == config%max_sweeps .or. (omega /= 1.0_wp .and. mod(s, config%check_every) == 0) &
-                                       .or. (correcting .and. mod(s, every) == 0), config%tol, cs, im, vfree, vel, vwork, &
-                                       present(bilateral), nq, stats%error, evaluated)
+                needed = s == config%max_sweeps .or. (omega /= 1.0_wp .and. mod(s, config%check_every) == 0) &
+                         .or. (correcting .and. mod(s, every) == 0)
+                call criterion%measure(s, needed, config%tol, cs, im, vfree, vel, vwork, present(bilateral), nq, &
+                                       stats%error, evaluated)
                 if (evaluated .and. stats%error <= config%tol) then
                     stats%converged = .true.
                     exit

@@ -1,11 +1,12 @@
 !> The global strategy of a step's contact solve (`[solver] method`; doc/theory.md
-!> sections 4.1 and 7.10): an abstract type whose `solve` takes the settings, the contacts and the free velocities
-!> and gives the reactions and the end-of-step velocities, and its plain kind, the NLGS
-!> sweeps over every contact (`method = nlgs`, and `method = coarse`, the sweeps with the
-!> coarse correction that the settings hold). The intact bonds solved directly as one
-!> block (`method = block`) extend it in dem_bonded_block (bonded_block_method_t). The
-!> strategy is state: the block keeps its factor from step to step, so the system holds
-!> it (dem_moreau_jean, `dem_system_t%method`), next to the settings.
+!> sections 4.1 and 7.10): an abstract type whose `solve` takes the settings, the contacts
+!> and the free velocities and gives the reactions and the end-of-step velocities, and its
+!> plain kind, the NLGS sweeps over every contact (`method = nlgs`, and `method = coarse`,
+!> the sweeps with the coarse correction that the settings hold). The intact bonds solved
+!> directly as one block (`method = block`) extend it in dem_bonded_block
+!> (bonded_block_method_t). The strategy is state: the block keeps its factor from step to
+!> step, so the system holds it (dem_moreau_jean, `dem_system_t%method`), next to the
+!> settings.
 module dem_solve_method
     use core_kinds, only: wp
     use dem_contacts, only: contact_set_t

@@ -783,6 +783,7 @@ contains
             character(len=:), allocatable :: g
             integer, allocatable :: k1(:), k2(:), kr(:), dead(:), deleted(:)
             real(wp), allocatable :: v(:)
+            logical :: restored
             g = group//'/block'
             if (.not. file%exists(g//'/values')) return
             call file%read_dataset(g//'/key_i1', k1, error)
@@ -819,16 +820,15 @@ contains
             if (allocated(error)) return
             ! the deck (whose hash the checkpoint matches) chose the strategy: only the
             ! bonded block has a factor to restore
-            if (.not. allocated(sys%method)) then
-                call damaged(error, g//': the deck solves no bonded block ([solver] method)')
-                return
+            restored = .false.
+            if (allocated(sys%method)) then
+                select type (m => sys%method)
+                type is (bonded_block_method_t)
+                    call bonded_block_restore(m%block, k1, k2, kr, v, dead == 1, deleted)
+                    restored = .true.
+                end select
             end if
-            select type (m => sys%method)
-            type is (bonded_block_method_t)
-                call bonded_block_restore(m%block, k1, k2, kr, v, dead == 1, deleted)
-            class default
-                call damaged(error, g//': the deck solves no bonded block ([solver] method)')
-            end select
+            if (.not. restored) call damaged(error, g//': the deck solves no bonded block ([solver] method)')
         end subroutine load_block
 
         !> Read the first n values of a per-body array (the array keeps its size).
