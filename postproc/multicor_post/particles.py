@@ -366,9 +366,7 @@ def plot_solver(res: DemResults) -> Figure:
     if np.any(bad):
         ax_s.plot(t[bad], s.sweeps[bad], "o", color="tab:red", ms=3,
                   label=f"not converged ({int(np.count_nonzero(bad))} steps)")
-    # the bonded block counts block iterations (a direct solve of the bonds, then a sweep
-    # over the other contacts) where the other methods count sweeps (doc/output.md)
-    ax_s.set_ylabel("block iterations" if s.method == "block" else "sweeps")
+    ax_s.set_ylabel("sweeps")
     if ax_s.get_legend_handles_labels()[0]:
         ax_s.legend(loc="best", fontsize="small")
     positive = lambda v: np.where(v > 0, v, np.nan)  # noqa: E731 (log axes skip zeros)
