@@ -1,8 +1,8 @@
 !> Coupled continuum-disk runs: a deck with [continuum], [particles] and [coupling] (regions).
 !>
 !> The continuum part of the deck (mesh, materials, supports, loads, initial velocity, [time])
-!> is read by the continuum run's own `init` (driver_simulation_continuum) on the deck without
-!> the particle sections, and the particle part by the particle run's `init`
+!> is read by the dynamic continuum run's own `init` (driver_simulation_continuum_dynamic) on
+!> the deck without the particle sections, and the particle part by the particle run's `init`
 !> (driver_simulation_dem) on the deck without [continuum]; every error keeps its file, line and
 !> keyword. [coupling] is read by driver_config_coupling2d, and coupling_arlequin2d builds the
 !> coupled system, whose time step (coupling_coupled_step's arlequin_step) is the beam's; the
@@ -29,7 +29,7 @@ module driver_simulation_coupled2d
     use driver_results, only: results_writer_t
     use driver_results_continuum, only: continuum_writer_t
     use driver_simulation, only: report_iface
-    use driver_simulation_continuum, only: continuum_simulation_t
+    use driver_simulation_continuum_dynamic, only: continuum_dynamic_t
     use driver_simulation_dem, only: dem_simulation_t
     use driver_coupled_loop, only: arlequin_simulation_t
     use driver_checkpoint, only: read_finite_attribute
@@ -40,7 +40,7 @@ module driver_simulation_coupled2d
     !> A 2D continuum and particles glued in overlap regions.
     type, extends(arlequin_simulation_t) :: coupled2d_simulation_t
         !> The continuum part (model, run settings, initial state).
-        type(continuum_simulation_t) :: continuum
+        type(continuum_dynamic_t) :: continuum
         !> The particle part (disks, walls, contact laws, solver).
         type(dem_simulation_t) :: particles
         !> The coupling from the deck.

@@ -1,0 +1,97 @@
+!> Static analysis of a frame: K u = F at t = 0, the displacements and the support reactions.
+module driver_simulation_beam_static
+    use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_error, make_input_error
+    use io_deck, only: deck_t
+    use fem_beam_model, only: beam_model_t
+    use fem_static, only: solve_static
+    use driver_results, only: results_writer_t
+    use driver_checkpoint, only: checkpoint_run_t
+    use driver_simulation, only: report_iface
+    use driver_simulation_beam, only: beam_simulation_t, beam_setup
+    implicit none
+    private
+    public :: beam_static_t
+
+    !> A static frame run.
+    type, extends(beam_simulation_t) :: beam_static_t
+    contains
+        !> See `simulation_t%init`: the supports must stop every rigid-body motion.
+        procedure :: init => static_init
+        !> See `simulation_t%run`.
+        procedure :: run => static_run
+    end type beam_static_t
+
+contains
+
+    !> Settings and model, then the supports.
+    subroutine static_init(self, deck, report, error)
+        !> The simulation.
+        class(beam_static_t), intent(inout) :: self
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        !> Where warnings go (none for beams).
+        procedure(report_iface) :: report
+        !> Set on any input error.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: message
+        integer :: line
+        call beam_setup(self, deck, error)
+        if (allocated(error)) return
+        ! A static solve needs supports that stop every rigid-body motion: the error names the
+        ! first `fix` of the deck (the supports as a whole; the message names the part), or
+        ! the first `line` when there is none.
+        call self%model%check_supports(error)
+        if (allocated(error)) then
+            message = error%message
+            line = deck%line('beam', 'fix')
+            if (line == 0) line = deck%line('beam', 'line')
+            call make_input_error(error, deck%file, line, 'fix', message)
+        end if
+    end subroutine static_init
+
+    !> The mesh, then the static solution.
+    subroutine static_run(self, out, quiet, report, ck, error)
+        !> The simulation.
+        class(beam_static_t), intent(inout) :: self
+        !> The results file.
+        type(results_writer_t), intent(inout) :: out
+        !> No progress lines (a static solve prints none).
+        logical, intent(in) :: quiet
+        !> Where the summary line goes.
+        procedure(report_iface) :: report
+        !> Checkpoints (none in a static analysis).
+        type(checkpoint_run_t), intent(inout) :: ck
+        !> Set on a run or write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call self%write_mesh(out, error)
+        if (allocated(error)) return
+        call run_static(self%model, out, report, error)
+    end subroutine static_run
+
+    subroutine run_static(model, out, report, error)
+        type(beam_model_t), intent(in) :: model
+        type(results_writer_t), intent(inout) :: out
+        procedure(report_iface) :: report
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: u(:), d(:, :), r(:, :)
+        character(len=120) :: buf
+        call solve_static(model, 0.0_wp, u, error)
+        if (allocated(error)) return
+        allocate (d(3, model%n_nodes), r(3, model%n_nodes))
+        call model%expand(u, d)
+        call model%reactions(u, 0.0_wp, r)
+        if (.not. (all(ieee_is_finite(d)) .and. all(ieee_is_finite(r)))) then
+            call make_error(error, 'static solution: a displacement or a reaction is not finite; '// &
+                            'likely cause: a load or a stiffness far too large or too small (check the '// &
+                            'magnitudes in [beam])')
+            return
+        end if
+        call out%write_static(d, r, error)
+        if (allocated(error)) return
+        write (buf, '(a,es13.5e3,a)') 'static solution: max |displacement| = ', &
+            maxval(abs(d(1:2, :))), ' m'
+        call report(trim(buf))
+    end subroutine run_static
+end module driver_simulation_beam_static
