@@ -18,18 +18,36 @@
 !> (below); on the reference stack its solves cost no more than the supernodal L L^T's.
 !>
 !> Regularisation: eps = 1e-12 max diag(W_BB). Redundant bonds (a closed loop, e.g. a
-!> triangle of a hexagonal stack) make W_BB singular: its kernel holds the self-stresses,
-!> which the velocities do not see. eps I makes the matrix definite and picks among them
-!> the reaction change of least norm. The factorisation of a semi-definite matrix in floating
-!> point meets pivots of the size of the rounding of its entries, about 1e-16 max diag, so
-!> 1e-12 keeps four orders of margin. The bias that eps adds (a relative error eps/lambda
-!> on an eigen-component lambda of W_BB) is removed by iterative refinement with the same
-!> factor, the residual being recomputed from the velocities themselves (-u_B after the
-!> impulses are applied, not W_BB x: the reactions of a long chain are poorly determined by
-!> W_BB, whose condition grows like N^4, and the velocity residual is the exact one): each
-!> pass contracts a component by eps/(lambda + eps) and, for a singular but consistent
-!> system, converges to a solution. It stops at the round-off of the velocities (64 eps
-!> |v|, as the NLGS's floor), when the residual no longer halves, or after max_passes.
+!> triangle of a hexagonal stack, or bonds between disks glued to a beam) make W_BB singular:
+!> its kernel holds the self-stresses, which the velocities do not see. eps I makes the matrix
+!> definite. The factorisation of a semi-definite matrix in floating point meets pivots of
+!> the size of the rounding of its entries, about 1e-16 max diag, so 1e-12 keeps four orders
+!> of margin. With the coupling rows, eps is 1e-12 max diag(H_B^T M^-1 H_B): W_BB's entries
+!> are then differences of those (a glued disk's mobility less the beam's share), round off
+!> as those, and can be a thousand times smaller.
+!>
+!> Least norm: each pass takes dr = W_BB (W_BB + eps I)^-2 (-u_B), two solves with the same
+!> factor (`solve_least_norm`): the change of (W_BB + eps I)^-1 (-u_B) to a relative eps/lambda
+!> on an eigen-component lambda >> eps, and none on the kernel. The first solve alone
+!> multiplies by 1/eps the part of -u_B in the kernel, which no change of the reactions
+!> removes: round-off of the velocities, or targets of bonds and coupling rows that disagree
+!> by a little. That part became a self-stress of the bonds and the coupling rows 10^12 times
+!> its size, which grew from step to step (larger reactions, larger round-off) until a bond
+!> broke and released it as kinetic energy: a cohesive stack with all its layers glued to a
+!> beam gained 1 J on 2e-7 J of external work, every step reported converged. Both the least
+!> norm and the scale of eps are needed: with the rows' share the kernel's computed
+!> eigenvalues are the rounding of the larger entries, near eps of max diag(W_BB), where
+!> W (W + eps I)^-2 still amplifies by 1/(4 eps) (the stack, at a tolerance of 1e-8, gained
+!> 1 J with the least norm alone, 654 J with the scale alone).
+!>
+!> The bias (a relative error of about 2 eps/lambda on an eigen-component lambda of W_BB) is
+!> removed by iterative refinement with the same factor, the residual being recomputed from
+!> the velocities themselves (-u_B after the impulses are applied, not W_BB x: the reactions
+!> of a long chain are poorly determined by W_BB, whose condition grows like N^4, and the
+!> velocity residual is the exact one): each pass contracts a component by
+!> 1 - lambda^2/(lambda + eps)^2 and, for a singular but consistent system, converges to the
+!> solution of least norm. It stops at the round-off of the velocities (64 eps |v|, as the
+!> NLGS's floor), when the residual no longer halves, or after max_passes.
 !>
 !> Reuse: the symbolic analysis is kept while the bond graph (the pairs of B and their
 !> locked components, in order) does not change. The values of W_BB change at every step in
@@ -220,14 +238,19 @@ module dem_bonded_block
         real(wp), allocatable :: tv(:)
         !> Number of triplets in use in ti, tj, tv.
         integer :: nt = 0
+        !> Entries of H_B^T M^-1 H_B among them (the first; the coupling rows' share follows).
+        integer :: nt_plain = 0
         !> Position of each triplet in mat%values (see `ti`).
         integer(i8), allocatable :: pos(:)
         !> Values of the last factorisation.
         real(wp), allocatable :: values_factored(:)
-        !> Regularisation of the current factor.
+        !> Regularisation of the current values (mat%values).
         real(wp) :: eps = 0.0_wp
+        !> Regularisation of the values of the factor (values_factored), which `solve_least_norm`
+        !> takes out again.
+        real(wp) :: eps_factored = 0.0_wp
         !> Work arrays (nu).
-        real(wp), allocatable :: rhs(:), x(:)
+        real(wp), allocatable :: rhs(:), x(:), y(:)
         !> Bonds released by the outer check that are swept in this solve (contacts), their
         !> number, and their Delassus blocks condensed on the block (6, n_released: nn, nt,
         !> tt, nm, tm, mm; `condense`), computed at the first solve after `prepare`.
@@ -248,6 +271,8 @@ module dem_bonded_block
         !> factored at the next `prepare` when its bond graph is the restored key, and the
         !> slots then deleted from it, in order.
         real(wp), allocatable :: restore_values(:)
+        !> See `restore_values`: their regularisation.
+        real(wp) :: restore_eps = 0.0_wp
         !> See `restore_values`.
         integer, allocatable :: restore_deleted(:)
     contains
@@ -288,13 +313,15 @@ contains
     !> whose bond graph is that one factors these values instead of the current ones, so
     !> that the same (possibly stale) factor is used as in the uninterrupted run and the
     !> results stay bitwise the same; otherwise it proceeds as usual.
-    subroutine bonded_block_restore(block, key_i1, key_i2, key_rows, values, dead, deleted)
+    subroutine bonded_block_restore(block, key_i1, key_i2, key_rows, values, eps, dead, deleted)
         !> The block (new).
         type(bonded_block_t), intent(inout) :: block
         !> Bond graph of the factor: pairs and locked components (bitmask) of each slot.
         integer, intent(in) :: key_i1(:), key_i2(:), key_rows(:)
         !> Values of the factor.
         real(wp), intent(in) :: values(:)
+        !> Their regularisation (eps_factored).
+        real(wp), intent(in) :: eps
         !> Dead slots (identity rows in the factor), and those of them deleted from it after
         !> its factorisation, in order.
         logical, intent(in) :: dead(:)
@@ -305,6 +332,7 @@ contains
         block%key_rows = key_rows
         block%dead = dead
         block%restore_values = values
+        block%restore_eps = eps
         block%restore_deleted = deleted
         block%analysed = .false.
         block%factored = .false.
@@ -590,6 +618,9 @@ contains
                     self%eps = max(self%eps, self%mat%values(self%diag(u)))
                 end do
             end do
+            ! with the coupling rows' share, W_BB's entries are differences of those of
+            ! H_B^T M^-1 H_B, and round off as those (module header)
+            if (self%nt_plain < self%nt) self%eps = max(self%eps, plain_diagonal_max(self))
             self%eps = bonded_block_eps_ratio*self%eps
             if (self%eps <= 0.0_wp) then
                 call give_up(self)
@@ -621,6 +652,7 @@ contains
                 self%mat%values = self%restore_values
                 deallocate (self%restore_values)
                 call refactor(self)
+                self%eps_factored = self%restore_eps
                 self%mat%values = current
                 if (self%factored) call delete_slots(self, self%restore_deleted)
                 if (self%factored) call delete_slots(self, newly)
@@ -821,6 +853,7 @@ contains
         self%factored = .true.
         self%stale = .false.
         self%values_factored = self%mat%values
+        self%eps_factored = self%eps
         self%n_deleted = 0
         self%counts%factorisations = self%counts%factorisations + 1
     end subroutine refactor
@@ -843,9 +876,9 @@ contains
         type(bonded_block_t), intent(inout) :: self
         if (allocated(self%rhs)) then
             if (size(self%rhs) == self%nu) return
-            deallocate (self%rhs, self%x)
+            deallocate (self%rhs, self%x, self%y)
         end if
-        allocate (self%rhs(self%nu), self%x(self%nu))
+        allocate (self%rhs(self%nu), self%x(self%nu), self%y(self%nu))
     end subroutine size_work
 
     !> Locked components of bond k as a bitmask: bit 0 normal (always), bit 1 tangential
@@ -915,8 +948,28 @@ contains
                 end do
             end do
         end do
+        self%nt_plain = self%nt
         if (present(bilateral)) call add_mobility(self, cs, im, bilateral)
     end subroutine assemble
+
+    !> Largest diagonal entry of H_B^T M^-1 H_B over the live slots (the first nt_plain
+    !> entries of the assembly, summed in their order).
+    pure real(wp) function plain_diagonal_max(self) result(m)
+        type(bonded_block_t), intent(in) :: self
+        real(wp) :: d(self%nu)
+        integer :: i, b, u
+        d = 0.0_wp
+        do i = 1, self%nt_plain
+            if (self%ti(i) == self%tj(i)) d(self%ti(i)) = d(self%ti(i)) + self%tv(i)
+        end do
+        m = 0.0_wp
+        do b = 1, self%nb
+            if (self%dead(b)) cycle
+            do u = self%first(b), self%first(b + 1) - 1
+                m = max(m, d(u))
+            end do
+        end do
+    end function plain_diagonal_max
 
     !> Append the entry (i, j, v) to the assembly (either triangle, each pair once; every
     !> unknown meets its diagonal entry, since every bond has a disk).
@@ -1151,8 +1204,7 @@ contains
                         self%rhs(p) = -u(self%comp(p))
                     end do
                 end do
-                self%x = 0.0_wp
-                call self%solver%solve(self%rhs, self%x, error)
+                call solve_least_norm(self, error)
                 if (allocated(error)) then
                     ! cannot happen with a factor held; the released bonds are then swept
                     ! as by the plain sweeps
@@ -1243,6 +1295,24 @@ contains
         call add_impulse(cs, k, dr, im, vel)
     end subroutine condensed_step
 
+    !> x = (W + eps I)^-1 rhs - eps (W + eps I)^-2 rhs = W (W + eps I)^-2 rhs with the factor of
+    !> W + eps I: the reaction change of least norm (module header, "Least norm"). The first
+    !> solve alone amplifies by 1/eps the part of rhs that no change of the bonds' reactions can
+    !> remove; the second takes it out.
+    subroutine solve_least_norm(self, error)
+        !> The block (rhs in, x out, y work).
+        type(bonded_block_t), intent(inout) :: self
+        !> Set if CHOLMOD fails.
+        type(error_t), allocatable, intent(out) :: error
+        self%x = 0.0_wp
+        call self%solver%solve(self%rhs, self%x, error)
+        if (allocated(error)) return
+        self%y = 0.0_wp
+        call self%solver%solve(self%x, self%y, error)
+        if (allocated(error)) return
+        self%x = self%x - self%eps_factored*self%y
+    end subroutine solve_least_norm
+
     !> The direct solve of `solve`, without the released bonds' steps.
     subroutine solve_direct(self, cs, im, vel, bilateral)
         !> The block.
@@ -1301,8 +1371,7 @@ contains
             if (it == max_passes) exit
             it = it + 1
             prev = rnorm
-            self%x = 0.0_wp
-            call self%solver%solve(self%rhs, self%x, error)
+            call solve_least_norm(self, error)
             if (allocated(error)) return
             if (it == 1) then
                 self%counts%solves = self%counts%solves + 1

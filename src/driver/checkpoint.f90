@@ -623,6 +623,7 @@ contains
                     if (.not. allocated(error)) call file%write_dataset(g//'/key_i2', b%key_i2, error)
                     if (.not. allocated(error)) call file%write_dataset(g//'/key_rows', b%key_rows, error)
                     if (.not. allocated(error)) call file%write_dataset(g//'/values', b%values_factored, error)
+                    if (.not. allocated(error)) call file%write_attribute(g//'/values', 'eps', [b%eps_factored], error)
                     ! slots whose bonds left the block: identity rows, some deleted from the factor
                     ! after its factorisation (replayed in order at the restart)
                     if (.not. any(b%dead)) return
@@ -782,7 +783,7 @@ contains
             type(error_t), allocatable, intent(out) :: error
             character(len=:), allocatable :: g
             integer, allocatable :: k1(:), k2(:), kr(:), dead(:), deleted(:)
-            real(wp), allocatable :: v(:)
+            real(wp), allocatable :: v(:), eps(:)
             logical :: restored
             g = group//'/block'
             if (.not. file%exists(g//'/values')) return
@@ -790,6 +791,7 @@ contains
             if (.not. allocated(error)) call file%read_dataset(g//'/key_i2', k2, error)
             if (.not. allocated(error)) call file%read_dataset(g//'/key_rows', kr, error)
             if (.not. allocated(error)) call file%read_dataset(g//'/values', v, error)
+            if (.not. allocated(error)) call read_finite_attribute(file, g//'/values', 'eps', eps, 1, error)
             if (allocated(error)) return
             if (size(k2) /= size(k1) .or. size(kr) /= size(k1)) then
                 call damaged(error, g//': key_i1, key_i2 and key_rows differ in size')
@@ -824,7 +826,7 @@ contains
             if (allocated(sys%method)) then
                 select type (m => sys%method)
                 type is (bonded_block_method_t)
-                    call bonded_block_restore(m%block, k1, k2, kr, v, dead == 1, deleted)
+                    call bonded_block_restore(m%block, k1, k2, kr, v, eps(1), dead == 1, deleted)
                     restored = .true.
                 end select
             end if
