@@ -254,6 +254,8 @@ contains
             integer, allocatable :: ids(:)
             integer :: i, j, func
             real(wp) :: gravity(2)
+            ! The loads of every record so far (constant and timed), before record e.
+            real(wp), allocatable :: before(:)
             deallocate (self%model%timed_load)
             allocate (self%model%timed_load(self%model%dof_count(), size(function_ids)), source=0.0_wp)
             list = deck%records('continuum', 'load')
@@ -264,16 +266,20 @@ contains
                 call self%model%mesh%node_set(e%word('node_set'), ids, error)
                 if (allocated(error)) call fail_at(error, e%line, 'load')
                 if (allocated(error)) return
+                before = applied()
                 do j = 1, size(ids)
                     call self%model%add_nodal_load(ids(j), component(e%word('component')), e%real('value'))
                 end do
                 call end_load(func)
+                call require_effect('load', before, error)
+                if (allocated(error)) return
             end do
             list = deck%records('continuum', 'traction')
             do i = 1, size(list)
                 e = list(i)
                 call start_load('traction', func, error)
                 if (allocated(error)) return
+                before = applied()
                 if (e%word('profile') == 'parabolic') then
                     call self%model%add_traction_parabolic(e%word('edge_set'), [e%real('tx'), e%real('ty')], error)
                 else
@@ -282,6 +288,8 @@ contains
                 if (allocated(error)) call fail_at(error, e%line, 'traction')
                 if (allocated(error)) return
                 call end_load(func)
+                call require_effect('traction', before, error)
+                if (allocated(error)) return
             end do
             gravity = [deck%get_real('continuum', 'gravity', 'gx'), deck%get_real('continuum', 'gravity', 'gy')]
             if (any(gravity /= 0)) then
@@ -314,6 +322,31 @@ contains
             if (func == 0) call make_input_error(error, deck%file, e%line, keyword, 'function '//e%word('function')// &
                                                  ' is not defined (no [functions] function record with this id)')
         end subroutine find_function
+
+        !> The loads of the records so far: the constant ones and every function's column.
+        function applied() result(total)
+            real(wp), allocatable :: total(:)
+            total = self%model%load + sum(self%model%timed_load, dim=2)
+        end function applied
+
+        !> A load or traction record whose forces all land on prescribed dofs (fix or
+        !> displacement) does nothing, like a beam's load on a support: an input error. One
+        !> that also loads a free dof is fine (an edge traction on a clamped corner).
+        subroutine require_effect(keyword, before, error)
+            character(len=*), intent(in) :: keyword
+            real(wp), intent(in) :: before(:)
+            type(error_t), allocatable, intent(out) :: error
+            real(wp), allocatable :: added(:)
+            integer, allocatable :: eq(:)
+            integer :: n
+            added = applied() - before
+            if (all(added == 0.0_wp)) return
+            call self%model%equations(eq, n)
+            if (any(added /= 0.0_wp .and. eq > 0)) return
+            call make_input_error(error, deck%file, e%line, keyword, 'every force of this '//keyword// &
+                                  ' lands on a prescribed dof (fix or displacement), where the support takes '// &
+                                  'it: it does nothing; remove it or free those dofs')
+        end subroutine require_effect
 
         !> After adding the load of record e: a timed load moves to its function's column.
         subroutine end_load(func)

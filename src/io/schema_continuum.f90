@@ -50,13 +50,17 @@ contains
                            tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
         call s%add_keyword('continuum', 'load', [word_field('node_set', ''), &
                                                  word_field('component', 'x y'), real_field('value', 'N')], &
-                           'Force on every node of a set, times a [functions] time function (none: constant 1).', &
+                           'Force on every node of a set, times a [functions] time function (none: constant 1). '// &
+                           'A load whose every force lands on a prescribed dof (fix, displacement) does nothing '// &
+                           'and is an error.', &
                            tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
         call s%add_keyword('continuum', 'traction', [word_field('edge_set', ''), &
                                                      real_field('tx', 'Pa'), real_field('ty', 'Pa')], &
                            'Traction on the edges of a set: uniform, or parabolic (1.5 t (1 - s^2) with s from '// &
                            '-1 to 1 across the set along its longer extent, the same resultant as uniform t), '// &
-                           'times a [functions] time function (none: constant 1; give the profile first).', &
+                           'times a [functions] time function (none: constant 1; give the profile first). A '// &
+                           'traction whose every force lands on a prescribed dof (a clamped edge) does nothing and '// &
+                           'is an error.', &
                            tails=[tail([word_field('profile', 'uniform parabolic'), int_field('function', lower=1)], &
                                        0, 2)], repeatable=.true.)
         call s%add_keyword('continuum', 'gravity', [real_field('gx', 'm/s^2'), real_field('gy', 'm/s^2')], &
