@@ -31,6 +31,9 @@ module coupling_map
         procedure :: row_of => map_row_of
         !> y += C_p u_p(t) (or its rate) over the FE dofs prescribed in time; none by default.
         procedure :: add_prescribed => map_add_prescribed
+        !> Distance between two coupled points across which the FE kinematics has no strain;
+        !> 0 by default (a continuum strains between any two points).
+        procedure :: rigid_distance => map_rigid_distance
     end type coupling_map_t
 
     abstract interface
@@ -81,4 +84,13 @@ contains
         real(wp), intent(inout) :: y(:)
         ! No prescribed dof in C: nothing to add.
     end subroutine map_add_prescribed
+
+    !> No rigid part: a continuum strains between any two points.
+    pure real(wp) function map_rigid_distance(self, p, q) result(d)
+        !> The operator.
+        class(coupling_map_t), intent(in) :: self
+        !> Two points (1..n_points).
+        integer, intent(in) :: p, q
+        d = 0.0_wp
+    end function map_rigid_distance
 end module coupling_map

@@ -59,6 +59,8 @@ module coupling_operator
         procedure :: to_dense
         !> Weight alpha at each coupled point; error if one is outside the overlap.
         procedure :: point_weights
+        !> See `coupling_map_t%rigid_distance`: the difference of the offsets.
+        procedure :: rigid_distance
     end type coupling_operator_t
 
     !> Mediator space of the multipliers on the beam nodes (see the module description).
@@ -303,6 +305,16 @@ contains
             end do
         end do
     end subroutine apply_transpose
+
+    !> |d_p - d_q|: plane sections stay plane and keep their depth, so the beam holds the
+    !> distance of two points across its axis rigid (to first order); along the axis it strains.
+    pure real(wp) function rigid_distance(self, p, q) result(d)
+        !> The operator.
+        class(coupling_operator_t), intent(in) :: self
+        !> Two points (1..n_points).
+        integer, intent(in) :: p, q
+        d = abs(self%offset(p) - self%offset(q))
+    end function rigid_distance
 
     !> Dense copy of C (n_rows, n_free).
     pure function to_dense(self) result(c)

@@ -225,6 +225,7 @@ contains
             if (.not. self%sys%stats%converged) call warn_unconverged()
             if (.not. speed_warned) call check_speed()
             if (.not. rotation_warned) call check_rotation()
+            if (k == 1) call check_redundant_bonds()
             act = end_of_step(k, n_steps, self%settings%output_interval, ck%schedule)
             if (act%store_first) call store(error)
             if (act%checkpoint .and. .not. allocated(error)) call checkpoint(error)
@@ -405,6 +406,40 @@ contains
                 call report(trim(buf))
             end associate
         end subroutine check_rotation
+
+        !> Warning (after the first step, when the bonds are made) when intact bonds join
+        !> coupled disks across the beam's axis with a multiplier per coupled dof (every layer
+        !> of a stack glued: [coupling] max_offset = 0, the default). The beam's sections do not
+        !> deform, so between two such disks the coupling leaves only the beam's bending and
+        !> stretching over a disk pitch: the bonds and the coupling rows are nearly redundant,
+        !> and any disagreement of their targets (the linear field's stretch, doc/theory.md 6.3;
+        !> round-off) loads them with a self-stress that grows from step to step and can break
+        !> bonds (doc/theory.md 7.10, "Least norm"; measured in
+        !> tests/regression/decks/coupled_glued_layers.dat: |lambda| of 1e4 N under 5 N).
+        subroutine check_redundant_bonds()
+            integer, allocatable :: point(:)
+            integer :: c, n, p
+            if (self%sys%on_nodes) return
+            associate (pa => self%sys%dem%particles, cs => self%sys%dem%contacts, op => self%sys%op)
+                if (pa%n == 0 .or. size(self%sys%coupled) == 0) return
+                allocate (point(pa%n), source=0)
+                point(self%sys%coupled) = [(p, p=1, size(self%sys%coupled))]
+                n = 0
+                do c = 1, cs%n
+                    if (cs%status(c) /= status_cohesive .or. cs%i1(c) <= 0) cycle
+                    if (point(cs%i1(c)) == 0 .or. point(cs%i2(c)) == 0) cycle
+                    ! across the axis by more than half the smaller disk: another layer
+                    if (op%rigid_distance(point(cs%i1(c)), point(cs%i2(c))) > &
+                        0.5_wp*min(pa%radius(cs%i1(c)), pa%radius(cs%i2(c)))) n = n + 1
+                end do
+            end associate
+            if (n == 0) return
+            call report('warning: '//counted(n, 'intact bond')//' join coupled disks at different distances '// &
+                        'from the beam axis (several layers glued): the beam''s sections do not deform, so '// &
+                        'these bonds and the coupling rows are nearly redundant and carry a self-stress that '// &
+                        'grows with any disagreement of their targets and can break bonds (doc/theory.md 7.10); '// &
+                        'glue one layer ([coupling] max_offset) or use [coupling] multipliers = nodes')
+        end subroutine check_redundant_bonds
 
         !> Closing lines: the model's (size, residuals, solver effort), energy balance, times.
         subroutine summary()

@@ -58,7 +58,10 @@ contains
         call s%add_keyword('coupling', 'max_offset', [real_field('max_offset', 'm', &
                                                                  lower=0.0_wp)], &
                            'Couple only disks whose centre lies at most this far from the beam axis (with '// &
-                           'coupled = auto; a listed disk farther away is an error); 0: any distance.', &
+                           'coupled = auto; a listed disk farther away is an error); 0: any distance. With '// &
+                           'bonds between the layers and multipliers = particles, coupling several layers makes '// &
+                           'the bonds and the coupling rows nearly redundant (a warning after the first step; '// &
+                           'doc/theory.md 7.10): glue one layer, or put the multipliers on the nodes.', &
                            default='0')
         call s%add_keyword('coupling', 'multipliers', [word_field('multipliers', &
                                                                   'particles nodes')], &

@@ -424,6 +424,19 @@ def glued_layers(exe, decks, work):
         # runs (`invariants`); 1e-6 leaves margin and is 12 orders below the failure (3e4).
         check(f"glued layers, {name}: energy balance closes", bal < 1e-6 * scale,
               f"max |balance| {bal:.3e} J, scale {scale:.3e} J, ratio {bal / scale:.1e}")
+    # The warning on bonds across the axis between coupled disks (driver_coupled_loop): once
+    # here (40 bonds join the axis layer to the two others), none with the multipliers on the
+    # nodes, which relieve the redundancy, and none on the reference decks (test_deck_warnings).
+    nodes = re.sub(r"^thickness = 0.01$", "thickness = 0.01\nmultipliers = nodes", text, count=1, flags=re.M)
+    check("glued layers: multipliers on the nodes set", "multipliers = nodes" in nodes, "")
+    for name, deck_text, expected in (("per dof", text, 1), ("on the nodes", nodes, 0)):
+        deck = truncated_text(deck_text, work / f"glued_warning_{expected}.dat", 5e-5)
+        proc = subprocess.run([str(exe), str(deck), "--output", str(work / deck.stem), "--quiet"],
+                              capture_output=True, text=True)
+        lines = [ln for ln in (proc.stdout + proc.stderr).splitlines() if "join coupled disks at different" in ln]
+        check(f"glued layers, multipliers {name}: exit 0", proc.returncode == 0, f"exit {proc.returncode}")
+        check(f"glued layers, multipliers {name}: {expected} warning on bonds across the axis",
+              len(lines) == expected, "; ".join(lines) or "no warning")
 
 
 def truncated_text(text, out, end):
