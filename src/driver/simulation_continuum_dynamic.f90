@@ -61,20 +61,11 @@ contains
 
     contains
 
-        !> Input error at a line (keeps the library's message).
-        subroutine fail_at(error, at, keyword)
-            type(error_t), allocatable, intent(inout) :: error
-            integer, intent(in) :: at
-            character(len=*), intent(in) :: keyword
-            character(len=:), allocatable :: message
-            message = error%message
-            call make_input_error(error, deck%file, at, keyword, message)
-        end subroutine fail_at
-
         !> Newmark or central difference from rest with the initial velocity field.
         subroutine make_integrator(error)
             type(error_t), allocatable, intent(out) :: error
             real(wp), allocatable :: u0(:), v0(:), v_all(:)
+            character(len=:), allocatable :: message
             integer, allocatable :: eq(:)
             real(wp) :: vx, vy, omega, xc, yc
             integer :: a, n, c
@@ -119,11 +110,12 @@ contains
             end select
             call self%integ%init(self%ops, self%settings%h, 0.0_wp, u0, v0, error)
             if (.not. allocated(error)) return
-            if (index(error%message, model_out_of_range) == 1) then
+            message = error%message
+            if (index(message, model_out_of_range) == 1) then
                 ! no time step resolves the model: its materials
-                call fail_at(error, deck%line('continuum', 'material'), 'material')
+                call make_input_error(error, deck%file, deck%line('continuum', 'material'), 'material', message)
             else
-                call fail_at(error, deck%line('time', 'step'), 'step')
+                call make_input_error(error, deck%file, deck%line('time', 'step'), 'step', message)
             end if
         end subroutine make_integrator
     end subroutine dynamic_init
