@@ -205,7 +205,7 @@ contains
         character(len=*), intent(in) :: run_id
         !> Set on a write failure.
         type(error_t), allocatable, intent(out) :: error
-        call file%create(path//'.tmp', error)
+        call file%create(path//'.tmp', error, checksums=.true.)
         if (allocated(error)) return
         call file%write_attribute('/', 'format', format_tag, error)
         if (allocated(error)) return
