@@ -47,7 +47,7 @@ module driver_checkpoint
     public :: save_integrator, load_integrator, save_dem, load_dem, save_coupled, load_coupled
     public :: save_results, load_results, save_dem_writer, load_dem_writer
     public :: save_coupled_writer, load_coupled_writer, save_loop, load_loop
-    public :: checkpoint_run_t, step_end_t, end_of_step, read_finite_attribute
+    public :: checkpoint_run_t, step_end_t, end_of_step, read_finite_attribute, checkpoint_owner
 
     !> File name of the checkpoint in the results folder.
     character(len=*), parameter :: checkpoint_name = 'checkpoint.h5'
@@ -103,6 +103,9 @@ module driver_checkpoint
         !> The deck's text followed by what stands for the files it reads (a mesh's hash), hashed
         !> into every checkpoint.
         character(len=:), allocatable :: deck_text
+        !> Name of the run's results file in the folder ('deck.h5'), recorded in every
+        !> checkpoint (root attribute 'results'; `checkpoint_owner`).
+        character(len=:), allocatable :: results
         !> When to write them besides signals and the end.
         type(checkpoint_schedule_t) :: schedule
         !> Whether the run continues from `source`.
@@ -263,6 +266,8 @@ contains
         real(wp), intent(in) :: t
         !> The error of the writes (kept), or set when the commit fails.
         type(error_t), allocatable, intent(inout) :: error
+        if (.not. allocated(error) .and. allocated(self%results)) &
+            call file%write_attribute('/', 'results', self%results, error)
         if (allocated(error)) then
             call checkpoint_discard(file, self%path)
             return
@@ -285,6 +290,32 @@ contains
         self%last_step = k
         self%last_time = t
     end subroutine checkpoint_run_finish
+
+    !> Whose checkpoint lies at `path`: the hash of its deck and the name of its results file
+    !> ('' when the checkpoint does not record it); `found` is false when there is no
+    !> checkpoint there or it cannot be read (a restart from it says why).
+    subroutine checkpoint_owner(path, found, hash, results)
+        !> Path of the checkpoint.
+        character(len=*), intent(in) :: path
+        !> A checkpoint could be read there.
+        logical, intent(out) :: found
+        !> Its 'deck_hash' and 'results' root attributes.
+        character(len=:), allocatable, intent(out) :: hash, results
+        type(h5_file_t) :: file
+        type(error_t), allocatable :: error, ignored
+        found = .false.
+        hash = ''
+        results = ''
+        if (.not. file_exists(path)) return
+        call file%open(path, error)
+        if (allocated(error)) return
+        call file%read_attribute('/', 'deck_hash', hash, error)
+        found = .not. allocated(error)
+        ! (a checkpoint of an older version has no 'results')
+        if (found) call file%read_attribute('/', 'results', results, ignored)
+        if (allocated(ignored)) results = ''
+        call file%close(ignored)
+    end subroutine checkpoint_owner
 
     !> After a failed run: the checkpoint found at `path` before the run's first commit is
     !> put back, or, when there was none, the run's own is deleted (it belongs to results

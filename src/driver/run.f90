@@ -42,7 +42,7 @@ module driver_run
     use driver_simulations, only: select_simulation
     use driver_run_kind, only: run_kind_warnings
     use driver_config, only: steps_to_end, max_steps
-    use driver_checkpoint, only: checkpoint_run_t, checkpoint_name, checkpoint_open
+    use driver_checkpoint, only: checkpoint_run_t, checkpoint_name, checkpoint_open, checkpoint_owner, deck_hash
     implicit none
     private
     public :: run_options_t, run_deck, report_iface
@@ -130,7 +130,12 @@ contains
             ck%deck_text = deck%text//sim%inputs_text()
             ck%schedule%every = sim%settings%checkpoint_interval
             ck%schedule%seconds = sim%settings%checkpoint_seconds
-            if (allocated(opts%restart)) call open_checkpoint(error)
+            ck%results = basename(path)
+            if (allocated(opts%restart)) then
+                call open_checkpoint(error)
+            else
+                call guard_other_run(error)
+            end if
             ! Until here a signal kills the program at once (nothing is written yet).
             if (.not. allocated(error)) call install_signal_handlers(error)
             if (.not. allocated(error)) call write_results(error)
@@ -351,6 +356,32 @@ contains
                 run%n_steps = max(int(steps, i8), 1_i8)
             end associate
         end subroutine apply_end_time
+
+        !> A fresh run replaces the folder's checkpoint (at its first commit). When that
+        !> checkpoint is another deck's and its run is interrupted (its results file still
+        !> '.partial'), the interrupted run could no longer be continued by the command it
+        !> printed: refused. Another deck's finished run only loses the checkpoint that would
+        !> extend it (`--restart --end`): a warning.
+        subroutine guard_other_run(error)
+            type(error_t), allocatable, intent(out) :: error
+            character(len=:), allocatable :: hash, results
+            logical :: found
+            call checkpoint_owner(ck%path, found, hash, results)
+            if (.not. found) return
+            if (hash == deck_hash(ck%deck_text) .or. results == basename(path)) return
+            if (len(results) > 0) then
+                if (file_exists(dir//'/'//results//'.partial')) then
+                    call make_error(error, deck%file//': the folder '//dir//' holds the checkpoint of an '// &
+                                    'interrupted run of another deck (its results '//dir//'/'//results// &
+                                    '.partial): this run would replace it, and that run could no longer be '// &
+                                    'continued; continue it first, or give this run another --output')
+                    return
+                end if
+            end if
+            if (len(results) > 0) results = ' ('//results//')'
+            call report('warning: this run replaces '//ck%path//', the checkpoint of another deck''s run'// &
+                        results//', which can then no longer be extended with --restart --end')
+        end subroutine guard_other_run
 
         !> Option `--restart`: open the checkpoint and check it belongs to this deck, this code and this
         !> kind of run, and that it leaves steps to do.

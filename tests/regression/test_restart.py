@@ -23,7 +23,8 @@ code version, of another kind of run, a restart with nothing left to do, a damag
 continues a finished run; the earlier finished result stays untouched when the continued run
 fails. A failing run leaves the folder as it found it: a finished result and its checkpoint,
 an interrupted run's partial file and checkpoint (the printed command still continues it),
-the checkpoint a failed restart started from.
+the checkpoint a failed restart started from. Another deck run into the folder of an
+interrupted run is refused (it would replace that run's checkpoint).
 Usage (ctest does this): test_restart.py --exe multicor --work DIR --source REPO
 """
 import argparse
@@ -299,6 +300,43 @@ def refusals(exe, deck, work):
           "records of" in proc.stderr and "the checkpoint is damaged" in proc.stderr, proc.stderr.strip())
     check("refusals leave the result untouched", digest(result) == before, "")
     check("refusals leave no partial file", not (folder / f"{deck.stem}.h5.partial").exists(), "")
+
+
+def two_decks_one_folder(exe, src, work):
+    """Another deck run afresh into the folder of an interrupted run would replace its
+    checkpoint, and the command that run printed would no longer continue it: refused, the
+    folder untouched, and the interrupted run continued afterwards. Into the folder of a
+    finished run of another deck: a warning (that run only loses the checkpoint that would
+    extend it)."""
+    folder = work / "two_decks"
+    beam = edit_deck(src / "input" / "cantilever.dat", work / "two_beam.dat", end=3.0, progress=0.02)
+    other = src / "input" / "continuum_cantilever_dynamic.dat"
+    proc = start(exe, beam, folder)
+    lines = []
+    if not wait_for_step(proc, 1000, lines):
+        check("two decks: the beam run reached step 1000", False, proc.communicate()[1][-300:])
+        return
+    proc.send_signal(signal.SIGTERM)
+    out, _ = proc.communicate()
+    c = re.search(r"^to continue: (multicor .*)$", "".join(lines) + out, flags=re.M)
+    check("two decks: the beam run stopped with a checkpoint", proc.returncode == 143 and c is not None,
+          f"exit {proc.returncode}")
+    if c is None:
+        return
+    before = {p.name: digest(p) for p in folder.iterdir() if p.is_file()}
+    second = run(exe, other, "--output", folder, "--quiet")
+    check("two decks: another deck into the interrupted run's folder refused", second.returncode == 1
+          and "interrupted run of another deck" in second.stderr, second.stderr.strip()[-300:])
+    after = {p.name: digest(p) for p in folder.iterdir() if p.is_file()}
+    check("two decks: the refusal leaves the folder as it was", before == after,
+          f"{sorted(before)} / {sorted(after)}")
+    third = run(exe, *c.group(1).split()[1:])
+    check("two decks: the printed command still continues the beam run", third.returncode == 0,
+          (third.stdout + third.stderr)[-300:])
+    fourth = run(exe, other, "--output", folder, "--quiet")
+    check("two decks: another deck into a finished run's folder: exit 0 with a warning",
+          fourth.returncode == 0 and "the checkpoint of another deck's run (two_beam.h5)" in fourth.stdout,
+          (fourth.stdout + fourth.stderr).strip()[-300:])
 
 
 def damaged_values(exe, src, work):
@@ -761,6 +799,7 @@ def main():
     # multipliers' work through the prescribed dofs come back from the checkpoint.
     by_end_time(exe, decks / "coupled2d_driven_edge.dat", work, "coupled2d_driven_end", 4.43e-4)
     refusals(exe, beam, work)
+    two_decks_one_folder(exe, src, work)
     damaged_values(exe, src, work)
     damaged_contacts(exe, src, work)
     failed_runs_keep_state(exe, src, work)
