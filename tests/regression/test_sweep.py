@@ -149,12 +149,29 @@ def failing_point(src, exe, work):
           "1 points finished before, 1 to run" in again.stdout, again.stdout.strip())
 
 
+def wrong_scalar(src, exe, work):
+    """A --scalar whose dataset the results do not have (a typo in its path): the points run,
+    and collecting says which scalar and exits 1 (before, exit 0 with an empty column and
+    h5py's own words)."""
+    folder = work / "wrong_scalar"
+    sweep_tool(src, ["create", src / "input" / "incline.dat", "--exe", exe, "--set", "time.end=0.1",
+                     "--scalar", "v=nonexist/x[0]", "--scalar", "vx=dem/velocity[-1,1,0]", "--dir", folder])
+    proc = sweep_tool(src, ["run", folder], expect=1)
+    rows = read_table(folder / "results.csv")
+    check("a wrong scalar: the point finished, its column empty, the good one filled",
+          rows[0]["summary.finished"] == "1" and rows[0]["v"] == "" and rows[0]["vx"] != "", str(rows[0]))
+    check("a wrong scalar: named with the dataset it lacks, exit 1",
+          "no dataset 'nonexist/x'" in proc.stderr and "error: scalar v=nonexist/x[0]" in proc.stderr,
+          proc.stderr.strip()[-300:])
+
+
 def main():
     exe, work, src = arguments(fresh=True)
     refused_keys(src, exe, work)
     folder = generated_decks(src, exe, work)
     sequential_run(src, folder)
     failing_point(src, exe, work)
+    wrong_scalar(src, exe, work)
     return summary()
 
 
