@@ -40,13 +40,15 @@ module driver_config_coupling2d
 contains
 
     !> Build and check the coupling of a deck with [continuum], [particles] and [coupling].
-    subroutine build_coupling2d_config(deck, run, particle_gravity, setup, error)
+    subroutine build_coupling2d_config(deck, run, particle_gravity, x, y, setup, error)
         !> Deck read with the MULTICOR schema.
         type(deck_t), intent(in) :: deck
         !> Run settings of the continuum (analysis, scheme, beta, gamma).
         type(run_config_t), intent(in) :: run
         !> Gravity of [particles] [m/s^2].
         real(wp), intent(in) :: particle_gravity(2)
+        !> Centres of the disks [m] (n_disks each): every region must hold one.
+        real(wp), intent(in) :: x(:), y(:)
         !> The coupling.
         type(coupled2d_setup_t), intent(out) :: setup
         !> Error naming file, line and keyword, if any.
@@ -98,6 +100,15 @@ contains
         do k = 1, size(regions)
             call make_region(regions(k), parts(k), error)
             if (allocated(error)) return
+            ! A region without a disk weights its part of the continuum by alpha < 1 with no
+            ! particles to carry the rest: that part would lose stiffness and mass, silently.
+            if (.not. any([(parts(k)%contains(x(j), y(j)), j=1, size(x))])) then
+                call make_input_error(error, deck%file, regions(k)%line, 'region', 'no disk centre lies in this '// &
+                                      'region: the continuum there would be weighted by alpha with no particles '// &
+                                      'to carry the rest of its stiffness and mass; remove the region or put disks '// &
+                                      'in it')
+                return
+            end if
             ! A point in two regions would be weighted twice (the Arlequin partition of unity).
             do j = 1, k - 1
                 if (regions_overlap(parts(j), parts(k))) then

@@ -110,8 +110,9 @@ contains
                               'time gamma'])
         call self%particles%init(part, report, error)
         if (allocated(error)) return
-        call build_coupling2d_config(deck, self%settings, self%particles%dem%system%particles%gravity, &
-                                     self%coupling, error)
+        associate (p => self%particles%dem%system%particles)
+            call build_coupling2d_config(deck, self%settings, p%gravity, p%x(1:p%n), p%y(1:p%n), self%coupling, error)
+        end associate
         if (allocated(error)) return
         do i = 1, size(self%coupling%warnings)
             call report(self%coupling%warnings(i)%s)

@@ -83,7 +83,8 @@ contains
                            '(none with weight = constant). polygon: fe_edge particle_edge x1 y1 x2 y2 x3 y3 ...: '// &
                            'the numbers of the FE-side and particle-side edges (edge k joins vertex k to k + 1, '// &
                            'the last to the first; 0: none), then at least 3 vertices. alpha ramps from 1 - '// &
-                           'alpha_min on the FE side to alpha_min on the particle side (weight, alpha_min).', &
+                           'alpha_min on the FE side to alpha_min on the particle side (weight, alpha_min). '// &
+                           'Every region must hold at least one disk centre.', &
                            repeatable=.true., selector=1, tails=tails)
         call s%add_keyword('coupling', 'pairing', [word_field('pairing', 'l2 h1')], &
                            'Pairing of the mediator space of a [continuum] coupling (multipliers = nodes): l2 '// &
