@@ -190,6 +190,19 @@ def wait_for_step(proc, min_step, lines):
     return False
 
 
+def stopped_after(exe, deck, folder, min_step, name):
+    """Start a run, stop it by SIGTERM once it reports step min_step: (exit code, its whole
+    output), or None (a failed check) when it never gets there."""
+    proc = start(exe, deck, folder)
+    lines = []
+    if not wait_for_step(proc, min_step, lines):
+        check(f"{name}: run reached step {min_step}", False, proc.communicate()[1][-300:])
+        return None
+    proc.send_signal(signal.SIGTERM)
+    out, _ = proc.communicate()
+    return proc.returncode, "".join(lines) + out
+
+
 def by_signal(exe, deck_src, work, name, sig, end, min_step):
     """A signal stops the run after step min_step; the command printed continues it."""
     deck = edit_deck(deck_src, work / f"{name}.dat", end=end, progress=0.02)
@@ -312,16 +325,12 @@ def two_decks_one_folder(exe, src, work):
     folder = work / "two_decks"
     beam = edit_deck(src / "input" / "cantilever.dat", work / "two_beam.dat", end=3.0, progress=0.02)
     other = src / "input" / "continuum_cantilever_dynamic.dat"
-    proc = start(exe, beam, folder)
-    lines = []
-    if not wait_for_step(proc, 1000, lines):
-        check("two decks: the beam run reached step 1000", False, proc.communicate()[1][-300:])
+    stopped = stopped_after(exe, beam, folder, 1000, "two decks")
+    if stopped is None:
         return
-    proc.send_signal(signal.SIGTERM)
-    out, _ = proc.communicate()
-    c = re.search(r"^to continue: (multicor .*)$", "".join(lines) + out, flags=re.M)
-    check("two decks: the beam run stopped with a checkpoint", proc.returncode == 143 and c is not None,
-          f"exit {proc.returncode}")
+    code, out = stopped
+    c = re.search(r"^to continue: (multicor .*)$", out, flags=re.M)
+    check("two decks: the beam run stopped with a checkpoint", code == 143 and c is not None, f"exit {code}")
     if c is None:
         return
     before = {p.name: digest(p) for p in folder.iterdir() if p.is_file()}
@@ -631,16 +640,13 @@ def failed_runs_keep_state(exe, src, work):
     # (fails at step 8), then a restart from a damaged copy of the checkpoint
     folder = work / "keep_partial"
     long = small_beam(work / "keep_long" / "beam.dat", end=20, extra="progress = 0.02")
-    proc = start(exe, long, folder)
-    lines = []
-    if not wait_for_step(proc, 200, lines):
-        check("keep_partial: run reached step 200", False, proc.communicate()[1][-300:])
+    stopped = stopped_after(exe, long, folder, 200, "keep_partial")
+    if stopped is None:
         return
-    proc.send_signal(signal.SIGTERM)
-    out, _ = proc.communicate()
-    command = re.search(r"^to continue: multicor (.*)$", "".join(lines) + out, flags=re.M)
-    check("keep_partial: SIGTERM stops the run with the command to continue", proc.returncode == 143 and
-          command is not None, f"exit {proc.returncode}")
+    code, out = stopped
+    command = re.search(r"^to continue: multicor (.*)$", out, flags=re.M)
+    check("keep_partial: SIGTERM stops the run with the command to continue", code == 143 and
+          command is not None, f"exit {code}")
     if command is None:
         return
     before = state(folder)
