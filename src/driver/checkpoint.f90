@@ -1181,6 +1181,13 @@ contains
         out%energy0 = energy0
         call file%read_attribute('/results', 'datasets', joined, error)
         if (allocated(error)) return
+        ! the results' own dataset paths, one per line: other bytes are damage (not quoted)
+        if (any([(.not. (joined(k:k) == new_line('a') .or. (iachar(joined(k:k)) >= 32 .and. &
+                                                            iachar(joined(k:k)) <= 126)), k=1, len(joined))])) then
+            call make_error(error, "checkpoint: '/results@datasets' holds bytes that are not a dataset path: the "// &
+                            'checkpoint is damaged')
+            return
+        end if
         n_saved = count([(joined(k:k) == new_line('a'), k=1, len(joined))])
         allocate (saved(0))
         if (n_saved > 0) call file%read_dataset('/results/records', saved, error)
