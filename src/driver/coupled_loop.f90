@@ -257,10 +257,12 @@ contains
         subroutine step_with_export(error)
             type(error_t), allocatable, intent(out) :: error
             type(local_problem_t) :: lp
+            character(len=:), allocatable :: path
             call arlequin_step(self%sys, error, lp)
             if (allocated(error)) return
-            call write_fclib_local(fclib_path(out%final_path, int(k)), self%settings%title, lp, int(k), &
-                                   self%sys%fe%t, self%sys%dem%stats%siconos_error, error)
+            call out%companion(fclib_path(out%final_path, int(k)), path)
+            call write_fclib_local(path, self%settings%title, lp, int(k), self%sys%fe%t, &
+                                   self%sys%dem%stats%siconos_error, error)
         end subroutine step_with_export
 
         !> Restart: state, writer counters and results file from the checkpoint `ck%source`.

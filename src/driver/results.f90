@@ -4,7 +4,11 @@
 !> when the run succeeded: an earlier result stays intact until then, and `abort` deletes the
 !> partial file. The partial file of an earlier run (interrupted, perhaps resumable) is set
 !> aside as '<final_path>.partial.prev' while this run writes its own: `abort` puts it back,
-!> `close` and `close_unfinished` (this run's own file takes its place) delete it. /summary is written at creation with finished = 0 and set to 1 by `close`;
+!> `close` and `close_unfinished` (this run's own file takes its place) delete it. Files written
+!> beside the results (an FCLIB export, `companion`) follow the results file: written as
+!> '<path>.partial', renamed by `close` and `close_unfinished`, deleted by `abort`, so that a
+!> failed run leaves an earlier run's export as it was. /summary is written at creation with
+!> finished = 0 and set to 1 by `close`;
 !> the run loops `flush` after every output, so the partial file of a killed run opens and
 !> holds every output up to the last one. A run stopped by a signal (`stop_at`) is closed by
 !> `close_unfinished`: it stays '.partial' with finished = 0 and the reason in /summary.
@@ -17,6 +21,7 @@ module driver_results
     use core_constants, only: two_pi
     use core_error, only: error_t, make_error, make_internal_error
     use core_version, only: multicor_version, multicor_name
+    use core_strings, only: string_t
     use io_hdf5_file, only: h5_file_t
     use io_paths, only: rename_file, remove_file, copy_file, file_exists
     implicit none
@@ -52,6 +57,8 @@ module driver_results
         !> Whether an earlier partial file was set aside as '<partial_path>.prev' (`abort`
         !> puts it back).
         logical :: set_aside = .false.
+        !> Final paths of the files written beside the results by this run (`companion`).
+        type(string_t), allocatable :: companions(:)
     contains
         !> Create the results file (written as .partial until `close`).
         procedure :: open => writer_open
@@ -87,6 +94,8 @@ module driver_results
         procedure :: abort => writer_abort
         !> True while the file is open.
         procedure :: is_open => writer_is_open
+        !> Path to write a file beside the results under, which follows the results file.
+        procedure :: companion => writer_companion
     end type results_writer_t
 
 contains
@@ -122,6 +131,7 @@ contains
         self%stop_time = 0.0_wp
         self%run_id = new_run_id()
         self%resumed = .false.
+        self%companions = [string_t ::]
         call set_aside_partial(self, error)
         if (allocated(error)) return
         call self%file%create(self%partial_path, error)
@@ -180,6 +190,7 @@ contains
         self%run_id = run_id
         self%resumed = .true.
         self%set_aside = .false.
+        self%companions = [string_t ::]
         if (.not. belongs(self%partial_path)) then
             if (.not. belongs(final_path)) then
                 call make_error(error, "results: neither '"//self%partial_path//"' nor '"// &
@@ -544,6 +555,7 @@ contains
             return
         end if
         call drop_set_aside(self)
+        call keep_companions(self, error)
     end subroutine writer_close
 
     !> Close the file of a run stopped early (`stop_at`) and keep it as '<final_path>.partial'
@@ -570,6 +582,7 @@ contains
             return
         end if
         call drop_set_aside(self)
+        call keep_companions(self, error)
     end subroutine writer_close_unfinished
 
     !> Close and delete the partial file after a failed run (an earlier result is untouched)
@@ -586,6 +599,7 @@ contains
             if (.not. self%resumed) call remove_file(self%partial_path)
         end if
         call put_back_partial(self)
+        call drop_companions(self)
     end subroutine writer_abort
 
     !> Before this run creates '<partial_path>': rename the partial file of an earlier run,
@@ -624,6 +638,55 @@ contains
         call remove_file(self%partial_path//'.prev')
         self%set_aside = .false.
     end subroutine drop_set_aside
+
+    !> Register `path`, a file this run writes beside the results, and return the name to
+    !> write it under, '<path>.partial': `close` and `close_unfinished` rename it to `path`,
+    !> `abort` deletes it.
+    subroutine writer_companion(self, path, partial)
+        !> The writer.
+        class(results_writer_t), intent(inout) :: self
+        !> Final path of the file.
+        character(len=*), intent(in) :: path
+        !> Path to write it under while the run goes on.
+        character(len=:), allocatable, intent(out) :: partial
+        if (.not. allocated(self%companions)) self%companions = [string_t ::]
+        self%companions = [self%companions, string_t(path)]
+        partial = path//'.partial'
+    end subroutine writer_companion
+
+    !> Give the files written beside the results their final names (the run ended or was
+    !> stopped: its files are the folder's now).
+    subroutine keep_companions(self, error)
+        !> The writer.
+        class(results_writer_t), intent(inout) :: self
+        !> Set if a rename fails (the file stays '.partial'; the error names it).
+        type(error_t), allocatable, intent(out) :: error
+        integer :: i
+        if (.not. allocated(self%companions)) return
+        do i = 1, size(self%companions)
+            associate (path => self%companions(i)%s)
+                if (.not. file_exists(path//'.partial')) cycle
+                call rename_file(path//'.partial', path, error)
+                if (allocated(error)) then
+                    error%message = 'results: '//error%message//" (the file is kept as '"//path//".partial')"
+                    return
+                end if
+            end associate
+        end do
+        self%companions = [string_t ::]
+    end subroutine keep_companions
+
+    !> Delete the files this run wrote beside the results (it failed).
+    subroutine drop_companions(self)
+        !> The writer.
+        class(results_writer_t), intent(inout) :: self
+        integer :: i
+        if (.not. allocated(self%companions)) return
+        do i = 1, size(self%companions)
+            call remove_file(self%companions(i)%s//'.partial')
+        end do
+        self%companions = [string_t ::]
+    end subroutine drop_companions
 
     !> Whether a results file is being written.
     pure logical function writer_is_open(self)

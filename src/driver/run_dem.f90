@@ -174,14 +174,16 @@ contains
             type(error_t), allocatable, intent(out) :: error
             type(local_problem_t) :: lp
             real(wp), allocatable :: vfree(:, :)
+            character(len=:), allocatable :: path
             associate (sys => cfg%system)
                 call mj_free_velocities(sys)
                 call mj_detect(sys)
                 allocate (vfree, source=sys%vel)
                 call mj_solve(sys)
                 call local_problem_build(sys%contacts, sys%im, vfree, lp)
-                call write_fclib_local(fclib_path(out%final_path, sys%step + 1), run%title, lp, sys%step + 1, &
-                                       sys%time + sys%scheme%h, sys%stats%siconos_error, error)
+                call out%companion(fclib_path(out%final_path, sys%step + 1), path)
+                call write_fclib_local(path, run%title, lp, sys%step + 1, sys%time + sys%scheme%h, &
+                                       sys%stats%siconos_error, error)
                 if (allocated(error)) return
                 call mj_end_step(sys)
             end associate

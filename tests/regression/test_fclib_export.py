@@ -208,7 +208,54 @@ def main():
     check("fclib_step after the end: warned, nothing written", proc.returncode == 0 and not written
           and "warning: [solver] fclib_step = 301 is after the last step of the run (300)" in proc.stdout,
           f"exit {proc.returncode}, files {written}")
+    failed_run_keeps_export(exe, work)
     return summary()
+
+
+def failed_run_keeps_export(exe, work):
+    """A run that fails after its export leaves the folder as it found it (doc/output.md,
+    "What a run replaces"): an earlier run's export unchanged, none of its own; into a new
+    folder, no folder at all. The failure: a force of 1e30 N switched on at 5 ms throws a disk
+    out of the box, which the run's guard stops (exit 1); a second disk moving at the start
+    makes its step-1 problem differ from the earlier run's."""
+    text = """[run]
+analysis = dynamic
+[particles]
+material = 1 2500
+row = 5 0 0.01 0.01 1
+disk = 0.2 0.2 0.01 1
+gravity = 0 -9.81
+initial_velocity = 1 x 0.5
+{force}
+[walls]
+wall = -0.1 0 0.3 0
+[contacts]
+law = 1 1 0.3 0 0
+[functions]
+function = 1 step 5e-3
+[time]
+step = 1e-3
+end = 1e-2
+[solver]
+fclib_step = 1
+"""
+    good, bad = work / "export_good", work / "export_bad"
+    good.mkdir(exist_ok=True)
+    bad.mkdir(exist_ok=True)
+    (good / "export.dat").write_text(text.format(force=""))
+    (bad / "export.dat").write_text(text.format(force="initial_velocity = 2 x 0.2\nforce = 6 y -1e30 1"))
+    out = work / "export_folder"
+    first = subprocess.run([str(exe), "-q", "-o", str(out), str(good / "export.dat")], capture_output=True, text=True)
+    before = {p.name: p.read_bytes() for p in out.iterdir()} if out.is_dir() else {}
+    second = subprocess.run([str(exe), "-q", "-o", str(out), str(bad / "export.dat")], capture_output=True, text=True)
+    after = {p.name: p.read_bytes() for p in out.iterdir()}
+    check("a failed run leaves the earlier export as it was", first.returncode == 0 and second.returncode == 1
+          and "export_fclib_1.h5" in before and after == before,
+          f"exits {first.returncode}, {second.returncode}; files before {sorted(before)}, after {sorted(after)}")
+    fresh = work / "export_fresh"
+    third = subprocess.run([str(exe), "-q", "-o", str(fresh), str(bad / "export.dat")], capture_output=True, text=True)
+    check("a failed run into a new folder leaves no folder", third.returncode == 1 and not fresh.exists(),
+          f"exit {third.returncode}, left {sorted(p.name for p in fresh.iterdir()) if fresh.exists() else []}")
 
 
 if __name__ == "__main__":
