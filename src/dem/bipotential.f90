@@ -386,14 +386,21 @@ contains
         real(wp), intent(in) :: mu, e
         !> The constants.
         real(wp), intent(out) :: sc(rolling_n_scaling)
-        real(wp) :: fl, a, bb, d, det
+        real(wp) :: fl_force, fl_moment, a, bb, d, det
         sc = 0.0_wp
         if (w(1) + w(3) + w(6) <= 0.0_wp) return
-        ! a direction held by the fixities has a zero diagonal: floor it as in `scaling`
-        fl = scaling_floor*(w(1) + w(3) + w(6))
-        sc(1) = sqrt(max(w(1), fl))
-        sc(2) = sqrt(max(w(3), fl))
-        sc(3) = sqrt(max(w(6), fl))
+        ! A direction held by the fixities has a zero diagonal: floor it as in `scaling`, the
+        ! force directions on their own scale and the moment on its own (W_nn and W_tt are in
+        ! 1/kg, W_mm in 1/(kg m^2): a common floor would depend on the unit of length and, for
+        ! disks of 1 micrometre in metres, exceed W_nn). A group held entirely takes the other's
+        ! floor: its row and column are zero, and any scale gives the same solution.
+        fl_force = scaling_floor*(w(1) + w(3))
+        fl_moment = scaling_floor*w(6)
+        if (fl_force <= 0.0_wp) fl_force = fl_moment
+        if (fl_moment <= 0.0_wp) fl_moment = fl_force
+        sc(1) = sqrt(max(w(1), fl_force))
+        sc(2) = sqrt(max(w(3), fl_force))
+        sc(3) = sqrt(max(w(6), fl_moment))
         sc(4:6) = 1.0_wp/sc(1:3)
         a = w(2)*sc(4)*sc(5)
         bb = w(4)*sc(4)*sc(6)
