@@ -3,7 +3,8 @@
 !> Syntax: `[section]` headers, then `keyword = value value ...` lines; `#` starts a comment
 !> that runs to the end of the line; blank lines and tabs are fine. Lines end with LF, CR LF
 !> or a lone CR (old Mac files); a UTF-8 byte-order mark at the start of the file is skipped;
-!> another control character outside a comment is an error. Every line is checked
+!> another control character outside a comment is an error, and a NUL byte anywhere (the
+!> deck is stored in the results as a C string). Every line is checked
 !> against the schema as it is read (known section and keyword, number of values, types,
 !> ranges, allowed words, duplicates of scalar keywords); then required keywords and
 !> conditional ones (`required_when`, `allowed_when`) are checked. The first problem found
@@ -258,6 +259,17 @@ contains
                 s = strip(raw(:hash - 1))
             else
                 s = strip(raw)
+            end if
+            ! A NUL byte even in a comment: the deck is stored in the results as a C string
+            ! (/deck_text, for a rerun), which would end there.
+            if (hash > 0) then
+                k = index(raw(hash:), achar(0))
+                if (k > 0) then
+                    call make_input_error(error, file, line_no, '', 'control character 0x00 (NUL) at column '// &
+                                          to_str(hash + k - 1)//' in a comment: the deck is stored in the '// &
+                                          'results as text, which would end there (a binary or damaged file?)')
+                    return
+                end if
             end if
             if (len(s) == 0) return
             if (hash > 0) then
