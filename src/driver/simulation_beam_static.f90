@@ -3,6 +3,7 @@ module driver_simulation_beam_static
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp
     use core_error, only: error_t, make_error, make_input_error
+    use core_strings, only: to_str
     use io_deck, only: deck_t
     use fem_beam_model, only: beam_model_t
     use fem_static, only: solve_static
@@ -31,7 +32,7 @@ contains
         class(beam_static_t), intent(inout) :: self
         !> The validated deck.
         type(deck_t), intent(in) :: deck
-        !> Where warnings go (none for beams).
+        !> Where warnings go (loads all zero at t = 0).
         procedure(report_iface) :: report
         !> Set on any input error.
         type(error_t), allocatable, intent(out) :: error
@@ -48,7 +49,32 @@ contains
             line = deck%line('beam', 'fix')
             if (line == 0) line = deck%line('beam', 'line')
             call make_input_error(error, deck%file, line, 'fix', message)
+            return
         end if
+        call warn_loads_zero_at_start()
+    contains
+        !> A static analysis takes the loads' time functions at t = 0: when every load given
+        !> is zero there (a ramp, a step that starts later), the solution is zero, which the
+        !> deck hardly means.
+        subroutine warn_loads_zero_at_start()
+            real(wp), allocatable :: f(:)
+            integer :: first
+            first = deck%line('beam', 'load')
+            if (deck%line('beam', 'distributed') > 0) then
+                if (first == 0) then
+                    first = deck%line('beam', 'distributed')
+                else
+                    first = min(first, deck%line('beam', 'distributed'))
+                end if
+            end if
+            if (first == 0) return
+            allocate (f(self%model%n_free))
+            call self%model%external_force(0.0_wp, f)
+            if (any(f /= 0.0_wp)) return
+            call report('warning: '//deck%file//':'//to_str(first)//': every load of this static analysis '// &
+                        'is zero at t = 0, where it takes the values of their time functions ([functions]): '// &
+                        'the solution is zero')
+        end subroutine warn_loads_zero_at_start
     end subroutine static_init
 
     !> The mesh, then the static solution.

@@ -88,7 +88,8 @@ contains
         type(schema_t), intent(inout) :: s
         call s%add_section('output', 'Results and progress reports.')
         call s%add_keyword('output', 'interval', [int_field('interval', lower=1)], &
-                           'Time steps between stored states.', default='1')
+                           'Time steps between stored states.', default='1', &
+                           effective_when=when('run', 'analysis', 'dynamic'))
         call s%add_keyword('output', 'progress', [real_field('progress', 's', lower=0.0_wp)], &
                            'Wall-clock seconds between progress lines (0 = none).', default='5')
         call s%add_keyword('output', 'contacts', [word_field('contacts', 'yes no')], &
@@ -96,8 +97,10 @@ contains
                            'state of the particles.', default='yes')
         call s%add_keyword('output', 'checkpoint_interval', [int_field('checkpoint_interval', lower=0)], &
                            'Time steps between checkpoints (0 = none); a dynamic run also writes one at its end '// &
-                           'and when a signal stops it (doc/output.md).', default='0')
+                           'and when a signal stops it (doc/output.md).', default='0', &
+                           effective_when=when('run', 'analysis', 'dynamic'))
         call s%add_keyword('output', 'checkpoint_seconds', [real_field('checkpoint_seconds', 's', lower=0.0_wp)], &
-                           'Wall-clock seconds between checkpoints (0 = none).', default='0')
+                           'Wall-clock seconds between checkpoints (0 = none).', default='0', &
+                           effective_when=when('run', 'analysis', 'dynamic'))
     end subroutine add_output
 end module io_schema_common

@@ -3,7 +3,7 @@
 !> builders: io_deck_schema.
 module io_schema_continuum
     use core_kinds, only: wp
-    use io_deck_schema, only: schema_t, tail_spec_t, int_field, real_field, positive, word_field, tail, when
+    use io_deck_schema, only: schema_t, tail_spec_t, int_field, real_field, positive, word_field, tail, when, unless
     implicit none
     private
     public :: add_continuum
@@ -37,7 +37,8 @@ contains
                            'earlier ones on shared elements).', &
                            tails=[tail([word_field('element_set', '')], 0, 1)], repeatable=.true.)
         call s%add_keyword('continuum', 'mass', [word_field('mass', 'consistent lumped')], &
-                           'Mass matrix: consistent, or row-sum lumped (diagonal).', default='consistent')
+                           'Mass matrix: consistent, or row-sum lumped (diagonal).', default='consistent', &
+                           effective_when=unless('run', 'analysis', 'static'))
         call s%add_keyword('continuum', 'fix', [word_field('node_set', '')], &
                            'Zero displacement of the nodes of a set, components x and/or y (a dof given by '// &
                            'several fix or displacement records must get the same value and function from each).', &
@@ -53,7 +54,8 @@ contains
                            'Force on every node of a set, times a [functions] time function (none: constant 1). '// &
                            'A load whose every force lands on a prescribed dof (fix, displacement) does nothing '// &
                            'and is an error.', &
-                           tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
+                           tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true., &
+                           effective_when=unless('run', 'analysis', 'modal'))
         call s%add_keyword('continuum', 'traction', [word_field('edge_set', ''), &
                                                      real_field('tx', 'Pa'), real_field('ty', 'Pa')], &
                            'Traction on the edges of a set: uniform, or parabolic (1.5 t (1 - s^2) with s from '// &
@@ -62,9 +64,10 @@ contains
                            'traction whose every force lands on a prescribed dof (a clamped edge) does nothing and '// &
                            'is an error.', &
                            tails=[tail([word_field('profile', 'uniform parabolic'), int_field('function', lower=1)], &
-                                       0, 2)], repeatable=.true.)
+                                       0, 2)], repeatable=.true., effective_when=unless('run', 'analysis', 'modal'))
         call s%add_keyword('continuum', 'gravity', [real_field('gx', 'm/s^2'), real_field('gy', 'm/s^2')], &
-                           'Acceleration of gravity (body force rho g).', default='0 0')
+                           'Acceleration of gravity (body force rho g).', default='0 0', &
+                           effective_when=unless('run', 'analysis', 'modal'))
         call s%add_keyword('continuum', 'rayleigh', &
                            [real_field('a0', '1/s', lower=0.0_wp), real_field('a1', 's', lower=0.0_wp)], &
                            'Rayleigh damping C = a0 M + a1 K.', default='0 0', allowed_when=when('run', 'analysis', 'dynamic'))

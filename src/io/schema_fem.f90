@@ -3,7 +3,7 @@
 !> the nodes). Machinery and field builders: io_deck_schema.
 module io_schema_fem
     use core_kinds, only: wp
-    use io_deck_schema, only: schema_t, int_field, real_field, positive, word_field, tail, when
+    use io_deck_schema, only: schema_t, int_field, real_field, positive, word_field, tail, when, unless
     implicit none
     private
 
@@ -21,7 +21,8 @@ contains
         call s%add_section('beam', &
                            'Planar Euler-Bernoulli frame: geometry, material, supports, loads.')
         call s%add_keyword('beam', 'mass', [word_field('mass', 'consistent lumped')], &
-                           'Mass matrix: consistent, or lumped (HRZ, diagonal).', default='consistent')
+                           'Mass matrix: consistent, or lumped (HRZ, diagonal).', default='consistent', &
+                           effective_when=unless('run', 'analysis', 'static'))
         call s%add_keyword('beam', 'section', [int_field('id', lower=1), &
                                                positive('young', 'Pa'), positive('density', 'kg/m^3'), positive('area', 'm^2'), &
                                                positive('inertia', 'm^4')], &
@@ -55,8 +56,9 @@ contains
         call s%add_keyword('beam', 'load', [int_field('node', lower=1), &
                                             word_field('dof', dof_words), real_field('value', 'N or N.m')], &
                            'Nodal force (u = x, w = y) or moment (theta = rot) times a time function (none: '// &
-                           'constant 1).', &
-                           tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
+                           'constant 1; a static analysis takes its value at t = 0).', &
+                           tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true., &
+                           effective_when=unless('run', 'analysis', 'modal'))
         call s%add_keyword('beam', 'distributed', [int_field('node_a', lower=1), &
                                                    int_field('node_b', lower=1), word_field('direction', 'x y axial transverse'), &
                                                    real_field('q_a', 'N/m')], &
@@ -65,13 +67,14 @@ contains
                            'element axis (axial) or across it (transverse, the axis turned by +90 deg), q_a '// &
                            'at node_a varying linearly to q_b at node_b (default q_b = q_a: uniform) with '// &
                            'the projection on the chord from node_a to node_b, times a time function (none: '// &
-                           'constant 1). It acts through consistent nodal forces and moments.', &
+                           'constant 1; a static analysis takes its value at t = 0). It acts through consistent '// &
+                           'nodal forces and moments.', &
                            tails=[tail([real_field('q_b', 'N/m'), int_field('function', lower=1)], 0, 2)], &
-                           repeatable=.true.)
+                           repeatable=.true., effective_when=unless('run', 'analysis', 'modal'))
         call s%add_keyword('beam', 'gravity', [real_field('gx', 'm/s^2'), real_field('gy', 'm/s^2')], &
                            'Gravity acceleration: self-weight density area (gx, gy) per unit length on every '// &
                            'element (the default is none; write gravity = 0 -9.81 for the usual one).', &
-                           default='0 0')
+                           default='0 0', effective_when=unless('run', 'analysis', 'modal'))
         call s%add_keyword('beam', 'rayleigh', &
                            [real_field('a0', '1/s', lower=0.0_wp), real_field('a1', 's', lower=0.0_wp)], &
                            'Rayleigh damping C = a0 M + a1 K.', default='0 0', allowed_when=when('run', 'analysis', 'dynamic'))

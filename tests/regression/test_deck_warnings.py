@@ -6,6 +6,9 @@ goes on, and a warning names the file, the line and the setting that turns it of
 - A solver tuning value where it does nothing (`coarse_size` with the default method,
   `anderson_sweeps` with `anderson = 0`, `check_every` at relaxation 1.0) is warned about,
   one line each, in the order of the deck; the same values where they act are not.
+- A static or modal analysis warns about what it does not use: [output] interval and the
+  checkpoints, the mass (static), the loads (modal), and loads that are all zero at t = 0,
+  where a static analysis takes their time functions.
 - A rolling length beyond the radius of the largest disk of its law's materials is warned
   about at the law's line (the moment's arm would be longer than the disk).
 - In a coupled run (beam or continuum: input/bending_hinged_row.dat, input/interface_shear.dat)
@@ -141,9 +144,58 @@ def coupled(exe, work, name, deck_path, ends, extra=""):
           f"sweeps per step {results['nlgs'][2].mean():.1f}")
 
 
+def analysis_without_time(exe, work):
+    """Settings that a static or modal analysis does not use: the output interval and the
+    checkpoints (no time steps), the mass (static), the loads (modal); and a static analysis
+    whose every load is zero at t = 0, where it takes its time functions (a ramp from 0): the
+    solution is zero. Each warned about at its line; a dynamic run of the same deck is quiet."""
+    text = """[run]
+analysis = {analysis}
+[beam]
+mass = lumped
+section = 1 2.1e11 7800 2.0e-4 1.6666666666666667e-9
+line = 1 0.0 0.0 1.0 0.0 10 1
+fix = 1 all
+load = 11 w -10.0 1
+gravity = 0 -9.81
+[functions]
+function = 1 ramp 0.1
+[output]
+interval = 5
+checkpoint_interval = 100
+checkpoint_seconds = 60
+"""
+    expected = {
+        "static": [(4, "[beam] mass has no effect"), (8, "every load of this static analysis is zero at t = 0"),
+                   (13, "[output] interval has no effect"), (14, "[output] checkpoint_interval has no effect"),
+                   (15, "[output] checkpoint_seconds has no effect")],
+        "modal": [(8, "[beam] load has no effect"), (9, "[beam] gravity has no effect"),
+                  (13, "[output] interval has no effect"), (14, "[output] checkpoint_interval has no effect"),
+                  (15, "[output] checkpoint_seconds has no effect")],
+        "dynamic": [],
+    }
+    for analysis, wanted in expected.items():
+        deck = work / f"no_time_{analysis}.dat"
+        body = text.format(analysis=analysis)
+        if analysis == "static":
+            body = body.replace("gravity = 0 -9.81\n", "")
+            wanted = [(line - 1 if line > 9 else line, what) for line, what in wanted]
+        if analysis == "dynamic":
+            body += "[time]\nstep = 1e-3\nend = 1e-2\n"
+        deck.write_text(body)
+        proc = multicor(exe, "--check", deck)
+        said = warnings_of(proc.stdout + proc.stderr)
+        found = [(int(m.group(1)), what) for line in said for what in [w for _, w in wanted]
+                 if (m := re.match(rf"warning: .*{deck.name}:(\d+): ", line)) and what in line]
+        check(f"{analysis} analysis: the settings it does not use are warned about at their lines",
+              proc.returncode == 0 and sorted(found) == sorted(wanted) and len(said) == len(wanted),
+              f"exit {proc.returncode}; " + "; ".join(said)[:600])
+
+
 def main():
     exe, work, src = arguments(fresh=True)
     example_decks_are_quiet(exe, src)
+    analysis_without_time(exe, work)
     solver_values(exe, src, work)
     rolling_length(exe, src, work)
     # the hinged row of the reference work (20 steps; with nlgs at 1e-4: 108 to 172 sweeps per
