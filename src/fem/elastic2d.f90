@@ -7,9 +7,22 @@
 module fem_elastic2d
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
+    use core_strings, only: to_str
     implicit none
     private
-    public :: elastic2d_t, make_elastic2d
+    public :: elastic2d_t, make_elastic2d, max_plane_strain_poisson
+
+    !> Largest Poisson's ratio in plane strain: lambda/mu = 2 nu/(1 - 2 nu) = 5e5 there. The
+    !> stiffness is then the shear part (mu) plus a volumetric part 5e5 times larger: the
+    !> factorisation keeps about 16 - 6 = 10 digits of the shear response before the mesh's
+    !> own condition number (1e4 to 1e8 for usual meshes) is taken off, the last that still
+    !> leaves digits. Closer to 1/2 (a ratio of 1e14 at nu = 0.5 - 1e-14) the factorisation
+    !> fails or returns displacements without a correct digit, and the failure looked like
+    !> missing supports. The Q4 and T3 displacement elements lock long before (their volumetric
+    !> constraints stiffen them visibly from nu = 0.49): the limit refuses only what double
+    !> precision cannot compute, not what the elements compute badly. Plane stress has no such
+    !> limit (D stays bounded as nu tends to 1/2).
+    real(wp), parameter :: max_plane_strain_poisson = 0.499999_wp
 
     !> An isotropic linear-elastic material of a 2D continuum (SI units).
     type :: elastic2d_t
@@ -31,7 +44,8 @@ module fem_elastic2d
 contains
 
     !> Build a material, checking E > 0, rho >= 0, t > 0 and -1 < nu < 1/2 (nu < 1 is
-    !> enough in plane stress, but 1/2 bounds both cases and excludes incompressibility).
+    !> enough in plane stress, but 1/2 bounds both cases and excludes incompressibility), and
+    !> nu <= max_plane_strain_poisson in plane strain.
     subroutine make_elastic2d(young, poisson, density, thickness, plane_strain, material, error)
         !> Young's modulus E (Pa, > 0).
         real(wp), intent(in) :: young
@@ -51,6 +65,13 @@ contains
             call make_error(error, 'elastic material: Young''s modulus must be > 0')
         else if (.not. (poisson > -1.0_wp .and. poisson < 0.5_wp)) then
             call make_error(error, 'elastic material: Poisson''s ratio must lie in (-1, 0.5)')
+        else if (plane_strain .and. poisson > max_plane_strain_poisson) then
+            call make_error(error, 'elastic material: Poisson''s ratio 1/2 - '//to_str(0.5_wp - poisson)// &
+                            ' is nearly incompressible in plane strain (lambda/mu = 2 nu/(1 - 2 nu) = '// &
+                            to_str(2*poisson/(1 - 2*poisson))//'); above nu = 0.499999 (lambda/mu = 5e5) the '// &
+                            'stiffness cannot be factored reliably in double precision, and the displacement '// &
+                            'elements Q4 and T3 lock long before (already at nu = 0.49): give nu <= 0.49, a '// &
+                            'compressible approximation')
         else if (.not. density >= 0.0_wp) then
             call make_error(error, 'elastic material: density must be >= 0')
         else if (.not. thickness > 0.0_wp) then

@@ -34,7 +34,8 @@ contains
                                                      positive('thickness', 'm'), &
                                                      word_field('hypothesis', 'plane_stress plane_strain')], &
                            'Isotropic elastic material of an element set (default all; later lines override '// &
-                           'earlier ones on shared elements).', &
+                           'earlier ones on shared elements). In plane strain poisson <= 0.499999 (closer to '// &
+                           '0.5 the stiffness cannot be factored in double precision).', &
                            tails=[tail([word_field('element_set', '')], 0, 1)], repeatable=.true.)
         call s%add_keyword('continuum', 'mass', [word_field('mass', 'consistent lumped')], &
                            'Mass matrix: consistent, or row-sum lumped (diagonal).', default='consistent', &
