@@ -846,7 +846,18 @@ contains
             end if
         end do
         if (ne == 0) then
-            call fail(cur, error, 'the mesh has no triangle or quadrangle (mesh it in 2D: gmsh -2)')
+            ! Gmsh saves only the elements of its physical groups when there is any: groups
+            ! of curves or points alone leave the surfaces' elements out of a 2D mesh.
+            if ((size(names) > 0 .or. any([(size(entities(k)%physical) > 0, k=1, size(entities))])) .and. &
+                .not. (any(names%dim == 2) .or. &
+                       any([(entities(k)%dim == 2 .and. size(entities(k)%physical) > 0, k=1, size(entities))]))) then
+                call fail(cur, error, 'the mesh has no triangle or quadrangle: the file has physical groups '// &
+                          'but none of dimension 2, and Gmsh then saves only the elements of the groups (the '// &
+                          'lines and points); add a Physical Surface holding the surfaces to the .geo file '// &
+                          '(or mesh with gmsh -2 -setnumber Mesh.SaveAll 1)')
+            else
+                call fail(cur, error, 'the mesh has no triangle or quadrangle (mesh it in 2D: gmsh -2)')
+            end if
             return
         end if
         nnodes = 0
