@@ -164,11 +164,11 @@ contains
                 if (sys%alpha(i) > 0) cycle
                 call grid%locate(model%mesh, dem%particles%x(i), dem%particles%y(i), e, xi)
                 if (e == 0) cycle
-                write (buf, '(a,i0,a,es13.5e3,a,es13.5e3,a,i0,a)') 'coupling: disk ', i, ' at (', &
-                    dem%particles%x(i), ', ', dem%particles%y(i), ') m lies in element ', e, &
-                    ' outside the overlap (the FE-only zone, where the continuum has its full weight): '// &
-                    'remove the disk, or extend the overlap region over it'
-                call make_error(error, trim(buf))
+                write (buf, '(a,i0,a,es13.5e3,a,es13.5e3,a)') 'coupling: disk ', i, ' at (', &
+                    dem%particles%x(i), ', ', dem%particles%y(i), ') m lies in '
+                call make_error(error, trim(buf)//' '//model%mesh%element_label(e)// &
+                                ' outside the overlap (the FE-only zone, where the continuum has its full weight): '// &
+                                'remove the disk, or extend the overlap region over it')
                 return
             end do
         end subroutine check_fe_zone
@@ -198,7 +198,7 @@ contains
             type(error_t), allocatable, intent(out) :: error
             real(wp) :: a(2), b(2), t(2), normal(2), p(2), q(2), length, offset, xi(2)
             integer :: k, n, j, e
-            character(len=400) :: buf
+            character(len=800) :: buf
             n = size(region%vertex, 2)
             do k = 1, n
                 if (.not. region%particle_edge(k)) cycle
@@ -217,11 +217,12 @@ contains
                     if (config%region%alpha_fe(q(1), q(2)) < 1.0_wp) cycle
                     call grid%locate(model%mesh, q(1), q(2), e, xi)
                     if (e == 0) cycle
-                    write (buf, '(a,i0,a,es13.5e3,a,es13.5e3,a,i0,a)') 'the particle side (edge ', k, &
+                    write (buf, '(a,i0,a,es13.5e3,a,es13.5e3,a)') 'the particle side (edge ', k, &
                         ') of this region borders the continuum outside the overlap (at (', q(1), ', ', q(2), &
-                        ') m, element ', e, '), where alpha = 1: the weight would jump there from alpha_min to 1; '// &
-                        'the particle side faces the particles only (no continuum beyond it): are the FE and '// &
-                        'particle sides swapped?'
+                        ') m, in '
+                    buf = trim(buf)//' '//model%mesh%element_label(e)//'), where alpha = 1: the weight would '// &
+                          'jump there from alpha_min to 1; the particle side faces the particles only (no '// &
+                          'continuum beyond it): are the FE and particle sides swapped?'
                     if (number > 0) then
                         write (buf, '(a,i0,a)') 'region ', number, ': '//trim(buf)
                     end if

@@ -178,7 +178,8 @@ contains
             if (allocated(error)) return
             i = self%model%unrepresentable_element()
             if (i > 0) call make_input_error(error, deck%file, list(self%model%element_material(i))%line, 'material', &
-                                             'the stiffness or mass of element '//to_str(i)//' overflows or vanishes '// &
+                                             'the stiffness or mass of '//self%model%mesh%element_label(i)// &
+                                             ' overflows or vanishes '// &
                                              'in double precision (beyond 1.8e308 or below 2.2e-308: E t, rho t A); '// &
                                              'check the modulus, density and thickness, and the mesh''s units')
         end subroutine set_materials

@@ -102,8 +102,10 @@ module fem_continuum_model
         procedure :: has_timed_prescribed => model_has_timed_prescribed
         !> Stress (xx, yy, xy) at every element centre.
         procedure :: centre_stresses => model_centre_stresses
-        !> Whether the prescribed dofs stop the three rigid motions of the plane.
+        !> Whether the prescribed dofs stop the three rigid motions of the plane of every body.
         procedure :: stops_rigid_motions => model_stops_rigid_motions
+        !> First body of the mesh whose rigid motions the prescribed dofs do not stop (0: none).
+        procedure :: unheld_body => model_unheld_body
     end type continuum_model_t
 
     !> Largest aspect ratio of an element (aspect_ratio). The stiffness of an element scales
@@ -136,17 +138,12 @@ contains
             associate (el => self%family(mesh%kind(e))%element)
                 xe = mesh%element_coordinates(e)
                 if (.not. el%min_jacobian(xe) > 0.0_wp) then
-                    ! The index is the mesh's, not a Gmsh tag: the centroid locates the element.
-                    call make_error(error, 'continuum model: element '//to_str(e)//' (centroid ('// &
-                                    to_str(sum(xe(1, :))/size(xe, 2))//', '// &
-                                    to_str(sum(xe(2, :))/size(xe, 2))//') m) is inverted, '// &
+                    call make_error(error, 'continuum model: '//mesh%element_label(e)//' is inverted, '// &
                                     'degenerate or not convex (det J <= 0)')
                     return
                 end if
                 if (aspect_ratio(xe) > max_aspect) then
-                    call make_error(error, 'continuum model: element '//to_str(e)//' (centroid ('// &
-                                    to_str(sum(xe(1, :))/size(xe, 2))//', '// &
-                                    to_str(sum(xe(2, :))/size(xe, 2))//') m) has an aspect ratio of '// &
+                    call make_error(error, 'continuum model: '//mesh%element_label(e)//' has an aspect ratio of '// &
                                     to_str(aspect_ratio(xe))//' (longest side over smallest height), above '// &
                                     to_str(max_aspect)//': its stiffness is lost in the rounding of double '// &
                                     'precision; mesh the body with elements of reasonable shape')
@@ -317,12 +314,10 @@ contains
         integer, intent(in) :: element
         real(wp), intent(out) :: thickness
         type(error_t), allocatable, intent(out) :: error
-        character(len=120) :: buf
         thickness = 0.0_wp
         if (self%element_material(element) == 0) then
-            write (buf, '(a,i0,a)') 'continuum model: a loaded edge is a side of element ', element, &
-                ', which has no material'
-            call make_error(error, trim(buf))
+            call make_error(error, 'continuum model: a loaded edge is a side of '//self%mesh%element_label(element)// &
+                            ', which has no material')
             return
         end if
         thickness = self%materials(self%element_material(element))%thickness
@@ -441,12 +436,10 @@ contains
         !> Set when an element has no material.
         type(error_t), allocatable, intent(out) :: error
         integer :: e
-        character(len=120) :: buf
         do e = 1, size(self%element_material)
             if (self%element_material(e) == 0) then
-                write (buf, '(a,i0,a)') 'continuum model: element ', e, &
-                    ' has no material (assign one to an element set containing it)'
-                call make_error(error, trim(buf))
+                call make_error(error, 'continuum model: '//self%mesh%element_label(e)// &
+                                ' has no material (assign one to an element set containing it)')
                 return
             end if
         end do
@@ -671,28 +664,59 @@ contains
         end do
     end subroutine model_centre_stresses
 
-    !> Whether the prescribed dofs stop the rigid motions (two translations and the rotation)
-    !> of a connected body: the rows (1, 0, -y) of prescribed x dofs and (0, 1, x) of prescribed
-    !> y dofs (coordinates from the centroid, scaled by the size of the mesh) have rank 3,
-    !> judged by det(G^T G) > 1e-12 (trace/3)^3.
+    !> Whether the prescribed dofs stop the rigid motions of every body (unheld_body is 0).
     pure logical function model_stops_rigid_motions(self) result(stops)
         !> The model.
         class(continuum_model_t), intent(in) :: self
-        real(wp) :: g(3, 3), r(3), c(2), extent, det
-        integer :: a, k
-        c = sum(self%mesh%x, dim=2)/self%mesh%node_count()
-        extent = max(maxval(abs(self%mesh%x(1, :) - c(1))), maxval(abs(self%mesh%x(2, :) - c(2))), tiny(1.0_wp))
-        g = 0.0_wp
-        do a = 1, self%mesh%node_count()
-            do k = 1, 2
-                if (.not. self%prescribed(2*a - 2 + k)) cycle
-                if (k == 1) r = [1.0_wp, 0.0_wp, -(self%mesh%x(2, a) - c(2))/extent]
-                if (k == 2) r = [0.0_wp, 1.0_wp, (self%mesh%x(1, a) - c(1))/extent]
-                g = g + spread(r, 2, 3)*spread(r, 1, 3)
-            end do
-        end do
-        det = g(1, 1)*(g(2, 2)*g(3, 3) - g(2, 3)*g(3, 2)) - g(1, 2)*(g(2, 1)*g(3, 3) - g(2, 3)*g(3, 1)) &
-              + g(1, 3)*(g(2, 1)*g(3, 2) - g(2, 2)*g(3, 1))
-        stops = det > singular_ratio*((g(1, 1) + g(2, 2) + g(3, 3))/3)**3 .and. det > 0
+        stops = self%unheld_body() == 0
     end function model_stops_rigid_motions
+
+    !> First body (connected part of the mesh, `mesh2d_t%bodies`) whose rigid motions (two
+    !> translations and the rotation) the prescribed dofs do not stop (0: every body is held).
+    !> Each body is its own rigid system: supports on one hold nothing of another, so the
+    !> test is per body: the rows (1, 0, -y) of its prescribed x dofs and (0, 1, x) of its
+    !> prescribed y dofs (coordinates from the body's centroid, scaled by its size) have rank 3,
+    !> judged by det(G^T G) > 1e-12 (trace/3)^3. A part joined to the rest by a single node (a
+    !> hinge) is in the same body and passes: its free rotation shows in the factorisation.
+    pure integer function model_unheld_body(self, body) result(unheld)
+        !> The model.
+        class(continuum_model_t), intent(in) :: self
+        !> Body of each node (as from `mesh%bodies`; computed when absent).
+        integer, intent(in), optional :: body(:)
+        integer, allocatable :: of(:)
+        real(wp) :: g(3, 3), r(3), c(2), extent, det
+        integer :: a, k, b, n_bodies
+        logical, allocatable :: in(:)
+        if (present(body)) then
+            of = body
+            n_bodies = 0
+            if (size(of) > 0) n_bodies = maxval(of)
+        else
+            call self%mesh%bodies(of, n_bodies)
+        end if
+        unheld = 0
+        do b = 1, n_bodies
+            in = of == b
+            c = [sum(self%mesh%x(1, :), mask=in), sum(self%mesh%x(2, :), mask=in)]/real(count(in), wp)
+            extent = max(maxval(abs(self%mesh%x(1, :) - c(1)), mask=in), &
+                         maxval(abs(self%mesh%x(2, :) - c(2)), mask=in), tiny(1.0_wp))
+            g = 0.0_wp
+            do a = 1, self%mesh%node_count()
+                if (.not. in(a)) cycle
+                do k = 1, 2
+                    if (.not. self%prescribed(2*a - 2 + k)) cycle
+                    if (k == 1) r = [1.0_wp, 0.0_wp, -(self%mesh%x(2, a) - c(2))/extent]
+                    if (k == 2) r = [0.0_wp, 1.0_wp, (self%mesh%x(1, a) - c(1))/extent]
+                    g = g + spread(r, 2, 3)*spread(r, 1, 3)
+                end do
+            end do
+            det = g(1, 1)*(g(2, 2)*g(3, 3) - g(2, 3)*g(3, 2)) - g(1, 2)*(g(2, 1)*g(3, 3) - g(2, 3)*g(3, 1)) &
+                  + g(1, 3)*(g(2, 1)*g(3, 2) - g(2, 2)*g(3, 1))
+            if (.not. (det > singular_ratio*((g(1, 1) + g(2, 2) + g(3, 3))/3)**3 .and. det > 0)) then
+                unheld = b
+                return
+            end if
+        end do
+
+    end function model_unheld_body
 end module fem_continuum_model

@@ -871,7 +871,8 @@ contains
             if (index_of_tag(k) == 0) cycle
             mesh%x(:, index_of_tag(k)) = xtag(:, k)
         end do
-        allocate (mesh%kind(ne), mesh%connectivity(4, ne), source=0)
+        allocate (mesh%kind(ne), mesh%connectivity(4, ne), mesh%element_tag(ne), mesh%element_line(ne), source=0)
+        mesh%file = cur%path
         e = 0
         do b = 1, size(blocks)
             if (blocks(b)%type /= 2 .and. blocks(b)%type /= 3) cycle
@@ -879,6 +880,8 @@ contains
             do k = 1, size(blocks(b)%nodes, 2)
                 e = e + 1
                 mesh%kind(e) = merge(element_t3, element_q4, blocks(b)%type == 2)
+                mesh%element_tag(e) = blocks(b)%tags(k)
+                mesh%element_line(e) = blocks(b)%lines(k)
                 mesh%connectivity(1:size(blocks(b)%nodes, 1), e) = index_of_tag(blocks(b)%nodes(:, k) - min_tag + 1)
             end do
         end do

@@ -7,6 +7,7 @@
 module fem_mesh2d
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
+    use core_strings, only: to_str
     implicit none
     private
     public :: mesh2d_t, named_set_t, edge_set_t, element_t3, element_q4, nodes_per_element
@@ -50,6 +51,13 @@ module fem_mesh2d
         type(named_set_t), allocatable :: element_sets(:)
         !> Named edge sets.
         type(edge_set_t), allocatable :: edge_sets(:)
+        !> Gmsh tag of each element (unallocated for a generated mesh, whose elements are
+        !> named by their index).
+        integer, allocatable :: element_tag(:)
+        !> Line of each element in the mesh file (with element_tag).
+        integer, allocatable :: element_line(:)
+        !> The mesh file (with element_tag).
+        character(len=:), allocatable :: file
     contains
         !> Number of nodes.
         procedure :: node_count => mesh_node_count
@@ -59,6 +67,11 @@ module fem_mesh2d
         procedure :: element_nodes => mesh_element_nodes
         !> Coordinates (2, n) of the nodes of element e.
         procedure :: element_coordinates => mesh_element_coordinates
+        !> How messages name element e: its Gmsh tag, file and line when read from a file, its
+        !> index otherwise, and its centroid.
+        procedure :: element_label => mesh_element_label
+        !> Body of each node: the connected parts of the mesh (elements sharing a node).
+        procedure :: bodies => mesh_bodies
         !> Add (or extend) a node set.
         procedure :: add_node_set => mesh_add_node_set
         !> Add (or extend) an element set.
@@ -117,6 +130,76 @@ contains
         real(wp), allocatable :: xe(:, :)
         xe = self%x(:, self%connectivity(1:nodes_per_element(self%kind(e)), e))
     end function mesh_element_coordinates
+
+    !> 'Gmsh element 29 (plate.msh:187, centroid (0.5, 0.25) m)' for an element read from a
+    !> Gmsh file (its tag and line there: the index in the mesh is no number the user can
+    !> find), 'element 3 (centroid (0.5, 0.25) m)' for a generated mesh.
+    function mesh_element_label(self, e) result(label)
+        !> The mesh.
+        class(mesh2d_t), intent(in) :: self
+        !> Element index.
+        integer, intent(in) :: e
+        !> The label.
+        character(len=:), allocatable :: label
+        real(wp), allocatable :: xe(:, :)
+        character(len=:), allocatable :: centroid
+        xe = self%element_coordinates(e)
+        centroid = 'centroid ('//to_str(sum(xe(1, :))/size(xe, 2))//', '//to_str(sum(xe(2, :))/size(xe, 2))//') m)'
+        label = 'element '//to_str(e)//' ('//centroid
+        if (.not. (allocated(self%element_tag) .and. allocated(self%element_line) .and. allocated(self%file))) return
+        if (size(self%element_tag) /= self%element_count() .or. size(self%element_line) /= self%element_count()) return
+        label = 'Gmsh element '//to_str(self%element_tag(e))//' ('//self%file//':'//to_str(self%element_line(e))// &
+                ', '//centroid
+    end function mesh_element_label
+
+    !> Body of each node, numbered 1..count in the order of their first node: two elements
+    !> sharing a node are in the same body (union-find over the connectivity); a node in no
+    !> element is a body of its own.
+    pure subroutine mesh_bodies(self, body, count)
+        !> The mesh.
+        class(mesh2d_t), intent(in) :: self
+        !> Body of each node (number of nodes).
+        integer, allocatable, intent(out) :: body(:)
+        !> Number of bodies.
+        integer, intent(out) :: count
+        integer, allocatable :: parent(:), number(:)
+        integer :: e, k, a, ra, r0
+        allocate (parent(self%node_count()))
+        parent = [(a, a=1, self%node_count())]
+        do e = 1, self%element_count()
+            call find_root(parent, self%connectivity(1, e), r0)
+            do k = 2, nodes_per_element(self%kind(e))
+                call find_root(parent, self%connectivity(k, e), ra)
+                ! The larger root under the smaller: a root stays the smallest node of its body.
+                parent(max(ra, r0)) = min(ra, r0)
+                r0 = min(ra, r0)
+            end do
+        end do
+        allocate (body(self%node_count()), number(self%node_count()), source=0)
+        count = 0
+        do a = 1, self%node_count()
+            call find_root(parent, a, ra)
+            if (number(ra) == 0) then
+                count = count + 1
+                number(ra) = count
+            end if
+            body(a) = number(ra)
+        end do
+
+    contains
+
+        !> Root of a node's tree, each node on the way pointed at its grandparent (path halving).
+        pure subroutine find_root(parent, node, r)
+            integer, intent(inout) :: parent(:)
+            integer, intent(in) :: node
+            integer, intent(out) :: r
+            r = node
+            do while (parent(r) /= r)
+                parent(r) = parent(parent(r))
+                r = parent(r)
+            end do
+        end subroutine find_root
+    end subroutine mesh_bodies
 
     !> Sorted unique copy of a list of positive indices (by marking: O(size + max)).
     pure function sorted_unique(ids) result(out)
