@@ -231,6 +231,25 @@ def kill_9_loop(exe, src, work, deck_name, label, min_step=300):
           f"{len(counts)} readable, unreadable: {failures}, outputs held {counts}; short: {short}")
 
 
+def readable_while_running(name, partial):
+    """The partial file of a running run opens in h5py with its defaults (HDF5's file locks
+    on), as doc/output.md promises: the writer does not lock it for itself alone (it did, and
+    h5py, h5dump and `multicor-sweep collect` got "unable to lock file"). A read may meet
+    the writer in the middle of a flush, so up to 5 tries; a lock error in every one fails."""
+    errors = []
+    for _ in range(5):
+        try:
+            with h5py.File(partial, "r") as f:
+                finished = int(f["summary"].attrs["finished"])
+            check(f"{name}: the partial file opens in h5py while the run goes on", finished == 0,
+                  f"finished = {finished}")
+            return
+        except Exception as e:  # noqa: BLE001 - any failure to read is recorded
+            errors.append(str(e))
+            time.sleep(0.05)
+    check(f"{name}: the partial file opens in h5py while the run goes on", False, errors[-1][:300])
+
+
 def stop_by_signal(exe, src, work, deck_name, sig, name):
     """Send `sig` to a long run: exit 128 + sig, message, partial closed with finished = 0
     and every output up to the step of the stop, equal to an uninterrupted run."""
@@ -244,6 +263,7 @@ def stop_by_signal(exe, src, work, deck_name, sig, name):
     if not wait_for_step(proc, 100, lines):
         check(f"{name}: run reached a few outputs", False, proc.communicate()[1][-300:])
         return
+    readable_while_running(name, partial)
     t0 = time.monotonic()
     proc.send_signal(sig)
     out, err = proc.communicate()
