@@ -29,7 +29,7 @@ module dem_contacts
     public :: contacts_set_frames, contacts_set_laws, contacts_finish, contacts_impulses
     public :: contacts_local_velocity, contacts_count_status, contacts_bytes, contacts_moments_active
     public :: contacts_apply_impulse, contacts_solver_velocity, contacts_directions
-    public :: contacts_list_problem
+    public :: contacts_list_problem, contacts_make_bonds
 
     !> Contact status, no reaction (separated or not active this step).
     integer, parameter :: status_open = 0
@@ -61,11 +61,9 @@ module dem_contacts
         real(wp) :: h = 0.0_wp
         !> Theta of the scheme.
         real(wp) :: theta = 0.5_wp
-        !> Create bonds on closed contacts with cohesion (first step only).
-        logical :: make_bonds = .false.
-        !> Bonds are created (first step) on contacts with gap <= bond_ratio * mean radius of
-        !> the pair; a bond that cannot take part in the solve (blocked) breaks when its gap
-        !> opens beyond that.
+        !> Gap ratio of the bonds (made at t = 0 by contacts_make_bonds on contacts with gap
+        !> <= bond_ratio * mean radius of the pair): a bond that cannot take part in the solve
+        !> (blocked) breaks when its gap opens beyond that.
         real(wp) :: bond_ratio = 1.0e-6_wp
         !> Round-off allowance of the activation, relative to the mean radius of the pair: a
         !> contact whose predicted gap is at most gap_allowance * mean radius is active.
@@ -546,6 +544,41 @@ contains
         u(2) = ut - cs%nrm(2, k)*dvx + cs%nrm(1, k)*dvy
     end subroutine contacts_solver_velocity
 
+    !> Make the bonds of a run on the contacts detected in the configuration at t = 0: a contact
+    !> whose pair of materials has cohesion and whose gap is at most bond_ratio * mean radius
+    !> of the pair (the radius of the disk for a wall) becomes an intact bond (status_cohesive);
+    !> the other statuses are left as they are. Called once, before the first step, on the
+    !> start positions (dem_moreau_jean): the first step's detection carries the statuses
+    !> over by pair, so that whether a bond exists depends on the configuration at t = 0 only,
+    !> not on the step, theta or the initial velocities (which move the configuration where
+    !> the steps detect their contacts).
+    pure subroutine contacts_make_bonds(cs, bond_ratio, radius, mat, wall_mat, materials)
+        !> Contacts detected on the configuration at t = 0.
+        type(contact_set_t), intent(inout) :: cs
+        !> Gap ratio of the bonds (>= 0).
+        real(wp), intent(in) :: bond_ratio
+        !> Disk radii [m].
+        real(wp), intent(in) :: radius(:)
+        !> Disk and wall materials.
+        integer, intent(in) :: mat(:), wall_mat(:)
+        !> Material pair table.
+        type(materials_t), intent(in) :: materials
+        integer :: k, ma, mb
+        real(wp) :: amoy
+        do k = 1, cs%n
+            mb = mat(cs%i2(k))
+            if (cs%i1(k) > 0) then
+                ma = mat(cs%i1(k))
+                amoy = 0.5_wp*(radius(cs%i1(k)) + radius(cs%i2(k)))
+            else
+                ma = wall_mat(-cs%i1(k))
+                amoy = radius(cs%i2(k))
+            end if
+            if (materials%cohesion(ma, mb) > 0.0_wp .and. cs%gap(k) <= bond_ratio*amoy) &
+                cs%status(k) = status_cohesive
+        end do
+    end subroutine contacts_make_bonds
+
     !> Material law, bonds, solver shifts and activation of every contact for the step.
     !> Intact bonds are always active, with Newton restitution: target = e max(-u_n(begin), 0)
     !> (a bond holds its gap, <= bond_ratio * mean radius, rather than pulling it shut with its
@@ -598,8 +631,6 @@ contains
             end if
             cs%amoy(k) = amoy
             e = materials%restitution(ma, mb)
-            if (law%make_bonds .and. materials%cohesion(ma, mb) > 0.0_wp .and. &
-                cs%gap(k) <= law%bond_ratio*amoy) cs%status(k) = status_cohesive
             cs%coh(k) = 0.0_wp
             cs%mu(k) = materials%mu(ma, mb)
             cs%erol(k) = materials%rolling(ma, mb)

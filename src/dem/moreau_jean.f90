@@ -5,7 +5,9 @@
 !>   1. free velocities v_free = v + h M^-1 F_theta (F_theta = (1 - theta) F(t) + theta F(t + h));
 !>      imposed and fixed DOFs take their values at t + h;
 !>   2. detection on the mid configuration q + (1 - theta) h v (warm start by pair), or on
-!>      q + h v with Siconos' rule of activation (`scheme%activation`, dem_activation);
+!>      q + h v with Siconos' rule of activation (`scheme%activation`, dem_activation); at
+!>      the first step it is preceded by the making of the bonds on the contacts closed in
+!>      the configuration at t = 0 (carried over by pair);
 !>   3. contact laws (by default activation on the predicted gap with a round-off allowance,
 !>      or on the previous reaction; Newton restitution or gap term; cohesion), frames;
 !>   4. NLGS with the bi-potential local solver: v+ and the impulses (blocked contacts, whose
@@ -36,7 +38,7 @@ module dem_moreau_jean
                              particles_bytes
     use dem_walls, only: walls_t, walls_velocity, walls_advance
     use dem_materials, only: materials_t
-    use dem_contacts, only: contact_set_t, contact_law_t, contacts_set_frames, &
+    use dem_contacts, only: contact_set_t, contact_law_t, contacts_set_frames, contacts_make_bonds, &
                             contacts_set_laws, contacts_finish, contacts_impulses, contacts_local_velocity, &
                             contacts_bytes
     use dem_detection, only: detector_t, detect_contacts, detector_bytes
@@ -58,8 +60,9 @@ module dem_moreau_jean
         real(wp) :: theta = 0.5_wp
         !> Alert distance of the detection [m].
         real(wp) :: alert = 0.0_wp
-        !> Gap ratio of the bonds, which are created at the first step on contacts with cohesion
-        !> and gap <= bond_ratio * mean radius, and broken for good once the solution needs
+        !> Gap ratio of the bonds, which are created before the first step on the contacts with
+        !> cohesion and gap <= bond_ratio * mean radius in the configuration at t = 0
+        !> (dem_contacts, contacts_make_bonds), and broken for good once the solution needs
         !> more tension than the cohesion (dem_contacts, contacts_finish).
         real(wp) :: bond_ratio = 1.0e-6_wp
         !> Round-off allowance of the contact activation and of the detection, relative to the
@@ -123,7 +126,7 @@ module dem_moreau_jean
         integer :: step = 0
         !> Wall-clock time spent in detection and in the solver [s].
         real(wp) :: time_detection = 0.0_wp, time_solver = 0.0_wp
-        !> Bonds are still to be created (first step).
+        !> Bonds are still to be created (before the first step, on the configuration at t = 0).
         logical :: bonds_pending = .true.
         !> Bond ruptures since the start (pair, step, time, mode).
         type(rupture_log_t) :: ruptures
@@ -208,8 +211,8 @@ contains
     !> Contact law parameters of the current step.
     pure type(contact_law_t) function step_law(sys) result(law)
         type(dem_system_t), intent(in) :: sys
-        law = contact_law_t(h=sys%scheme%h, theta=sys%scheme%theta, make_bonds=sys%bonds_pending, &
-                            bond_ratio=sys%scheme%bond_ratio, gap_allowance=sys%scheme%gap_allowance)
+        law = contact_law_t(h=sys%scheme%h, theta=sys%scheme%theta, bond_ratio=sys%scheme%bond_ratio, &
+                            gap_allowance=sys%scheme%gap_allowance)
     end function step_law
 
     !> Part 1 of a step: start velocities vel0, free velocities vel (loads and gravity,
@@ -225,6 +228,7 @@ contains
     !> Part 2 of a step: detection (on the configuration of the rule of activation), frames
     !> and Delassus blocks, contact laws; contacts are activated on the velocities in `vel`
     !> (the free velocities, plus whatever a coupling added since `mj_free_velocities`).
+    !> At the first step the bonds are made first, on the configuration at t = 0 (make_bonds).
     subroutine mj_detect(sys)
         !> System, after `mj_free_velocities`.
         type(dem_system_t), intent(inout) :: sys
@@ -236,6 +240,7 @@ contains
         if (sys%particles%n > 0) then
             alert = alert + sys%scheme%gap_allowance*maxval(sys%particles%radius(1:sys%particles%n))
         end if
+        if (sys%bonds_pending) call make_bonds(sys, alert)
         call detect_contacts(sys%detector, sys%xm, sys%ym, sys%particles%radius, alert, &
                              sys%wx1, sys%wy1, sys%wx2, sys%wy2, sys%contacts)
         call system_clock(c1)
@@ -286,6 +291,37 @@ contains
             end do
         end associate
     end subroutine mj_end_step
+
+    !> The bonds of the run, made on the configuration at the start of the first step (t = 0,
+    !> before any motion): the contacts detected there (alert distance widened by bond_ratio
+    !> times the largest radius, so that every pair within a bond's gap is found), bonds on
+    !> those with cohesion and a gap of at most bond_ratio * mean radius (contacts_make_bonds).
+    !> This list becomes the previous list of the step's detection, which carries the bonds
+    !> over by pair; its reactions are zero and its outputs none, as those of a pair new to the
+    !> list, so that only the bonds differ from a first step without this list.
+    subroutine make_bonds(sys, alert)
+        !> System at the start of its first step.
+        type(dem_system_t), intent(inout) :: sys
+        !> Alert distance of the step's detection [m].
+        real(wp), intent(in) :: alert
+        real(wp), allocatable :: wx1(:), wy1(:), wx2(:), wy2(:)
+        integer :: n, nw
+        n = sys%particles%n
+        nw = sys%walls%n
+        if (n == 0) return
+        allocate (wx1(nw), wy1(nw), wx2(nw), wy2(nw))
+        if (nw > 0) then
+            wx1 = sys%walls%x1(1:nw)
+            wy1 = sys%walls%y1(1:nw)
+            wx2 = sys%walls%x2(1:nw)
+            wy2 = sys%walls%y2(1:nw)
+        end if
+        call detect_contacts(sys%detector, sys%particles%x(1:n), sys%particles%y(1:n), sys%particles%radius, &
+                             alert + sys%scheme%bond_ratio*maxval(sys%particles%radius(1:n)), wx1, wy1, wx2, wy2, &
+                             sys%contacts)
+        call contacts_make_bonds(sys%contacts, sys%scheme%bond_ratio, sys%particles%radius, sys%particles%mat, &
+                                 sys%walls%mat, sys%materials)
+    end subroutine make_bonds
 
     !> vel0 = current velocities, im, theta-weighted loads, vel = free velocities, wall velocities.
     subroutine free_velocities(sys)
