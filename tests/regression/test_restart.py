@@ -4,7 +4,8 @@ continued from its checkpoint gives BITWISE the results of the uninterrupted run
 
 For a beam deck (input/cantilever.dat), a particle deck with contacts and bonds that break
 (input/cohesive_row.dat: bonded row, two ruptures, one before and one after the stop; also
-with [solver] method = block, whose factor is kept from step to step; a deposit under a
+with [solver] method = block, whose factor is kept from step to step; a spinning bonded pair,
+whose bond is made on the positions at t = 0; a deposit under a
 driven wall with unconverged steps before and after the stop) and
 coupled decks (input/bending_stack.dat, tests/regression/decks/coupled_rigid_translation.dat),
 a 2D continuum deck (input/continuum_cantilever_dynamic.dat) and continuum-disk coupled decks
@@ -46,6 +47,26 @@ from checks import check, summary
 # Attributes that measure wall-clock time or dates: they differ between any two runs.
 CLOCK_ATTRIBUTES = {"created", "ended", "wall_seconds", "detection_seconds", "solver_seconds",
                     "run_id"}
+
+# Two touching bonded disks spinning at 5 rad/s about their contact point (test_initial_bonds.py):
+# the bond is made on the positions at t = 0, before the first step, and carried by the
+# checkpoint.
+SPIN = """[run]
+analysis = dynamic
+[particles]
+material = 1 2500
+disk = 0.0 0.0 0.01 1
+disk = 0.02 0.0 0.01 1
+initial_rigid = all 0 0 5.0 0.01 0.0
+[contacts]
+law = 1 1 0 0 1.0e6
+bond = 1 1 1.0
+[time]
+step = 1e-3
+end = 0.2
+[output]
+interval = 20
+"""
 
 # Disks settling under a piston (the fourth wall, driven down at 0.2 m/s) with at most 3
 # sweeps per step: most steps end unconverged.
@@ -792,6 +813,13 @@ def main():
     # 0.2 m/s for 0.125 s: both ends at 0.1 - 0.025 m (to round-off)
     check("piston_end: the piston moved down 25 mm before the stop",
           all(abs(y - 0.075) < 1e-12 for y in ceiling), f"ends at y = {ceiling} m")
+    # A spinning bonded pair (bond made on the start positions): stopped at step 103.
+    spin = work / "spin_pair.dat"
+    spin.write_text(SPIN)
+    by_end_time(exe, spin, work, "spin_end", 0.1033)
+    with h5py.File(work / "spin_end_first_checkpoint.h5", "r") as c:
+        status = c["dem/contacts/status"][...].tolist() if "dem/contacts/status" in c else []
+    check("spin_end: the checkpoint holds the pair's intact bond", status == [3], f"statuses {status}")
     # The deposit compared with Siconos, with Siconos' rule of activation ([time] contact_scheme
     # = siconos): the rule reads the outputs of the previous step's contacts, which the
     # checkpoint keeps (dem/contacts/y). Stopped at step 85, while the pile forms.
