@@ -67,17 +67,19 @@ def summary_lines(runs, time):
                      f"{of(e, 'balance', lambda b: np.abs(b).max()):>12.3e} "
                      f"{of(e, 'external_work', lambda w: w[-1]):>13.4e} {wall:>9.2f}")
     lines.append("")
-    lines.append(f"profiles at t = {time:g} s (vertical displacement; rigid fit = straight line "
-                 "through the disks beyond the overlap):")
+    lines.append(f"profiles at the stored output nearest t = {time:g} s (vertical displacement; rigid fit "
+                 "= straight line through the disks beyond the overlap):")
     for name, r in runs.items():
         k = r.nearest_index(time)
         p = coupled.profile(r, k)
+        if abs(float(r.time[k]) - time) > 1e-9 * max(abs(time), float(np.abs(r.time).max()), 1e-300):
+            lines.append(f"  {name}: no output at t = {time:g} s; the nearest, t = {float(r.time[k]):g} s:")
         beyond = p.disk_x > r.overlap.max() + 1e-9
         on_axis = np.abs(p.disk_y) < 1e-9
         sel = beyond & on_axis
         fit, dev = coupled.rigid_fit(p.disk_x[sel], p.disk_d[sel, 1])
         tip_beam = p.node_d[np.argmax(p.node_x), 1]
-        lines.append(f"  {name}: beam end w = {tip_beam:.4e} m, loaded disk dy = "
+        lines.append(f"  {name} at t = {float(r.time[k]):g} s: beam end w = {tip_beam:.4e} m, loaded disk dy = "
                      f"{p.disk_d[np.argmax(np.where(on_axis, p.disk_x, -np.inf)), 1]:.4e} m, "
                      f"rigid fit slope {fit[0]:.4e}, max deviation {dev:.3e} m "
                      f"({dev / max(np.abs(p.disk_d[sel, 1]).max(initial=0.0), 1e-300):.2e} "

@@ -135,7 +135,7 @@ def test_plot_experiments_writes_png_pdf_and_summary(tmp_path, capsys):
     summary = (tmp_path / "experiments_summary.txt").read_text()
     assert "bending_stack" in summary and "max|q-Cu|" in summary
     # Beyond the overlap the synthetic disks lie on a straight line: rigid fit exact.
-    line = [s for s in summary.splitlines() if s.strip().startswith("bending_case1:")][0]
+    line = [s for s in summary.splitlines() if s.strip().startswith("bending_case1 at t = ")][0]
     assert float(line.split("max deviation")[1].split()[0]) < 1e-15
     assert "experiments_summary.txt" in out
 
@@ -143,3 +143,18 @@ def test_plot_experiments_writes_png_pdf_and_summary(tmp_path, capsys):
 def test_plot_experiments_reports_a_missing_case(tmp_path, capsys):
     assert plot_experiments.main(["--results", str(tmp_path)]) == 1
     assert "does not exist" in capsys.readouterr().err
+
+
+def test_experiments_summary_names_the_stored_time_it_reads(coupled_file):
+    """The profile lines give the time of the output they read: at a stored time only that,
+    elsewhere a line saying the requested time has no output and which one is read instead
+    (they were labelled with the requested time, 0.02 s, while they read the last output)."""
+    res = coupled.load_coupled(coupled_file)
+    dt = H * STEPS_PER_OUT
+    at = plot_experiments.summary_lines({"case": res}, float(res.time[2]))
+    assert not any("no output" in line for line in at)
+    assert any(line.startswith(f"  case at t = {float(res.time[2]):g} s: beam end w") for line in at)
+    late = plot_experiments.summary_lines({"case": res}, 100.0)
+    assert f"  case: no output at t = 100 s; the nearest, t = {float(res.time[-1]):g} s:" in late
+    assert any(line.startswith(f"  case at t = {float(res.time[-1]):g} s: beam end w") for line in late)
+    assert float(res.time[-1]) == pytest.approx((N_OUT - 1) * dt, rel=1e-12)
