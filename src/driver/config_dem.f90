@@ -3,7 +3,7 @@
 !> velocities on selections of disks, walls, contact laws, time-stepping and solver settings.
 !> The deck reader has checked each line on its own; here come the checks across lines: ids
 !> of materials and functions, selections against the number of disks, conflicting
-!> conditions on a DOF, duplicate laws, walls of zero length, disks that overlap each other or
+!> conditions on a DOF, duplicate laws, walls of zero length or repeated, disks that overlap each other or
 !> a wall at t = 0. Each error names the deck file, the line and the keyword concerned.
 !>
 !> Disks are numbered 1..N in the order the deck creates them (file order of `disk`, `row`,
@@ -454,6 +454,8 @@ contains
                     end if
                     return
                 end if
+                call check_repeated_wall(i, error)
+                if (allocated(error)) return
                 call walls_add(cfg%system%walls, e%real('x1'), e%real('y1'), e%real('x2'), e%real('y2'), &
                                error, mat=mat, vx=vx, vy=vy, func=func)
                 if (allocated(error)) then
@@ -463,6 +465,30 @@ contains
                 end if
             end associate
         end do
+
+    contains
+
+        !> Error when wall i repeats an earlier one (the same ends, in either order): each
+        !> would make its own contact with every disk on it, the reaction split between the
+        !> two in a way no law decides, and the contact counts doubled (a line copied twice).
+        subroutine check_repeated_wall(i, error)
+            !> The wall's index in the deck's order.
+            integer, intent(in) :: i
+            !> Set when an earlier wall has the same ends.
+            type(error_t), allocatable, intent(out) :: error
+            real(wp) :: a(4), b(4)
+            integer :: j
+            a = [list(i)%real('x1'), list(i)%real('y1'), list(i)%real('x2'), list(i)%real('y2')]
+            do j = 1, i - 1
+                b = [list(j)%real('x1'), list(j)%real('y1'), list(j)%real('x2'), list(j)%real('y2')]
+                if (all(a == b) .or. all(a == [b(3:4), b(1:2)])) then
+                    call make_input_error(error, deck%file, list(i)%line, 'wall', 'this wall has the ends of '// &
+                                          'the wall on line '//to_str(list(j)%line)//': each would make its own '// &
+                                          'contacts with the disks on it; remove one')
+                    return
+                end if
+            end do
+        end subroutine check_repeated_wall
     end subroutine build_walls
 
     !> Size of the model: diagonal of the bounding box of the disks and wall ends [m].
