@@ -1,24 +1,40 @@
 !> Stand-in for pFUnit 4.12, used only when pFUnit is not installed. Two modules:
 !>
 !> * `funit_fallback_runner`: the harness (test bookkeeping, assertion bodies, summary). The
-!>   generated suites and driver use it; test code never sees it.
+!>   generated suites and driver use it inside BLOCKs; test code never sees it.
 !> * `funit`: what a `.pf` file gets from `use funit`. It exports the same public names as
 !>   pFUnit 4.12's `FUnit` module that user code can collide with (`run`, `initialize`,
 !>   `finalize`, the `assert*` procedures, `SourceLocation`, `anyExceptions`, the fHamcrest
-!>   matchers, ...), so that a helper named like one of them fails to compile here as it does
-!>   under pFUnit. The assertions MULTICOR uses are real; the other names are placeholders
-!>   that stop the run if called.
+!>   matchers and their types, ...), so that a helper named like one of them fails to compile
+!>   here as it does under pFUnit. The assertions MULTICOR uses are real; the other names are
+!>   placeholders that stop the run if called. The fHamcrest types are those of 4.12
+!>   (fHamcrest.F90 uses pf_IsNear, pf_IsRelativelyNear, pf_AnyOf, pf_AllOf, pf_Every,
+!>   pf_StringContains/StartsWith/EndsWith, pf_IsArrayWithSize, pf_Matchable, each with its
+!>   type public): `IsNear` and `IsRelativelyNear`, not the `IsNear_32`/`IsNear_64` and
+!>   `IsRelativelyNear_32`/`_64` that replaced them in pFUnit PR #544 (April 2026, after 4.14),
+!>   so that the fallback refuses no name 4.12 accepts.
 !>
-!> Assertions follow pFUnit's argument names and rules (src/funit/asserts): `assertRelativelyEqual`
-!> needs a tolerance and fails with 'Zero denominator detected in AssertRelativelyEqual.' when an
-!> expected value is zero; `assertIsFinite` takes a scalar; the integer `assertLessThan` and
-!> `assertGreaterThan` take the message by keyword only (pFUnit's KeywordEnforcer dummy comes
-!> third); the string `assertEqual` names its second argument `found` and ignores leading and
-!> trailing blanks and tabs (pFUnit's default TRIM_ALL); `assertTrue`/`assertFalse` take a
-!> scalar or a rank-1 array (all elements). The fallback is narrower than pFUnit elsewhere (real64
-!> and default integers only, ranks 0 and 1, no mixed kinds), never wider. A failed assertion
-!> prints file, line, expected and actual values, marks the running test as failed, and the test
-!> returns.
+!> Assertions follow pFUnit's argument names, overloads and rules (src/funit/asserts): the real
+!> `assertEqual`, `assertLessThan` and `assertGreaterThan` have Assert_Real.tmpl's two sets,
+!> `(expected, actual, message, location)` and `(expected, actual, tolerance, message,
+!> location)` (lhs, rhs for comparisons: `lhs < rhs + tolerance`, `lhs > rhs - tolerance`);
+!> `assertRelativelyEqual` needs a tolerance and fails with 'Zero denominator detected in
+!> AssertRelativelyEqual.' when an expected value is zero; `assertIsFinite` takes a scalar; the
+!> integer `assertEqual` is `(expected, actual, message, location)` while the integer
+!> `assertLessThan` and `assertGreaterThan` take the message by keyword only (pFUnit's
+!> KeywordEnforcer dummy comes third, Assert_Integer.tmpl); the string `assertEqual` names its
+!> second argument `found` and ignores leading and trailing blanks and tabs (pFUnit's default
+!> TRIM_ALL); `assertTrue`/`assertFalse` take a scalar or a rank-1 array (all elements).
+!>
+!> Known differences, all narrower than pFUnit (a call the fallback accepts compiles under
+!> pFUnit, not always the reverse; MULTICOR's tests use none of them): real64 and default
+!> integers only; ranks 0 and 1 (pFUnit: 0 to MAX_ASSERT_RANK, 5 by default); no scalar
+!> expected against an array actual, no integer or default-real expected against a real64
+!> actual, no default-real tolerance (pFUnit's no_tol/with_tol sets have all of these); no
+!> array `assertLessThan`/`assertGreaterThan`, integer or real; no `whitespace=` option for
+!> strings. Each would take one more specific per kind and rank combination; they are left out.
+!> A failed assertion prints file, line, expected and actual values, marks the running test as
+!> failed, and the test returns.
 !> `fallback_finish` prints 'N passed, N failed' and stops with a non-zero exit code when a
 !> test failed. The state below is the test harness's own, not physics.
 module funit_fallback_runner
@@ -26,7 +42,7 @@ module funit_fallback_runner
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     implicit none
     private
-    public :: fallback_start_test, fallback_end_test, fallback_finish, fallback_unsupported
+    public :: fallback_run_test, fallback_finish, fallback_unsupported
     public :: SourceLocation, anyExceptions
     public :: assertEqual, assertTrue, assertFalse, assertLessThan, assertGreaterThan
     public :: assertRelativelyEqual, assertIsFinite
@@ -49,6 +65,12 @@ module funit_fallback_runner
         integer :: lineNumber = -1
     end type SourceLocation
 
+    abstract interface
+        !> A test, set-up or tear-down procedure (no arguments).
+        subroutine test_procedure()
+        end subroutine test_procedure
+    end interface
+
     interface assertTrue
         module procedure true_scalar, true_1d
     end interface assertTrue
@@ -57,8 +79,12 @@ module funit_fallback_runner
         module procedure false_scalar, false_1d
     end interface assertFalse
 
+    ! pFUnit's real overloads come in two sets (Assert_Real.tmpl): without a tolerance
+    ! (expected, actual, message, location) and with one (expected, actual, tolerance, message,
+    ! location), so a message may come third or fourth by position
     interface assertEqual
-        module procedure equal_real, equal_real_1d, equal_int, equal_int_1d, equal_string
+        module procedure equal_real, equal_real_tol, equal_real_1d, equal_real_1d_tol
+        module procedure equal_int, equal_int_1d, equal_string
     end interface assertEqual
 
     interface assertRelativelyEqual
@@ -66,11 +92,11 @@ module funit_fallback_runner
     end interface assertRelativelyEqual
 
     interface assertLessThan
-        module procedure less_real, less_int
+        module procedure less_real, less_real_tol, less_int
     end interface assertLessThan
 
     interface assertGreaterThan
-        module procedure greater_real, greater_int
+        module procedure greater_real, greater_real_tol, greater_int
     end interface assertGreaterThan
 
     interface assertIsFinite
@@ -78,6 +104,24 @@ module funit_fallback_runner
     end interface assertIsFinite
 
 contains
+
+    !> Runs one test as pFUnit's TestCase%runBare does: `set_up`, then, only if it raised
+    !> nothing, `test` and `tear_down` (also after a failed test, never after a failed set-up).
+    subroutine fallback_run_test(module_name, test_name, test, set_up, tear_down)
+        !> the test module and test procedure names, for the report
+        character(len=*), intent(in) :: module_name, test_name
+        !> the @test procedure
+        procedure(test_procedure) :: test
+        !> the @before and @after procedures, if the module has them
+        procedure(test_procedure), optional :: set_up, tear_down
+        call fallback_start_test(module_name, test_name)
+        if (present(set_up)) call set_up()
+        if (.not. current_failed) then
+            call test()
+            if (present(tear_down)) call tear_down()
+        end if
+        call fallback_end_test()
+    end subroutine fallback_run_test
 
     subroutine fallback_start_test(module_name, test_name)
         character(len=*), intent(in) :: module_name, test_name
@@ -125,45 +169,56 @@ contains
         flush (error_unit)
     end subroutine fail
 
-    subroutine equal_real(expected, actual, tolerance, message, location)
+    !> pFUnit's no-tolerance real assertEqual: exact equality (tolerance 0).
+    subroutine equal_real(expected, actual, message, location)
         real(dp), intent(in) :: expected, actual
-        real(dp), intent(in), optional :: tolerance
         character(len=*), intent(in), optional :: message
         type(SourceLocation), intent(in), optional :: location
-        real(dp) :: tol
-        character(len=200) :: buf
-        tol = 0.0_dp
-        if (present(tolerance)) tol = tolerance
-        if (actual == expected) return
-        if (.not. (abs(expected - actual) <= tol)) then
-            write (buf, '(a,es24.16,a,es24.16,a,es10.3,a,es10.3)') 'expected ', expected, &
-                ' actual ', actual, ' |diff| ', abs(expected - actual), ' > tolerance ', tol
-            call fail(location, trim(buf), message)
-        end if
+        call equal_real_tol(expected, actual, 0.0_dp, message, location)
     end subroutine equal_real
 
-    subroutine equal_real_1d(expected, actual, tolerance, message, location)
-        real(dp), intent(in) :: expected(:), actual(:)
-        real(dp), intent(in), optional :: tolerance
+    !> |expected - actual| <= tolerance, exact equality first (Inf == Inf), NaN fails.
+    subroutine equal_real_tol(expected, actual, tolerance, message, location)
+        real(dp), intent(in) :: expected, actual
+        real(dp), intent(in) :: tolerance
         character(len=*), intent(in), optional :: message
         type(SourceLocation), intent(in), optional :: location
-        real(dp) :: tol
+        character(len=200) :: buf
+        if (actual == expected) return
+        if (.not. (abs(expected - actual) <= tolerance)) then
+            write (buf, '(a,es24.16,a,es24.16,a,es10.3,a,es10.3)') 'expected ', expected, &
+                ' actual ', actual, ' |diff| ', abs(expected - actual), ' > tolerance ', tolerance
+            call fail(location, trim(buf), message)
+        end if
+    end subroutine equal_real_tol
+
+    !> pFUnit's no-tolerance real assertEqual on arrays: exact equality (tolerance 0).
+    subroutine equal_real_1d(expected, actual, message, location)
+        real(dp), intent(in) :: expected(:), actual(:)
+        character(len=*), intent(in), optional :: message
+        type(SourceLocation), intent(in), optional :: location
+        call equal_real_1d_tol(expected, actual, 0.0_dp, message, location)
+    end subroutine equal_real_1d
+
+    subroutine equal_real_1d_tol(expected, actual, tolerance, message, location)
+        real(dp), intent(in) :: expected(:), actual(:)
+        real(dp), intent(in) :: tolerance
+        character(len=*), intent(in), optional :: message
+        type(SourceLocation), intent(in), optional :: location
         integer :: i
         if (size(expected) /= size(actual)) then
             call fail(location, 'nonconforming arrays (sizes differ)', message)
             return
         end if
-        tol = 0.0_dp
-        if (present(tolerance)) tol = tolerance
         ! as pFUnit: exact equality first (Inf == Inf), then |diff| <= tolerance (NaN fails)
         do i = 1, size(expected)
             if (actual(i) == expected(i)) cycle
-            if (abs(actual(i) - expected(i)) <= tol) cycle
-            call equal_real(expected(i), actual(i), tol, message, location)
+            if (abs(actual(i) - expected(i)) <= tolerance) cycle
+            call equal_real_tol(expected(i), actual(i), tolerance, message, location)
             write (error_unit, '(4x,a,i0)') 'at index ', i
             return
         end do
-    end subroutine equal_real_1d
+    end subroutine equal_real_1d_tol
 
     subroutine equal_int(expected, actual, message, location)
         integer, intent(in) :: expected, actual
@@ -299,16 +354,26 @@ contains
         if (any(condition)) call fail(location, 'expected all elements .false.', message)
     end subroutine false_1d
 
+    !> pFUnit's no-tolerance real assertLessThan: lhs < rhs.
     subroutine less_real(lhs, rhs, message, location)
         real(dp), intent(in) :: lhs, rhs
         character(len=*), intent(in), optional :: message
         type(SourceLocation), intent(in), optional :: location
+        call less_real_tol(lhs, rhs, 0.0_dp, message, location)
+    end subroutine less_real
+
+    !> As pFUnit's assert_less_than: lhs < rhs + tolerance.
+    subroutine less_real_tol(lhs, rhs, tolerance, message, location)
+        real(dp), intent(in) :: lhs, rhs
+        real(dp), intent(in) :: tolerance
+        character(len=*), intent(in), optional :: message
+        type(SourceLocation), intent(in), optional :: location
         character(len=100) :: buf
-        if (.not. (lhs < rhs)) then
+        if (.not. (lhs < rhs + tolerance)) then
             write (buf, '(es24.16,a,es24.16)') lhs, ' is not less than ', rhs
             call fail(location, trim(buf), message)
         end if
-    end subroutine less_real
+    end subroutine less_real_tol
 
     !> `unused` is pFUnit's KeywordEnforcer: the message goes by keyword (integers only).
     subroutine less_int(lhs, rhs, unused, message, location)
@@ -323,16 +388,26 @@ contains
         end if
     end subroutine less_int
 
+    !> pFUnit's no-tolerance real assertGreaterThan: lhs > rhs.
     subroutine greater_real(lhs, rhs, message, location)
         real(dp), intent(in) :: lhs, rhs
         character(len=*), intent(in), optional :: message
         type(SourceLocation), intent(in), optional :: location
+        call greater_real_tol(lhs, rhs, 0.0_dp, message, location)
+    end subroutine greater_real
+
+    !> As pFUnit's assert_greater_than: lhs > rhs - tolerance.
+    subroutine greater_real_tol(lhs, rhs, tolerance, message, location)
+        real(dp), intent(in) :: lhs, rhs
+        real(dp), intent(in) :: tolerance
+        character(len=*), intent(in), optional :: message
+        type(SourceLocation), intent(in), optional :: location
         character(len=100) :: buf
-        if (.not. (lhs > rhs)) then
+        if (.not. (lhs > rhs - tolerance)) then
             write (buf, '(es24.16,a,es24.16)') lhs, ' is not greater than ', rhs
             call fail(location, trim(buf), message)
         end if
-    end subroutine greater_real
+    end subroutine greater_real_tol
 
     !> `unused` is pFUnit's KeywordEnforcer: the message goes by keyword (integers only).
     subroutine greater_int(lhs, rhs, unused, message, location)
@@ -390,7 +465,8 @@ module funit
     public :: less_than_or_equal_to, near, relatively_near, every_item, any_of, all_of
     public :: contains_string, starts_with, ends_with, array_with_size, empty_array
     public :: Is, IsNot, not, IsTrueOrFalse, true, false, AbstractMatcher, MatcherDescription
-    public :: StringDescription, IsEqual, IsGreater
+    public :: StringDescription, IsEqual, IsGreater, IsNear, IsRelativelyNear, AnyOf, AllOf
+    public :: Every, StringContains, StringStartsWith, StringEndsWith, IsArrayWithSize, Matchable
 
     !> pFUnit's whitespace option type for string comparisons.
     type :: WhitespaceOptions
@@ -406,7 +482,7 @@ module funit
     end type Test
     type :: TestSuite
     end type TestSuite
-    type :: TestMethod
+    type, extends(Test) :: TestMethod
     end type TestMethod
     type :: TestCase
     end type TestCase
@@ -474,6 +550,26 @@ module funit
     end type IsEqual
     type :: IsGreater
     end type IsGreater
+    type :: IsNear
+    end type IsNear
+    type :: IsRelativelyNear
+    end type IsRelativelyNear
+    type :: AnyOf
+    end type AnyOf
+    type :: AllOf
+    end type AllOf
+    type :: Every
+    end type Every
+    type :: StringContains
+    end type StringContains
+    type :: StringStartsWith
+    end type StringStartsWith
+    type :: StringEndsWith
+    end type StringEndsWith
+    type :: IsArrayWithSize
+    end type IsArrayWithSize
+    type :: Matchable
+    end type Matchable
 
     abstract interface
         subroutine LoadTests_interface()

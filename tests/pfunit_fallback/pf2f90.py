@@ -15,9 +15,11 @@ generation time what real pFUnit would refuse, at generation or at compile time:
 * test procedure names <= 63 characters (Fortran), module name = file name, spelled
   exactly (pFUnit's registry calls ``<file name>_suite``) and <= 57 characters (pFUnit
   generates ``<module>_suite`` and ``Wrap<module>``);
-* no code line longer than 132 characters in what pFUnit generates (gfortran's default
-  free-form limit, counted in bytes as gfortran does: ``add_pfunit_ctest`` adds no line-length
-  flag); for an assert, the line ``  call assert<Variant>(<arguments>, &`` that pFUnit writes.
+* no code past column 132 in what pFUnit generates (gfortran's default free-form limit,
+  counted in bytes as gfortran does: ``add_pfunit_ctest`` adds no line-length flag): a copied
+  line may run past it only with a comment (gfortran 12's scanner.c: a '!' outside character
+  literals before column 133, or as the first non-blank past it); for an assert, the line
+  ``  call assert<Variant>(<arguments>, &`` that pFUnit writes.
 
 Supported asserts: ``@assertEqual``, ``@assertTrue``, ``@assertFalse``, ``@assertLessThan``,
 ``@assertGreaterThan``, ``@assertRelativelyEqual`` (tolerance required, as in pFUnit),
@@ -25,10 +27,11 @@ Supported asserts: ``@assertEqual``, ``@assertTrue``, ``@assertFalse``, ``@asser
 ``location=SourceLocation(file, line)`` argument as pFUnit; the fallback's ``funit`` module
 (funit.f90) exports pFUnit's public names, so a helper named like one of them (``run``...)
 fails to compile as under pFUnit. After the module, a ``<module>_suite`` subroutine uses the
-test module and ``funit`` unrestricted and declares ``suite`` and ``t``, as pFUnit's
-generated suite function does, so the same name clashes fail. Each test runs as pFUnit's
-``TestCase%runBare`` runs it: the ``@before`` procedure, then, only if it raised nothing, the
-test and the ``@after`` procedure (also after a failed test, never after a failed set-up).
+test module and ``funit`` unrestricted, declares ``suite`` and ``t`` and names ``TestMethod``,
+as pFUnit's generated suite function does, so the same name clashes fail, and no other: the
+harness is used inside a ``block``. Each test runs as pFUnit's ``TestCase%runBare`` runs it
+(``fallback_run_test``): the ``@before`` procedure, then, only if it raised nothing, the test
+and the ``@after`` procedure (also after a failed test, never after a failed set-up).
 
 Line numbers are preserved (annotations become blank lines, asserts stay on their line),
 so compiler messages and failure reports point into the ``.pf`` file.
@@ -79,6 +82,35 @@ def fortran_string(text):
 def columns(line):
     """Line length as gfortran counts it: bytes (a UTF-8 'e' with an accent counts 2)."""
     return len(line.encode('utf-8'))
+
+
+def truncated(line):
+    """Whether gfortran, free form at its default 132 columns, reports 'Line truncated' (an
+    error by default) for `line`: gfortran 12's scanner.c load_line. It reads the first 132
+    bytes ('\\r' and NUL not counted), noting a '!' outside a character literal as a comment;
+    past column 132 it skips blanks and stops at the first other byte: the line is truncated
+    unless a comment started before, or that byte is a '!'."""
+    data = line.encode('utf-8')
+    kept, quote, comment, rest = 0, None, False, b''
+    for i, b in enumerate(data):
+        c = chr(b)
+        if c in '\r\0':
+            continue
+        if quote is None:
+            if c in "'\"":
+                quote = c
+        elif c == quote:
+            quote = None
+        if c == '!' and quote is None:
+            comment = True
+        kept += 1
+        if kept >= MAX_LINE:
+            rest = data[i + 1:]
+            break
+    if comment:
+        return False
+    rest = rest.lstrip(b' \r')
+    return bool(rest) and not rest.startswith(b'!')
 
 
 def check_arguments(args, where):
@@ -164,9 +196,10 @@ def parse(path):
             continue
         if '@assert' in line.lower().split('!')[0]:
             raise PfError(f"{where}: an @assert must stand alone on its line")
-        if columns(line) > MAX_LINE:
-            raise PfError(f"{where}: line of {columns(line)} characters, more than gfortran's "
-                          f"default {MAX_LINE} (pFUnit copies it unchanged)")
+        if truncated(line):
+            raise PfError(f"{where}: code past column {MAX_LINE} ({columns(line)} characters), "
+                          f"more than gfortran's default {MAX_LINE} (pFUnit copies the line "
+                          "unchanged; only a comment may run past it)")
         m = MODULE.match(line)
         if m and m.group(1).lower() != 'procedure':
             module = m.group(1)   # as pFUnit: the last 'module <name>' line wins
@@ -201,29 +234,33 @@ def parse(path):
 
 
 def suite_lines(module, tests, befores, afters):
-    """`<module>_suite`: runs every test, with pFUnit's suite-function scope."""
+    """`<module>_suite`: runs every test, with pFUnit's suite-function scope.
+
+    It declares `suite` and `t` and names `TestMethod`, as pFUnit's generated suite function
+    does, and nothing else: its other names (a TestMethod variable, the harness reached through
+    a USE) are local to BLOCKs, which hide the host's names, so they clash with nothing."""
     text = [f"subroutine {module}_suite()",
             "    use funit",
             f"    use {module}",
-            "    use funit_fallback_runner, only: fallback_start_test, fallback_end_test",
             "    implicit none",
             "    ! as in pFUnit's generated suite function (name clashes fail the same way)",
             "    type(TestSuite) :: suite",
             "    class(Test), allocatable :: t",
-            "    ! pFUnit builds each test with the TestMethod constructor",
-            "    type(TestMethod), allocatable :: method"]
-    # pFUnit's TestCase%runBare: set-up; then, only if the set-up raised nothing, the test
-    # and the tear-down (which runs after a failed test too, never after a failed set-up)
+            "    ! pFUnit builds each test with the TestMethod constructor (block-local: no clash)",
+            "    block",
+            "        type(TestMethod) :: method",
+            "        allocate (t, source=method)",
+            "    end block"]
+    extra = ''
+    if befores:
+        extra += f", set_up={befores[0]}"
+    if afters:
+        extra += f", tear_down={afters[0]}"
     for name in tests:
-        text.append(f"    call fallback_start_test('{module}', '{name}')")
-        if befores:
-            text.append(f"    call {befores[0]}()")
-        text.append("    if (.not. anyExceptions()) then")
-        text.append(f"        call {name}()")
-        if afters:
-            text.append(f"        call {afters[0]}()")
-        text.append("    end if")
-        text.append("    call fallback_end_test()")
+        text += ["    block",
+                 "        use funit_fallback_runner, only: fallback_run_test",
+                 f"        call fallback_run_test('{module}', '{name}', {name}{extra})",
+                 "    end block"]
     text.append(f"end subroutine {module}_suite")
     return text
 

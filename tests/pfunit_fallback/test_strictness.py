@@ -5,7 +5,8 @@ Each case is a small .pf module. Generation-time cases must make pf2f90.py fail 
 expected message; compile-time cases must generate, then fail to compile against the
 fallback's funit module with the expected compiler message; run-time cases must compile
 and the test executable must fail with the expected output. A correct module must
-generate, compile and pass, so that the refusals are not caused by a broken set-up.
+generate, compile and pass, so that the refusals are not caused by a broken set-up, and so
+must each ACCEPT case: what pFUnit 4.12 accepts, the fallback must not refuse.
 
 Usage: test_strictness.py --fc gfortran --moddir <funit .mod dir> --lib <libfunit.a>
                           --work <scratch dir>
@@ -57,6 +58,9 @@ GENERATION = [
     ('strict_long_line', module('strict_long_line', "        call sleep(0)" + ' ' * 120 + '; continue'),
      r'more than gfortran'),
     # gfortran counts bytes: 131 characters, 221 bytes
+    # a '!' inside a character literal starts no comment: the code past 132 counts
+    ('strict_long_quoted_bang', module('strict_long_quoted_bang', "        print *, 'a!b', "
+                                       + "1 + " * 30 + "1"), r'more than gfortran'),
     ('strict_long_bytes', module('strict_long_bytes', "    character(len=*), parameter :: s = '"
                                  + '\u00e9' * 90 + "'\n        @assertTrue(.true.)"),
      r'more than gfortran'),
@@ -74,6 +78,37 @@ GENERATION = [
     ('strict_module_case', module('Strict_Module_Case', "        @assertTrue(.true.)"),
      r'must be named exactly like the file'),
 ]
+
+# pFUnit 4.12 accepts these (each must generate, compile and pass)
+ACCEPT = [
+    # Assert_Real.tmpl: a no-tolerance overload (expected, actual, message, location) and a
+    # tolerance one (expected, actual, tolerance, message, location), for every comparison
+    ('strict_real_message', module('strict_real_message', "        real(real64) :: x\n"
+                                   "        x = 2.0_real64\n"
+                                   "        @assertEqual(2.0_real64, x, 'x is two')\n"
+                                   "        @assertEqual([x, x], [x, x], 'arrays')\n"
+                                   "        @assertEqual(2.0_real64, x, 0.0_real64, 'within 0')\n"
+                                   "        @assertEqual([x], [x], 0.0_real64, 'within 0')")),
+    ('strict_real_compare', module('strict_real_compare', "        real(real64) :: x\n"
+                                   "        x = 2.0_real64\n"
+                                   "        @assertLessThan(1.0_real64, x, '1 < x')\n"
+                                   "        @assertGreaterThan(x, 1.0_real64, 'x > 1')\n"
+                                   "        @assertLessThan(x, 2.0_real64, 1.0e-12_real64)\n"
+                                   "        @assertGreaterThan(x, 2.0_real64, 1.0e-12_real64, 'x > 2 - tol')")),
+    # gfortran (default 132) ignores what a comment puts past column 132; pFUnit copies the line
+    ('strict_tail_comment', module('strict_tail_comment', "        integer :: n\n        n = 1  ! "
+                                   + 'c' * 140 + "\n        @assertEqual(1, n)")),
+    # pFUnit's suite function declares `suite` and `t` only: a module may export other names
+    ('strict_suite_names', module('strict_suite_names', "        @assertEqual(1, method)",
+                                  ).replace('contains\n', '    integer, public :: method = 1, '
+                                            'fallback_start_test = 2, fallback_end_test = 3, '
+                                            'fallback_run_test = 4\ncontains\n')),
+]
+
+# fHamcrest's matcher types, public in pFUnit 4.12's FUnit (IsNear/IsRelativelyNear were split
+# into IsNear_32/_64 and IsRelativelyNear_32/_64 only after 4.14, pFUnit PR #544)
+MATCHER_TYPES = ['Every', 'AnyOf', 'AllOf', 'IsNear', 'IsRelativelyNear', 'StringContains',
+                 'StringStartsWith', 'StringEndsWith', 'IsArrayWithSize', 'Matchable']
 
 # (name, .pf text, regex the compiler output must match)
 COMPILE = [
@@ -109,6 +144,10 @@ COMPILE = [
      r"(already defined|USE-associated)"),
 ]
 
+COMPILE += [(f'strict_type_{t.lower()}', module(f'strict_type_{t.lower()}', "        @assertTrue(.true.)")
+             .replace('\ncontains\n', f'\n    type :: {t}\n    end type {t}\ncontains\n'), rf'Derived type definition of .{t.lower()}. at \(1\) has already been defined')
+            for t in MATCHER_TYPES]
+
 # (name, .pf text, regex the run output must match)
 RUN = [
     ('strict_relative_zero', module('strict_relative_zero',
@@ -134,6 +173,9 @@ RUN = [
                                  "        @assertTrue(.false., message='tear-down ran')\n"
                                  "    end subroutine tear_down\n"),
      r'(?=[\s\S]*test fails[\s\S]*tear-down ran)(?=[\s\S]*0 passed, 1 failed)'),
+    # pFUnit's assert_less_than with a tolerance: lhs < rhs + tolerance
+    ('strict_less_tol', module('strict_less_tol', "        @assertLessThan(2.0_real64, 1.5_real64, 0.5_real64)"),
+     r'is not less than'),
     # TRIM_ALL ignores the ends only: inner blanks count
     ('strict_string_inner', module('strict_string_inner', "        @assertEqual('a b', 'a  b')"),
      r'expected "a b" found "a  b"'),
@@ -204,6 +246,15 @@ def main():
     for name, text, pattern in GENERATION:
         rc, out = Case(args, name, text).generate()
         expect(rc == 1 and re.search(pattern, out), name, f'pf2f90 refuses ({pattern})', out)
+
+    for name, text in ACCEPT:
+        c = Case(args, name, text)
+        rc, out = c.generate()
+        if rc == 0:
+            rc, out = c.compile()
+        if rc == 0:
+            rc, out = c.execute()
+        expect(rc == 0 and '1 passed, 0 failed' in out, name, 'generates, compiles, passes', out)
 
     for name, text, pattern in COMPILE:
         c = Case(args, name, text)
