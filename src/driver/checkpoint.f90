@@ -6,7 +6,8 @@
 !> for the warm start, bond states and the rupture log; multipliers and constraint state of a
 !> coupling, with a beam or a continuum),
 !> the counters of the results writers and the record count of every dataset of the results
-!> file, the loop's own counters, and a header: code version, a hash of the deck's text, the
+!> file, the loop's own counters (with the wall time of the analysis up to the checkpoint and
+!> its number of runs, which a restart continues), and a header: code version, a hash of the deck's text, the
 !> kind of run, the step. What the deck builds (meshes, matrices, materials, functions) is
 !> built again from the deck at restart and not stored. There is no random state in a time
 !> loop: the random deposit is generated from the deck's seed when the model is built.
@@ -76,6 +77,13 @@ module driver_checkpoint
         !> Warnings given once: disk faster than the alert distance, blocked contacts, bonded
         !> coupled disks rotated beyond the range of the linear coupling.
         logical :: speed_warned = .false., blocked_warned = .false., rotation_warned = .false.
+        !> Wall time of the analysis up to this state, every run that led to it [s].
+        real(wp) :: wall_seconds = 0.0_wp
+        !> Runs that led to this state (1 + the restarts).
+        integer :: runs = 1
+        !> False for a checkpoint of an earlier build, which recorded neither: the wall time
+        !> of the runs before it is unknown (counted as 0, and 1 run).
+        logical :: wall_recorded = .true.
     end type loop_state_t
 
     !> When a time loop writes a checkpoint (besides signals and the end of the run).
@@ -439,6 +447,10 @@ contains
         call file%write_attribute('/loop', 'blocked_warned', merge(1, 0, loop%blocked_warned), error)
         if (allocated(error)) return
         call file%write_attribute('/loop', 'rotation_warned', merge(1, 0, loop%rotation_warned), error)
+        if (allocated(error)) return
+        call file%write_attribute('/loop', 'wall_seconds', loop%wall_seconds, error)
+        if (allocated(error)) return
+        call file%write_attribute('/loop', 'runs', loop%runs, error)
     end subroutine save_loop
 
     !> Read the loop counters.
@@ -462,7 +474,40 @@ contains
         call read_flag('speed_warned', loop%speed_warned, error)
         if (.not. allocated(error)) call read_flag('blocked_warned', loop%blocked_warned, error)
         if (.not. allocated(error)) call read_flag('rotation_warned', loop%rotation_warned, error)
+        if (.not. allocated(error)) call read_wall_time(error)
     contains
+        !> Wall time and runs up to the checkpoint; both absent in a checkpoint of an earlier
+        !> build (`wall_recorded` false, counted as 0 s and 1 run).
+        subroutine read_wall_time(error)
+            !> Set on a damaged value, or when only one of the two is there.
+            type(error_t), allocatable, intent(out) :: error
+            type(error_t), allocatable :: no_wall, no_runs
+            real(wp) :: w
+            call file%read_attribute('/loop', 'wall_seconds', w, no_wall)
+            if (.not. allocated(no_wall)) call require_finite([w], '/loop@wall_seconds', no_wall)
+            call file%read_attribute('/loop', 'runs', loop%runs, no_runs)
+            if (allocated(no_wall) .and. allocated(no_runs)) then
+                loop%wall_seconds = 0.0_wp
+                loop%runs = 1
+                loop%wall_recorded = .false.
+                return
+            end if
+            if (allocated(no_wall)) then
+                call move_alloc(no_wall, error)
+                return
+            end if
+            if (allocated(no_runs)) then
+                call move_alloc(no_runs, error)
+                return
+            end if
+            if (w < 0.0_wp) then
+                call damaged(error, '/loop@wall_seconds: '//real_text(w)//' s is negative')
+                return
+            end if
+            loop%wall_seconds = w
+            call require_range([loop%runs], 1, huge(0), '/loop@runs', error)
+        end subroutine read_wall_time
+
         subroutine read_flag(name, flag, error)
             character(len=*), intent(in) :: name
             logical, intent(out) :: flag

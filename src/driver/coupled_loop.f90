@@ -206,6 +206,7 @@ contains
         end if
         if (self%fclib_step > n_steps) call report(fclib_after_end_warning(self%fclib_step, n_steps))
         call progress%start(n_steps, self%settings%t_end, self%settings%progress_seconds)
+        if (ck%restart) call progress%resume(k0, ck%start%wall_seconds, ck%start%runs)
         call ck%schedule%start()
         do k = k0 + 1, n_steps
             call take_step_start(start, self%sys%dem%particles, self%sys%dem%walls)
@@ -246,7 +247,7 @@ contains
         if (allocated(error)) return
         call summary()
         ! n_steps <= max_steps = huge(0) (driver_config)
-        call out%write_summary(int(n_steps), progress%elapsed(), error)
+        call out%write_summary(int(n_steps), progress, error)
         if (allocated(error)) return
         call self%finish(out, error)
 
@@ -293,7 +294,8 @@ contains
             if (.not. allocated(error)) call self%cpl_out%flush_buffer(out%file, error)
             if (allocated(error)) return
             call checkpoint_create(f, ck%path, ck%deck_text, self%checkpoint_kind(), &
-                                   loop_state_t(k, unconverged, speed_warned, .false., rotation_warned), &
+                                   loop_state_t(k, unconverged, speed_warned, .false., rotation_warned, &
+                                                wall_seconds=progress%analysis_seconds(), runs=progress%runs), &
                                    self%sys%fe%t, &
                                    out%run_id, error)
             if (.not. allocated(error)) call save_coupled(f, self%sys, error)

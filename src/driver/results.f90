@@ -23,6 +23,7 @@ module driver_results
     use core_version, only: multicor_version, multicor_name
     use core_strings, only: string_t
     use io_hdf5_file, only: h5_file_t
+    use io_progress, only: progress_t
     use io_paths, only: rename_file, remove_file, copy_file, file_exists
     implicit none
     private
@@ -465,21 +466,30 @@ contains
         call self%file%write_attribute('/modal/axial_fraction', 'threshold', threshold, error)
     end subroutine writer_write_modal_kinds
 
-    !> Write run statistics as attributes of /summary.
-    subroutine writer_write_summary(self, steps, wall_seconds, error)
+    !> Write run statistics as attributes of /summary: `steps`, `wall_seconds` (the analysis,
+    !> every run of it: a restarted run adds its own time to that of the runs before its
+    !> checkpoint), `wall_seconds_last_run` (this run alone), `runs` (1 + the restarts) and
+    !> `ended`.
+    subroutine writer_write_summary(self, steps, clock, error)
         !> An open writer.
         class(results_writer_t), intent(inout) :: self
-        !> Number of time steps done.
+        !> Number of time steps done (0 for a static or modal analysis).
         integer, intent(in) :: steps
-        !> Wall time of the analysis [s].
-        real(wp), intent(in) :: wall_seconds
+        !> The run's clock (started at the start of this run's analysis; resumed at a restart).
+        type(progress_t), intent(in) :: clock
         !> Set on a write failure.
         type(error_t), allocatable, intent(out) :: error
+        real(wp) :: last_run
         call require_open(self, 'write_summary', error)
         if (allocated(error)) return
+        last_run = clock%elapsed()
         call self%file%write_attribute('/summary', 'steps', steps, error)
         if (allocated(error)) return
-        call self%file%write_attribute('/summary', 'wall_seconds', wall_seconds, error)
+        call self%file%write_attribute('/summary', 'wall_seconds', clock%earlier_seconds + last_run, error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/summary', 'wall_seconds_last_run', last_run, error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/summary', 'runs', clock%runs, error)
         if (allocated(error)) return
         call self%file%write_attribute('/summary', 'ended', iso_date_time(), error)
     end subroutine writer_write_summary

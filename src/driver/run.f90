@@ -405,6 +405,10 @@ contains
             end if
             ck%restart = .true.
             call report('restart from '//opts%restart//' at step '//to_str(ck%start%step))
+            if (.not. ck%start%wall_recorded) call report('note: the checkpoint, written by an earlier '// &
+                                                          'MULTICOR build, does not record the wall time of the '// &
+                                                          'runs before it: /summary wall_seconds counts from this '// &
+                                                          'restart')
         end subroutine open_checkpoint
 
         !> Title of the run ([run] title).

@@ -95,6 +95,7 @@ contains
         ! An export the run never reaches would pass unnoticed (the deck's end or --end).
         if (cfg%fclib_step > n_steps) call report(fclib_after_end_warning(cfg%fclib_step, n_steps))
         call progress%start(n_steps, run%t_end, run%progress_seconds)
+        if (ck%restart) call progress%resume(k0, ck%start%wall_seconds, ck%start%runs)
         call ck%schedule%start()
         do k = k0 + 1, n_steps
             call take_step_start(start, cfg%system%particles, cfg%system%walls)
@@ -133,7 +134,7 @@ contains
         if (allocated(error)) return
         call summary()
         ! n_steps <= max_steps = huge(0) (driver_config)
-        call out%write_summary(int(n_steps), progress%elapsed(), error)
+        call out%write_summary(int(n_steps), progress, error)
 
     contains
 
@@ -160,7 +161,8 @@ contains
             call writer%flush_buffer(out%file, error)
             if (allocated(error)) return
             call checkpoint_create(f, ck%path, ck%deck_text, 'particles', &
-                                   loop_state_t(k, unconverged, speed_warned, blocked_warned), &
+                                   loop_state_t(k, unconverged, speed_warned, blocked_warned, &
+                                                wall_seconds=progress%analysis_seconds(), runs=progress%runs), &
                                    cfg%system%time, out%run_id, error)
             if (.not. allocated(error)) call save_dem(f, '/dem', cfg%system, error)
             if (.not. allocated(error)) call save_dem_writer(f, writer, error)

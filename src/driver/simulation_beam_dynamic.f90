@@ -144,6 +144,7 @@ contains
             call store(error)
             if (allocated(error)) return
         end if
+        if (ck%restart) call progress%resume(k0, ck%start%wall_seconds, ck%start%runs)
         call ck%schedule%start()
         do k = k0 + 1, n_steps
             call integ%step(model, error)
@@ -170,7 +171,7 @@ contains
         call report(trim(buf))
         call report(progress%summary_line(n_steps, stopped=out%stopped()))
         ! n_steps <= max_steps = huge(0) (driver_config)
-        call out%write_summary(int(n_steps), progress%elapsed(), error)
+        call out%write_summary(int(n_steps), progress, error)
     contains
         !> Restart: integrator state and results file from the checkpoint `ck%source`.
         subroutine restore(error)
@@ -189,8 +190,9 @@ contains
             type(h5_file_t) :: f
             call out%flush(error)
             if (allocated(error)) return
-            call checkpoint_create(f, ck%path, ck%deck_text, 'beam', loop_state_t(k, 0, .false., .false.), &
-                                   integ%t, out%run_id, error)
+            call checkpoint_create(f, ck%path, ck%deck_text, 'beam', &
+                                   loop_state_t(k, 0, .false., .false., wall_seconds=progress%analysis_seconds(), &
+                                                runs=progress%runs), integ%t, out%run_id, error)
             if (.not. allocated(error)) call save_integrator(f, '/fe', integ, error)
             if (.not. allocated(error)) call save_results(f, out, error)
             call ck%finish(f, k, integ%t, error)

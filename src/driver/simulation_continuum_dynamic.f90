@@ -138,6 +138,8 @@ contains
         type(continuum_writer_t) :: writer
         ! Steps done, and at the start of the loop (a checkpoint's at a restart).
         integer(i8) :: k, k0
+        ! Progress lines and the wall time of the analysis (checkpointed).
+        type(progress_t) :: progress
         ! At a restart the file has the mesh and the series already (restore).
         if (.not. ck%restart) call writer%begin(out%file, self%model%mesh, self%settings%analysis, error)
         if (allocated(error)) return
@@ -162,7 +164,6 @@ contains
         !> checkpoint's state at a restart).
         subroutine run_dynamic(error)
             type(error_t), allocatable, intent(out) :: error
-            type(progress_t) :: progress
             integer(i8) :: n_steps
             type(step_end_t) :: act
             character(len=200) :: buf
@@ -176,6 +177,7 @@ contains
                 call store(error)
             end if
             if (allocated(error)) return
+            if (ck%restart) call progress%resume(k0, ck%start%wall_seconds, ck%start%runs)
             call ck%schedule%start()
             do k = k0 + 1, n_steps
                 call self%integ%step(self%ops, error)
@@ -209,7 +211,7 @@ contains
                 self%integ%t, ' s; energy balance residual ', self%audit%balance(), ' J'
             call report(trim(buf))
             call report(progress%summary_line(n_steps, stopped=out%stopped()))
-            call out%write_summary(int(n_steps), progress%elapsed(), error)
+            call out%write_summary(int(n_steps), progress, error)
         end subroutine run_dynamic
 
         !> Restart: integrator state, results file and writer from the checkpoint `ck%source`.
@@ -234,7 +236,8 @@ contains
             call out%flush(error)
             if (allocated(error)) return
             call checkpoint_create(f, ck%path, ck%deck_text, self%checkpoint_kind(), &
-                                   loop_state_t(k, 0, .false., .false.), self%integ%t, out%run_id, error)
+                                   loop_state_t(k, 0, .false., .false., wall_seconds=progress%analysis_seconds(), &
+                                                runs=progress%runs), self%integ%t, out%run_id, error)
             if (.not. allocated(error)) call save_integrator(f, '/fe', self%integ, error)
             if (.not. allocated(error)) call f%write_attribute('/fe', 'continuum_audit', self%audit%totals(), error)
             if (.not. allocated(error)) call save_results(f, out, error)

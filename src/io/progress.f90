@@ -4,6 +4,10 @@
 !> from `system_clock`; the text itself is built by pure helpers that take the elapsed time as
 !> an argument (`format_progress_line`, `format_summary_line`, `format_hms`), so the
 !> formatting and the ETA are testable without a clock.
+!>
+!> A run that continues an analysis from a checkpoint (`resume`) knows the steps and the wall
+!> time of the earlier runs: its ETA and its cost per step are those of its own steps, and
+!> `analysis_seconds` adds its wall time to theirs.
 module io_progress
     use core_kinds, only: wp, i8
     use core_strings, only: counted
@@ -25,13 +29,23 @@ module io_progress
         integer(i8) :: last_count = 0
         !> Clock counts per second.
         integer(i8) :: rate = 1
+        !> Steps done before this run (a restart's checkpoint step; 0 for a run from the start).
+        integer(i8) :: first_step = 0
+        !> Wall time of the earlier runs of the analysis up to that step [s].
+        real(wp) :: earlier_seconds = 0.0_wp
+        !> Runs of the analysis, this one included (1 + the restarts).
+        integer :: runs = 1
     contains
         !> Start the clock for a run of n steps to t_end, reporting every interval seconds.
         procedure :: start => progress_start
         !> True when a progress line is due (interval elapsed since the last one).
         procedure :: due => progress_due
+        !> This run continues an analysis: steps done, wall time and runs before it.
+        procedure :: resume => progress_resume
         !> Wall-clock seconds since `start`.
         procedure :: elapsed => progress_elapsed
+        !> Wall-clock seconds of the analysis: the earlier runs' and this run's.
+        procedure :: analysis_seconds => progress_analysis_seconds
         !> Progress line at a step: step, time, fraction done, elapsed and remaining time.
         procedure :: line => progress_line
         !> Closing line: steps done, wall time, time per step.
@@ -58,6 +72,22 @@ contains
         self%last_count = self%start_count
     end subroutine progress_start
 
+    !> Record that this run continues an analysis from step `first_step`, which its earlier
+    !> runs reached in `earlier_seconds` of wall time (call after `start`; the clock goes on).
+    subroutine progress_resume(self, first_step, earlier_seconds, earlier_runs)
+        !> The progress object (started).
+        class(progress_t), intent(inout) :: self
+        !> Steps done before this run.
+        integer(i8), intent(in) :: first_step
+        !> Wall time of the earlier runs [s].
+        real(wp), intent(in) :: earlier_seconds
+        !> Number of earlier runs.
+        integer, intent(in) :: earlier_runs
+        self%first_step = first_step
+        self%earlier_seconds = earlier_seconds
+        self%runs = earlier_runs + 1
+    end subroutine progress_resume
+
     !> True when at least `interval_seconds` of wall time have passed since `start` or since
     !> the last time `due` returned true (the interval then restarts).
     impure logical function progress_due(self)
@@ -80,6 +110,13 @@ contains
         progress_elapsed = real(now - self%start_count, wp)/real(self%rate, wp)
     end function progress_elapsed
 
+    !> Wall time of the analysis [s]: that of the earlier runs (`resume`) plus this run's.
+    impure real(wp) function progress_analysis_seconds(self)
+        !> The progress object.
+        class(progress_t), intent(in) :: self
+        progress_analysis_seconds = self%earlier_seconds + self%elapsed()
+    end function progress_analysis_seconds
+
     !> Progress line for the current step, e.g.
     !> `step 1200/5000 (24.0%)  t = 1.2000E-03 s  wall 00:00:12  ETA 00:00:38`.
     impure function progress_line(self, step, t) result(text)
@@ -91,11 +128,13 @@ contains
         real(wp), intent(in) :: t
         !> The line (no trailing newline).
         character(len=:), allocatable :: text
-        text = format_progress_line(step, self%total_steps, t, self%t_end, self%elapsed())
+        text = format_progress_line(step, self%total_steps, t, self%t_end, self%elapsed(), self%first_step)
     end function progress_line
 
     !> Closing line of a run, e.g. `done: 5000 steps, t = 5.0000E-03 s, wall 00:01:40
-    !> (20.000 ms/step)`, or `stopped after 2400 steps, ...` for a run stopped early.
+    !> (20.000 ms/step)`, or `stopped after 2400 steps, ...` for a run stopped early; a
+    !> restarted run gives the wall time and cost per step of its own steps, then the wall
+    !> time of the analysis (see `format_summary_line`).
     impure function progress_summary_line(self, steps, t, stopped) result(text)
         !> The progress object.
         class(progress_t), intent(in) :: self
@@ -107,7 +146,12 @@ contains
         logical, intent(in), optional :: stopped
         !> The line.
         character(len=:), allocatable :: text
-        text = format_summary_line(steps, self%elapsed(), t, stopped)
+        if (self%runs > 1) then
+            text = format_summary_line(steps, self%elapsed(), t, stopped, self%first_step, &
+                                       self%earlier_seconds + self%elapsed(), self%runs)
+        else
+            text = format_summary_line(steps, self%elapsed(), t, stopped)
+        end if
     end function progress_summary_line
 
     !> Estimated remaining wall time [s] after `step` of `total_steps` steps took `elapsed`
@@ -127,7 +171,7 @@ contains
     end function eta_seconds
 
     !> Progress line built from explicit values (see `progress_t%line`).
-    pure function format_progress_line(step, total_steps, t, t_end, elapsed) result(text)
+    pure function format_progress_line(step, total_steps, t, t_end, elapsed, first_step) result(text)
         !> Steps done.
         integer(i8), intent(in) :: step
         !> Number of steps of the run.
@@ -136,12 +180,17 @@ contains
         real(wp), intent(in) :: t
         !> End time of the run [s] (not shown when <= 0).
         real(wp), intent(in) :: t_end
-        !> Wall time spent so far [s].
+        !> Wall time spent so far [s] (by this run).
         real(wp), intent(in) :: elapsed
+        !> Steps done before this run, which `elapsed` does not cover (a restart; default 0).
+        integer(i8), intent(in), optional :: first_step
         !> The line.
         character(len=:), allocatable :: text
         character(len=64) :: buf
         real(wp) :: percent
+        integer(i8) :: k0
+        k0 = 0
+        if (present(first_step)) k0 = first_step
         write (buf, '(i0,a,i0)') step, '/', total_steps
         text = 'step '//trim(buf)
         if (total_steps > 0) then
@@ -155,38 +204,56 @@ contains
             text = text//' / '//trim(adjustl(buf))
         end if
         text = text//' s  wall '//format_hms(elapsed)//'  ETA ' &
-               //format_hms(eta_seconds(step, total_steps, elapsed))
+               //format_hms(eta_seconds(step - k0, total_steps - k0, elapsed))
     end function format_progress_line
 
     !> Summary line built from explicit values (see `progress_t%summary_line`).
-    pure function format_summary_line(steps, elapsed, t, stopped) result(text)
-        !> Steps done.
+    pure function format_summary_line(steps, elapsed, t, stopped, first_step, analysis_seconds, runs) result(text)
+        !> Steps done (by the analysis, earlier runs included).
         integer(i8), intent(in) :: steps
-        !> Wall time of the run [s].
+        !> Wall time of this run [s].
         real(wp), intent(in) :: elapsed
         !> Simulated time reached [s] (not shown when absent).
         real(wp), intent(in), optional :: t
         !> Whether the run was stopped before its end: 'stopped after N steps' instead of
         !> 'done: N steps' (default .false.).
         logical, intent(in), optional :: stopped
+        !> Steps done before this run (a restart): the line then says how many steps this
+        !> run did, and the cost per step is `elapsed` over those (default 0).
+        integer(i8), intent(in), optional :: first_step
+        !> Wall time of the analysis, earlier runs included [s] (shown with `runs`).
+        real(wp), intent(in), optional :: analysis_seconds
+        !> Runs of the analysis, this one included (shown with `analysis_seconds`).
+        integer, intent(in), optional :: runs
         !> The line.
         character(len=:), allocatable :: text
         character(len=64) :: buf
         logical :: early
+        integer(i8) :: k0, own
         early = .false.
         if (present(stopped)) early = stopped
+        k0 = 0
+        if (present(first_step)) k0 = first_step
+        own = steps - k0
         if (early) then
             text = 'stopped after '//counted(steps, 'step')
         else
             text = 'done: '//counted(steps, 'step')
+        end if
+        if (k0 > 0) then
+            write (buf, '(i0)') own
+            text = text//' ('//trim(buf)//' in this run)'
         end if
         if (present(t)) then
             write (buf, '(es12.4e3)') t
             text = text//', t = '//trim(adjustl(buf))//' s'
         end if
         text = text//', wall '//format_hms(elapsed)
-        if (steps > 0) then
-            text = text//' ('//fixed(1000.0_wp*elapsed/real(steps, wp), '(f0.3)')//' ms/step)'
+        if (own > 0) then
+            text = text//' ('//fixed(1000.0_wp*elapsed/real(own, wp), '(f0.3)')//' ms/step)'
+        end if
+        if (present(analysis_seconds) .and. present(runs)) then
+            text = text//'; analysis '//format_hms(analysis_seconds)//' in '//counted(runs, 'run')
         end if
     end function format_summary_line
 

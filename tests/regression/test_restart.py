@@ -44,9 +44,11 @@ import numpy as np
 
 from checks import check, summary
 
-# Attributes that measure wall-clock time or dates: they differ between any two runs.
-CLOCK_ATTRIBUTES = {"created", "ended", "wall_seconds", "detection_seconds", "solver_seconds",
-                    "run_id"}
+# Attributes that measure wall-clock time or dates: they differ between any two runs; and the
+# count of runs that made the file (/summary@runs: 2 for a restarted run, 1 for the
+# uninterrupted one).
+CLOCK_ATTRIBUTES = {"created", "ended", "wall_seconds", "wall_seconds_last_run", "runs",
+                    "detection_seconds", "solver_seconds", "run_id"}
 
 # Two touching bonded disks spinning at 5 rad/s about their contact point (test_initial_bonds.py):
 # the bond is made on the positions at t = 0, before the first step, and carried by the
@@ -763,6 +765,74 @@ def signal_with_end(exe, deck_src, work, name, end, t_stop, min_step):
         compare(name, folder / f"{deck.stem}.h5", ref_folder / f"{deck.stem}.h5")
 
 
+def wall_time_over_runs(exe, src, work):
+    """/summary@wall_seconds of a restarted run is the wall time of the analysis over its runs:
+    the time recorded in the checkpoint it starts from plus its own (wall_seconds_last_run), so
+    that it covers the solver's time (/dem/solver detection_seconds + solver_seconds, which
+    also count every run); runs = 2. Its `done:` line gives the cost per step of its own
+    steps. A checkpoint of an earlier build (without /loop@wall_seconds and runs) still
+    restarts, with a note, the count then starting at the restart."""
+    # 500 steps of a deposit, most of the wall time in the contact solver: the first run does
+    # 480 steps (--end 0.96 s), the restart 20; the last run alone takes about 1/25 of the
+    # solver's total.
+    deck = edit_deck(src / "input" / "siconos_deposit_200.dat", work / "wall_runs.dat", end=1.0)
+    folder = work / "wall_runs"
+    first = run(exe, deck, "--output", folder, "--quiet", "--end", 0.96)
+    check("wall_runs: first part exit 0", first.returncode == 0, (first.stdout + first.stderr)[-300:])
+    if first.returncode != 0:
+        return
+    old = work / "wall_runs_old"
+    shutil.copytree(folder, old)
+    with h5py.File(folder / "checkpoint.h5", "r") as c:
+        loop = dict(c["loop"].attrs)
+    check("wall_runs: the checkpoint records the wall time and the run",
+          float(loop.get("wall_seconds", -1)) > 0 and int(loop.get("runs", 0)) == 1, str(loop))
+    second = run(exe, deck, "--output", folder, "--restart", folder / "checkpoint.h5")
+    check("wall_runs: restart exit 0", second.returncode == 0, (second.stdout + second.stderr)[-300:])
+    if second.returncode != 0:
+        return
+    with h5py.File(folder / "wall_runs.h5", "r") as f:
+        s = dict(f["summary"].attrs)
+        solver = f["dem/solver"].attrs
+        in_solver = float(solver["detection_seconds"]) + float(solver["solver_seconds"])
+    total, last = float(s["wall_seconds"]), float(s.get("wall_seconds_last_run", np.nan))
+    check("wall_runs: /summary runs = 2", int(s.get("runs", 0)) == 2, str(s))
+    # total = checkpoint's + last, one double addition: within a few ulps of the total.
+    earlier = float(loop.get("wall_seconds", np.nan))
+    check("wall_runs: wall_seconds = the checkpoint's wall time + wall_seconds_last_run",
+          abs(total - (earlier + last)) <= 4 * np.spacing(total), f"{total} vs {earlier} + {last}")
+    # Detection and solver are timed inside the steps, on the clock that times the loop, in
+    # both runs; 1e-9 s for the rounding of their sums over 500 steps.
+    check("wall_runs: wall_seconds covers the detection and solver time of every run",
+          total + 1e-9 >= in_solver, f"wall {total} s, detection + solver {in_solver} s")
+    m = re.search(r"^done: 500 steps \(20 in this run\), t = \S+ s, wall \S+ \((\S+) ms/step\); "
+                  r"analysis \S+ in 2 runs$", second.stdout, flags=re.M)
+    check("wall_runs: the done: line counts the run's own 20 steps and the 2 runs", m is not None,
+          second.stdout.strip()[-400:])
+    if m:
+        # The line's time is read just before wall_seconds_last_run (the closing statistics
+        # written in between take milliseconds): 20 steps at the printed cost make the run's
+        # time to 0.2 s; the cost over all 500 steps would be 25 times smaller.
+        check("wall_runs: ms/step = the run's wall time / its 20 steps",
+              abs(float(m.group(1)) * 20 / 1000 - last) <= 0.2, f"{m.group(1)} ms/step, {last} s")
+    # A checkpoint of an earlier build: neither attribute.
+    with h5py.File(old / "checkpoint.h5", "r+") as c:
+        for k in ("wall_seconds", "runs"):
+            if k in c["loop"].attrs:
+                del c["loop"].attrs[k]
+    proc = run(exe, deck, "--output", old, "--restart", old / "checkpoint.h5")
+    check("wall_runs_old: a checkpoint without wall time restarts, with a note",
+          proc.returncode == 0 and "note: the checkpoint, written by an earlier MULTICOR build, does not "
+          "record the wall time" in proc.stdout, (proc.stdout + proc.stderr)[-300:])
+    if proc.returncode == 0:
+        with h5py.File(old / "wall_runs.h5", "r") as f:
+            s = dict(f["summary"].attrs)
+        check("wall_runs_old: wall_seconds counts from the restart, runs = 2",
+              s.get("wall_seconds") == s.get("wall_seconds_last_run") and int(s.get("runs", 0)) == 2,
+              str(s))
+        compare("wall_runs_old", old / "wall_runs.h5", folder / "wall_runs.h5")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--exe", required=True)
@@ -865,6 +935,7 @@ def main():
     # A displacement prescribed in time inside the overlap: the continuum's audit and the
     # multipliers' work through the prescribed dofs come back from the checkpoint.
     by_end_time(exe, decks / "coupled2d_driven_edge.dat", work, "coupled2d_driven_end", 4.43e-4)
+    wall_time_over_runs(exe, src, work)
     refusals(exe, beam, work)
     two_decks_one_folder(exe, src, work)
     damaged_bytes(exe, src, work)
