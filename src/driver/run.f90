@@ -30,6 +30,7 @@ module driver_run
     use core_strings, only: string_t, to_str, num => sci_text
     use io_lock, only: lock_t, lock_acquire, lock_release
     use io_memory, only: available_memory
+    use io_progress, only: progress_t
     use core_signals, only: caught_signal, signal_name, install_signal_handlers
     use io_deck_schema, only: multicor_schema
     use io_deck, only: deck_t, deck_entry_t, read_deck
@@ -87,6 +88,9 @@ contains
         type(checkpoint_run_t) :: ck
         character(len=:), allocatable :: dir, created, path, warning, kind, run_id
         character(len=32) :: tbuf
+        ! Wall time of a static or modal analysis, from the model's build (`init`: assembly,
+        ! factorisations, and for some kinds the solve) to its results written.
+        type(progress_t) :: clock
 
         if (present(stopped_by)) stopped_by = 0
         call read_deck(opts%deck_path, multicor_schema(), deck, error)
@@ -95,6 +99,7 @@ contains
         if (allocated(error)) return
         call check_model_size(deck, error)
         if (allocated(error)) return
+        call clock%start(0_i8, 0.0_wp, 0.0_wp)
         call sim%init(deck, report, error)
         if (allocated(error)) return
         kind = sim%checkpoint_kind()
@@ -181,6 +186,9 @@ contains
             end if
             if (allocated(error)) return
             call sim%run(out, opts%quiet, report, ck, error)
+            ! A time loop writes /summary itself; a static or modal analysis (no checkpoint
+            ! kind) has no steps, and its wall time is that of `clock`.
+            if (.not. allocated(error) .and. len(kind) == 0) call out%write_summary(0, clock, error)
             if (allocated(error)) then
                 call out%abort()
                 error%message = deck%file//': '//error%message

@@ -55,6 +55,23 @@ def multicor(exe, deck, work, quiet=True):
     return out / f"{deck.stem}.h5", proc
 
 
+def check_summary_without_steps(name, h5, seconds):
+    """/summary of a static or modal analysis (doc/output.md): finished, steps = 0, its wall
+    time (building the model, solving, writing: at most the `seconds` the process took, which
+    the caller measured around it), that of its only run, and the date-time it ended."""
+    import re
+    import h5py
+    import math
+    with h5py.File(h5, "r") as f:
+        s = dict(f["summary"].attrs)
+    wall = float(s.get("wall_seconds", math.nan))
+    ok = (int(s.get("finished", 0)) == 1 and s.get("status") == "finished" and int(s.get("steps", -1)) == 0
+          and int(s.get("runs", 0)) == 1 and 0 <= wall <= seconds
+          and s.get("wall_seconds_last_run") == wall
+          and re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d[+-]\d\d:\d\d", str(s.get("ended", ""))) is not None)
+    return check(f"{name}: /summary steps = 0, wall_seconds (<= the process's {seconds:.3f} s), ended", ok, str(s))
+
+
 def plots(src, h5, out, names):
     """plot_results.py on a results file, as ./run.sh calls it after a run (with Python's
     warnings turned into errors): check that it exits 0, prints nothing on stderr and writes

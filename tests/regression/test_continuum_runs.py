@@ -21,14 +21,16 @@
 Usage (ctest does this): test_continuum_runs.py --exe multicor --work DIR --source REPO
 """
 import math
+import re
 import shutil
 import subprocess
 import sys
+import time
 
 import h5py
 import numpy as np
 
-from checks import arguments, check, multicor, plots, summary
+from checks import arguments, check, check_summary_without_steps, multicor, plots, summary
 from paraview_read import read_paraview
 
 
@@ -325,6 +327,19 @@ def xdmf_paraview(h5_static, h5_dynamic, work):
     check("meshio opens the static XDMF (no pvpython)", np.array_equal(m.point_data["displacement"], d), "meshio")
 
 
+def summary_without_steps(exe, src, work):
+    """A static and a modal analysis write /summary as a time loop does: steps (0),
+    wall_seconds and ended (a sweep over them gets its wall-time column)."""
+    static = src / "input" / "continuum_cantilever.dat"
+    text = re.sub(r"^analysis\s*=\s*static", "analysis = modal\n[modal]\nmodes = 3", static.read_text(),
+                  count=1, flags=re.M)
+    modal = write_deck(work, "cantilever_modal", text)
+    for deck in (static, modal):
+        start = time.monotonic()
+        h5, _ = multicor(exe, deck, work / "summary")
+        check_summary_without_steps(deck.name, h5, time.monotonic() - start)
+
+
 def main():
     exe, work, src = arguments()
     h5_static = static_cantilever(exe, src, work)
@@ -333,6 +348,7 @@ def main():
     energy_balance(exe, src, work)
     gmsh_block(exe, src, work)
     timed_loads(exe, work)
+    summary_without_steps(exe, src, work)
     h5_dynamic = work / "continuum_cantilever_dynamic" / "continuum_cantilever_dynamic.h5"
     xdmf_paraview(h5_static, h5_dynamic, work)
     # every dataset with a physical unit carries it (doc/output.md), static and modal too
