@@ -176,6 +176,22 @@ def main():
               and math.isclose(vx, ref_vx, rel_tol=1e-10), f"vx={vx!r} closed form {ref_vx!r}")
     check("the table counts the starts of p002", rows.get("p002", {}).get("starts")
           == str(len(starts)), "")
+    # Its wall time is that of the whole analysis: every start continued the count from the
+    # checkpoint written at its stop (doc/cluster.md), so it covers the last start's and the
+    # time in detection and in the solver, which also count every start (1e-9 s for the
+    # rounding of their sums over the steps).
+    r = rows.get("p002", {})
+    wall = float(r.get("summary.wall_seconds") or "nan")
+    last = float(r.get("summary.wall_seconds_last_run") or "nan")
+    import h5py
+    with h5py.File(folder / "runs" / "p002" / "p002.h5", "r") as f:
+        solver = f["dem/solver"].attrs
+        in_solver = float(solver["detection_seconds"]) + float(solver["solver_seconds"])
+    check("p002: summary.wall_seconds covers every start (summary.runs = starts)",
+          r.get("summary.runs") == str(len(starts)) and wall >= last
+          and wall + 1e-9 >= in_solver,
+          f"runs {r.get('summary.runs')}, wall {wall} s, last start {last} s, "
+          f"detection + solver {in_solver} s")
 
     # the same deck run without interruption: the same numbers, bit for bit
     ref = work / "uninterrupted"
@@ -183,7 +199,6 @@ def main():
                            "--output", str(ref)], capture_output=True, text=True)
     if proc.returncode != 0:
         raise SystemExit(f"uninterrupted run failed: {proc.stdout}{proc.stderr}")
-    import h5py
     import numpy as np
     with h5py.File(ref / "p002.h5", "r") as a, \
             h5py.File(folder / "runs" / "p002" / "p002.h5", "r") as b:
