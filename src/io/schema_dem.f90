@@ -13,6 +13,12 @@ module io_schema_dem
     !> Words naming a DOF: the [beam] and [particles] vocabularies are both accepted
     !> (u = x, w = y, theta = rot).
     character(len=*), parameter :: dof_words = 'x y rot u w theta'
+    !> Largest friction coefficient of a law or a bond. The bi-potential local solver weighs
+    !> the normal velocity against mu |u_t| (De Saxce's velocity): an oblique impact on a wall
+    !> is exact up to mu = 1e4 and from 2e4 the disk sinks into the wall (steps unconverged),
+    !> from 1e16 the contact acts no more, silently. 1000 keeps a factor 10 of margin and
+    !> already sticks wherever a measured friction coefficient (at most a few) does.
+    real(wp), parameter :: max_friction = 1000.0_wp
     public :: add_particles, add_walls, add_contacts, add_solver
 
 contains
@@ -119,10 +125,13 @@ contains
                            'friction, Newton restitution, cohesion) and contact detection. A pair of '// &
                            'materials without a law is frictionless, perfectly plastic (e = 0), not cohesive.')
         call s%add_keyword('contacts', 'law', [int_field('material1', lower=1), &
-                                               int_field('material2', lower=1), real_field('mu', '', lower=0.0_wp), &
+                                               int_field('material2', lower=1), &
+                                               real_field('mu', '', lower=0.0_wp, upper=max_friction), &
                                                real_field('restitution', '', lower=0.0_wp, upper=1.0_wp), &
                                                real_field('cohesion', 'Pa', lower=0.0_wp)], &
-                           'Law of the contacts between two materials (either order): friction coefficient, '// &
+                           'Law of the contacts between two materials (either order): friction coefficient '// &
+                           '(at most 1000, which sticks wherever a real contact does: the local solver is exact '// &
+                           'to 1e4 and loses the normal direction beyond, letting disks sink), '// &
                            'restitution coefficient, cohesion stress sigma_cohe (the bond holds a tension '// &
                            'sigma_cohe times the mean radius of the pair per unit thickness; bonds form '// &
                            'between touching disks at t = 0 and break for good once a bound of their law is '// &
@@ -132,10 +141,12 @@ contains
                            'with both 0 they hold opening only (a hinge).', &
                            tails=[tail([real_field('rolling', 'm', lower=0.0_wp)], 0, 1)], repeatable=.true.)
         call s%add_keyword('contacts', 'bond', [int_field('material1', lower=1), &
-                                                int_field('material2', lower=1), real_field('mu_b', '', lower=0.0_wp)], &
+                                                int_field('material2', lower=1), &
+                                                real_field('mu_b', '', lower=0.0_wp, upper=max_friction)], &
                            'Bounds of the bonds between two materials (either order; the pair needs a law '// &
                            'with cohesion): an intact bond holds |r_t| <= mu_b (r_n + r_cohe) and |M| <= e_b '// &
-                           '(r_n + r_cohe), e_b in m (default: half the mean radius of the pair, the moment '// &
+                           '(r_n + r_cohe), mu_b at most 1000 as mu, e_b in m (default: half the mean radius of '// &
+                           'the pair, the moment '// &
                            'capacity of a rigid-plastic bond section, doc/theory.md). A bond that reaches a '// &
                            'bound breaks for good (tension, shear or moment) and the contact follows `law`.', &
                            tails=[tail([real_field('e_b', 'm', lower=0.0_wp)], 0, 1)], repeatable=.true.)
