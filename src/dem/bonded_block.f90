@@ -17,18 +17,36 @@
 !> CHOLMOD (core_sparse) as a simplicial L D L^T, the form whose rows CHOLMOD can delete
 !> (below); on the reference stack its solves cost no more than the supernodal L L^T's.
 !>
-!> Regularisation: eps = 1e-12 max diag(W_BB). Redundant bonds (a closed loop, e.g. a
+!> Scaling and regularisation: the factor is of S W_BB S + E, S = diag(H_B^T M^-1 H_B)^(-1/2)
+!> (W_BB's own diagonal without coupling rows) and E diagonal, eps_force = 1e-8 on the force
+!> components (r_n, r_t) and eps_moment = 1e-12 on the moments; the passes solve for y = S^-1
+!> dr. W_nn and W_tt are in 1/kg, W_mm in 1/(kg m^2): the former eps = 1e-12 max diag(W_BB)
+!> was, for the force components, 1e-12 W_mm/W_nn ~ 2e-12/R^2 of their diagonal: 2e-8 for
+!> R = 1 cm, but 200 for micrometre grains in metres (R = 1e-7 m), whose bonds then converged
+!> by 2.5e-5 per pass, every step unconverged with the bond carrying 2.4 % of the load. Scaled,
+!> every diagonal entry is 1 and the block, its convergence and its choice among redundant
+!> reactions are the same in any unit of length. With the coupling rows the scaled diagonal of
+!> W_BB is below 1 (a glued disk's mobility less the beam's share): its entries round off as
+!> those of H_B^T M^-1 H_B, to which E is relative. Redundant bonds (a closed loop, e.g. a
 !> triangle of a hexagonal stack, or bonds between disks glued to a beam) make W_BB singular:
-!> its kernel holds the self-stresses, which the velocities do not see. eps I makes the matrix
-!> definite. The factorisation of a semi-definite matrix in floating point meets pivots of
-!> the size of the rounding of its entries, about 1e-16 max diag, so 1e-12 keeps four orders
-!> of margin. With the coupling rows, eps is 1e-12 max diag(H_B^T M^-1 H_B): W_BB's entries
-!> are then differences of those (a glued disk's mobility less the beam's share), round off
-!> as those, and can be a thousand times smaller.
+!> its kernel holds the self-stresses, which the velocities do not see; E makes the matrix
+!> definite. The two values are those the former eps had, per component, at the centimetre
+!> scale where the decks and tests were made: the least norm (below) multiplies the rounding of
+!> the kernel (relative u ~ 1e-16 of the entries) by about u/eps^2, 1 for eps_force, which the
+!> kernels of the force components need (a lattice torn by imposed velocities, whose block has
+!> no solution: with 1e-12 its reactions reached 5e6 and flung disks at 1 600 m/s; the glued
+!> stack below gained energy), while the bending modes of a long row, eigenvalues down to about
+!> 1e-7 of the diagonal, need a small eps on the moments to converge in a few passes (1e-8
+!> there: errors of 9e-6 on a clamped row of 50 disks). The moments' self-stresses in loops are
+!> then set to about u/eps_moment^2 = 1e-8 relative (a lattice at two units of length: moments
+!> equal to 1.1e-7, forces to 1e-12).
 !>
-!> Least norm: each pass takes dr = W_BB (W_BB + eps I)^-2 (-u_B), two solves with the same
-!> factor (`solve_least_norm`): the change of (W_BB + eps I)^-1 (-u_B) to a relative eps/lambda
-!> on an eigen-component lambda >> eps, and none on the kernel. The first solve alone
+!> Least norm: each pass takes y = (A + E)^-1 A (A + E)^-1 S (-u_B), A = S W_BB S, dr = S y
+!> (two solves with the same factor, `solve_least_norm`; W_BB (W_BB + eps I)^-2 when E = eps I,
+!> as written below): the change of (A + E)^-1 S (-u_B) to a relative eps/lambda on an
+!> eigen-component lambda >> eps, and none on the kernel. The metric of the least norm is
+!> y^T E y = sum eps_c W_uu dr_u^2: each component weighted by its own mobility, independent
+!> of the units. The first solve alone
 !> multiplies by 1/eps the part of -u_B in the kernel, which no change of the reactions
 !> removes: round-off of the velocities, or targets of bonds and coupling rows that disagree
 !> by a little. That part became a self-stress of the bonds and the coupling rows 10^12 times
@@ -46,8 +64,11 @@
 !> of a long chain are poorly determined by W_BB, whose condition grows like N^4, and the
 !> velocity residual is the exact one): each pass contracts a component by
 !> 1 - lambda^2/(lambda + eps)^2 and, for a singular but consistent system, converges to the
-!> solution of least norm. It stops at the round-off of the velocities (64 eps |v|, as the
-!> NLGS's floor), when the residual no longer halves, or after max_passes.
+!> solution of least norm. The residual is measured in velocities, rotations times the mean
+!> radius (as the noise below and `measure`; in rad/s the rotations' round-off, 1/R times the
+!> rest, stalled the scaled passes and made every stale factor look worn: 890 factorisations in
+!> 1000 steps of the reference stack instead of 2). It stops at the round-off of the velocities
+!> (64 eps |v|, as the NLGS's floor), when the residual no longer halves, or after max_passes.
 !>
 !> Reuse: the symbolic analysis is kept while the bond graph (the pairs of B and their
 !> locked components, in order) does not change. The values of W_BB change at every step in
@@ -75,8 +96,10 @@
 !> it). A dead slot's entries are zeros and its diagonal 1 in the values, so a refactor with
 !> the current values (stale factor) keeps it dead, and the stale test compares the live
 !> entries only. Within a step the values do not change: the passes after a release keep
-!> those of the first (and its eps). A checkpoint holds the values of the last factorisation,
-!> the dead slots and the slots deleted since, in order; the restart factors those values and
+!> those of the first (and their scaling). The factor keeps the scaling S it was made with
+!> (scale_factored): a stale factor solves with it, as the matrix it factored. A checkpoint
+!> holds the values of the last factorisation, its scaling, the dead slots and the slots
+!> deleted since, in order; the restart factors those values and
 !> deletes them again, so that the factor, and the run, stay bitwise the same.
 !>
 !> Outer check (`bonded_block_solve`): after a converged solve every bond of B is checked
@@ -116,11 +139,14 @@ module dem_bonded_block
     use dem_solve_method, only: solve_method_t
     implicit none
     private
-    public :: bonded_block_t, bonded_block_counts_t, bonded_block_method_t, bonded_block_eps_ratio, &
+    public :: bonded_block_t, bonded_block_counts_t, bonded_block_method_t, bonded_block_eps_force, bonded_block_eps_moment, &
               bonded_block_restore
 
-    !> Regularisation eps relative to the largest diagonal entry of W_BB (module header).
-    real(wp), parameter :: bonded_block_eps_ratio = 1.0e-12_wp
+    !> Regularisation of the scaled block S W_BB S (module header, "Scaling and
+    !> regularisation"): eps on the force components (r_n, r_t), ...
+    real(wp), parameter :: bonded_block_eps_force = 1.0e-8_wp
+    !> ... and on the moments.
+    real(wp), parameter :: bonded_block_eps_moment = 1.0e-12_wp
     !> Largest number of passes (solve and refinements) per block solve.
     integer, parameter :: max_passes = 6
     !> A kept factor of older values is refactored when a pass reduces the residual by less
@@ -224,7 +250,7 @@ module dem_bonded_block
         !> whose velocities are imposed apart (the regularised solve then leaves a residual
         !> of the order of the velocities, with reactions of order 1/eps).
         logical :: consistent = .true.
-        !> W_BB + eps I (lower triangle).
+        !> S W_BB S + E (lower triangle; module header, "Scaling and regularisation").
         type(sparse_matrix_t) :: mat
         !> Its factorisation.
         type(sparse_solver_t) :: solver
@@ -244,11 +270,11 @@ module dem_bonded_block
         integer(i8), allocatable :: pos(:)
         !> Values of the last factorisation.
         real(wp), allocatable :: values_factored(:)
-        !> Regularisation of the current values (mat%values).
-        real(wp) :: eps = 0.0_wp
-        !> Regularisation of the values of the factor (values_factored), which `solve_least_norm`
-        !> takes out again.
-        real(wp) :: eps_factored = 0.0_wp
+        !> Scaling S of the current values (nu): mat%values holds S W_BB S + E.
+        real(wp), allocatable :: scale(:)
+        !> Scaling of the values of the factor (values_factored), with which `solve_least_norm`
+        !> scales the right-hand side and the change.
+        real(wp), allocatable :: scale_factored(:)
         !> Work arrays (nu).
         real(wp), allocatable :: rhs(:), x(:), y(:)
         !> Bonds released by the outer check that are swept in this solve (contacts), their
@@ -271,8 +297,8 @@ module dem_bonded_block
         !> factored at the next `prepare` when its bond graph is the restored key, and the
         !> slots then deleted from it, in order.
         real(wp), allocatable :: restore_values(:)
-        !> See `restore_values`: their regularisation.
-        real(wp) :: restore_eps = 0.0_wp
+        !> See `restore_values`: their scaling.
+        real(wp), allocatable :: restore_scale(:)
         !> See `restore_values`.
         integer, allocatable :: restore_deleted(:)
     contains
@@ -313,15 +339,15 @@ contains
     !> whose bond graph is that one factors these values instead of the current ones, so
     !> that the same (possibly stale) factor is used as in the uninterrupted run and the
     !> results stay bitwise the same; otherwise it proceeds as usual.
-    subroutine bonded_block_restore(block, key_i1, key_i2, key_rows, values, eps, dead, deleted)
+    subroutine bonded_block_restore(block, key_i1, key_i2, key_rows, values, scale, dead, deleted)
         !> The block (new).
         type(bonded_block_t), intent(inout) :: block
         !> Bond graph of the factor: pairs and locked components (bitmask) of each slot.
         integer, intent(in) :: key_i1(:), key_i2(:), key_rows(:)
         !> Values of the factor.
         real(wp), intent(in) :: values(:)
-        !> Their regularisation (eps_factored).
-        real(wp), intent(in) :: eps
+        !> Their scaling S (scale_factored: the values are S W_BB S + E), one per unknown.
+        real(wp), intent(in) :: scale(:)
         !> Dead slots (identity rows in the factor), and those of them deleted from it after
         !> its factorisation, in order.
         logical, intent(in) :: dead(:)
@@ -332,7 +358,7 @@ contains
         block%key_rows = key_rows
         block%dead = dead
         block%restore_values = values
-        block%restore_eps = eps
+        block%restore_scale = scale
         block%restore_deleted = deleted
         block%analysed = .false.
         block%factored = .false.
@@ -507,7 +533,7 @@ contains
         type(error_t), allocatable :: error
         integer :: k, b, u, i, nc
         integer, allocatable :: cur(:), newly(:)
-        logical :: match, excl, restoring, fresh, reassemble
+        logical :: match, excl, restoring, fresh, reassemble, ok
         real(wp), allocatable :: current(:)
         if (allocated(self%member)) then
             if (size(self%member) < cs%n) deallocate (self%member)
@@ -611,27 +637,12 @@ contains
                     self%mat%values(self%pos(i)) = self%mat%values(self%pos(i)) + self%tv(i)
                 end do
             end if
-            self%eps = 0.0_wp
-            do b = 1, self%nb
-                if (self%dead(b)) cycle
-                do u = self%first(b), self%first(b + 1) - 1
-                    self%eps = max(self%eps, self%mat%values(self%diag(u)))
-                end do
-            end do
-            ! with the coupling rows' share, W_BB's entries are differences of those of
-            ! H_B^T M^-1 H_B, and round off as those (module header)
-            if (self%nt_plain < self%nt) self%eps = max(self%eps, plain_diagonal_max(self))
-            self%eps = bonded_block_eps_ratio*self%eps
-            if (self%eps <= 0.0_wp) then
+            ! Jacobi scaling: S W_BB S + E, S = diag(H_B^T M^-1 H_B)^(-1/2) (module header)
+            call scale_values(self, ok)
+            if (.not. ok) then
                 call give_up(self)
                 return
             end if
-            do b = 1, self%nb
-                if (self%dead(b)) cycle
-                do u = self%first(b), self%first(b + 1) - 1
-                    self%mat%values(self%diag(u)) = self%mat%values(self%diag(u)) + self%eps
-                end do
-            end do
         end if
         call clear_dead(self)
         call size_work(self)
@@ -645,14 +656,14 @@ contains
             self%counts%analyses = self%counts%analyses + 1
         end if
         if (restoring) then
-            if (size(self%restore_values) == size(self%mat%values)) then
+            if (size(self%restore_values) == size(self%mat%values) .and. size(self%restore_scale) == self%nu) then
                 ! the factor of the checkpoint with its deletions, then the current values as
                 ! after a reuse
                 current = self%mat%values
                 self%mat%values = self%restore_values
                 deallocate (self%restore_values)
                 call refactor(self)
-                self%eps_factored = self%restore_eps
+                self%scale_factored = self%restore_scale
                 self%mat%values = current
                 if (self%factored) call delete_slots(self, self%restore_deleted)
                 if (self%factored) call delete_slots(self, newly)
@@ -853,7 +864,7 @@ contains
         self%factored = .true.
         self%stale = .false.
         self%values_factored = self%mat%values
-        self%eps_factored = self%eps
+        self%scale_factored = self%scale
         self%n_deleted = 0
         self%counts%factorisations = self%counts%factorisations + 1
     end subroutine refactor
@@ -952,24 +963,68 @@ contains
         if (present(bilateral)) call add_mobility(self, cs, im, bilateral)
     end subroutine assemble
 
-    !> Largest diagonal entry of H_B^T M^-1 H_B over the live slots (the first nt_plain
-    !> entries of the assembly, summed in their order).
-    pure real(wp) function plain_diagonal_max(self) result(m)
+    !> Diagonal of H_B^T M^-1 H_B (the first nt_plain entries of the assembly, summed in
+    !> their order): W_BB's own without coupling rows, else the mobility of the bonds' disks
+    !> before the rows take their share.
+    pure function plain_diagonal(self) result(d)
         type(bonded_block_t), intent(in) :: self
         real(wp) :: d(self%nu)
-        integer :: i, b, u
+        integer :: i
         d = 0.0_wp
         do i = 1, self%nt_plain
             if (self%ti(i) == self%tj(i)) d(self%ti(i)) = d(self%ti(i)) + self%tv(i)
         end do
-        m = 0.0_wp
-        do b = 1, self%nb
-            if (self%dead(b)) cycle
-            do u = self%first(b), self%first(b + 1) - 1
-                m = max(m, d(u))
+    end function plain_diagonal
+
+    !> Regularisation of unknown u of the scaled block: bonded_block_eps_moment on a moment,
+    !> bonded_block_eps_force on a force (module header).
+    pure real(wp) function eps_of(self, u) result(eps)
+        type(bonded_block_t), intent(in) :: self
+        integer, intent(in) :: u
+        eps = merge(bonded_block_eps_moment, bonded_block_eps_force, self%comp(u) == 3)
+    end function eps_of
+
+    !> Scale the assembled values of W_BB (mat%values) to S W_BB S and add E on the live
+    !> unknowns (module header, "Scaling and regularisation"): S = diag(H_B^T M^-1 H_B)^(-1/2)
+    !> on the live unknowns, 1 on the dead ones and on an unknown whose row is zero (a
+    !> component whose two bodies cannot move along it); E from `eps_of`.
+    subroutine scale_values(self, ok)
+        !> The block (mat%values and scale set).
+        type(bonded_block_t), intent(inout) :: self
+        !> False when no live unknown has a positive diagonal (nothing to solve: the caller
+        !> gives up).
+        logical, intent(out) :: ok
+        real(wp) :: d(self%nu)
+        logical :: dead(self%nu)
+        integer(i8) :: p
+        integer :: i, j, u
+        logical :: any_live
+        d = plain_diagonal(self)
+        dead = dead_unknowns(self)
+        if (allocated(self%scale)) then
+            if (size(self%scale) /= self%nu) deallocate (self%scale)
+        end if
+        if (.not. allocated(self%scale)) allocate (self%scale(self%nu))
+        any_live = .false.
+        do u = 1, self%nu
+            self%scale(u) = 1.0_wp
+            if (dead(u) .or. .not. d(u) > 0.0_wp) cycle
+            self%scale(u) = 1.0_wp/sqrt(d(u))
+            any_live = .true.
+        end do
+        do j = 1, self%nu
+            do p = self%mat%colptr(j) + 1, self%mat%colptr(j + 1)
+                i = int(self%mat%rowind(p)) + 1
+                self%mat%values(p) = self%mat%values(p)*(self%scale(i)*self%scale(j))
             end do
         end do
-    end function plain_diagonal_max
+        ok = any_live
+        if (.not. ok) return
+        do u = 1, self%nu
+            if (dead(u)) cycle
+            self%mat%values(self%diag(u)) = self%mat%values(self%diag(u)) + eps_of(self, u)
+        end do
+    end subroutine scale_values
 
     !> Append the entry (i, j, v) to the assembly (either triangle, each pair once; every
     !> unknown meets its diagonal entry, since every bond has a disk).
@@ -1295,22 +1350,27 @@ contains
         call add_impulse(cs, k, dr, im, vel)
     end subroutine condensed_step
 
-    !> x = (W + eps I)^-1 rhs - eps (W + eps I)^-2 rhs = W (W + eps I)^-2 rhs with the factor of
-    !> W + eps I: the reaction change of least norm (module header, "Least norm"). The first
-    !> solve alone amplifies by 1/eps the part of rhs that no change of the bonds' reactions can
-    !> remove; the second takes it out.
+    !> x = S (A + E)^-1 A (A + E)^-1 S rhs = S ((A + E)^-1 S rhs - (A + E)^-1 E (A + E)^-1 S rhs),
+    !> A = S W S, with the factor of A + E and its scaling S (scale_factored): the reaction change
+    !> of least norm (module header, "Least norm"). The first solve alone amplifies by 1/eps the
+    !> part of rhs that no change of the bonds' reactions can remove; the second takes it out.
     subroutine solve_least_norm(self, error)
         !> The block (rhs in, x out, y work).
         type(bonded_block_t), intent(inout) :: self
         !> Set if CHOLMOD fails.
         type(error_t), allocatable, intent(out) :: error
+        integer :: u
+        self%rhs = self%scale_factored*self%rhs
         self%x = 0.0_wp
         call self%solver%solve(self%rhs, self%x, error)
         if (allocated(error)) return
+        do u = 1, self%nu
+            self%rhs(u) = eps_of(self, u)*self%x(u)
+        end do
         self%y = 0.0_wp
-        call self%solver%solve(self%x, self%y, error)
+        call self%solver%solve(self%rhs, self%y, error)
         if (allocated(error)) return
-        self%x = self%x - self%eps_factored*self%y
+        self%x = self%scale_factored*(self%x - self%y)
     end subroutine solve_least_norm
 
     !> The direct solve of `solve`, without the released bonds' steps.
@@ -1338,7 +1398,8 @@ contains
         it = 0
         self%consistent = .true.
         do
-            ! the residual of the bonds, -u_B, from the velocities themselves
+            ! the residual of the bonds, -u_B, from the velocities themselves; its norm in
+            ! velocities (rotations times the mean radius, as the noise and `measure`)
             do b = 1, self%nb
                 k = self%bond(b)
                 ! a dead slot: an identity row with a zero right-hand side, a zero change
@@ -1347,8 +1408,12 @@ contains
                 do p = self%first(b), self%first(b + 1) - 1
                     self%rhs(p) = -u(self%comp(p))
                 end do
+                if (k > 0) u(3) = cs%amoy(k)*u(3)
+                do p = self%first(b), self%first(b + 1) - 1
+                    self%y(p) = u(self%comp(p))
+                end do
             end do
-            rnorm = norm2(self%rhs)
+            rnorm = norm2(self%y)
             self%consistent = rnorm <= max(noise, consistent_ratio*noise/roundoff)
             if (rnorm <= noise) exit
             if (rnorm > stale_contraction*prev) then

@@ -699,7 +699,7 @@ contains
                     if (.not. allocated(error)) call file%write_dataset(g//'/key_i2', b%key_i2, error)
                     if (.not. allocated(error)) call file%write_dataset(g//'/key_rows', b%key_rows, error)
                     if (.not. allocated(error)) call file%write_dataset(g//'/values', b%values_factored, error)
-                    if (.not. allocated(error)) call file%write_attribute(g//'/values', 'eps', [b%eps_factored], error)
+                    if (.not. allocated(error)) call file%write_dataset(g//'/scale', b%scale_factored, error)
                     ! slots whose bonds left the block: identity rows, some deleted from the factor
                     ! after its factorisation (replayed in order at the restart)
                     if (.not. any(b%dead)) return
@@ -859,15 +859,20 @@ contains
             type(error_t), allocatable, intent(out) :: error
             character(len=:), allocatable :: g
             integer, allocatable :: k1(:), k2(:), kr(:), dead(:), deleted(:)
-            real(wp), allocatable :: v(:), eps(:)
+            real(wp), allocatable :: v(:), scale(:)
             logical :: restored
             g = group//'/block'
             if (.not. file%exists(g//'/values')) return
+            ! a checkpoint of the block before its scaling (no 'scale'): its values are those of
+            ! W_BB + eps I, not of S W_BB S + eps I; the restart then factors the current values
+            ! (the run goes on within the solver's tolerance, not bitwise)
+            if (.not. file%exists(g//'/scale')) return
+            call file%read_dataset(g//'/scale', scale, error)
+            if (allocated(error)) return
             call file%read_dataset(g//'/key_i1', k1, error)
             if (.not. allocated(error)) call file%read_dataset(g//'/key_i2', k2, error)
             if (.not. allocated(error)) call file%read_dataset(g//'/key_rows', kr, error)
             if (.not. allocated(error)) call file%read_dataset(g//'/values', v, error)
-            if (.not. allocated(error)) call read_finite_attribute(file, g//'/values', 'eps', eps, 1, error)
             if (allocated(error)) return
             if (size(k2) /= size(k1) .or. size(kr) /= size(k1)) then
                 call damaged(error, g//': key_i1, key_i2 and key_rows differ in size')
@@ -895,14 +900,19 @@ contains
             call require_range(k1, -sys%walls%n, sys%particles%n, g//'/key_i1', error)
             if (.not. allocated(error)) call require_range(k2, 1, sys%particles%n, g//'/key_i2', error)
             if (.not. allocated(error)) call require_finite(v, g//'/values', error)
+            if (.not. allocated(error)) call require_finite(scale, g//'/scale', error)
             if (allocated(error)) return
+            if (size(scale) /= sum(popcnt(kr))) then
+                call damaged(error, g//': scale has not one value per unknown of key_rows')
+                return
+            end if
             ! the deck (whose hash the checkpoint matches) chose the strategy: only the
             ! bonded block has a factor to restore
             restored = .false.
             if (allocated(sys%method)) then
                 select type (m => sys%method)
                 type is (bonded_block_method_t)
-                    call bonded_block_restore(m%block, k1, k2, kr, v, eps(1), dead == 1, deleted)
+                    call bonded_block_restore(m%block, k1, k2, kr, v, scale, dead == 1, deleted)
                     restored = .true.
                 end select
             end if
