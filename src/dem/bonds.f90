@@ -9,7 +9,7 @@ module dem_bonds
     use core_kinds, only: wp, i8
     implicit none
     private
-    public :: break_none, break_tension, break_shear, break_moment, break_shear_moment
+    public :: break_none, break_tension, break_shear, break_moment, break_shear_moment, break_lost
     public :: break_mode_name, rupture_log_t
 
     !> Not broken (this step).
@@ -22,6 +22,10 @@ module dem_bonds
     integer, parameter :: break_moment = 3
     !> Broken with both the shear and the moment bounds reached.
     integer, parameter :: break_shear_moment = 4
+    !> The bond was lost: the detection no longer found the pair (its gap beyond the alert distance; the
+    !> bond held the velocity, and the positions drifted apart: dem_contacts,
+    !> contacts_lost_bonds). Not a rupture of the law: a limit of the rigid bond's scheme.
+    integer, parameter :: break_lost = 5
 
     !> Ruptures of a run, in the order they happen.
     type :: rupture_log_t
@@ -33,7 +37,7 @@ module dem_bonds
         integer(i8), allocatable :: step(:)
         !> Time at the end of that step [s].
         real(wp), allocatable :: time(:)
-        !> Mode (break_tension, break_shear, break_moment, break_shear_moment).
+        !> Mode (break_tension, break_shear, break_moment, break_shear_moment, break_lost).
         integer, allocatable :: mode(:)
     contains
         !> Append one rupture.
@@ -42,7 +46,7 @@ module dem_bonds
 
 contains
 
-    !> Name of a rupture mode ('tension', 'shear', 'moment', 'shear+moment', or 'none').
+    !> Name of a rupture mode ('tension', 'shear', 'moment', 'shear+moment', 'lost', or 'none').
     pure function break_mode_name(mode) result(name)
         !> One of the break_* values.
         integer, intent(in) :: mode
@@ -56,6 +60,8 @@ contains
             name = 'moment'
         case (break_shear_moment)
             name = 'shear+moment'
+        case (break_lost)
+            name = 'lost'
         case default
             name = 'none'
         end select

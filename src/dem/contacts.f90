@@ -29,7 +29,7 @@ module dem_contacts
     public :: contacts_set_frames, contacts_set_laws, contacts_finish, contacts_impulses
     public :: contacts_local_velocity, contacts_count_status, contacts_bytes, contacts_moments_active
     public :: contacts_apply_impulse, contacts_solver_velocity, contacts_directions
-    public :: contacts_list_problem, contacts_make_bonds
+    public :: contacts_list_problem, contacts_make_bonds, contacts_lost_bonds
 
     !> Contact status, no reaction (separated or not active this step).
     integer, parameter :: status_open = 0
@@ -543,6 +543,39 @@ contains
         u(1) = cs%nrm(1, k)*dvx + cs%nrm(2, k)*dvy + cs%shift(1, k)
         u(2) = ut - cs%nrm(2, k)*dvx + cs%nrm(1, k)*dvy
     end subroutine contacts_solver_velocity
+
+    !> Intact bonds of the previous list that the detection did not find again (their pair
+    !> beyond the alert distance): those bonds are gone from the list. The position update of a
+    !> bond holds its velocity, not its gap, so a spinning bonded pair drifts apart by about
+    !> d (omega h)^2 / 2 per step; after a long spin, or under `[contacts] alert = 0`, the gap
+    !> exceeds the alert distance and the pair is not a candidate any more. Both lists are in
+    !> contact order (pair_key): one merge.
+    pure subroutine contacts_lost_bonds(cs, i1, i2)
+        !> Contacts, after the detection of the step.
+        type(contact_set_t), intent(in) :: cs
+        !> Bodies of each lost bond: first (disk, or -wall) and second (disk).
+        integer, allocatable, intent(out) :: i1(:), i2(:)
+        integer(i8) :: key
+        integer :: p, k
+        allocate (i1(0), i2(0))
+        k = 1
+        if (allocated(cs%prev_status)) then
+            do p = 1, cs%n_prev
+                if (cs%prev_status(p) /= status_cohesive) cycle
+                key = pair_key(cs%prev_i1(p), cs%prev_i2(p))
+                do while (k <= cs%n)
+                    if (pair_key(cs%i1(k), cs%i2(k)) >= key) exit
+                    k = k + 1
+                end do
+                if (k <= cs%n) then
+                    if (cs%i1(k) == cs%prev_i1(p) .and. cs%i2(k) == cs%prev_i2(p)) cycle
+                end if
+                ! rare (each bond is lost once): grown one by one
+                i1 = [i1, cs%prev_i1(p)]
+                i2 = [i2, cs%prev_i2(p)]
+            end do
+        end if
+    end subroutine contacts_lost_bonds
 
     !> Make the bonds of a run on the contacts detected in the configuration at t = 0: a contact
     !> whose pair of materials has cohesion and whose gap is at most bond_ratio * mean radius

@@ -38,13 +38,13 @@ module dem_moreau_jean
                              particles_bytes
     use dem_walls, only: walls_t, walls_velocity, walls_advance
     use dem_materials, only: materials_t
-    use dem_contacts, only: contact_set_t, contact_law_t, contacts_set_frames, contacts_make_bonds, &
+    use dem_contacts, only: contact_set_t, contact_law_t, contacts_set_frames, contacts_make_bonds, contacts_lost_bonds, &
                             contacts_set_laws, contacts_finish, contacts_impulses, contacts_local_velocity, &
                             contacts_bytes
     use dem_detection, only: detector_t, detect_contacts, detector_bytes
     use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_bilateral_t
     use dem_solve_method, only: solve_method_t, sweeps_method_t
-    use dem_bonds, only: rupture_log_t, break_none
+    use dem_bonds, only: rupture_log_t, break_none, break_lost
     use dem_activation, only: activation_t, activation_predicted_t
     implicit none
     private
@@ -128,6 +128,8 @@ module dem_moreau_jean
         real(wp) :: time_detection = 0.0_wp, time_solver = 0.0_wp
         !> Bonds are still to be created (before the first step, on the configuration at t = 0).
         logical :: bonds_pending = .true.
+        !> Intact bonds lost by the detection of the last step (log_lost_bonds).
+        integer :: bonds_lost = 0
         !> Bond ruptures since the start (pair, step, time, mode).
         type(rupture_log_t) :: ruptures
         !> Work arrays (3, n): start and current velocities, inverse mass, loads, impulses.
@@ -243,6 +245,7 @@ contains
         if (sys%bonds_pending) call make_bonds(sys, alert)
         call detect_contacts(sys%detector, sys%xm, sys%ym, sys%particles%radius, alert, &
                              sys%wx1, sys%wy1, sys%wx2, sys%wy2, sys%contacts)
+        call log_lost_bonds(sys)
         call system_clock(c1)
         call contacts_set_frames(sys%contacts, sys%particles%radius, sys%im)
         call contacts_set_laws(sys%contacts, step_law(sys), sys%scheme%activation, sys%particles%radius, sys%particles%mat, &
@@ -291,6 +294,22 @@ contains
             end do
         end associate
     end subroutine mj_end_step
+
+    !> Intact bonds the step's detection did not find again (contacts_lost_bonds): logged
+    !> as ruptures of mode break_lost at this step and counted in `bonds_lost` (the driver
+    !> warns), where they vanished from the list unreported.
+    subroutine log_lost_bonds(sys)
+        !> System, after the step's detection.
+        type(dem_system_t), intent(inout) :: sys
+        integer, allocatable :: i1(:), i2(:)
+        integer :: k
+        call contacts_lost_bonds(sys%contacts, i1, i2)
+        sys%bonds_lost = size(i1)
+        do k = 1, size(i1)
+            call sys%ruptures%add(i1(k), i2(k), int(sys%step + 1, i8), real(sys%step + 1, wp)*sys%scheme%h, &
+                                  break_lost)
+        end do
+    end subroutine log_lost_bonds
 
     !> The bonds of the run, made on the configuration at the start of the first step (t = 0,
     !> before any motion): the contacts detected there (alert distance widened by bond_ratio

@@ -31,7 +31,7 @@ module driver_coupled_loop
     use driver_results_dem, only: dem_writer_t
     use driver_results_coupled, only: coupled_writer_t
     use driver_run_dem, only: max_warnings, speed_warning, last_unconverged_warning, fclib_path, &
-                              fclib_after_end_warning
+                              fclib_after_end_warning, lost_bonds_warning
     use driver_results_dem, only: write_fclib_local
     use dem_local_problem, only: local_problem_t
     use dem_contacts, only: status_cohesive
@@ -224,6 +224,7 @@ contains
             call self%cpl_out%record_step(out%file, self%sys, error)
             if (allocated(error)) return
             if (.not. self%sys%stats%converged) call warn_unconverged()
+            if (self%sys%dem%bonds_lost > 0) call report(lost_bonds_warning(k, self%sys%dem%time, self%sys%dem%bonds_lost))
             if (.not. speed_warned) call check_speed()
             if (.not. rotation_warned) call check_rotation()
             if (k == 1) call check_redundant_bonds()

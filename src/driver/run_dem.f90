@@ -28,7 +28,7 @@ module driver_run_dem
     implicit none
     private
     public :: run_dem, max_warnings, report_line_iface, speed_warning, last_unconverged_warning
-    public :: fclib_path, fclib_after_end_warning
+    public :: fclib_path, fclib_after_end_warning, lost_bonds_warning
 
     !> Unconverged steps reported one by one; later ones are only counted.
     integer, parameter :: max_warnings = 5
@@ -115,6 +115,7 @@ contains
                             'velocities) are left out of the solve; count per step in /dem/solver/blocked')
                 blocked_warned = .true.
             end if
+            if (cfg%system%bonds_lost > 0) call report(lost_bonds_warning(k, cfg%system%time, cfg%system%bonds_lost))
             if (.not. speed_warned) call check_speed()
             act = end_of_step(k, n_steps, run%output_interval, ck%schedule)
             if (act%store_first) call store(error)
@@ -278,6 +279,24 @@ contains
             ' m: contacts may be found late (overlaps); lower [time] step or raise [contacts] alert'
         line = trim(buf)
     end function speed_warning
+
+    !> Warning for intact bonds that the detection of step k lost (dem_moreau_jean,
+    !> log_lost_bonds): rare, each bond once, so said at every such step.
+    function lost_bonds_warning(k, t, n) result(line)
+        !> Step.
+        integer(i8), intent(in) :: k
+        !> Time at its end [s].
+        real(wp), intent(in) :: t
+        !> Bonds lost.
+        integer, intent(in) :: n
+        character(len=:), allocatable :: line
+        character(len=16) :: tbuf
+        write (tbuf, '(es11.4e2)') t
+        line = 'warning: step '//to_str(k)//' (t = '//trim(adjustl(tbuf))//' s): '//to_str(n)// &
+               ' intact bond(s) lost: their disks drifted apart beyond the alert distance ([contacts] '// &
+               'alert), which a bond holding the velocity allows under spin; logged in /dem/bonds with mode 5 '// &
+               '(lost); a larger alert distance or a shorter step keeps them'
+    end function lost_bonds_warning
 
     !> Line closing the series of per-step warnings about unconverged steps.
     pure function last_unconverged_warning() result(line)

@@ -182,6 +182,26 @@ def separating(name, r, h, theta):
           f"momentum {dp:.2e}, angular momentum {dl:.2e} of m u0 d0")
 
 
+def lost_bond(exe, work):
+    """A bond holds the velocity, not the gap: the spinning pair's centres drift apart by about
+    d (omega h)^2 / 2 per step (5e-7 m at h = 1e-3). Under `alert = 0` the first step's
+    detection (on q + (1 - theta) h v, 1.25e-7 m apart) no longer sees the pair: the bond is
+    gone from the list. It vanished unreported; now it is logged in /dem/bonds with mode 5
+    (lost) at that step, and the run warns."""
+    text = pair_deck(f"initial_rigid = all 0 0 {OMEGA} {D0 / 2} 0.0", 1e-3, 0.5, end=0.01)
+    text = text.replace("bond = 1 1 1.0\n", "bond = 1 1 1.0\nalert = 0\n")
+    deck = work / "lost_bond.dat"
+    deck.write_text(text)
+    path, proc = multicor(exe, deck, work, quiet=False)
+    with h5py.File(path, "r") as f:
+        mode, step = f["dem/bonds/mode"][...], f["dem/bonds/step"][...]
+    check("a bond the detection loses is logged (mode 5, lost) and warned about",
+          mode.tolist() == [5] and step.tolist() == [1]
+          and "warning: step 1 (t = 1.0000E-03 s): 1 intact bond(s) lost" in proc.stdout,
+          f"modes {mode.tolist()}, steps {step.tolist()}; "
+          + "; ".join(line for line in proc.stdout.splitlines() if "lost" in line)[:300])
+
+
 def main():
     exe, work, _ = arguments(fresh=True)
     for h in (1e-3, 1e-4):
@@ -195,6 +215,7 @@ def main():
     for method in ("nlgs", "block"):
         r = run(exe, work, f"row_{method}", row_deck(method))
         spinning(f"spinning row of 13 ({method})", r, 3.0, 1e-3, 0.1, pair=False)
+    lost_bond(exe, work)
     return summary()
 
 
