@@ -59,7 +59,10 @@
 !>
 !> Energy audit (`coupled_energies`): FE kinetic + strain (weighted), DEM kinetic + potential
 !> (weighted, times t), external works of both, Rayleigh, contact and numerical dissipation,
-!> coupling works of both sides; `balance` = total energy + dissipation - works - initial, which
+!> coupling works of both sides. The FE terms are those of the whole FE body when its driver
+!> sets `whole` (a 2D continuum: its audit over all dofs, with the reactions' work on the
+!> prescribed dofs), else the integrator's (free dofs; a beam, whose supports are fixed).
+!> `balance` = total energy + dissipation - works - initial, which
 !> equals the net coupling work (zero up to the drift term and round-off with the schemes
 !> above; a first-step impulse that removes inconsistent initial velocities dissipates energy
 !> like a plastic impact).
@@ -80,7 +83,7 @@ module coupling_coupled_step
     use coupling_multiplier_space, only: multiplier_space_t, disk_space_t
     implicit none
     private
-    public :: coupled_system_t, coupled_stats_t, coupled_energies_t
+    public :: coupled_system_t, coupled_stats_t, coupled_energies_t, fe_whole_t
     public :: notice_iface
     public :: complete_coupled_system, disk_space, arlequin_step, coupled_energies, coordinate_residual
     public :: multipliers_particles, multipliers_nodes
@@ -141,6 +144,8 @@ module coupling_coupled_step
         real(wp) :: fe_kinetic = 0.0_wp, fe_strain = 0.0_wp
         !> FE external work (weighted loads) and Rayleigh dissipation.
         real(wp) :: fe_external_work = 0.0_wp, fe_damping = 0.0_wp
+        !> Work of the FE supports' reactions on the prescribed dofs (zero where they are fixed).
+        real(wp) :: fe_reaction_work = 0.0_wp
         !> Work of the coupling forces -C^T lambda on the FE.
         real(wp) :: fe_coupling_work = 0.0_wp
         !> DEM kinetic and gravity potential energy (weighted).
@@ -158,6 +163,23 @@ module coupling_coupled_step
         !> Balance residual: energies + dissipations - external works - initial.
         real(wp) :: balance = 0.0_wp
     end type coupled_energies_t
+
+    !> The FE side's accounts over all its dofs, prescribed ones included [J]: a 2D continuum's
+    !> audit of the whole body (fem_continuum_dynamics `continuum_audit_t`, weighted), set by
+    !> its driver after every step. The integrator's own terms cover the free dofs only: with
+    !> a displacement prescribed in time they miss the energy stored through the prescribed
+    !> dofs and the supports' work. (A beam's supports are fixed, u = v = 0 there, and its
+    !> integrator's terms are already those of the whole beam.)
+    type :: fe_whole_t
+        !> The accounts below are set (otherwise the integrator's are used).
+        logical :: set = .false.
+        !> Kinetic 1/2 v.M v and strain 1/2 u.K u over all dofs.
+        real(wp) :: kinetic = 0.0_wp, strain = 0.0_wp
+        !> Work of the loads, Rayleigh dissipation, work of the reactions on the prescribed dofs.
+        real(wp) :: external_work = 0.0_wp, damping = 0.0_wp, reaction_work = 0.0_wp
+        !> Kinetic + strain energy at the start.
+        real(wp) :: initial = 0.0_wp
+    end type fe_whole_t
 
     !> A coupled simulation: both domains, the coupling and its state.
     type :: coupled_system_t
@@ -218,6 +240,8 @@ module coupling_coupled_step
         !> sum of (lambda_n + lambda_n+1)/2 . (C_p u_p(t_n+1) - C_p u_p(t_n)) [J]: the FE side's
         !> coupling work on those dofs is its negative.
         real(wp) :: prescribed_coupling_work = 0.0_wp
+        !> The FE side's accounts over all its dofs, when its driver sets them (see fe_whole_t).
+        type(fe_whole_t) :: whole
     end type coupled_system_t
 
     abstract interface
@@ -591,13 +615,29 @@ contains
         type(coupled_system_t), intent(in) :: sys
         type(coupled_energies_t) :: e
         real(wp) :: t
+        real(wp) :: fe_balance
         t = sys%thickness
-        e%fe_kinetic = sys%fe%kinetic
-        e%fe_strain = sys%fe%strain
-        e%fe_external_work = sys%fe%external_work
-        e%fe_damping = sys%fe%damping_dissipation
         ! On the free dofs (the integrator's), and on the prescribed ones (FE dofs prescribed in time).
         e%fe_coupling_work = sys%fe%coupling_work - sys%prescribed_coupling_work
+        if (sys%whole%set) then
+            ! The whole FE body (its audit closes with the coupling work on all its dofs).
+            e%fe_kinetic = sys%whole%kinetic
+            e%fe_strain = sys%whole%strain
+            e%fe_external_work = sys%whole%external_work
+            e%fe_damping = sys%whole%damping
+            e%fe_reaction_work = sys%whole%reaction_work
+            fe_balance = e%fe_kinetic + e%fe_strain + e%fe_damping - e%fe_external_work - e%fe_reaction_work - &
+                         e%fe_coupling_work - sys%whole%initial
+        else
+            e%fe_kinetic = sys%fe%kinetic
+            e%fe_strain = sys%fe%strain
+            e%fe_external_work = sys%fe%external_work
+            e%fe_damping = sys%fe%damping_dissipation
+            e%fe_reaction_work = 0.0_wp
+            ! (the integrator's balance, with its coupling work on the free dofs; nothing
+            ! prescribed in time then)
+            fe_balance = sys%fe%energy_balance()
+        end if
         associate (d => sys%dem%energies)
             e%dem_kinetic = t*d%kinetic
             e%dem_potential = t*d%potential
@@ -606,11 +646,15 @@ contains
             e%dem_contact_dissipation = t*d%contact_dissipation
             e%dem_numerical_dissipation = t*d%numerical_dissipation
             e%dem_coupling_work = t*d%coupling_work
-            e%initial = sys%fe%initial_energy + t*d%initial
+            if (sys%whole%set) then
+                e%initial = sys%whole%initial + t*d%initial
+            else
+                e%initial = sys%fe%initial_energy + t*d%initial
+            end if
             e%coupling_work = e%fe_coupling_work + e%dem_coupling_work
             ! Each side's own audit (its coupling work included) closes to round-off; their
             ! sum without the coupling works is the balance of the coupled system.
-            e%balance = sys%fe%energy_balance() + t*energies_balance(d) + e%coupling_work
+            e%balance = fe_balance + t*energies_balance(d) + e%coupling_work
         end associate
     end function coupled_energies
 end module coupling_coupled_step

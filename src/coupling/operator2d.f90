@@ -74,6 +74,8 @@ module coupling_operator2d
         procedure :: to_dense => op2d_to_dense
         !> y = C u with u over all dofs (prescribed ones included).
         procedure :: apply_all => op2d_apply_all
+        !> f = C^T lambda over all dofs (prescribed ones included).
+        procedure :: transpose_all => op2d_transpose_all
         !> y += C_p u_p(t) or C_p v_p(t) over the dofs prescribed in time.
         procedure :: add_prescribed => op2d_add_prescribed
     end type continuum_operator_t
@@ -214,6 +216,24 @@ contains
             end do
         end do
     end subroutine op2d_apply_all
+
+    !> f = C^T lambda over all dofs (2 per node): on the prescribed ones, the share of the
+    !> multipliers' force the supports take.
+    pure subroutine op2d_transpose_all(self, lambda, f)
+        !> The operator.
+        class(continuum_operator_t), intent(in) :: self
+        !> Values at the coupled rows (n_rows).
+        real(wp), intent(in) :: lambda(:)
+        !> Over all dofs (2 per node of the model).
+        real(wp), intent(out) :: f(:)
+        integer :: r, k
+        f = 0.0_wp
+        do r = 1, self%n_rows
+            do k = 1, width
+                if (self%dof(k, r) > 0) f(self%dof(k, r)) = f(self%dof(k, r)) + self%val(k, r)*lambda(r)
+            end do
+        end do
+    end subroutine op2d_transpose_all
 
     !> y += sum over the entries on dofs prescribed in time of value amplitude f(t) (derivative
     !> 0) or value amplitude f'(t) (derivative 1).

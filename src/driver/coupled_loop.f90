@@ -453,7 +453,7 @@ contains
             en = coupled_energies(self%sys)
             write (buf, '(a,es11.3e3,a,es11.3e3,a,es11.3e3,a)') 'energy balance residual ', en%balance, &
                 ' J (max over the outputs ', self%cpl_out%max_balance, ' J; external work ', &
-                en%fe_external_work + en%dem_external_work + en%dem_drive_work, ' J)'
+                en%fe_external_work + en%fe_reaction_work + en%dem_external_work + en%dem_drive_work, ' J)'
             call report(trim(buf))
             call report(progress%summary_line(n_steps, self%sys%fe%t, out%stopped()))
         end subroutine summary

@@ -22,10 +22,11 @@ module driver_results_coupled
     integer, parameter :: stats_buffer = 4096
     !> Datasets of /coupling/energy (besides time), in the order of `energy_values`.
     !&<
-    character(len=*), parameter :: energy_names(15) = [character(len=23) :: 'fe_kinetic', &
+    character(len=*), parameter :: energy_names(16) = [character(len=23) :: 'fe_kinetic', &
         'fe_strain', 'fe_external_work', 'fe_damping', 'fe_coupling_work', 'dem_kinetic', &
         'dem_potential', 'dem_external_work', 'dem_drive_work', 'contact_dissipation', &
-        'numerical_dissipation', 'dem_coupling_work', 'external_work', 'coupling_work', 'balance']
+        'numerical_dissipation', 'dem_coupling_work', 'external_work', 'coupling_work', 'balance', &
+        'fe_reaction_work']
     !> Real per-step datasets of /coupling, in the order of the buffer's columns.
     character(len=*), parameter :: step_names(6) = [character(len=19) :: 'g_norm', &
         'position_residual', 'velocity_residual', 'rotation_residual', 'coordinate_residual', &
@@ -227,8 +228,8 @@ contains
         values = [en%fe_kinetic, en%fe_strain, en%fe_external_work, en%fe_damping, &
                   en%fe_coupling_work, en%dem_kinetic, en%dem_potential, en%dem_external_work, &
                   en%dem_drive_work, en%dem_contact_dissipation, en%dem_numerical_dissipation, &
-                  en%dem_coupling_work, en%fe_external_work + en%dem_external_work + &
-                  en%dem_drive_work, en%coupling_work, en%balance]
+                  en%dem_coupling_work, en%fe_external_work + en%fe_reaction_work + en%dem_external_work + &
+                  en%dem_drive_work, en%coupling_work, en%balance, en%fe_reaction_work]
     end function energy_values
 
     !> Record the residuals and solver effort of the step just done; writes when the buffer

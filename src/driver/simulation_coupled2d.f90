@@ -23,7 +23,8 @@ module driver_simulation_coupled2d
     use io_deck, only: deck_t
     use io_hdf5_file, only: h5_file_t
     use fem_continuum_dynamics, only: continuum_dynamics_t
-    use coupling_coupled_step, only: coupled_energies_t, coupled_energies
+    use coupling_coupled_step, only: coupled_energies_t, coupled_energies, fe_whole_t
+    use coupling_operator2d, only: continuum_operator_t
     use coupling_arlequin2d, only: build_coupled2d
     use driver_config_coupling2d, only: coupled2d_setup_t, build_coupling2d_config
     use driver_results, only: results_writer_t
@@ -212,21 +213,35 @@ contains
 
     !> The continuum's audit of the whole body (prescribed dofs and reactions included) on
     !> the weighted operator: started (resumed with the totals of a checkpoint), or advanced
-    !> by the step just made.
+    !> by the step just made. The multipliers' force -C^T lambda on all dofs is the coupling
+    !> force of the audit (its share on the prescribed dofs is taken by the supports, and so
+    !> enters the reactions), and the audit's accounts are the FE side's in /coupling/energy.
     subroutine audit_step(self, first, totals)
         type(coupled2d_simulation_t), intent(inout) :: self
         logical, intent(in) :: first
         real(wp), intent(in), optional :: totals(4)
-        select type (ops => self%sys%model)
-        type is (continuum_dynamics_t)
-            if (first .and. present(totals)) then
-                call self%continuum%audit%resume(ops, self%continuum%model, self%sys%fe, totals)
-            else if (first) then
-                call self%continuum%audit%start(ops, self%continuum%model, self%sys%fe)
-            else
-                call self%continuum%audit%advance(ops, self%continuum%model, self%sys%fe)
-            end if
+        real(wp), allocatable :: fc(:)
+        allocate (fc(size(self%continuum%model%prescribed)), source=0.0_wp)
+        select type (op => self%sys%op)
+        type is (continuum_operator_t)
+            call op%transpose_all(self%sys%lambda, fc)
+            fc = -fc
         end select
+        associate (au => self%continuum%audit, w => self%sys%prescribed_coupling_work)
+            select type (ops => self%sys%model)
+            type is (continuum_dynamics_t)
+                if (first .and. present(totals)) then
+                    call au%resume(ops, self%continuum%model, self%sys%fe, totals, fc, -w)
+                else if (first) then
+                    call au%start(ops, self%continuum%model, self%sys%fe, fc, -w)
+                else
+                    call au%advance(ops, self%continuum%model, self%sys%fe, fc, -w)
+                end if
+            end select
+            self%sys%whole = fe_whole_t(set=.true., kinetic=au%kinetic, strain=au%strain, &
+                                        external_work=au%load_work, damping=au%damping, &
+                                        reaction_work=au%reaction_work, initial=au%initial)
+        end associate
     end subroutine audit_step
 
     !> Finite continuum state and energy accounts (a checkpoint may follow: it must hold
@@ -344,8 +359,8 @@ contains
         real(wp), allocatable :: totals(:)
         call read_finite_attribute(f, '/coupling', 'continuum_audit', totals, 5, error)
         if (allocated(error)) return
-        call audit_step(self, .true., totals(1:4))
         self%sys%prescribed_coupling_work = totals(5)
+        call audit_step(self, .true., totals(1:4))
         self%sys%cp = 0.0_wp
         call self%sys%op%add_prescribed(self%sys%fe%t, 0, self%sys%cp)
         call self%fe_out%resume(out%file, self%continuum%model%mesh, error)

@@ -19,8 +19,11 @@
 !>
 !> Energy audit of the whole body (`continuum_audit_t`): kinetic 1/2 v.M v and strain
 !> 1/2 u.K u over all dofs, Rayleigh dissipation int du.C v, work of the loads int du.f, work of
-!> the reactions on the prescribed dofs int du_p.r with r = (K u + C v + M a - f)_p, and the
-!> integrator's coupling work; every integral by the trapezoidal rule of the scheme.
+!> the reactions on the prescribed dofs int du_p.r with r = (K u + C v + M a - f - f_c)_p, and
+!> the work of the coupling force f_c; every integral by the trapezoidal rule of the scheme. In
+!> a coupled run f_c = -C^T lambda over all dofs (given to `start`, `advance`, `resume`): the
+!> supports then take what the multipliers put on the prescribed dofs, and the coupling work is
+!> the integrator's (free dofs) plus the one through the prescribed dofs; uncoupled, f_c = 0.
 !>
 !> Combinations c_m M + c_k K share the pattern of K (a lumped M is
 !> diagonal, inside it) and are factored by CHOLMOD (`sparse_cholesky`). The lowest modes come
@@ -385,7 +388,7 @@ contains
     end function dynamics_reactions
 
     !> Start the audit from the integrator's initial state.
-    subroutine audit_start(self, ops, model, integ)
+    subroutine audit_start(self, ops, model, integ, coupling, prescribed_coupling_work)
         !> The audit.
         class(continuum_audit_t), intent(inout) :: self
         !> The operator.
@@ -394,11 +397,18 @@ contains
         type(continuum_model_t), intent(in) :: model
         !> The integrator, initialised.
         class(time_integrator_t), intent(in) :: integ
+        !> Force of a coupling on the body over all dofs at the integrator's time (a coupled
+        !> run: -C^T lambda) [N]: the reactions are what the supports add to it and the loads.
+        real(wp), intent(in), optional :: coupling(:)
+        !> Work of that force through the prescribed dofs since the start [J] (added to the
+        !> integrator's coupling work, which covers the free dofs).
+        real(wp), intent(in), optional :: prescribed_coupling_work
         real(wp), allocatable :: a(:), w(:)
         self%u = model%expand(integ%u, integ%t)
         self%v = model%expand(integ%v, integ%t, 1)
         a = model%expand(integ%a, integ%t, 2)
         self%r = ops%reactions(integ%t, self%u, self%v, a)
+        if (present(coupling)) self%r = self%r - coupling
         self%f = ops%loads_at(integ%t)
         allocate (w(size(self%u)))
         call ops%m_all%matvec(self%v, w)
@@ -409,11 +419,12 @@ contains
         self%load_work = 0.0_wp
         self%reaction_work = 0.0_wp
         self%coupling_work = integ%coupling_work
+        if (present(prescribed_coupling_work)) self%coupling_work = self%coupling_work + prescribed_coupling_work
         call resultant(self, model)
     end subroutine audit_start
 
     !> Add the step the integrator just made (trapezoidal rule between the last time and now).
-    subroutine audit_advance(self, ops, model, integ)
+    subroutine audit_advance(self, ops, model, integ, coupling, prescribed_coupling_work)
         !> The audit (started).
         class(continuum_audit_t), intent(inout) :: self
         !> The operator.
@@ -422,11 +433,17 @@ contains
         type(continuum_model_t), intent(in) :: model
         !> The integrator, after the step.
         class(time_integrator_t), intent(in) :: integ
+        !> Force of a coupling on the body over all dofs at the integrator's time [N] (see
+        !> `start`).
+        real(wp), intent(in), optional :: coupling(:)
+        !> Work of that force through the prescribed dofs since the start [J] (see `start`).
+        real(wp), intent(in), optional :: prescribed_coupling_work
         real(wp), allocatable :: u(:), v(:), a(:), r(:), f(:), du(:), w(:), w2(:)
         u = model%expand(integ%u, integ%t)
         v = model%expand(integ%v, integ%t, 1)
         a = model%expand(integ%a, integ%t, 2)
         r = ops%reactions(integ%t, u, v, a)
+        if (present(coupling)) r = r - coupling
         f = ops%loads_at(integ%t)
         du = u - self%u
         allocate (w(size(u)), w2(size(u)))
@@ -437,6 +454,7 @@ contains
         self%load_work = self%load_work + 0.5_wp*dot_product(du, f + self%f)
         self%reaction_work = self%reaction_work + 0.5_wp*dot_product(merge(du, 0.0_wp, model%prescribed), r + self%r)
         self%coupling_work = integ%coupling_work
+        if (present(prescribed_coupling_work)) self%coupling_work = self%coupling_work + prescribed_coupling_work
         call ops%m_all%matvec(v, w)
         self%kinetic = 0.5_wp*dot_product(v, w)
         self%strain = ops%total_strain_energy(u)
@@ -466,7 +484,7 @@ contains
 
     !> Start from the integrator's state (restored from a checkpoint) and the accumulated
     !> scalars saved there: the state-dependent terms are recomputed, bit for bit.
-    subroutine audit_resume(self, ops, model, integ, totals)
+    subroutine audit_resume(self, ops, model, integ, totals, coupling, prescribed_coupling_work)
         !> The audit.
         class(continuum_audit_t), intent(inout) :: self
         !> The operator.
@@ -477,7 +495,11 @@ contains
         class(time_integrator_t), intent(in) :: integ
         !> (initial, damping, load_work, reaction_work) from `totals` [J].
         real(wp), intent(in) :: totals(4)
-        call self%start(ops, model, integ)
+        !> Force of a coupling on the body over all dofs, restored [N] (see `start`).
+        real(wp), intent(in), optional :: coupling(:)
+        !> Work of that force through the prescribed dofs, restored [J] (see `start`).
+        real(wp), intent(in), optional :: prescribed_coupling_work
+        call self%start(ops, model, integ, coupling, prescribed_coupling_work)
         self%initial = totals(1)
         self%damping = totals(2)
         self%load_work = totals(3)

@@ -9,7 +9,8 @@ of 8 disks, the same pressure, drive and laws, 6 ms (slip 1.9 mm).
   bands are equal and opposite (the disk layer's momentum hardly changes), and the apparent
   friction T / N of the top band follows disks sliding without rolling over the disks of the
   row below, tan(atan(mu) - asin(s / 2R)) (e_r = R: rolling never costs less than sliding);
-- the energy audits: the coupled system's closes to round-off; the continuum's audit of the
+- the energy audits: the coupled system's (whose FE terms are the continuum's audit of the
+  whole body) differs from the continuum's by round-off only; the continuum's audit of the
   whole body (with the work of the reactions on the prescribed dofs) moves only in the steps
   where the drive's rate jumps (kinks of its table function at 1, 2 and 3 ms, whose impulse
   the scheme does not represent) and is constant to round-off after the last one.
@@ -106,13 +107,18 @@ def main():
           f"(T/N {mu_app.max():.3f}..{mu_app.min():.3f})")
 
     with h5py.File(h5, "r") as f:
-        bal = np.abs(f["coupling/energy/balance"][...]).max()
+        cpl_bal = f["coupling/energy/balance"][...]
         scale = abs(f["coupling/energy/external_work"][-1]) + abs(f["continuum/energy/reaction_work"][-1])
         fe_bal = f["continuum/energy/balance"][...]
         t_fe = f["continuum/energy/time"][...]
         reaction_work = f["continuum/energy/reaction_work"][-1]
-    # Sums of O(scale) terms over 300 steps: round-off ~1e-13 of the scale; asserted at 1e-9.
-    check("coupled audit closes", bal <= 1e-9 * scale, f"max |balance| {bal:.2e} J, scale {scale:.2e} J")
+    # The coupled audit's FE terms are the continuum's audit of the whole body: the two
+    # balances differ by the disks' audit and the net work of the glue, sums of O(scale) terms
+    # over 300 steps: round-off ~1e-13 of the scale; asserted at 1e-9. (Both move at the
+    # drive's kinks, checked below.)
+    bal = np.abs(cpl_bal - fe_bal).max()
+    check("coupled audit closes (apart from the continuum audit's kink terms)", bal <= 1e-9 * scale,
+          f"max |balance - continuum balance| {bal:.2e} J, scale {scale:.2e} J")
     after = t_fe > 3.0e-3 + 1e-9
     drift = np.ptp(fe_bal[after])
     # After the last kink the prescribed motion is linear in every step: the audit's
