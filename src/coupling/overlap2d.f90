@@ -23,6 +23,7 @@ module coupling_overlap2d
     use core_kinds, only: wp
     use core_constants, only: relative_roundoff
     use core_error, only: error_t, make_error
+    use core_strings, only: to_str
     use coupling_weights, only: weight_config_t, overlap_weight_t, make_weight
     implicit none
     private
@@ -165,7 +166,8 @@ contains
         type(weight_config_t), intent(in) :: weight
         !> The region.
         type(overlap2d_t), intent(out) :: region
-        !> Set on too few vertices, a zero area, an edge index out of range or tagged twice,
+        !> Set on too few vertices, a repeated vertex (a zero-length edge, the last vertex equal
+        !> to the first included), a zero area, an edge index out of range or tagged twice,
         !> a ramp without edges on both sides, or an invalid weight.
         type(error_t), allocatable, intent(out) :: error
         type(weight_config_t) :: w
@@ -178,6 +180,18 @@ contains
             call make_error(error, 'overlap polygon: needs at least 3 vertices (x, y)')
             return
         end if
+        ! A repeated vertex makes a zero-length edge: the edges after it are numbered one
+        ! further than the user counted, so the tagged sides would silently be other edges.
+        do k = 1, n
+            if (all(vertex(:, k) == vertex(:, modulo(k, n) + 1))) then
+                call make_error(error, 'overlap polygon: vertices '//to_str(k)//' and '//to_str(modulo(k, n) + 1)// &
+                                ' are the same point ('//to_str(vertex(1, k))//', '//to_str(vertex(2, k))// &
+                                '): edge '//to_str(k)//' has zero length and would shift the numbering of '// &
+                                'the edges after it; give each vertex once (the polygon closes itself: '// &
+                                'the last vertex joins the first, do not repeat it)')
+                return
+            end if
+        end do
         area = 0.0_wp
         do k = 1, n
             area = area + cross(vertex(:, k), vertex(:, modulo(k, n) + 1))

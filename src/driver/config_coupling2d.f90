@@ -96,6 +96,18 @@ contains
         weight%shape = deck%get_word('coupling', 'weight')
         weight%alpha_min = deck%get_real('coupling', 'alpha_min')
         weight%constant = deck%get_real('coupling', 'constant')
+        ! (checked here to name the constant's line, the library would name the region's; the
+        ! default 0.5 always lies in the range)
+        if (weight%shape == 'constant' .and. weight%alpha_min > 0 .and. weight%alpha_min < 0.5_wp .and. &
+            .not. (weight%constant >= weight%alpha_min .and. weight%constant <= 1 - weight%alpha_min)) then
+            call make_input_error(error, deck%file, deck%line('coupling', 'constant'), 'constant', 'constant = '// &
+                                  to_str(weight%constant)//' must lie in [alpha_min, 1 - alpha_min] = ['// &
+                                  to_str(weight%alpha_min)//', '//to_str(1 - weight%alpha_min)//'] ([coupling] '// &
+                                  'alpha_min, default 1e-3): a coupled disk or element with a weight nearer 0 or 1 '// &
+                                  'has almost no mass on one side and makes the multiplier system ill-conditioned; '// &
+                                  'raise constant or lower alpha_min')
+            return
+        end if
         allocate (parts(size(regions)))
         do k = 1, size(regions)
             call make_region(regions(k), parts(k), error)

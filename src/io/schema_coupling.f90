@@ -37,7 +37,8 @@ contains
                            default='cubic')
         call s%add_keyword('coupling', 'constant', [real_field('constant', '', lower=0.0_wp, &
                                                                upper=1.0_wp, lower_strict=.true., upper_strict=.true.)], &
-                           'Value of alpha inside the overlap for weight = constant.', default='0.5', &
+                           'Value of alpha inside the overlap for weight = constant; it must lie in '// &
+                           '[alpha_min, 1 - alpha_min] (see alpha_min).', default='0.5', &
                            allowed_when=when('coupling', 'weight', 'constant'))
         call s%add_keyword('coupling', 'alpha_min', [real_field('alpha_min', '', lower=0.0_wp, &
                                                                 upper=0.5_wp, lower_strict=.true., upper_strict=.true.)], &
@@ -82,7 +83,9 @@ contains
                            'the side next to the FE-only zone and the side next to the particle-only zone '// &
                            '(none with weight = constant). polygon: fe_edge particle_edge x1 y1 x2 y2 x3 y3 ...: '// &
                            'the numbers of the FE-side and particle-side edges (edge k joins vertex k to k + 1, '// &
-                           'the last to the first; 0: none), then at least 3 vertices. alpha ramps from 1 - '// &
+                           'the last to the first; 0: none), then at least 3 vertices, each given once (the '// &
+                           'polygon closes itself; a repeated vertex, the first again at the end included, is '// &
+                           'refused: its zero-length edge would shift the edge numbers). alpha ramps from 1 - '// &
                            'alpha_min on the FE side to alpha_min on the particle side (weight, alpha_min). '// &
                            'Every region must hold at least one disk centre.', &
                            repeatable=.true., selector=1, tails=tails)
