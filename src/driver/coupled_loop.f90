@@ -20,7 +20,7 @@
 !> disks (non-finite values, beyond the representable box), then tunnelling (after a step).
 module driver_coupled_loop
     use core_kinds, only: wp, i8
-    use core_error, only: error_t
+    use core_error, only: error_t, make_error
     use core_signals, only: caught_signal, signal_name
     use io_progress, only: progress_t
     use core_strings, only: counted, to_str
@@ -281,6 +281,14 @@ contains
             if (.not. allocated(error)) call self%load_part(ck%source, out, error)
             call ck%source%close(ignored)
             if (allocated(error)) return
+            ! A results file of an earlier build lacks the series this one appends to (the
+            ! supports' work of the audit, 2026-11-27): said before any step is written.
+            if (.not. out%file%exists('/coupling/energy/fe_reaction_work')) then
+                call make_error(error, "restart: the results file '"//out%file%path//"' was written by an "// &
+                                'earlier version of MULTICOR (its /coupling/energy has no fe_reaction_work): '// &
+                                'continue it with that version, or run the deck again from the start')
+                return
+            end if
             k0 = ck%start%step
             unconverged = ck%start%unconverged
             speed_warned = ck%start%speed_warned

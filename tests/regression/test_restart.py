@@ -833,6 +833,34 @@ def wall_time_over_runs(exe, src, work):
         compare("wall_runs_old", old / "wall_runs.h5", folder / "wall_runs.h5")
 
 
+def earlier_results(exe, src, work):
+    """A coupled run whose results file lacks a series this build appends to (written by an
+    earlier version: /coupling/energy/fe_reaction_work came on 2026-11-27) is not continued:
+    a message that says so, exit 1, the folder as it was. It gave an HDF5 'no dataset'
+    error."""
+    folder = work / "earlier_results"
+    deck = src / "input" / "coupled2d_block.dat"
+    first = run(exe, deck, "--quiet", "--output", folder, "--end", "2e-3")
+    # as an earlier version wrote them: the results without the series, the checkpoint's list
+    # of the results' series (/results@datasets, one count each in /results/records) without it
+    gone = "/coupling/energy/fe_reaction_work"
+    with h5py.File(folder / "coupled2d_block.h5", "a") as f:
+        del f[gone]
+    with h5py.File(folder / "checkpoint.h5", "a") as c:
+        names = c["results"].attrs["datasets"].split("\n")[:-1]
+        records = c["results/records"][...]
+        keep = [i for i, name in enumerate(names) if name != gone]
+        c["results"].attrs["datasets"] = "".join(names[i] + "\n" for i in keep)
+        del c["results/records"]
+        c["results/records"] = records[keep]
+    before = {p.name: digest(p) for p in folder.iterdir()}
+    again = run(exe, deck, "--quiet", "--output", folder, "--restart", folder / "checkpoint.h5", "--end", "4e-3")
+    after = {p.name: digest(p) for p in folder.iterdir()}
+    check("a results file of an earlier version: restart refused, folder as it was",
+          first.returncode == 0 and again.returncode == 1 and "written by an earlier version of MULTICOR"
+          in again.stderr and after == before, f"exit {again.returncode}: {again.stderr.strip()[-300:]}")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--exe", required=True)
@@ -936,6 +964,7 @@ def main():
     # multipliers' work through the prescribed dofs come back from the checkpoint.
     by_end_time(exe, decks / "coupled2d_driven_edge.dat", work, "coupled2d_driven_end", 4.43e-4)
     wall_time_over_runs(exe, src, work)
+    earlier_results(exe, src, work)
     refusals(exe, beam, work)
     two_decks_one_folder(exe, src, work)
     damaged_bytes(exe, src, work)
