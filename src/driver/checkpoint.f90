@@ -29,6 +29,7 @@ module driver_checkpoint
     use core_error, only: error_t, make_error
     use core_version, only: multicor_version
     use core_signals, only: caught_signal
+    use core_threads, only: thread_setting
     use core_strings, only: to_str
     use io_hdf5_file, only: h5_file_t
     use io_paths, only: rename_file, remove_file, file_exists, link_or_copy_file
@@ -84,6 +85,9 @@ module driver_checkpoint
         !> False for a checkpoint of an earlier build, which recorded neither: the wall time
         !> of the runs before it is unknown (counted as 0, and 1 run).
         logical :: wall_recorded = .true.
+        !> Parallel setting of the run that wrote the checkpoint (core_threads; '' when the
+        !> checkpoint does not record it). Not written with the loop: read by checkpoint_open.
+        character(len=:), allocatable :: threads
     end type loop_state_t
 
     !> When a time loop writes a checkpoint (besides signals and the end of the run).
@@ -229,6 +233,8 @@ contains
         call file%write_attribute('/', 'time', time, error)
         if (allocated(error)) return
         call file%write_attribute('/', 'run_id', run_id, error)
+        if (allocated(error)) return
+        call file%write_attribute('/', 'threads', thread_setting(), error)
         if (allocated(error)) return
         call save_loop(file, loop, error)
     end subroutine checkpoint_create
@@ -413,7 +419,11 @@ contains
             if (allocated(error)) then
                 call file%close(ignored)
                 error%message = "--restart: '"//path//"': "//error%message
+                return
             end if
+            ! absent from the checkpoints of an earlier build
+            call file%read_attribute('/', 'threads', loop%threads, ignored)
+            if (allocated(ignored)) loop%threads = ''
         end if
     contains
         subroutine refuse(message)

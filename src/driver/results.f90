@@ -21,6 +21,7 @@ module driver_results
     use core_constants, only: two_pi
     use core_error, only: error_t, make_error, make_internal_error
     use core_version, only: multicor_version, multicor_name
+    use core_threads, only: thread_setting
     use core_strings, only: string_t
     use io_hdf5_file, only: h5_file_t
     use io_progress, only: progress_t
@@ -468,8 +469,8 @@ contains
 
     !> Write run statistics as attributes of /summary: `steps`, `wall_seconds` (the analysis,
     !> every run of it: a restarted run adds its own time to that of the runs before its
-    !> checkpoint), `wall_seconds_last_run` (this run alone), `runs` (1 + the restarts) and
-    !> `ended`.
+    !> checkpoint), `wall_seconds_last_run` (this run alone), `runs` (1 + the restarts),
+    !> `ended` and `threads` (this run's parallel setting, core_threads).
     subroutine writer_write_summary(self, steps, clock, error)
         !> An open writer.
         class(results_writer_t), intent(inout) :: self
@@ -492,6 +493,8 @@ contains
         call self%file%write_attribute('/summary', 'runs', clock%runs, error)
         if (allocated(error)) return
         call self%file%write_attribute('/summary', 'ended', iso_date_time(), error)
+        if (allocated(error)) return
+        call self%file%write_attribute('/summary', 'threads', thread_setting(), error)
     end subroutine writer_write_summary
 
     !> Write what HDF5 buffers to the file: called after every output, so that a killed run

@@ -32,6 +32,7 @@ module driver_run
     use io_memory, only: available_memory
     use io_progress, only: progress_t
     use core_signals, only: caught_signal, signal_name, install_signal_handlers
+    use core_threads, only: thread_setting
     use io_deck_schema, only: multicor_schema
     use io_deck, only: deck_t, deck_entry_t, read_deck
     use io_paths, only: stem, basename, mkdir_p, remove_empty_folders, file_exists, remove_file, rename_file
@@ -413,6 +414,12 @@ contains
             end if
             ck%restart = .true.
             call report('restart from '//opts%restart//' at step '//to_str(ck%start%step))
+            if (len(ck%start%threads) > 0 .and. ck%start%threads /= thread_setting()) &
+                call report('warning: the checkpoint was written with '//ck%start%threads//'; this run has '// &
+                            thread_setting()//': the results go on correctly, but bit for bit they are '// &
+                            'those of neither uninterrupted run (the split sweeps from 4 000 contacts, and '// &
+                            'OpenBLAS in the sparse factorisations, depend on the threads); set the same '// &
+                            'values to reproduce the run exactly')
             if (.not. ck%start%wall_recorded) call report('note: the checkpoint, written by an earlier '// &
                                                           'MULTICOR build, does not record the wall time of the '// &
                                                           'runs before it: /summary wall_seconds counts from this '// &

@@ -30,6 +30,7 @@ interrupted run is refused (it would replace that run's checkpoint).
 Usage (ctest does this): test_restart.py --exe multicor --work DIR --source REPO
 """
 import argparse
+import os
 import hashlib
 import pathlib
 import re
@@ -861,6 +862,29 @@ def earlier_results(exe, src, work):
           in again.stderr and after == before, f"exit {again.returncode}: {again.stderr.strip()[-300:]}")
 
 
+def other_threads(exe, src, work):
+    """A restart under another parallel setting (OMP_NUM_THREADS, OPENBLAS_NUM_THREADS) goes
+    on with a warning naming both settings: its results are those of neither uninterrupted run
+    bit for bit (doc/output.md, "Bitwise"); under the same setting, no warning. /summary
+    records the setting."""
+    folder = work / "other_threads"
+    deck = edit_deck(src / "input" / "cantilever.dat", work / "threads.dat", end=0.02)
+    env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
+    first = run(exe, deck, "--quiet", "--output", folder, "--end", "0.01", env=env)
+    same = run(exe, deck, "--output", folder, "--restart", folder / "checkpoint.h5", "--end", "0.015", env=env)
+    other = run(exe, deck, "--output", folder, "--restart", folder / "checkpoint.h5", "--end", "0.02",
+                env=dict(env, OMP_NUM_THREADS="2"))
+    with h5py.File(folder / "threads.h5", "r") as f:
+        recorded = f["summary"].attrs["threads"]
+    warned = [line for line in other.stdout.splitlines() if line.startswith("warning: the checkpoint was written with")]
+    check("restart under the same thread setting: no warning; under another: one naming both",
+          first.returncode == 0 and same.returncode == 0 and "warning: the checkpoint" not in same.stdout
+          and other.returncode == 0 and len(warned) == 1
+          and "OpenMP threads 1, OPENBLAS_NUM_THREADS 1; this run has OpenMP threads 2, OPENBLAS_NUM_THREADS 1"
+          in warned[0] and recorded == "OpenMP threads 2, OPENBLAS_NUM_THREADS 1",
+          f"exits {first.returncode}, {same.returncode}, {other.returncode}; {warned}; /summary {recorded!r}")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--exe", required=True)
@@ -965,6 +989,7 @@ def main():
     by_end_time(exe, decks / "coupled2d_driven_edge.dat", work, "coupled2d_driven_end", 4.43e-4)
     wall_time_over_runs(exe, src, work)
     earlier_results(exe, src, work)
+    other_threads(exe, src, work)
     refusals(exe, beam, work)
     two_decks_one_folder(exe, src, work)
     damaged_bytes(exe, src, work)
