@@ -14,6 +14,11 @@ Deck: input/incline.dat at a step of 2e-5 s (25 000 steps, about a second).
 4. A run stopped by SIGUSR1 (the signal before the time limit) writes its checkpoint and
    exits 138; the next start continues it with --restart and finishes with the results of
    the uninterrupted run, bit for bit.
+5. The same with a deck named incline.v2.txt, in the default folder ($SCRATCH/multicor/
+   incline.v2): the results are named as multicor names them, so the requeued start finds
+   the partial file and continues. 6. A deck named .incline (results .incline.h5).
+7. The executable: multicor on the PATH, build/src/multicor under the submission folder;
+   none found, or MULTICOR_EXE wrong: exit 2 with a message, before any results folder.
 Usage (ctest does this): test_slurm_job_script.py --exe multicor --work DIR --source REPO
 """
 import os
@@ -45,11 +50,18 @@ echo "scontrol $*" >> "$FAKE_LOG"
 
 
 def job(src, exe, work, deck, out, **extra):
-    """Run the job script once as a Slurm start would; its output and exit code."""
+    """Run the job script once as a Slurm start would; its output and exit code. `out` None:
+    the script's default folder; an `extra` variable None: removed from the environment."""
     env = dict(os.environ, PATH=f"{work / 'bin'}:{os.environ['PATH']}", MULTICOR_EXE=str(exe),
                FAKE_LOG=str(work / "scontrol.log"), OMP_NUM_THREADS="1", SLURM_JOB_ID="1")
-    env.update({k: str(v) for k, v in extra.items()})
-    proc = subprocess.run(["bash", str(src / "scripts" / "multicor.slurm"), str(deck), str(out)],
+    env.pop("SLURM_SUBMIT_DIR", None)
+    for k, v in extra.items():
+        if v is None:
+            env.pop(k, None)
+        else:
+            env[k] = str(v)
+    args = [str(deck)] + ([] if out is None else [str(out)])
+    proc = subprocess.run(["bash", str(src / "scripts" / "multicor.slurm")] + args,
                           capture_output=True, text=True, env=env, cwd=work)
     return proc.stdout + proc.stderr, proc.returncode
 
@@ -103,7 +115,71 @@ def main():
         differ = [k for k, v in reference.items() if not np.array_equal(v, f[k][...])]
         check("4. the continued run's /dem datasets equal the uninterrupted run's, bit for bit",
               not differ and reference, f"{len(reference)} datasets; differ: {differ}")
+    other_names(src, exe, work, text, reference)
+    executable(src, exe, work, deck)
     return summary()
+
+
+def other_names(src, exe, work, text, reference):
+    """Decks not named *.dat: the script names the results as multicor does (the file name
+    without its last extension), so a requeued start continues its run. Before, it dropped
+    only '.dat': it never found <name>.h5.partial, and every requeued start began again at
+    step 0 while the log said it continued. The default folder is named the same way."""
+    scratch = work / "scratch"
+    deck = work / "incline.v2.txt"
+    deck.write_text(text)
+    out = scratch / "multicor" / "incline.v2"
+    log, rc = job(src, exe, work, deck, None, SCRATCH=scratch, FAKE_SIGNAL_AFTER=0.3,
+                  FAKE_SIGNAL="USR1")
+    check("5. incline.v2.txt stopped by SIGUSR1: requeued, default folder multicor/incline.v2",
+          rc == 0 and (out / "checkpoint.h5").exists() and (out / "incline.v2.h5.partial").exists()
+          and "requeued" in log, f"exit {rc}; {sorted(p.name for p in scratch.rglob('*'))}")
+    log, rc = job(src, exe, work, deck, None, SCRATCH=scratch, SLURM_RESTART_COUNT=1)
+    check("5. the requeued start of incline.v2.txt continues with --restart",
+          "--restart" in start_line(log), start_line(log))
+    check("5. and finishes", rc == 0 and (out / "incline.v2.h5").exists(), f"exit {rc}")
+    if (out / "incline.v2.h5").exists():
+        f = h5py.File(out / "incline.v2.h5", "r")["dem"]
+        differ = [k for k, v in reference.items() if not np.array_equal(v, f[k][...])]
+        check("5. incline.v2.txt continued = the uninterrupted run, bit for bit",
+              not differ and reference, f"differ: {differ}")
+    # a name whose only dot is its first: multicor keeps it whole (.incline.h5)
+    deck = work / ".incline"
+    deck.write_text(text)
+    log, rc = job(src, exe, work, deck, None, SCRATCH=scratch)
+    check("6. deck .incline: results multicor/.incline/.incline.h5",
+          rc == 0 and (scratch / "multicor" / ".incline" / ".incline.h5").exists(),
+          f"exit {rc}; {sorted(p.name for p in (scratch / 'multicor').iterdir())}")
+
+
+def executable(src, exe, work, deck):
+    """The executable as multicor-sweep finds it: $MULTICOR_EXE, build/src/multicor under
+    the submission folder, multicor on the PATH; none: a clear error before any folder."""
+    path_bin = work / "path_bin"
+    path_bin.mkdir()
+    (path_bin / "multicor").symlink_to(exe)
+    log, rc = job(src, exe, work, deck, work / "exe_path", MULTICOR_EXE=None,
+                  PATH=f"{work / 'bin'}:{path_bin}:/usr/bin:/bin")
+    check("7. multicor on the PATH (no MULTICOR_EXE, no build/)", rc == 0
+          and f"{path_bin / 'multicor'} --quiet" in start_line(log), f"exit {rc}; {log[-300:]}")
+    submit_dir = work / "submit_dir"
+    (submit_dir / "build" / "src").mkdir(parents=True)
+    (submit_dir / "build" / "src" / "multicor").symlink_to(exe)
+    log, rc = job(src, exe, work, deck, work / "exe_build", MULTICOR_EXE=None,
+                  SLURM_SUBMIT_DIR=submit_dir, PATH=f"{work / 'bin'}:{path_bin}:/usr/bin:/bin")
+    check("7. build/src/multicor under the submission folder, before the PATH's", rc == 0
+          and f"{submit_dir}/build/src/multicor --quiet" in start_line(log),
+          f"exit {rc}; {log[-300:]}")
+    out = work / "exe_none"
+    log, rc = job(src, exe, work, deck, out, MULTICOR_EXE=None, PATH=f"{work / 'bin'}:/usr/bin:/bin")
+    check("7. no executable: exit 2, the places tried named, no results folder",
+          rc == 2 and "no multicor executable" in log and "MULTICOR_EXE" in log
+          and f"{work}/build/src/multicor" in log and "on the PATH" in log and not out.exists(),
+          f"exit {rc}; {log.strip()}")
+    log, rc = job(src, exe, work, deck, out, MULTICOR_EXE=work / "nothing")
+    check("7. MULTICOR_EXE not a file: exit 2, named, no results folder",
+          rc == 2 and f"MULTICOR_EXE={work / 'nothing'} is not an executable file" in log
+          and not out.exists(), f"exit {rc}; {log.strip()}")
 
 
 if __name__ == "__main__":
