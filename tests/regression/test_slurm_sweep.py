@@ -8,7 +8,10 @@ a = g (sin phi - mu cos phi); with mu = 0.4 it rolls, a = (2/3) g sin phi (the d
 derives both). The sweep is submitted as a job array plus the collect job that depends on
 it; the table they write (results.csv) must hold the four points, finished, with the final
 velocity of disk 2 equal to the closed form, and the same values as the same sweep run
-locally (`run -j 2`). scripts/multicor.slurm runs one deck as a job. (test_sweep.py tests
+locally (`run -j 2`); its folder has a space in its path. scripts/multicor.slurm runs one
+deck as a job. A resubmission keeps the cap of --max-running and skips the points that an
+earlier job holds pending; a point submitted twice (--force) while it runs is refused by the
+folder lock without changing its exit_status; cancelled, the point keeps 'running' there. (test_sweep.py tests
 the tool without Slurm: keys refused, decks written, failures.)
 Skips (exit 77, reason printed) when not root or when slurm-wlm / munge are missing.
 Usage (ctest does this): test_slurm_sweep.py --exe multicor --work DIR --source REPO
@@ -88,7 +91,8 @@ def on_slurm(src, exe, work):
     reason = cluster.unavailable()
     if reason:
         return reason
-    folder = work / "slurm"
+    # a folder with a space: its #SBATCH --output line (before: "Invalid directive")
+    folder = work / "slurm sweep"
     create(src, exe, folder)
     script = (folder / "sweep.slurm").read_text()
     check("job script: array, USR1 before the limit, requeue",
@@ -131,6 +135,8 @@ def on_slurm(src, exe, work):
               done and "multicor exit 0" in log and len(starts) == 1 and "--restart" not in starts[0]
               and first is not None
               and (single / "incline.h5").stat().st_mtime_ns > first, log[-400:])
+        resubmission(src, exe, work, cluster)
+        duplicate(src, exe, work, cluster)
     finally:
         cluster.stop()
     try:
@@ -155,6 +161,74 @@ def on_slurm(src, exe, work):
     check("the collect job drew results.png", (folder / "results.png").stat().st_size > 1000
           if (folder / "results.png").exists() else False, "")
     return rows
+
+
+def resubmission(src, exe, work, cluster):
+    """A resubmission keeps the cap of --max-running (before, its --array=2-3 replaced the
+    script's 1-3%1); a point that an earlier job holds pending is not submitted again, and
+    status does not advise it. The array is held (--hold): nothing runs."""
+    folder = work / "throttle"
+    sweep_tool(src, ["create", src / "input" / "incline.dat", "--exe", exe,
+                     "--set", "contacts.law[2].mu=0.1,0.2,0.3", "--max-running", "1",
+                     "--time", "5", "--dir", folder])
+    (folder / "runs" / "p001").mkdir(parents=True)
+    (folder / "runs" / "p001" / "exit_status").write_text("0\n")    # as if finished
+    job = sweep_tool(src, ["submit", "--no-collect", folder, "--hold"],
+                     env=cluster.env).stdout.strip().splitlines()[-1]
+    shown = cluster.query(["scontrol", "show", "job", job])
+    check("resubmission of p002, p003 with --max-running 1: ArrayTaskId=2-3%1, throttle 1",
+          "ArrayTaskId=2-3%1" in shown and "ArrayTaskThrottle=1" in shown, shown[:300])
+    status = sweep_tool(src, ["status", folder], env=cluster.env).stdout
+    check("status: p002, p003 pending; wait, no advice to submit", "p002 pending" in status
+          and "p003 pending" in status and "wait for them" in status
+          and "submit" not in status, status)
+    again = sweep_tool(src, ["submit", "--no-collect", folder], env=cluster.env).stdout
+    check("submit again: nothing (p002, p003 pending in the earlier job)",
+          "nothing to submit" in again and f"p002 (pending, job {job})" in again, again)
+    cluster.query(["scancel", job])
+    wait_idle(cluster, 30)
+    status = sweep_tool(src, ["status", folder], env=cluster.env).stdout
+    check("status once the job is cancelled: advises submit", "continue the others" in status,
+          status)
+
+
+def duplicate(src, exe, work, cluster):
+    """A point submitted again while it runs (submit --force): multicor's lock refuses the
+    second start, which leaves exit_status to the running start (before: it wrote 1, and
+    status called the running point failed, collect counted 2 starts). Cancelled, the point
+    keeps 'running' in exit_status: status calls it started."""
+    folder = work / "duplicate"
+    sweep_tool(src, ["create", src / "input" / "incline.dat", "--exe", exe,
+                     "--set", "time.step=1e-7", "--set", "output.interval=1000000",
+                     "--time", "5", "--dir", folder])
+    out = folder / "runs" / "p001"
+    job = sweep_tool(src, ["submit", "--no-collect", folder], env=cluster.env).stdout.split()[-1]
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < 30 and not (out / "p001.h5.partial").exists():
+        time.sleep(0.2)
+    second = sweep_tool(src, ["submit", "--force", "--no-collect", folder],
+                        env=cluster.env).stdout.split()[-1]
+    log = out / "job.log"
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < 30 and " refused " not in (log.read_text() if log.exists() else ""):
+        time.sleep(0.2)
+    text = log.read_text() if log.exists() else ""
+    status = (out / "exit_status").read_text().strip() if (out / "exit_status").exists() else ""
+    check("the second start (submit --force) refused by the lock: logged, exit_status kept",
+          f"p001 refused {second}" in text and status == "running", f"{status!r}\n{text}")
+    state = sweep_tool(src, ["status", folder], env=cluster.env).stdout
+    check("status: p001 running", "p001 running" in state, state)
+    cluster.query(["scancel", job])
+    wait_idle(cluster, 30)
+    state = sweep_tool(src, ["status", folder], env=cluster.env).stdout
+    # (scancel's SIGTERM: multicor may write a checkpoint before it stops)
+    check("cancelled: exit_status stays 'running', status says started or checkpoint",
+          ("p001 started" in state or "p001 checkpoint" in state)
+          and (out / "exit_status").read_text().strip() == "running", state)
+    sweep_tool(src, ["collect", "--no-plot", folder])
+    rows = read_table(folder / "results.csv")
+    check("collect: one start, exit_status running", rows and rows[0]["starts"] == "1"
+          and rows[0]["exit_status"] == "running", str(rows))
 
 
 def locally(src, exe, work):

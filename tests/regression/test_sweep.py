@@ -12,6 +12,10 @@
   disk 2, and reductions (absmax of the energy balance) next to indexed values.
 - A point that fails at run time (gravity 1e300: the run stops with exit code 1) is
   reported as failed; the next `run` runs only that point again.
+- create refuses a --time that is no Slurm time limit, --max-running 0, a --dir that is a
+  file; `submit` and `status` with stand-ins for sbatch and squeue (no Slurm daemon): the
+  cap of --max-running kept by a resubmission, points still pending or running in an earlier
+  job not submitted again, squeue out of reach (submit refuses unless --force).
 Usage (ctest does this): test_sweep.py --exe multicor --work DIR --source REPO
 """
 import csv
@@ -165,9 +169,120 @@ def wrong_scalar(src, exe, work):
           proc.stderr.strip()[-300:])
 
 
+def refused_options(src, exe, work):
+    """Options that sbatch would refuse only at submit, or no folder to write: refused by
+    create with a message (before: accepted, or a Python traceback)."""
+    deck = src / "input" / "incline.dat"
+    (work / "a_file").write_text("")
+    for options, said in ((["--time", "1 hour"], "--time '1 hour': not a Slurm time limit"),
+                          (["--max-running", "0"], "--max-running 0: at least 1"),
+                          (["--dir", work / "a_file"], "exists and is not a folder"),
+                          (["--dir", work / "a_file" / "x"], "cannot create the sweep folder")):
+        args = ["create", deck, "--exe", exe, "--set", "time.end=0.1,0.2"] + options
+        if "--dir" not in options:
+            args += ["--dir", work / "refused_option"]
+        proc = sweep_tool(src, args, expect=None)
+        check(f"create refuses {options[0]} {options[1]}", proc.returncode == 1
+              and f"multicor-sweep: error: " in proc.stderr and said in proc.stderr
+              and "Traceback" not in proc.stderr and not (work / "refused_option").exists(),
+              proc.stderr.strip()[-300:])
+    for time in ("90", "05:00", "01:30:00", "2-00", "2-00:30", "2-00:30:00", "UNLIMITED"):
+        folder = work / f"time_{time.replace(':', '_')}"
+        proc = sweep_tool(src, ["create", deck, "--exe", exe, "--set", "time.end=0.1",
+                                "--time", time, "--dir", folder], expect=None)
+        check(f"create accepts --time {time}", proc.returncode == 0
+              and f"#SBATCH --time={time}\n" in (folder / "sweep.slurm").read_text(),
+              proc.stderr.strip())
+
+
+SBATCH = """#!/bin/bash
+echo "$*" >> "$FAKE_LOG"
+echo 42
+"""
+SQUEUE = """#!/bin/bash
+# stand-in for squeue -h -r -o '%F|%K|%T' -j JOBS: prints $FAKE_SQUEUE; FAKE_SQUEUE_FAIL: fails
+if [ -n "${FAKE_SQUEUE_FAIL:-}" ]; then
+    echo "slurm_load_jobs error: Unable to contact slurm controller (connect failure)" >&2
+    exit 1
+fi
+printf "%b" "${FAKE_SQUEUE:-}"
+"""
+
+
+def submission(src, exe, work):
+    """`submit` and `status` with stand-ins for sbatch and squeue: a folder with a space, the
+    cap of --max-running kept by a resubmission, points that an earlier job still holds
+    pending or running neither resubmitted nor advised to be, squeue out of reach."""
+    import os
+    import shlex
+    bin_dir = work / "bin"
+    bin_dir.mkdir()
+    for name, text in (("sbatch", SBATCH), ("squeue", SQUEUE)):
+        (bin_dir / name).write_text(text)
+        (bin_dir / name).chmod(0o755)
+    folder = work / "stand in"
+    proc = sweep_tool(src, ["create", src / "input" / "incline.dat", "--exe", exe,
+                            "--set", "time.end=0.1,0.2,0.3", "--max-running", "1",
+                            "--time", "5", "--dir", folder])
+    check("create: the next command with the folder shell-quoted",
+          f"next: multicor-sweep submit {shlex.quote(str(folder))} " in proc.stdout, proc.stdout)
+    script = (folder / "sweep.slurm").read_text()
+    check("job script: the log folder between double quotes (it has a space)",
+          f'#SBATCH --output="{folder}/logs/%A_%a.out"\n' in script, "")
+    (folder / "runs" / "p001").mkdir(parents=True)
+    (folder / "runs" / "p001" / "exit_status").write_text("0\n")
+    log = work / "sbatch.log"
+
+    def tool(args, expect=0, **env):
+        e = dict(os.environ, PATH=f"{bin_dir}:{os.environ['PATH']}", FAKE_LOG=str(log), **env)
+        cmd = [sys.executable, str(src / "scripts" / "multicor-sweep")] + [str(a) for a in args]
+        proc = subprocess.run(cmd, capture_output=True, text=True, env=e)
+        if expect is not None and proc.returncode != expect:
+            print(proc.stdout, proc.stderr)
+        return proc
+
+    def calls():
+        return log.read_text().splitlines() if log.exists() else []
+
+    proc = tool(["submit", "--no-collect", folder])
+    check("resubmission of p002, p003 keeps the cap: --array=2-3%1",
+          proc.returncode == 0 and calls() and "--array=2-3%1 " in calls()[-1],
+          f"{proc.stderr.strip()} {calls()}")
+    queued = "42|2|RUNNING\n42|3|PENDING\n"
+    proc = tool(["submit", "--no-collect", folder], FAKE_SQUEUE=queued)
+    check("submit while the points are running or pending: nothing submitted",
+          proc.returncode == 0 and len(calls()) == 1 and "nothing to submit" in proc.stdout
+          and "p002 (running, job 42)" in proc.stdout, proc.stdout + proc.stderr)
+    proc = tool(["status", folder], FAKE_SQUEUE=queued)
+    check("status: p002 running, p003 pending, wait; no advice to submit",
+          "p002 running" in proc.stdout and "p003 pending" in proc.stdout
+          and "wait for them" in proc.stdout and "submit" not in proc.stdout, proc.stdout)
+    proc = tool(["submit", "--no-collect", folder], FAKE_SQUEUE="42|2|RUNNING\n")
+    check("submit while p002 runs: only p003, with the cap (--array=3%1)",
+          proc.returncode == 0 and len(calls()) == 2 and "--array=3%1 " in calls()[-1],
+          proc.stdout + proc.stderr)
+    proc = tool(["submit", "--no-collect", folder], expect=1, FAKE_SQUEUE_FAIL="1")
+    check("squeue out of reach: submit refuses, says so, names --force",
+          proc.returncode == 1 and "cannot ask Slurm" in proc.stderr
+          and "Unable to contact" in proc.stderr and "--force" in proc.stderr
+          and len(calls()) == 2, proc.stderr)
+    proc = tool(["status", folder], FAKE_SQUEUE_FAIL="1")
+    check("squeue out of reach: status says so, advises submit --force once they ended",
+          "cannot ask Slurm" in proc.stdout and "once those jobs have ended" in proc.stdout,
+          proc.stdout)
+    proc = tool(["submit", "--force", "--no-collect", folder], FAKE_SQUEUE_FAIL="1")
+    check("submit --force: submitted without squeue", proc.returncode == 0
+          and len(calls()) == 3 and "--array=2-3%1 " in calls()[-1], proc.stdout + proc.stderr)
+    proc = tool(["status", folder])
+    check("status once the jobs ended: advises submit", "continue the others: multicor-sweep "
+          f"submit {shlex.quote(str(folder))}" in proc.stdout, proc.stdout)
+
+
 def main():
     exe, work, src = arguments(fresh=True)
     refused_keys(src, exe, work)
+    refused_options(src, exe, work)
+    submission(src, exe, work)
     folder = generated_decks(src, exe, work)
     sequential_run(src, folder)
     failing_point(src, exe, work)
