@@ -235,12 +235,18 @@ contains
         !> System, after `mj_free_velocities`.
         type(dem_system_t), intent(inout) :: sys
         integer(i8) :: c0, c1, c2, rate
-        real(wp) :: alert
+        real(wp) :: alert, rmax
         call system_clock(c0, rate)
         ! touching disks must be found whatever the sign of their rounded gap
         alert = sys%scheme%alert
         if (sys%particles%n > 0) then
-            alert = alert + sys%scheme%gap_allowance*maxval(sys%particles%radius(1:sys%particles%n))
+            rmax = maxval(sys%particles%radius(1:sys%particles%n))
+            alert = alert + sys%scheme%gap_allowance*rmax
+            ! a bond is made on a gap of up to bond_ratio times the pair's radius: with cohesion
+            ! the search reaches that far, or an `alert` below it lost the bond at the first
+            ! step (at the default, a quarter of the mean radius, it changes nothing)
+            if (any(sys%materials%cohesion > 0.0_wp)) &
+                alert = max(alert, (sys%scheme%bond_ratio + sys%scheme%gap_allowance)*rmax)
         end if
         if (sys%bonds_pending) call make_bonds(sys, alert)
         call detect_contacts(sys%detector, sys%xm, sys%ym, sys%particles%radius, alert, &

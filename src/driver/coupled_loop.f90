@@ -175,6 +175,7 @@ contains
         type(progress_t) :: progress
         type(step_start_t) :: start
         integer(i8) :: n_steps, k, k0
+        integer :: lost_warnings
         integer :: unconverged
         logical :: speed_warned, rotation_warned, store_contacts
         type(step_end_t) :: act
@@ -183,6 +184,7 @@ contains
 
         n_steps = self%settings%n_steps
         unconverged = 0
+        lost_warnings = 0
         speed_warned = .false.
         rotation_warned = .false.
         k0 = 0
@@ -224,7 +226,12 @@ contains
             call self%cpl_out%record_step(out%file, self%sys, error)
             if (allocated(error)) return
             if (.not. self%sys%stats%converged) call warn_unconverged()
-            if (self%sys%dem%bonds_lost > 0) call report(lost_bonds_warning(k, self%sys%dem%time, self%sys%dem%bonds_lost))
+            if (self%sys%dem%bonds_lost > 0) then
+                lost_warnings = lost_warnings + 1
+                if (lost_warnings <= max_warnings) call report(lost_bonds_warning(k, self%sys%dem%time, self%sys%dem%bonds_lost))
+                if (lost_warnings == max_warnings) call report('warning: further lost bonds are only logged '// &
+                                                               '(/dem/bonds, mode 5)')
+            end if
             if (.not. speed_warned) call check_speed()
             if (.not. rotation_warned) call check_rotation()
             if (k == 1) call check_redundant_bonds()
@@ -277,23 +284,30 @@ contains
             if (.not. allocated(error)) call load_dem_writer(ck%source, self%dem_out, error)
             if (.not. allocated(error)) call load_coupled_writer(ck%source, self%cpl_out, error)
             if (.not. allocated(error)) call self%check_saved_part(ck%source, error)
+            if (.not. allocated(error)) call check_results_version(error)
             if (.not. allocated(error)) call load_results(ck%source, out, error)
             if (.not. allocated(error)) call self%load_part(ck%source, out, error)
             call ck%source%close(ignored)
             if (allocated(error)) return
-            ! A results file of an earlier build lacks the series this one appends to (the
-            ! supports' work of the audit, 2026-11-27): said before any step is written.
-            if (.not. out%file%exists('/coupling/energy/fe_reaction_work')) then
-                call make_error(error, "restart: the results file '"//out%file%path//"' was written by an "// &
-                                'earlier version of MULTICOR (its /coupling/energy has no fe_reaction_work): '// &
-                                'continue it with that version, or run the deck again from the start')
-                return
-            end if
             k0 = ck%start%step
             unconverged = ck%start%unconverged
             speed_warned = ck%start%speed_warned
             rotation_warned = ck%start%rotation_warned
+            ! an export before the checkpoint that a killed run left unrenamed
+            if (self%fclib_step > 0 .and. self%fclib_step <= k0) &
+                call out%adopt(fclib_path(out%final_path, self%fclib_step))
         end subroutine restore
+
+        !> Refuse a results file of an earlier build, which lacks a series this one appends to
+        !> (the supports' work of the audit, 2026-11-27), before load_results cuts or marks it:
+        !> an interrupted run's partial file stays as it was.
+        subroutine check_results_version(error)
+            type(error_t), allocatable, intent(out) :: error
+            if (out%file%exists('/coupling/energy/fe_reaction_work')) return
+            call make_error(error, "restart: the results file '"//out%file%path//"' was written by an "// &
+                            'earlier version of MULTICOR (its /coupling/energy has no fe_reaction_work): '// &
+                            'continue it with that version, or run the deck again from the start')
+        end subroutine check_results_version
 
         !> Write a checkpoint after step k (the buffered per-step values are written first).
         subroutine checkpoint(error)

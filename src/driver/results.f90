@@ -59,8 +59,11 @@ module driver_results
         !> Whether an earlier partial file was set aside as '<partial_path>.prev' (`abort`
         !> puts it back).
         logical :: set_aside = .false.
-        !> Final paths of the files written beside the results by this run (`companion`).
+        !> Final paths of the files written beside the results by this run (`companion`), and
+        !> of those an interrupted run wrote before its checkpoint (`adopt`).
         type(string_t), allocatable :: companions(:)
+        !> For each companion, whether this run wrote it (`abort` deletes only those).
+        logical, allocatable :: own(:)
     contains
         !> Create the results file (written as .partial until `close`).
         procedure :: open => writer_open
@@ -98,6 +101,8 @@ module driver_results
         procedure :: is_open => writer_is_open
         !> Path to write a file beside the results under, which follows the results file.
         procedure :: companion => writer_companion
+        !> Take over a file beside the results that a killed run left as '<path>.partial'.
+        procedure :: adopt => writer_adopt
     end type results_writer_t
 
 contains
@@ -134,6 +139,7 @@ contains
         self%run_id = new_run_id()
         self%resumed = .false.
         self%companions = [string_t ::]
+        self%own = [logical ::]
         call set_aside_partial(self, error)
         if (allocated(error)) return
         call self%file%create(self%partial_path, error)
@@ -193,6 +199,7 @@ contains
         self%resumed = .true.
         self%set_aside = .false.
         self%companions = [string_t ::]
+        self%own = [logical ::]
         if (.not. belongs(self%partial_path)) then
             if (.not. belongs(final_path)) then
                 call make_error(error, "results: neither '"//self%partial_path//"' nor '"// &
@@ -663,9 +670,27 @@ contains
         !> Path to write it under while the run goes on.
         character(len=:), allocatable, intent(out) :: partial
         if (.not. allocated(self%companions)) self%companions = [string_t ::]
+        if (.not. allocated(self%own)) self%own = [logical ::]
         self%companions = [self%companions, string_t(path)]
+        self%own = [self%own, .true.]
         partial = path//'.partial'
     end subroutine writer_companion
+
+    !> A restart takes over '<path>.partial', a file beside the results that the interrupted
+    !> run wrote and closed before its checkpoint but did not rename (killed by SIGKILL, a node
+    !> failure): `close` and `close_unfinished` give it its name, `abort` leaves it (the
+    !> interrupted run's, as the folder was). Nothing when there is no such file.
+    subroutine writer_adopt(self, path)
+        !> The writer.
+        class(results_writer_t), intent(inout) :: self
+        !> Final path of the file.
+        character(len=*), intent(in) :: path
+        if (.not. file_exists(path//'.partial')) return
+        if (.not. allocated(self%companions)) self%companions = [string_t ::]
+        if (.not. allocated(self%own)) self%own = [logical ::]
+        self%companions = [self%companions, string_t(path)]
+        self%own = [self%own, .false.]
+    end subroutine writer_adopt
 
     !> Give the files written beside the results their final names (the run ended or was
     !> stopped: its files are the folder's now).
@@ -687,6 +712,7 @@ contains
             end associate
         end do
         self%companions = [string_t ::]
+        self%own = [logical ::]
     end subroutine keep_companions
 
     !> Delete the files this run wrote beside the results (it failed).
@@ -696,9 +722,10 @@ contains
         integer :: i
         if (.not. allocated(self%companions)) return
         do i = 1, size(self%companions)
-            call remove_file(self%companions(i)%s//'.partial')
+            if (self%own(i)) call remove_file(self%companions(i)%s//'.partial')
         end do
         self%companions = [string_t ::]
+        self%own = [logical ::]
     end subroutine drop_companions
 
     !> Whether a results file is being written.

@@ -63,6 +63,7 @@ contains
         type(progress_t) :: progress
         type(step_start_t) :: start
         integer(i8) :: n_steps, k, k0
+        integer :: lost_warnings
         integer :: unconverged
         logical :: blocked_warned
         logical :: speed_warned
@@ -78,6 +79,7 @@ contains
         end if
         n_steps = run%n_steps
         unconverged = 0
+        lost_warnings = 0
         speed_warned = .false.
         blocked_warned = .false.
         k0 = 0
@@ -115,7 +117,12 @@ contains
                             'velocities) are left out of the solve; count per step in /dem/solver/blocked')
                 blocked_warned = .true.
             end if
-            if (cfg%system%bonds_lost > 0) call report(lost_bonds_warning(k, cfg%system%time, cfg%system%bonds_lost))
+            if (cfg%system%bonds_lost > 0) then
+                lost_warnings = lost_warnings + 1
+                if (lost_warnings <= max_warnings) call report(lost_bonds_warning(k, cfg%system%time, cfg%system%bonds_lost))
+                if (lost_warnings == max_warnings) call report('warning: further lost bonds are only logged '// &
+                                                               '(/dem/bonds, mode 5)')
+            end if
             if (.not. speed_warned) call check_speed()
             act = end_of_step(k, n_steps, run%output_interval, ck%schedule)
             if (act%store_first) call store(error)
@@ -153,6 +160,8 @@ contains
             unconverged = ck%start%unconverged
             speed_warned = ck%start%speed_warned
             blocked_warned = ck%start%blocked_warned
+            ! an export before the checkpoint that a killed run left unrenamed
+            if (cfg%fclib_step > 0 .and. cfg%fclib_step <= k0) call out%adopt(fclib_path(out%final_path, cfg%fclib_step))
         end subroutine restore
 
         !> Write a checkpoint after step k (the buffered statistics are written first).

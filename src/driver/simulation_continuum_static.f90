@@ -93,6 +93,28 @@ contains
     contains
 
         !> K_ff u_f = f_f - K_fp u_p at t = 0, and its equilibrium checked.
+        !> A static analysis takes the time functions at t = 0: when the deck loads the body
+        !> (load, traction, gravity, displacement) and all of it is zero there (a ramp, a step
+        !> that starts later), the solution is zero, which the deck hardly means.
+        subroutine warn_loads_zero_at_start(f)
+            !> Right-hand side on the free dofs at t = 0.
+            real(wp), intent(in) :: f(:)
+            integer :: first, k
+            character(len=*), parameter :: keys(4) = [character(len=12) :: 'load', 'traction', 'gravity', &
+                                                                                                                     'displacement']
+            if (any(f /= 0.0_wp)) return
+            first = 0
+            do k = 1, size(keys)
+                associate (line => deck%line('continuum', trim(keys(k))))
+                    if (line > 0 .and. (first == 0 .or. line < first)) first = line
+                end associate
+            end do
+            if (first == 0) return
+            call report('warning: '//deck%file//':'//to_str(first)//': every load and prescribed displacement '// &
+                        'of this static analysis is zero at t = 0, where it takes the values of their time '// &
+                        'functions ([functions]): the solution is zero')
+        end subroutine warn_loads_zero_at_start
+
         subroutine solve(error)
             type(error_t), allocatable, intent(out) :: error
             real(wp), allocatable :: f(:), ku(:)
@@ -103,6 +125,7 @@ contains
             ! Loads at t = 0 (their time functions' values there, as for the beam).
             allocate (self%uf(self%ops%n_free), f(self%ops%n_free), ku(self%ops%n_free))
             call self%ops%static_force(0.0_wp, f)
+            call warn_loads_zero_at_start(f)
             self%uf = f
             call self%k_factor%solve(self%uf, error)
             if (allocated(error)) return

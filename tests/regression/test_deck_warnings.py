@@ -192,10 +192,37 @@ checkpoint_seconds = 60
               f"exit {proc.returncode}; " + "; ".join(said)[:600])
 
 
+def continuum_static_ramp(exe, work):
+    """A continuum's static analysis whose only load is a traction under a ramp from 0: zero
+    at t = 0, where it takes the functions, so the solution is zero; warned about at the
+    traction's line (as for the beam). The same traction constant: no warning."""
+    text = """[run]
+analysis = static
+[continuum]
+mesh = rectangle 0 -0.5 10 1 20 4 q4
+material = 70e9 0.3 2700 0.1 plane_stress
+fix = left x y
+traction = right 0 10000 parabolic{function}
+[functions]
+function = 1 ramp 0.1
+"""
+    for function, wanted in ((" 1", 1), ("", 0)):
+        deck = work / f"continuum_static{'_ramp' if function else ''}.dat"
+        deck.write_text(text.format(function=function))
+        proc = multicor(exe, "--check", deck)
+        said = [line for line in warnings_of(proc.stdout + proc.stderr)
+                if f"{deck.name}:7: every load and prescribed displacement" in line]
+        check(f"continuum static, traction {'under a ramp' if function else 'constant'}: "
+              f"{'warned' if wanted else 'no warning'} that the solution is zero",
+              proc.returncode == 0 and len(said) == wanted and len(warnings_of(proc.stdout)) == wanted,
+              f"exit {proc.returncode}; " + "; ".join(warnings_of(proc.stdout + proc.stderr))[:300])
+
+
 def main():
     exe, work, src = arguments(fresh=True)
     example_decks_are_quiet(exe, src)
     analysis_without_time(exe, work)
+    continuum_static_ramp(exe, work)
     solver_values(exe, src, work)
     rolling_length(exe, src, work)
     # the hinged row of the reference work (20 steps; with nlgs at 1e-4: 108 to 172 sweeps per

@@ -18,6 +18,7 @@ Usage (ctest does this): test_fclib_export.py --exe multicor --work DIR --source
 import re
 import subprocess
 import sys
+import time
 
 import h5py
 import numpy as np
@@ -209,7 +210,39 @@ def main():
           and "warning: [solver] fclib_step = 301 is after the last step of the run (300)" in proc.stdout,
           f"exit {proc.returncode}, files {written}")
     failed_run_keeps_export(exe, work)
+    killed_run_export(exe, decks, work)
     return summary()
+
+
+def killed_run_export(exe, decks, work):
+    """A run killed by SIGKILL after its export of step 2 and a checkpoint at step 50 leaves
+    the export as '.partial' (renamed only when a run ends); the restart takes it over and
+    gives it its name when it ends. It stayed '.partial' for good."""
+    deck = with_export(decks / "dem_small_deposit.dat", 2, work, ("max_sweeps = 1000",), name="killed.dat")
+    text = deck.read_text().replace("end = 0.06", "end = 1000").replace("[output]", "[output]\ncheckpoint_interval = 50")
+    deck.write_text(text)
+    out = work / "killed"
+    proc = subprocess.Popen([str(exe), str(deck), "--output", str(out), "--quiet"], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    step, deadline = 0, time.monotonic() + 120
+    while step < 100 and time.monotonic() < deadline and proc.poll() is None:
+        time.sleep(0.1)
+        try:
+            with h5py.File(out / "checkpoint.h5", "r") as f:
+                step = int(f["loop"].attrs["step"])
+        except (OSError, KeyError):
+            pass
+    proc.kill()
+    proc.wait()
+    left = sorted(p.name for p in out.iterdir())
+    again = subprocess.run([str(exe), str(deck), "--output", str(out), "--quiet", "--restart",
+                            str(out / "checkpoint.h5"), "--end", f"{(step + 20) * 2e-4!r}"],
+                           capture_output=True, text=True)
+    after = sorted(p.name for p in out.iterdir())
+    check("killed after its export: the restart gives the export its name",
+          step >= 100 and "killed_fclib_2.h5.partial" in left and again.returncode == 0
+          and "killed_fclib_2.h5" in after and "killed_fclib_2.h5.partial" not in after,
+          f"checkpoint at step {step}; before {left}; exit {again.returncode}; after {after}")
 
 
 def failed_run_keeps_export(exe, work):

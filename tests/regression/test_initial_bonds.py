@@ -202,6 +202,26 @@ def lost_bond(exe, work):
           + "; ".join(line for line in proc.stdout.splitlines() if "lost" in line)[:300])
 
 
+def bond_within_its_gap(exe, work):
+    """Two disks at rest 5e-9 m apart (R = 10 mm: 5e-7 R, within the bond gap of 1e-6 times
+    the mean radius, so they are bonded) under `alert = 0`: the bond made at t = 0 is found
+    again by the steps' search, which reaches the bond gap whenever there is cohesion (it was
+    logged lost at step 1: the search stopped at the alert distance)."""
+    text = pair_deck("", 1e-3, 0.5, end=0.01)
+    text = text.replace(f"disk = {D0} 0.0 {R} 1", f"disk = {D0 + 5e-9} 0.0 {R} 1")
+    text = text.replace("bond = 1 1 1.0\n", "bond = 1 1 1.0\nalert = 0\n")
+    deck = work / "gap_bond.dat"
+    deck.write_text(text)
+    path, proc = multicor(exe, deck, work, quiet=False)
+    with h5py.File(path, "r") as f:
+        modes = f["dem/bonds/mode"][...].tolist()
+        status = f["dem/contacts/status"][...]
+        off = f["dem/contacts/offset"][...]
+    check("a bond within its gap under alert = 0: kept at every step, not lost",
+          modes == [] and bool(np.all(np.diff(off)[1:] == 1)) and bool(np.all(status == 3))
+          and "lost" not in proc.stdout, f"ruptures {modes}, statuses {sorted(set(status.tolist()))}")
+
+
 def main():
     exe, work, _ = arguments(fresh=True)
     for h in (1e-3, 1e-4):
@@ -216,6 +236,7 @@ def main():
         r = run(exe, work, f"row_{method}", row_deck(method))
         spinning(f"spinning row of 13 ({method})", r, 3.0, 1e-3, 0.1, pair=False)
     lost_bond(exe, work)
+    bond_within_its_gap(exe, work)
     return summary()
 
 

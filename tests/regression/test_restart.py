@@ -837,29 +837,44 @@ def wall_time_over_runs(exe, src, work):
 def earlier_results(exe, src, work):
     """A coupled run whose results file lacks a series this build appends to (written by an
     earlier version: /coupling/energy/fe_reaction_work came on 2026-11-27) is not continued:
-    a message that says so, exit 1, the folder as it was. It gave an HDF5 'no dataset'
-    error."""
-    folder = work / "earlier_results"
-    deck = src / "input" / "coupled2d_block.dat"
-    first = run(exe, deck, "--quiet", "--output", folder, "--end", "2e-3")
-    # as an earlier version wrote them: the results without the series, the checkpoint's list
-    # of the results' series (/results@datasets, one count each in /results/records) without it
+    a message that says so, exit 1, the folder as it was: the finished result, and an
+    interrupted run's partial file, which the restart continues in place (the check came after
+    the partial file was cut and marked running). It gave an HDF5 'no dataset' error."""
     gone = "/coupling/energy/fe_reaction_work"
-    with h5py.File(folder / "coupled2d_block.h5", "a") as f:
-        del f[gone]
-    with h5py.File(folder / "checkpoint.h5", "a") as c:
-        names = c["results"].attrs["datasets"].split("\n")[:-1]
-        records = c["results/records"][...]
-        keep = [i for i, name in enumerate(names) if name != gone]
-        c["results"].attrs["datasets"] = "".join(names[i] + "\n" for i in keep)
-        del c["results/records"]
-        c["results/records"] = records[keep]
-    before = {p.name: digest(p) for p in folder.iterdir()}
-    again = run(exe, deck, "--quiet", "--output", folder, "--restart", folder / "checkpoint.h5", "--end", "4e-3")
-    after = {p.name: digest(p) for p in folder.iterdir()}
-    check("a results file of an earlier version: restart refused, folder as it was",
-          first.returncode == 0 and again.returncode == 1 and "written by an earlier version of MULTICOR"
-          in again.stderr and after == before, f"exit {again.returncode}: {again.stderr.strip()[-300:]}")
+
+    def as_earlier(results, checkpoint):
+        """The results without the series, the checkpoint's list of the results' series
+        (/results@datasets, one count each in /results/records) without it."""
+        with h5py.File(results, "a") as f:
+            del f[gone]
+        with h5py.File(checkpoint, "a") as c:
+            names = c["results"].attrs["datasets"].split("\n")[:-1]
+            records = c["results/records"][...]
+            keep = [i for i, name in enumerate(names) if name != gone]
+            c["results"].attrs["datasets"] = "".join(names[i] + "\n" for i in keep)
+            del c["results/records"]
+            c["results/records"] = records[keep]
+
+    deck = edit_deck(src / "input" / "coupled2d_block.dat", work / "earlier.dat", end=0.01, progress=0.02,
+                     extra_output=["checkpoint_interval = 20"])
+    for kind in ("finished", "interrupted"):
+        folder = work / f"earlier_{kind}"
+        if kind == "finished":
+            first = run(exe, deck, "--quiet", "--output", folder, "--end", "2e-3").returncode
+            results = folder / "earlier.h5"
+        else:
+            stopped = stopped_after(exe, deck, folder, 60, "earlier_interrupted")
+            if stopped is None:
+                continue
+            first = 0 if stopped[0] == 128 + signal.SIGTERM else stopped[0]
+            results = folder / "earlier.h5.partial"
+        as_earlier(results, folder / "checkpoint.h5")
+        before = {p.name: digest(p) for p in folder.iterdir()}
+        again = run(exe, deck, "--quiet", "--output", folder, "--restart", folder / "checkpoint.h5")
+        after = {p.name: digest(p) for p in folder.iterdir()}
+        check(f"{kind} run, results of an earlier version: restart refused, folder as it was",
+              first == 0 and again.returncode == 1 and "written by an earlier version of MULTICOR"
+              in again.stderr and after == before, f"exit {again.returncode}: {again.stderr.strip()[-300:]}")
 
 
 def other_threads(exe, src, work):
