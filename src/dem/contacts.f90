@@ -599,18 +599,36 @@ contains
         integer :: k, ma, mb
         real(wp) :: amoy
         do k = 1, cs%n
-            mb = mat(cs%i2(k))
-            if (cs%i1(k) > 0) then
-                ma = mat(cs%i1(k))
-                amoy = 0.5_wp*(radius(cs%i1(k)) + radius(cs%i2(k)))
-            else
-                ma = wall_mat(-cs%i1(k))
-                amoy = radius(cs%i2(k))
-            end if
+            call pair_of(cs, k, radius, mat, wall_mat, ma, mb, amoy)
             if (materials%cohesion(ma, mb) > 0.0_wp .and. cs%gap(k) <= bond_ratio*amoy) &
                 cs%status(k) = status_cohesive
         end do
     end subroutine contacts_make_bonds
+
+    !> Materials of contact k's two bodies and its mean radius (that of the disk against a
+    !> wall).
+    pure subroutine pair_of(cs, k, radius, mat, wall_mat, ma, mb, amoy)
+        !> Contacts.
+        type(contact_set_t), intent(in) :: cs
+        !> The contact.
+        integer, intent(in) :: k
+        !> Disk radii [m].
+        real(wp), intent(in) :: radius(:)
+        !> Disk and wall materials.
+        integer, intent(in) :: mat(:), wall_mat(:)
+        !> Materials of the first body (disk or wall) and of the second (disk).
+        integer, intent(out) :: ma, mb
+        !> Mean radius of the pair [m].
+        real(wp), intent(out) :: amoy
+        mb = mat(cs%i2(k))
+        if (cs%i1(k) > 0) then
+            ma = mat(cs%i1(k))
+            amoy = 0.5_wp*(radius(cs%i1(k)) + radius(cs%i2(k)))
+        else
+            ma = wall_mat(-cs%i1(k))
+            amoy = radius(cs%i2(k))
+        end if
+    end subroutine pair_of
 
     !> Material law, bonds, solver shifts and activation of every contact for the step.
     !> Intact bonds are always active, with Newton restitution: target = e max(-u_n(begin), 0)
@@ -654,14 +672,7 @@ contains
         !$omp parallel do schedule(static) private(k, ma, mb, ub, uf, uw, amoy, target, e, active) &
         !$omp if (cs%n >= parallel_min)
         do k = 1, cs%n
-            mb = mat(cs%i2(k))
-            if (cs%i1(k) > 0) then
-                ma = mat(cs%i1(k))
-                amoy = 0.5_wp*(radius(cs%i1(k)) + radius(cs%i2(k)))
-            else
-                ma = wall_mat(-cs%i1(k))
-                amoy = radius(cs%i2(k))
-            end if
+            call pair_of(cs, k, radius, mat, wall_mat, ma, mb, amoy)
             cs%amoy(k) = amoy
             e = materials%restitution(ma, mb)
             cs%coh(k) = 0.0_wp
