@@ -738,10 +738,12 @@ contains
         call solver_destroy(self)
     end subroutine solver_final
 
-    ! Defined assignment: a deep copy (own CHOLMOD object, copied factor), so that two
-    ! objects never share, and free twice, one CHOLMOD handle.
+    !> Defined assignment: a deep copy (own CHOLMOD object, copied factor), so that two
+    !> objects never share, and free twice, one CHOLMOD handle.
     subroutine solver_assign(lhs, rhs)
+        !> The copy.
         class(sparse_solver_t), intent(inout) :: lhs
+        !> The solver copied.
         class(sparse_solver_t), intent(in) :: rhs
         if (c_associated(lhs%handle) .and. c_associated(rhs%handle)) then
             if (c_associated(lhs%handle, rhs%handle)) return

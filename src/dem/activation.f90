@@ -117,6 +117,7 @@ contains
         active = gp <= allowance .or. rn > 0.0_wp
     end subroutine predicted_decide
 
+    !> The deck's word for the predicted-gap rule ('multicor').
     pure function predicted_name() result(word)
         character(len=:), allocatable :: word
         word = 'multicor'
@@ -147,6 +148,7 @@ contains
         target = -e*y(2)
     end subroutine siconos_decide
 
+    !> The deck's word for Siconos' rule ('siconos').
     pure function siconos_name() result(word)
         character(len=:), allocatable :: word
         word = 'siconos'

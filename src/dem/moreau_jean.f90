@@ -361,8 +361,8 @@ contains
             sys%vel0(2, :) = p%vy(1:p%n)
             sys%vel0(3, :) = p%w(1:p%n)
             call particles_inverse_mass(p, sys%im)
-            call particles_forces(p, t, .false., sys%impulse)
-            call particles_forces(p, t + h, .false., sys%load)
+            call particles_forces(p, t, sys%impulse)
+            call particles_forces(p, t + h, sys%load)
             sys%load = (1.0_wp - th)*sys%impulse + th*sys%load
             sys%vel(1, :) = sys%vel0(1, :) + h*sys%im(1, :)*(sys%load(1, :) + p%mass(1:p%n)*p%gravity(1))
             sys%vel(2, :) = sys%vel0(2, :) + h*sys%im(2, :)*(sys%load(2, :) + p%mass(1:p%n)*p%gravity(2))

@@ -305,25 +305,17 @@ contains
         end do
     end subroutine particles_constrained_velocity
 
-    !> Generalised forces (3, n) at time t: loads, plus gravity when `with_gravity`.
-    pure subroutine particles_forces(p, t, with_gravity, f)
+    !> Generalised forces (3, n) of the loads at time t (the weight is added by the time stepper).
+    pure subroutine particles_forces(p, t, f)
         !> Disks.
         type(particles_t), intent(in) :: p
         !> Time [s].
         real(wp), intent(in) :: t
-        !> Include the weight m g.
-        logical, intent(in) :: with_gravity
         !> Forces and torques per unit thickness (3, n).
         real(wp), intent(out) :: f(:, :)
         integer :: k
         type(particle_load_t) :: l
-        if (with_gravity) then
-            f(1, :) = p%mass(1:p%n)*p%gravity(1)
-            f(2, :) = p%mass(1:p%n)*p%gravity(2)
-        else
-            f(1:2, :) = 0.0_wp
-        end if
-        f(3, :) = 0.0_wp
+        f = 0.0_wp
         do k = 1, p%n_loads
             l = p%loads(k)
             f(l%dof, l%particle) = f(l%dof, l%particle) + l%value*particles_time_function(p, l%func, t)
