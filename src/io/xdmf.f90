@@ -102,8 +102,14 @@ contains
         integer :: ios
         character(len=256) :: msg
         self%path = path
-        ! a file name is element text: '&' and '<' (a deck named 'a&b.dat') would end the XML
-        self%h5_name = xml_text(h5_name)
+        ! a file name is element text: '&' and '<' (a deck named 'a&b.dat') would end the XML.
+        ! ParaView's XDMF 2 reader strips the leading bytes <= ' ' of a reference, those of a
+        ! UTF-8 letter among them ('ñ.h5' becomes '.h5'): a relative name starts with './'.
+        if (h5_name(1:min(1, len(h5_name))) == '/' .or. h5_name(1:min(2, len(h5_name))) == './') then
+            self%h5_name = xml_text(h5_name)
+        else
+            self%h5_name = xml_text('./'//h5_name)
+        end if
         self%depth = 0
         self%ios = 0
         open (newunit=self%unit, file=path, status='replace', action='write', iostat=ios, iomsg=msg)

@@ -41,7 +41,7 @@ for path in sys.argv[1:]:
         warp = WarpByVector(Input=r, Vectors=["POINTS", "displacement"])
         warp.UpdatePipeline(times[-1])
         out["warped"] = dsa.WrapDataObject(sm.Fetch(warp)).Points.tolist()
-    print("RESULT", path, json.dumps(out))
+    print("RESULT", json.dumps([path, out]))  # a path may hold blanks
 """
 
 
@@ -55,8 +55,8 @@ def read_paraview(paths, work, name="ParaView (pvpython, XDMF Reader) opens ever
     rows = {}
     for line in proc.stdout.splitlines():
         if line.startswith("RESULT "):
-            _, path, text = line.split(" ", 2)
-            rows[path] = json.loads(text)
+            path, row = json.loads(line.split(" ", 1)[1])
+            rows[path] = row
     ok = proc.returncode == 0 and len(rows) == len(paths)
     check(name, ok, proc.stderr[-400:] if not ok else f"{len(rows)} files")
     return rows if ok else None
