@@ -31,9 +31,10 @@
 module io_deck
     use core_kinds, only: wp
     use core_error, only: error_t, make_input_error, make_internal_error
-    use core_strings, only: string_t, strip, split_words, join_words, &
+    use core_strings, only: string_t, strip, split_words, join_words, is_blank_char, &
                             closest_match, parse_real, parse_int, to_str, shorten
-    use io_deck_schema, only: schema_t, keyword_spec_t, field_spec_t, condition_t, field_text
+    use io_deck_schema, only: schema_t, keyword_spec_t, field_spec_t, condition_t, field_text, field_name, &
+                              type_name
     implicit none
     private
     public :: deck_t, deck_entry_t, read_deck, read_deck_text
@@ -251,10 +252,24 @@ contains
         !> Validate one line and store its entry.
         subroutine parse_line(raw)
             character(len=*), intent(in) :: raw
-            character(len=:), allocatable :: s, key, value
+            character(len=:), allocatable :: s, key, value, message
             type(string_t), allocatable :: tokens(:)
-            integer :: hash, eq, k
+            logical, allocatable :: quoted(:)
+            integer :: hash, eq, k, raw_eq, last
             hash = index(raw, '#')
+            ! The values of a keyword line may hold double-quoted names, where '#' is no
+            ! comment; those of a text keyword (title) are the rest of the line up to the first
+            ! '#', quotes included, as they always were.
+            raw_eq = index(raw(:merge(hash - 1, len(raw), hash > 0)), '=')
+            if (raw_eq > 0) then
+                k = 0
+                if (len(current) > 0) k = schema%find_keyword(current, strip(raw(:raw_eq - 1)))
+                if (k > 0) then
+                    if (schema%keywords(k)%fields(1)%value_type /= field_text) hash = comment_column(raw, raw_eq + 1)
+                else
+                    hash = comment_column(raw, raw_eq + 1)
+                end if
+            end if
             if (hash > 0) then
                 s = strip(raw(:hash - 1))
             else
@@ -319,10 +334,17 @@ contains
             if (schema%keywords(k)%fields(1)%value_type == field_text) then
                 allocate (tokens(1))
                 tokens(1)%s = value
+                allocate (quoted(1), source=.false.)
             else
-                call split_words(value, tokens)
+                last = len(raw)
+                if (hash > 0) last = hash - 1
+                call split_values(raw, raw_eq + 1, last, tokens, quoted, message)
+                if (len(message) > 0) then
+                    call make_input_error(error, file, line_no, key, message)
+                    return
+                end if
             end if
-            call check_values(schema%keywords(k), tokens, file, line_no, error)
+            call check_values(schema%keywords(k), tokens, quoted, file, line_no, error)
             if (allocated(error)) return
             if (first_line(k) == 0) first_line(k) = line_no
             open_header = 0
@@ -403,6 +425,103 @@ contains
             text(i:i) = achar(10)
         end do
     end function normalized_text
+
+    !> Column of the '#' that starts the comment of line `raw`, looking from column `from` on
+    !> (0 when there is none): the first '#' outside double quotes. A quote left open runs to
+    !> the end of the line (split_values reports it).
+    pure integer function comment_column(raw, from) result(column)
+        !> The line.
+        character(len=*), intent(in) :: raw
+        !> First column searched (after the '=').
+        integer, intent(in) :: from
+        logical :: inside
+        inside = .false.
+        do column = from, len(raw)
+            if (raw(column:column) == '"') then
+                inside = .not. inside
+            else if (raw(column:column) == '#' .and. .not. inside) then
+                return
+            end if
+        end do
+        column = 0
+    end function comment_column
+
+    !> The values of line `raw` between columns `first` and `last`: words separated by blanks,
+    !> or values in double quotes, which may hold blanks and '#' (the quotes are not part of the
+    !> value); `quoted` tells which were quoted. A quote left open, an empty or blank quoted
+    !> value, a quote inside a word or a closing quote followed by more than a blank give
+    !> `message` naming the column in `raw` ('' when the values are well formed).
+    pure subroutine split_values(raw, first, last, tokens, quoted, message)
+        !> The line.
+        character(len=*), intent(in) :: raw
+        !> First and last columns of the values.
+        integer, intent(in) :: first, last
+        !> The values, quotes taken off.
+        type(string_t), allocatable, intent(out) :: tokens(:)
+        !> Whether each value was written in double quotes.
+        logical, allocatable, intent(out) :: quoted(:)
+        !> What is wrong ('' when nothing is).
+        character(len=:), allocatable, intent(out) :: message
+        integer :: i, j
+        message = ''
+        allocate (tokens(0), quoted(0))
+        i = first
+        do while (i <= last)
+            if (is_blank_char(raw(i:i))) then
+                i = i + 1
+            else if (raw(i:i) == '"') then
+                j = index(raw(i + 1:last), '"')
+                if (j == 0) then
+                    message = 'unterminated quote: the double quote at column '//to_str(i)// &
+                              ' has no closing one on its line (a quoted name ends on the line it starts)'
+                    return
+                end if
+                j = i + j
+                if (len(strip(raw(i + 1:j - 1))) == 0) then
+                    message = 'empty quoted value at column '//to_str(i)//': a name has at least one character '// &
+                              'other than a blank'
+                    return
+                end if
+                if (j < last) then
+                    if (.not. is_blank_char(raw(j + 1:j + 1))) then
+                        message = 'the quoted value "'//shorten(raw(i + 1:j - 1))//'" closed at column '// &
+                                  to_str(j)//' is followed by '''//raw(j + 1:j + 1)//''' (column '//to_str(j + 1)// &
+                                  '): put a blank after the closing quote, or the whole name between the quotes'
+                        return
+                    end if
+                end if
+                tokens = [tokens, string_t(raw(i + 1:j - 1))]
+                quoted = [quoted, .true.]
+                i = j + 1
+            else
+                j = i
+                do while (j <= last)
+                    if (is_blank_char(raw(j:j))) exit
+                    if (raw(j:j) == '"') then
+                        message = 'double quote inside a value at column '//to_str(j)//': quotes go around a '// &
+                                  'whole name ("left edge"), after a blank'
+                        return
+                    end if
+                    j = j + 1
+                end do
+                tokens = [tokens, string_t(raw(i:j - 1))]
+                quoted = [quoted, .false.]
+                i = j
+            end if
+        end do
+    end subroutine split_values
+
+    !> A noun with its indefinite article: `a real`, `an integer`.
+    pure function article(noun) result(text)
+        !> The noun.
+        character(len=*), intent(in) :: noun
+        character(len=:), allocatable :: text
+        if (scan(noun(1:1), 'aeiou') > 0) then
+            text = 'an '//noun
+        else
+            text = 'a '//noun
+        end if
+    end function article
 
     !> Names of the values of a line of keyword `spec` with values `tokens`: the fixed
     !> fields and the tail chosen by the selector word.
@@ -494,12 +613,15 @@ contains
         end do
     end function required_list
 
-    !> Check the values of one line: count (fixed fields and tail), types, ranges, words.
-    subroutine check_values(spec, tokens, file, line, error)
+    !> Check the values of one line: count (fixed fields and tail), types, ranges, words, and
+    !> that only names were quoted.
+    subroutine check_values(spec, tokens, quoted, file, line, error)
         !> Keyword spec.
         type(keyword_spec_t), intent(in) :: spec
-        !> Values as written.
+        !> Values as written (quotes taken off).
         type(string_t), intent(in) :: tokens(:)
+        !> Whether each value was written in double quotes.
+        logical, intent(in) :: quoted(:)
         !> Deck name.
         character(len=*), intent(in) :: file
         !> Line number.
@@ -507,22 +629,17 @@ contains
         !> Error, if any.
         type(error_t), allocatable, intent(out) :: error
         character(len=:), allocatable :: message, selector
-        type(field_spec_t) :: field
         integer :: nf, ntok, i, kt, g
         logical :: ok
         if (spec%fields(1)%value_type == field_text) return
         nf = size(spec%fields)
         ntok = size(tokens)
-        do i = 1, min(ntok, nf)
-            call spec%fields(i)%check(tokens(i)%s, ok, message)
-            if (.not. ok) then
-                call make_input_error(error, file, line, spec%name, 'value '//to_str(i)//' ('// &
-                                      spec%fields(i)%name//'): '//message)
-                return
-            end if
-        end do
         selector = ''
         if (spec%selector > 0 .and. spec%selector <= ntok) selector = tokens(spec%selector)%s
+        do i = 1, min(ntok, nf)
+            call check_one(spec%fields(i), i)
+            if (allocated(error)) return
+        end do
         if (ntok < nf) then
             call count_error('too few')
             return
@@ -550,24 +667,71 @@ contains
                 return
             end if
             do i = 1, ntok - nf
-                field = t%field(i)
-                call field%check(tokens(nf + i)%s, ok, message)
-                if (.not. ok) then
-                    call make_input_error(error, file, line, spec%name, 'value '//to_str(nf + i)// &
-                                          ' ('//field%name//'): '//message)
-                    return
-                end if
+                call check_one(t%field(i), nf + i)
+                if (allocated(error)) return
             end do
         end associate
 
     contains
 
+        !> Check value k against its field: quoted only if a name, then its type and range.
+        subroutine check_one(field, k)
+            type(field_spec_t), intent(in) :: field
+            integer, intent(in) :: k
+            if (quoted(k) .and. field%value_type /= field_name) then
+                call make_input_error(error, file, line, spec%name, 'value '//to_str(k)//' ('//field%name// &
+                                      '): "'//shorten(tokens(k)%s)//'" is in double quotes, which are only for '// &
+                                      'names (a path, a set name); '//article(type_name(field%value_type))// &
+                                      ' is written without them')
+                return
+            end if
+            call field%check(tokens(k)%s, ok, message)
+            if (.not. ok) call make_input_error(error, file, line, spec%name, 'value '//to_str(k)// &
+                                                ' ('//field%name//'): '//message//name_hint(k - 1, k))
+        end subroutine check_one
+
         !> Error for a wrong number of values, with the expected usage.
         subroutine count_error(what)
             character(len=*), intent(in) :: what
+            character(len=:), allocatable :: hint
+            integer :: last_expected, kt_here
+            hint = ''
+            if (what == 'too many') then
+                ! the last value expected may be a name that went on past its first blank
+                last_expected = nf
+                kt_here = spec%tail_index(selector)
+                if (kt_here > 0) last_expected = nf + spec%tails(kt_here)%max_values
+                hint = name_hint(last_expected, ntok)
+            end if
             call make_input_error(error, file, line, spec%name, what//' values (got '// &
-                                  to_str(ntok)//"): expected '"//spec%usage(selector)//"'")
+                                  to_str(ntok)//"): expected '"//spec%usage(selector)//"'"//hint)
         end subroutine count_error
+
+        !> When value p is a name written without quotes, values p + 1 .. k (the one that went
+        !> wrong, or the last of too many) may be the rest of a name with blanks, split into
+        !> words: the hint shows values p .. k quoted as one name; '' otherwise.
+        function name_hint(p, k) result(hint)
+            integer, intent(in) :: p, k
+            character(len=:), allocatable :: hint, joined
+            type(field_spec_t) :: f
+            integer :: q, kt_here
+            hint = ''
+            if (p < 1 .or. p >= k .or. k > ntok) return
+            if (quoted(p)) return
+            if (p <= nf) then
+                f = spec%fields(p)
+            else
+                kt_here = spec%tail_index(selector)
+                if (kt_here == 0) return
+                f = spec%tails(kt_here)%field(p - nf)
+            end if
+            if (f%value_type /= field_name) return
+            joined = tokens(p)%s
+            do q = p + 1, k
+                joined = joined//' '//tokens(q)%s
+            end do
+            hint = '; if "'//shorten(joined)//'" is one name, write it in double quotes'
+        end function name_hint
     end subroutine check_values
 
     !> Check required and conditional keywords once the whole deck is read.

@@ -15,6 +15,10 @@
 !> table). The tail may depend on a word field (the selector): `function = 1 table 0 0 1 1`
 !> takes the tail declared for `table`.
 !>
+!> A name field (`field_name`) is a word that names something the deck does not list: a path
+!> or a set of a mesh. It alone may be written in double quotes (`"left edge"`), which lets it
+!> hold blanks and `#` (the reader, io_deck, takes the quotes off).
+!>
 !> A selection field (`field_selection`) names particles: a number `n`, a range `a:b` (either
 !> end may be `last`), `last` or `all`. Its syntax is checked here; whether the numbers exist
 !> is checked when the model is built.
@@ -24,8 +28,8 @@ module io_deck_schema
     implicit none
     private
     public :: field_spec_t, tail_spec_t, condition_t, keyword_spec_t, section_spec_t, schema_t
-    public :: field_int, field_real, field_word, field_text, field_selection
-    public :: int_field, real_field, positive, word_field, text_field, selection_field, tail, when, unless
+    public :: field_int, field_real, field_word, field_text, field_selection, field_name
+    public :: int_field, real_field, positive, word_field, name_field, text_field, selection_field, tail, when, unless
     public :: multicor_schema, schema_markdown, type_name, parse_selection
 
     !> Field type: integer.
@@ -39,12 +43,14 @@ module io_deck_schema
     !> Field type: a selection of particles: `n`, `a:b` (`last` allowed at either end),
     !> `last` or `all`.
     integer, parameter :: field_selection = 5
+    !> Field type: a name (a path, a set of a mesh): any word, or any text in double quotes.
+    integer, parameter :: field_name = 6
 
     !> One value of a keyword: name, type, unit, range, allowed words.
     type :: field_spec_t
         !> Name shown in documentation and messages.
         character(len=:), allocatable :: name
-        !> field_int, field_real, field_word or field_text.
+        !> field_int, field_real, field_word, field_text, field_selection or field_name.
         integer :: value_type = field_real
         !> SI unit ('' when dimensionless or not a number).
         character(len=:), allocatable :: unit
@@ -260,6 +266,18 @@ contains
         f%unit = ''
         call split_words(allowed, f%allowed)
     end function word_field
+
+    !> A name field: a path or the name of a set of a mesh, any word; it may be written in
+    !> double quotes to hold blanks or `#` (`"left edge"`), unlike the other fields.
+    pure function name_field(name) result(f)
+        !> Field name.
+        character(len=*), intent(in) :: name
+        type(field_spec_t) :: f
+        f%name = name
+        f%value_type = field_name
+        f%unit = ''
+        allocate (f%allowed(0))
+    end function name_field
 
     !> A free-text field: the rest of the line.
     pure function text_field(name) result(f)
@@ -505,7 +523,7 @@ contains
 
     !> Name of a field type as used in messages and documentation.
     pure function type_name(value_type) result(name)
-        !> field_int, field_real, field_word or field_text.
+        !> field_int, field_real, field_word, field_text, field_selection or field_name.
         integer, intent(in) :: value_type
         character(len=:), allocatable :: name
         select case (value_type)
@@ -517,6 +535,8 @@ contains
             name = 'word'
         case (field_selection)
             name = 'selection'
+        case (field_name)
+            name = 'name'
         case default
             name = 'text'
         end select
@@ -563,6 +583,10 @@ contains
             return
         case (field_selection)
             call parse_selection(token, huge(1), i, j, ok, message)
+            return
+        case (field_name)
+            ok = len(token) > 0
+            if (.not. ok) message = 'a name is not empty'
             return
         case default
             ok = .true.

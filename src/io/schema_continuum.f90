@@ -3,7 +3,7 @@
 !> builders: io_deck_schema.
 module io_schema_continuum
     use core_kinds, only: wp
-    use io_deck_schema, only: schema_t, tail_spec_t, int_field, real_field, positive, word_field, tail, when, unless
+    use io_deck_schema, only: schema_t, tail_spec_t, int_field, real_field, positive, word_field, name_field, tail, when, unless
     implicit none
     private
     public :: add_continuum
@@ -21,11 +21,12 @@ contains
         tails = [tail([real_field('x0', 'm'), real_field('y0', 'm'), positive('lx', 'm'), positive('ly', 'm'), &
                        int_field('nx', lower=1), int_field('ny', lower=1), word_field('element', 'q4 t3')], &
                       7, 7, selected_by='rectangle'), &
-                 tail([word_field('path', '')], 1, 1, selected_by='file')]
+                 tail([name_field('path')], 1, 1, selected_by='file')]
         call s%add_keyword('continuum', 'mesh', [word_field('kind', 'rectangle file')], &
                            'rectangle: [x0, x0 + lx] x [y0, y0 + ly] with nx x ny Q4 (or 2 nx ny T3), sets '// &
                            'left, right, bottom, top (nodes and edges) and all (nodes and elements); file: a '// &
-                           'Gmsh 4.1 ASCII .msh (path relative to the deck), its physical groups as named sets.', &
+                           'Gmsh 4.1 ASCII .msh (path relative to the deck''s folder, in double quotes if it holds '// &
+                           'blanks), its physical groups as named sets.', &
                            selector=1, tails=tails)
         call s%add_keyword('continuum', 'material', [positive('young', 'Pa'), &
                                                      real_field('poisson', '', lower=-1.0_wp, upper=0.5_wp, &
@@ -36,28 +37,28 @@ contains
                            'Isotropic elastic material of an element set (default all; later lines override '// &
                            'earlier ones on shared elements). In plane strain poisson <= 0.499999 (closer to '// &
                            '0.5 the stiffness cannot be factored in double precision).', &
-                           tails=[tail([word_field('element_set', '')], 0, 1)], repeatable=.true.)
+                           tails=[tail([name_field('element_set')], 0, 1)], repeatable=.true.)
         call s%add_keyword('continuum', 'mass', [word_field('mass', 'consistent lumped')], &
                            'Mass matrix: consistent, or row-sum lumped (diagonal).', default='consistent', &
                            effective_when=unless('run', 'analysis', 'static'))
-        call s%add_keyword('continuum', 'fix', [word_field('node_set', '')], &
+        call s%add_keyword('continuum', 'fix', [name_field('node_set')], &
                            'Zero displacement of the nodes of a set, components x and/or y (a dof given by '// &
                            'several fix or displacement records must get the same value and function from each).', &
                            tails=[tail([word_field('component', 'x y')], 1, 2)], repeatable=.true.)
-        call s%add_keyword('continuum', 'displacement', [word_field('node_set', ''), &
+        call s%add_keyword('continuum', 'displacement', [name_field('node_set'), &
                                                          word_field('component', 'x y'), real_field('value', 'm')], &
                            'Prescribed displacement of the nodes of a set: the value, or the value times a '// &
                            '[functions] time function (its rate and acceleration are the derivatives of the '// &
                            'function); a dof given twice must get the same value and function both times.', &
                            tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
-        call s%add_keyword('continuum', 'load', [word_field('node_set', ''), &
+        call s%add_keyword('continuum', 'load', [name_field('node_set'), &
                                                  word_field('component', 'x y'), real_field('value', 'N')], &
                            'Force on every node of a set, times a [functions] time function (none: constant 1). '// &
                            'A load whose every force lands on a prescribed dof (fix, displacement) does nothing '// &
                            'and is an error.', &
                            tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true., &
                            effective_when=unless('run', 'analysis', 'modal'))
-        call s%add_keyword('continuum', 'traction', [word_field('edge_set', ''), &
+        call s%add_keyword('continuum', 'traction', [name_field('edge_set'), &
                                                      real_field('tx', 'Pa'), real_field('ty', 'Pa')], &
                            'Traction on the edges of a set: uniform, or parabolic (1.5 t (1 - s^2) with s from '// &
                            '-1 to 1 across the set along its longer extent, the same resultant as uniform t), '// &
