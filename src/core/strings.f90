@@ -8,7 +8,7 @@ module core_strings
     private
     public :: string_t, to_lower, strip, is_blank_char, split_words, join_words
     public :: levenshtein, closest_match, parse_real, parse_int, to_str, shorten, max_echo, is_real_syntax
-    public :: gib, counted, sci_to_str, sci_text
+    public :: gib, counted, sci_to_str, sci_text, quoted_name
 
     !> Longest token echoed whole in a message (see `shorten`).
     integer, parameter :: max_echo = 40
@@ -113,6 +113,20 @@ contains
             words(n)%s = text(start:i - 1)
         end do
     end subroutine split_words
+
+    !> A name as a deck writes it, for messages: as is, or between double quotes when it holds
+    !> a blank or a '#' (`left` stays `left`, `left edge` becomes `"left edge"`).
+    pure function quoted_name(name) result(text)
+        !> The name.
+        character(len=*), intent(in) :: name
+        character(len=:), allocatable :: text
+        integer :: i
+        if (len(name) == 0 .or. any([(is_blank_char(name(i:i)), i=1, len(name))]) .or. index(name, '#') > 0) then
+            text = '"'//name//'"'
+        else
+            text = name
+        end if
+    end function quoted_name
 
     !> Join words with a separator: `join_words(['a','b'], ', ')` is `'a, b'`.
     pure function join_words(words, separator) result(joined)

@@ -13,7 +13,7 @@
 module driver_simulation_continuum
     use core_kinds, only: wp
     use core_error, only: error_t, make_input_error
-    use core_strings, only: string_t, to_str
+    use core_strings, only: string_t, to_str, quoted_name
     use io_deck, only: deck_t, deck_entry_t
     use fem_mesh2d, only: mesh2d_t
     use fem_mesh_generator, only: rectangle_mesh
@@ -237,7 +237,7 @@ contains
                     call make_input_error(error, deck%file, e%line, keyword, 'node '//to_str(ids(k))// &
                                           ' at ('//to_str(self%model%mesh%x(1, ids(k)))//', '// &
                                           to_str(self%model%mesh%x(2, ids(k)))//') m of set '// &
-                                          e%word('node_set')//', component '//merge('x', 'y', comp == 1)// &
+                                          quoted_name(e%word('node_set'))//', component '//merge('x', 'y', comp == 1)// &
                                           ', is already prescribed by line '//to_str(by_line(dof))// &
                                           ' with another value or function: give each displacement component '// &
                                           'of a node one prescription (a repeated one must be the same value '// &

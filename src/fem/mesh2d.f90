@@ -371,7 +371,8 @@ contains
         names = ''
         if (allocated(self%edge_sets)) then
             do k = 1, size(self%edge_sets)
-                names = names//merge(' ', ',', k == 1)//" '"//self%edge_sets(k)%name//"'"
+                if (k > 1) names = names//','
+                names = names//" '"//self%edge_sets(k)%name//"'"
             end do
         end if
         if (len(names) == 0) names = ' (none)'
@@ -386,7 +387,8 @@ contains
         text = ' (known:'
         if (allocated(sets)) then
             do k = 1, size(sets)
-                text = text//merge(' ', ',', k == 1)//" '"//sets(k)%name//"'"
+                if (k > 1) text = text//','
+                text = text//" '"//sets(k)%name//"'"
             end do
             if (size(sets) == 0) text = text//' none'
         else
