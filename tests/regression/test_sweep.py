@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """scripts/multicor-sweep without Slurm: keys, generated decks, local runs, the table.
 
+- The deck parser reads a name in double quotes as one value, blanks and '#' inside it.
 - Keys that the deck does not contain are refused with exit code 1, naming the key, and
   leave no sweep folder; a value that fails `multicor --check` is reported with multicor's
   message naming the generated deck and line.
@@ -19,9 +20,11 @@
 Usage (ctest does this): test_sweep.py --exe multicor --work DIR --source REPO
 """
 import csv
+import importlib.machinery
 import math
 import subprocess
 import sys
+import types
 
 from checks import arguments, check, summary
 
@@ -114,6 +117,24 @@ def generated_decks(src, exe, work):
               and len(changed) == (0 if mu == "0.1" else 1)
               and all(b == expected_line for _, b in changed), str(changed))
     return folder
+
+
+def quoted_names(src):
+    """The deck parser of multicor-sweep reads names in double quotes as multicor does: one
+    value each, blanks and '#' inside; the value after such a name is the one a key names."""
+    loader = importlib.machinery.SourceFileLoader("multicor_sweep", str(src / "scripts" / "multicor-sweep"))
+    sweep = types.ModuleType(loader.name)
+    loader.exec_module(sweep)
+    lines = ["[run]", 'title = a "quoted # title', "analysis = static", "[continuum]",
+             'mesh = file "My Meshes/bar #1.msh"  # "an open quote in a comment',
+             'load = "loaded  end #2" x 1e3   # the load',
+             "fix = left x y"]
+    records = {r.keyword: r for r in sweep.parse_deck(lines)}
+    tokens = {k: [lines[r.lineno - 1][a:b] for a, b in r.spans] for k, r in records.items()}
+    check("multicor-sweep: quoted names are one value each",
+          tokens["mesh"] == ["file", '"My Meshes/bar #1.msh"'] and tokens["load"] == ['"loaded  end #2"', "x", "1e3"]
+          and tokens["fix"] == ["left", "x", "y"] and tokens["title"] == ["a", '"quoted'], str(tokens))
+    check("multicor-sweep: a quoted name matches a selector's value", sweep.same_value('"left"', "left"), "")
 
 
 def sequential_run(src, folder):
@@ -280,6 +301,7 @@ def submission(src, exe, work):
 
 def main():
     exe, work, src = arguments(fresh=True)
+    quoted_names(src)
     refused_keys(src, exe, work)
     refused_options(src, exe, work)
     submission(src, exe, work)
