@@ -4,7 +4,11 @@
 !> that runs to the end of the line; blank lines and tabs are fine. Lines end with LF, CR LF
 !> or a lone CR (old Mac files); a UTF-8 byte-order mark at the start of the file is skipped;
 !> another control character outside a comment is an error, and a NUL byte anywhere (the
-!> deck is stored in the results as a C string). Every line is checked
+!> deck is stored in the results as a C string). A value is a word; a name (schema
+!> `field_name`: a path, a set of a mesh) may instead be written between double quotes, which
+!> makes blanks and `#` part of it; quotes elsewhere, left open, empty or glued to a word are
+!> errors naming the column. A text keyword (`title`) keeps the rest of the line up to the
+!> first `#`, quotes and all. Every line is checked
 !> against the schema as it is read (known section and keyword, number of values, types,
 !> ranges, allowed words, duplicates of scalar keywords); then required keywords and
 !> conditional ones (`required_when`, `allowed_when`) are checked. The first problem found
