@@ -25,7 +25,7 @@ Supported asserts: ``@assertEqual``, ``@assertTrue``, ``@assertFalse``, ``@asser
 ``@assertGreaterThan``, ``@assertRelativelyEqual`` (tolerance required, as in pFUnit),
 ``@assertIsFinite`` (scalar). The generated code calls the same procedures with the same
 ``location=SourceLocation(file, line)`` argument as pFUnit; the fallback's ``funit`` module
-(funit.f90) exports pFUnit's public names, so a helper named like one of them (``run``...)
+(funit.fypp) exports pFUnit's public names, so a helper named like one of them (``run``...)
 fails to compile as under pFUnit. After the module, a ``<module>_suite`` subroutine uses the
 test module and ``funit`` unrestricted, declares ``suite`` and ``t`` and names ``TestMethod``,
 as pFUnit's generated suite function does, so the same name clashes fail, and no other: the
@@ -53,7 +53,7 @@ PFUNIT_ASSERT_OPERANDS = {
     'all': 1, 'notall': 1, 'none': 1, 'ispermutationof': 2, 'exceptionraised': 0,
     'sameshape': 2, 'that': 2, '_that': 2,
 }
-# The variants the fallback implements (funit.f90).
+# The variants the fallback implements (funit.fypp).
 SUPPORTED = {'equal', 'true', 'false', 'lessthan', 'greaterthan', 'relativelyequal', 'isfinite'}
 
 # pFUnit's patterns (same regular expressions, anchored with re.match).
