@@ -6,7 +6,12 @@ expected message; compile-time cases must generate, then fail to compile against
 fallback's funit module with the expected compiler message; run-time cases must compile
 and the test executable must fail with the expected output. A correct module must
 generate, compile and pass, so that the refusals are not caused by a broken set-up, and so
-must each ACCEPT case: what pFUnit 4.12 accepts, the fallback must not refuse.
+must each ACCEPT case: what pFUnit 4.12 accepts, the fallback must not refuse. Each PAIRS case
+is an assertion form pFUnit 4.12 accepts (a kind, rank or option of its generated overloads,
+src/funit/asserts/Assert_Real.tmpl, Assert_Integer.tmpl, Assert_Logical.tmpl, AssertString.F90,
+AssertBasic.F90 in Goddard-Fortran-Ecosystem/pFUnit): written once so that it holds (the suite
+must pass) and once so that it does not (the suite must fail, naming the .pf file and the line
+of the assertion).
 
 Usage: test_strictness.py --fc gfortran --moddir <funit .mod dir> --lib <libfunit.a>
                           --work <scratch dir>
@@ -24,7 +29,8 @@ PF2F90 = HERE / 'pf2f90.py'
 
 def module(name, body, helpers=''):
     """A .pf test module `name` with one test whose body is `body`."""
-    return (f"module {name}\n    use funit\n    use, intrinsic :: iso_fortran_env, only: real64\n"
+    return (f"module {name}\n    use funit\n    use, intrinsic :: iso_fortran_env, only: int8, int16, "
+            f"int64, real32, real64, real128\n"
             f"    implicit none\ncontains\n    @test\n    subroutine test_one()\n{body}\n"
             f"    end subroutine test_one\n{helpers}end module {name}\n")
 
@@ -105,6 +111,114 @@ ACCEPT = [
                                             'fallback_run_test = 4\ncontains\n')),
 ]
 
+# (name, declarations, assertion that holds, assertion that fails, regex the failure must match).
+# Tolerances: pFUnit's assert_equal passes an element when |actual - expected| <= tolerance
+# (Assert_Real.tmpl); without a tolerance it uses 0, exact equality. Each case's values are chosen
+# exactly representable (or their difference known) so that the tolerance decides.
+PAIRS = [
+    # no_tol (integer default, real kind(actual)): the integer is converted to real64; 3 and
+    # 3 + spacing(3) are exact, no tolerance means exact equality
+    ('pair_int_real64', "        real(real64) :: x\n        x = 3.0_real64",
+     "        @assertEqual(3, x)",
+     "        @assertEqual(3, x + spacing(x))", r'expected 3\.0+ actual 3\.0+4'),
+    # no_tol (real default, real64): the default real 0.1 is converted to real64 and differs from
+    # 0.1_real64 by 1.49e-9 (real32's 0.1 is 0.100000001490116...): exact comparison fails ...
+    ('pair_default_real64', "        real(real64) :: x, y\n        x = 0.5_real64\n        y = 0.1_real64",
+     "        @assertEqual(0.5, x)",
+     "        @assertEqual(0.1, y)", r'\|diff\| 0\.149'),
+    # ... with_tol (real default, real64, tolerance default real): 1.0e-8 > 1.49e-9 passes,
+    # 1.0e-9 < 1.49e-9 fails
+    ('pair_default_tol', "        real(real64) :: x\n        x = 0.1_real64",
+     "        @assertEqual(0.1, x, 1.0e-8)",
+     "        @assertEqual(0.1, x, 1.0e-9)", r'> tolerance'),
+    # real32 throughout: |1.5 - 1.0| = 0.5 exactly; <= tolerance, so 0.5 passes, 0.25 fails
+    ('pair_real32', "        real(real32) :: y\n        y = 1.5_real32",
+     "        @assertEqual(1.0_real32, y, 0.5_real32)",
+     "        @assertEqual(1.0_real32, y, 0.25)", r'> tolerance'),
+    # real128: z = 1 + 1.0e-31 is resolved (epsilon 1.9e-34, lost in real64): within 1.0e-30,
+    # not within 1.0e-32, so the comparison is made in real128
+    ('pair_real128', "        real(real128) :: z\n        z = 1.0_real128 + 1.0e-31_real128",
+     "        @assertEqual(1, z, 1.0e-30_real128)",
+     "        @assertEqual(1.0_real128, z, 1.0e-32_real128)", r'> tolerance'),
+    # scalar expected against an array actual ("Rank 0 is also conformable"), exact values;
+    # the first failing element is reported
+    ('pair_scalar_array', "        real(real64) :: v(2)\n        v = [2.0_real64, 2.5_real64]",
+     "        @assertEqual(2.0_real64, v(1:1))",
+     "        @assertEqual(2.0_real64, v)", r'at index \[2\]'),
+    # rank 2, real64 tolerance: one element off by 1.0e-10 (rounded to about 1.00000008e-10),
+    # within 1.0e-9, not within 1.0e-11
+    ('pair_rank2', "        real(real64) :: a(2, 3), b(2, 3)\n        a = 1\n        b = a\n"
+                   "        b(2, 3) = 1 + 1.0e-10_real64",
+     "        @assertEqual(a, b, 1.0e-9_real64)",
+     "        @assertEqual(a, b, 1.0e-11_real64)", r'at index \[2, 3\]'),
+    # rank 5 (pFUnit's MAX_ASSERT_RANK), exact
+    ('pair_rank5', "        real(real64) :: c(1, 2, 1, 2, 1)\n        c = 0",
+     "        @assertEqual(0, c)",
+     "        c(1, 2, 1, 2, 1) = 1\n        @assertEqual(0.0, c)", r'at index \[1, 2, 1, 2, 1\]'),
+    # Inf == Inf passes (exact equality first); NaN fails whatever the tolerance
+    ('pair_inf_nan', "        use, intrinsic :: ieee_arithmetic\n        real(real64) :: f, n\n"
+                     "        f = ieee_value(f, ieee_positive_inf)\n        n = ieee_value(n, ieee_quiet_nan)",
+     "        @assertEqual(f, [f, f])",
+     "        @assertEqual(n, n, huge(n))", r'NaN'),
+    # integer kinds (Assert_Integer.tmpl 'useful'): a default-integer expected against int8,
+    # exact
+    ('pair_int8', "        integer(int8) :: k\n        k = 7_int8",
+     "        @assertEqual(7, k)",
+     "        @assertEqual(8, k)", r'expected 8 actual 7'),
+    # int64 rank 2 against a scalar, exact
+    ('pair_int64_2d', "        integer(int64) :: m(2, 2)\n        m = 5\n        m(1, 2) = 6",
+     "        @assertEqual(5_int64, m(:, 1))",
+     "        @assertEqual(5, m)", r'at index \[1, 2\]'),
+    # int16 arrays compared (strict <), message by keyword
+    ('pair_int_less', "        integer(int16) :: j(2)\n        j = [2_int16, 3_int16]",
+     "        @assertLessThan([1_int16, 2_int16], j, message='lt')",
+     "        @assertLessThan([1_int16, 3_int16], j, message='lt')", r'3 is not less than 3 at index \[2\]'),
+    # a scalar lhs against an array rhs (not the reverse, see strict_lhs_array_rhs_scalar)
+    ('pair_int_greater', "        integer :: i(3)\n        i = [4, 5, 6]",
+     "        @assertGreaterThan(7, i)",
+     "        @assertGreaterThan(6, i)", r'6 is not greater than 6 at index \[3\]'),
+    # real array comparisons: lhs < rhs + tolerance with a scalar lhs (no tolerance: strict)
+    ('pair_real_less', "        real(real64) :: r(2)\n        r = [1.0_real64, 2.0_real64]",
+     "        @assertLessThan(0.5_real64, r)",
+     "        @assertLessThan(1, r)", r'is not less than'),
+    # lhs > rhs - tolerance: 1 > 1.5 - 0.75 holds; 1 > 1.5 - 0.5 = 1 does not (strict), values exact
+    ('pair_real_greater', "        real(real32) :: q(1)\n        q = 1.0_real32",
+     "        @assertGreaterThan(q, [1.5_real32], 0.75)",
+     "        @assertGreaterThan(q, [1.5_real32], 0.5)", r'is not greater than'),
+    # relative: |actual - expected| <= tolerance*|expected|; both errors are 0.005 (to real32
+    # rounding), within 0.01, not within 0.001
+    ('pair_relative', "        real(real32) :: y(2)\n        y = [100.5_real32, 201.0_real32]",
+     "        @assertRelativelyEqual([100.0, 200.0], y, 0.01)",
+     "        @assertRelativelyEqual([100.0, 200.0], y, 0.001)", r'relative error'),
+    # logical assertEqual (Assert_Logical.tmpl), a scalar expected spread over the array
+    ('pair_logical', "        logical :: l(2)\n        l = [.true., .false.]",
+     "        @assertEqual([.true., .false.], l)",
+     "        @assertEqual(.true., l, message='logical')", r'at index \[2\]'),
+    # whitespace= (AssertString.F90, StringUtilities.F90): any run of blanks and tabs equals
+    # any other run under IGNORE_DIFFERENCES, but not none
+    ('pair_ws_differences', "",
+     "        @assertEqual('a b', 'a ' // achar(9) // ' b', whitespace=IGNORE_DIFFERENCES)",
+     "        @assertEqual('a b', 'ab', whitespace=IGNORE_DIFFERENCES)", r'expected "a b" found "ab"'),
+    ('pair_ws_ignore_all', "",
+     "        @assertEqual('ab', ' a  b ', whitespace=IGNORE_ALL)",
+     "        @assertEqual('ab', ' a  c ', whitespace=IGNORE_ALL)", r'found "a  c"'),
+    ('pair_ws_keep_all', "",
+     "        @assertEqual(' a', ' a', whitespace=KEEP_ALL)",
+     "        @assertEqual(' a', 'a', whitespace=KEEP_ALL)", r'expected " a" found "a"'),
+    ('pair_ws_trim_all', "",
+     "        @assertEqual('a', ' a ', 'msg', whitespace=TRIM_ALL)",
+     "        @assertEqual('a', ' a b', 'msg', whitespace=TRIM_ALL)", r'found "a b"'),
+    # string arrays (AssertString.F90 0d1d and 1d1d)
+    ('pair_string_arrays', "",
+     "        @assertEqual('x', ['x ', ' x'])",
+     "        @assertEqual(['ab', 'cd'], ['ab', 'ce'])", r'expected "cd" found "ce"'),
+    # assertIsFinite for real32 and real128 (AssertBasic.F90)
+    ('pair_finite', "        use, intrinsic :: ieee_arithmetic\n        real(real128) :: z\n"
+                    "        z = ieee_value(z, ieee_positive_inf)",
+     "        @assertIsFinite(1.0_real32)",
+     "        @assertIsFinite(z)", r'not finite'),
+]
+
 # fHamcrest's matcher types, public in pFUnit 4.12's FUnit (IsNear/IsRelativelyNear were split
 # into IsNear_32/_64 and IsRelativelyNear_32/_64 only after 4.14, pFUnit PR #544)
 MATCHER_TYPES = ['Every', 'AnyOf', 'AllOf', 'IsNear', 'IsRelativelyNear', 'StringContains',
@@ -142,6 +256,71 @@ COMPILE = [
                                   "    logical function true()\n        true = .true.\n"
                                   "    end function true\n"),
      r"(already defined|USE-associated)"),
+    # Kinds and ranks pFUnit 4.12 does not combine (Assert_Real.tmpl's no_tol/with_tol lists,
+    # after tools/overload_template.py drops duplicates and the kinds gfortran lacks): expected
+    # of another real kind than default real or the actual's, an array expected against a
+    # scalar or another rank, a tolerance of another kind, an integer tolerance, rank 6
+    ('strict_kind_real64_real32', module('strict_kind_real64_real32',
+                                         "        @assertEqual(1.0_real64, 1.0_real32)"),
+     r"no specific subroutine for the generic .assertequal."),
+    ('strict_kind_real64_real128', module('strict_kind_real64_real128',
+                                          "        @assertEqual(1.0_real64, 1.0_real128)"),
+     r"no specific subroutine for the generic .assertequal."),
+    ('strict_rank_array_scalar', module('strict_rank_array_scalar',
+                                        "        @assertEqual([1.0_real64], 1.0_real64)"),
+     r"no specific subroutine for the generic .assertequal."),
+    ('strict_rank_mixed', module('strict_rank_mixed', "        real(real64) :: a(1, 1)\n        a = 1\n"
+                                 "        @assertEqual([1.0_real64], a)"),
+     r"no specific subroutine for the generic .assertequal."),
+    ('strict_tol_kind', module('strict_tol_kind', "        @assertEqual(1.0_real32, 1.0_real32, 0.1_real64)"),
+     r"no specific subroutine for the generic .assertequal."),
+    ('strict_tol_real128', module('strict_tol_real128',
+                                  "        @assertEqual(1.0_real64, 1.0_real64, 0.1_real128)"),
+     r"no specific subroutine for the generic .assertequal."),
+    ('strict_tol_integer', module('strict_tol_integer', "        @assertEqual(1.0_real64, 1.0_real64, 0)"),
+     r"no specific subroutine for the generic .assertequal."),
+    ('strict_rank6', module('strict_rank6', "        real(real64) :: a(1, 1, 1, 1, 1, 1)\n        a = 1\n"
+                            "        @assertEqual(a, a)"),
+     r"no specific subroutine for the generic .assertequal."),
+    ('strict_less_rank6', module('strict_less_rank6', "        integer :: a(1, 1, 1, 1, 1, 1)\n        a = 1\n"
+                                 "        @assertLessThan(0, a)"),
+     r"no specific subroutine for the generic .assertlessthan."),
+    # the scalar may be the expected value or lhs only ("Rank 0 is also conformable" lists the
+    # expected/lhs at rank 0, never the actual/rhs)
+    ('strict_lhs_array_rhs_scalar', module('strict_lhs_array_rhs_scalar',
+                                           "        @assertGreaterThan([4, 5], 3)"),
+     r"no specific subroutine for the generic .assertgreaterthan."),
+    ('strict_real_lhs_array', module('strict_real_lhs_array',
+                                     "        @assertLessThan([1.0_real64], 2.0_real64, 0.5_real64)"),
+     r"no specific subroutine for the generic .assertlessthan."),
+    # Assert_Integer.tmpl: expected of the actual's kind or default only; no real expected for
+    # an integer actual, no tolerance
+    ('strict_int_kinds', module('strict_int_kinds', "        @assertEqual(1_int64, 1)"),
+     r"no specific subroutine for the generic .assertequal."),
+    ('strict_int_kinds_8_16', module('strict_int_kinds_8_16', "        @assertEqual(1_int8, 1_int16)"),
+     r"no specific subroutine for the generic .assertequal."),
+    ('strict_real_int_actual', module('strict_real_int_actual', "        @assertEqual(1.0_real64, 1)"),
+     r"no specific subroutine for the generic .assertequal."),
+    ('strict_int_tolerance', module('strict_int_tolerance', "        @assertEqual(1, 1, 1)"),
+     r"no specific subroutine for the generic .assertequal."),
+    ('strict_relative_int', module('strict_relative_int', "        @assertRelativelyEqual(1, 1, 0.1)"),
+     r"no specific subroutine for the generic .assertrelativelyequal."),
+    # Assert_Logical.tmpl puts a KeywordEnforcer third: the message goes by keyword
+    ('strict_logical_message', module('strict_logical_message',
+                                      "        @assertEqual(.true., .true., 'msg')"),
+     r"no specific subroutine for the generic .assertequal."),
+    # AssertString.F90: no array expected against a scalar; whitespace is a WhitespaceOptions,
+    # whose component has no default (StringUtilities.F90)
+    ('strict_string_1d0d', module('strict_string_1d0d', "        @assertEqual(['a'], 'a')"),
+     r"no specific subroutine for the generic .assertequal."),
+    ('strict_whitespace_int', module('strict_whitespace_int', "        @assertEqual('a', 'a', whitespace=1)"),
+     r"no specific subroutine for the generic .assertequal."),
+    ('strict_whitespace_default', module('strict_whitespace_default',
+                                         "        @assertEqual('a', 'a', whitespace=WhitespaceOptions())"),
+     r"No initializer for component .value."),
+    # AssertBasic.F90: assertIsFinite takes a scalar
+    ('strict_finite_array', module('strict_finite_array', "        @assertIsFinite([1.0_real64])"),
+     r"no specific subroutine for the generic .assertisfinite."),
 ]
 
 COMPILE += [(f'strict_type_{t.lower()}', module(f'strict_type_{t.lower()}', "        @assertTrue(.true.)")
@@ -179,6 +358,24 @@ RUN = [
     # TRIM_ALL ignores the ends only: inner blanks count
     ('strict_string_inner', module('strict_string_inner', "        @assertEqual('a b', 'a  b')"),
      r'expected "a b" found "a  b"'),
+    # same rank, other shape: pFUnit's conformable() fails ('Arrays not conformable')
+    ('strict_shape_real', module('strict_shape_real', "        real(real64) :: a(2, 3), b(3, 2)\n"
+                                 "        a = 1\n        b = 1\n        @assertEqual(a, b, 1.0_real64)"),
+     r'Arrays not conformable: expected shape \[2, 3\] actual shape \[3, 2\]'),
+    ('strict_shape_int', module('strict_shape_int', "        @assertLessThan([1, 2], [3, 4, 5])"),
+     r'Arrays not conformable'),
+    ('strict_shape_string', module('strict_shape_string', "        @assertEqual(['a', 'b'], ['a'])"),
+     r'Arrays not conformable'),
+    # AssertRelativelyEqual takes expected as 0*actual + expected: an Inf actual makes it NaN,
+    # which fails even with an infinite tolerance
+    ('strict_relative_inf', module('strict_relative_inf', "        use, intrinsic :: ieee_arithmetic\n"
+                                   "        real(real64) :: f\n        f = ieee_value(f, ieee_positive_inf)\n"
+                                   "        @assertRelativelyEqual(1.0_real64, f, f)"),
+     r'relative error'),
+    # a whitespace value outside pFUnit's four
+    ('strict_whitespace_unknown', module('strict_whitespace_unknown',
+                                         "        @assertEqual('a', 'a', whitespace=WhitespaceOptions(7))"),
+     r'Unknown case for handling Whitespace'),
 ]
 
 
@@ -255,6 +452,27 @@ def main():
         if rc == 0:
             rc, out = c.execute()
         expect(rc == 0 and '1 passed, 0 failed' in out, name, 'generates, compiles, passes', out)
+
+    for name, decls, holds, fails, pattern in PAIRS:
+        for suffix, assertion in (('ok', holds), ('ko', fails)):
+            case = f'{name}_{suffix}'
+            body = '\n'.join(x for x in (decls, assertion) if x)
+            c = Case(args, case, module(case, body))
+            rc, out = c.generate()
+            if rc == 0:
+                rc, out = c.compile()
+            if rc != 0:
+                expect(False, case, 'generates and compiles', out)
+                continue
+            rc, out = c.execute()
+            if suffix == 'ok':
+                expect(rc == 0 and '1 passed, 0 failed' in out, case, 'passes', out)
+            else:
+                # the failing assertion is the body's last line: module() puts the body at line 8
+                line = 7 + body.count('\n') + 1
+                where = rf'{case}\.pf:{line}: assertion failed'
+                expect(rc != 0 and re.search(where, out) is not None and re.search(pattern, out) is not None,
+                       case, f'fails at {case}.pf:{line} ({pattern})', out)
 
     for name, text, pattern in COMPILE:
         c = Case(args, name, text)
