@@ -378,6 +378,16 @@ RUN = [
      r'Unknown case for handling Whitespace'),
 ]
 
+# (name, .pf text, regex the run output must match, or None: must pass), compiled with the Debug
+# unit tests' trap on invalid operations: pFUnit's array assert_equal (WHERE/ELSEWHERE) computes
+# Inf - Inf for equal infinities, which traps; its scalar one returns on equality first and passes
+INF = "        use, intrinsic :: ieee_arithmetic\n        real(real64) :: f\n        f = ieee_value(f, ieee_positive_inf)\n"
+TRAP = [
+    ('trap_inf_scalar', module('trap_inf_scalar', INF + "        @assertEqual(f, f)"), None),
+    ('trap_inf_array', module('trap_inf_array', INF + "        @assertEqual([f], [f])"),
+     r'Floating-point exception'),
+]
+
 
 def run(cmd, cwd):
     p = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True)
@@ -403,8 +413,8 @@ class Case:
             out += out2
         return rc, out
 
-    def compile(self):
-        fc = [self.args.fc, '-ffree-line-length-none', f'-I{self.args.moddir}']
+    def compile(self, flags=()):
+        fc = [self.args.fc, '-ffree-line-length-none', f'-I{self.args.moddir}', *flags]
         rc, out = run(fc + ['-c', f'{self.name}.F90'], self.dir)
         if rc == 0:
             rc, out2 = run(fc + ['-c', 'driver.f90'], self.dir)
@@ -495,6 +505,23 @@ def main():
         else:
             ok = False
         expect(ok, name, f'compiles, then fails at run time ({pattern})', out)
+
+    for name, text, pattern in TRAP:
+        c = Case(args, name, text)
+        rc, out = c.generate()
+        if rc == 0:
+            rc, out = c.compile(['-ffpe-trap=invalid'])
+            ok = rc == 0
+            if ok:
+                rc, out = c.execute()
+                if pattern is None:
+                    ok = rc == 0 and '1 passed, 0 failed' in out
+                else:
+                    ok = rc != 0 and re.search(pattern, out) is not None and 'passed' not in out
+        else:
+            ok = False
+        expect(ok, name, 'passes with -ffpe-trap=invalid' if pattern is None
+               else f'compiles, then stops on a trap ({pattern})', out)
 
     print(f'{len(failures)} failed')
     return 1 if failures else 0
