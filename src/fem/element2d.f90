@@ -1,17 +1,23 @@
 !> The family of isoparametric 2D continuum elements (two displacement dofs per node).
 !>
 !> An extension gives its number of nodes, the natural coordinates of its nodes, its shape
-!> functions and their natural derivatives at a point, and its quadrature rule. Everything else
-!> is common and lives here: geometry (x = sum N_a x_a, J = dx/dxi), strain-displacement matrix
-!> B, stiffness K = int B^T D B t dA, consistent mass M = int rho t N^T N dA, row-sum lumped
-!> mass, body force f = int rho t N^T g dA, and the stress D B u at a point.
+!> functions and their natural derivatives at a point, its quadrature rule, and what the code
+!> outside the family asks of an element kind: its deck name, its reference element (which
+!> natural points it holds), a quadrature rule of a chosen order, its XDMF topology and Gmsh
+!> type, and how it fills a cell of a structured grid (fem_element_registry maps kind ids,
+!> deck names and Gmsh types to elements). Everything else is common and lives here: geometry
+!> (x = sum N_a x_a, J = dx/dxi), strain-displacement matrix B, stiffness K = int B^T D B t dA,
+!> consistent mass M = int rho t N^T N dA, row-sum lumped mass, body force f = int rho t N^T g
+!> dA, the stress D B u at a point, and the inverse map of a physical point (Newton from the
+!> centre, which an element may replace by a closed form).
 !> Local dofs are ordered (u_1x, u_1y, u_2x, u_2y, ...).
 module fem_element2d
     use core_kinds, only: wp
+    use core_constants, only: pi
     use fem_elastic2d, only: elastic2d_t
     implicit none
     private
-    public :: element2d_t
+    public :: element2d_t, gauss_legendre
 
     !> An isoparametric 2D continuum element type (stateless: one instance serves every element
     !> of that type; the nodal coordinates are passed in).
@@ -25,6 +31,22 @@ module fem_element2d
         procedure(shape_iface), deferred :: shape
         !> Quadrature points (natural coordinates) and weights on the reference element.
         procedure(quadrature_iface), deferred :: quadrature
+        !> Name of the element kind in the deck (lower case, e.g. 'q4').
+        procedure(name_iface), deferred :: name
+        !> Whether a natural point lies in the reference element, up to a tolerance.
+        procedure(inside_iface), deferred :: inside
+        !> Quadrature rule of n Gauss-Legendre points per direction on the reference element.
+        procedure(gauss_rule_iface), deferred :: gauss_rule
+        !> XDMF topology type of a mesh of this kind alone (e.g. 'Quadrilateral').
+        procedure(xdmf_topology_iface), deferred :: xdmf_topology
+        !> XDMF cell type code in a 'Mixed' topology.
+        procedure(integer_iface), deferred :: xdmf_code
+        !> Gmsh element type number (MSH 4.1).
+        procedure(integer_iface), deferred :: gmsh_type
+        !> Elements of this kind filling one cell of a structured grid, by the cell's corners.
+        procedure(grid_cell_iface), deferred :: grid_cell
+        !> Natural coordinates of a physical point (Newton from the centre by default).
+        procedure :: inverse_map => element_inverse_map
         !> Shape functions, Cartesian derivatives and det J at a natural point.
         procedure :: geometry => element_geometry
         !> Smallest det J over the nodes and quadrature points (> 0 for a valid element).
@@ -89,6 +111,68 @@ module fem_element2d
             !> Weights (npoints), summing to the reference area.
             real(wp), allocatable, intent(out) :: weights(:)
         end subroutine quadrature_iface
+
+        !> Name of the element kind in the deck.
+        pure function name_iface(self) result(name)
+            import :: element2d_t
+            !> The element type.
+            class(element2d_t), intent(in) :: self
+            !> The name, lower case.
+            character(len=:), allocatable :: name
+        end function name_iface
+
+        !> True when the natural point xi lies in the reference element enlarged by tol.
+        pure logical function inside_iface(self, xi, tol)
+            import :: element2d_t, wp
+            !> The element type.
+            class(element2d_t), intent(in) :: self
+            !> Natural coordinates of the point.
+            real(wp), intent(in) :: xi(2)
+            !> How far (in natural coordinates) outside the reference element still counts.
+            real(wp), intent(in) :: tol
+        end function inside_iface
+
+        !> A rule of n Gauss-Legendre points per direction on the reference element (the
+        !> tensor rule on a square, its collapsed form on a triangle): n^2 points.
+        pure subroutine gauss_rule_iface(self, n, points, weights)
+            import :: element2d_t, wp
+            !> The element type.
+            class(element2d_t), intent(in) :: self
+            !> Gauss-Legendre points per direction (>= 1).
+            integer, intent(in) :: n
+            !> Natural coordinates of the points (2, n^2).
+            real(wp), allocatable, intent(out) :: points(:, :)
+            !> Weights (n^2), summing to the reference area.
+            real(wp), allocatable, intent(out) :: weights(:)
+        end subroutine gauss_rule_iface
+
+        !> XDMF topology type of a mesh of elements of this kind only.
+        pure function xdmf_topology_iface(self) result(topology)
+            import :: element2d_t
+            !> The element type.
+            class(element2d_t), intent(in) :: self
+            !> The XDMF TopologyType.
+            character(len=:), allocatable :: topology
+        end function xdmf_topology_iface
+
+        !> An integer property of the element kind.
+        pure integer function integer_iface(self)
+            import :: element2d_t
+            !> The element type.
+            class(element2d_t), intent(in) :: self
+        end function integer_iface
+
+        !> The elements of this kind covering one cell of a structured grid: the cell's corner
+        !> nodes are numbered 1 (lower left), 2 (lower right), 3 (upper right), 4 (upper left);
+        !> column k gives the corners that are the nodes of the cell's element k, in element
+        !> node order (counter-clockwise).
+        pure function grid_cell_iface(self) result(cell)
+            import :: element2d_t
+            !> The element type.
+            class(element2d_t), intent(in) :: self
+            !> Corner numbers (node_count, elements per cell).
+            integer, allocatable :: cell(:, :)
+        end function grid_cell_iface
     end interface
 
 contains
@@ -331,4 +415,76 @@ contains
         call self%shape(sum(xin, dim=2)/size(xin, 2), n, dn)
         c = matmul(x, n)
     end function element_centre
+
+    !> Natural coordinates xi of the physical point p by Newton's method on x(xi) = p from the
+    !> centre (the mean natural node position): stopped when |xi| exceeds 10 (the point is far
+    !> outside, where Newton may wander), when det J = 0, or after 30 iterations; converged when
+    !> the step falls below max(1e-14, 64 eps max|x| / sqrt|det J|). The step bound is the
+    !> rounding of xi: the residual carries the rounding of the coordinates (eps |x|), which the
+    !> step divides by the element size, so small elements far from the origin need more than
+    !> 1e-14.
+    pure subroutine element_inverse_map(self, x, p, xi, converged)
+        !> The element type.
+        class(element2d_t), intent(in) :: self
+        !> Nodal coordinates (2, node_count).
+        real(wp), intent(in) :: x(:, :)
+        !> The physical point.
+        real(wp), intent(in) :: p(2)
+        !> Natural coordinates of the point (the last iterate when not converged).
+        real(wp), intent(out) :: xi(2)
+        !> Whether the map was inverted (always, for a closed form).
+        logical, intent(out) :: converged
+        real(wp), allocatable :: xin(:, :)
+        real(wp) :: jac(2, 2), det, r(2), dxi(2), n(self%node_count()), dn(self%node_count(), 2)
+        integer :: it
+        xin = self%natural_nodes()
+        xi = sum(xin, dim=2)/size(xin, 2)
+        converged = .false.
+        do it = 1, 30
+            call self%shape(xi, n, dn)
+            r = p - matmul(x, n)
+            jac = matmul(x, dn)
+            det = jac(1, 1)*jac(2, 2) - jac(1, 2)*jac(2, 1)
+            if (.not. abs(det) > 0) exit
+            dxi(1) = (jac(2, 2)*r(1) - jac(1, 2)*r(2))/det
+            dxi(2) = (-jac(2, 1)*r(1) + jac(1, 1)*r(2))/det
+            xi = xi + dxi
+            if (maxval(abs(xi)) > 10) exit
+            if (maxval(abs(dxi)) < max(1.0e-14_wp, 64*epsilon(1.0_wp)*maxval(abs(x))/sqrt(abs(det)))) then
+                converged = .true.
+                exit
+            end if
+        end do
+    end subroutine element_inverse_map
+
+    !> Gauss-Legendre points and weights on [-1, 1] (Newton on P_n from the Chebyshev guesses).
+    pure subroutine gauss_legendre(n, t, w)
+        !> Number of points.
+        integer, intent(in) :: n
+        !> Points (n), increasing.
+        real(wp), intent(out) :: t(n)
+        !> Weights (n), summing to 2.
+        real(wp), intent(out) :: w(n)
+        real(wp) :: x, p0, p1, p2, dp, dx
+        integer :: i, k, it
+        do i = 1, n
+            x = -cos(pi*(i - 0.25_wp)/(n + 0.5_wp))
+            do it = 1, 100
+                p0 = 1.0_wp
+                p1 = x
+                do k = 2, n
+                    p2 = ((2*k - 1)*x*p1 - (k - 1)*p0)/k
+                    p0 = p1
+                    p1 = p2
+                end do
+                ! p1 = P_n(x), p0 = P_{n-1}(x).
+                dp = n*(x*p1 - p0)/(x*x - 1)
+                dx = p1/dp
+                x = x - dx
+                if (abs(dx) < 1.0e-16_wp) exit
+            end do
+            t(i) = x
+            w(i) = 2/((1 - x*x)*dp*dp)
+        end do
+    end subroutine gauss_legendre
 end module fem_element2d

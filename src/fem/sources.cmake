@@ -12,6 +12,7 @@ set(MULTICOR_FEM_SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/element2d.f90
     ${CMAKE_CURRENT_LIST_DIR}/element_q4.f90
     ${CMAKE_CURRENT_LIST_DIR}/element_t3.f90
+    ${CMAKE_CURRENT_LIST_DIR}/element_registry.f90
     ${CMAKE_CURRENT_LIST_DIR}/edge_load.f90
     ${CMAKE_CURRENT_LIST_DIR}/mesh2d.f90
     ${CMAKE_CURRENT_LIST_DIR}/mesh_generator.f90
