@@ -5,17 +5,18 @@
 !> The grid covers the bounding box of the mesh with about one cell per element (square-ish
 !> cells of the mean element bounding-box size). Every element is registered in each cell
 !> its bounding box touches (compressed rows, elements in increasing order). A query tests
-!> only the elements of the point's cell: bounding box first, then the inverse isoparametric
-!> map, barycentric (exact) for T3 and Newton for Q4 (from the centre, converged when the
-!> step is below 1e-14, at most 30 iterations). The point is in the element when its natural
-!> coordinates lie in the reference element up to 1e-10. The first such element in element
+!> only the elements of the point's cell: bounding box first, then the element's inverse
+!> isoparametric map (`element2d_t%inverse_map`: barycentric, exact, for T3; Newton from the
+!> centre for Q4, converged when the step is below 1e-14, at most 30 iterations). The point is
+!> in the element when the map converged and its natural coordinates lie in the reference
+!> element up to 1e-10 (`element2d_t%inside`). The first such element in element
 !> order is returned, so that a point on a shared edge gets the same element as a brute-force
 !> search in element order (`locate_brute`, kept for the tests).
 module coupling_locate2d
     use core_kinds, only: wp
     use core_constants, only: relative_roundoff
-    use fem_mesh2d, only: mesh2d_t, element_t3, element_q4
-    use fem_element_q4, only: element_q4_t
+    use fem_mesh2d, only: mesh2d_t
+    use fem_element_registry, only: element_slot_t, new_element
     implicit none
     private
     public :: element_grid_t, build_element_grid, locate_brute, inverse_map
@@ -191,9 +192,9 @@ contains
         xi = 0.0_wp
     end subroutine locate_brute
 
-    !> Natural coordinates of (x, y) in element e: barycentric for T3 (xi, eta with
-    !> N = (1 - xi - eta, xi, eta)), Newton for Q4 (xi, eta in [-1, 1]); inside is true when
-    !> they lie in the reference element up to 1e-10 (for Q4, also when Newton converged).
+    !> Natural coordinates of (x, y) in element e by its kind's inverse map (barycentric for T3,
+    !> xi, eta with N = (1 - xi - eta, xi, eta); Newton for Q4, xi, eta in [-1, 1]); inside is
+    !> true when the map converged and they lie in the reference element up to 1e-10.
     pure subroutine inverse_map(mesh, e, x, y, xi, inside)
         !> The mesh.
         type(mesh2d_t), intent(in) :: mesh
@@ -205,44 +206,11 @@ contains
         real(wp), intent(out) :: xi(2)
         !> The point lies in the element.
         logical, intent(out) :: inside
-        real(wp), allocatable :: xe(:, :)
-        real(wp) :: jac(2, 2), det, r(2), dxi(2), n(4), dn(4, 2)
-        type(element_q4_t) :: q4
-        integer :: it
+        type(element_slot_t) :: slot
         logical :: converged
-        xe = mesh%element_coordinates(e)
-        select case (mesh%kind(e))
-        case (element_t3)
-            jac(:, 1) = xe(:, 2) - xe(:, 1)
-            jac(:, 2) = xe(:, 3) - xe(:, 1)
-            det = jac(1, 1)*jac(2, 2) - jac(1, 2)*jac(2, 1)
-            r = [x, y] - xe(:, 1)
-            xi(1) = (jac(2, 2)*r(1) - jac(1, 2)*r(2))/det
-            xi(2) = (-jac(2, 1)*r(1) + jac(1, 1)*r(2))/det
-            inside = xi(1) >= -inside_tol .and. xi(2) >= -inside_tol .and. xi(1) + xi(2) <= 1 + inside_tol
-        case default
-            xi = 0.0_wp
-            converged = .false.
-            do it = 1, 30
-                call q4%shape(xi, n, dn)
-                r = [x, y] - matmul(xe, n)
-                jac = matmul(xe, dn)
-                det = jac(1, 1)*jac(2, 2) - jac(1, 2)*jac(2, 1)
-                if (.not. abs(det) > 0) exit
-                dxi(1) = (jac(2, 2)*r(1) - jac(1, 2)*r(2))/det
-                dxi(2) = (-jac(2, 1)*r(1) + jac(1, 1)*r(2))/det
-                xi = xi + dxi
-                ! Far outside: Newton may wander; stop once clearly out.
-                if (maxval(abs(xi)) > 10) exit
-                ! Converged when the step is at the rounding of xi: the residual r carries the
-                ! rounding of the coordinates (eps |x|), which the step divides by the element
-                ! size, so small elements far from the origin need a step bound above eps.
-                if (maxval(abs(dxi)) < max(1.0e-14_wp, 64*epsilon(1.0_wp)*maxval(abs(xe))/sqrt(abs(det)))) then
-                    converged = .true.
-                    exit
-                end if
-            end do
-            inside = converged .and. maxval(abs(xi)) <= 1 + inside_tol
-        end select
+        call new_element(mesh%kind(e), slot)
+        call slot%element%inverse_map(mesh%element_coordinates(e), [x, y], xi, converged)
+        inside = converged
+        if (inside) inside = slot%element%inside(xi, inside_tol)
     end subroutine inverse_map
 end module coupling_locate2d

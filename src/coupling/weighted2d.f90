@@ -4,24 +4,23 @@
 !> with alpha = the FE weight of a coupling_overlap2d weight field (one region or a set of
 !> disjoint regions; 1 outside). Elements whose bounding
 !> box misses the region's are assembled with their own rule (alpha = 1, bitwise the
-!> unweighted model); the others by an n x n Gauss-Legendre rule (Q4) or its collapsed
-!> (Duffy) form on the triangle (T3), n = `order` (default 4). A polynomial alpha of degree d
+!> unweighted model); the others by the element's rule of n Gauss-Legendre points per direction
+!> (`element2d_t%gauss_rule`: n x n Gauss on Q4, its collapsed (Duffy) form on T3), n = `order`
+!> (default 4). A polynomial alpha of degree d
 !> on an element lying in the region is integrated exactly when 2 n - 1 >= d + 2 (Q4 mass,
 !> per direction); across the region's boundary alpha has a kink and the rule is only
 !> convergent (refine the mesh or raise the order there).
 module coupling_weighted2d
     use core_kinds, only: wp
-    use core_constants, only: pi
     use core_error, only: error_t, make_error
     use fem_continuum_model, only: continuum_model_t
-    use fem_mesh2d, only: element_t3
     use fem_element2d, only: element2d_t
     use fem_elastic2d, only: elastic2d_t
     use fem_triplets, only: fem_triplets_t
     use coupling_overlap2d, only: weight_field_t
     implicit none
     private
-    public :: assemble_weighted, gauss_legendre
+    public :: assemble_weighted
 
 contains
 
@@ -66,7 +65,7 @@ contains
                     ke = el%stiffness(xe, mat)
                     me = el%mass_consistent(xe, mat)
                 else
-                    call element_rule(model%mesh%kind(e), nq, pts, w)
+                    call el%gauss_rule(nq, pts, w)
                     call weighted_element(el, xe, mat, region, pts, w, ke, me)
                 end if
             end associate
@@ -110,62 +109,4 @@ contains
             end do
         end do
     end subroutine weighted_element
-
-    !> n x n Gauss rule on the reference square [-1, 1]^2 (Q4) or its collapsed form on the
-    !> reference triangle (0,0), (1,0), (0,1) (T3).
-    pure subroutine element_rule(kind, n, pts, w)
-        integer, intent(in) :: kind, n
-        real(wp), allocatable, intent(out) :: pts(:, :), w(:)
-        real(wp) :: t(n), wt(n)
-        integer :: i, j, q
-        call gauss_legendre(n, t, wt)
-        allocate (pts(2, n*n), w(n*n))
-        q = 0
-        do j = 1, n
-            do i = 1, n
-                q = q + 1
-                if (kind == element_t3) then
-                    ! (u, v) in [0, 1]^2 -> (u, v (1 - u)), Jacobian (1 - u).
-                    associate (u => 0.5_wp*(1 + t(i)), v => 0.5_wp*(1 + t(j)))
-                        pts(:, q) = [u, v*(1 - u)]
-                        w(q) = 0.25_wp*wt(i)*wt(j)*(1 - u)
-                    end associate
-                else
-                    pts(:, q) = [t(i), t(j)]
-                    w(q) = wt(i)*wt(j)
-                end if
-            end do
-        end do
-    end subroutine element_rule
-
-    !> Gauss-Legendre points and weights on [-1, 1] (Newton on P_n from the Chebyshev guesses).
-    pure subroutine gauss_legendre(n, t, w)
-        !> Number of points.
-        integer, intent(in) :: n
-        !> Points (n), increasing.
-        real(wp), intent(out) :: t(n)
-        !> Weights (n), summing to 2.
-        real(wp), intent(out) :: w(n)
-        real(wp) :: x, p0, p1, p2, dp, dx
-        integer :: i, k, it
-        do i = 1, n
-            x = -cos(pi*(i - 0.25_wp)/(n + 0.5_wp))
-            do it = 1, 100
-                p0 = 1.0_wp
-                p1 = x
-                do k = 2, n
-                    p2 = ((2*k - 1)*x*p1 - (k - 1)*p0)/k
-                    p0 = p1
-                    p1 = p2
-                end do
-                ! p1 = P_n(x), p0 = P_{n-1}(x).
-                dp = n*(x*p1 - p0)/(x*x - 1)
-                dx = p1/dp
-                x = x - dx
-                if (abs(dx) < 1.0e-16_wp) exit
-            end do
-            t(i) = x
-            w(i) = 2/((1 - x*x)*dp*dp)
-        end do
-    end subroutine gauss_legendre
 end module coupling_weighted2d

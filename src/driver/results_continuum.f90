@@ -1,8 +1,9 @@
 !> The /continuum group of a results file (layout in doc/output.md) and the XDMF file next to it.
 !>
 !> /continuum/mesh: coordinates (2, n_nodes), connectivity (4, n_elements; 1-based, 0 beyond
-!> a triangle's 3 nodes), kind (1 = T3, 2 = Q4), topology (the 0-based XDMF connectivity:
-!> (3 or 4, n_elements) for one kind of element, a flat mixed list otherwise);
+!> a triangle's 3 nodes), kind (1 = T3, 2 = Q4: the kind ids of fem_element_registry),
+!> topology (the 0-based XDMF connectivity: (3 or 4, n_elements) for one kind of element, a
+!> flat mixed list otherwise; the topology names and codes are the element kinds');
 !> /continuum/sets/{nodes,elements}/<name> (1-based indices) and /continuum/sets/edges/<name>
 !> (2, n_edges). A static run writes /continuum/static/{displacement (2, n_nodes), stress
 !> (3, n_elements: xx, yy, xy at element centres), strain_energy}; a modal run
@@ -19,7 +20,8 @@ module driver_results_continuum
     use core_constants, only: two_pi
     use core_error, only: error_t, make_error
     use io_hdf5_file, only: h5_file_t
-    use fem_mesh2d, only: mesh2d_t, element_t3, nodes_per_element
+    use fem_mesh2d, only: mesh2d_t
+    use fem_element_registry, only: element_slot_t, element_family
     implicit none
     private
     public :: continuum_writer_t
@@ -85,7 +87,7 @@ contains
         if (allocated(error)) return
         call set_topology(self, mesh, topo)
         if (self%topology /= 'Mixed') then
-            n = nodes_per_element(mesh%kind(1))
+            n = size(mesh%element_nodes(1))
             call file%write_dataset('/continuum/mesh/topology', reshape(topo, [n, self%n_elements]), error)
         else
             call file%write_dataset('/continuum/mesh/topology', topo, error)
@@ -135,24 +137,29 @@ contains
     end subroutine writer_begin
 
     !> The XDMF topology of a mesh: its name and the 0-based connectivity, flat (one kind of
-    !> element: n nodes per element, element after element; mixed: type code 4 (triangle)
-    !> or 5 (quadrilateral), then the nodes).
+    !> element: the kind's topology, n nodes per element, element after element; mixed: each
+    !> element's XDMF type code (4 triangle, 5 quadrilateral), then its nodes).
     subroutine set_topology(self, mesh, topo)
         type(continuum_writer_t), intent(inout) :: self
         type(mesh2d_t), intent(in) :: mesh
         integer, allocatable, intent(out) :: topo(:)
+        type(element_slot_t), allocatable :: family(:)
         integer :: e, n
+        call element_family(family)
         if (all(mesh%kind == mesh%kind(1))) then
-            n = nodes_per_element(mesh%kind(1))
-            self%topology = merge('Triangle     ', 'Quadrilateral', mesh%kind(1) == element_t3)
-            self%topology = trim(self%topology)
+            associate (el => family(mesh%kind(1))%element)
+                n = el%node_count()
+                self%topology = el%xdmf_topology()
+            end associate
             topo = reshape(mesh%connectivity(1:n, :) - 1, [n*size(mesh%kind)])
         else
             self%topology = 'Mixed'
             allocate (topo(0))
             do e = 1, size(mesh%kind)
-                n = nodes_per_element(mesh%kind(e))
-                topo = [topo, merge(4, 5, mesh%kind(e) == element_t3), mesh%connectivity(1:n, e) - 1]
+                associate (el => family(mesh%kind(e))%element)
+                    n = el%node_count()
+                    topo = [topo, el%xdmf_code(), mesh%connectivity(1:n, e) - 1]
+                end associate
             end do
         end if
         self%topology_size = size(topo)

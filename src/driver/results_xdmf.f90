@@ -23,6 +23,7 @@ module driver_results_xdmf
     use core_strings, only: to_str
     use io_hdf5_file, only: h5_file_t
     use io_xdmf, only: xdmf_file_t, xdmf_item_t, xdmf_whole, xdmf_slab
+    use fem_element_registry, only: element_slot_t, new_element
     implicit none
     private
     public :: write_results_xdmf
@@ -112,8 +113,9 @@ contains
         type(h5_file_t), intent(in) :: file
         type(survey_t), intent(out) :: s
         type(error_t), allocatable, intent(out) :: error
-        integer, allocatable :: d(:)
+        integer, allocatable :: d(:), kinds(:)
         integer :: k
+        type(element_slot_t) :: slot
         call file%read_attribute('/', 'analysis', s%analysis, error)
         if (allocated(error)) return
         s%beam = file%exists('/fem/mesh/coordinates')
@@ -139,10 +141,16 @@ contains
             if (allocated(error)) return
             if (size(s%topology_dims) == 1) then
                 s%topology = 'Mixed'
-            else if (s%topology_dims(2) == 3) then
-                s%topology = 'Triangle'
             else
-                s%topology = 'Quadrilateral'
+                ! One kind of element: its topology, from the kind id of the first element.
+                call file%read_dataset('/continuum/mesh/kind', kinds, error)
+                if (allocated(error)) return
+                if (size(kinds) > 0) call new_element(kinds(1), slot)
+                if (.not. allocated(slot%element)) then
+                    call make_error(error, 'XDMF file: /continuum/mesh/kind holds no known element kind')
+                    return
+                end if
+                s%topology = slot%element%xdmf_topology()
             end if
         end if
         if (s%disks) then

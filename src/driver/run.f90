@@ -40,6 +40,7 @@ module driver_run
     use driver_results_xdmf, only: write_results_xdmf
     use driver_guards, only: model_size_t, model_memory_bytes, check_memory
     use fem_mesh_generator, only: rectangle_size, check_rectangle_size
+    use fem_element_registry, only: element_slot_t, new_element, kind_of_name
     use driver_simulation, only: simulation_t, report_iface
     use driver_simulations, only: select_simulation
     use driver_run_kind, only: run_kind_warnings
@@ -451,6 +452,7 @@ contains
         !> Set when the model is too large.
         type(error_t), allocatable, intent(out) :: error
         type(model_size_t) :: total, part
+        type(element_slot_t) :: element
         integer(i8) :: n_nodes, n_elements, largest
         integer :: k, line
         character(len=:), allocatable :: keyword, message
@@ -473,13 +475,15 @@ contains
                     part%beam_elements = e%int('elements')
                 case ('continuum mesh')
                     if (e%word('kind') /= 'rectangle') cycle
-                    call check_rectangle_size(e%int('nx'), e%int('ny'), e%word('element') == 't3', error)
+                    ! The schema admits only the names of registered element kinds.
+                    call new_element(kind_of_name(e%word('element')), element)
+                    call check_rectangle_size(e%int('nx'), e%int('ny'), element%element, error)
                     if (allocated(error)) then
                         message = error%message
                         call make_input_error(error, deck%file, e%line, e%keyword, message)
                         return
                     end if
-                    call rectangle_size(e%int('nx'), e%int('ny'), e%word('element') == 't3', n_nodes, n_elements)
+                    call rectangle_size(e%int('nx'), e%int('ny'), element%element, n_nodes, n_elements)
                     if (e%word('element') == 't3') then
                         part%t3 = n_elements
                     else

@@ -17,6 +17,7 @@ module driver_simulation_continuum
     use io_deck, only: deck_t, deck_entry_t
     use fem_mesh2d, only: mesh2d_t
     use fem_mesh_generator, only: rectangle_mesh
+    use fem_element_registry, only: element_slot_t, new_element, kind_of_name
     use fem_gmsh_reader, only: read_gmsh
     use io_paths, only: read_file_text
     use fem_elastic2d, only: elastic2d_t, make_elastic2d
@@ -112,6 +113,7 @@ contains
         subroutine build_mesh(error)
             type(error_t), allocatable, intent(out) :: error
             character(len=:), allocatable :: path, text
+            type(element_slot_t) :: element
             integer :: i
             if (.not. deck%has('continuum', 'mesh')) then
                 call make_input_error(error, deck%file, first_line(), 'mesh', '[continuum] needs a mesh: '// &
@@ -120,8 +122,10 @@ contains
             end if
             e = deck%record('continuum', 'mesh', 1)
             if (e%word('kind') == 'rectangle') then
+                ! The schema admits only the names of registered element kinds.
+                call new_element(kind_of_name(e%word('element')), element)
                 call rectangle_mesh(e%real('x0'), e%real('x0') + e%real('lx'), e%real('y0'), e%real('y0') + e%real('ly'), &
-                                    e%int('nx'), e%int('ny'), e%word('element') == 't3', mesh, error)
+                                    e%int('nx'), e%int('ny'), element%element, mesh, error)
             else
                 path = e%word('path')
                 if (path(1:1) /= '/') path = folder(deck%file)//path

@@ -18,22 +18,14 @@ module fem_continuum_model
     use core_strings, only: to_str
     use core_timefunc, only: time_function_t
     use fem_elastic2d, only: elastic2d_t
-    use fem_element2d, only: element2d_t
-    use fem_element_q4, only: element_q4_t
-    use fem_element_t3, only: element_t3_t
+    use fem_element_registry, only: element_slot_t, element_family, kind_node_count
     use fem_edge_load, only: edge_traction_linear, edge_traction_normal_tangential, &
                              edge_traction_function, traction_field_t, parabolic_traction_t
-    use fem_mesh2d, only: mesh2d_t, element_t3, element_q4, nodes_per_element
+    use fem_mesh2d, only: mesh2d_t
     use fem_triplets, only: fem_triplets_t
     implicit none
     private
     public :: continuum_model_t
-
-    !> One element type of the family, indexed by the mesh's element kind code.
-    type :: element_slot_t
-        !> The element type.
-        class(element2d_t), allocatable :: element
-    end type element_slot_t
 
     !> The continuum model.
     type :: continuum_model_t
@@ -43,8 +35,8 @@ module fem_continuum_model
         type(elastic2d_t), allocatable :: materials(:)
         !> Material index of each element (0 until assigned).
         integer, allocatable :: element_material(:)
-        !> Element types by kind code (element_t3, element_q4).
-        type(element_slot_t) :: family(2)
+        !> One element of every kind, indexed by kind id (fem_element_registry).
+        type(element_slot_t), allocatable :: family(:)
         !> Prescribed flag of each dof.
         logical, allocatable :: prescribed(:)
         !> Prescribed value of each dof (m; 0 where free); for a timed dof, the amplitude.
@@ -127,8 +119,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         integer :: e
         real(wp), allocatable :: xe(:, :)
-        allocate (element_t3_t :: self%family(element_t3)%element)
-        allocate (element_q4_t :: self%family(element_q4)%element)
+        call element_family(self%family)
         self%mesh = mesh
         if (mesh%element_count() == 0) then
             call make_error(error, 'continuum model: the mesh has no element')
@@ -200,7 +191,7 @@ contains
         integer, intent(in) :: e
         integer, allocatable :: dofs(:)
         integer :: n
-        n = nodes_per_element(self%mesh%kind(e))
+        n = kind_node_count(self%mesh%kind(e))
         allocate (dofs(2*n))
         dofs(1::2) = 2*self%mesh%connectivity(1:n, e) - 1
         dofs(2::2) = 2*self%mesh%connectivity(1:n, e)

@@ -2,11 +2,12 @@
 !>
 !> Sections read: $MeshFormat (version 4.1, ASCII), $PhysicalNames, $Entities (physical tags of
 !> each point, curve and surface), $Nodes and $Elements; any other section is skipped. Element
-!> types: 2 (3-node triangle) and 3 (4-node quadrangle) become elements, 1 (2-node line) and
-!> 15 (point) only feed named sets. A physical group becomes a node set with the nodes of its
-!> elements, an element set when it is 2D and an edge set when it is 1D; it is named by its
-!> $PhysicalNames entry, or 'physical_<dim>_<tag>' when it has none. Nodes that belong to no
-!> triangle or quadrangle are dropped; elements are turned counter-clockwise and edges are
+!> types: those of the registered element kinds (fem_element_registry: 2, 3-node triangle, and
+!> 3, 4-node quadrangle) become elements, 1 (2-node line) and 15 (point) only feed named sets.
+!> A physical group becomes a node set with the nodes of its elements, an element set when it
+!> is 2D and an edge set when it is 1D; it is named by its $PhysicalNames entry, or
+!> 'physical_<dim>_<tag>' when it has none. Nodes that belong to no triangle or quadrangle are
+!> dropped; elements are turned counter-clockwise and edges are
 !> oriented with the body on their left. Malformed input gives an error naming file and line;
 !> a count read from the file is checked against the file's size before it sizes an array, and
 !> node tags must be numbered nearly contiguously (the node table is indexed by tag).
@@ -23,7 +24,8 @@ module fem_gmsh_reader
     use core_error, only: error_t, make_input_error
     use core_strings, only: string_t, split_words, parse_real, to_str
     use core_sort, only: sort_index, sort_in_place
-    use fem_mesh2d, only: mesh2d_t, element_t3, element_q4
+    use fem_mesh2d, only: mesh2d_t
+    use fem_element_registry, only: kind_of_gmsh_type, kind_node_count, max_node_count
     implicit none
     private
     public :: read_gmsh
@@ -573,7 +575,8 @@ contains
         end if
     end subroutine read_nodes
 
-    !> Number of nodes of a Gmsh element type this reader accepts (0 otherwise).
+    !> Number of nodes of a Gmsh element type this reader accepts (0 otherwise): points, lines
+    !> and the types of the registered element kinds.
     pure integer function type_nodes(type)
         integer, intent(in) :: type
         select case (type)
@@ -581,12 +584,8 @@ contains
             type_nodes = 1
         case (1)
             type_nodes = 2
-        case (2)
-            type_nodes = 3
-        case (3)
-            type_nodes = 4
         case default
-            type_nodes = 0
+            type_nodes = kind_node_count(kind_of_gmsh_type(type))
         end select
     end function type_nodes
 
@@ -730,13 +729,13 @@ contains
         character(len=96) :: buf
         n = 0
         do b = 1, size(blocks)
-            if (blocks(b)%type /= 1 .and. blocks(b)%type /= 2 .and. blocks(b)%type /= 3) cycle
+            if (blocks(b)%type /= 1 .and. kind_of_gmsh_type(blocks(b)%type) == 0) cycle
             n = n + size(blocks(b)%tags)
         end do
         allocate (high(n), low(n), lines(n), tags(n))
         n = 0
         do b = 1, size(blocks)
-            if (blocks(b)%type /= 1 .and. blocks(b)%type /= 2 .and. blocks(b)%type /= 3) cycle
+            if (blocks(b)%type /= 1 .and. kind_of_gmsh_type(blocks(b)%type) == 0) cycle
             do k = 1, size(blocks(b)%tags)
                 n = n + 1
                 sorted = 0
@@ -833,14 +832,14 @@ contains
         type(mesh2d_t), intent(out) :: mesh
         type(error_t), allocatable, intent(out) :: error
         integer, allocatable :: index_of_tag(:), phys(:), local(:, :)
-        integer :: b, ne, e, k, p, nnodes, failed(2)
+        integer :: b, ne, e, k, p, nnodes, failed(2), kind
         character(len=64) :: buf
         character(len=:), allocatable :: name
         ! Map tags to compact node indices, keeping the nodes of triangles and quadrangles.
         allocate (index_of_tag(size(xtag, 2)), source=0)
         ne = 0
         do b = 1, size(blocks)
-            if (blocks(b)%type == 2 .or. blocks(b)%type == 3) then
+            if (kind_of_gmsh_type(blocks(b)%type) > 0) then
                 index_of_tag(reshape(blocks(b)%nodes, [size(blocks(b)%nodes)]) - min_tag + 1) = 1
                 ne = ne + size(blocks(b)%nodes, 2)
             end if
@@ -871,15 +870,17 @@ contains
             if (index_of_tag(k) == 0) cycle
             mesh%x(:, index_of_tag(k)) = xtag(:, k)
         end do
-        allocate (mesh%kind(ne), mesh%connectivity(4, ne), mesh%element_tag(ne), mesh%element_line(ne), source=0)
+        allocate (mesh%kind(ne), mesh%connectivity(max_node_count(), ne), mesh%element_tag(ne), mesh%element_line(ne), &
+                  source=0)
         mesh%file = cur%path
         e = 0
         do b = 1, size(blocks)
-            if (blocks(b)%type /= 2 .and. blocks(b)%type /= 3) cycle
+            kind = kind_of_gmsh_type(blocks(b)%type)
+            if (kind == 0) cycle
             blocks(b)%first = e + 1
             do k = 1, size(blocks(b)%nodes, 2)
                 e = e + 1
-                mesh%kind(e) = merge(element_t3, element_q4, blocks(b)%type == 2)
+                mesh%kind(e) = kind
                 mesh%element_tag(e) = blocks(b)%tags(k)
                 mesh%element_line(e) = blocks(b)%lines(k)
                 mesh%connectivity(1:size(blocks(b)%nodes, 1), e) = index_of_tag(blocks(b)%nodes(:, k) - min_tag + 1)

@@ -1,23 +1,20 @@
-!> A 2D finite-element mesh: nodes, Q4/T3 elements, and named node, element and edge sets.
+!> A 2D finite-element mesh: nodes, elements of the kinds of fem_element_registry (T3, Q4), and
+!> named node, element and edge sets.
 !>
-!> Elements are stored counter-clockwise in `connectivity(1:nodes_per_element, e)` (the fourth
-!> row is 0 for a triangle). Named sets carry the names the deck refers to (Gmsh physical
-!> groups, or left/right/bottom/top/all for generated rectangles). Edge sets hold 2-node
-!> boundary edges, oriented so that the body lies on their left (outward normal (s_y, -s_x)).
+!> Element e is of kind id `kind(e)` and its nodes are stored counter-clockwise in
+!> `connectivity(1:n, e)`, n the node count of its kind (the connectivity has max_node_count()
+!> rows, 0 beyond the element's nodes: the fourth row of a triangle). Named sets carry the names
+!> the deck refers to (Gmsh physical groups, or left/right/bottom/top/all for generated
+!> rectangles). Edge sets hold 2-node boundary edges, oriented so that the body lies on their
+!> left (outward normal (s_y, -s_x)).
 module fem_mesh2d
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
     use core_strings, only: to_str
+    use fem_element_registry, only: kind_node_count
     implicit none
     private
-    public :: mesh2d_t, named_set_t, edge_set_t, element_t3, element_q4, nodes_per_element
-
-    !> Element kind code of the linear triangle.
-    integer, parameter :: element_t3 = 1
-    !> Element kind code of the bilinear quadrilateral.
-    integer, parameter :: element_q4 = 2
-    !> Number of nodes of each element kind.
-    integer, parameter :: nodes_per_element(2) = [3, 4]
+    public :: mesh2d_t, named_set_t, edge_set_t
 
     !> A named set of node or element indices.
     type :: named_set_t
@@ -41,9 +38,10 @@ module fem_mesh2d
     type :: mesh2d_t
         !> Node coordinates (2, number of nodes) (m).
         real(wp), allocatable :: x(:, :)
-        !> Element kind (element_t3 or element_q4) of each element.
+        !> Element kind id of each element (fem_element_registry: 1 = T3, 2 = Q4).
         integer, allocatable :: kind(:)
-        !> Connectivity (4, number of elements), counter-clockwise; 0 beyond the element's nodes.
+        !> Connectivity (max_node_count(), number of elements), counter-clockwise; 0 beyond the
+        !> element's nodes.
         integer, allocatable :: connectivity(:, :)
         !> Named node sets.
         type(named_set_t), allocatable :: node_sets(:)
@@ -117,7 +115,7 @@ contains
         integer, intent(in) :: e
         !> Its nodes, counter-clockwise.
         integer, allocatable :: nodes(:)
-        nodes = self%connectivity(1:nodes_per_element(self%kind(e)), e)
+        nodes = self%connectivity(1:kind_node_count(self%kind(e)), e)
     end function mesh_element_nodes
 
     !> Coordinates of the nodes of element e.
@@ -128,7 +126,7 @@ contains
         integer, intent(in) :: e
         !> Coordinates (2, nodes of the element).
         real(wp), allocatable :: xe(:, :)
-        xe = self%x(:, self%connectivity(1:nodes_per_element(self%kind(e)), e))
+        xe = self%x(:, self%connectivity(1:kind_node_count(self%kind(e)), e))
     end function mesh_element_coordinates
 
     !> 'Gmsh element 29 (plate.msh:187, centroid (0.5, 0.25) m)' for an element read from a
@@ -168,7 +166,7 @@ contains
         parent = [(a, a=1, self%node_count())]
         do e = 1, self%element_count()
             call find_root(parent, self%connectivity(1, e), r0)
-            do k = 2, nodes_per_element(self%kind(e))
+            do k = 2, kind_node_count(self%kind(e))
                 call find_root(parent, self%connectivity(k, e), ra)
                 ! The larger root under the smaller: a root stays the smallest node of its body.
                 parent(max(ra, r0)) = min(ra, r0)
