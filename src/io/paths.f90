@@ -153,38 +153,39 @@ contains
         type(error_t), allocatable, intent(out) :: error
         integer, parameter :: block = 1048576
         character(len=block) :: buf
+        character(len=256) :: msg
         integer :: src, dst, ios, n
         integer(int64) :: size_bytes, pos
         open (newunit=src, file=old, access='stream', form='unformatted', status='old', &
-              action='read', iostat=ios)
+              action='read', iostat=ios, iomsg=msg)
         if (ios /= 0) then
-            call make_error(error, "cannot read '"//old//"'")
+            call make_error(error, "cannot read '"//old//"': "//trim(msg))
             return
         end if
         inquire (unit=src, size=size_bytes)
         open (newunit=dst, file=new, access='stream', form='unformatted', status='replace', &
-              action='write', iostat=ios)
+              action='write', iostat=ios, iomsg=msg)
         if (ios /= 0) then
             close (src)
-            call make_error(error, "cannot create '"//new//"'")
+            call make_error(error, "cannot create '"//new//"': "//trim(msg))
             return
         end if
         pos = 0
         do while (pos < size_bytes .and. ios == 0)
             n = int(min(int(block, int64), size_bytes - pos))
-            read (src, iostat=ios) buf(:n)
-            if (ios == 0) write (dst, iostat=ios) buf(:n)
+            read (src, iostat=ios, iomsg=msg) buf(:n)
+            if (ios == 0) write (dst, iostat=ios, iomsg=msg) buf(:n)
             pos = pos + n
         end do
         close (src)
         if (ios == 0) then
-            close (dst, iostat=ios)
+            close (dst, iostat=ios, iomsg=msg)
         else
             close (dst, status='delete')
         end if
         if (ios /= 0) then
             call remove_file(new)
-            call make_error(error, "cannot copy '"//old//"' to '"//new//"' (disk full?)")
+            call make_error(error, "cannot copy '"//old//"' to '"//new//"': "//trim(msg))
         end if
     end subroutine copy_file
 
