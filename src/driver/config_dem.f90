@@ -16,7 +16,7 @@ module driver_config_dem
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp, i8
     use core_constants, only: deg_to_rad, pi
-    use core_error, only: error_t, make_input_error
+    use core_error, only: error_t, make_input_error, make_internal_error
     use core_strings, only: string_t, to_str, sci_to_str, num => sci_text
     use core_timefunc, only: time_function_t
     use io_deck, only: deck_t, deck_entry_t
@@ -117,7 +117,8 @@ contains
         if (allocated(error)) return
         call build_laws(deck, cfg, error)
         if (allocated(error)) return
-        call build_settings(deck, run, cfg)
+        call build_settings(deck, run, cfg, error)
+        if (allocated(error)) return
         call check_overlaps(deck, cfg, error)
         if (allocated(error)) return
         call check_alert_reach(deck, cfg, available_memory(), error)
@@ -870,22 +871,27 @@ contains
     end subroutine build_bonds
 
     !> Time stepping, detection, solver and output settings.
-    subroutine build_settings(deck, run, cfg)
+    subroutine build_settings(deck, run, cfg, error)
         !> The deck.
         type(deck_t), intent(in) :: deck
         !> Run settings (time step).
         type(run_config_t), intent(in) :: run
         !> The model (scheme, solver, store_contacts filled).
         type(dem_config_t), intent(inout) :: cfg
+        !> Internal error on a word that the schema allows and no kind here builds.
+        type(error_t), allocatable, intent(out) :: error
         associate (sys => cfg%system)
             sys%scheme%h = run%h
             sys%scheme%theta = deck%get_real('time', 'theta')
             if (allocated(sys%scheme%activation)) deallocate (sys%scheme%activation)
             select case (deck%get_word('time', 'contact_scheme'))
+            case ('multicor')
+                allocate (activation_predicted_t :: sys%scheme%activation)
             case ('siconos')
                 allocate (activation_siconos_t :: sys%scheme%activation)
             case default
-                allocate (activation_predicted_t :: sys%scheme%activation)
+                call unknown_word('time', 'contact_scheme')
+                return
             end select
             cfg%default_alert = .not. deck%has('contacts', 'alert')
             if (cfg%default_alert) then
@@ -900,6 +906,8 @@ contains
             sys%solver%local_max_iter = deck%get_int('solver', 'local_iterations')
             if (allocated(sys%method)) deallocate (sys%method)
             select case (deck%get_word('solver', 'method'))
+            case ('nlgs')
+                allocate (sweeps_method_t :: sys%method)
             case ('block')
                 allocate (bonded_block_method_t :: sys%method)
             case ('coarse')
@@ -908,7 +916,8 @@ contains
                 allocate (sys%solver%correction, source=coarse_correction_t(every=deck%get_int('solver', 'coarse_every'), &
                                                                             aggregate=deck%get_int('solver', 'coarse_size')))
             case default
-                allocate (sweeps_method_t :: sys%method)
+                call unknown_word('solver', 'method')
+                return
             end select
             sys%solver%relaxation = deck%get_real('solver', 'relaxation')
             sys%solver%check_every = deck%get_int('solver', 'check_every')
@@ -918,14 +927,26 @@ contains
             if (deck%get_word('solver', 'cold_start') == 'hydrostatic') allocate (hydrostatic_start_t :: sys%solver%start)
             sys%solver%symmetric = deck%get_word('solver', 'sweep_order') == 'alternating'
             if (allocated(sys%solver%criterion)) deallocate (sys%solver%criterion)
-            if (deck%get_word('solver', 'criterion') == 'siconos') then
-                allocate (siconos_criterion_t :: sys%solver%criterion)
-            else
+            select case (deck%get_word('solver', 'criterion'))
+            case ('lmgc90')
                 allocate (lmgc90_criterion_t :: sys%solver%criterion)
-            end if
+            case ('siconos')
+                allocate (siconos_criterion_t :: sys%solver%criterion)
+            case default
+                call unknown_word('solver', 'criterion')
+                return
+            end select
             if (deck%has('solver', 'fclib_step')) cfg%fclib_step = deck%get_int('solver', 'fclib_step')
         end associate
         cfg%store_contacts = deck%get_word('output', 'contacts') == 'yes'
+    contains
+        ! the schema refuses a word outside its list: one it allows that no case here builds is
+        ! a bug (a word added to the schema without its kind)
+        subroutine unknown_word(section, keyword)
+            character(len=*), intent(in) :: section, keyword
+            call make_internal_error(error, 'driver_config_dem', '['//section//'] '//keyword//" = '"// &
+                                     deck%get_word(section, keyword)//"' builds no kind")
+        end subroutine unknown_word
     end subroutine build_settings
 
     !> Error when two disks, or a disk and a wall, overlap at t = 0 by more than
