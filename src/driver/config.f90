@@ -118,7 +118,7 @@ contains
         if (allocated(error)) return
         call build_mesh(deck, section_ids, beam, error)
         if (allocated(error)) return
-        call build_functions(deck, beam, function_ids, error)
+        call build_time_functions(deck, beam%functions, function_ids, error)
         if (allocated(error)) return
         call build_supports(deck, beam, fix_line, error)
         if (allocated(error)) return
@@ -155,7 +155,7 @@ contains
                                   deck%get_word('run', 'analysis')//' analysis needs a [beam] model)')
             return
         end if
-        call build_functions(deck, beam, function_ids, error)
+        call build_time_functions(deck, beam%functions, function_ids, error)
         if (allocated(error)) return
         call build_run(deck, beam, run, error)
         if (allocated(error)) return
@@ -567,8 +567,9 @@ contains
         end do
     end function representable_element
 
-    !> The deck's [functions] (for models other than the beam, e.g. the continuum): the
-    !> functions in file order and their deck ids, checked as for the beam's loads.
+    !> The deck's [functions], for every model (the beam's loads, the continuum's, the
+    !> particles' drives): the functions in file order and their deck ids, with unique ids and
+    !> increasing table times.
     subroutine build_time_functions(deck, functions, ids, error)
         !> The deck.
         type(deck_t), intent(in) :: deck
@@ -578,22 +579,6 @@ contains
         integer, allocatable, intent(out) :: ids(:)
         !> Error (duplicate id, table times not increasing), if any.
         type(error_t), allocatable, intent(out) :: error
-        type(beam_config_t) :: holder
-        call build_functions(deck, holder, ids, error)
-        if (allocated(error)) return
-        call move_alloc(holder%functions, functions)
-    end subroutine build_time_functions
-
-    !> Time functions, with unique ids and increasing table times.
-    subroutine build_functions(deck, beam, ids, error)
-        !> The deck.
-        type(deck_t), intent(in) :: deck
-        !> Beam configuration (functions filled).
-        type(beam_config_t), intent(inout) :: beam
-        !> Deck id of each function.
-        integer, allocatable, intent(out) :: ids(:)
-        !> Error, if any.
-        type(error_t), allocatable, intent(out) :: error
         type(deck_entry_t), allocatable :: list(:)
         type(deck_entry_t) :: e
         type(string_t), allocatable :: times(:)
@@ -601,7 +586,7 @@ contains
         integer :: i, j, n
         allocate (list, source=deck%records('functions', 'function'))
         n = size(list)
-        allocate (beam%functions(n), ids(n))
+        allocate (functions(n), ids(n))
         do i = 1, n
             e = list(i)
             ids(i) = e%int('id')
@@ -612,7 +597,7 @@ contains
                                       to_str(ids(i))//': already defined on line '//to_str(list(j)%line))
                 return
             end if
-            associate (f => beam%functions(i))
+            associate (f => functions(i))
                 f%p = 0.0_wp
                 select case (e%word('kind'))
                 case ('constant')
@@ -644,7 +629,7 @@ contains
                 end select
             end associate
         end do
-    end subroutine build_functions
+    end subroutine build_time_functions
 
     !> Fixed DOFs; `fix_line(dof, node)` is the line fixing it (0 = free).
     subroutine build_supports(deck, beam, fix_line, error)
