@@ -24,8 +24,7 @@ module coupling_arlequin2d
     use fem_continuum_dynamics, only: continuum_dynamics_t
     use fem_triplets, only: fem_triplets_t
     use dem_moreau_jean, only: dem_system_t
-    use coupling_weights, only: overlap_weight_t
-    use coupling_overlap2d, only: weight_field_t, overlap2d_t, overlap_set_t
+    use coupling_overlap2d, only: weight_field_t
     use coupling_weighted2d, only: assemble_weighted
     use coupling_locate2d, only: element_grid_t, build_element_grid
     use coupling_operator2d, only: continuum_operator_t, build_continuum_operator, build_mediator2d, &
@@ -122,7 +121,7 @@ contains
         sys%dem = dem
         sys%thickness = config%thickness
         sys%condensed = config%condensed_contacts
-        sys%weight = ramp_of(config%region)
+        sys%weight = config%region%ramp()
         call config%region%select_disks(dem%particles%x(:dem%particles%n), dem%particles%y(:dem%particles%n), &
                                         sys%coupled, sys%alpha)
         call build_element_grid(model%mesh, grid)
@@ -176,73 +175,32 @@ contains
         !> Error for a particle-side edge along which the continuum goes on outside every
         !> region: alpha would jump there from alpha_min to 1 (the FE-only zone), the disks'
         !> weight from 1 - alpha_min to 0. The FE and particle sides swapped (a box with
-        !> `right left` for `left right`) gave such a jump and was accepted. Probes at 9 points
-        !> along each particle edge, just outside the region (beyond its boundary tolerance).
+        !> `right left` for `left right`) gave such a jump and was accepted. The field's probes
+        !> just outside its particle-side edges (`weight_field_t%particle_side_probes`) tell.
         subroutine check_particle_sides(error)
             type(error_t), allocatable, intent(out) :: error
-            integer :: r
-            select type (field => config%region)
-            type is (overlap2d_t)
-                call check_region(field, 0, error)
-            type is (overlap_set_t)
-                do r = 1, size(field%regions)
-                    call check_region(field%regions(r), r, error)
-                    if (allocated(error)) return
-                end do
-            end select
-        end subroutine check_particle_sides
-
-        subroutine check_region(region, number, error)
-            type(overlap2d_t), intent(in) :: region
-            integer, intent(in) :: number
-            type(error_t), allocatable, intent(out) :: error
-            real(wp) :: a(2), b(2), t(2), normal(2), p(2), q(2), length, offset, xi(2)
-            integer :: k, n, j, e
+            real(wp), allocatable :: q(:, :)
+            integer, allocatable :: edge(:), region(:)
+            real(wp) :: xi(2)
+            integer :: j, e
             character(len=800) :: buf
-            n = size(region%vertex, 2)
-            do k = 1, n
-                if (.not. region%particle_edge(k)) cycle
-                a = region%vertex(:, k)
-                b = region%vertex(:, modulo(k, n) + 1)
-                length = norm2(b - a)
-                if (.not. (length > 0)) cycle
-                t = (b - a)/length
-                normal = [t(2), -t(1)]
-                offset = max(4*region%tol, 1.0e-6_wp*length)
-                do j = 1, 9
-                    p = a + (real(j, wp)/10)*(b - a)
-                    q = p + offset*normal
-                    if (region%contains(q(1), q(2))) q = p - offset*normal
-                    if (region%contains(q(1), q(2))) cycle
-                    if (config%region%alpha_fe(q(1), q(2)) < 1.0_wp) cycle
-                    call grid%locate(model%mesh, q(1), q(2), e, xi)
-                    if (e == 0) cycle
-                    write (buf, '(a,i0,a,es13.5e3,a,es13.5e3,a)') 'the particle side (edge ', k, &
-                        ') of this region borders the continuum outside the overlap (at (', q(1), ', ', q(2), &
-                        ') m, in '
-                    buf = trim(buf)//' '//model%mesh%element_label(e)//'), where alpha = 1: the weight would '// &
-                          'jump there from alpha_min to 1; the particle side faces the particles only (no '// &
-                          'continuum beyond it): are the FE and particle sides swapped?'
-                    if (number > 0) then
-                        write (buf, '(a,i0,a)') 'region ', number, ': '//trim(buf)
-                    end if
-                    call make_error(error, 'coupling: '//trim(buf))
-                    return
-                end do
+            call config%region%particle_side_probes(q, edge, region)
+            do j = 1, size(edge)
+                if (config%region%alpha_fe(q(1, j), q(2, j)) < 1.0_wp) cycle
+                call grid%locate(model%mesh, q(1, j), q(2, j), e, xi)
+                if (e == 0) cycle
+                write (buf, '(a,i0,a,es13.5e3,a,es13.5e3,a)') 'the particle side (edge ', edge(j), &
+                    ') of this region borders the continuum outside the overlap (at (', q(1, j), ', ', q(2, j), &
+                    ') m, in '
+                buf = trim(buf)//' '//model%mesh%element_label(e)//'), where alpha = 1: the weight would '// &
+                      'jump there from alpha_min to 1; the particle side faces the particles only (no '// &
+                      'continuum beyond it): are the FE and particle sides swapped?'
+                if (region(j) > 0) then
+                    write (buf, '(a,i0,a)') 'region ', region(j), ': '//trim(buf)
+                end if
+                call make_error(error, 'coupling: '//trim(buf))
+                return
             end do
-        end subroutine check_region
+        end subroutine check_particle_sides
     end subroutine build_coupled2d
-
-    !> The ramp (shape and floor) of a weight field: that of the region, or of the first
-    !> region of a set (default ramp for another field).
-    function ramp_of(field) result(ramp)
-        class(weight_field_t), intent(in) :: field
-        type(overlap_weight_t) :: ramp
-        select type (field)
-        type is (overlap2d_t)
-            ramp = field%weight
-        type is (overlap_set_t)
-            if (size(field%regions) > 0) ramp = field%regions(1)%weight
-        end select
-    end function ramp_of
 end module coupling_arlequin2d

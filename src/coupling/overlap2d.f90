@@ -18,7 +18,10 @@
 !> `overlap_set_t`: a point takes the weight of the first region holding it, and 1 (FE) or
 !> 0 (disks) outside all of them. Regions that share more than boundary points would weight
 !> the same material twice: `regions_overlap` tells them apart from regions that only touch.
-!> Both types extend the abstract `weight_field_t` that the weighted assembly takes.
+!> Both types extend the abstract `weight_field_t` that the weighted assembly takes; its
+!> bindings also give the ramp the results record (`ramp`) and the points just beyond the
+!> particle-side edges where coupling_arlequin2d checks that the continuum stops
+!> (`particle_side_probes`).
 module coupling_overlap2d
     use core_kinds, only: wp
     use core_constants, only: relative_roundoff
@@ -40,6 +43,10 @@ module coupling_overlap2d
         procedure(weight_misses_iface), deferred :: misses
         !> The disks to couple (alpha > 0: centre in the overlap) and every disk's alpha.
         procedure :: select_disks => field_select_disks
+        !> The ramp (shape and floor) of the weight, as the results give it.
+        procedure(weight_ramp_iface), deferred :: ramp
+        !> Points just outside the particle-side edges, where the continuum must not go on.
+        procedure(weight_probes_iface), deferred :: particle_side_probes
     end type weight_field_t
 
     abstract interface
@@ -60,6 +67,28 @@ module coupling_overlap2d
             !> The box (xmin, xmax, ymin, ymax) [m].
             real(wp), intent(in) :: box(4)
         end function weight_misses_iface
+
+        !> The ramp of a weight field.
+        pure function weight_ramp_iface(self) result(ramp)
+            import :: weight_field_t, overlap_weight_t
+            !> The weight field.
+            class(weight_field_t), intent(in) :: self
+            !> Its ramp and floor.
+            type(overlap_weight_t) :: ramp
+        end function weight_ramp_iface
+
+        !> Probe points along the particle-side edges of a weight field.
+        pure subroutine weight_probes_iface(self, q, edge, region)
+            import :: weight_field_t, wp
+            !> The weight field.
+            class(weight_field_t), intent(in) :: self
+            !> The points (2, n_probes) [m].
+            real(wp), allocatable, intent(out) :: q(:, :)
+            !> Number of the edge of each point, in its region (n_probes).
+            integer, allocatable, intent(out) :: edge(:)
+            !> Number of the region of each point in a set (n_probes; 0 for a single region).
+            integer, allocatable, intent(out) :: region(:)
+        end subroutine weight_probes_iface
     end interface
 
     !> A polygonal overlap region and its weight (see the module description).
@@ -87,6 +116,10 @@ module coupling_overlap2d
         procedure :: alpha_disk => overlap_alpha_disk
         !> True when a box misses the region's bounding box.
         procedure :: misses => overlap_misses
+        !> The region's ramp.
+        procedure :: ramp => overlap_ramp
+        !> Probes just outside the region's particle-side edges (region number 0).
+        procedure :: particle_side_probes => overlap_particle_side_probes
     end type overlap2d_t
 
     !> Disjoint overlap regions (see the module description).
@@ -100,6 +133,10 @@ module coupling_overlap2d
         procedure :: alpha_disk => set_alpha_disk
         !> True when a box misses every region.
         procedure :: misses => set_misses
+        !> The ramp of the first region (the default ramp for an empty set).
+        procedure :: ramp => set_ramp
+        !> The probes of every region in turn, with its number.
+        procedure :: particle_side_probes => set_particle_side_probes
     end type overlap_set_t
 
     !> Names of the edges of a box, in edge order.
@@ -515,4 +552,86 @@ contains
             if (.not. self%regions(k)%misses(box)) set_misses = .false.
         end do
     end function set_misses
+
+    !> The region's ramp and floor.
+    pure function overlap_ramp(self) result(ramp)
+        !> The region.
+        class(overlap2d_t), intent(in) :: self
+        !> Its ramp.
+        type(overlap_weight_t) :: ramp
+        ramp = self%weight
+    end function overlap_ramp
+
+    !> The ramp of the first region (a set's regions share the deck's weight); the default
+    !> ramp for an empty set.
+    pure function set_ramp(self) result(ramp)
+        !> The regions.
+        class(overlap_set_t), intent(in) :: self
+        !> The ramp.
+        type(overlap_weight_t) :: ramp
+        if (size(self%regions) > 0) ramp = self%regions(1)%weight
+    end function set_ramp
+
+    !> Probes at 9 points along each particle-side edge (at tenths of its length), just outside
+    !> the region (beyond its boundary tolerance), on the side of the edge away from the
+    !> region; a point that falls in the region on both sides is left out. In edge order.
+    pure subroutine overlap_particle_side_probes(self, q, edge, region)
+        !> The region.
+        class(overlap2d_t), intent(in) :: self
+        !> The points (2, n_probes) [m].
+        real(wp), allocatable, intent(out) :: q(:, :)
+        !> Edge of each point (n_probes).
+        integer, allocatable, intent(out) :: edge(:)
+        !> 0 for each point (a single region).
+        integer, allocatable, intent(out) :: region(:)
+        real(wp) :: a(2), b(2), t(2), normal(2), p(2), r(2), length, offset
+        integer :: k, n, j, m
+        n = size(self%vertex, 2)
+        allocate (q(2, 9*count(self%particle_edge)), edge(9*count(self%particle_edge)))
+        m = 0
+        do k = 1, n
+            if (.not. self%particle_edge(k)) cycle
+            a = self%vertex(:, k)
+            b = self%vertex(:, modulo(k, n) + 1)
+            length = norm2(b - a)
+            if (.not. (length > 0)) cycle
+            t = (b - a)/length
+            normal = [t(2), -t(1)]
+            offset = max(4*self%tol, 1.0e-6_wp*length)
+            do j = 1, 9
+                p = a + (real(j, wp)/10)*(b - a)
+                r = p + offset*normal
+                if (self%contains(r(1), r(2))) r = p - offset*normal
+                if (self%contains(r(1), r(2))) cycle
+                m = m + 1
+                q(:, m) = r
+                edge(m) = k
+            end do
+        end do
+        q = q(:, :m)
+        edge = edge(:m)
+        allocate (region(m), source=0)
+    end subroutine overlap_particle_side_probes
+
+    !> The probes of each region in turn (`overlap2d_t%particle_side_probes`), with its number.
+    pure subroutine set_particle_side_probes(self, q, edge, region)
+        !> The regions.
+        class(overlap_set_t), intent(in) :: self
+        !> The points (2, n_probes) [m].
+        real(wp), allocatable, intent(out) :: q(:, :)
+        !> Edge of each point, in its region (n_probes).
+        integer, allocatable, intent(out) :: edge(:)
+        !> Region of each point (n_probes).
+        integer, allocatable, intent(out) :: region(:)
+        real(wp), allocatable :: qr(:, :)
+        integer, allocatable :: er(:), unused(:)
+        integer :: r
+        allocate (q(2, 0), edge(0), region(0))
+        do r = 1, size(self%regions)
+            call self%regions(r)%particle_side_probes(qr, er, unused)
+            q = reshape([q, qr], [2, size(q, 2) + size(qr, 2)])
+            edge = [edge, er]
+            region = [region, spread(r, 1, size(er))]
+        end do
+    end subroutine set_particle_side_probes
 end module coupling_overlap2d
