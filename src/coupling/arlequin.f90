@@ -164,28 +164,38 @@ contains
     end subroutine make_space
 
     !> The weighted beam of a system built by `build_coupled_system` (a copy).
-    function coupled_beam(sys) result(model)
+    subroutine coupled_beam(sys, model, error)
         !> The coupled system (beam and disks).
         type(coupled_system_t), intent(in) :: sys
         !> Its beam model.
-        type(beam_model_t) :: model
+        type(beam_model_t), intent(out) :: model
+        !> Internal error when the system's FE model is not a beam (not built here).
+        type(error_t), allocatable, intent(out) :: error
         select type (m => sys%model)
         type is (beam_model_t)
             model = m
+        class default
+            call make_internal_error(error, 'coupled_beam', 'the coupled system has no beam model '// &
+                                     '(not built by build_coupled_system)')
         end select
-    end function coupled_beam
+    end subroutine coupled_beam
 
     !> The coupling operator of a system built by `build_coupled_system` (a copy).
-    function coupled_beam_operator(sys) result(op)
+    subroutine coupled_beam_operator(sys, op, error)
         !> The coupled system (beam and disks).
         type(coupled_system_t), intent(in) :: sys
         !> Its C.
-        type(coupling_operator_t) :: op
+        type(coupling_operator_t), intent(out) :: op
+        !> Internal error when the system's C is not a beam's (not built here).
+        type(error_t), allocatable, intent(out) :: error
         select type (o => sys%op)
         type is (coupling_operator_t)
             op = o
+        class default
+            call make_internal_error(error, 'coupled_beam_operator', 'the coupled system''s C is not a beam''s '// &
+                                     '(not built by build_coupled_system)')
         end select
-    end function coupled_beam_operator
+    end subroutine coupled_beam_operator
 
     !> Error when an element lies wholly where alpha = 0 (beyond the overlap's particle end):
     !> it would have neither mass nor stiffness.

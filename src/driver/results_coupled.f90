@@ -170,7 +170,8 @@ contains
         !> Set on a write failure.
         type(error_t), allocatable, intent(out) :: error
         type(coupling_operator_t) :: op
-        op = coupled_beam_operator(sys)
+        call coupled_beam_operator(sys, op, error)
+        if (allocated(error)) return
         call put('/coupling/overlap', [sys%weight%s_fe, sys%weight%s_particle], error)
         if (allocated(error)) return
         call put('/coupling/abscissa', op%abscissa, error)

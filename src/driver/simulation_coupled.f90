@@ -101,7 +101,8 @@ contains
             end if
             return
         end if
-        self%model = coupled_beam(self%sys)
+        call coupled_beam(self%sys, self%model, error)
+        if (allocated(error)) return
         call check_initial_energy(deck, self%settings, self%model, error)
         if (allocated(error)) return
         self%fclib_step = self%dem%fclib_step

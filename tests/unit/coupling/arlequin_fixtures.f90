@@ -103,7 +103,7 @@ contains
         real(wp) :: mv(sys%model%n_free)
         type(beam_model_t) :: model
         integer :: i, d
-        model = coupled_beam(sys)
+        call weighted_beam(sys, model)
         call sys%model%mass_times(sys%fe%v, mv)
         p = 0.0_wp
         do i = 1, model%n_nodes
@@ -118,7 +118,7 @@ contains
         type(coupled_system_t), intent(in) :: sys
         real(wp) :: k_max
         type(beam_model_t) :: model
-        model = coupled_beam(sys)
+        call weighted_beam(sys, model)
         k_max = maxval(abs(model%k%ab))
     end function beam_k_max
 
@@ -127,7 +127,17 @@ contains
         type(coupled_system_t), intent(in) :: sys
         integer, intent(in) :: d, i
         type(beam_model_t) :: model
-        model = coupled_beam(sys)
+        call weighted_beam(sys, model)
         beam_eq = model%eq(d, i)
     end function beam_eq
+
+    ! The weighted beam of a coupled system built by build_coupled_system (stops the test
+    ! program on the internal error of another system: a fixture's bug).
+    subroutine weighted_beam(sys, model)
+        type(coupled_system_t), intent(in) :: sys
+        type(beam_model_t), intent(out) :: model
+        type(error_t), allocatable :: error
+        call coupled_beam(sys, model, error)
+        if (allocated(error)) error stop error%message
+    end subroutine weighted_beam
 end module arlequin_fixtures
