@@ -218,7 +218,8 @@ contains
                 call arlequin_step(self%sys, error)
             end if
             if (allocated(error)) return
-            call self%after_step()
+            call self%after_step(error)
+            if (allocated(error)) return
             call check_step(error)
             if (allocated(error)) return
             call self%dem_out%record_step(out%file, self%sys%dem%stats, error)
@@ -516,9 +517,11 @@ contains
     end function constraint_line
 
     !> No work after a step.
-    subroutine no_after_step(self)
+    subroutine no_after_step(self, error)
         !> The simulation.
         class(arlequin_simulation_t), intent(inout) :: self
+        !> Never set.
+        type(error_t), allocatable, intent(out) :: error
     end subroutine no_after_step
 
     !> Nothing to add to a checkpoint.

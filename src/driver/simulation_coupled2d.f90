@@ -18,7 +18,7 @@
 module driver_simulation_coupled2d
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp, i8
-    use core_error, only: error_t, make_error, make_input_error
+    use core_error, only: error_t, make_error, make_input_error, make_internal_error
     use core_strings, only: counted, to_str
     use io_deck, only: deck_t
     use io_hdf5_file, only: h5_file_t
@@ -201,14 +201,16 @@ contains
             call out%file%write_dataset('/coupling/mediator_nodes', self%sys%mediator_nodes, error)
             if (allocated(error)) return
         end if
-        call audit_step(self, .true.)
+        call audit_step(self, .true., error)
     end subroutine coupled2d_begin
 
     !> The continuum's audit advanced by the step just made.
-    subroutine coupled2d_after_step(self)
+    subroutine coupled2d_after_step(self, error)
         !> The simulation.
         class(coupled2d_simulation_t), intent(inout) :: self
-        call audit_step(self, .false.)
+        !> Internal error when the coupled system is not a continuum's.
+        type(error_t), allocatable, intent(out) :: error
+        call audit_step(self, .false., error)
     end subroutine coupled2d_after_step
 
     !> The continuum's audit of the whole body (prescribed dofs and reactions included) on
@@ -216,9 +218,12 @@ contains
     !> by the step just made. The multipliers' force -C^T lambda on all dofs is the coupling
     !> force of the audit (its share on the prescribed dofs is taken by the supports, and so
     !> enters the reactions), and the audit's accounts are the FE side's in /coupling/energy.
-    subroutine audit_step(self, first, totals)
+    !> A system that coupling_arlequin2d did not build (its C or FE model another kind's) is
+    !> an internal error.
+    subroutine audit_step(self, first, error, totals)
         type(coupled2d_simulation_t), intent(inout) :: self
         logical, intent(in) :: first
+        type(error_t), allocatable, intent(out) :: error
         real(wp), intent(in), optional :: totals(4)
         real(wp), allocatable :: fc(:)
         allocate (fc(size(self%continuum%model%prescribed)), source=0.0_wp)
@@ -226,6 +231,9 @@ contains
         type is (continuum_operator_t)
             call op%transpose_all(self%sys%lambda, fc)
             fc = -fc
+        class default
+            call make_internal_error(error, 'coupled2d audit', 'the coupled system''s C is not a continuum''s')
+            return
         end select
         associate (au => self%continuum%audit, w => self%sys%prescribed_coupling_work)
             select type (ops => self%sys%model)
@@ -237,6 +245,10 @@ contains
                 else
                     call au%advance(ops, self%continuum%model, self%sys%fe, fc, -w)
                 end if
+            class default
+                call make_internal_error(error, 'coupled2d audit', 'the coupled system''s FE model is not a '// &
+                                         'continuum''s')
+                return
             end select
             self%sys%whole = fe_whole_t(set=.true., kinetic=au%kinetic, strain=au%strain, &
                                         external_work=au%load_work, damping=au%damping, &
@@ -360,7 +372,8 @@ contains
         call read_finite_attribute(f, '/coupling', 'continuum_audit', totals, 5, error)
         if (allocated(error)) return
         self%sys%prescribed_coupling_work = totals(5)
-        call audit_step(self, .true., totals(1:4))
+        call audit_step(self, .true., error, totals(1:4))
+        if (allocated(error)) return
         self%sys%cp = 0.0_wp
         call self%sys%op%add_prescribed(self%sys%fe%t, 0, self%sys%cp)
         call self%fe_out%resume(out%file, self%continuum%model%mesh, error)
