@@ -26,17 +26,18 @@
 module driver_checkpoint
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
     use core_kinds, only: wp, i8
-    use core_error, only: error_t, make_error
+    use core_error, only: error_t, make_error, make_internal_error
     use core_version, only: multicor_version
     use core_signals, only: caught_signal
     use core_threads, only: thread_setting
     use core_strings, only: to_str
     use io_hdf5_file, only: h5_file_t
     use io_paths, only: rename_file, remove_file, file_exists, link_or_copy_file
-    use fem_newmark, only: time_integrator_t, newmark_t
+    use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
     use dem_contacts, only: contacts_list_problem
     use dem_moreau_jean, only: dem_system_t
     use dem_nlgs, only: nlgs_stats_t
+    use dem_solve_method, only: sweeps_method_t
     use dem_bonded_block, only: bonded_block_method_t, bonded_block_restore
     use coupling_arlequin, only: coupled_system_t
     use driver_results, only: results_writer_t
@@ -572,6 +573,10 @@ contains
             call file%write_attribute(group, 'predicted', merge(1, 0, integ%predicted), error)
             if (allocated(error)) return
             call put_r1(file, group//'/fc_old', integ%fc_old, error)
+        type is (central_difference_t)
+            ! no state beyond the common one (init builds the rest from the deck)
+        class default
+            call make_internal_error(error, 'save_integrator', 'no checkpoint for the state of this time integrator')
         end select
     end subroutine save_integrator
 
@@ -634,6 +639,10 @@ contains
             if (allocated(error)) return
             integ%predicted = k /= 0
             call get_r1(file, group//'/fc_old', integ%fc_old, error)
+        type is (central_difference_t)
+            ! no state beyond the common one (init builds the rest from the deck)
+        class default
+            call make_internal_error(error, 'load_integrator', 'no checkpoint for the state of this time integrator')
         end select
     end subroutine load_integrator
 
@@ -717,6 +726,10 @@ contains
                     if (.not. allocated(error) .and. b%n_deleted > 0) &
                         call file%write_dataset(g//'/deleted', b%deleted(1:b%n_deleted), error)
                 end associate
+            type is (sweeps_method_t)
+                ! no state between steps
+            class default
+                call make_internal_error(error, 'save_dem', 'no checkpoint for the state of this solve method')
             end select
         end subroutine save_block
 
@@ -870,7 +883,6 @@ contains
             character(len=:), allocatable :: g
             integer, allocatable :: k1(:), k2(:), kr(:), dead(:), deleted(:)
             real(wp), allocatable :: v(:), scale(:)
-            logical :: restored
             g = group//'/block'
             if (.not. file%exists(g//'/values')) return
             ! a checkpoint of the block before its scaling (no 'scale'): its values are those of
@@ -918,15 +930,16 @@ contains
             end if
             ! the deck (whose hash the checkpoint matches) chose the strategy: only the
             ! bonded block has a factor to restore
-            restored = .false.
-            if (allocated(sys%method)) then
-                select type (m => sys%method)
-                type is (bonded_block_method_t)
-                    call bonded_block_restore(m%block, k1, k2, kr, v, scale, dead == 1, deleted)
-                    restored = .true.
-                end select
+            if (.not. allocated(sys%method)) then
+                call damaged(error, g//': the deck solves no bonded block ([solver] method)')
+                return
             end if
-            if (.not. restored) call damaged(error, g//': the deck solves no bonded block ([solver] method)')
+            select type (m => sys%method)
+            type is (bonded_block_method_t)
+                call bonded_block_restore(m%block, k1, k2, kr, v, scale, dead == 1, deleted)
+            class default
+                call damaged(error, g//': the deck solves no bonded block ([solver] method)')
+            end select
         end subroutine load_block
 
         !> Read the first n values of a per-body array (the array keeps its size).
