@@ -22,10 +22,10 @@ module driver_config
                                load_x, load_y, load_axial, load_transverse
     use fem_beam_element, only: element_stiffness, element_mass_consistent, element_mass_lumped
     use io_deck, only: deck_t, deck_entry_t
-    use driver_run_kind, only: run_kind_of, run_particles
     implicit none
     private
-    public :: run_config_t, build_config, max_steps, build_run_settings, steps_to_end, build_time_functions, repeated_dof
+    public :: run_config_t, build_config, build_particles_config, max_steps, build_run_settings, steps_to_end
+    public :: build_time_functions, repeated_dof
 
     !> Largest number of time steps of a run. The step counter is 64-bit; the bound is that of
     !> the 32-bit step counts stored in the results file (/summary steps, /dem/solver).
@@ -110,10 +110,6 @@ contains
         !> Error naming file, line and keyword, if any.
         type(error_t), allocatable, intent(out) :: error
         integer, allocatable :: section_ids(:), function_ids(:), fix_line(:, :)
-        if (run_kind_of(deck) == run_particles) then
-            call build_particles_only(deck, run, beam, error)
-            return
-        end if
         call build_sections(deck, beam, section_ids, error)
         if (allocated(error)) return
         call build_mesh(deck, section_ids, beam, error)
@@ -135,32 +131,34 @@ contains
         call build_initial(deck, beam, fix_line, run, error)
     end subroutine build_config
 
-    !> Configuration of a deck without [beam]: an empty frame, the time functions, the run
-    !> settings (a time integration: particles have no static or modal analysis).
-    subroutine build_particles_only(deck, run, beam, error)
+    !> Run configuration and time functions of a deck of particles (no [beam]): the run
+    !> settings of a time integration (particles have no static or modal analysis), for a frame
+    !> without nodes.
+    subroutine build_particles_config(deck, run, functions, error)
         !> The deck.
         type(deck_t), intent(in) :: deck
         !> Run configuration.
         type(run_config_t), intent(out) :: run
-        !> Beam configuration (empty, functions filled).
-        type(beam_config_t), intent(out) :: beam
+        !> The deck's time functions.
+        type(time_function_t), allocatable, intent(out) :: functions(:)
         !> Error, if any.
         type(error_t), allocatable, intent(out) :: error
+        type(beam_config_t) :: frame
         integer, allocatable :: function_ids(:), fix_line(:, :)
-        allocate (beam%x(0), beam%y(0), beam%node_id(0), beam%conn(2, 0), beam%elem_section(0))
-        allocate (beam%sections(0), beam%loads(0), beam%fixed(3, 0), fix_line(3, 0))
+        allocate (frame%x(0), frame%y(0), frame%node_id(0), frame%conn(2, 0), frame%elem_section(0))
+        allocate (frame%sections(0), frame%loads(0), frame%fixed(3, 0), frame%functions(0), fix_line(3, 0))
         if (deck%get_word('run', 'analysis') /= 'dynamic') then
             call make_input_error(error, deck%file, deck%line('run', 'analysis'), 'analysis', &
                                   'particles are integrated in time: set analysis = dynamic (a '// &
                                   deck%get_word('run', 'analysis')//' analysis needs a [beam] model)')
             return
         end if
-        call build_time_functions(deck, beam%functions, function_ids, error)
+        call build_time_functions(deck, functions, function_ids, error)
         if (allocated(error)) return
-        call build_run(deck, beam, run, error)
+        call build_run(deck, frame, run, error)
         if (allocated(error)) return
-        call build_initial(deck, beam, fix_line, run, error)
-    end subroutine build_particles_only
+        call build_initial(deck, frame, fix_line, run, error)
+    end subroutine build_particles_config
 
     !> Sections, with unique ids.
     subroutine build_sections(deck, beam, ids, error)

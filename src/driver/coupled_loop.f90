@@ -23,7 +23,8 @@ module driver_coupled_loop
     use core_error, only: error_t, make_error
     use core_signals, only: caught_signal, signal_name
     use io_progress, only: progress_t
-    use core_strings, only: counted, to_str
+    use core_strings, only: string_t, counted, to_str
+    use io_deck, only: deck_t
     use io_hdf5_file, only: h5_file_t
     use coupling_coupled_step, only: coupled_system_t, coupled_energies_t, arlequin_step, coupled_energies, &
                                      velocity_mismatch_t, velocity_mismatch
@@ -59,6 +60,13 @@ module driver_coupled_loop
     contains
         !> See `simulation_t%run`: the coupled time loop.
         procedure :: run => arlequin_run
+        !> See `simulation_t%has_time_loop`: yes.
+        procedure :: has_time_loop => arlequin_has_time_loop
+        !> See `simulation_t%check_deck`: both models' keywords are used.
+        procedure :: check_deck => arlequin_check_deck
+        !> See `simulation_t%deck_warnings`: the solver settings that do not act on the
+        !> coupling rows.
+        procedure :: deck_warnings => arlequin_deck_warnings
         !> Material ids of the disks and whether contacts are stored (for /dem).
         procedure(particle_output_iface), deferred :: particle_output
         !> Static data of a new run (mesh, overlap), after /dem and /coupling are begun.
@@ -515,6 +523,54 @@ contains
             self%cpl_out%max_velocity, ' m/s'
         line = trim(buf)
     end function constraint_line
+
+    !> True: the coupled steps.
+    pure logical function arlequin_has_time_loop(self)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(in) :: self
+        arlequin_has_time_loop = .true.
+    end function arlequin_has_time_loop
+
+    !> No error: a coupled deck uses the keywords of both models.
+    subroutine arlequin_check_deck(self, deck, error)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(in) :: self
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        !> Never set.
+        type(error_t), allocatable, intent(out) :: error
+    end subroutine arlequin_check_deck
+
+    !> Warnings for the solver settings that a coupled run accepts and does not use, as
+    !> 'warning: file:line: ...': `method = coarse` (a coupled run sweeps as with `nlgs`) and
+    !> `cold_start = hydrostatic` (its estimate leaves out the coupling rows); documented
+    !> fallbacks, so warnings rather than errors.
+    function arlequin_deck_warnings(self, deck) result(warnings)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(in) :: self
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        !> The warnings.
+        type(string_t), allocatable :: warnings(:)
+        allocate (warnings(0))
+        if (set_to('method', 'coarse')) &
+            warnings = [warnings, string_t('warning: '//deck%file//':'//to_str(deck%line('solver', 'method'))// &
+                                           ': [solver] method = coarse has no effect in a coupled run: '// &
+                                           'the coarse correction does not act on the coupling rows, and the run '// &
+                                           'sweeps as with method = nlgs')]
+        if (set_to('cold_start', 'hydrostatic')) &
+            warnings = [warnings, string_t('warning: '//deck%file//':'//to_str(deck%line('solver', 'cold_start'))// &
+                                           ': [solver] cold_start = hydrostatic has no effect in a coupled run: '// &
+                                           'the hydrostatic estimate leaves out the coupling rows, and a step without '// &
+                                           'reactions starts from zero')]
+    contains
+        ! whether the deck itself sets [solver] keyword to value
+        logical function set_to(keyword, value)
+            character(len=*), intent(in) :: keyword, value
+            set_to = .false.
+            if (deck%has('solver', keyword)) set_to = deck%get_word('solver', keyword) == value
+        end function set_to
+    end function arlequin_deck_warnings
 
     !> No work after a step.
     subroutine no_after_step(self, error)

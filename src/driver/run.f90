@@ -43,7 +43,6 @@ module driver_run
     use fem_element_registry, only: element_slot_t, new_element, kind_of_name
     use driver_simulation, only: simulation_t, report_iface
     use driver_simulations, only: select_simulation
-    use driver_run_kind, only: run_kind_warnings
     use driver_config, only: steps_to_end, max_steps
     use driver_checkpoint, only: checkpoint_run_t, checkpoint_name, checkpoint_open, checkpoint_owner, deck_hash
     implicit none
@@ -188,9 +187,9 @@ contains
             end if
             if (allocated(error)) return
             call sim%run(out, opts%quiet, report, ck, error)
-            ! A time loop writes /summary itself; a static or modal analysis (no checkpoint
-            ! kind) has no steps, and its wall time is that of `clock`.
-            if (.not. allocated(error) .and. len(kind) == 0) call out%write_summary(0, clock, error)
+            ! A time loop writes /summary itself; a static or modal analysis has no steps,
+            ! and its wall time is that of `clock`.
+            if (.not. allocated(error) .and. .not. sim%has_time_loop()) call out%write_summary(0, clock, error)
             if (allocated(error)) then
                 call out%abort()
                 error%message = deck%file//': '//error%message
@@ -289,7 +288,7 @@ contains
         subroutine warn_keywords_without_effect()
             type(string_t), allocatable :: warnings(:)
             integer :: i
-            warnings = [deck%ineffective(), run_kind_warnings(deck)]
+            warnings = [deck%ineffective(), sim%deck_warnings(deck)]
             do i = 1, size(warnings)
                 call report(warnings(i)%s)
             end do
@@ -345,7 +344,7 @@ contains
             type(error_t), allocatable, intent(out) :: error
             real(wp) :: steps
             if (opts%end_time < 0.0_wp) return
-            if (len(kind) == 0) then
+            if (.not. sim%has_time_loop()) then
                 call make_error(error, '--end: '//deck%file//' is not a dynamic analysis (static and modal '// &
                                 'analyses have no time steps to continue)')
                 return
@@ -398,7 +397,7 @@ contains
         subroutine open_checkpoint(error)
             type(error_t), allocatable, intent(out) :: error
             type(error_t), allocatable :: ignored
-            if (len(kind) == 0) then
+            if (.not. sim%has_time_loop()) then
                 call make_error(error, '--restart: '//deck%file//' is not a dynamic analysis (only time '// &
                                 'integrations have checkpoints)')
                 return

@@ -1,16 +1,19 @@
 !> One kind of run (beam, particles, coupled, continuum) as an extension of one abstract type.
 !>
 !> `driver_run` reads the deck, lets `driver_simulations` pick the extension from the deck's
-!> sections, then calls, in order: `init` (build the configuration and the model from the
+!> sections (which then refuses, through `check_deck`, the keywords the kind does not use),
+!> then calls, in order: `init` (build the configuration and the model from the
 !> deck; everything that can fail because of the input fails here, before the results folder
-!> is touched), `describe` (the line of a `--check` run), and `run` (static solve, modes or
-!> time steps, writing every output into the open results file). A time loop that writes
-!> checkpoints (driver_checkpoint) names its kind of run with `checkpoint_kind`, which a
-!> restart checks. Adding a kind of model adds an extension in its own file and one line in
-!> `driver_simulations`.
+!> is touched), `deck_warnings` (settings accepted without effect), `describe` (the line of a
+!> `--check` run), and `run` (static solve, modes or time steps, writing every output into the
+!> open results file). A run with a time loop (`has_time_loop`) can be extended (`--end`) and
+!> restarted; its checkpoints (driver_checkpoint) name its kind of run with `checkpoint_kind`,
+!> which a restart checks. Adding a kind of model adds an extension in its own file and one
+!> line in `driver_simulations`.
 module driver_simulation
     use, intrinsic :: iso_fortran_env, only: output_unit
     use core_error, only: error_t
+    use core_strings, only: string_t
     use io_deck, only: deck_t
     use driver_results, only: results_writer_t
     use driver_config, only: run_config_t
@@ -43,6 +46,14 @@ module driver_simulation
         !> 'coupled', 'continuum', 'coupled2d'); '' for a run without checkpoints (static and
         !> modal analyses).
         procedure(simulation_checkpoint_kind), deferred :: checkpoint_kind
+        !> Whether the run integrates in time (steps, checkpoints, `--end` and `--restart`),
+        !> rather than a static solve or modes.
+        procedure(simulation_has_time_loop), deferred :: has_time_loop
+        !> Error when the deck sets keywords that this kind of run does not use (they would
+        !> have no effect); called before `init`.
+        procedure(simulation_check_deck), deferred :: check_deck
+        !> Warnings for settings that this kind of run accepts and does not use.
+        procedure(simulation_deck_warnings), deferred :: deck_warnings
         !> Text that stands for the files besides the deck the model was read from (the hash of
         !> a Gmsh mesh); hashed into checkpoints with the deck, so that a restart refuses a
         !> changed mesh. Default: none.
@@ -97,6 +108,35 @@ module driver_simulation
             !> 'beam', 'particles', 'coupled', 'continuum', 'coupled2d' or ''.
             character(len=:), allocatable :: kind
         end function simulation_checkpoint_kind
+
+        !> Whether the simulation steps in time.
+        pure logical function simulation_has_time_loop(self)
+            import :: simulation_t
+            !> The simulation.
+            class(simulation_t), intent(in) :: self
+        end function simulation_has_time_loop
+
+        !> Error for keywords of the deck that the kind of run would ignore.
+        subroutine simulation_check_deck(self, deck, error)
+            import :: simulation_t, deck_t, error_t
+            !> The simulation (not yet initialised).
+            class(simulation_t), intent(in) :: self
+            !> The validated deck.
+            type(deck_t), intent(in) :: deck
+            !> Error naming file, line and keyword, if any.
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine simulation_check_deck
+
+        !> Warnings ('warning: file:line: ...') for settings without effect in this kind of run.
+        function simulation_deck_warnings(self, deck) result(warnings)
+            import :: simulation_t, deck_t, string_t
+            !> The simulation.
+            class(simulation_t), intent(in) :: self
+            !> The validated deck.
+            type(deck_t), intent(in) :: deck
+            !> The warnings (none: size 0).
+            type(string_t), allocatable :: warnings(:)
+        end function simulation_deck_warnings
     end interface
 
 contains

@@ -6,13 +6,14 @@ module driver_simulation_beam
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp
     use core_error, only: error_t, make_input_error
-    use core_strings, only: to_str
+    use core_strings, only: string_t, to_str
     use io_deck, only: deck_t
     use fem_beam_config, only: beam_config_t
     use fem_beam_model, only: beam_model_t, build_beam_model
     use driver_config, only: run_config_t, build_config
     use driver_results, only: results_writer_t
     use driver_simulation, only: simulation_t
+    use driver_run_kind, only: check_particle_keywords_unused
     implicit none
     private
     public :: beam_simulation_t, beam_setup, check_initial_energy
@@ -28,6 +29,12 @@ module driver_simulation_beam
         procedure :: describe => beam_describe
         !> See `simulation_t%checkpoint_kind`: none (the dynamic analysis writes them).
         procedure :: checkpoint_kind => beam_checkpoint_kind
+        !> See `simulation_t%has_time_loop`: no (the dynamic analysis has one).
+        procedure :: has_time_loop => beam_has_time_loop
+        !> See `simulation_t%check_deck`: no particle settings.
+        procedure :: check_deck => beam_check_deck
+        !> See `simulation_t%deck_warnings`: none.
+        procedure :: deck_warnings => beam_deck_warnings
         !> Write the nodes and the elements into the results file.
         procedure :: write_mesh => beam_write_mesh
     end type beam_simulation_t
@@ -66,6 +73,35 @@ contains
         character(len=:), allocatable :: kind
         kind = ''
     end function beam_checkpoint_kind
+
+    !> False: static and modal analyses have no time steps.
+    pure logical function beam_has_time_loop(self)
+        !> The simulation.
+        class(beam_simulation_t), intent(in) :: self
+        beam_has_time_loop = .false.
+    end function beam_has_time_loop
+
+    !> Error for particle-only keywords in a beam deck.
+    subroutine beam_check_deck(self, deck, error)
+        !> The simulation.
+        class(beam_simulation_t), intent(in) :: self
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        !> Error naming the first such keyword, if any.
+        type(error_t), allocatable, intent(out) :: error
+        call check_particle_keywords_unused(deck, error)
+    end subroutine beam_check_deck
+
+    !> No warning.
+    function beam_deck_warnings(self, deck) result(warnings)
+        !> The simulation.
+        class(beam_simulation_t), intent(in) :: self
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        !> None.
+        type(string_t), allocatable :: warnings(:)
+        allocate (warnings(0))
+    end function beam_deck_warnings
 
     !> The frame's nodes and elements into the results file.
     subroutine beam_write_mesh(self, out, error)

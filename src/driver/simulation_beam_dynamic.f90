@@ -31,6 +31,8 @@ module driver_simulation_beam_dynamic
         procedure :: run => dynamic_run
         !> See `simulation_t%checkpoint_kind`: 'beam'.
         procedure :: checkpoint_kind => dynamic_checkpoint_kind
+        !> See `simulation_t%has_time_loop`: yes.
+        procedure :: has_time_loop => dynamic_has_time_loop
     end type beam_dynamic_t
 
 contains
@@ -91,6 +93,13 @@ contains
         character(len=:), allocatable :: kind
         kind = 'beam'
     end function dynamic_checkpoint_kind
+
+    !> True: the Newmark or central-difference steps.
+    pure logical function dynamic_has_time_loop(self)
+        !> The simulation.
+        class(beam_dynamic_t), intent(in) :: self
+        dynamic_has_time_loop = .true.
+    end function dynamic_has_time_loop
 
     !> Build the time integrator the deck asks for (refuses an unstable explicit step).
     subroutine make_integrator(run, model, integ, error)

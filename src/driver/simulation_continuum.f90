@@ -26,6 +26,7 @@ module driver_simulation_continuum
     use driver_config, only: build_run_settings, build_time_functions
     use driver_checkpoint, only: deck_hash
     use driver_simulation, only: simulation_t
+    use driver_run_kind, only: check_particle_keywords_unused, check_initial_unused
     implicit none
     private
     public :: continuum_simulation_t, continuum_setup, check_density
@@ -45,6 +46,12 @@ module driver_simulation_continuum
         procedure :: describe => continuum_describe
         !> See `simulation_t%checkpoint_kind`: none (the dynamic analysis writes them).
         procedure :: checkpoint_kind => continuum_checkpoint_kind
+        !> See `simulation_t%has_time_loop`: no (the dynamic analysis has one).
+        procedure :: has_time_loop => continuum_has_time_loop
+        !> See `simulation_t%check_deck`: no particle settings, no [initial].
+        procedure :: check_deck => continuum_check_deck
+        !> See `simulation_t%deck_warnings`: none.
+        procedure :: deck_warnings => continuum_deck_warnings
         !> See `simulation_t%inputs_text`: the Gmsh mesh file.
         procedure :: inputs_text => continuum_inputs_text
     end type continuum_simulation_t
@@ -411,6 +418,37 @@ contains
         character(len=:), allocatable :: kind
         kind = ''
     end function continuum_checkpoint_kind
+
+    !> False: static and modal analyses have no time steps.
+    pure logical function continuum_has_time_loop(self)
+        !> The simulation.
+        class(continuum_simulation_t), intent(in) :: self
+        continuum_has_time_loop = .false.
+    end function continuum_has_time_loop
+
+    !> Error for particle-only keywords and for [initial] (beam dofs) in a continuum deck.
+    subroutine continuum_check_deck(self, deck, error)
+        !> The simulation.
+        class(continuum_simulation_t), intent(in) :: self
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        !> Error naming the first such keyword, if any.
+        type(error_t), allocatable, intent(out) :: error
+        call check_particle_keywords_unused(deck, error)
+        if (allocated(error)) return
+        call check_initial_unused(deck, error)
+    end subroutine continuum_check_deck
+
+    !> No warning.
+    function continuum_deck_warnings(self, deck) result(warnings)
+        !> The simulation.
+        class(continuum_simulation_t), intent(in) :: self
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        !> None.
+        type(string_t), allocatable :: warnings(:)
+        allocate (warnings(0))
+    end function continuum_deck_warnings
 
     !> See `simulation_t%inputs_text`: the hash of the Gmsh mesh file ('' for a generated mesh).
     function continuum_inputs_text(self) result(text)

@@ -37,6 +37,8 @@ module driver_simulation_continuum_dynamic
         procedure :: run => dynamic_run
         !> See `simulation_t%checkpoint_kind`: 'continuum'.
         procedure :: checkpoint_kind => dynamic_checkpoint_kind
+        !> See `simulation_t%has_time_loop`: yes.
+        procedure :: has_time_loop => dynamic_has_time_loop
     end type continuum_dynamic_t
 
 contains
@@ -282,4 +284,11 @@ contains
         character(len=:), allocatable :: kind
         kind = 'continuum'
     end function dynamic_checkpoint_kind
+
+    !> True: the Newmark or central-difference steps.
+    pure logical function dynamic_has_time_loop(self)
+        !> The simulation.
+        class(continuum_dynamic_t), intent(in) :: self
+        dynamic_has_time_loop = .true.
+    end function dynamic_has_time_loop
 end module driver_simulation_continuum_dynamic

@@ -1,23 +1,24 @@
 !> Particle (Contact Dynamics) runs: a [particles] deck without [beam].
 module driver_simulation_dem
     use core_error, only: error_t
-    use core_strings, only: counted, to_str
+    use core_strings, only: string_t, counted, to_str
+    use core_timefunc, only: time_function_t
     use io_deck, only: deck_t
-    use fem_beam_config, only: beam_config_t
-    use driver_config, only: run_config_t, build_config
+    use driver_config, only: run_config_t, build_particles_config
     use driver_config_dem, only: dem_config_t, build_dem_config
     use driver_run_dem, only: run_dem
     use driver_results, only: results_writer_t
     use driver_checkpoint, only: checkpoint_run_t
     use driver_simulation, only: simulation_t, report_iface
+    use driver_run_kind, only: check_beam_keywords_unused
     implicit none
     private
     public :: dem_simulation_t
 
     !> A run of rigid disks and walls.
     type, extends(simulation_t) :: dem_simulation_t
-        !> Empty frame holding the time functions.
-        type(beam_config_t) :: beam
+        !> The deck's time functions.
+        type(time_function_t), allocatable :: functions(:)
         !> Particles, walls, contact laws and solver settings.
         type(dem_config_t) :: dem
     contains
@@ -29,6 +30,12 @@ module driver_simulation_dem
         procedure :: run => dem_run
         !> See `simulation_t%checkpoint_kind`.
         procedure :: checkpoint_kind => dem_checkpoint_kind
+        !> See `simulation_t%has_time_loop`: yes.
+        procedure :: has_time_loop => dem_has_time_loop
+        !> See `simulation_t%check_deck`: no beam settings.
+        procedure :: check_deck => dem_check_deck
+        !> See `simulation_t%deck_warnings`: none.
+        procedure :: deck_warnings => dem_deck_warnings
     end type dem_simulation_t
 
 contains
@@ -44,9 +51,9 @@ contains
         !> Set on any input error.
         type(error_t), allocatable, intent(out) :: error
         integer :: i
-        call build_config(deck, self%settings, self%beam, error)
+        call build_particles_config(deck, self%settings, self%functions, error)
         if (allocated(error)) return
-        call build_dem_config(deck, self%settings, self%beam%functions, self%dem, error)
+        call build_dem_config(deck, self%settings, self%functions, self%dem, error)
         if (allocated(error)) return
         do i = 1, size(self%dem%warnings)
             call report(self%dem%warnings(i)%s)
@@ -88,4 +95,33 @@ contains
         character(len=:), allocatable :: kind
         kind = 'particles'
     end function dem_checkpoint_kind
+
+    !> True: the Moreau-Jean steps.
+    pure logical function dem_has_time_loop(self)
+        !> The simulation.
+        class(dem_simulation_t), intent(in) :: self
+        dem_has_time_loop = .true.
+    end function dem_has_time_loop
+
+    !> Error for beam-only keywords in a particle deck.
+    subroutine dem_check_deck(self, deck, error)
+        !> The simulation.
+        class(dem_simulation_t), intent(in) :: self
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        !> Error naming the first such keyword, if any.
+        type(error_t), allocatable, intent(out) :: error
+        call check_beam_keywords_unused(deck, error)
+    end subroutine dem_check_deck
+
+    !> No warning.
+    function dem_deck_warnings(self, deck) result(warnings)
+        !> The simulation.
+        class(dem_simulation_t), intent(in) :: self
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        !> None.
+        type(string_t), allocatable :: warnings(:)
+        allocate (warnings(0))
+    end function dem_deck_warnings
 end module driver_simulation_dem
