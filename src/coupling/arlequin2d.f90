@@ -23,6 +23,7 @@ module coupling_arlequin2d
     use fem_continuum_model, only: continuum_model_t
     use fem_continuum_dynamics, only: continuum_dynamics_t
     use fem_triplets, only: fem_triplets_t
+    use fem_mass_scheme, only: mass_scheme_t, consistent_mass_t
     use dem_moreau_jean, only: dem_system_t
     use coupling_overlap2d, only: weight_field_t
     use coupling_weighted2d, only: assemble_weighted
@@ -52,8 +53,9 @@ module coupling_arlequin2d
         integer :: pairing = pairing_l2
         !> Length l of the H1 pairing [m].
         real(wp) :: h1_length = 0.0_wp
-        !> Row-sum lumped M_alpha instead of the consistent one.
-        logical :: lumped = .false.
+        !> How the element masses enter M_alpha: consistent or row-sum lumped; unallocated:
+        !> consistent.
+        class(mass_scheme_t), allocatable :: mass_scheme
         !> Rayleigh damping of the continuum C = a0 M_alpha + a1 K_alpha: a0 [1/s], a1 [s].
         real(wp) :: rayleigh(2) = 0.0_wp
         !> Gravity acting on the continuum, weighted by alpha [m/s^2].
@@ -93,6 +95,7 @@ contains
         type(mediator_space_t) :: med
         class(multiplier_space_t), allocatable :: space
         real(wp), allocatable :: load(:), g_nodes(:), mg(:), uf(:), vf(:)
+        class(mass_scheme_t), allocatable :: mass
         integer :: a
         if (.not. (config%thickness > 0)) then
             call make_error(error, 'coupling: thickness (out-of-plane depth of the particle domain) must be > 0')
@@ -107,7 +110,12 @@ contains
             return
         end if
         ! Weighted matrices and loads of the continuum.
-        call assemble_weighted(model, config%region, k_all, m_all, error, lumped=config%lumped, order=config%order)
+        if (allocated(config%mass_scheme)) then
+            allocate (mass, source=config%mass_scheme)
+        else
+            allocate (consistent_mass_t :: mass)
+        end if
+        call assemble_weighted(model, config%region, k_all, m_all, error, mass=mass, order=config%order)
         if (allocated(error)) return
         allocate (g_nodes(model%dof_count()), mg(model%dof_count()))
         do a = 1, model%mesh%node_count()
@@ -115,7 +123,7 @@ contains
         end do
         call m_all%matvec(g_nodes, mg)
         load = model%load + mg
-        call ops%build_from(model, k_all, m_all, load, config%lumped, config%rayleigh(1), config%rayleigh(2), error)
+        call ops%build_from(model, k_all, m_all, load, mass, config%rayleigh(1), config%rayleigh(2), error)
         if (allocated(error)) return
         ! Disks: weights, coupled ones, none in the FE-only zone.
         sys%dem = dem

@@ -17,6 +17,7 @@ module coupling_weighted2d
     use fem_element2d, only: element2d_t
     use fem_elastic2d, only: elastic2d_t
     use fem_triplets, only: fem_triplets_t
+    use fem_mass_scheme, only: mass_scheme_t, consistent_mass_t
     use coupling_overlap2d, only: weight_field_t
     implicit none
     private
@@ -25,7 +26,7 @@ module coupling_weighted2d
 contains
 
     !> Weighted stiffness and mass (consistent, or row-sum lumped) over all dofs, as triplets.
-    subroutine assemble_weighted(model, region, k, m, error, lumped, order)
+    subroutine assemble_weighted(model, region, k, m, error, mass, order)
         !> The continuum model (materials assigned).
         type(continuum_model_t), intent(in) :: model
         !> The overlap weight (one region, or a set of regions).
@@ -36,14 +37,14 @@ contains
         type(fem_triplets_t), intent(out) :: m
         !> Set when an element has no material or the order is out of 1..10.
         type(error_t), allocatable, intent(out) :: error
-        !> Row-sum lumped mass (default: consistent).
-        logical, intent(in), optional :: lumped
+        !> How the element masses enter: consistent (the default) or row-sum lumped.
+        class(mass_scheme_t), intent(in), optional :: mass
         !> Gauss points per direction in the elements touching the region (default 4).
         integer, intent(in), optional :: order
         real(wp), allocatable :: xe(:, :), ke(:, :), me(:, :), pts(:, :), w(:)
         integer, allocatable :: dofs(:), nodes(:)
-        logical :: lump
-        integer :: e, a, nq
+        class(mass_scheme_t), allocatable :: scheme
+        integer :: e, nq
         call model%check(error)
         if (allocated(error)) return
         nq = 4
@@ -52,8 +53,11 @@ contains
             call make_error(error, 'weighted assembly: order must lie in 1..10 Gauss points per direction')
             return
         end if
-        lump = .false.
-        if (present(lumped)) lump = lumped
+        if (present(mass)) then
+            allocate (scheme, source=mass)
+        else
+            allocate (consistent_mass_t :: scheme)
+        end if
         call k%init(model%dof_count(), 64*model%mesh%element_count())
         call m%init(model%dof_count(), 64*model%mesh%element_count())
         do e = 1, model%mesh%element_count()
@@ -70,13 +74,7 @@ contains
                 end if
             end associate
             call k%add_block(dofs, ke)
-            if (lump) then
-                do a = 1, size(dofs)
-                    call m%add(dofs(a), dofs(a), sum(me(a, :)))
-                end do
-            else
-                call m%add_block(dofs, me)
-            end if
+            call scheme%add_element(m, dofs, me, sum(me, dim=2))
         end do
     end subroutine assemble_weighted
 

@@ -21,6 +21,7 @@ module driver_config
     use fem_beam_config, only: beam_config_t, beam_section_t, dof_u, dof_w, dof_theta, beam_element_load_t, &
                                load_x, load_y, load_axial, load_transverse
     use fem_beam_element, only: element_stiffness, element_mass_consistent, element_mass_lumped
+    use fem_mass_scheme, only: mass_scheme_t, consistent_mass_t, make_mass_scheme
     use io_deck, only: deck_t, deck_entry_t
     implicit none
     private
@@ -123,7 +124,8 @@ contains
         call build_distributed_loads(deck, function_ids, beam, error)
         if (allocated(error)) return
         beam%gravity = [deck%get_real('beam', 'gravity', 'gx'), deck%get_real('beam', 'gravity', 'gy')]
-        beam%lumped_mass = deck%get_word('beam', 'mass') == 'lumped'
+        call make_mass_scheme(deck%get_word('beam', 'mass'), beam%mass_scheme, error)
+        if (allocated(error)) return
         beam%rayleigh_a0 = deck%get_real('beam', 'rayleigh', 'a0')
         beam%rayleigh_a1 = deck%get_real('beam', 'rayleigh', 'a1')
         call build_run(deck, beam, run, error)
@@ -147,6 +149,7 @@ contains
         integer, allocatable :: function_ids(:), fix_line(:, :)
         allocate (frame%x(0), frame%y(0), frame%node_id(0), frame%conn(2, 0), frame%elem_section(0))
         allocate (frame%sections(0), frame%loads(0), frame%fixed(3, 0), frame%functions(0), fix_line(3, 0))
+        allocate (consistent_mass_t :: frame%mass_scheme)
         if (deck%get_word('run', 'analysis') /= 'dynamic') then
             call make_input_error(error, deck%file, deck%line('run', 'analysis'), 'analysis', &
                                   'particles are integrated in time: set analysis = dynamic (a '// &
@@ -815,18 +818,19 @@ contains
         type(run_config_t), intent(inout) :: run
         !> Error, if any.
         type(error_t), allocatable, intent(out) :: error
-        call build_run_settings(deck, count(.not. beam%fixed), beam%lumped_mass, 'beam', run, error)
+        call build_run_settings(deck, count(.not. beam%fixed), beam%mass_scheme, 'beam', run, error)
     end subroutine build_run
 
     !> Run settings ([run], [time], [modal], [output]) of a model with n_free free DOFs whose
-    !> mass matrix is lumped or not (`section` names where the mass is chosen, for messages).
-    subroutine build_run_settings(deck, n_free, lumped_mass, section, run, error)
+    !> mass matrix is assembled under `mass` (`section` names where the mass is chosen, for
+    !> messages).
+    subroutine build_run_settings(deck, n_free, mass, section, run, error)
         !> The deck.
         type(deck_t), intent(in) :: deck
         !> Number of free DOFs of the model.
         integer, intent(in) :: n_free
-        !> Whether the model's mass matrix is lumped.
-        logical, intent(in) :: lumped_mass
+        !> The model's mass scheme (the central-difference scheme needs a diagonal mass).
+        class(mass_scheme_t), intent(in) :: mass
         !> Section choosing the mass matrix ('beam', 'continuum').
         character(len=*), intent(in) :: section
         !> Run configuration.
@@ -848,7 +852,7 @@ contains
             run%gamma = 0.5_wp
         end select
         if (run%analysis == 'dynamic' .and. run%scheme == 'central_difference' .and. &
-            .not. lumped_mass) then
+            .not. mass%is_diagonal()) then
             call make_input_error(error, deck%file, deck%line('time', 'scheme'), 'scheme', &
                                   'the central-difference scheme needs a lumped mass matrix: set ['//section// &
                                   '] mass = lumped, or use scheme = average_acceleration')

@@ -21,6 +21,7 @@ module driver_config_coupling2d
                                   regions_overlap
     use coupling_operator2d, only: pairing_l2, pairing_h1
     use coupling_coupled_step, only: multipliers_particles, multipliers_nodes
+    use fem_mass_scheme, only: make_mass_scheme
     use coupling_arlequin2d, only: coupling2d_config_t
     use driver_config, only: run_config_t
     implicit none
@@ -145,7 +146,8 @@ contains
                                   deck%get_word('coupling', 'multipliers') == 'nodes')
             c%pairing = merge(pairing_h1, pairing_l2, deck%get_word('coupling', 'pairing') == 'h1')
             c%h1_length = deck%get_real('coupling', 'h1_length')
-            c%lumped = deck%get_word('continuum', 'mass') == 'lumped'
+            call make_mass_scheme(deck%get_word('continuum', 'mass'), c%mass_scheme, error)
+            if (allocated(error)) return
             c%rayleigh = [deck%get_real('continuum', 'rayleigh', 'a0'), deck%get_real('continuum', 'rayleigh', 'a1')]
             c%gravity = gravity
         end associate

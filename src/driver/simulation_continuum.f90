@@ -23,6 +23,7 @@ module driver_simulation_continuum
     use fem_elastic2d, only: elastic2d_t, make_elastic2d
     use fem_continuum_model, only: continuum_model_t
     use fem_continuum_dynamics, only: continuum_dynamics_t
+    use fem_mass_scheme, only: mass_scheme_t, make_mass_scheme
     use driver_config, only: build_run_settings, build_time_functions
     use driver_checkpoint, only: deck_hash
     use driver_simulation, only: simulation_t
@@ -74,7 +75,7 @@ contains
         ! Deck ids of the time functions; constant loads set aside while a timed one is added.
         integer, allocatable :: function_ids(:)
         real(wp), allocatable :: constant(:)
-        logical :: lumped
+        class(mass_scheme_t), allocatable :: mass
         integer :: n_free
         integer, allocatable :: eq(:)
         self%deck_file = deck%file
@@ -97,12 +98,13 @@ contains
                                   'every dof of the continuum is prescribed: nothing to solve')
             return
         end if
-        lumped = deck%get_word('continuum', 'mass') == 'lumped'
-        call self%ops%build(self%model, lumped, deck%get_real('continuum', 'rayleigh', 'a0'), &
+        call make_mass_scheme(deck%get_word('continuum', 'mass'), mass, error)
+        if (allocated(error)) return
+        call self%ops%build(self%model, mass, deck%get_real('continuum', 'rayleigh', 'a0'), &
                             deck%get_real('continuum', 'rayleigh', 'a1'), error)
         if (allocated(error)) call fail_at(error, deck%line('continuum', 'mesh'), 'mesh')
         if (allocated(error)) return
-        call build_run_settings(deck, self%ops%n_free, lumped, 'continuum', self%settings, error)
+        call build_run_settings(deck, self%ops%n_free, mass, 'continuum', self%settings, error)
         if (allocated(error)) return
 
     contains

@@ -6,6 +6,7 @@
 module fem_beam_config
     use core_kinds, only: wp
     use core_timefunc, only: time_function_t
+    use fem_mass_scheme, only: mass_scheme_t
     implicit none
     private
     public :: beam_section_t, beam_load_t, beam_config_t, dof_u, dof_w, dof_theta
@@ -76,8 +77,8 @@ module fem_beam_config
         integer, allocatable :: elem_section(:)
         !> Sections.
         type(beam_section_t), allocatable :: sections(:)
-        !> Lumped (HRZ) instead of consistent mass.
-        logical :: lumped_mass = .false.
+        !> How the element masses enter: consistent or lumped (HRZ); unallocated: consistent.
+        class(mass_scheme_t), allocatable :: mass_scheme
         !> Fixed DOFs (3, n_nodes).
         logical, allocatable :: fixed(:, :)
         !> Nodal loads.

@@ -19,6 +19,7 @@ module fem_beam_model
     use core_timefunc, only: time_function_t
     use core_weight, only: weight_function_t
     use fem_dynamic_operator, only: dynamic_operator_t, spd_factor_t
+    use fem_mass_scheme, only: consistent_mass_t
     use fem_beam_config, only: beam_config_t, beam_load_t, beam_section_t, beam_element_load_t, &
                                load_x, load_y, load_axial, load_transverse
     use fem_beam_element, only: element_stiffness, element_mass_consistent, &
@@ -42,7 +43,7 @@ module fem_beam_model
                            0.3607615730481386075698025_wp, 0.1713244923791703450402961_wp]
 
     !> A planar Euler-Bernoulli frame ready for static, modal and transient analysis. From
-    !> `dynamic_operator_t`: n_free, lumped_mass (HRZ, diagonal: `m%kd` = 0), rayleigh_a0/a1.
+    !> `dynamic_operator_t`: n_free, mass_scheme (lumped: HRZ, diagonal, `m%kd` = 0), rayleigh_a0/a1.
     type, extends(dynamic_operator_t) :: beam_model_t
         !> Number of nodes.
         integer :: n_nodes = 0
@@ -160,7 +161,11 @@ contains
         call copy_geometry(config, model)
         call number_equations(config, model, error)
         if (allocated(error)) return
-        model%lumped_mass = config%lumped_mass
+        if (allocated(config%mass_scheme)) then
+            allocate (model%mass_scheme, source=config%mass_scheme)
+        else
+            allocate (consistent_mass_t :: model%mass_scheme)
+        end if
         model%rayleigh_a0 = config%rayleigh_a0
         model%rayleigh_a1 = config%rayleigh_a1
         allocate (model%loads(0), model%functions(0))
@@ -505,16 +510,18 @@ contains
         type(beam_model_t), intent(inout) :: model
         type(error_t), allocatable, intent(out) :: error
         class(weight_function_t), intent(in), optional :: weight
-        integer :: e, a, b, kd
+        integer :: e, a, b, kd, p
         integer :: dofs(6)
+        integer, allocatable :: rows(:), cols(:)
         real(wp) :: kg(6, 6), mg(6, 6), ml(6)
+        real(wp), allocatable :: values(:)
         kd = 0
         do e = 1, model%n_elements
             dofs = element_dofs(model, e)
             if (count(dofs > 0) > 1) kd = max(kd, maxval(dofs) - minval(dofs, dofs > 0))
         end do
         call model%k%init(model%n_free, kd)
-        call model%m%init(model%n_free, merge(0, kd, model%lumped_mass))
+        call model%m%init(model%n_free, merge(0, kd, model%mass_scheme%is_diagonal()))
         if (present(weight)) allocate (model%k_element(6, 6, model%n_elements))
         do e = 1, model%n_elements
             dofs = element_dofs(model, e)
@@ -533,9 +540,12 @@ contains
                 do a = 1, 6
                     if (dofs(a) == 0) cycle
                     call model%k%add(dofs(a), dofs(b), kg(a, b))
-                    if (.not. model%lumped_mass) call model%m%add(dofs(a), dofs(b), mg(a, b))
                 end do
-                if (model%lumped_mass) call model%m%add(dofs(b), dofs(b), ml(b))
+            end do
+            call model%mass_scheme%element_entries(mg, ml, rows, cols, values)
+            do p = 1, size(values)
+                if (dofs(rows(p)) == 0 .or. dofs(cols(p)) == 0) cycle
+                call model%m%add(dofs(rows(p)), dofs(cols(p)), values(p))
             end do
         end do
         if (model%k%out_of_band .or. model%m%out_of_band) &

@@ -40,6 +40,7 @@ module fem_continuum_dynamics
     use fem_continuum_model, only: continuum_model_t
     use fem_triplets, only: fem_triplets_t
     use fem_newmark, only: time_integrator_t
+    use fem_mass_scheme, only: mass_scheme_t
     implicit none
     private
     public :: continuum_dynamics_t, continuum_audit_t
@@ -151,13 +152,13 @@ module fem_continuum_dynamics
 contains
 
     !> Assemble K and M of the model, reduce them and the loads to the free dofs.
-    subroutine dynamics_build(self, model, lumped, a0, a1, error)
+    subroutine dynamics_build(self, model, mass, a0, a1, error)
         !> The operator.
         class(continuum_dynamics_t), intent(out) :: self
         !> The continuum (materials, loads and prescribed dofs set).
         type(continuum_model_t), intent(in) :: model
-        !> Row-sum lumped instead of consistent mass.
-        logical, intent(in) :: lumped
+        !> How the element masses enter: consistent or row-sum lumped (fem_mass_scheme).
+        class(mass_scheme_t), intent(in) :: mass
         !> Rayleigh coefficients: C = a0 M + a1 K.
         real(wp), intent(in) :: a0, a1
         !> Set when an element has no material or CHOLMOD fails.
@@ -165,28 +166,28 @@ contains
         type(fem_triplets_t) :: k_all, m_all
         call model%assemble_stiffness(k_all, error)
         if (allocated(error)) return
-        call model%assemble_mass(lumped, m_all, error)
+        call model%assemble_mass(mass, m_all, error)
         if (allocated(error)) return
-        call self%build_from(model, k_all, m_all, model%load, lumped, a0, a1, error)
+        call self%build_from(model, k_all, m_all, model%load, mass, a0, a1, error)
     end subroutine dynamics_build
 
     !> Reduce given K, M and loads over all dofs to the free dofs of the model (e.g. the
     !> alpha-weighted K_alpha, M_alpha and loads of an Arlequin overlap, coupling_weighted2d).
     !> The element bound of the critical step is that of the model's own element matrices: a
     !> weight constant on an element scales K_e and M_e alike and leaves it unchanged.
-    subroutine dynamics_build_from(self, model, k_all, m_all, load, lumped, a0, a1, error)
+    subroutine dynamics_build_from(self, model, k_all, m_all, load, mass, a0, a1, error)
         !> The operator.
         class(continuum_dynamics_t), intent(out) :: self
         !> The continuum (materials and prescribed dofs set).
         type(continuum_model_t), intent(in) :: model
         !> Stiffness over all dofs.
         type(fem_triplets_t), intent(in) :: k_all
-        !> Mass over all dofs (diagonal when lumped).
+        !> Mass over all dofs (assembled under `mass`: diagonal when lumped).
         type(fem_triplets_t), intent(in) :: m_all
         !> Loads over all dofs [N].
         real(wp), intent(in) :: load(:)
-        !> The mass is lumped.
-        logical, intent(in) :: lumped
+        !> The scheme `m_all` was assembled with.
+        class(mass_scheme_t), intent(in) :: mass
         !> Rayleigh coefficients: C = a0 M + a1 K.
         real(wp), intent(in) :: a0, a1
         !> Set when CHOLMOD fails or the element bound cannot be computed.
@@ -212,7 +213,7 @@ contains
         ! M acts on accelerations: the prescribed dofs do not move, no right-hand side.
         call model%reduce(m_all, 0*load, self%m_triplets, dummy)
         self%n_free = self%k_triplets%n
-        self%lumped_mass = lumped
+        allocate (self%mass_scheme, source=mass)
         self%rayleigh_a0 = a0
         self%rayleigh_a1 = a1
         call self%k%init(self%n_free, int(self%k_triplets%nnz, i8))
@@ -251,15 +252,7 @@ contains
                 associate (el => model%family(model%mesh%kind(e))%element, xe => model%mesh%element_coordinates(e), &
                            mat => model%materials(model%element_material(e)))
                     k_e = el%stiffness(xe, mat)
-                    if (lumped) then
-                        m_e = 0*k_e
-                        lambda = el%mass_lumped(xe, mat)
-                        do a = 1, size(lambda)
-                            m_e(a, a) = lambda(a)
-                        end do
-                    else
-                        m_e = el%mass_consistent(xe, mat)
-                    end if
+                    m_e = mass%element_matrix(el%mass_consistent(xe, mat), el%mass_lumped(xe, mat))
                 end associate
                 n = size(k_e, 1)
                 call ke%init(n, n - 1)

@@ -23,6 +23,7 @@ module fem_continuum_model
                              edge_traction_function, traction_field_t, parabolic_traction_t
     use fem_mesh2d, only: mesh2d_t
     use fem_triplets, only: fem_triplets_t
+    use fem_mass_scheme, only: mass_scheme_t
     implicit none
     private
     public :: continuum_model_t
@@ -80,7 +81,7 @@ module fem_continuum_model
         procedure :: unrepresentable_element => model_unrepresentable_element
         !> Global stiffness (all dofs) as triplets.
         procedure :: assemble_stiffness => model_assemble_stiffness
-        !> Global mass (all dofs), consistent or row-sum lumped, as triplets.
+        !> Global mass (all dofs) under a mass scheme (consistent or row-sum lumped), as triplets.
         procedure :: assemble_mass => model_assemble_mass
         !> Equation number of each dof (0 for prescribed dofs) and their count.
         procedure :: equations => model_equations
@@ -485,34 +486,25 @@ contains
         end do
     end subroutine model_assemble_stiffness
 
-    !> Global mass over all dofs: consistent, or row-sum lumped (diagonal triplets only).
-    subroutine model_assemble_mass(self, lumped, m, error)
+    !> Global mass over all dofs under a mass scheme: consistent, or row-sum lumped (diagonal
+    !> triplets only).
+    subroutine model_assemble_mass(self, scheme, m, error)
         !> The model.
         class(continuum_model_t), intent(in) :: self
-        !> True: row-sum lumped; false: consistent.
-        logical, intent(in) :: lumped
+        !> How the element masses enter (fem_mass_scheme).
+        class(mass_scheme_t), intent(in) :: scheme
         !> Mass (dof_count x dof_count) as triplets.
         type(fem_triplets_t), intent(out) :: m
         !> Set when an element has no material.
         type(error_t), allocatable, intent(out) :: error
-        integer :: e, a
-        integer, allocatable :: dofs(:)
-        real(wp), allocatable :: diag(:)
+        integer :: e
         call self%check(error)
         if (allocated(error)) return
-        call m%init(self%dof_count(), merge(8, 64, lumped)*self%mesh%element_count())
+        call m%init(self%dof_count(), merge(8, 64, scheme%is_diagonal())*self%mesh%element_count())
         do e = 1, self%mesh%element_count()
-            dofs = element_dofs(self, e)
             associate (el => self%family(self%mesh%kind(e))%element, &
                        xe => self%mesh%element_coordinates(e), mat => self%materials(self%element_material(e)))
-                if (lumped) then
-                    diag = el%mass_lumped(xe, mat)
-                    do a = 1, size(dofs)
-                        call m%add(dofs(a), dofs(a), diag(a))
-                    end do
-                else
-                    call m%add_block(dofs, el%mass_consistent(xe, mat))
-                end if
+                call scheme%add_element(m, element_dofs(self, e), el%mass_consistent(xe, mat), el%mass_lumped(xe, mat))
             end associate
         end do
     end subroutine model_assemble_mass

@@ -11,6 +11,7 @@
 module fem_dynamic_operator
     use core_kinds, only: wp
     use core_error, only: error_t
+    use fem_mass_scheme, only: mass_scheme_t
     implicit none
     private
     public :: dynamic_operator_t, spd_factor_t
@@ -30,8 +31,8 @@ module fem_dynamic_operator
     type, abstract :: dynamic_operator_t
         !> Number of free DOFs (equations).
         integer :: n_free = 0
-        !> Lumped (diagonal) instead of consistent mass.
-        logical :: lumped_mass = .false.
+        !> How the mass matrix was assembled (consistent or lumped; fem_mass_scheme).
+        class(mass_scheme_t), allocatable :: mass_scheme
         !> Rayleigh damping C = a0 M + a1 K: a0 [1/s], a1 [s].
         real(wp) :: rayleigh_a0 = 0.0_wp
         !> See `rayleigh_a0`.
@@ -57,6 +58,8 @@ module fem_dynamic_operator
         procedure(operator_diagonal), deferred :: mass_diagonal
         !> Largest eigenvalue omega_max^2 of K phi = omega^2 M phi (for critical steps).
         procedure(operator_largest), deferred :: largest_eigenvalue
+        !> Whether the mass matrix is diagonal (false without a mass scheme).
+        procedure, non_overridable :: has_diagonal_mass
     end type dynamic_operator_t
 
     abstract interface
@@ -186,4 +189,14 @@ module fem_dynamic_operator
             type(error_t), allocatable, intent(out) :: error
         end subroutine operator_largest
     end interface
+
+contains
+
+    !> Whether the mass matrix is diagonal (lumped); false when no mass scheme is set.
+    pure logical function has_diagonal_mass(self)
+        !> The model.
+        class(dynamic_operator_t), intent(in) :: self
+        has_diagonal_mass = .false.
+        if (allocated(self%mass_scheme)) has_diagonal_mass = self%mass_scheme%is_diagonal()
+    end function has_diagonal_mass
 end module fem_dynamic_operator

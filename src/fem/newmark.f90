@@ -535,7 +535,7 @@ contains
         real(wp), intent(in) :: u0(:), v0(:)
         !> Set when the mass is not lumped, h is too large, or on eigensolver failure.
         type(error_t), allocatable, intent(out) :: error
-        if (.not. model%lumped_mass) then
+        if (.not. model%has_diagonal_mass()) then
             call make_error(error, 'the central-difference scheme needs a lumped mass matrix: '// &
                             'ask for lumped mass or use the Newmark scheme')
             return
