@@ -7,7 +7,7 @@ module driver_simulation_beam_dynamic
     use io_deck, only: deck_t
     use io_progress, only: progress_t
     use fem_beam_model, only: beam_model_t
-    use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t, model_out_of_range
+    use fem_newmark, only: time_integrator_t, make_time_integrator, model_out_of_range
     use driver_config, only: run_config_t
     use driver_results, only: results_writer_t
     use driver_checkpoint, only: end_of_step, step_end_t, checkpoint_run_t, loop_state_t, checkpoint_create, &
@@ -108,17 +108,8 @@ contains
         class(time_integrator_t), allocatable, intent(out) :: integ
         type(error_t), allocatable, intent(out) :: error
         real(wp), allocatable :: u0(:), v0(:)
-        select case (run%scheme)
-        case ('central_difference')
-            allocate (central_difference_t :: integ)
-        case default
-            allocate (newmark_t :: integ)
-            select type (integ)
-            type is (newmark_t)
-                integ%beta = run%beta
-                integ%gamma = run%gamma
-            end select
-        end select
+        call make_time_integrator(run%scheme, run%beta, run%gamma, integ, error)
+        if (allocated(error)) return
         call model%restrict(run%u0, u0)
         call model%restrict(run%v0, v0)
         call integ%init(model, run%h, 0.0_wp, u0, v0, error)

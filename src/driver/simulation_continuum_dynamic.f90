@@ -11,7 +11,7 @@ module driver_simulation_continuum_dynamic
     use io_deck, only: deck_t, deck_entry_t
     use io_progress, only: progress_t
     use fem_continuum_dynamics, only: continuum_audit_t
-    use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t, model_out_of_range
+    use fem_newmark, only: time_integrator_t, make_time_integrator, model_out_of_range
     use driver_results, only: results_writer_t
     use io_hdf5_file, only: h5_file_t
     use driver_checkpoint, only: checkpoint_run_t, end_of_step, step_end_t, loop_state_t, checkpoint_create, &
@@ -99,17 +99,8 @@ contains
                                       'and omega, and the densities of [continuum] material')
                 return
             end if
-            select case (self%settings%scheme)
-            case ('central_difference')
-                allocate (central_difference_t :: self%integ)
-            case default
-                allocate (newmark_t :: self%integ)
-                select type (integ => self%integ)
-                type is (newmark_t)
-                    integ%beta = self%settings%beta
-                    integ%gamma = self%settings%gamma
-                end select
-            end select
+            call make_time_integrator(self%settings%scheme, self%settings%beta, self%settings%gamma, self%integ, error)
+            if (allocated(error)) return
             call self%integ%init(self%ops, self%settings%h, 0.0_wp, u0, v0, error)
             if (.not. allocated(error)) return
             message = error%message

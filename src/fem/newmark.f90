@@ -27,7 +27,7 @@ module fem_newmark
     implicit none
     private
     public :: time_integrator_t, newmark_t, central_difference_t, critical_time_step, newmark_critical_step
-    public :: model_out_of_range
+    public :: model_out_of_range, make_time_integrator
 
     !> State and energy accounts common to all time integrators.
     type, abstract :: time_integrator_t
@@ -155,6 +155,33 @@ module fem_newmark
     end type central_difference_t
 
 contains
+
+    !> The time integrator named by a deck word of [time] scheme: 'average_acceleration' or
+    !> 'newmark' (a `newmark_t` with the given beta and gamma), 'central_difference'. The schema
+    !> refuses any other word, so another one here is a bug. `init` is left to the caller.
+    subroutine make_time_integrator(scheme, beta, gamma, integ, error)
+        !> The deck word.
+        character(len=*), intent(in) :: scheme
+        !> Newmark beta and gamma in effect (used by the Newmark schemes).
+        real(wp), intent(in) :: beta, gamma
+        !> The integrator, not yet initialised.
+        class(time_integrator_t), allocatable, intent(out) :: integ
+        !> Set (internal error) for a word that names no scheme.
+        type(error_t), allocatable, intent(out) :: error
+        type(newmark_t) :: newmark
+        select case (scheme)
+        case ('average_acceleration', 'newmark')
+            newmark%beta = beta
+            newmark%gamma = gamma
+            allocate (integ, source=newmark)
+        case ('central_difference')
+            allocate (central_difference_t :: integ)
+        case default
+            call make_internal_error(error, 'make_time_integrator', 'time scheme '''//scheme// &
+                                     ''' is none of average_acceleration, newmark, central_difference '// &
+                                     '(the schema should have refused it)')
+        end select
+    end subroutine make_time_integrator
 
     !> kinetic + strain + damping_dissipation - external_work - initial energy [J]; zero up
     !> to rounding for average acceleration.
