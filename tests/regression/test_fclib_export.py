@@ -234,6 +234,13 @@ def killed_run_export(exe, decks, work):
             pass
     proc.kill()
     proc.wait()
+    # the run may have written a later checkpoint between the last poll and the kill: the
+    # restart continues from the one it left
+    try:
+        with h5py.File(out / "checkpoint.h5", "r") as f:
+            step = int(f["loop"].attrs["step"])
+    except (OSError, KeyError):
+        pass
     left = sorted(p.name for p in out.iterdir())
     again = subprocess.run([str(exe), str(deck), "--output", str(out), "--quiet", "--restart",
                             str(out / "checkpoint.h5"), "--end", f"{(step + 20) * 2e-4!r}"],
