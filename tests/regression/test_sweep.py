@@ -13,6 +13,10 @@
   disk 2, and reductions (absmax of the energy balance) next to indexed values.
 - A point that fails at run time (gravity 1e300: the run stops with exit code 1) is
   reported as failed; the next `run` runs only that point again.
+- Decks whose Gmsh mesh path is relative to their folder, quoted ("My Meshes/bar #1.msh")
+  or bare, swept into a folder elsewhere: each point's deck names the mesh by its absolute
+  path (quoted when needed), nothing else changes, and a static bar in tension runs
+  (max |u| = tx L / E); the mesh path swept itself; an absolute path left as written.
 - create refuses a --time that is no Slurm time limit, --max-running 0, a --dir that is a
   file; `submit` and `status` with stand-ins for sbatch and squeue (no Slurm daemon): the
   cap of --max-running kept by a resubmission, points still pending or running in an earlier
@@ -22,6 +26,7 @@ Usage (ctest does this): test_sweep.py --exe multicor --work DIR --source REPO
 import csv
 import importlib.machinery
 import math
+import re
 import subprocess
 import sys
 import types
@@ -216,6 +221,136 @@ def refused_options(src, exe, work):
               proc.stderr.strip())
 
 
+BAR_GEO = """// A bar [0, 2] x [0, 0.2] m in 10 quadrangles; set names with blanks and '#'.
+Point(1) = {0, 0, 0};
+Point(2) = {2, 0, 0};
+Point(3) = {2, 0.2, 0};
+Point(4) = {0, 0.2, 0};
+Line(1) = {1, 2};
+Line(2) = {2, 3};
+Line(3) = {3, 4};
+Line(4) = {4, 1};
+Curve Loop(1) = {1, 2, 3, 4};
+Plane Surface(1) = {1};
+Transfinite Curve{1, 3} = 11;
+Transfinite Curve{2, 4} = 2;
+Transfinite Surface{1};
+Recombine Surface{1};
+Physical Surface("bar") = {1};
+Physical Curve("left edge") = {4};
+Physical Curve("right #end") = {2};
+Physical Curve("top") = {3};
+Physical Point("lower left corner") = {1};
+"""
+BAR_L, BAR_E = 2.0, 2e11
+
+
+def bar_deck(mesh):
+    return f"""[run]
+analysis = static
+[continuum]
+mesh     = file {mesh}   # relative to this deck's folder
+material = {BAR_E} 0.3 7800 0.01 plane_stress bar
+fix      = "left edge" x
+fix      = "lower left corner" y
+traction = "right #end" 5e7 0
+traction = top 0 0
+"""
+
+
+def name_in_deck(path):
+    """A path as a deck names it: between double quotes when it holds blanks or '#'."""
+    return f'"{path}"' if re.search(r"[\s#]", str(path)) else str(path)
+
+
+def relative_meshes(src, exe, work):
+    """Decks whose Gmsh mesh path is relative to their folder (the default): written into
+    SWEEP/decks/, each point's deck names the same mesh by its absolute path (quoted when it
+    holds blanks or '#'); every other line unchanged. A static bar in tension, tx swept by a
+    quoted selector: max |u| = tx L / E. The mesh path swept itself: its values are relative to
+    the deck's folder too. Returns the deck with the quoted path (or None without gmsh)."""
+    import shutil
+    gmsh = shutil.which("gmsh")
+    if not check("gmsh available", gmsh is not None, "gmsh not found (Debian package gmsh)"):
+        return None
+    # the deck with the quoted path in "deck dir"; the other (unquoted path) in "plain"
+    folder, plain = work / "deck dir", work / "plain"
+    (folder / "My Meshes").mkdir(parents=True)
+    (plain / "meshes").mkdir(parents=True)
+    (work / "bar.geo").write_text(BAR_GEO)
+    quoted_mesh = folder / "My Meshes" / "bar #1.msh"
+    subprocess.run([gmsh, "-2", "-format", "msh41", str(work / "bar.geo"), "-o", str(quoted_mesh)],
+                   check=True, capture_output=True)
+    plain_mesh = plain / "meshes" / "bar.msh"
+    shutil.copy(quoted_mesh, plain_mesh)
+    decks = {"quoted": folder / "bar.dat", "plain": plain / "plain.dat"}
+    decks["quoted"].write_text(bar_deck('"My Meshes/bar #1.msh"'))
+    decks["plain"].write_text(bar_deck("meshes/bar.msh"))
+    scalar = ["--scalar", "umax=absmax(continuum/static/displacement)"]
+    # the sweep folders lie elsewhere (not next to the deck): a path relative to the deck's
+    # folder would name no file from SWEEP/decks/
+    cases = (("quoted", ["continuum.traction[1].tx=5e7,1e8"],
+              f'"{quoted_mesh}"'),
+             ("plain", ["continuum.traction[1].tx=5e7,1e8"], name_in_deck(plain_mesh)))
+    for name, sets, mesh in cases:
+        sweep = work / "sweeps" / f"{name} mesh"
+        args = ["create", decks[name], "--exe", exe, "--dir", sweep] + scalar
+        for s in sets:
+            args += ["--set", s]
+        proc = sweep_tool(src, args, expect=None)
+        if not check(f"{name} relative mesh path: create passes multicor --check",
+                     proc.returncode == 0, proc.stderr.strip()[-600:]):
+            continue
+        original = decks[name].read_text().splitlines()
+        for p, tx in (("p001", "5e7"), ("p002", "1e8")):
+            body = (sweep / "decks" / f"{p}.dat").read_text().splitlines()[2:]   # header: 2 lines
+            changed = [(a, b) for a, b in zip(original, body) if a != b]
+            expected = [(original[3], f"mesh     = file {mesh}   # relative to this deck's folder")]
+            if tx != "5e7":
+                expected.append((original[7], f'traction = "right #end" {tx} 0'))
+            check(f"{name} {p}: the mesh path made absolute, the swept value, nothing else",
+                  len(body) == len(original) and changed == expected, str(changed))
+        proc = sweep_tool(src, ["run", sweep, "--no-collect"], expect=None)
+        sweep_tool(src, ["collect", sweep, "--no-plot"], expect=None)
+        rows = read_table(sweep / "results.csv") if (sweep / "results.csv").exists() else []
+        key = sets[0].rsplit("=", 1)[0]
+        for r in rows:
+            ref = float(r[key]) * BAR_L / BAR_E
+            check(f"{name} {r['point']}: the run finds the mesh, max |u| = tx L / E",
+                  r.get("summary.finished") == "1" and r.get("umax")
+                  and math.isclose(float(r["umax"]), ref, rel_tol=1e-9),
+                  f"umax={r.get('umax')} tx L / E={ref!r}")
+        check(f"{name}: both points ran", len(rows) == 2 and proc.returncode == 0,
+              proc.stdout.strip()[-300:] + proc.stderr.strip()[-300:])
+    # the mesh path swept: each value relative to the deck's folder, quoted or not
+    sweep = work / "sweeps" / "mesh path"
+    proc = sweep_tool(src, ["create", decks["plain"], "--exe", exe, "--dir", sweep, "--set",
+                            'continuum.mesh.path=meshes/bar.msh,"../deck dir/My Meshes/bar #1.msh"'],
+                      expect=None)
+    if check("the mesh path swept: create passes multicor --check", proc.returncode == 0,
+             proc.stderr.strip()[-600:]):
+        lines = [(sweep / "decks" / f"{p}.dat").read_text().splitlines()[5] for p in ("p001", "p002")]
+        check("the mesh path swept: each value made absolute",
+              lines == [f"mesh     = file {name_in_deck(plain_mesh)}   # relative to this deck's folder",
+                        f'mesh     = file "{plain}/../deck dir/My Meshes/bar #1.msh"   # relative to '
+                        "this deck's folder"],
+              str(lines))
+        proc = sweep_tool(src, ["run", sweep, "--no-collect"], expect=None)
+        check("the mesh path swept: both points run", proc.returncode == 0 and all(
+            (sweep / "runs" / p / "exit_status").read_text().strip() == "0" for p in ("p001", "p002")),
+            proc.stdout.strip()[-300:] + proc.stderr.strip()[-300:])
+    # an absolute mesh path stays as written
+    absolute = folder / "absolute.dat"
+    absolute.write_text(bar_deck(f'"{quoted_mesh}"'))
+    sweep = work / "sweeps" / "absolute"
+    proc = sweep_tool(src, ["create", absolute, "--exe", exe, "--dir", sweep,
+                            "--set", "continuum.traction[1].tx=5e7"], expect=None)
+    check("an absolute mesh path: the deck unchanged but its header",
+          proc.returncode == 0 and (sweep / "decks" / "p001.dat").read_text().splitlines()[2:]
+          == absolute.read_text().splitlines(), proc.stderr.strip()[-600:])
+    return decks["quoted"]
+
+
 SBATCH = """#!/bin/bash
 echo "$*" >> "$FAKE_LOG"
 echo 42
@@ -309,6 +444,7 @@ def main():
     sequential_run(src, folder)
     failing_point(src, exe, work)
     wrong_scalar(src, exe, work)
+    relative_meshes(src, exe, work)
     return summary()
 
 
