@@ -17,6 +17,9 @@
   or bare, swept into a folder elsewhere: each point's deck names the mesh by its absolute
   path (quoted when needed), nothing else changes, and a static bar in tension runs
   (max |u| = tx L / E); the mesh path swept itself; an absolute path left as written.
+- Records selected by a quoted name (`[edge_set="right #end"]`, in --set and in a grid
+  file), matched exactly (a trailing blank is another name); a bare value with '#' or a
+  blank, or a quote left open: refused, the message showing the quotes.
 - create refuses a --time that is no Slurm time limit, --max-running 0, a --dir that is a
   file; `submit` and `status` with stand-ins for sbatch and squeue (no Slurm daemon): the
   cap of --max-running kept by a resubmission, points still pending or running in an earlier
@@ -289,7 +292,7 @@ def relative_meshes(src, exe, work):
     scalar = ["--scalar", "umax=absmax(continuum/static/displacement)"]
     # the sweep folders lie elsewhere (not next to the deck): a path relative to the deck's
     # folder would name no file from SWEEP/decks/
-    cases = (("quoted", ["continuum.traction[1].tx=5e7,1e8"],
+    cases = (("quoted", ['continuum.traction[edge_set="right #end"].tx=5e7,1e8'],
               f'"{quoted_mesh}"'),
              ("plain", ["continuum.traction[1].tx=5e7,1e8"], name_in_deck(plain_mesh)))
     for name, sets, mesh in cases:
@@ -349,6 +352,36 @@ def relative_meshes(src, exe, work):
           proc.returncode == 0 and (sweep / "decks" / "p001.dat").read_text().splitlines()[2:]
           == absolute.read_text().splitlines(), proc.stderr.strip()[-600:])
     return decks["quoted"]
+
+
+def quoted_selectors(src, exe, work, deck):
+    """A record selected by a quoted name: blanks and '#' inside, matched exactly (a trailing
+    blank is another name); a bare value with '#' or a blank: the message says to quote it."""
+    cases = (('continuum.traction[edge_set="right #end"].tx=1e6', 0, None),
+             ('continuum.traction[edge_set="top"].ty=1e3', 0, None),
+             ("continuum.traction[edge_set=top tx=0].ty=1e3", 0, None),
+             ('continuum.traction[edge_set="right #end" tx=5e7].tx=1e6', 0, None),
+             ('continuum.traction[edge_set="right #end "].tx=1e6', 1, "it matches 0 (none)"),
+             ('continuum.traction[edge_set="right"].tx=1e6', 1, "it matches 0 (none)"),
+             ("continuum.traction[edge_set=right #end].tx=1e6", 1, "between double quotes"),
+             ('continuum.traction[edge_set="right #end].tx=1e6', 1, "between double quotes"))
+    for n, (key, code, said) in enumerate(cases):
+        folder = work / "selectors" / str(n)
+        proc = sweep_tool(src, ["create", deck, "--exe", exe, "--set", key, "--dir", folder],
+                          expect=None)
+        check(f"selector {key.rsplit('=', 1)[0]}: " + ("accepted" if code == 0 else "refused"),
+              proc.returncode == code and (said is None or said in proc.stderr)
+              and "Traceback" not in proc.stderr, proc.stderr.strip()[-400:])
+    # a grid file: the '#' of a quoted name is no comment
+    grid = work / "selectors" / "grid.txt"
+    grid.write_text('continuum.traction[edge_set="right #end"].tx = 1e6, 2e6   # the loaded end\n')
+    proc = sweep_tool(src, ["create", deck, "--exe", exe, "--grid", grid, "--dir",
+                            work / "selectors" / "grid"], expect=None)
+    check("a grid file: a quoted selector with '#'", proc.returncode == 0, proc.stderr.strip()[-400:])
+    if (work / "selectors" / "0" / "decks" / "p001.dat").exists():
+        line = (work / "selectors" / "0" / "decks" / "p001.dat").read_text().splitlines()[9]
+        check("the quoted selector names the record of its name", line == 'traction = "right #end" 1e6 0',
+              line)
 
 
 SBATCH = """#!/bin/bash
@@ -444,7 +477,9 @@ def main():
     sequential_run(src, folder)
     failing_point(src, exe, work)
     wrong_scalar(src, exe, work)
-    relative_meshes(src, exe, work)
+    deck = relative_meshes(src, exe, work)
+    if deck is not None:
+        quoted_selectors(src, exe, work, deck)
     return summary()
 
 
