@@ -113,6 +113,12 @@
 !> bond outside its cone is released at once. A bond left in B on a bound is judged at it
 !> (bound_case). This is the problem the plain NLGS solves, so the
 !> judgement of dem_contacts (contacts_finish) then breaks it exactly as after the NLGS.
+!> A pass is converged by the error of the problem it solves, the bonds of B held: the norm of
+!> the sweeps with the block's share |u_B|^2, or with criterion = siconos the Siconos error
+!> with the members measured by their equalities (nlgs criterion `begin`, `held`). Measured
+!> against their cones, bonds that must yield kept the error of every pass at their excess
+!> (7.2e-2 on a bonded row hit by a disk, at the cap of 50 000 iterations): the outer check
+!> never ran and no bond was released (doc/theory.md 7.10, "The stopping test of a pass").
 !>
 !> Released bonds that hold a part alone (`condense`): a released bond whose two bodies are
 !> not connected through B carries the part beyond it by itself, a rigid body or a structure

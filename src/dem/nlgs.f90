@@ -42,6 +42,9 @@
 !> contacts instead of three), only after the sweeps where it may be near the tolerance
 !> (siconos_period, siconos_margin); once that is below the tolerance it is computed again in
 !> full, and only that value stops the sweeps (Siconos' "light, full final" evaluation).
+!> With a block, its members are measured by the natural map of their equalities (u_hat on
+!> their locked components: the problem the solve solves, in which their reactions may leave
+!> their cones), and the final Siconos error is that of the contact problem, in full.
 !> Blocked contacts (both bodies immobile along the normal: W_nn = 0) are taken out of the
 !> solve with r = 0 and counted in the statistics (`nlgs_stats_t%n_blocked`).
 !> The constants of each contact's scaled frame (bipotential_scaling) are computed once per
@@ -345,13 +348,17 @@ module dem_nlgs
             character(len=:), allocatable :: name
         end function criterion_name
 
-        !> Start of a solve (contacts of the solve: the active ones).
-        subroutine criterion_begin(self, cs)
+        !> Start of a solve (contacts of the solve: the active ones; those of a block, held as
+        !> bilateral constraints within the solve, are `held`).
+        subroutine criterion_begin(self, cs, held)
             import :: nlgs_criterion_t, contact_set_t
             !> The criterion (the copy of a solve).
             class(nlgs_criterion_t), intent(inout) :: self
             !> Contacts (activity set).
             type(contact_set_t), intent(in) :: cs
+            !> Contact k is held as a bilateral constraint in this solve (size >= cs%n; none
+            !> when absent).
+            logical, intent(in), optional :: held(:)
         end subroutine criterion_begin
 
         !> The error after sweep s: on entry the convergence norm of the sweeps, on exit the
@@ -400,6 +407,10 @@ module dem_nlgs
     type, extends(nlgs_criterion_t) :: siconos_criterion_t
         !> The active contacts of the solve, in increasing order.
         integer, allocatable, private :: act(:)
+        !> Contacts held as bilateral constraints in the solve (the members of a block),
+        !> measured by the equality u = 0 on their locked components (siconos_ratio);
+        !> size 0 when none.
+        logical, allocatable, private :: held(:)
         !> Ratio of the Siconos error to the norm of the sweeps at its last evaluation, that
         !> norm, and that sweep.
         real(wp), private :: per_norm = 0.0_wp, norm_evaluated = huge(1.0_wp)
@@ -577,11 +588,12 @@ module dem_nlgs
 
         !> Siconos error of the current reactions, u computed in full (submodule
         !> dem_nlgs_siconos).
-        real(wp) module function siconos_error(cs, im, vfree, vel, vwork, bilateral, nq) result(err)
+        real(wp) module function siconos_error(cs, im, vfree, vel, vwork, bilateral, nq, held) result(err)
             type(contact_set_t), intent(in) :: cs
             real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :), nq
             real(wp), intent(inout) :: vwork(:, :)
             logical, intent(in) :: bilateral
+            logical, intent(in), optional :: held(:)
         end function siconos_error
 
         !> Siconos error of the contact problem u = W r + q over the active contacts,
@@ -606,12 +618,13 @@ module dem_nlgs
             class(nlgs_bilateral_t), intent(in), optional :: bilateral
         end function siconos_free_norm
 
-        !> Siconos error of the contacts act from the velocities vel, |q| = nq
-        !> (dem_nlgs_siconos).
-        pure real(wp) module function siconos_ratio(cs, act, vel, nq) result(err)
+        !> Siconos error of the contacts act from the velocities vel, |q| = nq, the contacts
+        !> with held(k) measured as bilateral constraints (dem_nlgs_siconos).
+        pure real(wp) module function siconos_ratio(cs, act, vel, nq, held) result(err)
             type(contact_set_t), intent(in) :: cs
             integer, intent(in) :: act(:)
             real(wp), intent(in) :: vel(:, :), nq
+            logical, intent(in), optional :: held(:)
         end function siconos_ratio
     end interface
 
@@ -675,7 +688,11 @@ contains
         else
             allocate (lmgc90_criterion_t :: criterion)
         end if
-        call criterion%begin(cs)
+        if (stats%n_block > 0) then
+            call criterion%begin(cs, block%member)
+        else
+            call criterion%begin(cs)
+        end if
         s = 0
         floor = 0.0_wp
         do k = 1, cs%n
@@ -812,8 +829,9 @@ contains
         stats%relaxation = omega
         stats%updates = int(n_swept, i8)*stats%sweeps
         stats%residual = nlgs_residual(cs, vel)
-        if (criterion%is_siconos_error() .and. stats%converged) then
-            ! the last error of the sweeps, computed in full
+        if (criterion%is_siconos_error() .and. stats%converged .and. stats%n_block == 0) then
+            ! the last error of the sweeps, computed in full (with a block, that of the
+            ! problem with its members held: below, the error of the contact problem)
             stats%siconos_error = stats%error
         else
             stats%siconos_error = siconos_error(cs, im, vfree, vel, vwork, present(bilateral), nq)
@@ -854,11 +872,13 @@ contains
     end function lmgc90_name
 
     !> Nothing to set up.
-    subroutine lmgc90_begin(self, cs)
+    subroutine lmgc90_begin(self, cs, held)
         !> The criterion.
         class(lmgc90_criterion_t), intent(inout) :: self
         !> Contacts.
         type(contact_set_t), intent(in) :: cs
+        !> Contacts held (not used: the norm of the sweeps measures the block by its own share).
+        logical, intent(in), optional :: held(:)
     end subroutine lmgc90_begin
 
     !> The convergence norm of the sweeps is the error, exact.
@@ -896,15 +916,23 @@ contains
         name = 'siconos'
     end function siconos_name
 
-    !> The active contacts, in increasing order (the running error runs over them); no
-    !> evaluation yet.
-    subroutine siconos_begin(self, cs)
+    !> The active contacts, in increasing order (the running error runs over them), and those
+    !> held; no evaluation yet.
+    subroutine siconos_begin(self, cs, held)
         !> The criterion (the copy of a solve).
         class(siconos_criterion_t), intent(inout) :: self
         !> Contacts (activity set).
         type(contact_set_t), intent(in) :: cs
+        !> Contacts held as bilateral constraints (a block's members; none when absent).
+        logical, intent(in), optional :: held(:)
         integer :: k
         self%act = pack([(k, k=1, cs%n)], cs%active(1:cs%n))
+        if (present(held)) then
+            self%held = held(1:cs%n)
+        else
+            if (allocated(self%held)) deallocate (self%held)
+            allocate (self%held(0))
+        end if
         self%per_norm = 0.0_wp
         self%norm_evaluated = huge(1.0_wp)
         self%last_evaluation = 0
@@ -945,11 +973,21 @@ contains
         if (evaluated) then
             norm = error
             self%norm_evaluated = norm
-            error = siconos_ratio(cs, self%act, vel, nq)
+            if (size(self%held) > 0) then
+                error = siconos_ratio(cs, self%act, vel, nq, self%held)
+            else
+                error = siconos_ratio(cs, self%act, vel, nq)
+            end if
             self%per_norm = 0.0_wp
             if (norm > 0.0_wp) self%per_norm = error/norm
             self%last_evaluation = s
-            if (error <= tol) error = siconos_error(cs, im, vfree, vel, vwork, bilateral, nq)
+            if (error <= tol) then
+                if (size(self%held) > 0) then
+                    error = siconos_error(cs, im, vfree, vel, vwork, bilateral, nq, self%held)
+                else
+                    error = siconos_error(cs, im, vfree, vel, vwork, bilateral, nq)
+                end if
+            end if
         else
             error = error*self%per_norm
         end if

@@ -9,12 +9,13 @@ contains
     !> Siconos error of the current reactions (doc/theory.md, "Siconos error"), u computed in
     !> full from the free velocities: vwork = vfree + M^-1 H r (or vel itself when bilateral
     !> constraints changed the velocities: their impulses are not contacts); nq = |q|
-    !> (siconos_free_norm).
-    real(wp) module function siconos_error(cs, im, vfree, vel, vwork, bilateral, nq) result(err)
+    !> (siconos_free_norm); `held` as in siconos_ratio.
+    real(wp) module function siconos_error(cs, im, vfree, vel, vwork, bilateral, nq, held) result(err)
         type(contact_set_t), intent(in) :: cs
         real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :), nq
         real(wp), intent(inout) :: vwork(:, :)
         logical, intent(in) :: bilateral
+        logical, intent(in), optional :: held(:)
         integer :: k
         if (bilateral) then
             vwork = vel
@@ -22,7 +23,7 @@ contains
             vwork = vfree
             call nlgs_apply_reactions(cs, im, vwork)
         end if
-        err = siconos_ratio(cs, pack([(k, k=1, cs%n)], cs%active(1:cs%n)), vwork, nq)
+        err = siconos_ratio(cs, pack([(k, k=1, cs%n)], cs%active(1:cs%n)), vwork, nq, held)
     end function siconos_error
 
     !> Siconos error of the contact problem u = W r + q over the active contacts:
@@ -89,24 +90,27 @@ contains
     end function siconos_free_norm
 
     !> The ratio of nlgs_siconos_error for the velocities vel, with nq = |q|
-    !> (siconos_free_norm), over the active contacts act (in increasing order).
-    pure real(wp) module function siconos_ratio(cs, act, vel, nq) result(err)
+    !> (siconos_free_norm), over the active contacts act (in increasing order). With `held`
+    !> (size >= cs%n), the contacts k with held(k) are measured as the bilateral constraints
+    !> of a block solve (the intact bonds of dem_bonded_block): their residual is u_hat on the
+    !> locked components (siconos_ratio_contacts), zero exactly when u = 0 there, whether or
+    !> not the reaction lies in its cone.
+    pure real(wp) module function siconos_ratio(cs, act, vel, nq, held) result(err)
         type(contact_set_t), intent(in) :: cs
         integer, intent(in) :: act(:)
         real(wp), intent(in) :: vel(:, :), nq
+        logical, intent(in), optional :: held(:)
         real(wp) :: num, nr, nu, amax, c
         err = 0.0_wp
         ! (no contact arrays to pass before the first contact)
         if (size(act) == 0) return
-        call siconos_ratio_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%shift, cs%r, cs%coh, cs%erol, cs%mu, &
-                                    size(vel, 2), vel, size(act), act, .false., 1.0_wp, num, nr, nu, amax)
+        call ratio_pass(.false., 1.0_wp, num, nr, nu, amax)
         if (ieee_is_finite(num) .and. ieee_is_finite(nr) .and. ieee_is_finite(nu)) then
             err = siconos_quotient(num, nr, nu, nq)
             return
         end if
         ! (a second pass measures the largest component; non-finite values stay as they are)
-        call siconos_ratio_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%shift, cs%r, cs%coh, cs%erol, cs%mu, &
-                                    size(vel, 2), vel, size(act), act, .true., 1.0_wp, num, nr, nu, amax)
+        call ratio_pass(.true., 1.0_wp, num, nr, nu, amax)
         if (.not. (amax > 0.0_wp .and. amax <= huge(amax))) then
             err = siconos_quotient(num, nr, nu, nq)
             return
@@ -115,9 +119,25 @@ contains
         ! gave a NaN error, inf/inf). The projections on the cones are positively homogeneous:
         ! r and u scaled by the power of 2 c ~ 1/amax (exact) give the same ratio.
         c = scale(1.0_wp, -exponent(amax))
-        call siconos_ratio_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%shift, cs%r, cs%coh, cs%erol, &
-                                    cs%mu, size(vel, 2), vel, size(act), act, .true., c, num, nr, nu, amax)
+        call ratio_pass(.true., c, num, nr, nu, amax)
         err = siconos_quotient(num, nr, nu, nq*c)
+    contains
+        !> One pass of siconos_ratio_contacts (scaled, by c), with or without `held`.
+        pure subroutine ratio_pass(scaled, c, num, nr, nu, amax)
+            logical, intent(in) :: scaled
+            real(wp), intent(in) :: c
+            real(wp), intent(out) :: num, nr, nu, amax
+            logical :: none(0)
+            if (present(held)) then
+                call siconos_ratio_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%shift, cs%r, cs%coh, cs%erol, &
+                                            cs%mu, size(vel, 2), vel, size(act), act, cs%n, held(1:cs%n), scaled, c, &
+                                            num, nr, nu, amax)
+            else
+                call siconos_ratio_contacts(cs%n, cs%i1, cs%i2, cs%nrm, cs%lever, cs%shift, cs%r, cs%coh, cs%erol, &
+                                            cs%mu, size(vel, 2), vel, size(act), act, 0, none, scaled, c, num, nr, &
+                                            nu, amax)
+            end if
+        end subroutine ratio_pass
     end function siconos_ratio
 
     !> sqrt(num) / max(nq, sqrt(nr), sqrt(nu)), 0 when the denominator vanishes.
@@ -133,9 +153,18 @@ contains
     !> local velocity written out as there: this runs after most sweeps of a long solve, and a
     !> shared procedure for it was not inlined, 3 % more time on the 200-disk deposit).
     pure subroutine siconos_ratio_contacts(n, i1s, i2s, nrm, lever, shift, rc, coh, erol, mu, nd, vel, na, &
-                                           act, scaled, c, num, nr, nu, amax)
-        integer, intent(in) :: n, nd, na
+                                           act, nh, held, scaled, c, num, nr, nu, amax)
+        integer, intent(in) :: n, nd, na, nh
         integer, intent(in) :: i1s(n), i2s(n), act(na)
+        !> Contacts held as bilateral constraints (nh = n), or none (nh = 0): for those the
+        !> residual is u_hat on the locked components (the normal one, the tangential one when
+        !> mu > 0, the rotation when e > 0), the natural map of the equality u = 0 there (the
+        !> bilateral constraints of a block solve, whose reactions may leave their cones until
+        !> the outer check releases them). A held contact whose reaction lies in its cone
+        !> contributes at least as much as its term of the Siconos error, the projection on
+        !> the cone being non-expansive (|r - P_K(r - u_hat)| = |P_K(r) - P_K(r - u_hat)| <=
+        !> |u_hat|), and exactly as much while r - u_hat stays in the cone.
+        logical, intent(in) :: held(nh)
         real(wp), intent(in) :: nrm(2, n), lever(2, n), shift(2, n), rc(3, n), coh(n), erol(n), mu(n)
         real(wp), intent(in) :: vel(3, nd)
         !> Whether r and u are scaled by c and amax measured (only after squares overflowed:
@@ -177,12 +206,25 @@ contains
                 u = c*u
                 amax = max(amax, maxval(abs(r)), maxval(abs(u)))
             end if
+            if (erol(k) <= 0.0_wp) then
+                u(3) = 0.0_wp
+                r(3) = 0.0_wp
+            end if
+            if (nh > 0) then
+                if (held(k)) then
+                    ! held: the residual is u_hat on the locked components (see `held`)
+                    p = [u(1) + mu(k)*abs(u(2)) + erol(k)*abs(u(3)), u(2), u(3)]
+                    if (mu(k) <= 0.0_wp) p(2) = 0.0_wp
+                    num = num + sum(p**2)
+                    nr = nr + sum(r**2)
+                    nu = nu + sum(u**2)
+                    cycle
+                end if
+            end if
             if (erol(k) > 0.0_wp) then
                 t = r - [u(1) + mu(k)*abs(u(2)) + erol(k)*abs(u(3)), u(2), u(3)]
                 call rolling_projection(t(1), t(2), t(3), mu(k), erol(k), p(1), p(2), p(3), pcase)
             else
-                u(3) = 0.0_wp
-                r(3) = 0.0_wp
                 t = [r(1) - (u(1) + mu(k)*abs(u(2))), r(2) - u(2), 0.0_wp]
                 call coulomb_projection(t(1), t(2), mu(k), p(1), p(2), pcase)
                 p(3) = 0.0_wp
