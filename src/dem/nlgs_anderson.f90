@@ -14,6 +14,7 @@ contains
         aa%started = .false.
         aa%fnorm_prev = huge(1.0_wp)
         aa%x_valid = .false.
+        aa%mixed = .false.
     end subroutine anderson_restart
 
     !> Size the history and the scaling D = sqrt(diag W) of the Anderson acceleration.
@@ -26,7 +27,7 @@ contains
         n = 3*size(list)
         aa%depth = depth
         allocate (aa%df(n, depth), aa%dg(n, depth), aa%gram(depth, depth))
-        allocate (aa%x(n), aa%fprev(n), aa%gprev(n), aa%d(n), aa%dinv(n))
+        allocate (aa%x(n), aa%fprev(n), aa%gprev(n), aa%gplain(n), aa%d(n), aa%dinv(n))
         allocate (aa%part(max(2*depth, 4), (size(list) + dot_chunk - 1)/dot_chunk), aa%dgnorm(depth))
         do a = 1, size(list)
             k = list(a)
@@ -85,7 +86,14 @@ contains
     !> for any number of threads. f and g of the step are kept in fprev and gprev. With
     !> `others` (a block with members) vel holds impulses of contacts outside the list: the
     !> velocities are rebuilt by removing the swept contacts' impulses, not from vfree.
-    module subroutine anderson_mix(aa, cs, list, im, vfree, vel, split, bilateral, others)
+    !> The fallback: when the last step mixed and the residual of the map from the mixed iterate
+    !> is larger than anderson_fallback times that of the map before it, the mixed iterate was
+    !> worse than the plain one:
+    !> the reactions go back to that map's output g (kept in gplain), the velocities are
+    !> rebuilt from them and the history is cleared. With `judge_only` (after the last sweep
+    !> of a solve) only this judgement is made, nothing is mixed: the solve never ends on an
+    !> iterate that no sweep judged.
+    module subroutine anderson_mix(aa, cs, list, im, vfree, vel, split, bilateral, others, judge_only)
         type(anderson_t), intent(inout) :: aa
         type(contact_set_t), intent(inout) :: cs
         integer, intent(in) :: list(:)
@@ -94,6 +102,8 @@ contains
         type(nlgs_split_t), intent(in) :: split
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         logical, intent(in) :: others
+        logical, intent(in) :: judge_only
+        logical :: fall_back
         real(wp) :: gamma(aa%depth), rhs(aa%depth), fnorm, gnorm, fnorm_before, dfnorm2, drift
         integer :: slot, m, nc, c, j
         nc = size(aa%part, 2)
@@ -108,6 +118,29 @@ contains
             dfnorm2 = sum(aa%part(4, :))
         end if
         drift = 0.0_wp
+        fall_back = .false.
+        ! (divided, not multiplied: fnorm_prev is huge before the first map; a NaN falls back)
+        if (aa%mixed) fall_back = .not. fnorm/anderson_fallback <= aa%fnorm_prev
+        if (fall_back) then
+            ! the mixed iterate was worse than the plain one (its map's residual rose): back to
+            ! the plain output of the map before it, the history cleared (doc/theory.md 4.4).
+            ! Keeping G(mixed) instead, as for a plain map whose residual rose, let a wild
+            ! extrapolation through: the sweeps take a light disk under a heavy one back into
+            ! line only at 1 - m_light/m_heavy per sweep (a stack at 5e5, doc/theory.md 4.4)
+            aa%gprev = aa%gplain
+            call rebuild(0)
+            aa%used = 0
+            aa%next = 1
+            aa%started = .false.
+            aa%fnorm_prev = aa%fnorm_plain
+            aa%mixed = .false.
+            return
+        end if
+        aa%mixed = .false.
+        if (judge_only) then
+            aa%x = aa%gprev
+            return
+        end if
         if (ieee_is_finite(fnorm)) drift = drift_length()
         if (drift > 0.0_wp) then
             ! the sweeps drift: no mixing of the history can follow them (there is no fixed
@@ -156,6 +189,10 @@ contains
             aa%x = aa%gprev
             return
         end if
+        ! the plain output, to fall back to if the next map finds the mixed iterate worse
+        aa%gplain = aa%gprev
+        aa%fnorm_plain = fnorm
+        aa%mixed = .true.
         call rebuild(m)
     contains
         ! the iterate x = g - dG gamma(1:m) (+ drift f), projected on the cones, and the

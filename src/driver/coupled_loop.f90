@@ -219,7 +219,8 @@ contains
         if (ck%restart) call progress%resume(k0, ck%start%wall_seconds, ck%start%runs)
         call ck%schedule%start()
         do k = k0 + 1, n_steps
-            call take_step_start(start, self%sys%dem%particles, self%sys%dem%walls)
+            call take_step_start(start, self%sys%dem%particles, self%sys%dem%walls, &
+                                 self%sys%dem%energies%contact_dissipation)
             if (k == self%fclib_step) then
                 call step_with_export(error)
             else
@@ -351,7 +352,8 @@ contains
                 if (allocated(error)) return
                 if (k == 0) return
                 call check_tunnelling(k, sys%fe%t, self%settings%h, sys%dem%scheme%alert, start, &
-                                      sys%dem%particles, sys%dem%walls, sys%dem%contacts, error)
+                                      sys%dem%particles, sys%dem%walls, sys%dem%contacts, error, &
+                                      sys%dem%energies%contact_dissipation)
             end associate
         end subroutine check_step
 

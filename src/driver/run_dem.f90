@@ -100,7 +100,7 @@ contains
         if (ck%restart) call progress%resume(k0, ck%start%wall_seconds, ck%start%runs)
         call ck%schedule%start()
         do k = k0 + 1, n_steps
-            call take_step_start(start, cfg%system%particles, cfg%system%walls)
+            call take_step_start(start, cfg%system%particles, cfg%system%walls, cfg%system%energies%contact_dissipation)
             if (k == cfg%fclib_step) then
                 call step_with_export(error)
                 if (allocated(error)) return
@@ -210,7 +210,7 @@ contains
                 call check_walls_state(k, sys%time, sys%particles, sys%walls, error)
                 if (allocated(error)) return
                 call check_tunnelling(k, sys%time, run%h, sys%scheme%alert, start, sys%particles, &
-                                      sys%walls, sys%contacts, error)
+                                      sys%walls, sys%contacts, error, sys%energies%contact_dissipation)
             end associate
         end subroutine check_step
 
