@@ -17,9 +17,10 @@ module dem_local_problem
     use core_kinds, only: wp
     use dem_contacts, only: contact_set_t, contacts_directions
     use dem_nlgs, only: nlgs_bilateral_t
+    use dem_bipotential, only: coulomb_projection, rolling_projection
     implicit none
     private
-    public :: local_problem_t, local_problem_build
+    public :: local_problem_t, local_problem_build, local_problem_siconos_error
 
     !> The assembled local problem.
     type :: local_problem_t
@@ -41,6 +42,49 @@ module dem_local_problem
     end type local_problem_t
 
 contains
+
+    !> Siconos error of the solution (r, u) of the problem as exported, every contact with its
+    !> dim components (doc/theory.md 4.5):
+    !>     sqrt(sum_a |r_a - P_K(r_a - u_hat_a)|^2) / max(|q|, |r|, |u|),
+    !> u_hat = (u_n + mu |u_t| + e |w_r|, u_t, w_r), K the cone |r_t| <= mu r_n, |M| <= e r_n
+    !> (for e = 0 the cone holds M = 0: the third residual component is M itself). The sums
+    !> |q|^2 and |u|^2 take every component, the rotation w_r of a contact without a moment
+    !> too, so that this is the error of the file's problem; the run's own error
+    !> (nlgs_siconos_error) leaves the third component of such contacts out of |q| and |u|.
+    !> 0 without contacts.
+    pure real(wp) function local_problem_siconos_error(lp) result(err)
+        !> The problem and its solution.
+        type(local_problem_t), intent(in) :: lp
+        real(wp) :: r(3), u(3), t(3), p(3), num, nq, nr, nu, den
+        integer :: j, d, lo, pcase
+        d = lp%dim
+        num = 0.0_wp
+        nq = 0.0_wp
+        nr = 0.0_wp
+        nu = 0.0_wp
+        do j = 1, lp%n
+            lo = d*(j - 1)
+            r = 0.0_wp
+            u = 0.0_wp
+            r(1:d) = lp%r(lo + 1:lo + d)
+            u(1:d) = lp%u(lo + 1:lo + d)
+            if (lp%rolling(j) > 0.0_wp) then
+                t = r - [u(1) + lp%mu(j)*abs(u(2)) + lp%rolling(j)*abs(u(3)), u(2), u(3)]
+                call rolling_projection(t(1), t(2), t(3), lp%mu(j), lp%rolling(j), p(1), p(2), p(3), pcase)
+            else
+                t = [r(1) - (u(1) + lp%mu(j)*abs(u(2))), r(2) - u(2), 0.0_wp]
+                call coulomb_projection(t(1), t(2), lp%mu(j), p(1), p(2), pcase)
+                p(3) = 0.0_wp
+            end if
+            num = num + sum((r - p)**2)
+            nq = nq + sum(lp%q(lo + 1:lo + d)**2)
+            nr = nr + sum(r**2)
+            nu = nu + sum(u**2)
+        end do
+        den = sqrt(max(nq, nr, nu))
+        err = 0.0_wp
+        if (den > 0.0_wp) err = sqrt(num)/den
+    end function local_problem_siconos_error
 
     !> Assemble the local problem of the active contacts of cs.
     subroutine local_problem_build(cs, im, vfree, lp, bilateral, vel)

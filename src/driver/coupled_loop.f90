@@ -32,7 +32,7 @@ module driver_coupled_loop
     use driver_results_dem, only: dem_writer_t
     use driver_results_coupled, only: coupled_writer_t
     use driver_run_dem, only: max_warnings, speed_warning, last_unconverged_warning, fclib_path, &
-                              fclib_after_end_warning, lost_bonds_warning
+                              fclib_after_end_warning, fclib_no_contacts_warning, lost_bonds_warning
     use driver_results_dem, only: write_fclib_local
     use dem_local_problem, only: local_problem_t
     use dem_contacts, only: status_cohesive
@@ -279,6 +279,11 @@ contains
             character(len=:), allocatable :: path
             call arlequin_step(self%sys, error, lp)
             if (allocated(error)) return
+            if (lp%n == 0) then
+                ! FCLIB's reader refuses a problem without contacts
+                call report(fclib_no_contacts_warning(int(k)))
+                return
+            end if
             call out%companion(fclib_path(out%final_path, int(k)), path)
             call write_fclib_local(path, self%settings%title, lp, int(k), self%sys%fe%t, &
                                    self%sys%dem%stats%siconos_error, error)

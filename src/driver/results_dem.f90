@@ -18,7 +18,7 @@ module driver_results_dem
     use io_hdf5_file, only: h5_file_t
     use dem_nlgs, only: nlgs_stats_t, nlgs_criterion_name, nlgs_start_name
     use dem_moreau_jean, only: dem_system_t, energies_balance
-    use dem_local_problem, only: local_problem_t
+    use dem_local_problem, only: local_problem_t, local_problem_siconos_error
     implicit none
     private
     public :: dem_writer_t, write_fclib_local
@@ -504,7 +504,9 @@ contains
     !> /fclib_local/vectors/q and mu, /fclib_local/info (title, description, math_info:
     !> fixed-length strings), /solution/r and u; MULTICOR's extra data, which FCLIB readers
     !> ignore, in /multicor: cohesion (r_cohe h), rolling (moment lengths), i1 and i2 (bodies),
-    !> and the attributes step, time and siconos_error (doc/theory.md, "Siconos error").
+    !> and the attributes step, time, unknowns, siconos_error (the error of the exported
+    !> problem, local_problem_siconos_error) and solver_siconos_error (the run's, as stored in
+    !> /dem/solver/siconos_error; doc/theory.md, "Siconos error").
     subroutine write_fclib_local(path, title, lp, step, time, siconos_error, error)
         !> File name (created, or truncated).
         character(len=*), intent(in) :: path
@@ -516,7 +518,7 @@ contains
         integer, intent(in) :: step
         !> Time at the end of the step [s].
         real(wp), intent(in) :: time
-        !> Siconos error of the solution found by the solver.
+        !> Siconos error of the solution found by the solver, as the run stores it.
         real(wp), intent(in) :: siconos_error
         !> Set on a write failure.
         type(error_t), allocatable, intent(out) :: error
@@ -580,7 +582,9 @@ contains
             if (allocated(error)) return
             call file%write_attribute('/multicor', 'time', time, error)
             if (allocated(error)) return
-            call file%write_attribute('/multicor', 'siconos_error', siconos_error, error)
+            call file%write_attribute('/multicor', 'siconos_error', local_problem_siconos_error(lp), error)
+            if (allocated(error)) return
+            call file%write_attribute('/multicor', 'solver_siconos_error', siconos_error, error)
             if (allocated(error)) return
             if (lp%dim == 3) then
                 call file%write_attribute('/multicor', 'unknowns', 'per contact (r_n + r_cohe h, r_t, M); cone '// &

@@ -44,6 +44,7 @@ module driver_run
     use driver_simulation, only: simulation_t, report_iface
     use driver_simulations, only: select_simulation
     use driver_config, only: steps_to_end, max_steps
+    use driver_run_dem, only: fclib_after_end_warning
     use driver_checkpoint, only: checkpoint_run_t, checkpoint_name, checkpoint_open, checkpoint_owner, deck_hash
     implicit none
     private
@@ -110,6 +111,8 @@ contains
         call warn_aliased_functions()
         call warn_end_off_the_steps()
         if (opts%check_only) then
+            ! (the run itself warns when its loop starts)
+            call warn_fclib_after_end()
             call report(opts%deck_path//': deck is valid ('//sim%describe()//')')
             return
         end if
@@ -337,6 +340,15 @@ contains
                 end if
             end associate
         end subroutine warn_end_off_the_steps
+
+        !> Warn of `[solver] fclib_step` after the last step (end / step, or --end) at --check,
+        !> as the run does when it starts.
+        subroutine warn_fclib_after_end()
+            integer :: step
+            if (sim%settings%analysis /= 'dynamic' .or. .not. deck%has('solver', 'fclib_step')) return
+            step = deck%get_int('solver', 'fclib_step')
+            if (step > sim%settings%n_steps) call report(fclib_after_end_warning(step, sim%settings%n_steps))
+        end subroutine warn_fclib_after_end
 
         !> Option `--end`: a new end time (the models built by `init` do not depend on it, the step
         !> count does).

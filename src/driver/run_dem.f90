@@ -28,7 +28,7 @@ module driver_run_dem
     implicit none
     private
     public :: run_dem, max_warnings, report_line_iface, speed_warning, last_unconverged_warning
-    public :: fclib_path, fclib_after_end_warning, lost_bonds_warning
+    public :: fclib_path, fclib_after_end_warning, fclib_no_contacts_warning, lost_bonds_warning
 
     !> Unconverged steps reported one by one; later ones are only counted.
     integer, parameter :: max_warnings = 5
@@ -193,10 +193,15 @@ contains
                 allocate (vfree, source=sys%vel)
                 call mj_solve(sys)
                 call local_problem_build(sys%contacts, sys%im, vfree, lp)
-                call out%companion(fclib_path(out%final_path, sys%step + 1), path)
-                call write_fclib_local(path, run%title, lp, sys%step + 1, sys%time + sys%scheme%h, &
-                                       sys%stats%siconos_error, error)
-                if (allocated(error)) return
+                if (lp%n == 0) then
+                    ! FCLIB's reader refuses a problem without contacts
+                    call report(fclib_no_contacts_warning(sys%step + 1))
+                else
+                    call out%companion(fclib_path(out%final_path, sys%step + 1), path)
+                    call write_fclib_local(path, run%title, lp, sys%step + 1, sys%time + sys%scheme%h, &
+                                           sys%stats%siconos_error, error)
+                    if (allocated(error)) return
+                end if
                 call mj_end_step(sys)
             end associate
         end subroutine step_with_export
@@ -339,4 +344,14 @@ contains
         line = 'warning: [solver] fclib_step = '//to_str(step)//' is after the last step of the run ('// &
                to_str(n_steps)//'): no FCLIB problem written'
     end function fclib_after_end_warning
+
+    !> Warning for an FCLIB export of a step without active contacts: FCLIB's reader
+    !> (fclib_read_local) refuses a problem without contacts, so none is written.
+    function fclib_no_contacts_warning(step) result(line)
+        !> `[solver] fclib_step`.
+        integer, intent(in) :: step
+        character(len=:), allocatable :: line
+        line = 'warning: [solver] fclib_step = '//to_str(step)//': the step has no active contact, '// &
+               'no FCLIB problem written (FCLIB refuses a problem without contacts)'
+    end function fclib_no_contacts_warning
 end module driver_run_dem

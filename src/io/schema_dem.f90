@@ -263,6 +263,7 @@ contains
                            'lengths and the solution found) in FCLIB''s HDF5 format to <output>_fclib_<step>.h5 '// &
                            '(doc/theory.md, "Siconos error"). In a coupled run: the problem the contacts see, '// &
                            'the coupling rows condensed (W dense among the contacts on coupled disks). '// &
-                           'Default: none.')
+                           'A step without active contacts is not written (FCLIB refuses an empty problem): a '// &
+                           'warning, as for a step after the end (which --check reports too). Default: none.')
     end subroutine add_solver
 end module io_schema_dem

@@ -13,9 +13,18 @@ interface experiment (continuum, rolling resistance: 3 components) and the bonde
 of the reference work (beam, bonds with cohesion). There u comes from the velocities of the
 joint solve, which keeps the rows satisfied at every contact update: u = W r + q checks the
 condensed W and the free term with the rows held against the solver's own motion.
+Two errors per file: the run's (/dem/solver/siconos_error, also the attribute
+/multicor@solver_siconos_error), where a contact without a moment length has 2 components, and
+the exported problem's (/multicor@siconos_error), every contact with the file's spacedim
+components: they differ when spacedim is 3 and such a contact rotates (its w_r and q_3 enter
+|u| and |q|). A mixed case checks this: the bonded row hit by a disk at its impact (bonds
+without moment length, row-wall contacts with rolling resistance, the disk on the row without).
+A step without active contacts writes no file and warns (FCLIB's reader refuses a problem
+without contacts).
 Usage (ctest does this): test_fclib_export.py --exe multicor --work DIR --source REPO
 """
 import re
+import shutil
 import subprocess
 import sys
 import time
@@ -79,20 +88,25 @@ def proj_rolling(t, mu, e):
     return np.array([n3, s, np.copysign(e * n3, m)])
 
 
-def siconos_error(W, q, r, mu, rolling, dim):
-    """||r - P_K(r - u_hat)|| / max(||q||, ||r||, ||u||), u = W r + q; components M of
-    contacts without a moment length are not part of their problem (M = 0)."""
+def siconos_error(W, q, r, mu, rolling, dim, exported=False):
+    """||r - P_K(r - u_hat)|| / max(||q||, ||r||, ||u||), u = W r + q. As the run computes it
+    (exported False): the components M of contacts without a moment length are not part of
+    their problem. The exported problem's (exported True): every contact has its dim
+    components; for e = 0 the cone holds M = 0, so the residual's third component is M, and
+    w_r and q_3 count in |u| and |q|."""
     u = W @ r + q
     num = nq = nr = nu = 0.0
     for j, (muj, ej) in enumerate(zip(mu, rolling)):
-        s = slice(dim * j, dim * j + (3 if ej > 0 else 2))
+        s = slice(dim * j, dim * j + (dim if exported else 3 if ej > 0 else 2))
         rj, uj, qj = r[s], u[s], q[s]
         if ej > 0:
             uh = np.array([uj[0] + muj * abs(uj[1]) + ej * abs(uj[2]), uj[1], uj[2]])
             p = proj_rolling(rj - uh, muj, ej)
         else:
             uh = np.array([uj[0] + muj * abs(uj[1]), uj[1]])
-            p = proj_coulomb(rj - uh, muj)
+            p = proj_coulomb(rj[:2] - uh, muj)
+            if len(rj) == 3:
+                p = np.append(p, 0.0)
         num += np.sum((rj - p) ** 2)
         nq += qj @ qj
         nr += rj @ rj
@@ -124,6 +138,7 @@ def case(exe, deck, step, work, expect_dim, extra=(), replace=None, name=None, e
         rolling = f["multicor/rolling"][...]
         cohesion = f["multicor/cohesion"][...]
         attr = float(f["multicor"].attrs["siconos_error"])
+        attr_run = float(f["multicor"].attrs["solver_siconos_error"])
     name = deck.stem
     check(f"{name}: layout", nz == -1 and m == n == dim * len(mu) and len(p) == n + 1
           and p[-1] == len(i) == len(x) and dim == expect_dim,
@@ -153,8 +168,12 @@ def case(exe, deck, step, work, expect_dim, extra=(), replace=None, name=None, e
     # that for an error of 1e-6, and any mistake in the formula changes the error at O(1).
     check(f"{name}: Siconos error, code against numpy", abs(err - stored) <= 1e-8 * err + 1e-14,
           f"numpy {err:.10e}, stored {stored:.10e}, file attribute {attr:.10e}")
-    check(f"{name}: the file's attribute is the stored error", attr == stored, "")
-    return cohesion, rolling
+    check(f"{name}: the file's solver_siconos_error is the stored error", attr_run == stored, "")
+    # the exported problem's error against the attribute: the same rounding of u as above
+    err_file, _ = siconos_error(W, q, r, mu, rolling, dim, exported=True)
+    check(f"{name}: Siconos error of the exported problem, attribute against numpy",
+          abs(err_file - attr) <= 1e-8 * err_file + 1e-14, f"numpy {err_file:.10e}, attribute {attr:.10e}")
+    return cohesion, rolling, stored, attr
 
 
 def main():
@@ -162,18 +181,25 @@ def main():
     src_input = src / "input"
     decks = src / "tests" / "regression" / "decks"
     # a loose tolerance, so that the error compared is well above round-off
-    case(exe, decks / "dem_small_deposit.dat", 276, work, 2, ("tolerance = 1e-3",))
+    _, _, stored, attr = case(exe, decks / "dem_small_deposit.dat", 276, work, 2, ("tolerance = 1e-3",))
+    # 2 components: the two problems are the same (up to the rounding of the two computations
+    # of u, the same bound as above)
+    check("deposit: file and run errors agree with 2 components", abs(stored - attr) <= 1e-8 * stored + 1e-14,
+          f"run {stored:.10e}, file {attr:.10e}")
     # a step where the free term is the largest of |q|, |r|, |u| (the other cases have |r| or |u|
     # larger): the denominator max(|q|, |r|, |u|) is checked with |q| in it. |q| is 1.2 times the
     # next (measured |q| 0.289, |u| 0.237, |r| 0.074); 1.1 keeps the case meaningful against round-off.
     case(exe, decks / "dem_small_deposit.dat", 250, work, 2, ("tolerance = 1e-3",), name="deposit_free_term.dat",
          q_largest=True)
     # rolling resistance (e_r = 1 mm) on the pair 1-1, the one of every contact of that step
-    _, rolling = case(exe, decks / "dem_small_deposit.dat", 291, work, 3, ("tolerance = 1e-3",),
-                      ("law = 1 1 0.4 0.2 0", ["law = 1 1 0.4 0.2 0 0.001"]), "deposit_rolling.dat")
+    _, rolling, stored, attr = case(exe, decks / "dem_small_deposit.dat", 291, work, 3, ("tolerance = 1e-3",),
+                                    ("law = 1 1 0.4 0.2 0", ["law = 1 1 0.4 0.2 0 0.001"]), "deposit_rolling.dat")
+    # every contact with a moment length: the file's problem is the run's
+    check("deposit_rolling: file and run errors agree", abs(stored - attr) <= 1e-8 * stored + 1e-14,
+          f"run {stored:.10e}, file {attr:.10e}")
     check("deposit_rolling: contacts with a moment", np.all(rolling == 0.001), f"{len(rolling)} contacts")
     # bonds (cohesion) that carry moments (e_b = R/2)
-    cohesion, rolling = case(exe, src / "input" / "cohesive_row.dat", 100, work, 3, (),
+    cohesion, rolling, _, _ = case(exe, src / "input" / "cohesive_row.dat", 100, work, 3, (),
                              ("law      = 1          1          0.3  0            2.0e4",
                               ["law = 1 1 0.3 0 2.0e4", "bond = 1 1 0.3 0.0025"]), "bonded_row.dat")
     check("bonded_row: bonds exported with cohesion and moment length",
@@ -182,12 +208,23 @@ def main():
     # under the rising pressure, every disk in contact) and the hinged row of the reference
     # work, bonded and glued to the beam at both ends, solved by plain sweeps to a loose
     # tolerance so that the error compared is well above round-off.
-    _, rolling = case(exe, src_input / "interface_shear.dat", 12, work, 3, name="interface.dat", end="4e-4")
+    _, rolling, _, _ = case(exe, src_input / "interface_shear.dat", 12, work, 3, name="interface.dat", end="4e-4")
     check("interface: contacts with a moment (rolling resistance)", np.all(rolling > 0), f"{len(rolling)} contacts")
-    cohesion, _ = case(exe, src_input / "bending_hinged_row.dat", 12, work, 2,
+    cohesion, _, _, _ = case(exe, src_input / "bending_hinged_row.dat", 12, work, 2,
                        ("method = nlgs", "tolerance = 1e-4"), name="hinged_row.dat", end="2e-4",
                        replace=("tolerance  = 1.0e-8", []))
     check("hinged_row: bonds exported with their cohesion", np.all(cohesion > 0), f"{len(cohesion)} contacts")
+    # Mixed moment lengths: the bonded row hit by a disk at the impact (step 187), plain sweeps.
+    # The contact disk-row has no moment length and rotates (w_r = -46.7 rad/s): in the file's
+    # problem it counts in |u|, which is then the largest term of the denominator, so that the
+    # file's error is far below the run's (measured 2.8e-12 against 9.8e-11); a factor 10 keeps
+    # the case meaningful, and any drop of the third components from the file's error fails it.
+    cohesion, rolling, stored, attr = case(exe, decks / "dem_bonded_row_impact.dat", 187, work, 3,
+                                           ("method = nlgs",), name="row_impact.dat")
+    check("row_impact: contacts with and without a moment length, bonds",
+          np.any(rolling > 0) and np.any(rolling == 0) and np.any(cohesion > 0), f"rolling {rolling}")
+    check("row_impact: the file's error is below the run's (the rotation of a contact without moment)",
+          attr < 0.1 * stored, f"run {stored:.4e}, file {attr:.4e}")
     # The criterion chosen by the deck stops the sweeps: with criterion = siconos every
     # converged step has a stored Siconos error at most the tolerance.
     deck = with_export(src / "tests" / "regression" / "decks" / "dem_small_deposit.dat", 250, work,
@@ -209,19 +246,39 @@ def main():
     check("fclib_step after the end: warned, nothing written", proc.returncode == 0 and not written
           and "warning: [solver] fclib_step = 301 is after the last step of the run (300)" in proc.stdout,
           f"exit {proc.returncode}, files {written}")
+    # A step without active contacts (a disk falling alone): no file, a warning.
+    deck = work / "no_contacts.dat"
+    deck.write_text("[run]\nanalysis = dynamic\n[particles]\nmaterial = 1 2000\ndisk = 0 0.5 0.01 1\n"
+                    "gravity = 0 -9.81\n[solver]\nfclib_step = 2\n[time]\nstep = 1e-3\nend = 3e-3\n")
+    out = work / deck.stem
+    proc = subprocess.run([str(exe), str(deck), "--output", str(out), "--quiet"], capture_output=True, text=True)
+    written = sorted(p.name for p in out.glob("*_fclib_*")) if out.is_dir() else []
+    check("fclib_step at a step without contacts: warned, nothing written", proc.returncode == 0 and not written
+          and "warning: [solver] fclib_step = 2: the step has no active contact" in proc.stdout,
+          f"exit {proc.returncode}, files {written}, output {proc.stdout.strip()!r}")
+    # --check warns of an export after the end, as the run does
+    deck = with_export(decks / "dem_small_deposit.dat", 301, work, name="check_after_end.dat")
+    proc = subprocess.run([str(exe), "--check", str(deck)], capture_output=True, text=True)
+    check("--check: fclib_step after the end warned", proc.returncode == 0
+          and "warning: [solver] fclib_step = 301 is after the last step of the run (300)" in proc.stdout,
+          f"exit {proc.returncode}, output {proc.stdout.strip()!r}")
     failed_run_keeps_export(exe, work)
     killed_run_export(exe, decks, work)
     return summary()
 
 
 def killed_run_export(exe, decks, work):
-    """A run killed by SIGKILL after its export of step 2 and a checkpoint at step 50 leaves
-    the export as '.partial' (renamed only when a run ends); the restart takes it over and
-    gives it its name when it ends. It stayed '.partial' for good."""
-    deck = with_export(decks / "dem_small_deposit.dat", 2, work, ("max_sweeps = 1000",), name="killed.dat")
+    """A run killed by SIGKILL after its export of step 81 (the deposit's first contacts are at
+    step 80; a step without contacts is not exported) and a checkpoint at step 100 leaves the
+    export as '.partial' (renamed only when a run ends); the restart takes it over and gives it
+    its name when it ends. It stayed '.partial' for good."""
+    deck = with_export(decks / "dem_small_deposit.dat", 81, work, ("max_sweeps = 1000",), name="killed.dat")
     text = deck.read_text().replace("end = 0.06", "end = 1000").replace("[output]", "[output]\ncheckpoint_interval = 50")
     deck.write_text(text)
     out = work / "killed"
+    # a fresh folder: a checkpoint left by an earlier run of this script would be read as this
+    # run's before it reaches its export
+    shutil.rmtree(out, ignore_errors=True)
     proc = subprocess.Popen([str(exe), str(deck), "--output", str(out), "--quiet"], stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL)
     step, deadline = 0, time.monotonic() + 120
@@ -247,8 +304,8 @@ def killed_run_export(exe, decks, work):
                            capture_output=True, text=True)
     after = sorted(p.name for p in out.iterdir())
     check("killed after its export: the restart gives the export its name",
-          step >= 100 and "killed_fclib_2.h5.partial" in left and again.returncode == 0
-          and "killed_fclib_2.h5" in after and "killed_fclib_2.h5.partial" not in after,
+          step >= 100 and "killed_fclib_81.h5.partial" in left and again.returncode == 0
+          and "killed_fclib_81.h5" in after and "killed_fclib_81.h5.partial" not in after,
           f"checkpoint at step {step}; before {left}; exit {again.returncode}; after {after}")
 
 
