@@ -325,9 +325,11 @@ module dem_nlgs
     !> anderson_fallback times that of the map before it, the reactions go back to that map's
     !> output. A rise by itself is common and harmless (the mixing is not monotone): falling back
     !> at every rise (a factor 1) cost 19 to 25 % more sweeps on the interface experiment and
-    !> the 200-disk deposit, for nothing; an extrapolation that leaves the solution, as on the
-    !> stack at a mass ratio of 5e5, raises it by orders of magnitude.
-    real(wp), parameter :: anderson_fallback = 10.0_wp
+    !> the 200-disk deposit, for nothing, and a factor 10 still changed the path of the
+    !> interface experiment's sliding layer (a fallback at step 325 of 1 500); an extrapolation
+    !> that leaves the solution, as on the stack at a mass ratio of 5e5, raises it by orders of
+    !> magnitude.
+    real(wp), parameter :: anderson_fallback = 1.0e3_wp
     !> Drift of the sweeps (anderson_mix, drift_length): |f| / |f_prev| between 1 and
     !> drift_high, 1 - cos(f, f_prev) below drift_cosine; a face of a cone nearer than
     !> drift_slack times |r| counts as the one the reaction is on; the skip is taken when it is
