@@ -1,0 +1,248 @@
+!> The results side of a checkpoint (driver_checkpoint): the counters of the results writers
+!> and the record count of every dataset of the results file, to which a restart cuts the
+!> file back.
+module driver_checkpoint_results
+    use core_kinds, only: wp
+    use core_error, only: error_t, make_error
+    use core_strings, only: to_str
+    use io_hdf5_file, only: h5_file_t
+    use driver_results, only: results_writer_t
+    use driver_results_dem, only: dem_writer_t
+    use driver_results_coupled, only: coupled_writer_t
+    use driver_checkpoint_values, only: read_int_attr_1d, read_finite_attribute, require_finite, require_range, &
+                                        damaged
+    implicit none
+    private
+    public :: save_results, load_results, save_dem_writer, load_dem_writer
+    public :: save_coupled_writer, load_coupled_writer
+
+contains
+
+    !> Write the results writer's counters and the record count of every dataset of the
+    !> results file (flushed before).
+    subroutine save_results(file, out, error)
+        !> Checkpoint being written.
+        type(h5_file_t), intent(inout) :: file
+        !> The results writer (open).
+        type(results_writer_t), intent(in) :: out
+        !> Set on a read or write failure.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=256), allocatable :: paths(:)
+        integer, allocatable :: counts(:)
+        character(len=:), allocatable :: joined
+        integer :: k
+        call out%file%list_datasets(paths, counts, error)
+        if (allocated(error)) return
+        call file%create_group('/results', error)
+        if (allocated(error)) return
+        call file%write_attribute('/results', 'writer', real([out%n_nodes, merge(1, 0, out%have_state), &
+                                                              merge(1, 0, out%have_energy)], wp), error)
+        if (allocated(error)) return
+        call file%write_attribute('/results', 'energy0', out%energy0, error)
+        if (allocated(error)) return
+        joined = ''
+        do k = 1, size(paths)
+            joined = joined//trim(paths(k))//new_line('a')
+        end do
+        call file%write_attribute('/results', 'datasets', joined, error)
+        if (allocated(error) .or. size(paths) == 0) return
+        call file%write_dataset('/results/records', counts, error)
+    end subroutine save_results
+
+    !> Restore the results writer's counters, and bring its (open) results file back to the
+    !> checkpoint: datasets written after it are deleted, series cut to their record counts.
+    !> The first write to the results file of a restart: everything read before it (the state)
+    !> and in it is checked first.
+    subroutine load_results(file, out, error)
+        !> Checkpoint being read.
+        type(h5_file_t), intent(inout) :: file
+        !> The results writer, its file open for writing.
+        type(results_writer_t), intent(inout) :: out
+        !> Set on a read or write failure, or when a dataset of the checkpoint is missing.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=256), allocatable :: paths(:)
+        integer, allocatable :: counts(:), saved(:), w(:)
+        character(len=:), allocatable :: joined
+        integer :: k, j, start, n_saved
+        real(wp) :: energy0
+        call read_int_attr_1d(file, '/results', 'writer', w, error)
+        if (allocated(error)) return
+        if (size(w) /= 3) then
+            call damaged(error, '/results@writer: '//to_str(size(w))//' values, not 3')
+            return
+        end if
+        ! nodes, state series written, energy series written
+        call require_range(w(1:1), 0, huge(0), '/results@writer value 1 (nodes)', error)
+        if (.not. allocated(error)) call require_range(w(2:3), 0, 1, '/results@writer (flags)', error, first=2)
+        if (.not. allocated(error)) call file%read_attribute('/results', 'energy0', energy0, error)
+        if (.not. allocated(error)) call require_finite([energy0], '/results@energy0', error)
+        if (allocated(error)) return
+        out%n_nodes = w(1)
+        out%have_state = w(2) /= 0
+        out%have_energy = w(3) /= 0
+        out%energy0 = energy0
+        call file%read_attribute('/results', 'datasets', joined, error)
+        if (allocated(error)) return
+        ! the results' own dataset paths, one per line: other bytes are damage (not quoted)
+        if (any([(.not. (joined(k:k) == new_line('a') .or. (iachar(joined(k:k)) >= 32 .and. &
+                                                            iachar(joined(k:k)) <= 126)), k=1, len(joined))])) then
+            call make_error(error, "checkpoint: '/results@datasets' holds bytes that are not a dataset path: the "// &
+                            'checkpoint is damaged')
+            return
+        end if
+        n_saved = count([(joined(k:k) == new_line('a'), k=1, len(joined))])
+        allocate (saved(0))
+        if (n_saved > 0) call file%read_dataset('/results/records', saved, error)
+        if (allocated(error)) return
+        if (size(saved) /= n_saved) then
+            call make_error(error, 'checkpoint: '//to_str(size(saved))//' record counts for '// &
+                            to_str(n_saved)//' datasets: the checkpoint is damaged')
+            return
+        end if
+        call out%file%list_datasets(paths, counts, error)
+        if (allocated(error)) return
+        ! The results file holds at least the records of the checkpoint: a count beyond it
+        ! (a damaged checkpoint) would extend the series instead of cutting it.
+        do k = 1, size(paths)
+            j = find(trim(paths(k)))
+            if (j == 0) cycle
+            if (saved(j) >= 0 .and. saved(j) <= counts(k)) cycle
+            call make_error(error, "checkpoint: it counts "//to_str(saved(j))//" records of '"// &
+                            trim(paths(k))//"', the results file '"//out%file%path//"' holds "// &
+                            to_str(counts(k))//': the checkpoint is damaged or not of these results')
+            return
+        end do
+        ! Every dataset of the checkpoint must be there.
+        start = 1
+        do k = 1, len(joined)
+            if (joined(k:k) /= new_line('a')) cycle
+            if (.not. any(paths == joined(start:k - 1))) then
+                call make_error(error, "checkpoint: the results file '"//out%file%path// &
+                                "' has no dataset '"//joined(start:k - 1)//"'")
+                return
+            end if
+            start = k + 1
+        end do
+        call out%mark_running(error)
+        if (allocated(error)) return
+        ! Every dataset of the file: kept (series cut to the checkpoint) or deleted.
+        do k = 1, size(paths)
+            j = find(trim(paths(k)))
+            if (j == 0) then
+                call out%file%delete(trim(paths(k)), error)
+            else if (counts(k) /= saved(j)) then
+                call out%file%resize_series(trim(paths(k)), saved(j), error)
+            end if
+            if (allocated(error)) return
+        end do
+    contains
+        !> Index of `path` in the checkpoint's list (0: not there).
+        integer function find(path)
+            character(len=*), intent(in) :: path
+            integer :: i, s0, idx
+            find = 0
+            s0 = 1
+            idx = 0
+            do i = 1, len(joined)
+                if (joined(i:i) /= new_line('a')) cycle
+                idx = idx + 1
+                if (joined(s0:i - 1) == path) then
+                    find = idx
+                    return
+                end if
+                s0 = i + 1
+            end do
+        end function find
+    end subroutine load_results
+
+    !> Write the counters of the particle writer (its buffered statistics written before).
+    subroutine save_dem_writer(file, writer, error)
+        !> Checkpoint being written.
+        type(h5_file_t), intent(inout) :: file
+        !> The writer, nothing buffered.
+        type(dem_writer_t), intent(in) :: writer
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call file%create_group('/writers', error)
+        if (allocated(error)) return
+        call file%write_attribute('/writers', 'dem', real([writer%n_out, writer%n_contacts_stored, &
+                                                           writer%n_steps, writer%n_buffered, writer%n_ruptures], wp), error)
+    end subroutine save_dem_writer
+
+    !> Read the counters of the particle writer (begun again: its buffers exist).
+    subroutine load_dem_writer(file, writer, error)
+        !> Checkpoint being read.
+        type(h5_file_t), intent(inout) :: file
+        !> The writer.
+        type(dem_writer_t), intent(inout) :: writer
+        !> Set on a read failure.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: c(:)
+        call read_int_attr_1d(file, '/writers', 'dem', c, error)
+        if (allocated(error)) return
+        if (size(c) /= 5) then
+            call make_error(error, 'checkpoint: /writers: wrong number of particle writer counters')
+            return
+        end if
+        call require_range(c, 0, huge(0), '/writers@dem', error)
+        if (allocated(error)) return
+        if (c(4) /= 0) then
+            call make_error(error, 'checkpoint: the particle writer had unwritten statistics')
+            return
+        end if
+        writer%n_out = c(1)
+        writer%n_contacts_stored = c(2)
+        writer%n_steps = c(3)
+        writer%n_buffered = 0
+        writer%n_ruptures = c(5)
+    end subroutine load_dem_writer
+
+    !> Write the counters and running maxima of the coupling writer (nothing buffered).
+    subroutine save_coupled_writer(file, writer, error)
+        !> Checkpoint being written.
+        type(h5_file_t), intent(inout) :: file
+        !> The writer, nothing buffered.
+        type(coupled_writer_t), intent(in) :: writer
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call file%create_group('/writers', error)
+        if (allocated(error)) return
+        call file%write_attribute('/writers', 'coupled', real([writer%n_out, writer%n_steps, &
+                                                               writer%n_buffered], wp), error)
+        if (allocated(error)) return
+        call file%write_attribute('/writers', 'coupled_max', [writer%max_position, writer%max_velocity, &
+                                                              writer%max_coordinate, writer%max_balance], error)
+    end subroutine save_coupled_writer
+
+    !> Read the counters and running maxima of the coupling writer (begun again).
+    subroutine load_coupled_writer(file, writer, error)
+        !> Checkpoint being read.
+        type(h5_file_t), intent(inout) :: file
+        !> The writer.
+        type(coupled_writer_t), intent(inout) :: writer
+        !> Set on a read failure.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: c(:)
+        real(wp), allocatable :: m(:)
+        call read_int_attr_1d(file, '/writers', 'coupled', c, error)
+        if (allocated(error)) return
+        if (size(c) /= 3) then
+            call make_error(error, 'checkpoint: /writers: wrong number of coupling writer counters')
+            return
+        end if
+        call require_range(c, 0, huge(0), '/writers@coupled', error)
+        if (.not. allocated(error)) call read_finite_attribute(file, '/writers', 'coupled_max', m, 4, error)
+        if (allocated(error)) return
+        if (c(3) /= 0) then
+            call make_error(error, 'checkpoint: the coupling writer had unwritten statistics')
+            return
+        end if
+        writer%n_out = c(1)
+        writer%n_steps = c(2)
+        writer%n_buffered = 0
+        writer%max_position = m(1)
+        writer%max_velocity = m(2)
+        writer%max_coordinate = m(3)
+        writer%max_balance = m(4)
+    end subroutine load_coupled_writer
+end module driver_checkpoint_results
