@@ -1,0 +1,251 @@
+!> Checks and warnings of a deck before its run (driver_run): the model's size against the
+!> memory, before anything is built; option `--end` applied to the model built; the settings
+!> the deck gives without effect, harmonic functions the time step aliases, and an end time
+!> that is not a whole number of steps.
+module driver_run_checks
+    use core_kinds, only: wp, i8
+    use core_error, only: error_t, make_error, make_input_error
+    use core_strings, only: string_t, to_str, num => sci_text
+    use io_memory, only: available_memory
+    use io_deck, only: deck_t, deck_entry_t
+    use driver_guards, only: model_size_t, model_memory_bytes, check_memory
+    use fem_mesh_generator, only: rectangle_size, check_rectangle_size
+    use fem_element_registry, only: element_slot_t, new_element, kind_of_name
+    use driver_simulation, only: simulation_t, report_iface
+    use driver_config, only: steps_to_end, max_steps
+    use driver_run_dem, only: fclib_after_end_warning
+    implicit none
+    private
+    public :: check_model_size, apply_end_time, warn_about_deck, warn_fclib_after_end
+
+contains
+
+    !> The deck's warnings, in this order: settings without effect, harmonic functions the
+    !> time step aliases, an end time that is not a whole number of steps.
+    subroutine warn_about_deck(end_time, deck, sim, report)
+        !> Option `--end`: the end time replacing the deck's [s] (negative: none).
+        real(wp), intent(in) :: end_time
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Its simulation (model built, `--end` applied).
+        class(simulation_t), intent(in) :: sim
+        !> Where the warnings go.
+        procedure(report_iface) :: report
+        call warn_keywords_without_effect(deck, sim, report)
+        call warn_aliased_functions(deck, sim, report)
+        call warn_end_off_the_steps(end_time, deck, sim, report)
+    end subroutine warn_about_deck
+
+    !> `--check` only (a run warns when its loop starts): an FCLIB export asked for a step after
+    !> the last one.
+    subroutine warn_fclib_after_end(deck, sim, report)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Its simulation (model built, `--end` applied).
+        class(simulation_t), intent(in) :: sim
+        !> Where the warning goes.
+        procedure(report_iface) :: report
+        integer :: step
+        if (sim%settings%analysis /= 'dynamic' .or. .not. deck%has('solver', 'fclib_step')) return
+        step = deck%get_int('solver', 'fclib_step')
+        if (step > sim%settings%n_steps) call report(fclib_after_end_warning(step, sim%settings%n_steps))
+    end subroutine warn_fclib_after_end
+
+    !> Settings given in the deck that another setting or the kind of run turns off (the
+    !> deck is valid: a tuning value left in place while it is off).
+    subroutine warn_keywords_without_effect(deck, sim, report)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Its simulation.
+        class(simulation_t), intent(in) :: sim
+        !> Where the warnings go.
+        procedure(report_iface) :: report
+        type(string_t), allocatable :: warnings(:)
+        integer :: i
+        warnings = [deck%ineffective(), sim%deck_warnings(deck)]
+        do i = 1, size(warnings)
+            call report(warnings(i)%s)
+        end do
+    end subroutine warn_keywords_without_effect
+
+    !> Warn about a harmonic function faster than half the sampling rate of the time step:
+    !> the run sees it at fewer than two steps per period, i.e. an alias of another
+    !> frequency. Allowed (the deck may mean it), said once per function.
+    subroutine warn_aliased_functions(deck, sim, report)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Its simulation (run settings built).
+        class(simulation_t), intent(in) :: sim
+        !> Where the warnings go.
+        procedure(report_iface) :: report
+        type(deck_entry_t), allocatable :: list(:)
+        real(wp) :: nyquist
+        integer :: i
+        if (sim%settings%analysis /= 'dynamic' .or. .not. sim%settings%h > 0.0_wp) return
+        nyquist = 0.5_wp/sim%settings%h
+        allocate (list, source=deck%records('functions', 'function'))
+        do i = 1, size(list)
+            if (list(i)%word('kind') /= 'harmonic') cycle
+            if (.not. list(i)%real('freq') > nyquist) cycle
+            call report('warning: '//deck%file//':'//to_str(list(i)%line)//': harmonic function '// &
+                        to_str(list(i)%int('id'))//' at '//to_str(list(i)%real('freq'))// &
+                        ' Hz is above 1/(2 h) = '//to_str(nyquist)//' Hz of [time] step: the run '// &
+                        'samples it below two steps per period and sees an alias; lower the step')
+        end do
+    end subroutine warn_aliased_functions
+
+    !> Warn when the end time (the deck's, or --end) is not a whole number of time steps: the
+    !> run goes on to the next step, past the end asked for.
+    subroutine warn_end_off_the_steps(end_time, deck, sim, report)
+        !> Option `--end`: the end time replacing the deck's [s] (negative: none).
+        real(wp), intent(in) :: end_time
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Its simulation (run settings built, `--end` applied).
+        class(simulation_t), intent(in) :: sim
+        !> Where the warning goes.
+        procedure(report_iface) :: report
+        real(wp) :: t_last
+        character(len=24) :: buf
+        if (sim%settings%analysis /= 'dynamic' .or. .not. sim%settings%h > 0.0_wp) return
+        associate (run => sim%settings)
+            t_last = real(run%n_steps, wp)*run%h
+            ! a whole number of steps up to the rounding of end / step (steps_to_end)
+            if (abs(t_last - run%t_end) <= 1.0e-9_wp*run%t_end) return
+            if (end_time >= 0.0_wp) then
+                write (buf, '(es17.10e3)') run%t_end
+                call report('warning: --end '//trim(adjustl(buf))//' s is not a whole number of time '// &
+                            'steps of '//num(run%h)//' s: the run ends after '//to_str(run%n_steps)// &
+                            ' steps, at t = '//num(t_last)//' s')
+            else
+                call report('warning: '//deck%file//':'//to_str(deck%line('time', 'end'))//': [time] end = '// &
+                            deck%get_word('time', 'end')//' s is not a whole number of time steps of '// &
+                            deck%get_word('time', 'step')//' s: the run ends after '//to_str(run%n_steps)// &
+                            ' steps, at t = '//num(t_last)//' s')
+            end if
+        end associate
+    end subroutine warn_end_off_the_steps
+
+    !> Option `--end`: a new end time (the models built by `init` do not depend on it, the step
+    !> count does).
+    subroutine apply_end_time(end_time, deck, sim, error)
+        !> Option `--end`: the end time replacing the deck's [s] (negative: none).
+        real(wp), intent(in) :: end_time
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Its simulation: end time and step count replaced.
+        class(simulation_t), intent(inout) :: sim
+        !> Set when the deck has no time steps, or the end time is too short or too long.
+        type(error_t), allocatable, intent(out) :: error
+        real(wp) :: steps
+        if (end_time < 0.0_wp) return
+        if (.not. sim%has_time_loop()) then
+            call make_error(error, '--end: '//deck%file//' is not a dynamic analysis (static and modal '// &
+                            'analyses have no time steps to continue)')
+            return
+        end if
+        associate (run => sim%settings)
+            if (.not. (end_time >= run%h)) then
+                call make_error(error, '--end '//num(end_time)//' s: shorter than the time step '// &
+                                num(run%h)//' s')
+                return
+            end if
+            steps = steps_to_end(end_time, run%h)
+            if (steps > real(max_steps, wp)) then
+                call make_error(error, '--end '//num(end_time)//' s with step '//num(run%h)// &
+                                ' s needs more time steps than a run can count ('//to_str(max_steps)//')')
+                return
+            end if
+            run%t_end = end_time
+            run%n_steps = max(int(steps, i8), 1_i8)
+        end associate
+    end subroutine apply_end_time
+
+    !> Refuse a model whose memory estimate exceeds the available memory, from the numbers of
+    !> disks, nodes and elements the deck asks for (before allocating them), and a rectangle
+    !> mesh with more nodes or elements than a mesh can number. The memory error names the
+    !> generator record (lattice, row, deposit, beam line, continuum mesh) that asks for the
+    !> most memory; the counts are summed without overflow (saturating at huge(0_i8), where
+    !> the estimate is refused anyway).
+    subroutine check_model_size(deck, error)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Set when the model is too large.
+        type(error_t), allocatable, intent(out) :: error
+        type(model_size_t) :: total, part
+        type(element_slot_t) :: element
+        integer(i8) :: n_nodes, n_elements, largest
+        integer :: k, line
+        character(len=:), allocatable :: keyword, message
+        largest = -1
+        line = 0
+        keyword = ''
+        total%disks = deck%count('particles', 'disk')
+        total%beam_nodes = deck%count('beam', 'node')
+        total%beam_elements = deck%count('beam', 'element')
+        do k = 1, size(deck%entries)
+            associate (e => deck%entries(k))
+                part = model_size_t()
+                select case (e%section//' '//e%keyword)
+                case ('particles row', 'particles deposit')
+                    part%disks = e%int('n')
+                case ('particles square_lattice', 'particles hex_lattice')
+                    part%disks = int(e%int('nx'), i8)*int(e%int('ny'), i8)
+                case ('beam line', 'beam polar_line')
+                    part%beam_nodes = int(e%int('elements'), i8) + 1
+                    part%beam_elements = e%int('elements')
+                case ('continuum mesh')
+                    if (e%word('kind') /= 'rectangle') cycle
+                    ! The schema admits only the names of registered element kinds.
+                    call new_element(kind_of_name(e%word('element')), element)
+                    call check_rectangle_size(e%int('nx'), e%int('ny'), element%element, error)
+                    if (allocated(error)) then
+                        message = error%message
+                        call make_input_error(error, deck%file, e%line, e%keyword, message)
+                        return
+                    end if
+                    call rectangle_size(e%int('nx'), e%int('ny'), element%element, n_nodes, n_elements)
+                    if (e%word('element') == 't3') then
+                        part%t3 = n_elements
+                    else
+                        part%q4 = n_elements
+                    end if
+                case default
+                    cycle
+                end select
+                total%disks = add(total%disks, part%disks)
+                total%beam_nodes = add(total%beam_nodes, part%beam_nodes)
+                total%beam_elements = add(total%beam_elements, part%beam_elements)
+                total%q4 = add(total%q4, part%q4)
+                total%t3 = add(total%t3, part%t3)
+                if (model_memory_bytes(part) > largest) then
+                    largest = model_memory_bytes(part)
+                    line = e%line
+                    keyword = e%keyword
+                end if
+            end associate
+        end do
+        if (total%disks > huge(0)) then
+            call make_error(error, deck%file//': the deck asks for '//to_str(total%disks)// &
+                            ' disks, more than a run can number ('//to_str(huge(0))//')')
+            return
+        end if
+        call check_memory(total, available_memory(), error)
+        if (allocated(error)) then
+            message = error%message
+            call make_input_error(error, deck%file, line, keyword, message)
+        end if
+
+    contains
+
+        !> a + b for counts >= 0, huge(0_i8) when that overflows.
+        pure integer(i8) function add(a, b)
+            integer(i8), intent(in) :: a, b
+            if (a > huge(0_i8) - b) then
+                add = huge(0_i8)
+            else
+                add = a + b
+            end if
+        end function add
+    end subroutine check_model_size
+end module driver_run_checks
