@@ -95,6 +95,31 @@ module driver_coupled_loop
         procedure, non_overridable :: constraint_line
     end type arlequin_simulation_t
 
+    !> The state of a coupled time loop, shared by the procedures of `arlequin_run`.
+    type :: coupled_loop_t
+        !> Steps of the run (the step of a stop, once stopped).
+        integer(i8) :: n_steps = 0
+        !> The step just done (0: the initial state).
+        integer(i8) :: k = 0
+        !> Steps done at the start (those of the checkpoint of a restart).
+        integer(i8) :: k0 = 0
+        !> Steps with lost bonds warned about so far.
+        integer :: lost_warnings = 0
+        !> Unconverged steps so far.
+        integer :: unconverged = 0
+        !> Warnings given once: a disk faster than the alert distance, bonded coupled disks
+        !> turned too far.
+        logical :: speed_warned = .false., rotation_warned = .false.
+        !> Whether /dem stores the contacts with each output.
+        logical :: store_contacts = .false.
+        !> Deck id of each particle material (for /dem).
+        integer, allocatable :: material_id(:)
+        !> Progress lines and the wall time of the analysis.
+        type(progress_t) :: progress
+        !> The disks and walls at the start of the step (guard against tunnelling).
+        type(step_start_t) :: start
+    end type coupled_loop_t
+
     abstract interface
         !> The particle deck data the /dem writer needs.
         subroutine particle_output_iface(self, material_id, store_contacts)
@@ -180,322 +205,436 @@ contains
         type(checkpoint_run_t), intent(inout) :: ck
         !> Set on a run or write failure.
         type(error_t), allocatable, intent(out) :: error
-        type(progress_t) :: progress
-        type(step_start_t) :: start
-        integer(i8) :: n_steps, k, k0
-        integer :: lost_warnings
-        integer :: unconverged
-        logical :: speed_warned, rotation_warned, store_contacts
+        type(coupled_loop_t) :: lp
         type(step_end_t) :: act
-        integer, allocatable :: material_id(:)
-        character(len=512) :: buf
+        integer(i8) :: k
 
-        n_steps = self%settings%n_steps
-        unconverged = 0
-        lost_warnings = 0
-        speed_warned = .false.
-        rotation_warned = .false.
-        k0 = 0
-        call self%particle_output(material_id, store_contacts)
+        lp%n_steps = self%settings%n_steps
+        call self%particle_output(lp%material_id, lp%store_contacts)
         if (ck%restart) then
-            call restore(error)
-            if (allocated(error)) return
+            call restore(self, lp, out, ck, error)
         else
-            call self%dem_out%begin(out%file, self%sys%dem, material_id, store_contacts, error)
-            if (allocated(error)) return
-            call self%cpl_out%begin(out%file, self%sys, error)
-            if (allocated(error)) return
-            call self%begin(out, error)
-            if (allocated(error)) return
-            k = 0
-            call check_step(error)
-            if (allocated(error)) return
-            call store(error)
-            if (allocated(error)) return
-            call check_initial_velocities()
+            call begin_new_run(self, lp, out, report, error)
         end if
-        if (self%fclib_step > n_steps) call report(fclib_after_end_warning(self%fclib_step, n_steps))
-        call progress%start(n_steps, self%settings%t_end, self%settings%progress_seconds)
-        if (ck%restart) call progress%resume(k0, ck%start%wall_seconds, ck%start%runs)
+        if (allocated(error)) return
+        if (self%fclib_step > lp%n_steps) call report(fclib_after_end_warning(self%fclib_step, lp%n_steps))
+        call lp%progress%start(lp%n_steps, self%settings%t_end, self%settings%progress_seconds)
+        if (ck%restart) call lp%progress%resume(lp%k0, ck%start%wall_seconds, ck%start%runs)
         call ck%schedule%start()
-        do k = k0 + 1, n_steps
-            call take_step_start(start, self%sys%dem%particles, self%sys%dem%walls, &
-                                 self%sys%dem%energies%contact_dissipation)
-            if (k == self%fclib_step) then
-                call step_with_export(error)
-            else
-                call arlequin_step(self%sys, error)
-            end if
+        do k = lp%k0 + 1, lp%n_steps
+            lp%k = k
+            call take_step(self, lp, out, report, error)
             if (allocated(error)) return
-            call self%after_step(error)
-            if (allocated(error)) return
-            call check_step(error)
-            if (allocated(error)) return
-            call self%dem_out%record_step(out%file, self%sys%dem%stats, error)
-            if (allocated(error)) return
-            call self%cpl_out%record_step(out%file, self%sys, error)
-            if (allocated(error)) return
-            if (.not. self%sys%stats%converged) call warn_unconverged()
-            if (self%sys%dem%bonds_lost > 0) then
-                lost_warnings = lost_warnings + 1
-                if (lost_warnings <= max_warnings) call report(lost_bonds_warning(k, self%sys%dem%time, self%sys%dem%bonds_lost))
-                if (lost_warnings == max_warnings) call report('warning: further lost bonds are only logged '// &
-                                                               '(/dem/bonds, mode 5)')
-            end if
-            if (.not. speed_warned) call check_speed()
-            if (.not. rotation_warned) call check_rotation()
-            if (k == 1) call check_redundant_bonds()
-            act = end_of_step(k, n_steps, self%settings%output_interval, ck%schedule)
-            if (act%store_first) call store(error)
-            if (act%checkpoint .and. .not. allocated(error)) call checkpoint(error)
-            if (act%store_last .and. .not. allocated(error)) call store(error)
+            call warn_after_step(self, lp, report)
+            act = end_of_step(k, lp%n_steps, self%settings%output_interval, ck%schedule)
+            if (act%store_first) call store_output(self, out, error)
+            if (act%checkpoint .and. .not. allocated(error)) call write_checkpoint(self, lp, out, ck, error)
+            if (act%store_last .and. .not. allocated(error)) call store_output(self, out, error)
             if (allocated(error)) return
             if (act%stop) then
                 ! Stop request: the step just done is the last output.
                 call out%stop_at(signal_name(caught_signal()), k, self%sys%fe%t)
-                n_steps = k
+                lp%n_steps = k
                 exit
             end if
             if (quiet) cycle
-            if (progress%due()) call report(progress%line(k, self%sys%fe%t))
+            if (lp%progress%due()) call report(lp%progress%line(k, self%sys%fe%t))
         end do
-        call self%dem_out%finish(out%file, self%sys%dem, unconverged, error)
+        call self%dem_out%finish(out%file, self%sys%dem, lp%unconverged, error)
         if (allocated(error)) return
         call self%cpl_out%finish(out%file, error)
         if (allocated(error)) return
-        call summary()
+        call summary(self, lp, out, report)
         ! n_steps <= max_steps = huge(0) (driver_config)
-        call out%write_summary(int(n_steps), progress, error)
+        call out%write_summary(int(lp%n_steps), lp%progress, error)
         if (allocated(error)) return
         call self%finish(out, error)
-
-    contains
-
-        !> One step (as arlequin_step) that writes its local contact problem, the coupling
-        !> rows condensed, in FCLIB's format to <results without .h5>_fclib_<step>.h5.
-        subroutine step_with_export(error)
-            type(error_t), allocatable, intent(out) :: error
-            type(local_problem_t) :: lp
-            character(len=:), allocatable :: path
-            call arlequin_step(self%sys, error, lp)
-            if (allocated(error)) return
-            if (lp%n == 0) then
-                ! FCLIB's reader refuses a problem without contacts
-                call report(fclib_no_contacts_warning(int(k)))
-                return
-            end if
-            call out%companion(fclib_path(out%final_path, int(k)), path)
-            call write_fclib_local(path, self%settings%title, lp, int(k), self%sys%fe%t, &
-                                   self%sys%dem%stats%siconos_error, error)
-        end subroutine step_with_export
-
-        !> Restart: state, writer counters and results file from the checkpoint `ck%source`.
-        subroutine restore(error)
-            type(error_t), allocatable, intent(out) :: error
-            type(error_t), allocatable :: ignored
-            call self%dem_out%resume(self%sys%dem, store_contacts)
-            call self%cpl_out%resume(self%sys)
-            call load_coupled(ck%source, self%sys, ck%start%step, error)
-            if (.not. allocated(error)) call load_dem_writer(ck%source, self%dem_out, error)
-            if (.not. allocated(error)) call load_coupled_writer(ck%source, self%cpl_out, error)
-            if (.not. allocated(error)) call self%check_saved_part(ck%source, error)
-            if (.not. allocated(error)) call check_results_version(error)
-            if (.not. allocated(error)) call load_results(ck%source, out, error)
-            if (.not. allocated(error)) call self%load_part(ck%source, out, error)
-            call ck%source%close(ignored)
-            if (allocated(error)) return
-            k0 = ck%start%step
-            unconverged = ck%start%unconverged
-            speed_warned = ck%start%speed_warned
-            rotation_warned = ck%start%rotation_warned
-            ! an export before the checkpoint that a killed run left unrenamed
-            if (self%fclib_step > 0 .and. self%fclib_step <= k0) &
-                call out%adopt(fclib_path(out%final_path, self%fclib_step))
-        end subroutine restore
-
-        !> Refuse a results file of an earlier build, which lacks a series this one appends to
-        !> (the supports' work of the audit, 2026-11-27), before load_results cuts or marks it:
-        !> an interrupted run's partial file stays as it was.
-        subroutine check_results_version(error)
-            type(error_t), allocatable, intent(out) :: error
-            if (out%file%exists('/coupling/energy/fe_reaction_work')) return
-            call make_error(error, "restart: the results file '"//out%file%path//"' was written by an "// &
-                            'earlier version of MULTICOR (its /coupling/energy has no fe_reaction_work): '// &
-                            'continue it with that version, or run the deck again from the start')
-        end subroutine check_results_version
-
-        !> Write a checkpoint after step k (the buffered per-step values are written first).
-        subroutine checkpoint(error)
-            type(error_t), allocatable, intent(out) :: error
-            type(h5_file_t) :: f
-            call self%dem_out%flush_buffer(out%file, error)
-            if (.not. allocated(error)) call self%cpl_out%flush_buffer(out%file, error)
-            if (allocated(error)) return
-            call checkpoint_create(f, ck%path, ck%deck_text, self%checkpoint_kind(), &
-                                   loop_state_t(k, unconverged, speed_warned, .false., rotation_warned, &
-                                                wall_seconds=progress%analysis_seconds(), runs=progress%runs), &
-                                   self%sys%fe%t, &
-                                   out%run_id, error)
-            if (.not. allocated(error)) call save_coupled(f, self%sys, error)
-            if (.not. allocated(error)) call self%save_part(f, error)
-            if (.not. allocated(error)) call save_dem_writer(f, self%dem_out, error)
-            if (.not. allocated(error)) call save_coupled_writer(f, self%cpl_out, error)
-            if (.not. allocated(error)) call save_results(f, out, error)
-            call ck%finish(f, k, self%sys%fe%t, error)
-        end subroutine checkpoint
-
-        !> Guards after step k (k = 0: the initial state): the finite-element state, finite disk
-        !> states in the box, no tunnelling in the step.
-        subroutine check_step(error)
-            type(error_t), allocatable, intent(out) :: error
-            call self%check_part(k, error)
-            if (allocated(error)) return
-            associate (sys => self%sys)
-                call check_disks_state(k, sys%fe%t, sys%dem%particles, sys%dem%energies, error)
-                if (allocated(error)) return
-                call check_walls_state(k, sys%fe%t, sys%dem%particles, sys%dem%walls, error)
-                if (allocated(error)) return
-                if (k == 0) return
-                call check_tunnelling(k, sys%fe%t, self%settings%h, sys%dem%scheme%alert, start, &
-                                      sys%dem%particles, sys%dem%walls, sys%dem%contacts, error, &
-                                      sys%dem%energies%contact_dissipation)
-            end associate
-        end subroutine check_step
-
-        !> One stored output: the finite-element side, the disks, the coupling.
-        subroutine store(error)
-            type(error_t), allocatable, intent(out) :: error
-            call self%store_part(out, error)
-            if (allocated(error)) return
-            call self%dem_out%store(out%file, self%sys%dem, error)
-            if (allocated(error)) return
-            call self%cpl_out%store(out%file, self%sys, error)
-            if (allocated(error)) return
-            call out%flush(error)
-        end subroutine store
-
-        !> Warning for an unconverged step (the first max_warnings ones).
-        subroutine warn_unconverged()
-            unconverged = unconverged + 1
-            if (unconverged > max_warnings) return
-            write (buf, '(a,i0,a,es12.4e3,a,i0,a)') 'warning: step ', k, ' (t = ', self%sys%fe%t, &
-                ' s): the joint contact/multiplier solve did not converge in ', self%sys%stats%sweeps, ' sweeps'
-            call report(trim(buf)//self%unconverged_detail())
-            if (unconverged == max_warnings) call report(last_unconverged_warning())
-        end subroutine warn_unconverged
-
-        !> Warning when the initial velocities of the coupled disks differ from the FE model's
-        !> at their centres (beyond round-off: 1e-8 of the velocities, the rotation rows times
-        !> the largest coupled radius, so that a rotation mismatch of rounding next to zero
-        !> rotations does not count). The first step's
-        !> multipliers remove the difference with an impulse that dissipates its energy like a
-        !> plastic impact: the run goes on, but /coupling/energy/balance shows that loss (5 % to
-        !> 30 % of the energy for disks given initial_velocity over a block at rest).
-        subroutine check_initial_velocities()
-            real(wp), parameter :: relative = 1.0e-8_wp
-            type(velocity_mismatch_t) :: m
-            m = velocity_mismatch(self%sys)
-            if (hypot(m%translation, m%radius*m%rotation) <= &
-                relative*hypot(m%translation_scale, m%radius*m%rotation_scale)) return
-            write (buf, '(a,es10.3e3,a,es10.3e3,a,es10.3e3,a,es10.3e3,a,i0,a)') &
-                'warning: the initial velocities of the coupled disks differ from the finite-element '// &
-                'model''s at their centres (|G v - C v| = ', m%translation, ' m/s against ', &
-                m%translation_scale, ' m/s, rotations ', m%rotation, ' rad/s against ', m%rotation_scale, &
-                ' rad/s; disk ', m%disk, ' the most)'
-            call report(trim(buf)//': the first step glues them with an impulse that dissipates '// &
-                        'energy like a plastic impact, and /coupling/energy/balance shows that loss; give '// &
-                        'the coupled disks the motion of the finite-element model (e.g. [particles] '// &
-                        'initial_rigid with the rigid motion of [initial] rigid or [continuum] initial_velocity)')
-        end subroutine check_initial_velocities
-
-        !> Warning (once) when a disk moved farther than the alert distance in the step.
-        subroutine check_speed()
-            character(len=:), allocatable :: line
-            line = speed_warning(self%sys%dem%particles, self%settings%h, self%sys%dem%scheme%alert, &
-                                 self%sys%fe%t)
-            if (len(line) == 0) return
-            speed_warned = .true.
-            call report(line)
-        end subroutine check_speed
-
-        !> Warning (once) when two coupled disks joined by an intact bond have turned by more than
-        !> rotation_limit. The bond keeps their distance through the rotation, the coupling
-        !> (C built on the reference configuration) moves them with the linear field, which
-        !> stretches the chord by about theta^2/2 of its length: the multipliers then carry a
-        !> spurious axial force of about alpha E A theta^2/2 and the bending moments come out
-        !> short (doc/theory.md 6.3).
-        subroutine check_rotation()
-            real(wp), parameter :: rotation_limit = 1.0e-2_wp
-            logical, allocatable :: coupled(:)
-            real(wp) :: theta
-            integer :: c
-            associate (p => self%sys%dem%particles, cs => self%sys%dem%contacts)
-                if (p%n == 0 .or. size(self%sys%coupled) == 0) return
-                allocate (coupled(p%n), source=.false.)
-                coupled(self%sys%coupled) = .true.
-                theta = 0.0_wp
-                do c = 1, cs%n
-                    if (cs%status(c) /= status_cohesive .or. cs%i1(c) <= 0) cycle
-                    if (.not. (coupled(cs%i1(c)) .and. coupled(cs%i2(c)))) cycle
-                    theta = max(theta, abs(p%rot(cs%i1(c))), abs(p%rot(cs%i2(c))))
-                end do
-                if (theta <= rotation_limit) return
-                write (buf, '(a,es12.4e3,a,es10.2e3,a,es8.1e2,a)') 'warning: at t = ', self%sys%fe%t, &
-                    ' s bonded coupled disks have turned by ', theta, ' rad (more than ', rotation_limit, &
-                    '): the linear coupling stretches their bonds by about theta^2/2, which adds an '// &
-                    'axial force of about alpha E A theta^2/2 and shortens the bending moments by a few % '// &
-                    '(doc/theory.md 6.3); lower the load or treat the results as approximate'
-                rotation_warned = .true.
-                call report(trim(buf))
-            end associate
-        end subroutine check_rotation
-
-        !> Warning (after the first step, when the bonds are made) when intact bonds join
-        !> coupled disks across the beam's axis with a multiplier per coupled dof (every layer
-        !> of a stack glued: [coupling] max_offset = 0, the default). The beam's sections do not
-        !> deform, so between two such disks the coupling leaves only the beam's bending and
-        !> stretching over a disk pitch: the bonds and the coupling rows are nearly redundant,
-        !> and any disagreement of their targets (the linear field's stretch, doc/theory.md 6.3;
-        !> round-off) loads them with a self-stress that grows from step to step and can break
-        !> bonds (doc/theory.md 7.10, "Least norm"; measured in
-        !> tests/regression/decks/coupled_glued_layers.dat: |lambda| of 1e4 N under 5 N).
-        subroutine check_redundant_bonds()
-            integer, allocatable :: point(:)
-            integer :: c, n, p
-            if (self%sys%on_nodes) return
-            associate (pa => self%sys%dem%particles, cs => self%sys%dem%contacts, op => self%sys%op)
-                if (pa%n == 0 .or. size(self%sys%coupled) == 0) return
-                allocate (point(pa%n), source=0)
-                point(self%sys%coupled) = [(p, p=1, size(self%sys%coupled))]
-                n = 0
-                do c = 1, cs%n
-                    if (cs%status(c) /= status_cohesive .or. cs%i1(c) <= 0) cycle
-                    if (point(cs%i1(c)) == 0 .or. point(cs%i2(c)) == 0) cycle
-                    ! across the axis by more than half the smaller disk: another layer
-                    if (op%rigid_distance(point(cs%i1(c)), point(cs%i2(c))) > &
-                        0.5_wp*min(pa%radius(cs%i1(c)), pa%radius(cs%i2(c)))) n = n + 1
-                end do
-            end associate
-            if (n == 0) return
-            call report('warning: '//counted(n, 'intact bond')//' join coupled disks at different distances '// &
-                        'from the beam axis (several layers glued): the beam''s sections do not deform, so '// &
-                        'these bonds and the coupling rows are nearly redundant and carry a self-stress that '// &
-                        'grows with any disagreement of their targets and can break bonds (doc/theory.md 7.10); '// &
-                        'glue one layer ([coupling] max_offset) or use [coupling] multipliers = nodes')
-        end subroutine check_redundant_bonds
-
-        !> Closing lines: the model's (size, residuals, solver effort), energy balance, times.
-        subroutine summary()
-            type(coupled_energies_t) :: en
-            call self%summary_lines(n_steps, unconverged, report)
-            en = coupled_energies(self%sys)
-            write (buf, '(a,es11.3e3,a,es11.3e3,a,es11.3e3,a)') 'energy balance residual ', en%balance, &
-                ' J (max over the outputs ', self%cpl_out%max_balance, ' J; external work ', &
-                en%fe_external_work + en%fe_reaction_work + en%dem_external_work + en%dem_drive_work, ' J)'
-            call report(trim(buf))
-            call report(progress%summary_line(n_steps, self%sys%fe%t, out%stopped()))
-        end subroutine summary
     end subroutine arlequin_run
+
+    !> A new run: /dem, /coupling and the finite-element side begun, the initial state checked
+    !> and stored, its velocities compared.
+    subroutine begin_new_run(self, lp, out, report, error)
+        !> The simulation (after `init`).
+        class(arlequin_simulation_t), intent(inout) :: self
+        !> The loop's state (`material_id`, `store_contacts` set).
+        type(coupled_loop_t), intent(inout) :: lp
+        !> The results file.
+        type(results_writer_t), intent(inout) :: out
+        !> Where the warning goes.
+        procedure(report_iface) :: report
+        !> Set on a write failure or a bad initial state.
+        type(error_t), allocatable, intent(out) :: error
+        call self%dem_out%begin(out%file, self%sys%dem, lp%material_id, lp%store_contacts, error)
+        if (allocated(error)) return
+        call self%cpl_out%begin(out%file, self%sys, error)
+        if (allocated(error)) return
+        call self%begin(out, error)
+        if (allocated(error)) return
+        lp%k = 0
+        call check_step(self, lp, error)
+        if (allocated(error)) return
+        call store_output(self, out, error)
+        if (allocated(error)) return
+        call check_initial_velocities(self, report)
+    end subroutine begin_new_run
+
+    !> Restart: state, writer counters and results file from the checkpoint `ck%source`.
+    subroutine restore(self, lp, out, ck, error)
+        !> The simulation (after `init`).
+        class(arlequin_simulation_t), intent(inout) :: self
+        !> The loop's state: its counters and flags those of the checkpoint.
+        type(coupled_loop_t), intent(inout) :: lp
+        !> The results file, cut back to the checkpoint.
+        type(results_writer_t), intent(inout) :: out
+        !> The run's checkpoints (`source` closed on return).
+        type(checkpoint_run_t), intent(inout) :: ck
+        !> Set on a read failure or a damaged checkpoint.
+        type(error_t), allocatable, intent(out) :: error
+        type(error_t), allocatable :: ignored
+        call self%dem_out%resume(self%sys%dem, lp%store_contacts)
+        call self%cpl_out%resume(self%sys)
+        call load_coupled(ck%source, self%sys, ck%start%step, error)
+        if (.not. allocated(error)) call load_dem_writer(ck%source, self%dem_out, error)
+        if (.not. allocated(error)) call load_coupled_writer(ck%source, self%cpl_out, error)
+        if (.not. allocated(error)) call self%check_saved_part(ck%source, error)
+        if (.not. allocated(error)) call check_results_version(out, error)
+        if (.not. allocated(error)) call load_results(ck%source, out, error)
+        if (.not. allocated(error)) call self%load_part(ck%source, out, error)
+        call ck%source%close(ignored)
+        if (allocated(error)) return
+        lp%k0 = ck%start%step
+        lp%unconverged = ck%start%unconverged
+        lp%speed_warned = ck%start%speed_warned
+        lp%rotation_warned = ck%start%rotation_warned
+        ! an export before the checkpoint that a killed run left unrenamed
+        if (self%fclib_step > 0 .and. self%fclib_step <= lp%k0) &
+            call out%adopt(fclib_path(out%final_path, self%fclib_step))
+    end subroutine restore
+
+    !> Refuse a results file of an earlier build, which lacks a series this one appends to
+    !> (the supports' work of the audit, 2026-11-27), before load_results cuts or marks it:
+    !> an interrupted run's partial file stays as it was.
+    subroutine check_results_version(out, error)
+        !> The results file being resumed.
+        type(results_writer_t), intent(in) :: out
+        !> Set when the file lacks the series.
+        type(error_t), allocatable, intent(out) :: error
+        if (out%file%exists('/coupling/energy/fe_reaction_work')) return
+        call make_error(error, "restart: the results file '"//out%file%path//"' was written by an "// &
+                        'earlier version of MULTICOR (its /coupling/energy has no fe_reaction_work): '// &
+                        'continue it with that version, or run the deck again from the start')
+    end subroutine check_results_version
+
+    !> Step `lp%k`: the coupling step (with the FCLIB export at its step), the work after it,
+    !> the guards and the per-step records of /dem and /coupling.
+    subroutine take_step(self, lp, out, report, error)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(inout) :: self
+        !> The loop's state.
+        type(coupled_loop_t), intent(inout) :: lp
+        !> The results file.
+        type(results_writer_t), intent(inout) :: out
+        !> Where a warning of the export goes.
+        procedure(report_iface) :: report
+        !> Set on a failure of the step, a guard or a write.
+        type(error_t), allocatable, intent(out) :: error
+        call take_step_start(lp%start, self%sys%dem%particles, self%sys%dem%walls, &
+                             self%sys%dem%energies%contact_dissipation)
+        if (lp%k == self%fclib_step) then
+            call step_with_export(self, lp%k, out, report, error)
+        else
+            call arlequin_step(self%sys, error)
+        end if
+        if (allocated(error)) return
+        call self%after_step(error)
+        if (allocated(error)) return
+        call check_step(self, lp, error)
+        if (allocated(error)) return
+        call self%dem_out%record_step(out%file, self%sys%dem%stats, error)
+        if (allocated(error)) return
+        call self%cpl_out%record_step(out%file, self%sys, error)
+    end subroutine take_step
+
+    !> One step (as arlequin_step) that writes its local contact problem, the coupling
+    !> rows condensed, in FCLIB's format to <results without .h5>_fclib_<step>.h5.
+    subroutine step_with_export(self, k, out, report, error)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(inout) :: self
+        !> The step.
+        integer(i8), intent(in) :: k
+        !> The results file (its companion file is registered).
+        type(results_writer_t), intent(inout) :: out
+        !> Where the warning of a step without contacts goes.
+        procedure(report_iface) :: report
+        !> Set on a failure of the step or of the export.
+        type(error_t), allocatable, intent(out) :: error
+        type(local_problem_t) :: lp
+        character(len=:), allocatable :: path
+        call arlequin_step(self%sys, error, lp)
+        if (allocated(error)) return
+        if (lp%n == 0) then
+            ! FCLIB's reader refuses a problem without contacts
+            call report(fclib_no_contacts_warning(int(k)))
+            return
+        end if
+        call out%companion(fclib_path(out%final_path, int(k)), path)
+        call write_fclib_local(path, self%settings%title, lp, int(k), self%sys%fe%t, &
+                               self%sys%dem%stats%siconos_error, error)
+    end subroutine step_with_export
+
+    !> Write a checkpoint after step `lp%k` (the buffered per-step values are written first).
+    subroutine write_checkpoint(self, lp, out, ck, error)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(inout) :: self
+        !> The loop's state.
+        type(coupled_loop_t), intent(in) :: lp
+        !> The results file.
+        type(results_writer_t), intent(inout) :: out
+        !> The run's checkpoints.
+        type(checkpoint_run_t), intent(inout) :: ck
+        !> Set on a write failure (the previous checkpoint stays).
+        type(error_t), allocatable, intent(out) :: error
+        type(h5_file_t) :: f
+        call self%dem_out%flush_buffer(out%file, error)
+        if (.not. allocated(error)) call self%cpl_out%flush_buffer(out%file, error)
+        if (allocated(error)) return
+        call checkpoint_create(f, ck%path, ck%deck_text, self%checkpoint_kind(), &
+                               loop_state_t(lp%k, lp%unconverged, lp%speed_warned, .false., lp%rotation_warned, &
+                                            wall_seconds=lp%progress%analysis_seconds(), runs=lp%progress%runs), &
+                               self%sys%fe%t, &
+                               out%run_id, error)
+        if (.not. allocated(error)) call save_coupled(f, self%sys, error)
+        if (.not. allocated(error)) call self%save_part(f, error)
+        if (.not. allocated(error)) call save_dem_writer(f, self%dem_out, error)
+        if (.not. allocated(error)) call save_coupled_writer(f, self%cpl_out, error)
+        if (.not. allocated(error)) call save_results(f, out, error)
+        call ck%finish(f, lp%k, self%sys%fe%t, error)
+    end subroutine write_checkpoint
+
+    !> Guards after step `lp%k` (k = 0: the initial state): the finite-element state, finite
+    !> disk states in the box, no tunnelling in the step.
+    subroutine check_step(self, lp, error)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(in) :: self
+        !> The loop's state (step, and the state at its start).
+        type(coupled_loop_t), intent(in) :: lp
+        !> Set when a guard fails.
+        type(error_t), allocatable, intent(out) :: error
+        integer(i8) :: k
+        k = lp%k
+        call self%check_part(k, error)
+        if (allocated(error)) return
+        associate (sys => self%sys)
+            call check_disks_state(k, sys%fe%t, sys%dem%particles, sys%dem%energies, error)
+            if (allocated(error)) return
+            call check_walls_state(k, sys%fe%t, sys%dem%particles, sys%dem%walls, error)
+            if (allocated(error)) return
+            if (k == 0) return
+            call check_tunnelling(k, sys%fe%t, self%settings%h, sys%dem%scheme%alert, lp%start, &
+                                  sys%dem%particles, sys%dem%walls, sys%dem%contacts, error, &
+                                  sys%dem%energies%contact_dissipation)
+        end associate
+    end subroutine check_step
+
+    !> One stored output: the finite-element side, the disks, the coupling.
+    subroutine store_output(self, out, error)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(inout) :: self
+        !> The results file.
+        type(results_writer_t), intent(inout) :: out
+        !> Set on a non-finite output or a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call self%store_part(out, error)
+        if (allocated(error)) return
+        call self%dem_out%store(out%file, self%sys%dem, error)
+        if (allocated(error)) return
+        call self%cpl_out%store(out%file, self%sys, error)
+        if (allocated(error)) return
+        call out%flush(error)
+    end subroutine store_output
+
+    !> The warnings after step `lp%k`: unconverged solve, lost bonds, a disk faster than the
+    !> alert distance and bonded coupled disks turned too far (once each), bonds that the
+    !> coupling makes redundant (after the first step).
+    subroutine warn_after_step(self, lp, report)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(in) :: self
+        !> The loop's state: its counters and flags updated.
+        type(coupled_loop_t), intent(inout) :: lp
+        !> Where the warnings go.
+        procedure(report_iface) :: report
+        if (.not. self%sys%stats%converged) call warn_unconverged(self, lp, report)
+        if (self%sys%dem%bonds_lost > 0) then
+            lp%lost_warnings = lp%lost_warnings + 1
+            if (lp%lost_warnings <= max_warnings) &
+                call report(lost_bonds_warning(lp%k, self%sys%dem%time, self%sys%dem%bonds_lost))
+            if (lp%lost_warnings == max_warnings) call report('warning: further lost bonds are only logged '// &
+                                                              '(/dem/bonds, mode 5)')
+        end if
+        if (.not. lp%speed_warned) call check_speed(self, lp, report)
+        if (.not. lp%rotation_warned) call check_rotation(self, lp, report)
+        if (lp%k == 1) call check_redundant_bonds(self, report)
+    end subroutine warn_after_step
+
+    !> Warning for an unconverged step (the first max_warnings ones).
+    subroutine warn_unconverged(self, lp, report)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(in) :: self
+        !> The loop's state: its count of unconverged steps updated.
+        type(coupled_loop_t), intent(inout) :: lp
+        !> Where the warning goes.
+        procedure(report_iface) :: report
+        character(len=512) :: buf
+        lp%unconverged = lp%unconverged + 1
+        if (lp%unconverged > max_warnings) return
+        write (buf, '(a,i0,a,es12.4e3,a,i0,a)') 'warning: step ', lp%k, ' (t = ', self%sys%fe%t, &
+            ' s): the joint contact/multiplier solve did not converge in ', self%sys%stats%sweeps, ' sweeps'
+        call report(trim(buf)//self%unconverged_detail())
+        if (lp%unconverged == max_warnings) call report(last_unconverged_warning())
+    end subroutine warn_unconverged
+
+    !> Warning when the initial velocities of the coupled disks differ from the FE model's
+    !> at their centres (beyond round-off: 1e-8 of the velocities, the rotation rows times
+    !> the largest coupled radius, so that a rotation mismatch of rounding next to zero
+    !> rotations does not count). The first step's
+    !> multipliers remove the difference with an impulse that dissipates its energy like a
+    !> plastic impact: the run goes on, but /coupling/energy/balance shows that loss (5 % to
+    !> 30 % of the energy for disks given initial_velocity over a block at rest).
+    subroutine check_initial_velocities(self, report)
+        !> The simulation (initial state).
+        class(arlequin_simulation_t), intent(in) :: self
+        !> Where the warning goes.
+        procedure(report_iface) :: report
+        character(len=512) :: buf
+        real(wp), parameter :: relative = 1.0e-8_wp
+        type(velocity_mismatch_t) :: m
+        m = velocity_mismatch(self%sys)
+        if (hypot(m%translation, m%radius*m%rotation) <= &
+            relative*hypot(m%translation_scale, m%radius*m%rotation_scale)) return
+        write (buf, '(a,es10.3e3,a,es10.3e3,a,es10.3e3,a,es10.3e3,a,i0,a)') &
+            'warning: the initial velocities of the coupled disks differ from the finite-element '// &
+            'model''s at their centres (|G v - C v| = ', m%translation, ' m/s against ', &
+            m%translation_scale, ' m/s, rotations ', m%rotation, ' rad/s against ', m%rotation_scale, &
+            ' rad/s; disk ', m%disk, ' the most)'
+        call report(trim(buf)//': the first step glues them with an impulse that dissipates '// &
+                    'energy like a plastic impact, and /coupling/energy/balance shows that loss; give '// &
+                    'the coupled disks the motion of the finite-element model (e.g. [particles] '// &
+                    'initial_rigid with the rigid motion of [initial] rigid or [continuum] initial_velocity)')
+    end subroutine check_initial_velocities
+
+    !> Warning (once) when a disk moved farther than the alert distance in the step.
+    subroutine check_speed(self, lp, report)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(in) :: self
+        !> The loop's state: `speed_warned` set when warned.
+        type(coupled_loop_t), intent(inout) :: lp
+        !> Where the warning goes.
+        procedure(report_iface) :: report
+        character(len=:), allocatable :: line
+        line = speed_warning(self%sys%dem%particles, self%settings%h, self%sys%dem%scheme%alert, &
+                             self%sys%fe%t)
+        if (len(line) == 0) return
+        lp%speed_warned = .true.
+        call report(line)
+    end subroutine check_speed
+
+    !> Warning (once) when two coupled disks joined by an intact bond have turned by more than
+    !> rotation_limit. The bond keeps their distance through the rotation, the coupling
+    !> (C built on the reference configuration) moves them with the linear field, which
+    !> stretches the chord by about theta^2/2 of its length: the multipliers then carry a
+    !> spurious axial force of about alpha E A theta^2/2 and the bending moments come out
+    !> short (doc/theory.md 6.3).
+    subroutine check_rotation(self, lp, report)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(in) :: self
+        !> The loop's state: `rotation_warned` set when warned.
+        type(coupled_loop_t), intent(inout) :: lp
+        !> Where the warning goes.
+        procedure(report_iface) :: report
+        real(wp), parameter :: rotation_limit = 1.0e-2_wp
+        logical, allocatable :: coupled(:)
+        real(wp) :: theta
+        integer :: c
+        character(len=512) :: buf
+        associate (p => self%sys%dem%particles, cs => self%sys%dem%contacts)
+            if (p%n == 0 .or. size(self%sys%coupled) == 0) return
+            allocate (coupled(p%n), source=.false.)
+            coupled(self%sys%coupled) = .true.
+            theta = 0.0_wp
+            do c = 1, cs%n
+                if (cs%status(c) /= status_cohesive .or. cs%i1(c) <= 0) cycle
+                if (.not. (coupled(cs%i1(c)) .and. coupled(cs%i2(c)))) cycle
+                theta = max(theta, abs(p%rot(cs%i1(c))), abs(p%rot(cs%i2(c))))
+            end do
+            if (theta <= rotation_limit) return
+            write (buf, '(a,es12.4e3,a,es10.2e3,a,es8.1e2,a)') 'warning: at t = ', self%sys%fe%t, &
+                ' s bonded coupled disks have turned by ', theta, ' rad (more than ', rotation_limit, &
+                '): the linear coupling stretches their bonds by about theta^2/2, which adds an '// &
+                'axial force of about alpha E A theta^2/2 and shortens the bending moments by a few % '// &
+                '(doc/theory.md 6.3); lower the load or treat the results as approximate'
+            lp%rotation_warned = .true.
+            call report(trim(buf))
+        end associate
+    end subroutine check_rotation
+
+    !> Warning (after the first step, when the bonds are made) when intact bonds join
+    !> coupled disks across the beam's axis with a multiplier per coupled dof (every layer
+    !> of a stack glued: [coupling] max_offset = 0, the default). The beam's sections do not
+    !> deform, so between two such disks the coupling leaves only the beam's bending and
+    !> stretching over a disk pitch: the bonds and the coupling rows are nearly redundant,
+    !> and any disagreement of their targets (the linear field's stretch, doc/theory.md 6.3;
+    !> round-off) loads them with a self-stress that grows from step to step and can break
+    !> bonds (doc/theory.md 7.10, "Least norm"; measured in
+    !> tests/regression/decks/coupled_glued_layers.dat: |lambda| of 1e4 N under 5 N).
+    subroutine check_redundant_bonds(self, report)
+        !> The simulation (bonds made).
+        class(arlequin_simulation_t), intent(in) :: self
+        !> Where the warning goes.
+        procedure(report_iface) :: report
+        integer, allocatable :: point(:)
+        integer :: c, n, p
+        if (self%sys%on_nodes) return
+        associate (pa => self%sys%dem%particles, cs => self%sys%dem%contacts, op => self%sys%op)
+            if (pa%n == 0 .or. size(self%sys%coupled) == 0) return
+            allocate (point(pa%n), source=0)
+            point(self%sys%coupled) = [(p, p=1, size(self%sys%coupled))]
+            n = 0
+            do c = 1, cs%n
+                if (cs%status(c) /= status_cohesive .or. cs%i1(c) <= 0) cycle
+                if (point(cs%i1(c)) == 0 .or. point(cs%i2(c)) == 0) cycle
+                ! across the axis by more than half the smaller disk: another layer
+                if (op%rigid_distance(point(cs%i1(c)), point(cs%i2(c))) > &
+                    0.5_wp*min(pa%radius(cs%i1(c)), pa%radius(cs%i2(c)))) n = n + 1
+            end do
+        end associate
+        if (n == 0) return
+        call report('warning: '//counted(n, 'intact bond')//' join coupled disks at different distances '// &
+                    'from the beam axis (several layers glued): the beam''s sections do not deform, so '// &
+                    'these bonds and the coupling rows are nearly redundant and carry a self-stress that '// &
+                    'grows with any disagreement of their targets and can break bonds (doc/theory.md 7.10); '// &
+                    'glue one layer ([coupling] max_offset) or use [coupling] multipliers = nodes')
+    end subroutine check_redundant_bonds
+
+    !> Closing lines: the model's (size, residuals, solver effort), energy balance, times.
+    subroutine summary(self, lp, out, report)
+        !> The simulation.
+        class(arlequin_simulation_t), intent(in) :: self
+        !> The loop's state (steps done, unconverged steps, progress).
+        type(coupled_loop_t), intent(in) :: lp
+        !> The results file (whether the run stopped).
+        type(results_writer_t), intent(in) :: out
+        !> Where the lines go.
+        procedure(report_iface) :: report
+        character(len=512) :: buf
+        type(coupled_energies_t) :: en
+        call self%summary_lines(lp%n_steps, lp%unconverged, report)
+        en = coupled_energies(self%sys)
+        write (buf, '(a,es11.3e3,a,es11.3e3,a,es11.3e3,a)') 'energy balance residual ', en%balance, &
+            ' J (max over the outputs ', self%cpl_out%max_balance, ' J; external work ', &
+            en%fe_external_work + en%fe_reaction_work + en%dem_external_work + en%dem_drive_work, ' J)'
+        call report(trim(buf))
+        call report(lp%progress%summary_line(lp%n_steps, self%sys%fe%t, out%stopped()))
+    end subroutine summary
 
     !> 'coupled run: <model>, N disks (M coupled), K steps to t = T s'.
     function run_line(self, model, n_steps) result(line)
