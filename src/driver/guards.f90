@@ -73,10 +73,8 @@ module driver_guards
         real(wp), allocatable :: x(:), y(:)
         !> Wall end points [m].
         real(wp), allocatable :: wx1(:), wy1(:), wx2(:), wy2(:)
-        !> Energy dissipated by the contacts since the start of the run [J/m], when known.
+        !> Energy dissipated by the contacts since the start of the run [J/m].
         real(wp) :: dissipated = 0.0_wp
-        !> `dissipated` was recorded.
-        logical :: has_dissipated = .false.
     end type step_start_t
 
     character(len=*), parameter :: dof_name(3) = ['u    ', 'w    ', 'theta']
@@ -205,8 +203,8 @@ contains
         end do
     end subroutine check_walls_state
 
-    !> Record the disk centres and wall end points at the start of a step (and the energy the
-    !> contacts dissipated so far, when given).
+    !> Record the disk centres and wall end points at the start of a step, and the energy the
+    !> contacts dissipated so far.
     subroutine take_step_start(start, p, w, dissipated)
         !> The record (reused from step to step).
         type(step_start_t), intent(inout) :: start
@@ -215,9 +213,8 @@ contains
         !> The walls.
         type(walls_t), intent(in) :: w
         !> Energy dissipated by the contacts since the start of the run [J/m].
-        real(wp), intent(in), optional :: dissipated
-        start%has_dissipated = present(dissipated)
-        if (present(dissipated)) start%dissipated = dissipated
+        real(wp), intent(in) :: dissipated
+        start%dissipated = dissipated
         start%x = p%x(1:p%n)
         start%y = p%y(1:p%n)
         start%wx1 = w%x1(1:w%n)
@@ -259,7 +256,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         !> Energy dissipated by the contacts since the start of the run, at the end of the step
         !> [J/m].
-        real(wp), intent(in), optional :: dissipated
+        real(wp), intent(in) :: dissipated
         integer :: i, j, k, c
         real(wp) :: travel, created
         ! swept boxes of the disks over the step, and which disks moved beyond the alert
@@ -267,8 +264,7 @@ contains
         real(wp), allocatable :: lo(:), hi(:), ylo(:), yhi(:)
         logical, allocatable :: fast(:)
         ! kinetic energy the contacts gave the bodies in the step (negative: dissipated)
-        created = -huge(1.0_wp)
-        if (present(dissipated) .and. start%has_dissipated) created = start%dissipated - dissipated
+        created = start%dissipated - dissipated
         do i = 1, p%n
             do k = 1, w%n
                 if (.not. crosses_wall(i, k)) cycle

@@ -9,7 +9,7 @@
 !> (N.m for rotation rows), the force the beam exerts on the disk through the glue.
 module driver_results_coupled
     use core_kinds, only: wp
-    use core_error, only: error_t, make_error, make_internal_error
+    use core_error, only: error_t, make_internal_error
     use io_hdf5_file, only: h5_file_t
     use coupling_arlequin, only: coupled_system_t, coupled_energies_t, coupled_energies, &
                                  coordinate_residual, coupled_beam_operator

@@ -4,7 +4,7 @@
 !> that is not a whole number of steps.
 module driver_run_checks
     use core_kinds, only: wp, i8
-    use core_error, only: error_t, make_error, make_input_error
+    use core_error, only: error_t, make_error, make_input_error, make_internal_error
     use core_strings, only: string_t, to_str, num => sci_text
     use io_memory, only: available_memory
     use io_deck, only: deck_t, deck_entry_t
@@ -205,11 +205,18 @@ contains
                         return
                     end if
                     call rectangle_size(e%int('nx'), e%int('ny'), element%element, n_nodes, n_elements)
-                    if (e%word('element') == 't3') then
+                    ! the memory model has a figure per kind (driver_guards): a kind without
+                    ! one is an internal error, not Q4's figure
+                    select case (element%element%name())
+                    case ('t3')
                         part%t3 = n_elements
-                    else
+                    case ('q4')
                         part%q4 = n_elements
-                    end if
+                    case default
+                        call make_internal_error(error, 'check_model_size', 'no memory figure for the element kind '// &
+                                                 element%element%name()//' (driver_guards)')
+                        return
+                    end select
                 case default
                     cycle
                 end select

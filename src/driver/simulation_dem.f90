@@ -1,10 +1,10 @@
 !> Particle (Contact Dynamics) runs: a [particles] deck without [beam].
 module driver_simulation_dem
     use core_error, only: error_t
-    use core_strings, only: string_t, counted, to_str
+    use core_strings, only: string_t, counted
     use core_timefunc, only: time_function_t
     use io_deck, only: deck_t
-    use driver_config, only: run_config_t, build_particles_config
+    use driver_config, only: build_particles_config
     use driver_config_dem, only: dem_config_t, build_dem_config
     use driver_run_dem, only: run_dem
     use driver_results, only: results_writer_t

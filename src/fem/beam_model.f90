@@ -20,7 +20,7 @@ module fem_beam_model
     use core_weight, only: weight_function_t
     use fem_dynamic_operator, only: dynamic_operator_t, spd_factor_t
     use fem_mass_scheme, only: consistent_mass_t
-    use fem_beam_config, only: beam_config_t, beam_load_t, beam_section_t, beam_element_load_t, &
+    use fem_beam_config, only: beam_config_t, beam_load_t, beam_section_t, &
                                load_x, load_y, load_axial, load_transverse
     use fem_beam_element, only: element_stiffness, element_mass_consistent, &
                                 element_mass_lumped, to_global, hermite_shape, rotation_matrix

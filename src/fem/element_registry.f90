@@ -2,7 +2,8 @@
 !> and every other question about the kinds (which kind a deck name or a Gmsh element type
 !> denotes, how many kinds there are, the most nodes an element has) is answered by asking the
 !> elements it makes. A new element kind is a new module extending `element2d_t` and one case
-!> in `new_element`.
+!> in `new_element` (plus its deck word in the schema and its memory figure in the driver,
+!> doc/continuum.md).
 !>
 !> Kind ids are what a mesh stores for each element (`mesh2d_t%kind`) and what the results file
 !> holds in /continuum/mesh/kind: 1 = T3, 2 = Q4; a new kind takes the next id.
