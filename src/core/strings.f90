@@ -8,7 +8,7 @@ module core_strings
     private
     public :: string_t, to_lower, strip, is_blank_char, split_words, join_words
     public :: levenshtein, closest_match, parse_real, parse_int, to_str, shorten, max_echo, is_real_syntax
-    public :: gib, counted, sci_to_str, sci_text, quoted_name
+    public :: gib, counted, sci_to_str, sci_text, quoted_name, same_name
 
     !> Longest token echoed whole in a message (see `shorten`).
     integer, parameter :: max_echo = 40
@@ -127,6 +127,17 @@ contains
             text = name
         end if
     end function quoted_name
+
+    !> Whether two names are the same string, of the same length: Fortran's `==` pads the
+    !> shorter operand with blanks, so that `'a' == 'a '` holds; names compare exactly.
+    pure logical function same_name(a, b)
+        !> A name.
+        character(len=*), intent(in) :: a
+        !> The other name.
+        character(len=*), intent(in) :: b
+        same_name = len(a) == len(b)
+        if (same_name) same_name = a == b
+    end function same_name
 
     !> Join words with a separator: `join_words(['a','b'], ', ')` is `'a, b'`.
     pure function join_words(words, separator) result(joined)

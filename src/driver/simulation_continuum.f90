@@ -13,7 +13,7 @@
 module driver_simulation_continuum
     use core_kinds, only: wp
     use core_error, only: error_t, make_input_error
-    use core_strings, only: string_t, to_str, quoted_name
+    use core_strings, only: string_t, to_str, quoted_name, same_name
     use io_deck, only: deck_t, deck_entry_t
     use fem_mesh2d, only: mesh2d_t
     use fem_mesh_generator, only: rectangle_mesh
@@ -142,9 +142,9 @@ contains
                 if (.not. allocated(error)) call read_file_text(path, text, error)
                 if (.not. allocated(error)) self%mesh_hash = deck_hash(text)
                 if (.not. allocated(error)) then
-                    if (.not. any([(mesh%element_sets(i)%name == 'all', i=1, size(mesh%element_sets))])) &
+                    if (.not. any([(same_name(mesh%element_sets(i)%name, 'all'), i=1, size(mesh%element_sets))])) &
                         call mesh%add_element_set('all', [(i, i=1, mesh%element_count())])
-                    if (.not. any([(mesh%node_sets(i)%name == 'all', i=1, size(mesh%node_sets))])) &
+                    if (.not. any([(same_name(mesh%node_sets(i)%name, 'all'), i=1, size(mesh%node_sets))])) &
                         call mesh%add_node_set('all', [(i, i=1, mesh%node_count())])
                 end if
             end if

@@ -22,9 +22,9 @@
 module fem_gmsh_reader
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_input_error
-    use core_strings, only: string_t, split_words, parse_real, to_str
+    use core_strings, only: string_t, split_words, parse_real, to_str, same_name, strip
     use core_sort, only: sort_index, sort_in_place
-    use fem_mesh2d, only: mesh2d_t
+    use fem_mesh2d, only: mesh2d_t, set_name_problem
     use fem_element_registry, only: kind_of_gmsh_type, kind_node_count, max_node_count
     implicit none
     private
@@ -369,7 +369,7 @@ contains
         type(cursor_t), intent(inout) :: cur
         type(physical_name_t), allocatable, intent(out) :: names(:)
         type(error_t), allocatable, intent(out) :: error
-        character(len=:), allocatable :: text
+        character(len=:), allocatable :: text, message
         integer :: n(1), k, dt(2), q1, q2
         call section_line(cur, text, error)
         if (allocated(error)) return
@@ -381,10 +381,24 @@ contains
         do k = 1, n(1)
             call section_line(cur, text, error)
             if (allocated(error)) return
+            ! The name runs from the first double quote to the next: Gmsh writes a name
+            ! without quotes inside, and nothing after it.
             q1 = index(text, '"')
-            q2 = index(text, '"', back=.true.)
-            if (q1 == 0 .or. q2 <= q1 + 1) then
+            q2 = 0
+            if (q1 > 0) q2 = index(text(q1 + 1:), '"')
+            if (q1 == 0 .or. q2 <= 1) then
                 call fail(cur, error, 'expected dim tag "name", found "'//trim(text)//'"')
+                return
+            end if
+            q2 = q1 + q2
+            if (verify(text(q2 + 1:), ' '//achar(9)) > 0) then
+                if (index(text(q2 + 1:), '"') > 0) then
+                    call fail(cur, error, 'a physical name cannot hold a double quote (Gmsh writes none), found '// &
+                              trim(text(q1:))//' (expected dim tag "name")')
+                else
+                    call fail(cur, error, 'text after the name "'//text(q1 + 1:q2 - 1)//'": "'// &
+                              strip(text(q2 + 1:))//'" (expected dim tag "name", nothing after it)')
+                end if
                 return
             end if
             call read_ints(cur, text(1:q1 - 1), 2, dt, error)
@@ -392,6 +406,12 @@ contains
             names(k)%dim = dt(1)
             names(k)%tag = dt(2)
             names(k)%name = text(q1 + 1:q2 - 1)
+            message = set_name_problem(names(k)%name)
+            if (len(message) > 0) then
+                call fail(cur, error, 'physical group "'//names(k)%name//'" (dimension '//to_str(dt(1))// &
+                          ', tag '//to_str(dt(2))//'): '//message//'; rename the group in the .geo file')
+                return
+            end if
         end do
     end subroutine read_physical_names
 
@@ -940,7 +960,7 @@ contains
                 if (blocks(bb)%type /= 1) cycle
                 phys = entity_physical(entities, blocks(bb)%dim, blocks(bb)%tag)
                 do q = 1, size(phys)
-                    if (group_name(names, blocks(bb)%dim, phys(q)) /= mesh%edge_sets(failed(1))%name) cycle
+                    if (.not. same_name(group_name(names, blocks(bb)%dim, phys(q)), mesh%edge_sets(failed(1))%name)) cycle
                     if (kk <= size(blocks(bb)%lines)) return
                     kk = kk - size(blocks(bb)%lines)
                     exit

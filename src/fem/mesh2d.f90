@@ -10,11 +10,11 @@
 module fem_mesh2d
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
-    use core_strings, only: to_str
+    use core_strings, only: to_str, same_name
     use fem_element_registry, only: kind_node_count
     implicit none
     private
-    public :: mesh2d_t, named_set_t, edge_set_t
+    public :: mesh2d_t, named_set_t, edge_set_t, set_name_problem
 
     !> A named set of node or element indices.
     type :: named_set_t
@@ -210,14 +210,41 @@ contains
         out = pack([(k, k=1, size(mark))], mark)
     end function sorted_unique
 
-    !> Index of the set called name in sets (0 if none).
+    !> Why `name` cannot name a set ('' when it can). The results file stores each set as an
+    !> HDF5 link named after it (/continuum/sets/nodes/<name>), where '/' separates groups and
+    !> '.' is the group itself, and HDF5's Fortran interface drops the trailing blanks of a link
+    !> name: a name with '/' was stored under another name ('a/b' as dataset b of a group a) or
+    !> failed the write, '.' failed it, 'a ' was stored as 'a'. HDF5 stores '..', but tools that
+    !> resolve paths (Python's posixpath.normpath) read it as the parent group: refused with '.'.
+    !> A blank name (blanks and tabs only) is refused too. Leading blanks and tabs are kept.
+    pure function set_name_problem(name) result(why)
+        !> The name, as written.
+        character(len=*), intent(in) :: name
+        character(len=:), allocatable :: why
+        character(len=*), parameter :: stored = 'the results file stores each set as an HDF5 link named after it'
+        why = ''
+        if (verify(name, ' '//achar(9)) == 0) then
+            why = 'the name is blank: a set name needs a character other than a blank'
+        else if (index(name, '/') > 0) then
+            why = 'the name holds a ''/'': '//stored//', where ''/'' separates groups'
+        else if (same_name(name, '.') .or. same_name(name, '..')) then
+            why = 'the name is '''//name//''': '//stored//', where ''.'' is the group itself and ''..'' its '// &
+                  'parent in a path'
+        else if (name(len(name):) == ' ') then
+            why = 'the name ends in a blank: '//stored//', and HDF5 drops the trailing blanks of a link name (it '// &
+                  'would be stored as "'//trim(name)//'", another name)'
+        end if
+    end function set_name_problem
+
+    !> Index of the set called name in sets (0 if none): the name exactly, so that 'a' and
+    !> 'a ' (a Gmsh group with a trailing blank) are two sets.
     pure integer function find_set(sets, name) result(k)
         type(named_set_t), allocatable, intent(in) :: sets(:)
         character(len=*), intent(in) :: name
         k = 0
         if (.not. allocated(sets)) return
         do k = 1, size(sets)
-            if (sets(k)%name == name) return
+            if (same_name(sets(k)%name, name)) return
         end do
         k = 0
     end function find_set
@@ -284,7 +311,7 @@ contains
         type(edge_set_t), allocatable :: grown(:)
         if (.not. allocated(self%edge_sets)) allocate (self%edge_sets(0))
         do k = 1, size(self%edge_sets)
-            if (self%edge_sets(k)%name == name) then
+            if (same_name(self%edge_sets(k)%name, name)) then
                 allocate (merged(2, size(self%edge_sets(k)%nodes, 2) + size(edges, 2)))
                 merged(:, 1:size(self%edge_sets(k)%nodes, 2)) = self%edge_sets(k)%nodes
                 merged(:, size(self%edge_sets(k)%nodes, 2) + 1:) = edges
@@ -359,7 +386,7 @@ contains
         character(len=:), allocatable :: names
         if (allocated(self%edge_sets)) then
             do k = 1, size(self%edge_sets)
-                if (self%edge_sets(k)%name == name) then
+                if (same_name(self%edge_sets(k)%name, name)) then
                     edges = self%edge_sets(k)%nodes
                     if (present(elements)) elements = self%edge_sets(k)%elements
                     return
