@@ -259,7 +259,7 @@ contains
             character(len=:), allocatable :: s, key, value, message
             type(string_t), allocatable :: tokens(:)
             logical, allocatable :: quoted(:)
-            integer :: hash, eq, k, raw_eq, last
+            integer :: hash, eq, k, raw_eq, last, glued
             hash = index(raw, '#')
             ! The values of a keyword line may hold double-quoted names, where '#' is no
             ! comment; those of a text keyword (title) are the rest of the line up to the first
@@ -348,7 +348,12 @@ contains
                     return
                 end if
             end if
-            call check_values(schema%keywords(k), tokens, quoted, file, line_no, error)
+            ! A '#' glued to the text after it (`block #2.msh`) may have cut a name in two.
+            glued = 0
+            if (hash > 0 .and. hash < len(raw)) then
+                if (.not. is_blank_char(raw(hash + 1:hash + 1))) glued = hash
+            end if
+            call check_values(schema%keywords(k), tokens, quoted, file, line_no, error, glued)
             if (allocated(error)) return
             if (first_line(k) == 0) first_line(k) = line_no
             open_header = 0
@@ -649,7 +654,7 @@ contains
 
     !> Check the values of one line: count (fixed fields and tail), types, ranges, words, and
     !> that only names were quoted.
-    subroutine check_values(spec, tokens, quoted, file, line, error)
+    subroutine check_values(spec, tokens, quoted, file, line, error, comment)
         !> Keyword spec.
         type(keyword_spec_t), intent(in) :: spec
         !> Values as written (quotes taken off).
@@ -662,6 +667,9 @@ contains
         integer, intent(in) :: line
         !> Error, if any.
         type(error_t), allocatable, intent(out) :: error
+        !> Column of the '#' that starts the line's comment when text follows it without a blank
+        !> (absent or 0: none), for the hint of a name that ran into it.
+        integer, intent(in), optional :: comment
         character(len=:), allocatable :: message, selector
         integer :: nf, ntok, i, kt, g
         logical :: ok
@@ -728,7 +736,7 @@ contains
         subroutine count_error(what)
             character(len=*), intent(in) :: what
             character(len=:), allocatable :: hint
-            integer :: last_expected, kt_here
+            integer :: last_expected, kt_here, p, extra
             hint = ''
             if (what == 'too many') then
                 ! the last value expected may be a name that went on past its first blank
@@ -736,10 +744,47 @@ contains
                 kt_here = spec%tail_index(selector)
                 if (kt_here > 0) last_expected = nf + spec%tails(kt_here)%max_values
                 hint = name_hint(last_expected, ntok)
+                ! or a name among the fixed fields, when the line is valid with the words after
+                ! it joined into that name (`fix = left edge x y`; not `load = top x 1 2 3`)
+                do p = 1, nf
+                    do extra = ntok - last_expected, ntok - nf
+                        if (len(hint) > 0) exit
+                        if (fits_joined(p, extra)) hint = name_hint(p, p + extra)
+                    end do
+                end do
             end if
             call make_input_error(error, file, line, spec%name, what//' values (got '// &
                                   to_str(ntok)//"): expected '"//spec%usage(selector)//"'"//hint)
         end subroutine count_error
+
+        !> Whether the values would fit the fields if value p, a name written without quotes,
+        !> took the `extra` values after it (their count, types and words; no selector among
+        !> the values moved).
+        logical function fits_joined(p, extra) result(fits)
+            integer, intent(in) :: p, extra
+            integer :: q, kt_here
+            character(len=:), allocatable :: why
+            type(field_spec_t) :: f
+            fits = .false.
+            if (extra < 1 .or. quoted(p) .or. spec%fields(p)%value_type /= field_name) return
+            if (spec%selector > p) return
+            do q = p + 1, nf
+                call spec%fields(q)%check(tokens(q + extra)%s, fits, why)
+                if (.not. fits) return
+            end do
+            kt_here = spec%tail_index(selector)
+            fits = kt_here > 0 .or. ntok - extra == nf
+            if (kt_here == 0) return
+            associate (t => spec%tails(kt_here))
+                fits = ntok - extra - nf >= t%min_values .and. (t%max_values < 0 .or. ntok - extra - nf <= t%max_values)
+                if (t%cyclic) fits = fits .and. modulo(ntok - extra - nf, size(t%fields)) == 0
+                do q = 1, ntok - extra - nf
+                    if (.not. fits) return
+                    f = t%field(q)
+                    call f%check(tokens(nf + q + extra)%s, fits, why)
+                end do
+            end associate
+        end function fits_joined
 
         !> When value p is a name written without quotes, values p + 1 .. k (the one that went
         !> wrong, or the last of too many) may be the rest of a name with blanks, split into
@@ -765,6 +810,11 @@ contains
                 joined = joined//' '//tokens(q)%s
             end do
             hint = '; if "'//shorten(joined)//'" is one name, write it in double quotes'
+            ! the name may go on after a '#' (`My Meshes/block #2.msh`)
+            if (present(comment) .and. k == ntok) then
+                if (comment > 0) hint = hint//" (outside them '#' starts a comment, which cut the line at column "// &
+                                        to_str(comment)//')'
+            end if
         end function name_hint
     end subroutine check_values
 

@@ -690,14 +690,16 @@ contains
                        ' of '//to_str(g)//')'
             end if
         else
-            do i = 1, g
+            ! The last field repeats up to max_values: 'component [component]', 'dof [dof] [dof]'.
+            do i = 1, max(g, self%max_values)
                 if (i > 1) text = text//' '
                 if (i > self%min_values) then
-                    text = text//'['//self%fields(i)%name//']'
+                    text = text//'['//self%fields(min(i, g))%name//']'
                 else
-                    text = text//self%fields(i)%name
+                    text = text//self%fields(min(i, g))%name
                 end if
             end do
+            if (self%max_values < 0) text = text//' ...'
         end if
     end function tail_usage
 
