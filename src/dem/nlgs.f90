@@ -242,6 +242,10 @@ module dem_nlgs
         real(wp) :: residual = 0.0_wp
         !> Siconos error of the final state (nlgs_siconos_error), whatever the criterion.
         real(wp) :: siconos_error = 0.0_wp
+        !> Estimate of the round-off floor of the Siconos error at the final state
+        !> (siconos_floor): set when a solve under the Siconos criterion stops unconverged,
+        !> 0 otherwise. A tolerance below it cannot be reached by any number of sweeps.
+        real(wp) :: siconos_floor = 0.0_wp
         !> Over-relaxation factor at the end of the solve (1 once the safeguard fell back).
         real(wp) :: relaxation = 1.0_wp
         !> error <= tol reached.
@@ -612,6 +616,13 @@ module dem_nlgs
             logical, intent(in), optional :: held(:)
         end function siconos_error
 
+        !> Estimate of the round-off floor of the Siconos error of the current reactions
+        !> (submodule dem_nlgs_siconos).
+        real(wp) module function siconos_floor(cs, im, vfree, vel, nq) result(floor)
+            type(contact_set_t), intent(in) :: cs
+            real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :), nq
+        end function siconos_floor
+
         !> Siconos error of the contact problem u = W r + q over the active contacts,
         !> sqrt(sum_a |r_a - P_K(r_a - u_hat_a)|^2) / max(|q|, |r|, |u|) (doc/theory.md 4.5;
         !> submodule dem_nlgs_siconos).
@@ -858,6 +869,9 @@ contains
         else
             stats%siconos_error = siconos_error(cs, im, vfree, vel, vwork, present(bilateral), nq)
         end if
+        stats%siconos_floor = 0.0_wp
+        if (criterion%is_siconos_error() .and. .not. stats%converged) &
+            stats%siconos_floor = siconos_floor(cs, im, vfree, vel, nq)
     end subroutine nlgs_solve
 
     !> Name of the settings' stopping criterion (lmgc90 when none is set).

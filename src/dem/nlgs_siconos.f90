@@ -89,6 +89,66 @@ contains
         nq = qmax*sqrt(nq)
     end function siconos_free_norm
 
+    !> Estimate of the round-off floor of the Siconos error of the current reactions. The local
+    !> velocities u = H^T (vfree + M^-1 H r) + shift are sums whose terms can be far larger than
+    !> u: under a heavy disk a light one receives two opposite impulses of the heavy one's
+    !> weight, each changing its velocity by (m_heavy / m_light) g h, and they cancel. Each
+    !> component of u is then known only to epsilon times the magnitudes summed into it, so
+    !> the error cannot fall below epsilon times the norm of those magnitudes over its
+    !> denominator max(|q|, |r|, |u|) (nq = |q|). The magnitudes: per disk |vfree| plus
+    !> M^-1 times the sum of the absolute impulses of its active contacts (plus the net
+    !> velocity change of bilateral constraints, if any, in vel), then per contact the
+    !> absolute frame components of its two disks' magnitudes and of its shift. An estimate
+    !> of the worst rounding, not a bound: a tolerance below it is out of reach (a stack at a
+    !> mass ratio of 5e5 stalls at about the estimate, `test_nlgs`).
+    real(wp) module function siconos_floor(cs, im, vfree, vel, nq) result(floor)
+        type(contact_set_t), intent(in) :: cs
+        real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :), nq
+        real(wp), allocatable :: s(:, :), vnet(:, :)
+        real(wp) :: m(3), u(3), px, py, mz1, mz2, nx, ny, num, nr, nu, den
+        integer :: k, a, b
+        ! the velocities of the contacts alone; what vel holds beyond them is the bilateral part
+        allocate (vnet, source=vfree)
+        do k = 1, cs%n
+            if (cs%active(k)) call contacts_apply_impulse(cs, k, im, vnet, cs%r(1, k), cs%r(2, k), cs%r(3, k))
+        end do
+        s = abs(vfree) + abs(vel - vnet)
+        do k = 1, cs%n
+            if (.not. cs%active(k)) cycle
+            a = cs%i1(k)
+            b = cs%i2(k)
+            px = abs(cs%r(1, k)*cs%nrm(1, k)) + abs(cs%r(2, k)*cs%nrm(2, k))
+            py = abs(cs%r(1, k)*cs%nrm(2, k)) + abs(cs%r(2, k)*cs%nrm(1, k))
+            mz2 = abs(cs%lever(2, k)*cs%r(2, k)) + abs(cs%r(3, k))
+            mz1 = abs(cs%lever(1, k)*cs%r(2, k)) + abs(cs%r(3, k))
+            s(:, b) = s(:, b) + im(:, b)*[px, py, mz2]
+            if (a > 0) s(:, a) = s(:, a) + im(:, a)*[px, py, mz1]
+        end do
+        num = 0.0_wp
+        nr = 0.0_wp
+        nu = 0.0_wp
+        do k = 1, cs%n
+            if (.not. cs%active(k)) cycle
+            a = cs%i1(k)
+            b = cs%i2(k)
+            nx = abs(cs%nrm(1, k))
+            ny = abs(cs%nrm(2, k))
+            m = [nx*s(1, b) + ny*s(2, b) + abs(cs%shift(1, k)), &
+                 ny*s(1, b) + nx*s(2, b) + abs(cs%lever(2, k))*s(3, b) + abs(cs%shift(2, k)), s(3, b)]
+            if (a > 0) m = m + [nx*s(1, a) + ny*s(2, a), ny*s(1, a) + nx*s(2, a) + abs(cs%lever(1, k))*s(3, a), &
+                                s(3, a)]
+            if (cs%erol(k) <= 0.0_wp) m(3) = 0.0_wp
+            num = num + sum(m**2)
+            call contacts_solver_velocity(cs, k, vel, u)
+            if (cs%erol(k) <= 0.0_wp) u(3) = 0.0_wp
+            nr = nr + (cs%r(1, k) + cs%coh(k))**2 + cs%r(2, k)**2 + merge(cs%r(3, k)**2, 0.0_wp, cs%erol(k) > 0.0_wp)
+            nu = nu + sum(u**2)
+        end do
+        den = max(nq, sqrt(nr), sqrt(nu))
+        floor = 0.0_wp
+        if (den > 0.0_wp) floor = epsilon(1.0_wp)*sqrt(num)/den
+    end function siconos_floor
+
     !> The ratio of nlgs_siconos_error for the velocities vel, with nq = |q|
     !> (siconos_free_norm), over the active contacts act (in increasing order). With `held`
     !> (size >= cs%n), the contacts k with held(k) are measured as the bilateral constraints

@@ -31,7 +31,7 @@ module driver_coupled_loop
     use driver_results, only: results_writer_t
     use driver_results_dem, only: dem_writer_t
     use driver_results_coupled, only: coupled_writer_t
-    use driver_run_dem, only: max_warnings, speed_warning, last_unconverged_warning, fclib_path, &
+    use driver_run_dem, only: max_warnings, speed_warning, last_unconverged_warning, fclib_path, tolerance_floor_hint, &
                               fclib_after_end_warning, fclib_no_contacts_warning, lost_bonds_warning
     use driver_results_dem, only: write_fclib_local
     use dem_local_problem, only: local_problem_t
@@ -489,7 +489,8 @@ contains
         if (lp%unconverged > max_warnings) return
         write (buf, '(a,i0,a,es12.4e3,a,i0,a)') 'warning: step ', lp%k, ' (t = ', self%sys%fe%t, &
             ' s): the joint contact/multiplier solve did not converge in ', self%sys%stats%sweeps, ' sweeps'
-        call report(trim(buf)//self%unconverged_detail())
+        call report(trim(buf)//self%unconverged_detail()// &
+                    tolerance_floor_hint(self%sys%dem%stats%siconos_floor, self%sys%dem%solver%tol))
         if (lp%unconverged == max_warnings) call report(last_unconverged_warning())
     end subroutine warn_unconverged
 

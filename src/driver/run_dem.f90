@@ -28,6 +28,7 @@ module driver_run_dem
     implicit none
     private
     public :: run_dem, max_warnings, report_line_iface, speed_warning, last_unconverged_warning
+    public :: tolerance_floor_hint
     public :: fclib_path, fclib_after_end_warning, fclib_no_contacts_warning, lost_bonds_warning
 
     !> Unconverged steps reported one by one; later ones are only counted.
@@ -235,7 +236,7 @@ contains
                 ' (t = ', cfg%system%time, ' s): the contact solver did not converge in ', &
                 cfg%system%stats%sweeps, ' sweeps (error ', cfg%system%stats%error, &
                 ' > tolerance ', cfg%system%solver%tol, ')'
-            call report(trim(buf))
+            call report(trim(buf)//tolerance_floor_hint(cfg%system%stats%siconos_floor, cfg%system%solver%tol))
             if (unconverged == max_warnings) call report(last_unconverged_warning())
         end subroutine warn_unconverged
 
@@ -311,6 +312,26 @@ contains
                'alert), which a bond holding the velocity allows under spin; logged in /dem/bonds with mode 5 '// &
                '(lost); a larger alert distance or a shorter step keeps them'
     end function lost_bonds_warning
+
+    !> Text added to an unconverged step's warning when the tolerance is more than ten times
+    !> below the estimated round-off floor of the Siconos error (nlgs_stats_t%siconos_floor; 0
+    !> when not estimated): '' otherwise. The estimate is a worst case, 4 to 10 times the level
+    !> the sweeps reach (`test_nlgs`), so a tolerance below a tenth of it is out of reach: each
+    !> step then runs to max_sweeps.
+    function tolerance_floor_hint(floor, tol) result(text)
+        !> Estimated floor of the error at the step's end.
+        real(wp), intent(in) :: floor
+        !> The tolerance of [solver].
+        real(wp), intent(in) :: tol
+        character(len=:), allocatable :: text
+        character(len=16) :: fbuf
+        text = ''
+        if (.not. tol < 0.1_wp*floor) return
+        write (fbuf, '(es10.2e3)') floor
+        text = '; the tolerance is more than ten times below the round-off floor of the Siconos error at this '// &
+               'state (estimated '//trim(adjustl(fbuf))//'; u = W r + q cancels terms far larger than u): '// &
+               'no number of sweeps reaches it, raise [solver] tolerance'
+    end function tolerance_floor_hint
 
     !> Line closing the series of per-step warnings about unconverged steps.
     pure function last_unconverged_warning() result(line)

@@ -551,6 +551,24 @@ def unconverged(exe, decks, work):
     check("unconverged: contacts = no stores no network", not has_contacts, "")
 
 
+def tolerance_floor(exe, decks, work):
+    """dem_tolerance_floor.dat: a tolerance far below the round-off floor of the Siconos
+    error is called unreachable in the unconverged steps' warnings; one above it is not."""
+    _, out = run(exe, decks / "dem_tolerance_floor.dat", work, quiet=False)
+    unreachable = "more than ten times below the round-off floor of the Siconos error"
+    warnings = [line for line in out.splitlines() if line.startswith("warning: step")]
+    check("tolerance floor: each unconverged step calls 1e-14 unreachable",
+          len(warnings) == 2 and all(unreachable in line for line in warnings), "\n".join(warnings))
+    deck = work / "dem_tolerance_floor_1e-11.dat"
+    deck.write_text((decks / "dem_tolerance_floor.dat").read_text().replace("tolerance = 1e-14", "tolerance = 1e-11"))
+    _, out = run(exe, deck, work, quiet=False)
+    warnings = [line for line in out.splitlines() if line.startswith("warning: step")]
+    # still unconverged at 300 sweeps (the sweeps bring a light disk under a heavy one into
+    # line slowly), but 1e-11 is above the floor: the warning must not say otherwise
+    check("tolerance floor: 1e-11 unconverged but not called unreachable",
+          len(warnings) == 2 and not any(unreachable in line for line in warnings), "\n".join(warnings))
+
+
 def rigid_spin(exe, decks, work):
     rho, R, pitch, vx, vy, om, xc, yc = 2500.0, 0.01, 0.025, 0.5, -0.3, 2.0, 0.02, 0.01
     f, _ = run(exe, decks / "dem_rigid_spin.dat", work)
@@ -599,6 +617,7 @@ def main():
     cohesive_row(exe, src, work)
     small_deposit(exe, decks, work)
     unconverged(exe, decks, work)
+    tolerance_floor(exe, decks, work)
     strategies(exe, src, work)
     deposit_strategies(exe, decks, work)
     coarse_on_impacts(exe, src, work)
