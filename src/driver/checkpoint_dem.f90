@@ -7,7 +7,9 @@ module driver_checkpoint_dem
     use core_error, only: error_t, make_error, make_internal_error
     use core_strings, only: to_str
     use io_hdf5_file, only: h5_file_t
-    use dem_contacts, only: contacts_list_problem
+    use dem_contacts, only: contacts_list_problem, status_open, status_broken
+    use dem_bipotential, only: case_slip_roll
+    use dem_bonds, only: break_none, break_tension, break_lost
     use dem_moreau_jean, only: dem_system_t
     use dem_solve_method, only: sweeps_method_t
     use dem_bonded_block, only: bonded_block_method_t, bonded_block_restore
@@ -507,9 +509,10 @@ contains
             if (.not. allocated(error)) call require_finite(cs%coh, g//'/coh', error)
             ! codes: dem_contacts status_*, dem_bipotential case_* (0 before a solve),
             ! dem_bonds break_*
-            if (.not. allocated(error)) call require_range(cs%status, 0, 4, g//'/status', error)
-            if (.not. allocated(error)) call require_range(cs%pcase, 0, 5, g//'/pcase', error)
-            if (.not. allocated(error)) call require_range(cs%break_mode, 0, 4, g//'/break_mode', error)
+            if (.not. allocated(error)) call require_range(cs%status, status_open, status_broken, g//'/status', error)
+            if (.not. allocated(error)) call require_range(cs%pcase, 0, case_slip_roll, g//'/pcase', error)
+            if (.not. allocated(error)) &
+                call require_range(cs%break_mode, break_none, break_lost, g//'/break_mode', error)
             if (.not. allocated(error)) call require_range(active, 0, 1, g//'/active', error)
             if (allocated(error)) return
             cs%active = active /= 0
@@ -585,8 +588,9 @@ contains
             if (.not. allocated(error)) call require_range(rl%i2, 1, sys%particles%n, g//'/i2', error)
             if (.not. allocated(error)) call require_range(rupture_step, 1, int(step), g//'/step', error)
             if (.not. allocated(error)) call require_finite(rl%time, g//'/time', error)
-            ! dem_bonds break_tension .. break_shear_moment
-            if (.not. allocated(error)) call require_range(rl%mode, 1, 4, g//'/mode', error)
+            ! dem_bonds break_tension .. break_lost (a bond the detection lost, logged like a
+            ! rupture: a checkpoint after one was refused as damaged)
+            if (.not. allocated(error)) call require_range(rl%mode, break_tension, break_lost, g//'/mode', error)
             if (allocated(error)) return
             rl%step = int(rupture_step, i8)
         end associate

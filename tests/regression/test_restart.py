@@ -957,6 +957,17 @@ def main():
     with h5py.File(work / "spin_end_first_checkpoint.h5", "r") as c:
         status = c["dem/contacts/status"][...].tolist() if "dem/contacts/status" in c else []
     check("spin_end: the checkpoint holds the pair's intact bond", status == [3], f"statuses {status}")
+    # The same pair at 50 rad/s: the rigid bond holds the velocity, so the pair drifts apart by
+    # about d (omega h)^2 / 2 per step and the detection loses the bond at step 117 (logged in
+    # /dem/bonds with mode 5, lost). Stopped at step 200, after the loss: a checkpoint holding
+    # a lost bond was refused as damaged ('/dem/ruptures/mode is 5, outside 1..4').
+    lost = work / "spin_lost.dat"
+    lost.write_text(SPIN.replace("initial_rigid = all 0 0 5.0", "initial_rigid = all 0 0 50.0")
+                    .replace("end = 0.2", "end = 0.4"))
+    by_end_time(exe, lost, work, "lost_end", 0.2)
+    with h5py.File(work / "lost_end_first_checkpoint.h5", "r") as c:
+        modes = c["dem/ruptures/mode"][...].tolist() if "dem/ruptures/mode" in c else []
+    check("lost_end: the checkpoint holds the lost bond (mode 5)", modes == [5], f"modes {modes}")
     # The deposit compared with Siconos, with Siconos' rule of activation ([time] contact_scheme
     # = siconos): the rule reads the outputs of the previous step's contacts, which the
     # checkpoint keeps (dem/contacts/y). Stopped at step 85, while the pile forms.
