@@ -7,7 +7,7 @@ Writes, depending on what the run stored: <name>_deflection.png (deflection alon
 beam, or the deformed shape of a frame, at the stored time nearest to T; default the last),
 <name>_history_node<ID>.png (w(t) and u(t) of node ID; default the tip), <name>_energy.png,
 <name>_static.png and <name>_modes.png. Exit code 1 with a message on a missing or invalid
-file.
+file, or one with no stored output (a run stopped before its first).
 """
 import argparse
 import os

@@ -17,7 +17,7 @@ nearest to T), and for a dynamic run <name>_continuum_energy.png and <name>_hist
 node --node, a 1-based mesh index; default the node with the largest displacement), for a modal run
 <name>_modes.png; coupled to disks (/coupling), <name>_coupling.png (the same diagnostics as a
 beam-coupled run's) and the particle plots too. Exit code 1 with a message on a missing or
-invalid file.
+invalid file, or one with no stored output (a run stopped before its first).
 """
 import argparse
 import os

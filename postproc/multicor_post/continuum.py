@@ -24,7 +24,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
 from .beam import _time_unit
-from .results import FigureFiles, ResultsError
+from .results import FigureFiles, ResultsError, no_output_error
 
 
 @dataclass
@@ -99,6 +99,8 @@ def load_continuum(path) -> ContinuumResults:
         else:
             analysis = "dynamic"
             time = need("continuum/time")
+            if time.size == 0:
+                raise no_output_error(f, path, "continuum/time")
             u = need("continuum/displacement")
             stress = need("continuum/stress")
             energy = {name: need(f"continuum/energy/{name}") for name in ENERGY_TERMS}
@@ -109,6 +111,8 @@ def load_continuum(path) -> ContinuumResults:
             res.disk_position = f["dem/position"][...]
             res.disk_radius = need("dem/particles/radius")
             res.disk_time = need("dem/time")
+            if res.disk_time.size == 0:
+                raise no_output_error(f, path, "dem/time")
             if "dem/walls/position" in f:
                 res.walls = f["dem/walls/position"][...]
     return res

@@ -25,7 +25,8 @@ from matplotlib.collections import EllipseCollection
 from matplotlib.figure import Figure
 
 from .beam import _time_unit
-from .results import FigureFiles, ResultsError, _decode_attrs, _Getter, _open_results
+from .results import (FigureFiles, ResultsError, _decode_attrs, _Getter, _open_results,
+                      no_output_error)
 
 #: Columns of the nodal and per-disk arrays: x (u), y (w), rotation.
 X, Y, ROT = 0, 1, 2
@@ -97,6 +98,8 @@ def load_continuum_coupling(path) -> CouplingDiagnostics:
                                "continuum coupled to disks)")
         get = _Getter(f, path, kind="coupled continuum results file")
         time = get("coupling/time", (None,))
+        if time.size == 0:
+            raise no_output_error(f, path, "coupling/time")
         _same_times(path, time, get("continuum/time", (time.size,)),
                     "/coupling/time and /continuum/time")
         return _read_coupling(f, get, path, time, body="continuum")
@@ -176,6 +179,8 @@ def load_coupled(path) -> CoupledResults:
         xy = get("fem/mesh/coordinates", (None, 2))
         n_nodes = xy.shape[0]
         time = get("fem/time", (None,))
+        if time.size == 0:
+            raise no_output_error(f, path, "fem/time")
         n_out = time.size
         radius = get("dem/particles/radius", (None,))
         n = radius.size

@@ -18,7 +18,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from .beam import _time_unit
-from .results import FigureFiles, ResultsError, _decode_attrs, _Getter, _open_results
+from .results import (FigureFiles, ResultsError, _decode_attrs, _Getter, _open_results,
+                      no_output_error)
 
 #: Columns of the per-disk arrays: x [m], y [m], rotation [rad].
 X, Y, ROT = 0, 1, 2
@@ -134,6 +135,8 @@ def load_dem(path) -> DemResults:
         radius = get("dem/particles/radius", (None,))
         n = radius.size
         time = get("dem/time", (None,))
+        if time.size == 0:
+            raise no_output_error(f, path, "dem/time")
         n_out = time.size
         walls = None
         if "dem/walls/position" in f:

@@ -96,7 +96,39 @@ def file_contents(path) -> tuple[bool, bool, bool, bool]:
         if "fclib_local" in f:
             raise ResultsError(f"'{path}' is a contact problem exported in FCLIB's format "
                                "([solver] fclib_step), not a results file")
-        return "fem/mesh" in f, "dem" in f, "coupling" in f, "continuum/mesh" in f
+        contents = ("fem/mesh" in f, "dem" in f, "coupling" in f, "continuum/mesh" in f)
+        # a run killed before its first stored output leaves the root attributes and /summary
+        status = unfinished_status(f)
+        if (not any(contents) and status is not None
+                and _decode_attrs(f.attrs).get("code_name") == "MULTICOR"):
+            raise ResultsError(f"'{path}' is the {STOPPED_BEFORE_OUTPUT} (status: {status})")
+        return contents
+
+
+#: What the scripts say of the file of a run that stopped before its first stored output.
+STOPPED_BEFORE_OUTPUT = "partial file of a run stopped before its first stored output: nothing to plot"
+
+
+def unfinished_status(f) -> Optional[str]:
+    """The /summary status of an open results file whose run did not finish (finished = 0:
+    a partial file); None for a finished run's file or one without /summary."""
+    if "summary" not in f:
+        return None
+    attrs = _decode_attrs(f["summary"].attrs)
+    if int(attrs.get("finished", 1)) != 0:
+        return None
+    return str(attrs.get("status", "")) or "unknown"
+
+
+def no_output_error(f, path: str, dataset: str) -> ResultsError:
+    """The error for an open results file whose time series ``dataset`` (e.g. 'dem/time')
+    holds no record: saying so, and for a partial file that its run stopped before its first
+    stored output."""
+    status = unfinished_status(f)
+    if status is not None:
+        return ResultsError(f"'{path}' is the {STOPPED_BEFORE_OUTPUT} (/{dataset} holds none; "
+                            f"status: {status})")
+    return ResultsError(f"{path}: /{dataset} holds no stored output: nothing to plot")
 
 
 def figure_stem(path) -> str:
@@ -224,6 +256,8 @@ def load_results(path) -> Results:
         res = Results(path=path, attrs=_decode_attrs(f.attrs), mesh=mesh)
         if "fem/time" in f:
             time = reader.array("fem/time", ndim=1)
+            if time.size == 0:
+                raise no_output_error(f, path, "fem/time")
             shape = (time.size, n, 3)
             res.dynamic = Dynamic(time=time,
                                   displacement=reader.array("fem/displacement", shape=shape),

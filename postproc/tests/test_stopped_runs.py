@@ -1,0 +1,141 @@
+"""Files of runs stopped early: the plotting scripts say why there is nothing to plot, in one
+line, never with a traceback.
+
+The files mimic what `kill -9` leaves (doc/output.md, Interrupted runs). Killed before its
+first stored output, a run's partial file holds the root attributes and /summary only
+(finished = 0, status = 'running (or killed)'); killed after the output datasets were
+created but before their first record, it holds time series of 0 records.
+"""
+import h5py
+import numpy as np
+import pytest
+from synthetic_dem import write_dem
+from test_continuum import write as write_continuum
+
+import plot_beam
+import plot_results
+from multicor_post import continuum, particles
+from multicor_post.results import ResultsError, load_results
+
+STOPPED = "partial file of a run stopped before its first stored output: nothing to plot"
+
+
+def mark_killed(path):
+    """Give a results file the root attributes and /summary of a killed run's partial file
+    (as written by multicor at the file's creation)."""
+    with h5py.File(path, "a") as f:
+        f.attrs["code_name"] = "MULTICOR"
+        f.attrs["code_version"] = "0.1.0"
+        f.attrs["analysis"] = "dynamic"
+        f.attrs["run_id"] = "2026-01-01T00:00:00+00:00 1"
+        f.attrs["title"] = ""
+        summary = f.require_group("summary")
+        summary.attrs["finished"] = np.int32(0)
+        summary.attrs["status"] = "running (or killed)"
+    return path
+
+
+def empty_series(path, names):
+    """Cut the datasets ``names`` of a file to 0 records along their first axis (extendible,
+    as multicor creates them)."""
+    with h5py.File(path, "a") as f:
+        for name in names:
+            data = f[name][()]
+            del f[name]
+            f.create_dataset(name, data=data[:0], maxshape=(None,) + data.shape[1:], chunks=True)
+    return path
+
+
+def dem_series(path):
+    """The /dem datasets with one record per stored output."""
+    with h5py.File(path, "r") as f:
+        names = ["dem/time", "dem/position", "dem/velocity", "dem/walls/position"]
+        return names + [f"dem/energy/{n}" for n in f["dem/energy"]]
+
+
+#: The concatenated contact lists of /dem/contacts (no record before the first output).
+CONTACT_LISTS = ("i", "j", "normal", "rn", "rt", "status")
+
+
+def assert_one_line_error(err, *parts):
+    assert err.startswith(parts[0]) and err.count("\n") == 1 and "Traceback" not in err
+    for part in parts[1:]:
+        assert part in err
+
+
+# --------------------------------------------------------------------------------------------
+# Killed before the first stored output: root attributes and /summary only
+# --------------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("script", [plot_results, plot_beam])
+def test_a_run_killed_before_its_first_output_has_nothing_to_plot(script, tmp_path, capsys):
+    # it said "neither /fem/mesh, /continuum nor /dem: not a MULTICOR results file"
+    path = mark_killed(tmp_path / "big.h5.partial")
+    out = tmp_path / "png"
+    assert script.main([str(path), "--out", str(out)]) == 1
+    assert_one_line_error(capsys.readouterr().err, f"{script.__name__}.py: error: ", str(path),
+                          STOPPED, "running (or killed)")
+    assert not out.exists()
+
+
+def test_a_finished_file_without_results_is_still_not_a_results_file(tmp_path, capsys):
+    # only the file of an unfinished run is explained by a stop before the first output
+    path = mark_killed(tmp_path / "odd.h5")
+    with h5py.File(path, "a") as f:
+        f["summary"].attrs["finished"] = np.int32(1)
+    assert plot_results.main([str(path)]) == 1
+    err = capsys.readouterr().err
+    assert "not a MULTICOR results file" in err and STOPPED not in err
+
+
+# --------------------------------------------------------------------------------------------
+# Time series of 0 records
+# --------------------------------------------------------------------------------------------
+
+def test_particles_without_a_stored_output(tmp_path, capsys):
+    # plot_configuration failed with IndexError on res.position[-1]
+    path = write_dem(tmp_path / "column.h5")
+    empty_series(path, dem_series(path) + [f"dem/contacts/{n}" for n in CONTACT_LISTS])
+    with h5py.File(path, "a") as f:
+        del f["dem/contacts/offset"]               # [0]: multicor's first entry, at creation
+        f.create_dataset("dem/contacts/offset", data=[0], maxshape=(None,), dtype=np.int32)
+    with pytest.raises(ResultsError, match="/dem/time holds no stored output: nothing to plot"):
+        particles.load_dem(path)
+    assert plot_results.main([str(path), "--out", str(tmp_path / "png")]) == 1
+    assert_one_line_error(capsys.readouterr().err, "plot_results.py: error: ",
+                          "/dem/time holds no stored output: nothing to plot")
+    # the same file left by a killed run says so
+    mark_killed(path)
+    assert plot_results.main([str(path), "--out", str(tmp_path / "png")]) == 1
+    assert_one_line_error(capsys.readouterr().err, "plot_results.py: error: ", STOPPED,
+                          "/dem/time holds none")
+    assert not (tmp_path / "png").exists()
+
+
+@pytest.mark.parametrize("script", [plot_results, plot_beam])
+def test_a_beam_without_a_stored_output(script, cantilever_file, tmp_path, capsys):
+    # beam.plot_deflection failed with IndexError on dyn.time[-1]
+    path = cantilever_file(parts=("dynamic", "energy"))
+    empty_series(path, ["fem/time", "fem/displacement", "fem/velocity", "fem/acceleration",
+                        "energy/time", "energy/kinetic", "energy/strain", "energy/external_work",
+                        "energy/damping", "energy/balance"])
+    mark_killed(path)
+    with pytest.raises(ResultsError, match=STOPPED):
+        load_results(path)
+    assert script.main([str(path), "--out", str(tmp_path / "png")]) == 1
+    assert_one_line_error(capsys.readouterr().err, f"{script.__name__}.py: error: ", STOPPED,
+                          "/fem/time holds none")
+
+
+def test_a_continuum_without_a_stored_output(tmp_path, capsys):
+    # continuum.plot_stress failed with IndexError on res.u[-1]
+    path = write_continuum(tmp_path / "plate.h5")
+    with h5py.File(path, "r") as f:
+        names = ["continuum/time", "continuum/displacement", "continuum/velocity",
+                 "continuum/stress"] + [f"continuum/energy/{n}" for n in f["continuum/energy"]]
+    empty_series(path, names)
+    with pytest.raises(ResultsError, match="/continuum/time holds no stored output"):
+        continuum.load_continuum(path)
+    assert plot_results.main([str(path), "--out", str(tmp_path / "png")]) == 1
+    assert_one_line_error(capsys.readouterr().err, "plot_results.py: error: ",
+                          "/continuum/time holds no stored output: nothing to plot")
