@@ -17,7 +17,9 @@ nearest to T), and for a dynamic run <name>_continuum_energy.png and <name>_hist
 node --node, a 1-based mesh index; default the node with the largest displacement), for a modal run
 <name>_modes.png; coupled to disks (/coupling), <name>_coupling.png (the same diagnostics as a
 beam-coupled run's) and the particle plots too. Exit code 1 with a message on a missing or
-invalid file, or one with no stored output (a run stopped before its first).
+invalid file, or one with no stored output (a run stopped before its first); a note on stderr
+for a --time outside the stored outputs and for a figure left out because its series is
+empty.
 """
 import argparse
 import os
@@ -27,7 +29,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from multicor_post import beam, continuum, coupled, particles  # noqa: E402
 from multicor_post.results import (ResultsError, file_contents, finite_float,  # noqa: E402
-                                   load_results, scale_factor)
+                                   load_results, outside_time_note, scale_factor)
 
 
 def contents(path):
@@ -54,6 +56,7 @@ def main(argv=None):
                              "(default: auto)")
     args = parser.parse_args(argv)
     out = args.out if args.out is not None else (os.path.dirname(args.results) or ".")
+    notes = []      # what the figures do not show as asked, printed after them
     try:
         has_beam, has_particles, is_coupled, has_continuum = contents(args.results)
         if not (has_beam or has_particles or has_continuum):
@@ -64,24 +67,33 @@ def main(argv=None):
             print(f"plot_results.py: note: '{args.results}' is the partial file of a run that did not "
                   "finish: the figures show the outputs stored so far", file=sys.stderr)
         if has_continuum:
-            paths += continuum.write_all(continuum.load_continuum(args.results), out,
-                                         time=args.time, scale=args.scale, node=args.node)
+            res = continuum.load_continuum(args.results)
+            notes.append(outside_time_note(args.time, res.time))
+            paths += continuum.write_all(res, out, time=args.time, scale=args.scale, node=args.node)
             if is_coupled:
                 paths += coupled.write_coupling(coupled.load_continuum_coupling(args.results), out)
         if is_coupled and has_beam:
-            paths += coupled.write_all(coupled.load_coupled(args.results), out, time=args.time,
-                                       scale=args.scale)
+            res = coupled.load_coupled(args.results)
+            notes.append(outside_time_note(args.time, res.time))
+            paths += coupled.write_all(res, out, time=args.time, scale=args.scale)
         if has_beam:
-            paths += beam.write_all(load_results(args.results), out, time=args.time,
-                                    node_id=args.node, scale=args.scale)
+            res = load_results(args.results)
+            notes.append(outside_time_note(args.time, None if res.dynamic is None
+                                           else res.dynamic.time))
+            paths += beam.write_all(res, out, time=args.time, node_id=args.node, scale=args.scale)
         if has_particles:
-            paths += particles.write_all(particles.load_dem(args.results), out, time=args.time)
+            res = particles.load_dem(args.results)
+            notes.append(outside_time_note(args.time, res.time))
+            paths += particles.write_all(res, out, time=args.time, notes=notes)
     except ResultsError as exc:
         print(f"plot_results.py: error: {exc}", file=sys.stderr)
         return 1
     if args.node is not None and not any("_history" in os.path.basename(p) for p in paths):
-        print(f"plot_results.py: note: --node {args.node} is not used: '{args.results}' has no node "
-              "history to plot (dynamic beam and continuum runs have one)", file=sys.stderr)
+        notes.append(f"--node {args.node} is not used: '{args.results}' has no node history to "
+                     "plot (dynamic beam and continuum runs have one)")
+    # the parts of a coupled run share their outputs: one note each
+    for note in dict.fromkeys(n for n in notes if n):
+        print(f"plot_results.py: note: {note}", file=sys.stderr)
     for path in paths:
         print(path)
     return 0

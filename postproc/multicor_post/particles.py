@@ -425,11 +425,13 @@ def plot_velocities(res: DemResults) -> Figure:
 # --------------------------------------------------------------------------------------------
 
 def write_all(res: DemResults, out_dir, time: Optional[float] = None,
-              dpi: int = 120) -> list[str]:
+              dpi: int = 120, notes: Optional[list] = None) -> list[str]:
     """Write every particle plot as PNG files in ``out_dir``; return their paths:
     <name>_particles.png (configuration at the output nearest to ``time``, default the last),
     <name>_particles_start.png (at t = 0, when ``time`` is not given), <name>_dem_energy.png,
-    <name>_solver.png, and <name>_velocities.png for small systems."""
+    <name>_solver.png, and <name>_velocities.png for small systems. A figure left out because
+    its series is empty (the solver statistics of a run stopped before its 4096th step) gets a
+    sentence in ``notes``, when given, for the caller to print."""
     files = FigureFiles(res.path, out_dir, dpi)
     save = files.save
     # Thousands of disks need more pixels to be seen one by one.
@@ -442,6 +444,10 @@ def write_all(res: DemResults, out_dir, time: Optional[float] = None,
     save(plot_energy(res), "dem_energy")
     if res.solver.sweeps.size:
         save(plot_solver(res), "solver")
+    elif notes is not None:
+        notes.append(f"{files.stem}_solver.png is not written: /dem/solver holds no step (its "
+                     "series are written every 4096 steps and at the end of a run: a run "
+                     "stopped before its 4096th step has none)")
     if res.n <= SMALL_SYSTEM:
         save(plot_velocities(res), "velocities")
     return files.written

@@ -131,6 +131,24 @@ def no_output_error(f, path: str, dataset: str) -> ResultsError:
     return ResultsError(f"{path}: /{dataset} holds no stored output: nothing to plot")
 
 
+def outside_time_note(requested: Optional[float], times: Optional[np.ndarray]) -> Optional[str]:
+    """The note for a requested snapshot time outside the stored outputs [t0, t_last] (the
+    snapshot figures then show the first or the last one, the nearest); None when the time is
+    inside, not given, or the run has no time series (static, modal)."""
+    if requested is None or times is None or np.size(times) == 0:
+        return None
+    t0, t1 = float(np.min(times)), float(np.max(times))
+    # the stored times are multiples of the step computed in binary: a requested time that
+    # matches an end to 1e-9 of the run's span (far above that round-off, far below any
+    # step) is that end, not outside
+    tol = 1e-9 * max(abs(t0), abs(t1), t1 - t0)
+    if t0 - tol <= requested <= t1 + tol:
+        return None
+    used = "the last one, t = %.6g s" % t1 if requested > t1 else "the first one, t = %.6g s" % t0
+    return (f"--time {requested:g} s is outside the stored outputs [{t0:.6g}, {t1:.6g}] s: the "
+            f"snapshot figures show {used}")
+
+
 def figure_stem(path) -> str:
     """The name the figures of a results file start with: the deck name, also for the
     partial file of an unfinished run (``deck.h5.partial`` gives ``deck``)."""

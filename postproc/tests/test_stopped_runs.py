@@ -1,23 +1,27 @@
-"""Files of runs stopped early: the plotting scripts say why there is nothing to plot, in one
-line, never with a traceback.
+"""Files of runs stopped early, and a --time outside the stored outputs: the plotting scripts
+say what they did or why there is nothing to plot, in one line, never with a traceback.
 
 The files mimic what `kill -9` leaves (doc/output.md, Interrupted runs). Killed before its
 first stored output, a run's partial file holds the root attributes and /summary only
 (finished = 0, status = 'running (or killed)'); killed after the output datasets were
-created but before their first record, it holds time series of 0 records.
+created but before their first record, it holds time series of 0 records; killed before its
+4096th step (the solver statistics are written in blocks of 4096 steps), /dem/solver holds 0
+steps while the outputs are there.
 """
 import h5py
 import numpy as np
 import pytest
-from synthetic_dem import write_dem
+from synthetic_dem import H, N_OUT, STEPS_PER_OUT, write_dem
 from test_continuum import write as write_continuum
 
 import plot_beam
 import plot_results
 from multicor_post import continuum, particles
-from multicor_post.results import ResultsError, load_results
+from multicor_post.results import ResultsError, load_results, outside_time_note
 
 STOPPED = "partial file of a run stopped before its first stored output: nothing to plot"
+#: The times of synthetic_dem's outputs: 0, 5 ms, 10 ms, 15 ms.
+T_LAST = H * STEPS_PER_OUT * (N_OUT - 1)
 
 
 def mark_killed(path):
@@ -139,3 +143,67 @@ def test_a_continuum_without_a_stored_output(tmp_path, capsys):
     assert plot_results.main([str(path), "--out", str(tmp_path / "png")]) == 1
     assert_one_line_error(capsys.readouterr().err, "plot_results.py: error: ",
                           "/continuum/time holds no stored output: nothing to plot")
+
+
+# --------------------------------------------------------------------------------------------
+# A figure skipped because its series is empty
+# --------------------------------------------------------------------------------------------
+
+def test_a_solver_figure_without_steps_is_skipped_with_a_note(tmp_path, capsys):
+    # a run killed before its 4096th step: the outputs are there, /dem/solver holds no step;
+    # the solver figure was skipped without a word
+    path = write_dem(tmp_path / "column.h5")
+    with h5py.File(path, "r") as f:
+        names = [f"dem/solver/{n}" for n in f["dem/solver"]]
+    mark_killed(empty_series(path, names))
+    out = tmp_path / "png"
+    assert plot_results.main([str(path), "--out", str(out)]) == 0
+    printed = capsys.readouterr()
+    assert str(out / "column_particles.png") in printed.out.split()
+    assert not (out / "column_solver.png").exists()
+    assert ("plot_results.py: note: column_solver.png is not written: /dem/solver holds no step"
+            in printed.err)
+    # with the steps, no note
+    assert plot_results.main([str(write_dem(tmp_path / "full.h5")), "--out", str(out)]) == 0
+    printed = capsys.readouterr()
+    assert (out / "full_solver.png").exists() and "note" not in printed.err
+
+
+# --------------------------------------------------------------------------------------------
+# --time outside [t0, t_last]
+# --------------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("time, used", [("99", "the last one, t = 0.015 s"),
+                                        ("-5", "the first one, t = 0 s")])
+def test_a_time_outside_the_outputs_gets_a_note(time, used, tmp_path, capsys):
+    # --time 99 on a run that ends at 15 ms drew the last output without a word
+    path = write_dem(tmp_path / "column.h5")
+    assert plot_results.main([str(path), "--time", time, "--out", str(tmp_path / "png")]) == 0
+    err = capsys.readouterr().err
+    assert err == (f"plot_results.py: note: --time {time} s is outside the stored outputs "
+                   f"[0, 0.015] s: the snapshot figures show {used}\n")
+
+
+@pytest.mark.parametrize("time", [0.0, 0.007, T_LAST, 0.015, T_LAST * (1 + 1e-12), -1e-14])
+def test_a_time_inside_the_outputs_gets_no_note(time):
+    # the ends are inside, also within round-off of them: 1e-12 relative (a few hundred ulps,
+    # the size of the error of a time summed step by step) is below the 1e-9 of the span that
+    # outside_time_note allows
+    assert outside_time_note(time, np.array([0.0, 0.005, 0.01, T_LAST])) is None
+
+
+@pytest.mark.parametrize("time", [T_LAST * (1 + 1e-6), -1e-6 * T_LAST])
+def test_a_time_just_outside_the_outputs_gets_a_note(time):
+    # 1e-6 of the span beyond an end: 1000 times the allowance, still a real request outside
+    assert "is outside the stored outputs" in outside_time_note(time, np.array([0.0, T_LAST]))
+
+
+@pytest.mark.parametrize("script", [plot_results, plot_beam])
+def test_a_beam_time_outside_the_outputs_gets_a_note(script, cantilever_file, tmp_path, capsys):
+    path = cantilever_file(parts=("dynamic", "energy"))
+    with h5py.File(path, "r") as f:
+        t_last = float(f["fem/time"][-1])
+    assert script.main([str(path), "--time", "1e3", "--out", str(tmp_path / "png")]) == 0
+    err = capsys.readouterr().err
+    assert f"{script.__name__}.py: note: --time 1000 s is outside the stored outputs" in err
+    assert f"the last one, t = {t_last:.6g} s" in err and err.count("\n") == 1
