@@ -31,6 +31,7 @@ module coupling_overlap2d
     implicit none
     private
     public :: weight_field_t, overlap2d_t, overlap_set_t, make_box_overlap, make_polygon_overlap, regions_overlap
+    public :: crossing_edges
 
     !> A weight field alpha(x, y) of the 2D coupling.
     type, abstract :: weight_field_t
@@ -204,14 +205,16 @@ contains
         !> The region.
         type(overlap2d_t), intent(out) :: region
         !> Set on too few vertices, a repeated vertex (a zero-length edge, the last vertex equal
-        !> to the first included), a zero area, an edge index out of range or tagged twice,
+        !> to the first included), a zero area, edges that cross, touch or fold back on each
+        !> other (`crossing_edges`), an edge index out of range or tagged twice,
         !> a ramp without edges on both sides, or an invalid weight.
         type(error_t), allocatable, intent(out) :: error
         type(weight_config_t) :: w
         integer, allocatable :: tags(:)
-        integer :: n, k, e
+        integer :: n, k, e, crossing(2)
         real(wp) :: area
         character(len=200) :: buf
+        character(len=:), allocatable :: message
         n = size(vertex, 2)
         if (n < 3 .or. size(vertex, 1) /= 2) then
             call make_error(error, 'overlap polygon: needs at least 3 vertices (x, y)')
@@ -235,6 +238,22 @@ contains
         end do
         if (.not. abs(area) > 0) then
             call make_error(error, 'overlap polygon: zero area')
+            return
+        end if
+        ! The inside test, the distances to the tagged edges and the triangulation all take the
+        ! boundary for a simple closed curve: a bow-tie would weight its two lobes as one region.
+        crossing = crossing_edges(vertex)
+        if (crossing(1) > 0) then
+            if (crossing(2) == crossing(1) + 1 .or. (crossing(1) == 1 .and. crossing(2) == n)) then
+                message = 'edges '//edge_name(crossing(1))//' and '//edge_name(crossing(2))//' fold back on '// &
+                          'each other (one runs back along the other)'
+            else
+                message = 'edges '//edge_name(crossing(1))//' and '//edge_name(crossing(2))//' cross or touch'
+            end if
+            call make_error(error, 'overlap polygon: '//message//': a region must be a simple polygon, its '// &
+                            'vertices given in order around it (either direction), no edge meeting another '// &
+                            'except its neighbours at their common vertex; reorder the vertices, or split the '// &
+                            'region into several region lines')
             return
         end if
         allocate (region%fe_edge(n), region%particle_edge(n), source=.false.)
@@ -270,7 +289,74 @@ contains
         region%box = [minval(vertex(1, :)), maxval(vertex(1, :)), minval(vertex(2, :)), maxval(vertex(2, :))]
         ! Rounding of coordinates at the scale of the region.
         region%tol = relative_roundoff*max(region%box(2) - region%box(1), region%box(4) - region%box(3))
+    contains
+        !> 'k (vertex k to k + 1)', the last edge back to vertex 1.
+        pure function edge_name(k) result(name)
+            integer, intent(in) :: k
+            character(len=:), allocatable :: name
+            name = to_str(k)//' (vertex '//to_str(k)//' to '//to_str(modulo(k, n) + 1)//')'
+        end function edge_name
     end subroutine make_polygon_overlap
+
+    !> The first pair (i, j), i < j, of edges of a polygon that meet where a simple polygon's
+    !> edges do not; [0, 0] when there is none (the polygon is simple). Edges that are not
+    !> neighbours must not meet at all (a crossing, a vertex on another edge, two equal
+    !> vertices); neighbours meet only at their common vertex (one running back along the
+    !> other is a fold-back; a vertex on the straight line between its neighbours is fine).
+    !> Two edges meet when they are closer than the rounding of the coordinates
+    !> (`relative_roundoff` times the larger side of the bounding box). Edge k joins vertex k
+    !> to vertex k + 1, the last vertex to the first.
+    pure function crossing_edges(vertex) result(edges)
+        !> Vertices (2, n), n >= 3 [m].
+        real(wp), intent(in) :: vertex(:, :)
+        !> The two edges, or [0, 0].
+        integer :: edges(2)
+        real(wp) :: tol, a(2), b(2), c(2), d(2)
+        integer :: n, i, j
+        logical :: meet
+        edges = 0
+        n = size(vertex, 2)
+        tol = relative_roundoff*max(maxval(vertex(1, :)) - minval(vertex(1, :)), &
+                                    maxval(vertex(2, :)) - minval(vertex(2, :)))
+        do i = 1, n - 1
+            a = vertex(:, i)
+            b = vertex(:, i + 1)
+            do j = i + 1, n
+                c = vertex(:, j)
+                d = vertex(:, modulo(j, n) + 1)
+                if (j == i + 1) then
+                    ! neighbours through b = c: the far end of either lies on the other
+                    meet = segment_distance(d, a, b) <= tol .or. segment_distance(a, c, d) <= tol
+                else if (i == 1 .and. j == n) then
+                    ! neighbours through a = d
+                    meet = segment_distance(b, c, d) <= tol .or. segment_distance(c, a, b) <= tol
+                else
+                    meet = segments_meet(a, b, c, d, tol)
+                end if
+                if (meet) then
+                    edges = [i, j]
+                    return
+                end if
+            end do
+        end do
+    end function crossing_edges
+
+    !> Whether the segments [a, b] and [c, d] have a point within tol of each other: they
+    !> cross (each one's ends strictly on both sides of the other's line), or an end of one
+    !> lies within tol of the other.
+    pure logical function segments_meet(a, b, c, d, tol) result(meet)
+        real(wp), intent(in) :: a(2), b(2), c(2), d(2), tol
+        real(wp) :: o1, o2, o3, o4
+        o1 = cross(b - a, c - a)
+        o2 = cross(b - a, d - a)
+        o3 = cross(d - c, a - c)
+        o4 = cross(d - c, b - c)
+        meet = ((o1 > 0 .and. o2 < 0) .or. (o1 < 0 .and. o2 > 0)) .and. &
+               ((o3 > 0 .and. o4 < 0) .or. (o3 < 0 .and. o4 > 0))
+        if (meet) return
+        meet = min(segment_distance(c, a, b), segment_distance(d, a, b), segment_distance(a, c, d), &
+                   segment_distance(b, c, d)) <= tol
+    end function segments_meet
 
     !> True when the interiors of two regions intersect (a common area, more than the
     !> rounding of the coordinates: the larger `tol` of the two); regions that only touch along

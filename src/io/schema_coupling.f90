@@ -85,7 +85,9 @@ contains
                            'the numbers of the FE-side and particle-side edges (edge k joins vertex k to k + 1, '// &
                            'the last to the first; 0: none), then at least 3 vertices, each given once (the '// &
                            'polygon closes itself; a repeated vertex, the first again at the end included, is '// &
-                           'refused: its zero-length edge would shift the edge numbers). alpha ramps from 1 - '// &
+                           'refused: its zero-length edge would shift the edge numbers). The polygon must be '// &
+                           'simple, its vertices in order around it (either direction): edges that cross, '// &
+                           'touch or fold back on each other are refused. alpha ramps from 1 - '// &
                            'alpha_min on the FE side to alpha_min on the particle side (weight, alpha_min). '// &
                            'Every region must hold at least one disk centre.', &
                            repeatable=.true., selector=1, tails=tails)
