@@ -8,10 +8,12 @@
 !> - [continuum] gravity and [particles] gravity agree (both sides carry their weighted share
 !>   of the weight in the overlap);
 !> - a polygon's edge numbers are integers within its edges;
-!> - the regions are disjoint (they may share edges): a common area would be weighted twice.
+!> - the regions are disjoint (they may share edges): a common area would be weighted twice;
+!> - thickness is that of the continuum's material under the regions (else a warning).
 !> Errors name the deck file, the line and the keyword.
 module driver_config_coupling2d
     use core_kinds, only: wp
+    use core_constants, only: relative_roundoff
     use core_error, only: error_t, make_input_error
     use core_strings, only: string_t, to_str
     use io_memory, only: available_memory
@@ -22,6 +24,7 @@ module driver_config_coupling2d
     use coupling_operator2d, only: pairing_l2, pairing_h1
     use coupling_coupled_step, only: multipliers_particles, multipliers_nodes
     use fem_mass_scheme, only: make_mass_scheme
+    use fem_continuum_model, only: continuum_model_t
     use coupling_arlequin2d, only: coupling2d_config_t
     use driver_config, only: run_config_t
     implicit none
@@ -41,11 +44,13 @@ module driver_config_coupling2d
 contains
 
     !> Build and check the coupling of a deck with [continuum], [particles] and [coupling].
-    subroutine build_coupling2d_config(deck, run, particle_gravity, x, y, setup, error)
+    subroutine build_coupling2d_config(deck, run, model, particle_gravity, x, y, setup, error)
         !> Deck read with the MULTICOR schema.
         type(deck_t), intent(in) :: deck
         !> Run settings of the continuum (analysis, scheme, beta, gamma).
         type(run_config_t), intent(in) :: run
+        !> The continuum (its mesh and materials: the thickness under the regions).
+        type(continuum_model_t), intent(in) :: model
         !> Gravity of [particles] [m/s^2].
         real(wp), intent(in) :: particle_gravity(2)
         !> Centres of the disks [m] (n_disks each): every region must hold one.
@@ -151,8 +156,57 @@ contains
             c%rayleigh = [deck%get_real('continuum', 'rayleigh', 'a0'), deck%get_real('continuum', 'rayleigh', 'a1')]
             c%gravity = gravity
         end associate
+        call check_thickness(setup%config%thickness)
 
     contains
+
+        !> A warning when thickness differs from the thickness of a material of the elements
+        !> under the regions (centroid in a region; for regions narrower than the elements, a
+        !> node in a region): the disks' masses and forces scale with thickness, the continuum's
+        !> with its own, so that the two models of the overlap would stand for different amounts
+        !> of one body, and their weighted masses would not add up to its mass.
+        subroutine check_thickness(thickness)
+            real(wp), intent(in) :: thickness
+            type(deck_entry_t), allocatable :: materials(:)
+            real(wp), allocatable :: xe(:, :)
+            logical, allocatable :: under(:)
+            integer :: e, m, i, n_elements
+            n_elements = model%mesh%element_count()
+            allocate (under(n_elements))
+            do e = 1, n_elements
+                xe = model%mesh%element_coordinates(e)
+                under(e) = in_regions(sum(xe(1, :))/size(xe, 2), sum(xe(2, :))/size(xe, 2))
+            end do
+            if (.not. any(under)) then
+                do e = 1, n_elements
+                    xe = model%mesh%element_coordinates(e)
+                    under(e) = any([(in_regions(xe(1, i), xe(2, i)), i=1, size(xe, 2))])
+                end do
+            end if
+            materials = deck%records('continuum', 'material')
+            do m = 1, size(model%materials)
+                if (.not. any(under .and. model%element_material == m)) cycle
+                associate (t => model%materials(m)%thickness)
+                    if (abs(t - thickness) <= relative_roundoff*max(t, thickness)) cycle
+                    message = 'warning: '//deck%file//':'//to_str(deck%line('coupling', 'thickness'))// &
+                              ': [coupling] thickness = '//to_str(thickness)//' m differs from the thickness '// &
+                              to_str(t)//' m of the continuum''s material under the region'
+                    if (m <= size(materials)) message = message//' ([continuum] material, line '// &
+                                                        to_str(materials(m)%line)//')'
+                    message = message//': the disks'' masses and forces scale with the one, the '// &
+                              'continuum''s with the other, so that in the overlap the two models stand for '// &
+                              'different amounts of the same body; set thickness = '//to_str(t)
+                end associate
+                setup%warnings = [setup%warnings, string_t(message)]
+            end do
+        end subroutine check_thickness
+
+        !> Whether a point lies in a region.
+        logical function in_regions(px, py)
+            real(wp), intent(in) :: px, py
+            integer :: r
+            in_regions = any([(parts(r)%contains(px, py), r=1, size(parts))])
+        end function in_regions
 
         !> Analysis, Newmark and Moreau-Jean parameters.
         subroutine check_schemes(error)

@@ -112,7 +112,8 @@ contains
         call self%particles%init(part, report, error)
         if (allocated(error)) return
         associate (p => self%particles%dem%system%particles)
-            call build_coupling2d_config(deck, self%settings, p%gravity, p%x(1:p%n), p%y(1:p%n), self%coupling, error)
+            call build_coupling2d_config(deck, self%settings, self%continuum%model, p%gravity, p%x(1:p%n), p%y(1:p%n), &
+                                         self%coupling, error)
         end associate
         if (allocated(error)) return
         do i = 1, size(self%coupling%warnings)

@@ -47,7 +47,9 @@ contains
                            'make the multiplier system singular).', default='1e-3')
         call s%add_keyword('coupling', 'thickness', [positive('thickness', 'm')], &
                            'Out-of-plane depth of the disks (the particles are per unit thickness; the beam '// &
-                           'is not): usually the width of the beam section. Required in a coupled deck.')
+                           'is not): usually the width of the beam section, or the thickness of the '// &
+                           '[continuum] material in the regions (another value: a warning). Required in a '// &
+                           'coupled deck.')
         call s%add_keyword('coupling', 'rotation', [word_field('rotation', 'off on')], &
                            'Also glue the rotation of each coupled disk to the beam rotation theta.', &
                            default='off')

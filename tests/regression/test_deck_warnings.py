@@ -11,6 +11,8 @@ goes on, and a warning names the file, the line and the setting that turns it of
   where a static analysis takes their time functions.
 - A rolling length beyond the radius of the largest disk of its law's materials is warned
   about at the law's line (the moment's arm would be longer than the disk).
+- A [coupling] thickness other than the thickness of the continuum's material under the
+  regions is warned about at its line, naming that material's line (--check and the run).
 - In a coupled run (beam or continuum: input/bending_hinged_row.dat, input/interface_shear.dat)
   `method = coarse` and `cold_start = hydrostatic` are warned about, and the warning is true:
   the run's results are those of `method = nlgs` (and of `cold_start = zero`), bit for bit.
@@ -218,6 +220,41 @@ function = 1 ramp 0.1
               f"exit {proc.returncode}; " + "; ".join(warnings_of(proc.stdout + proc.stderr))[:300])
 
 
+def coupling_thickness(exe, src, work):
+    """input/coupled2d_block.dat (material thickness 0.05 m) with [coupling] thickness = 0.5:
+    one warning at the thickness line naming the material's line and thickness, under --check
+    and at the run (exit 0 both); input/interface_shear.dat with its bottom block 0.02 m thick
+    (the top block and thickness 0.01 m): the warning names the bottom block's line only."""
+    text = (src / "input" / "coupled2d_block.dat").read_text()
+    text = re.sub(r"^thickness\s*=.*$", "thickness = 0.5", text, count=1, flags=re.M)
+    text = re.sub(r"^end\s*=.*$", "end = 2e-5", text, count=1, flags=re.M)
+    deck = work / "thickness_block.dat"
+    deck.write_text(text)
+    expected = (f"warning: {deck}:{line_of(text, 'thickness')}: [coupling] thickness = 0.5 m differs from the "
+                f"thickness 0.05 m of the continuum's material under the region ([continuum] material, line "
+                f"{line_of(text, 'material')}): ")
+    for mode, args in (("--check", ("--check", deck)), ("run", (deck, "--output", work / "thickness_block", "--quiet"))):
+        proc = multicor(exe, *args)
+        said = warnings_of(proc.stdout)
+        check(f"coupling thickness 0.5 m on a 0.05 m continuum ({mode}): exit 0, one warning naming both lines",
+              proc.returncode == 0 and len(said) == 1 and said[0].startswith(expected)
+              and said[0].endswith("set thickness = 0.05"),
+              f"exit {proc.returncode}; " + ("\n".join(said) or proc.stderr.strip()[:300]))
+    source = src / "input" / "interface_shear.dat"
+    text = source.read_text().replace("mesh = file ", f"mesh = file {source.parent}/")
+    text = re.sub(r"^(material = 210e9 0.3 7800) 0.01 ", r"\1 0.02 ", text, count=1, flags=re.M)
+    deck = work / "thickness_interface.dat"
+    deck.write_text(text)
+    proc = multicor(exe, "--check", deck)
+    said = warnings_of(proc.stdout)
+    expected = (f"warning: {deck}:{line_of(text, 'thickness')}: [coupling] thickness = 0.01 m differs from the "
+                f"thickness 0.02 m of the continuum's material under the region ([continuum] material, line "
+                f"{line_of(text, 'material')}): ")
+    check("two blocks, the bottom one 0.02 m thick: one warning, naming its material line",
+          proc.returncode == 0 and len(said) == 1 and said[0].startswith(expected),
+          f"exit {proc.returncode}; " + ("\n".join(said) or proc.stderr.strip()[:300]))
+
+
 def main():
     exe, work, src = arguments(fresh=True)
     example_decks_are_quiet(exe, src)
@@ -225,6 +262,7 @@ def main():
     continuum_static_ramp(exe, work)
     solver_values(exe, src, work)
     rolling_length(exe, src, work)
+    coupling_thickness(exe, src, work)
     # the hinged row of the reference work (20 steps; with nlgs at 1e-4: 108 to 172 sweeps per
     # step) and the interface experiment (10 steps: 19 to 47 sweeps per step)
     coupled(exe, work, "beam", src / "input" / "bending_hinged_row.dat", "2e-4", "tolerance = 1e-4\n")
