@@ -15,7 +15,9 @@
 !>   zero weighted mass);
 !> - listed coupled disks exist, are listed once, and lie inside the overlap (alpha strictly
 !>   between 0 and 1), within max_offset of the axis when it is given; with coupled = auto at
-!>   least one disk centre lies in the overlap.
+!>   least one disk centre lies in the overlap;
+!> - without max_offset, a coupled disk off the beam's section (farther from the axis than its
+!>   radius plus the section's half-height) is warned about (`warn_far_disks`).
 !> Each error names the deck file, the line and the keyword concerned, and the disk by its
 !> number and the line that created it.
 module driver_config_coupling
@@ -144,7 +146,7 @@ contains
         end associate
         call check_fe_zone(deck, setup, weight, dem, s, error)
         if (allocated(error)) return
-        call select_coupled(deck, setup, weight, dem, s, off, error)
+        call select_coupled(deck, setup, weight, dem, s, off, model%ea, model%ei, error)
     end subroutine build_coupling_config
 
     !> First line of the [coupling] entries (0 if none).
@@ -258,12 +260,14 @@ contains
     end subroutine check_fe_zone
 
     !> The coupled disks: `auto` or selections, checked against the overlap.
-    subroutine select_coupled(deck, setup, weight, dem, s, off, error)
+    subroutine select_coupled(deck, setup, weight, dem, s, off, beam_ea, beam_ei, error)
         type(deck_t), intent(in) :: deck
         type(coupled_setup_t), intent(inout) :: setup
         type(overlap_weight_t), intent(in) :: weight
         type(dem_config_t), intent(in) :: dem
         real(wp), intent(in) :: s(:), off(:)
+        ! axial and bending stiffnesses EA and EI of the beam's elements
+        real(wp), intent(in) :: beam_ea(:), beam_ei(:)
         type(error_t), allocatable, intent(out) :: error
         type(deck_entry_t) :: e
         type(string_t), allocatable :: selections(:)
@@ -284,11 +288,12 @@ contains
                                       ' write coupled = auto, or a list of selections of disks')
                 return
             end if
-            do i = 1, n
-                alpha = weight%value(s(i))
-                if (alpha > 0 .and. alpha < 1 .and. &
-                    (max_offset <= 0 .or. abs(off(i)) <= max_offset)) return
-            end do
+            list = pack([(i, i=1, n)], [(in_overlap(i) .and. (max_offset <= 0 .or. abs(off(i)) <= max_offset), &
+                                         i=1, n)])
+            if (size(list) > 0) then
+                call warn_far_disks(list)
+                return
+            end if
             message = ''
             if (max_offset > 0) message = ' within max_offset = '//to_str(max_offset)// &
                                           ' m of the axis'
@@ -334,6 +339,56 @@ contains
             end do
         end do
         setup%config%particles = list
+        call warn_far_disks(list)
+
+    contains
+
+        !> Whether disk i lies inside the overlap (0 < alpha < 1).
+        logical function in_overlap(i)
+            integer, intent(in) :: i
+            real(wp) :: a
+            a = weight%value(s(i))
+            in_overlap = a > 0 .and. a < 1
+        end function in_overlap
+
+        !> With no max_offset, a warning when a coupled disk lies off the beam's section.
+        !> The coupling glues a disk to the section at its abscissa through a rigid arm of its
+        !> offset: the disk stands for material of that section only when it touches it, its
+        !> centre within its radius plus the section's half-height of the axis. The section
+        !> gives A and I, not its height: the half-height taken is that of the rectangle with
+        !> the same A and I, sqrt(3 I / A) (the largest over the beam's elements; a rectangle
+        !> is exact, an I-section's flanges sit within it, a solid circle's rim is 15 % beyond
+        !> it). A disk farther out is glued to nothing it touches: accepted, but warned about.
+        subroutine warn_far_disks(coupled)
+            integer, intent(in) :: coupled(:)
+            real(wp) :: half_height, reach
+            integer :: far, i, beyond, at
+            if (max_offset > 0 .or. size(coupled) == 0) return
+            half_height = sqrt(3*maxval(beam_ei/beam_ea))
+            beyond = 0
+            far = 0
+            do i = 1, size(coupled)
+                associate (k => coupled(i))
+                    if (abs(off(k)) <= dem%system%particles%radius(k) + half_height) cycle
+                    beyond = beyond + 1
+                    if (far == 0) far = k
+                    if (abs(off(k)) > abs(off(far))) far = k
+                end associate
+            end do
+            if (beyond == 0) return
+            reach = dem%system%particles%radius(far) + half_height
+            at = deck%line('coupling', 'coupled')
+            if (at == 0) at = setup%overlap_line
+            message = 'warning: '//deck%file//':'//to_str(at)//': [coupling] '//to_str(beyond)//' of the '// &
+                      to_str(size(coupled))//' coupled disks lie off the beam''s section; the farthest, disk '// &
+                      to_str(far)//' (line '//to_str(dem%disk_line(far))//'), is '//to_str(abs(off(far)))// &
+                      ' m from the beam axis, beyond its radius plus the section''s half-height ('// &
+                      to_str(reach)//' m; half-height sqrt(3 I / A) = '//to_str(half_height)//' m): it is '// &
+                      'glued to the beam through a rigid arm of that length without touching it; set '// &
+                      '[coupling] max_offset (e.g. '//to_str(reach)//' m) to couple only the disks on the beam, '// &
+                      'or check the disks'' positions'
+            setup%warnings = [setup%warnings, string_t(message)]
+        end subroutine warn_far_disks
     end subroutine select_coupled
 
     !> Prefix a library error with the deck file, line and keyword.

@@ -61,7 +61,9 @@ contains
         call s%add_keyword('coupling', 'max_offset', [real_field('max_offset', 'm', &
                                                                  lower=0.0_wp)], &
                            'Couple only disks whose centre lies at most this far from the beam axis (with '// &
-                           'coupled = auto; a listed disk farther away is an error); 0: any distance. With '// &
+                           'coupled = auto; a listed disk farther away is an error); 0: any distance, with a '// &
+                           'warning when a coupled disk lies farther than its radius plus the section''s '// &
+                           'half-height sqrt(3 I / A) (it does not touch the beam). With '// &
                            'bonds between the layers and multipliers = particles, coupling several layers makes '// &
                            'the bonds and the coupling rows nearly redundant (a warning after the first step; '// &
                            'doc/theory.md 7.10): glue one layer, or put the multipliers on the nodes.', &

@@ -13,6 +13,9 @@ goes on, and a warning names the file, the line and the setting that turns it of
   about at the law's line (the moment's arm would be longer than the disk).
 - A [coupling] thickness other than the thickness of the continuum's material under the
   regions is warned about at its line, naming that material's line (--check and the run).
+- Without max_offset, coupled disks off the beam's section (farther from the axis than their
+  radius plus sqrt(3 I / A), the section's half-height) are warned about, naming the
+  farthest; disks within it, or any distance once max_offset is set, are not.
 - In a coupled run (beam or continuum: input/bending_hinged_row.dat, input/interface_shear.dat)
   `method = coarse` and `cold_start = hydrostatic` are warned about, and the warning is true:
   the run's results are those of `method = nlgs` (and of `cold_start = zero`), bit for bit.
@@ -255,6 +258,48 @@ def coupling_thickness(exe, src, work):
           f"exit {proc.returncode}; " + ("\n".join(said) or proc.stderr.strip()[:300]))
 
 
+def coupled_disks_off_the_beam(exe, src, work):
+    """The coupled example of doc/input.md (beam section A = 1e-4 m^2, I = 8.33e-10 m^4: the
+    10 mm square, half-height sqrt(3 I / A) = 5 mm; disks of radius 5 mm in a row from
+    x = 0.20 m, 7 of them in the overlap), its row moved off the axis by y0: warned about
+    beyond 5 + 5 = 10 mm (the disk no longer touches the section), naming disk 1, its offset
+    and max_offset; not below 10 mm, nor at 0.5 m once max_offset is set."""
+    doc = (src / "doc" / "input.md").read_text()
+    block = doc[doc.index("## Coupled runs (Arlequin)"):]
+    text = block[block.index("```\n") + 4:]
+    text = text[:text.index("```")]
+    text = re.sub(r"^end\s*=.*$", "end = 2e-5", text, count=1, flags=re.M)
+    # the distance 0.0101 and 0.0099 m are 1 % beside the threshold 0.01 m, far beyond the
+    # rounding of the offset (1e-18 m)
+    for y0, extra, warned in (("0.5", "", True), ("0.0101", "", True), ("0.0099", "", False),
+                              ("0", "", False), ("0.5", "max_offset = 1\n", False)):
+        body = re.sub(r"^row(\s*)= 17 0.20 0 ", rf"row\1= 17 0.20 {y0} ", text, count=1, flags=re.M)
+        body = body.replace("[coupling]\n", "[coupling]\n" + extra)
+        deck = work / f"offset_{y0}{'_limited' if extra else ''}.dat"
+        deck.write_text(body)
+        proc = multicor(exe, "--check", deck)
+        said = warnings_of(proc.stdout)
+        expected = (f"warning: {deck}:{line_of(body, 'coupled')}: [coupling] 7 of the 7 coupled disks lie off "
+                    f"the beam's section; the farthest, disk 1 (line {line_of(body, 'row')}), is {y0} m from the "
+                    "beam axis, beyond its radius plus the section's half-height (0.01 m; half-height sqrt(3 I / A) "
+                    "= 0.005 m)")
+        check(f"coupled row at y = {y0} m{' with max_offset' if extra else ''}: "
+              f"{'warned' if warned else 'no warning'}, exit 0",
+              proc.returncode == 0
+              and (len(said) == 1 and said[0].startswith(expected) and "max_offset (e.g. 0.01 m)" in said[0]
+                   if warned else not said),
+              f"exit {proc.returncode}; " + ("\n".join(said) or proc.stderr.strip()[:300]))
+    # the stacked layers of input/bending_stack.dat without max_offset: the outer rows at
+    # 8.66 mm touch the section (below 10 mm), all 19 coupled quietly
+    text = re.sub(r"^max_offset\s*=.*\n", "", (src / "input" / "bending_stack.dat").read_text(), flags=re.M)
+    deck = work / "stack_all_layers.dat"
+    deck.write_text(text)
+    proc = multicor(exe, "--check", deck)
+    check("three stacked rows, all coupled (offsets 8.66 mm < 10 mm): no warning",
+          proc.returncode == 0 and "19 coupled" in proc.stdout and not warnings_of(proc.stdout),
+          f"exit {proc.returncode}; " + (proc.stdout.strip()[-300:] or proc.stderr.strip()[:300]))
+
+
 def main():
     exe, work, src = arguments(fresh=True)
     example_decks_are_quiet(exe, src)
@@ -263,6 +308,7 @@ def main():
     solver_values(exe, src, work)
     rolling_length(exe, src, work)
     coupling_thickness(exe, src, work)
+    coupled_disks_off_the_beam(exe, src, work)
     # the hinged row of the reference work (20 steps; with nlgs at 1e-4: 108 to 172 sweeps per
     # step) and the interface experiment (10 steps: 19 to 47 sweeps per step)
     coupled(exe, work, "beam", src / "input" / "bending_hinged_row.dat", "2e-4", "tolerance = 1e-4\n")
