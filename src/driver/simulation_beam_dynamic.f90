@@ -16,6 +16,7 @@ module driver_simulation_beam_dynamic
     use driver_guards, only: check_beam_state
     use driver_simulation, only: report_iface
     use driver_simulation_beam, only: beam_simulation_t, beam_setup, check_initial_energy
+    use driver_displacement_scale, only: largest_displacement, model_extent, large_displacement_warning
     implicit none
     private
     public :: beam_dynamic_t
@@ -130,7 +131,11 @@ contains
         integer(i8) :: n_steps, k, k0
         type(step_end_t) :: act
         character(len=160) :: buf
+        character(len=:), allocatable :: warning
+        ! Largest displacement of the stored states, their mean translation removed [m].
+        real(wp) :: u_max
 
+        u_max = 0.0_wp
         n_steps = run%n_steps
         allocate (d(3, model%n_nodes), v(3, model%n_nodes), a(3, model%n_nodes))
         call progress%start(n_steps, run%t_end, run%progress_seconds)
@@ -169,6 +174,9 @@ contains
         write (buf, '(a,i0,a,es13.5e3,a,es11.3e3)') 'dynamic run: ', n_steps, ' steps to t = ', &
             integ%t, ' s; energy balance residual ', integ%energy_balance()
         call report(trim(buf))
+        warning = large_displacement_warning(u_max, model_extent(model%x, model%y), &
+                                             '[beam] section, load, distributed, gravity, line, node, [initial]')
+        if (len(warning) > 0) call report(warning)
         call report(progress%summary_line(n_steps, stopped=out%stopped()))
         ! n_steps <= max_steps = huge(0) (driver_config)
         call out%write_summary(int(n_steps), progress, error)
@@ -216,6 +224,8 @@ contains
             call model%expand(integ%a, a)
             call out%append_state(integ%t, d, v, a, error)
             if (allocated(error)) return
+            ! a free body's translation strains nothing: only the rest counts
+            u_max = max(u_max, largest_displacement(d(1:2, :) - spread(sum(d(1:2, :), dim=2)/size(d, 2), 2, size(d, 2))))
             call out%append_energy(integ%t, integ%kinetic, integ%strain, integ%external_work, &
                                    integ%damping_dissipation, error)
             if (allocated(error)) return

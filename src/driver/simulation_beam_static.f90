@@ -11,6 +11,7 @@ module driver_simulation_beam_static
     use driver_checkpoint, only: checkpoint_run_t
     use driver_simulation, only: report_iface
     use driver_simulation_beam, only: beam_simulation_t, beam_setup
+    use driver_displacement_scale, only: largest_displacement, model_extent, large_displacement_warning
     implicit none
     private
     public :: beam_static_t
@@ -103,6 +104,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         real(wp), allocatable :: u(:), d(:, :), r(:, :)
         character(len=120) :: buf
+        character(len=:), allocatable :: warning
         call solve_static(model, 0.0_wp, u, error)
         if (allocated(error)) return
         allocate (d(3, model%n_nodes), r(3, model%n_nodes))
@@ -119,5 +121,8 @@ contains
         write (buf, '(a,es13.5e3,a)') 'static solution: max |displacement| = ', &
             maxval(abs(d(1:2, :))), ' m'
         call report(trim(buf))
+        warning = large_displacement_warning(largest_displacement(d(1:2, :)), model_extent(model%x, model%y), &
+                                             '[beam] section, load, distributed, gravity, line, node')
+        if (len(warning) > 0) call report(warning)
     end subroutine run_static
 end module driver_simulation_beam_static

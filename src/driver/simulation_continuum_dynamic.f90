@@ -20,6 +20,7 @@ module driver_simulation_continuum_dynamic
     use driver_results_continuum, only: continuum_writer_t
     use driver_simulation, only: report_iface
     use driver_simulation_continuum, only: continuum_simulation_t, continuum_setup, check_density
+    use driver_displacement_scale, only: largest_displacement, model_extent, large_displacement_warning
     implicit none
     private
     public :: continuum_dynamic_t
@@ -133,6 +134,9 @@ contains
         integer(i8) :: k, k0
         ! Progress lines and the wall time of the analysis (checkpointed).
         type(progress_t) :: progress
+        ! Largest displacement of the stored states, their mean translation removed [m].
+        real(wp) :: u_max
+        u_max = 0.0_wp
         ! At a restart the file has the mesh and the series already (restore).
         if (.not. ck%restart) call writer%begin(out%file, self%model%mesh, self%settings%analysis, error)
         if (allocated(error)) return
@@ -160,6 +164,7 @@ contains
             integer(i8) :: n_steps
             type(step_end_t) :: act
             character(len=200) :: buf
+            character(len=:), allocatable :: warning
             n_steps = self%settings%n_steps
             call progress%start(n_steps, self%settings%t_end, self%settings%progress_seconds)
             k0 = 0
@@ -203,6 +208,12 @@ contains
             write (buf, '(a,i0,a,es13.5e3,a,es11.3e3,a)') 'dynamic run: ', n_steps, ' steps to t = ', &
                 self%integ%t, ' s; energy balance residual ', self%audit%balance(), ' J'
             call report(trim(buf))
+            associate (x => self%model%mesh%x)
+                warning = large_displacement_warning(u_max, model_extent(x(1, :), x(2, :)), &
+                                                     '[continuum] material, load, traction, gravity, '// &
+                                                     'displacement, initial_velocity, mesh')
+            end associate
+            if (len(warning) > 0) call report(warning)
             call report(progress%summary_line(n_steps, stopped=out%stopped()))
             call out%write_summary(int(n_steps), progress, error)
         end subroutine run_dynamic
@@ -259,6 +270,10 @@ contains
                 end if
                 call writer%store(out%file, g%t, reshape(u, [2, n]), reshape(v, [2, n]), stress, error)
                 if (allocated(error)) return
+                ! a free body's translation strains nothing: only the rest counts
+                associate (un => reshape(u, [2, n]))
+                    u_max = max(u_max, largest_displacement(un - spread(sum(un, dim=2)/n, 2, n)))
+                end associate
                 call writer%store_energy(out%file, g%t, energies(1), energies(2), energies(3), energies(4), &
                                          energies(5), error, au%reaction_work, au%reaction_resultant)
             end associate

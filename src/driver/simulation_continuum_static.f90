@@ -12,6 +12,7 @@ module driver_simulation_continuum_static
     use driver_results_continuum, only: continuum_writer_t
     use driver_simulation, only: report_iface
     use driver_simulation_continuum, only: continuum_simulation_t, continuum_setup
+    use driver_displacement_scale, only: largest_displacement, model_extent, large_displacement_warning
     implicit none
     private
     public :: continuum_static_t
@@ -190,6 +191,7 @@ contains
             type(error_t), allocatable, intent(out) :: error
             real(wp), allocatable :: u(:), stress(:, :)
             character(len=160) :: buf
+            character(len=:), allocatable :: warning
             real(wp) :: energy
             u = self%model%expand(self%uf)
             call self%model%centre_stresses(u, stress, error)
@@ -210,6 +212,13 @@ contains
             write (buf, '(a,es13.5e3,a,es13.5e3,a)') 'static solution: max |displacement| = ', maxval(abs(u)), &
                 ' m, strain energy = ', energy, ' J'
             call report(trim(buf))
+            associate (x => self%model%mesh%x)
+                warning = large_displacement_warning(largest_displacement(reshape(u, [2, size(u)/2])), &
+                                                     model_extent(x(1, :), x(2, :)), &
+                                                     '[continuum] material, load, traction, gravity, '// &
+                                                     'displacement, mesh')
+            end associate
+            if (len(warning) > 0) call report(warning)
         end subroutine run_static
     end subroutine static_run
 end module driver_simulation_continuum_static

@@ -16,6 +16,9 @@ goes on, and a warning names the file, the line and the setting that turns it of
 - Without max_offset, coupled disks off the beam's section (farther from the axis than their
   radius plus sqrt(3 I / A), the section's half-height) are warned about, naming the
   farthest; disks within it, or any distance once max_offset is set, are not.
+- A static or dynamic beam or continuum run whose largest displacement exceeds 10 % of the
+  model's extent (a modulus in MPa read as Pa) warns that linear theory does not hold, with
+  exit 0; the threshold is checked on a cantilever's closed-form tip deflection.
 - In a coupled run (beam or continuum: input/bending_hinged_row.dat, input/interface_shear.dat)
   `method = coarse` and `cold_start = hydrostatic` are warned about, and the warning is true:
   the run's results are those of `method = nlgs` (and of `cold_start = zero`), bit for bit.
@@ -300,6 +303,69 @@ def coupled_disks_off_the_beam(exe, src, work):
           f"exit {proc.returncode}; " + (proc.stdout.strip()[-300:] or proc.stderr.strip()[:300]))
 
 
+def large_displacements(exe, src, work):
+    """Linear runs whose displacement exceeds 10 % of the model's extent warn, exit 0.
+    A 1 m cantilever (E I = 350 N m^2) under an end load P: the cubic beam elements give the
+    tip deflection P L^3 / (3 E I) exactly, 0.1 m (10 % of the extent, the bounding-box
+    diagonal of 1 m) at P = 105 N: 110 N (0.105 m) warns, 100 N (0.095 m) does not; E in MPa
+    read as Pa (2.1e5) warns, statically and in the dynamic input/cantilever.dat. The
+    continuum cantilevers of input/ (static and dynamic) with E = 70e3 Pa (70 GPa written in
+    kPa) warn; with 70e9 they do not."""
+    beam = """[run]
+analysis = static
+[beam]
+section = 1 {young} 7800 2.0e-4 1.6666666666666667e-9
+line = 1 0.0 0.0 1.0 0.0 10 1
+fix = 1 all
+load = 11 w -{load}
+"""
+    lead = "warning: the largest displacement, "
+    tail = ("linear small-strain theory does not hold at this displacement; check the units of E, the loads and "
+            "the lengths ([beam] section, load, distributed, gravity, line, node)")
+    for young, load, warned in (("2.1e11", "110", True), ("2.1e11", "100", False), ("2.1e5", "10", True)):
+        deck = work / f"beam_{young}_{load}.dat"
+        deck.write_text(beam.format(young=young, load=load))
+        proc = multicor(exe, deck, "--output", work / deck.stem, "--quiet")
+        said = warnings_of(proc.stdout)
+        tip = float(load) / (3 * float(young) * 1.6666666666666667e-9)
+        check(f"static beam, E = {young} Pa, P = {load} N (tip {tip:.4g} m on 1 m): "
+              f"{'warned' if warned else 'no warning'}, exit 0",
+              proc.returncode == 0 and (len(said) == 1 and said[0].startswith(lead) and said[0].endswith(tail)
+                                        if warned else not said),
+              f"exit {proc.returncode}; " + ("\n".join(said) or proc.stderr.strip()[:300]))
+    text = re.sub(r"^(section\s*=\s*1\s+)2.1e11", r"\g<1>2.1e5", (src / "input" / "cantilever.dat").read_text(),
+                  count=1, flags=re.M)
+    deck = work / "cantilever_mpa.dat"
+    deck.write_text(text)
+    proc = multicor(exe, deck, "--output", work / deck.stem, "--quiet")
+    said = warnings_of(proc.stdout)
+    check("dynamic beam with E = 2.1e5 Pa: warned at the end of the run, exit 0",
+          proc.returncode == 0 and len(said) == 1 and said[0].startswith(lead)
+          and "[beam] section, load" in said[0], f"exit {proc.returncode}; " + ("\n".join(said) or proc.stderr[:300]))
+    # the dynamic continuum cantilever with E = 70e3 Pa: a largest displacement of 1.2 m
+    # (mean translation removed) on an extent of 10.05 m; 70e9 Pa is quiet (input/ decks)
+    text = re.sub(r"^material = 70e9 ", "material = 70e3 ", (src / "input" / "continuum_cantilever_dynamic.dat")
+                  .read_text(), count=1, flags=re.M)
+    deck = work / "continuum_dynamic_70e3.dat"
+    deck.write_text(text)
+    proc = multicor(exe, deck, "--output", work / deck.stem, "--quiet")
+    said = warnings_of(proc.stdout)
+    check("dynamic continuum with E = 70e3 Pa: warned at the end of the run, exit 0",
+          proc.returncode == 0 and len(said) == 1 and said[0].startswith(lead)
+          and "([continuum] material, load" in said[0], f"exit {proc.returncode}; " + ("\n".join(said) or proc.stderr[:300]))
+    source = (src / "input" / "continuum_cantilever.dat").read_text()
+    for young, warned in (("70e3", True), ("70e9", False)):
+        text = re.sub(r"^material = 70e9 ", f"material = {young} ", source, count=1, flags=re.M)
+        deck = work / f"continuum_{young}.dat"
+        deck.write_text(text)
+        proc = multicor(exe, deck, "--output", work / deck.stem, "--quiet")
+        said = warnings_of(proc.stdout)
+        check(f"static continuum, E = {young} Pa: {'warned' if warned else 'no warning'}, exit 0",
+              proc.returncode == 0 and (len(said) == 1 and said[0].startswith(lead)
+                                        and "([continuum] material, load" in said[0] if warned else not said),
+              f"exit {proc.returncode}; " + ("\n".join(said) or proc.stderr.strip()[:300]))
+
+
 def main():
     exe, work, src = arguments(fresh=True)
     example_decks_are_quiet(exe, src)
@@ -309,6 +375,7 @@ def main():
     rolling_length(exe, src, work)
     coupling_thickness(exe, src, work)
     coupled_disks_off_the_beam(exe, src, work)
+    large_displacements(exe, src, work)
     # the hinged row of the reference work (20 steps; with nlgs at 1e-4: 108 to 172 sweeps per
     # step) and the interface experiment (10 steps: 19 to 47 sweeps per step)
     coupled(exe, work, "beam", src / "input" / "bending_hinged_row.dat", "2e-4", "tolerance = 1e-4\n")
