@@ -10,10 +10,12 @@
 !> zig-zag between the nodes).
 !>
 !> Build (`build_coupled_system`): the beam is assembled with the weight alpha(s) (mass,
-!> stiffness and loads integrated with alpha); every disk gets the weight alpha at the
-!> abscissa of its centre (projection on the nearest element, extended past the beam's ends)
-!> and its mass, inertia and loads are scaled by (1 - alpha) (alpha = 0 beyond the overlap:
-!> unchanged; a disk in the FE-only zone, alpha = 1, is an error). The coupled disks are those
+!> stiffness and self-weight integrated with alpha; its nodal and distributed loads in full);
+!> every disk gets the weight alpha at the abscissa of its centre (projection on the nearest
+!> element, extended past the beam's ends) and its mass and inertia are scaled by (1 - alpha),
+!> its loads applied in full (alpha = 0 beyond the overlap: unchanged; a disk in the FE-only
+!> zone, alpha = 1, is an error). A load is given to one model only, the other carries no
+!> share of it: weighting it would drop the other share. The coupled disks are those
 !> whose centre lies in the overlap (optionally within `max_offset` of the axis, or an explicit
 !> list); C interpolates the beam at their centres (offset included, optional rotation row).
 !> `coupled_beam` and `coupled_beam_operator` give back the beam and its C from a system built

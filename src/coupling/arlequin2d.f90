@@ -6,10 +6,10 @@
 !> Build (`build_coupled2d`):
 !> - the continuum's K_alpha and M_alpha (coupling_weighted2d, alpha = the FE weight of the
 !>   overlap field, 1 outside it) and its loads: the model's own loads (nodal loads and
-!>   tractions, taken as they are: apply them outside the overlap) plus the weighted body
-!>   force int alpha rho t N g dA = M_alpha g_nodes (the rows of M_alpha, consistent or
-!>   lumped, sum to int alpha rho t N_a dA since the shape functions sum to 1), reduced to the
-!>   free dofs (fem_continuum_dynamics `build_from`);
+!>   tractions, applied in full, also inside the overlap: the disks carry no share of them)
+!>   plus the weighted body force int alpha rho t N g dA = M_alpha g_nodes (the rows of
+!>   M_alpha, consistent or lumped, sum to int alpha rho t N_a dA since the shape functions
+!>   sum to 1), reduced to the free dofs (fem_continuum_dynamics `build_from`);
 !> - every disk's weight alpha (`weight_field_t%select_disks`: 0 outside the overlap); the
 !>   coupled disks are those with alpha > 0. A disk outside the overlap whose centre lies in an
 !>   element is in the FE-only zone, where it would be counted twice: an error;

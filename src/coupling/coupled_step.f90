@@ -142,7 +142,7 @@ module coupling_coupled_step
     type :: coupled_energies_t
         !> FE kinetic and strain energy (weighted).
         real(wp) :: fe_kinetic = 0.0_wp, fe_strain = 0.0_wp
-        !> FE external work (weighted loads) and Rayleigh dissipation.
+        !> FE external work (its loads in full, its self-weight weighted) and Rayleigh dissipation.
         real(wp) :: fe_external_work = 0.0_wp, fe_damping = 0.0_wp
         !> Work of the FE supports' reactions on the prescribed dofs (zero where they are fixed).
         real(wp) :: fe_reaction_work = 0.0_wp
@@ -187,7 +187,7 @@ module coupling_coupled_step
         class(dynamic_operator_t), allocatable :: model
         !> FE time integrator (Newmark, split predict/correct).
         type(newmark_t) :: fe
-        !> Discrete domain, masses and loads weighted by (1 - alpha).
+        !> Discrete domain, masses weighted by (1 - alpha) (loads in full).
         type(dem_system_t) :: dem
         !> Shape and floor of the weight alpha (for a beam also the overlap interval).
         type(overlap_weight_t) :: weight
@@ -342,17 +342,16 @@ contains
         allocate (space, source=disk_space_t([((k, k=1, op%rows_per_point), p=1, op%n_points)]))
     end subroutine disk_space
 
-    !> Masses, inertias and loads of the disks times (1 - alpha).
+    !> Masses and inertias of the disks times (1 - alpha) (their gravity follows through the
+    !> mass). Their loads (`force`, `moment`) are applied in full: a load is given to the disks
+    !> only, the FE side carries no share of it, so weighting it would drop a share alpha.
     subroutine scale_disks(sys)
         type(coupled_system_t), intent(inout) :: sys
-        integer :: i, k
+        integer :: i
         associate (p => sys%dem%particles)
             do i = 1, p%n
                 p%mass(i) = (1 - sys%alpha(i))*p%mass(i)
                 p%inertia(i) = (1 - sys%alpha(i))*p%inertia(i)
-            end do
-            do k = 1, p%n_loads
-                p%loads(k)%value = (1 - sys%alpha(p%loads(k)%particle))*p%loads(k)%value
             end do
         end associate
     end subroutine scale_disks

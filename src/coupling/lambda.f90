@@ -1,8 +1,8 @@
 !> Lagrange multipliers of the Arlequin coupling at velocity level (doc/theory.md section 6.4).
 !>
 !> Conventions: on the particle side the multiplier lambda acts as a force +lambda on the
-!> coupled DOF ((1 - alpha) m qdd = (1 - alpha) F + lambda), on the FE side as -C^T lambda
-!> (alpha M udd = alpha F - C^T lambda). In a step of length h, the particle velocities
+!> coupled DOF ((1 - alpha) m qdd = F + (1 - alpha) m g + lambda: the disk's loads in full),
+!> on the FE side as -C^T lambda (M_alpha udd = F_alpha - C^T lambda). In a step of length h, the particle velocities
 !> respond by h W lambda (W = ((1 - alpha) m)^-1 for independent particles, or the mobility
 !> of rigid clusters), the FE velocities by -gamma h S^-1 C^T lambda (Newmark, S = M +
 !> gamma h C + beta h^2 K). With the free velocity residual g = v_d,free - C v_c,free (plus

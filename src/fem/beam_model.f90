@@ -9,7 +9,9 @@
 !> distance from node 1 along the elements), mass and stiffness are integrated as
 !> int alpha(s) (...) ds by Gauss quadrature (6 points on each piece of an element between
 !> the weight's breakpoints: exact for a piecewise cubic alpha times the degree-6 Hermite
-!> mass products) and nodal loads are multiplied by alpha at their node.
+!> mass products), and so is the self-weight (int alpha rho A g N ds: gravity acts through the
+!> weighted mass). The loads of the deck (nodal and distributed) are not weighted: they are
+!> given to the beam only, the disks carry no share of them, so the beam applies them in full.
 module fem_beam_model
     use core_kinds, only: wp
     use core_constants, only: relative_roundoff, singular_ratio
@@ -75,14 +77,15 @@ module fem_beam_model
         integer, allocatable :: eload_func(:)
         !> Consistent nodal forces and moments of each distributed load in global axes
         !> (6, n_element_loads), on all six DOFs of its element (fixed ones included, for the
-        !> reactions), weighted by the Arlequin weight like the mass.
+        !> reactions); the self-weight is weighted by the Arlequin weight like the mass, the
+        !> distributed loads of the deck are not.
         real(wp), allocatable :: eload_vector(:, :)
         !> Curvilinear abscissa of each node [m]: distance from node 1 along the elements
         !> (from the lowest node of each connected part); size n_nodes.
         real(wp), allocatable :: abscissa(:)
-        !> True when mass, stiffness and loads were weighted by an Arlequin weight.
+        !> True when mass, stiffness and self-weight were weighted by an Arlequin weight.
         logical :: weighted = .false.
-        !> Weight alpha at each node (1 when not weighted); loads are already multiplied by it.
+        !> Weight alpha at each node (1 when not weighted).
         real(wp), allocatable :: node_weight(:)
         !> Weighted element stiffness matrices in global axes (6, 6, n_elements), kept for
         !> `reactions` (allocated only when weighted).
@@ -136,8 +139,9 @@ contains
     !> Build the model from its description: checks, equation numbering, assembly of K and M.
     !> A model without enough supports is accepted here (explicit dynamics and modal analysis
     !> do not need it); the singular stiffness is reported when K is factored.
-    !> With a weight, K and M are integrated with alpha(s) and loads scaled by alpha at their
-    !> node (Arlequin partition); elements where alpha = 0 get no mass nor stiffness.
+    !> With a weight, K, M and the self-weight are integrated with alpha(s) (Arlequin
+    !> partition); elements where alpha = 0 get no mass nor stiffness. The nodal and distributed
+    !> loads are applied in full (the disks carry no share of them).
     subroutine build_beam_model(config, model, error, weight)
         !> The frame description.
         type(beam_config_t), intent(in) :: config
@@ -178,11 +182,6 @@ contains
             do i = 1, model%n_nodes
                 model%node_weight(i) = weight%value(model%abscissa(i))
             end do
-            do i = 1, size(model%loads)
-                associate (ld => model%loads(i))
-                    ld%value = ld%value*model%node_weight(ld%node)
-                end associate
-            end do
             call assemble(model, error, weight)
             call build_element_loads(config, model, weight)
         else
@@ -219,10 +218,11 @@ contains
         end do
     end subroutine check_element_loads
 
-    !> Consistent nodal forces of the distributed loads and of the self-weight rho A g:
-    !> f = int alpha N^T q ds over each element (Gauss, 6 points per piece between the
-    !> weight's breakpoints: exact for a linear q times a cubic Hermite N times a piecewise
-    !> cubic alpha), in global axes, on all six DOFs of the element.
+    !> Consistent nodal forces of the distributed loads, f = int N^T q ds, and of the
+    !> self-weight rho A g, f = int alpha N^T q ds with a weight (Gauss, 6 points per piece
+    !> between the weight's breakpoints: exact for a linear q times a cubic Hermite N times a
+    !> piecewise cubic alpha), over each element, in global axes, on all six DOFs of the
+    !> element. The distributed loads are not weighted (applied in full, see build_beam_model).
     subroutine build_element_loads(config, model, weight)
         type(beam_config_t), intent(in) :: config
         type(beam_model_t), intent(inout) :: model
@@ -255,7 +255,7 @@ contains
                 end associate
                 model%eload_element(i) = e
                 model%eload_func(i) = ld%func
-                model%eload_vector(:, i) = element_load_vector(model, e, qa, qt, weight)
+                model%eload_vector(:, i) = element_load_vector(model, e, qa, qt)
             end associate
         end do
         do e = 1, n - n_given
