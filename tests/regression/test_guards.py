@@ -109,11 +109,14 @@ def non_finite(exe, work):
 
 
 def coupled_non_finite(exe, work, decks):
-    """A coupled run with a beam load of 1e300 stops at the first step."""
+    """A coupled run with a beam load of 1e300 stops at the first step. Node 11 lies on the
+    overlap's end (alpha = alpha_min = 1e-3): the load is applied in full on a thousandth of
+    the node's mass, so the initial acceleration (step 0) already overflows (when the load was
+    weighted by alpha the run stopped at step 1)."""
     text = (decks / "coupled_rigid_translation.dat").read_text()
     bad = text.replace("line     = 1   0.0  0.0  0.10  0.0  10  1",
                        "line     = 1   0.0  0.0  0.10  0.0  10  1\nload = 11 w -1e300", 1)
-    failing_run(exe, work, "coupled_load_1e300", bad, r"step 1 \(t = .*\): beam", text)
+    failing_run(exe, work, "coupled_load_1e300", bad, r"step 0 \(t = 0\.00000E\+000 s\): beam .*a load", text)
 
 
 def coupled2d_initial_state(exe, work, src):
