@@ -49,7 +49,7 @@ module dem_moreau_jean
     implicit none
     private
     public :: mj_config_t, energies_t, dem_system_t, mj_init, mj_step, energies_balance, dem_system_bytes
-    public :: mj_free_velocities, mj_detect, mj_solve, mj_end_step
+    public :: mj_free_velocities, mj_detect, mj_solve, mj_end_step, mj_load_energy
 
     !> Time-stepping settings.
     type :: mj_config_t
@@ -469,6 +469,24 @@ contains
                                                + size(sys%impulse) + size(sys%xm) + size(sys%ym))
         if (allocated(sys%coupling_impulse)) b = b + 8_i8*size(sys%coupling_impulse)
     end function dem_system_bytes
+
+    !> Kinetic energy that the loads, the weight and the coupling impulse of the step just done
+    !> would give the free DOFs of disks at rest, sum |h F_theta + coupling impulse|^2 / (2 m)
+    !> [J/m]: the scale of the energy a step can create near rest (doc/theory.md 2.5).
+    pure real(wp) function mj_load_energy(sys) result(e)
+        !> System, after a step.
+        type(dem_system_t), intent(in) :: sys
+        real(wp) :: f(3)
+        integer :: i
+        e = 0.0_wp
+        if (.not. allocated(sys%load)) return
+        associate (p => sys%particles)
+            do i = 1, p%n
+                f = sys%scheme%h*(sys%load(:, i) + [p%mass(i)*p%gravity, 0.0_wp]) + sys%coupling_impulse(:, i)
+                e = e + 0.5_wp*sum(sys%im(:, i)*f*f)
+            end do
+        end associate
+    end function mj_load_energy
 
     !> Closing error of the energy audit [J/m] (zero up to round-off).
     pure real(wp) function energies_balance(e) result(b)

@@ -14,8 +14,9 @@
 !> than the coupled system, `save_part` / `load_part` (checkpoints) and `finish`.
 !>
 !> Warnings go through the report callback: steps whose joint solve did not converge (the
-!> first `max_warnings`, then only the count) and, once, a disk moving farther than the alert
-!> distance in a step. The initial state (step 0) and the state after every step are checked
+!> first `max_warnings`, then only the count), once, a disk moving farther than the alert
+!> distance in a step, and once, then counted in the summary, a converged step whose contacts
+!> created energy (driver_guards::creation_allowance; doc/theory.md 2.4). The initial state (step 0) and the state after every step are checked
 !> as in the uncoupled runs (driver_guards): the finite-element side by `check_part`, then the
 !> disks (non-finite values, beyond the representable box), then tunnelling (after a step).
 module driver_coupled_loop
@@ -29,6 +30,7 @@ module driver_coupled_loop
     use coupling_coupled_step, only: coupled_system_t, coupled_energies_t, arlequin_step, coupled_energies, &
                                      velocity_mismatch_t, velocity_mismatch
     use driver_results, only: results_writer_t
+    use dem_moreau_jean, only: mj_load_energy
     use driver_results_dem, only: dem_writer_t
     use driver_results_coupled, only: coupled_writer_t
     use driver_run_dem, only: max_warnings, speed_warning, last_unconverged_warning, fclib_path, tolerance_floor_hint, &
@@ -36,7 +38,8 @@ module driver_coupled_loop
     use driver_results_dem, only: write_fclib_local
     use dem_local_problem, only: local_problem_t
     use dem_contacts, only: status_cohesive
-    use driver_guards, only: check_disks_state, check_walls_state, step_start_t, take_step_start, check_tunnelling
+    use driver_guards, only: check_disks_state, check_walls_state, step_start_t, take_step_start, check_tunnelling, &
+                             step_created_energy, creation_allowance, energy_creation_warning, energy_creation_summary
     use driver_checkpoint, only: checkpoint_run_t, end_of_step, step_end_t, loop_state_t, checkpoint_create, &
                                  save_coupled, load_coupled, &
                                  save_results, load_results, save_dem_writer, load_dem_writer, &
@@ -107,6 +110,8 @@ module driver_coupled_loop
         integer :: lost_warnings = 0
         !> Unconverged steps so far.
         integer :: unconverged = 0
+        !> Converged steps whose contacts created energy so far (the first one warned about).
+        integer(i8) :: creating = 0
         !> Warnings given once: a disk faster than the alert distance, bonded coupled disks
         !> turned too far.
         logical :: speed_warned = .false., rotation_warned = .false.
@@ -338,8 +343,7 @@ contains
         procedure(report_iface) :: report
         !> Set on a failure of the step, a guard or a write.
         type(error_t), allocatable, intent(out) :: error
-        call take_step_start(lp%start, self%sys%dem%particles, self%sys%dem%walls, &
-                             self%sys%dem%energies%contact_dissipation)
+        call take_step_start(lp%start, self%sys%dem%particles, self%sys%dem%walls, self%sys%dem%energies)
         if (lp%k == self%fclib_step) then
             call step_with_export(self, lp%k, out, report, error)
         else
@@ -464,6 +468,13 @@ contains
         !> Where the warnings go.
         procedure(report_iface) :: report
         if (.not. self%sys%stats%converged) call warn_unconverged(self, lp, report)
+        if (self%sys%stats%converged .and. step_created_energy(lp%start, self%sys%dem%energies) > &
+            creation_allowance(lp%start, self%sys%dem%energies, mj_load_energy(self%sys%dem))) then
+            lp%creating = lp%creating + 1
+            if (lp%creating == 1) &
+                call report(energy_creation_warning(lp%k, self%sys%fe%t, step_created_energy(lp%start, self%sys%dem%energies), &
+                                                    lp%start%kinetic, self%sys%dem%energies%kinetic))
+        end if
         if (self%sys%dem%bonds_lost > 0) then
             lp%lost_warnings = lp%lost_warnings + 1
             if (lp%lost_warnings <= max_warnings) &
@@ -634,6 +645,7 @@ contains
             ' J (max over the outputs ', self%cpl_out%max_balance, ' J; external work ', &
             en%fe_external_work + en%fe_reaction_work + en%dem_external_work + en%dem_drive_work, ' J)'
         call report(trim(buf))
+        if (lp%creating > 0) call report(energy_creation_summary(lp%creating, lp%n_steps))
         call report(lp%progress%summary_line(lp%n_steps, self%sys%fe%t, out%stopped()))
     end subroutine summary
 

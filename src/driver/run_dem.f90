@@ -2,8 +2,10 @@
 !> states, energies and contacts at the stored outputs, solver statistics at every step.
 !>
 !> Warnings go through the report callback: a step whose contact solve did not converge
-!> (the first `max_warnings` ones, then only the count in the summary), and, once, a step in
-!> which a disk moved farther than the alert distance (contacts may then be found late).
+!> (the first `max_warnings` ones, then only the count in the summary), once, a step in
+!> which a disk moved farther than the alert distance (contacts may then be found late), and
+!> once, then counted in the summary, a converged step whose contacts created energy
+!> (driver_guards::creation_allowance; Newton's restitution, doc/theory.md 2.4).
 !> After every step the state is checked (driver_guards): a non-finite value, a disk beyond
 !> the representable box, or a disk that passed through a wall or another disk stops the run
 !> with an error.
@@ -15,13 +17,14 @@ module driver_run_dem
     use io_progress, only: progress_t
     use dem_particles, only: particles_t
     use dem_moreau_jean, only: mj_init, mj_step, energies_balance, mj_free_velocities, mj_detect, mj_solve, &
-                               mj_end_step
+                               mj_end_step, mj_load_energy
     use dem_local_problem, only: local_problem_t, local_problem_build
     use driver_config, only: run_config_t
     use driver_config_dem, only: dem_config_t
     use driver_results, only: results_writer_t
     use driver_results_dem, only: dem_writer_t, write_fclib_local
-    use driver_guards, only: check_disks_state, check_walls_state, step_start_t, take_step_start, check_tunnelling
+    use driver_guards, only: check_disks_state, check_walls_state, step_start_t, take_step_start, check_tunnelling, &
+                             step_created_energy, creation_allowance, energy_creation_warning, energy_creation_summary
     use io_hdf5_file, only: h5_file_t
     use driver_checkpoint, only: end_of_step, step_end_t, checkpoint_run_t, loop_state_t, checkpoint_create, &
                                  save_dem, load_dem, save_results, load_results, save_dem_writer, load_dem_writer
@@ -66,6 +69,7 @@ contains
         integer(i8) :: n_steps, k, k0
         integer :: lost_warnings
         integer :: unconverged
+        integer(i8) :: creating
         logical :: blocked_warned
         logical :: speed_warned
         type(step_end_t) :: act
@@ -80,6 +84,7 @@ contains
         end if
         n_steps = run%n_steps
         unconverged = 0
+        creating = 0
         lost_warnings = 0
         speed_warned = .false.
         blocked_warned = .false.
@@ -101,7 +106,7 @@ contains
         if (ck%restart) call progress%resume(k0, ck%start%wall_seconds, ck%start%runs)
         call ck%schedule%start()
         do k = k0 + 1, n_steps
-            call take_step_start(start, cfg%system%particles, cfg%system%walls, cfg%system%energies%contact_dissipation)
+            call take_step_start(start, cfg%system%particles, cfg%system%walls, cfg%system%energies)
             if (k == cfg%fclib_step) then
                 call step_with_export(error)
                 if (allocated(error)) return
@@ -113,6 +118,7 @@ contains
             call writer%record_step(out%file, cfg%system%stats, error)
             if (allocated(error)) return
             if (.not. cfg%system%stats%converged) call warn_unconverged()
+            call check_created_energy()
             if (cfg%system%stats%n_blocked > 0 .and. .not. blocked_warned) then
                 call report('warning: contacts between bodies that cannot move (fixed or imposed '// &
                             'velocities) are left out of the solve; count per step in /dem/solver/blocked')
@@ -240,6 +246,20 @@ contains
             if (unconverged == max_warnings) call report(last_unconverged_warning())
         end subroutine warn_unconverged
 
+        !> Warning (once, then counted) when a converged step created energy beyond
+        !> driver_guards::creation_allowance (an unconverged one has its own warning).
+        subroutine check_created_energy()
+            associate (sys => cfg%system)
+                if (.not. sys%stats%converged) return
+                if (.not. step_created_energy(start, sys%energies) > &
+                    creation_allowance(start, sys%energies, mj_load_energy(sys))) return
+                creating = creating + 1
+                if (creating > 1) return
+                call report(energy_creation_warning(k, sys%time, step_created_energy(start, sys%energies), &
+                                                    start%kinetic, sys%energies%kinetic))
+            end associate
+        end subroutine check_created_energy
+
         !> Warning (once) when a disk moved farther than the alert distance in the step.
         subroutine check_speed()
             character(len=:), allocatable :: line
@@ -266,6 +286,7 @@ contains
                     energies_balance(sys%energies), ' J/m (dissipated in contacts ', &
                     sys%energies%contact_dissipation, ' J/m)'
                 call report(trim(buf))
+                if (creating > 0) call report(energy_creation_summary(creating, n_steps))
             end associate
             call report(progress%summary_line(n_steps, cfg%system%time, out%stopped()))
         end subroutine summary
