@@ -132,7 +132,9 @@ contains
                            'Law of the contacts between two materials (either order): friction coefficient '// &
                            '(at most 1000, which sticks wherever a real contact does: the local solver is exact '// &
                            'to 1e4 and loses the normal direction beyond, letting disks sink), '// &
-                           'restitution coefficient, cohesion stress sigma_cohe (the bond holds a tension '// &
+                           'restitution coefficient (with friction and e close to 1 an oblique impact can '// &
+                           'gain energy, Kane''s paradox of Newton''s law; the run warns, doc/theory.md 2.4), '// &
+                           'cohesion stress sigma_cohe (the bond holds a tension '// &
                            'sigma_cohe times the mean radius of the pair per unit thickness; bonds form '// &
                            'between touching disks at t = 0 and break for good once a bound of their law is '// &
                            'reached), and optionally the rolling resistance length e_r (default 0: none; '// &
