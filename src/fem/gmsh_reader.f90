@@ -907,6 +907,11 @@ contains
             end do
         end do
         call mesh%orient_elements()
+        allocate (mesh%declared(size(names)))
+        do k = 1, size(names)
+            mesh%declared(k)%name = names(k)%name
+            mesh%declared(k)%dim = names(k)%dim
+        end do
         ! Named sets from the physical groups of each block's entity.
         do b = 1, size(blocks)
             phys = entity_physical(entities, blocks(b)%dim, blocks(b)%tag)

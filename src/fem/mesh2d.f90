@@ -14,7 +14,7 @@ module fem_mesh2d
     use fem_element_registry, only: kind_node_count
     implicit none
     private
-    public :: mesh2d_t, named_set_t, edge_set_t, set_name_problem
+    public :: mesh2d_t, named_set_t, edge_set_t, physical_group_t, set_name_problem
 
     !> A named set of node or element indices.
     type :: named_set_t
@@ -33,6 +33,14 @@ module fem_mesh2d
         !> Element of which each edge is a side (0 until `orient_edges` has run).
         integer, allocatable :: elements(:)
     end type edge_set_t
+
+    !> A physical group a mesh file declares by name ($PhysicalNames).
+    type :: physical_group_t
+        !> Name (case-sensitive).
+        character(len=:), allocatable :: name
+        !> Dimension: 0 points, 1 lines, 2 surfaces.
+        integer :: dim = 0
+    end type physical_group_t
 
     !> The mesh.
     type :: mesh2d_t
@@ -56,6 +64,9 @@ module fem_mesh2d
         integer, allocatable :: element_line(:)
         !> The mesh file (with element_tag).
         character(len=:), allocatable :: file
+        !> The physical groups the mesh file declares by name, with or without elements
+        !> (unallocated for a generated mesh).
+        type(physical_group_t), allocatable :: declared(:)
     contains
         !> Number of nodes.
         procedure :: node_count => mesh_node_count
@@ -345,7 +356,8 @@ contains
         integer :: k
         k = find_set(self%node_sets, name)
         if (k == 0) then
-            call make_error(error, "mesh: no node set named '"//name//"'"//known(self%node_sets))
+            call make_error(error, "mesh: no node set named '"//name//"'"//empty_group(self, name, [0, 1, 2])// &
+                            known(self%node_sets))
             return
         end if
         ids = self%node_sets(k)%ids
@@ -364,7 +376,8 @@ contains
         integer :: k
         k = find_set(self%element_sets, name)
         if (k == 0) then
-            call make_error(error, "mesh: no element set named '"//name//"'"//known(self%element_sets))
+            call make_error(error, "mesh: no element set named '"//name//"'"//empty_group(self, name, [2])// &
+                            known(self%element_sets))
             return
         end if
         ids = self%element_sets(k)%ids
@@ -401,8 +414,30 @@ contains
             end do
         end if
         if (len(names) == 0) names = ' (none)'
-        call make_error(error, "mesh: no edge set named '"//name//"' (known:"//names//')')
+        call make_error(error, "mesh: no edge set named '"//name//"'"//empty_group(self, name, [1])//' (known:'// &
+                        names//')')
     end subroutine mesh_edge_set
+
+    !> ": 'name' is declared in $PhysicalNames of <file> (dimension d) but holds no elements
+    !> of that dimension" when the mesh file declares a group of that name and one of the
+    !> dimensions `dims` (that of the set looked for: no set was made of it), else ''.
+    pure function empty_group(self, name, dims) result(text)
+        type(mesh2d_t), intent(in) :: self
+        character(len=*), intent(in) :: name
+        integer, intent(in) :: dims(:)
+        character(len=:), allocatable :: text
+        integer :: k
+        text = ''
+        if (.not. allocated(self%declared)) return
+        do k = 1, size(self%declared)
+            if (.not. same_name(self%declared(k)%name, name)) cycle
+            if (.not. any(dims == self%declared(k)%dim)) cycle
+            text = ": '"//name//"' is declared in $PhysicalNames"
+            if (allocated(self%file)) text = text//' of '//self%file
+            text = text//' (dimension '//to_str(self%declared(k)%dim)//') but holds no elements of that dimension'
+            return
+        end do
+    end function empty_group
 
     !> " (known: 'a', 'b')" listing the names of sets.
     pure function known(sets) result(text)
