@@ -29,6 +29,8 @@ module core_timefunc
         !> Second derivative d2f/dt2 at time t (zero on the linear pieces; the impulses at the
         !> kinks of ramp, step and table are not represented).
         procedure :: acceleration => time_function_acceleration
+        !> Whether f(t) = 0 at every t of a closed interval [t0, t1].
+        procedure :: zero_on => time_function_zero_on
     end type time_function_t
 
 contains
@@ -106,4 +108,35 @@ contains
             d2f = 0.0_wp
         end select
     end function time_function_acceleration
+
+    !> Whether f(t) = 0 at every t of [t0, t1] (true for an empty interval, t1 < t0), exact for
+    !> f as `value` computes it: constant, c = 0; ramp and step (non-decreasing from 0),
+    !> f(t1) = 0; table (linear between its points), f = 0 at t0, at t1 and at every table
+    !> time between; harmonic, f(t0) = 0 when t0 = t1 and never on a longer interval (freq > 0
+    !> in a deck; freq = 0 is the constant sin(phase)).
+    pure logical function time_function_zero_on(self, t0, t1) result(zero)
+        !> The function.
+        class(time_function_t), intent(in) :: self
+        !> Start and end of the interval [s].
+        real(wp), intent(in) :: t0, t1
+        zero = .true.
+        if (t1 < t0) return
+        select case (self%kind)
+        case (tf_constant)
+            zero = self%p(1) == 0.0_wp
+        case (tf_ramp, tf_step)
+            zero = self%value(t1) == 0.0_wp
+        case (tf_table)
+            zero = self%value(t0) == 0.0_wp .and. self%value(t1) == 0.0_wp .and. &
+                   all(self%f == 0.0_wp .or. self%t <= t0 .or. self%t >= t1)
+        case (tf_harmonic)
+            if (t1 > t0 .and. self%p(1) /= 0.0_wp) then
+                zero = .false.
+            else
+                zero = self%value(t0) == 0.0_wp
+            end if
+        case default
+            zero = .true.
+        end select
+    end function time_function_zero_on
 end module core_timefunc

@@ -1,7 +1,7 @@
 !> Checks and warnings of a deck before its run (driver_run): the model's size against the
 !> memory, before anything is built; option `--end` applied to the model built; the settings
-!> the deck gives without effect, harmonic functions the time step aliases, and an end time
-!> that is not a whole number of steps.
+!> the deck gives without effect, harmonic functions the time step aliases, time functions
+!> that are zero over the whole run, and an end time that is not a whole number of steps.
 module driver_run_checks
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error, make_input_error, make_internal_error
@@ -12,7 +12,8 @@ module driver_run_checks
     use fem_mesh_generator, only: rectangle_size, check_rectangle_size
     use fem_element_registry, only: element_slot_t, new_element, kind_of_name
     use driver_simulation, only: simulation_t, report_iface
-    use driver_config, only: steps_to_end, max_steps
+    use driver_config, only: steps_to_end, max_steps, build_time_functions
+    use core_timefunc, only: time_function_t
     use driver_run_dem, only: fclib_after_end_warning
     implicit none
     private
@@ -21,7 +22,8 @@ module driver_run_checks
 contains
 
     !> The deck's warnings, in this order: settings without effect, harmonic functions the
-    !> time step aliases, an end time that is not a whole number of steps.
+    !> time step aliases, time functions zero over the whole run, an end time that is not a
+    !> whole number of steps.
     subroutine warn_about_deck(end_time, deck, sim, report)
         !> Option `--end`: the end time replacing the deck's [s] (negative: none).
         real(wp), intent(in) :: end_time
@@ -33,6 +35,7 @@ contains
         procedure(report_iface) :: report
         call warn_keywords_without_effect(deck, sim, report)
         call warn_aliased_functions(deck, sim, report)
+        call warn_idle_functions(deck, sim, report)
         call warn_end_off_the_steps(end_time, deck, sim, report)
     end subroutine warn_about_deck
 
@@ -93,6 +96,58 @@ contains
                         'samples it below two steps per period and sees an alias; lower the step')
         end do
     end subroutine warn_aliased_functions
+
+    !> Warn about each time function that records of the deck use (loads, tractions, imposed
+    !> displacements and velocities, driven walls) and that is zero at every time of a dynamic
+    !> run, from t = 0 to its last step (`time_function_t%zero_on`): nothing it multiplies is
+    !> applied before the end. Allowed (the deck may be the first part of a longer run), said
+    !> once per function with the lines of the records that use it.
+    subroutine warn_idle_functions(deck, sim, report)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> Its simulation (run settings built, `--end` applied).
+        class(simulation_t), intent(in) :: sim
+        !> Where the warnings go.
+        procedure(report_iface) :: report
+        !> Records named in full in a warning; the others are counted.
+        integer, parameter :: listed = 3
+        type(time_function_t), allocatable :: functions(:)
+        type(deck_entry_t), allocatable :: list(:)
+        type(error_t), allocatable :: error
+        integer, allocatable :: ids(:)
+        character(len=:), allocatable :: users
+        real(wp) :: t_last
+        integer :: i, k, n_users
+        if (sim%settings%analysis /= 'dynamic' .or. .not. sim%settings%h > 0.0_wp) return
+        ! the model's build has read the same functions without error
+        call build_time_functions(deck, functions, ids, error)
+        if (allocated(error)) return
+        allocate (list, source=deck%records('functions', 'function'))
+        ! the last step's loads are those at n h, at or just past the end asked for
+        t_last = max(sim%settings%t_end, real(sim%settings%n_steps, wp)*sim%settings%h)
+        do i = 1, size(functions)
+            if (.not. functions(i)%zero_on(0.0_wp, t_last)) cycle
+            users = ''
+            n_users = 0
+            do k = 1, size(deck%entries)
+                associate (e => deck%entries(k))
+                    if (index(' '//e%names//' ', ' function ') == 0) cycle
+                    if (.not. e%has('function')) cycle
+                    if (e%int('function') /= ids(i)) cycle
+                    n_users = n_users + 1
+                    if (n_users > listed) cycle
+                    if (n_users > 1) users = users//', '
+                    users = users//'['//e%section//'] '//e%keyword//' on line '//to_str(e%line)
+                end associate
+            end do
+            if (n_users == 0) cycle
+            if (n_users > listed) users = users//' and '//to_str(n_users - listed)//' more'
+            call report('warning: '//deck%file//':'//to_str(list(i)%line)//': time function '//to_str(ids(i))// &
+                        ' is zero at every time of the run, from t = 0 to its end at '//num(t_last)// &
+                        ' s: nothing it multiplies ('//users//') is applied before the end; make it non-zero '// &
+                        'before the end, or raise the end time')
+        end do
+    end subroutine warn_idle_functions
 
     !> Warn when the end time (the deck's, or --end) is not a whole number of time steps: the
     !> run goes on to the next step, past the end asked for.

@@ -19,6 +19,10 @@ goes on, and a warning names the file, the line and the setting that turns it of
 - A static or dynamic beam or continuum run whose largest displacement exceeds 10 % of the
   model's extent (a modulus in MPa read as Pa) warns that linear theory does not hold, with
   exit 0; the threshold is checked on a cantilever's closed-form tip deflection.
+- A time function used by a load that is zero over the whole run (a step at 1.0 s of a run
+  that ends at 0.5 s) is warned about at its line, with the line of the load, under --check
+  and at the run's start, once per such function; not when it acts before the end (the
+  step at 1.0 s with --end 2, a table pulse inside the run).
 - In a coupled run (beam or continuum: input/bending_hinged_row.dat, input/interface_shear.dat)
   `method = coarse` and `cold_start = hydrostatic` are warned about, and the warning is true:
   the run's results are those of `method = nlgs` (and of `cold_start = zero`), bit for bit.
@@ -136,6 +140,9 @@ def coupled(exe, work, name, deck_path, ends, extra=""):
                   any(w.startswith(f"warning: {deck}:{line_of(text, 'cold_start')}: [solver] cold_start = "
                                    "hydrostatic has no effect in a coupled run") for w in said), "\n".join(said))
         else:
+            # (interface_shear's displacement starts at 1 ms: cut at 0.2 ms, its function is
+            # zero over the whole run, which is warned about and is not the point here)
+            said = [w for w in said if "is zero at every time of the run" not in w]
             check(f"{name}: method = nlgs is not warned about", proc.returncode == 0 and not said, "\n".join(said))
         with h5py.File(work / f"{name}_{variant}" / f"{name}_{variant}.h5", "r") as f:
             results[variant] = (f["dem/position"][...], f["dem/velocity"][...], f["dem/solver/sweeps"][...])
@@ -366,6 +373,42 @@ load = 11 w -{load}
               f"exit {proc.returncode}; " + ("\n".join(said) or proc.stderr.strip()[:300]))
 
 
+def idle_functions(exe, src, work):
+    """input/cantilever.dat with its step moved to t0 = 1.0 s, after the end (0.5 s): the tip
+    load is never applied; warned about at the function's line, naming the load's line. A
+    second load under a ramp (acting) adds no warning; --end 2 (the step inside the run) and a
+    table pulse inside the run give none."""
+    base = (src / "input" / "cantilever.dat").read_text()
+    late = base.replace("function = 1 step 0.0", "function = 1 step 1.0\nfunction = 2 ramp 0.1")
+    late = re.sub(r"^(load\s*=.*)$", r"\1\nload = 11 w -1.0 2", late, count=1, flags=re.M)
+    deck = work / "cantilever_late.dat"
+    deck.write_text(late)
+    expected = (f"warning: {deck}:{line_of(late, 'function')}: time function 1 is zero at every time of the "
+                f"run, from t = 0 to its end at 5.000E-001 s: nothing it multiplies ([beam] load on line "
+                f"{line_of(late, 'load')}) is applied before the end")
+    proc = multicor(exe, "--check", deck)
+    said = warnings_of(proc.stdout)
+    check("time function zero over the run: --check warns once, at its line, naming the load",
+          proc.returncode == 0 and len(said) == 1 and said[0].startswith(expected),
+          "\n".join(said) or proc.stderr.strip()[:300])
+    proc = multicor(exe, "--check", deck, "--end", "2")
+    check("time function zero over the run: no warning when --end 2 takes the run past the step",
+          proc.returncode == 0 and not warnings_of(proc.stdout), "\n".join(warnings_of(proc.stdout)))
+    # the run's start (10 steps: --end 2e-3), where the interval is [0, 2 ms]
+    proc = multicor(exe, deck, "--output", work / "cantilever_late", "--end", "2e-3")
+    said = warnings_of(proc.stdout)
+    check("time function zero over the run: the run warns at its start",
+          proc.returncode == 0 and len(said) == 1
+          and said[0].startswith(expected.replace("5.000E-001", "2.000E-003")),
+          "\n".join(said) or proc.stderr.strip()[:300])
+    pulse = base.replace("function = 1 step 0.0", "function = 1 table 0 0 0.1 1 0.2 0 1 0")
+    deck = work / "cantilever_pulse.dat"
+    deck.write_text(pulse)
+    proc = multicor(exe, "--check", deck)
+    check("time function non-zero only inside the run (a table pulse): no warning",
+          proc.returncode == 0 and not warnings_of(proc.stdout), "\n".join(warnings_of(proc.stdout)))
+
+
 def main():
     exe, work, src = arguments(fresh=True)
     example_decks_are_quiet(exe, src)
@@ -376,6 +419,7 @@ def main():
     coupling_thickness(exe, src, work)
     coupled_disks_off_the_beam(exe, src, work)
     large_displacements(exe, src, work)
+    idle_functions(exe, src, work)
     # the hinged row of the reference work (20 steps; with nlgs at 1e-4: 108 to 172 sweeps per
     # step) and the interface experiment (10 steps: 19 to 47 sweeps per step)
     coupled(exe, work, "beam", src / "input" / "bending_hinged_row.dat", "2e-4", "tolerance = 1e-4\n")
