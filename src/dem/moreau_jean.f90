@@ -39,7 +39,7 @@ module dem_moreau_jean
     use dem_walls, only: walls_t, walls_velocity, walls_advance
     use dem_materials, only: materials_t
     use dem_contacts, only: contact_set_t, contact_law_t, contacts_set_frames, contacts_make_bonds, contacts_lost_bonds, &
-                            contacts_set_laws, contacts_finish, contacts_impulses, contacts_local_velocity, &
+                            status_cohesive, contacts_set_laws, contacts_finish, contacts_impulses, contacts_local_velocity, &
                             contacts_bytes
     use dem_detection, only: detector_t, detect_contacts, detector_bytes
     use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_bilateral_t
@@ -49,7 +49,7 @@ module dem_moreau_jean
     implicit none
     private
     public :: mj_config_t, energies_t, dem_system_t, mj_init, mj_step, energies_balance, dem_system_bytes
-    public :: mj_free_velocities, mj_detect, mj_solve, mj_end_step, mj_load_energy
+    public :: mj_free_velocities, mj_detect, mj_solve, mj_end_step, mj_load_energy, mj_bonds_at_start, mj_bonds_made
 
     !> Time-stepping settings.
     type :: mj_config_t
@@ -235,19 +235,9 @@ contains
         !> System, after `mj_free_velocities`.
         type(dem_system_t), intent(inout) :: sys
         integer(i8) :: c0, c1, c2, rate
-        real(wp) :: alert, rmax
+        real(wp) :: alert
         call system_clock(c0, rate)
-        ! touching disks must be found whatever the sign of their rounded gap
-        alert = sys%scheme%alert
-        if (sys%particles%n > 0) then
-            rmax = maxval(sys%particles%radius(1:sys%particles%n))
-            alert = alert + sys%scheme%gap_allowance*rmax
-            ! a bond is made on a gap of up to bond_ratio times the pair's radius: with cohesion
-            ! the search reaches that far, or an `alert` below it lost the bond at the first
-            ! step (at the default, a quarter of the mean radius, it changes nothing)
-            if (any(sys%materials%cohesion > 0.0_wp)) &
-                alert = max(alert, (sys%scheme%bond_ratio + sys%scheme%gap_allowance)*rmax)
-        end if
+        alert = detection_alert(sys)
         if (sys%bonds_pending) call make_bonds(sys, alert)
         call detect_contacts(sys%detector, sys%xm, sys%ym, sys%particles%radius, alert, &
                              sys%wx1, sys%wy1, sys%wx2, sys%wy2, sys%contacts)
@@ -317,6 +307,25 @@ contains
         end do
     end subroutine log_lost_bonds
 
+    !> Alert distance of a step's detection [m]: `[contacts] alert` widened by the round-off
+    !> allowance (touching disks must be found whatever the sign of their rounded gap) and,
+    !> with cohesion, to the largest gap of a bond.
+    pure real(wp) function detection_alert(sys) result(alert)
+        !> The system.
+        type(dem_system_t), intent(in) :: sys
+        real(wp) :: rmax
+        alert = sys%scheme%alert
+        if (sys%particles%n > 0) then
+            rmax = maxval(sys%particles%radius(1:sys%particles%n))
+            alert = alert + sys%scheme%gap_allowance*rmax
+            ! a bond is made on a gap of up to bond_ratio times the pair's radius: with cohesion
+            ! the search reaches that far, or an `alert` below it lost the bond at the first
+            ! step (at the default, a quarter of the mean radius, it changes nothing)
+            if (any(sys%materials%cohesion > 0.0_wp)) &
+                alert = max(alert, (sys%scheme%bond_ratio + sys%scheme%gap_allowance)*rmax)
+        end if
+    end function detection_alert
+
     !> The bonds of the run, made on the configuration at the start of the first step (t = 0,
     !> before any motion): the contacts detected there (alert distance widened by bond_ratio
     !> times the largest radius, so that every pair within a bond's gap is found), bonds on
@@ -329,24 +338,79 @@ contains
         type(dem_system_t), intent(inout) :: sys
         !> Alert distance of the step's detection [m].
         real(wp), intent(in) :: alert
+        call find_bonds(sys%particles, sys%walls, sys%materials, sys%scheme%bond_ratio, alert, sys%detector, &
+                        sys%contacts)
+    end subroutine make_bonds
+
+    !> The contacts of the disks and walls as they are (detection with the alert distance
+    !> widened by bond_ratio times the largest radius), those with cohesion and a gap of at
+    !> most bond_ratio * mean radius marked as intact bonds (contacts_make_bonds).
+    subroutine find_bonds(particles, walls, materials, bond_ratio, alert, det, cs)
+        !> Disks.
+        type(particles_t), intent(in) :: particles
+        !> Walls.
+        type(walls_t), intent(in) :: walls
+        !> Material pair table.
+        type(materials_t), intent(in) :: materials
+        !> Gap ratio of the bonds.
+        real(wp), intent(in) :: bond_ratio
+        !> Alert distance of the step's detection [m].
+        real(wp), intent(in) :: alert
+        !> Detection workspace.
+        type(detector_t), intent(inout) :: det
+        !> The contacts found, bonds marked.
+        type(contact_set_t), intent(inout) :: cs
         real(wp), allocatable :: wx1(:), wy1(:), wx2(:), wy2(:)
         integer :: n, nw
-        n = sys%particles%n
-        nw = sys%walls%n
+        n = particles%n
+        nw = walls%n
         if (n == 0) return
         allocate (wx1(nw), wy1(nw), wx2(nw), wy2(nw))
         if (nw > 0) then
-            wx1 = sys%walls%x1(1:nw)
-            wy1 = sys%walls%y1(1:nw)
-            wx2 = sys%walls%x2(1:nw)
-            wy2 = sys%walls%y2(1:nw)
+            wx1 = walls%x1(1:nw)
+            wy1 = walls%y1(1:nw)
+            wx2 = walls%x2(1:nw)
+            wy2 = walls%y2(1:nw)
         end if
-        call detect_contacts(sys%detector, sys%particles%x(1:n), sys%particles%y(1:n), sys%particles%radius, &
-                             alert + sys%scheme%bond_ratio*maxval(sys%particles%radius(1:n)), wx1, wy1, wx2, wy2, &
-                             sys%contacts)
-        call contacts_make_bonds(sys%contacts, sys%scheme%bond_ratio, sys%particles%radius, sys%particles%mat, &
-                                 sys%walls%mat, sys%materials)
-    end subroutine make_bonds
+        call detect_contacts(det, particles%x(1:n), particles%y(1:n), particles%radius, &
+                             alert + bond_ratio*maxval(particles%radius(1:n)), wx1, wy1, wx2, wy2, cs)
+        call contacts_make_bonds(cs, bond_ratio, particles%radius, particles%mat, walls%mat, materials)
+    end subroutine find_bonds
+
+    !> The bonds the first step makes (make_bonds), counted by pair of materials, without
+    !> changing the system: found as the first step finds them, on the configuration at hand
+    !> (that at t = 0 before the first step).
+    function mj_bonds_at_start(sys) result(bonds)
+        !> The system (its settings, materials, disks and walls; `mj_init` not needed).
+        type(dem_system_t), intent(in) :: sys
+        !> bonds(a, b) = bonds(b, a): the bonds between a body of material a and one of b.
+        integer, allocatable :: bonds(:, :)
+        type(detector_t) :: det
+        type(contact_set_t) :: cs
+        integer :: k, ma, mb
+        allocate (bonds(sys%materials%n, sys%materials%n), source=0)
+        call find_bonds(sys%particles, sys%walls, sys%materials, sys%scheme%bond_ratio, detection_alert(sys), det, cs)
+        do k = 1, cs%n
+            if (cs%status(k) /= status_cohesive) cycle
+            mb = sys%particles%mat(cs%i2(k))
+            if (cs%i1(k) > 0) then
+                ma = sys%particles%mat(cs%i1(k))
+            else
+                ma = sys%walls%mat(-cs%i1(k))
+            end if
+            bonds(ma, mb) = bonds(ma, mb) + 1
+            if (ma /= mb) bonds(mb, ma) = bonds(mb, ma) + 1
+        end do
+    end function mj_bonds_at_start
+
+    !> Bonds made at t = 0 by a run that has taken steps: those intact now and those broken or
+    !> lost since (each logged once in `ruptures`).
+    pure integer function mj_bonds_made(sys) result(n)
+        !> The system.
+        type(dem_system_t), intent(in) :: sys
+        n = sys%ruptures%n
+        if (sys%contacts%n > 0) n = n + count(sys%contacts%status(1:sys%contacts%n) == status_cohesive)
+    end function mj_bonds_made
 
     !> vel0 = current velocities, im, theta-weighted loads, vel = free velocities, wall velocities.
     subroutine free_velocities(sys)

@@ -32,7 +32,7 @@ module driver_config_dem
     use dem_materials, only: materials_init, materials_set_pair, materials_set_bond, bond_e_default
     use dem_contacts, only: contact_set_t
     use dem_detection, only: detector_t, detect_contacts, coordinate_limit
-    use dem_moreau_jean, only: dem_system_t
+    use dem_moreau_jean, only: dem_system_t, mj_bonds_at_start
     use dem_nlgs, only: lmgc90_criterion_t, siconos_criterion_t
     use dem_solve_method, only: sweeps_method_t
     use dem_bonded_block, only: bonded_block_method_t
@@ -122,7 +122,48 @@ contains
         call check_overlaps(deck, cfg, error)
         if (allocated(error)) return
         call check_alert_reach(deck, cfg, available_memory(), error)
+        if (allocated(error)) return
+        call warn_bonds_without_pairs(deck, cfg)
     end subroutine build_dem_config
+
+    !> Warn about each `[contacts] bond` record that bonds no pair at t = 0 (the bonds of the
+    !> first step, mj_bonds_at_start): no body of one of its materials touches one of the
+    !> other, and bonds form only then, so the record has no effect. A cohesive law alone
+    !> is not warned about: its contacts that form later follow the law.
+    subroutine warn_bonds_without_pairs(deck, cfg)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> The model (disks, walls, materials and settings built); warnings appended.
+        type(dem_config_t), intent(inout) :: cfg
+        type(deck_entry_t), allocatable :: list(:)
+        integer, allocatable :: bonds(:, :)
+        character(len=:), allocatable :: pairs
+        integer :: i, a, b
+        allocate (list, source=deck%records('contacts', 'bond'))
+        if (size(list) == 0) return
+        bonds = mj_bonds_at_start(cfg%system)
+        do i = 1, size(list)
+            associate (e => list(i))
+                ! (build_bonds checked that both materials are defined)
+                a = findloc(cfg%material_id, e%int('material1'), dim=1)
+                b = findloc(cfg%material_id, e%int('material2'), dim=1)
+                if (bonds(a, b) > 0) cycle
+                if (a == b) then
+                    pairs = 'no two bodies of material '//e%word('material1')//' touch'
+                else
+                    pairs = 'no body of material '//e%word('material1')//' touches one of material '// &
+                            e%word('material2')
+                end if
+                cfg%warnings = [cfg%warnings, string_t('warning: '//deck%file//':'//to_str(e%line)// &
+                                                       ': [contacts] bond between materials '//e%word('material1')// &
+                                                       ' and '//e%word('material2')//' makes no bond: '//pairs// &
+                                                       ' at t = 0 (a gap of at most '//to_str(cfg%system%scheme%bond_ratio)// &
+                                                       ' times the mean radius of the pair), and bonds form only '// &
+                                                       'then; place the disks in contact at t = 0 (e.g. a lattice), '// &
+                                                       'or remove the record')]
+            end associate
+        end do
+    end subroutine warn_bonds_without_pairs
 
     !> Error when the alert distance makes so many disk pairs contact candidates that their
     !> contact list would not fit in the available memory (nothing checked when that is

@@ -34,7 +34,7 @@ module driver_coupled_loop
     use driver_results_dem, only: dem_writer_t
     use driver_results_coupled, only: coupled_writer_t
     use driver_run_dem, only: max_warnings, speed_warning, last_unconverged_warning, fclib_path, tolerance_floor_hint, &
-                              fclib_after_end_warning, fclib_no_contacts_warning, lost_bonds_warning
+                              fclib_after_end_warning, fclib_no_contacts_warning, lost_bonds_warning, bonds_line
     use driver_results_dem, only: write_fclib_local
     use dem_local_problem, only: local_problem_t
     use dem_contacts, only: status_cohesive
@@ -640,6 +640,7 @@ contains
         character(len=512) :: buf
         type(coupled_energies_t) :: en
         call self%summary_lines(lp%n_steps, lp%unconverged, report)
+        if (any(self%sys%dem%materials%cohesion > 0.0_wp)) call report(bonds_line(self%sys%dem))
         en = coupled_energies(self%sys)
         write (buf, '(a,es11.3e3,a,es11.3e3,a,es11.3e3,a)') 'energy balance residual ', en%balance, &
             ' J (max over the outputs ', self%cpl_out%max_balance, ' J; external work ', &

@@ -16,8 +16,8 @@ module driver_run_dem
     use core_signals, only: caught_signal, signal_name
     use io_progress, only: progress_t
     use dem_particles, only: particles_t
-    use dem_moreau_jean, only: mj_init, mj_step, energies_balance, mj_free_velocities, mj_detect, mj_solve, &
-                               mj_end_step, mj_load_energy
+    use dem_moreau_jean, only: dem_system_t, mj_init, mj_step, energies_balance, mj_free_velocities, mj_detect, &
+                               mj_solve, mj_end_step, mj_load_energy, mj_bonds_made
     use dem_local_problem, only: local_problem_t, local_problem_build
     use driver_config, only: run_config_t
     use driver_config_dem, only: dem_config_t
@@ -32,7 +32,7 @@ module driver_run_dem
     private
     public :: run_dem, max_warnings, report_line_iface, speed_warning, last_unconverged_warning
     public :: tolerance_floor_hint
-    public :: fclib_path, fclib_after_end_warning, fclib_no_contacts_warning, lost_bonds_warning
+    public :: fclib_path, fclib_after_end_warning, fclib_no_contacts_warning, lost_bonds_warning, bonds_line
 
     !> Unconverged steps reported one by one; later ones are only counted.
     integer, parameter :: max_warnings = 5
@@ -279,6 +279,7 @@ contains
                     sys%contacts%n, ' (', sys%stats%n_active, ' active); time in detection ', &
                     sys%time_detection, ' s, in the solver ', sys%time_solver, ' s'
                 call report(trim(buf))
+                if (any(sys%materials%cohesion > 0.0_wp)) call report(bonds_line(sys))
                 call report('unconverged steps: '//to_str(unconverged)//' of '//to_str(n_steps)// &
                             ' (tolerance '//to_str(sys%solver%tol)//', at most '// &
                             to_str(sys%solver%max_sweeps)//' sweeps)')
@@ -291,6 +292,16 @@ contains
             call report(progress%summary_line(n_steps, cfg%system%time, out%stopped()))
         end subroutine summary
     end subroutine run_dem
+    !> Summary line of the bonds of a run with cohesion: 'bonds at t = 0: N (M ruptures since,
+    !> /dem/bonds)', the ruptures counting the bonds broken and those the detection lost.
+    function bonds_line(sys) result(line)
+        !> The system, after its steps.
+        type(dem_system_t), intent(in) :: sys
+        character(len=:), allocatable :: line
+        line = 'bonds at t = 0: '//to_str(mj_bonds_made(sys))//' ('//counted(sys%ruptures%n, 'rupture')// &
+               ' since, /dem/bonds)'
+    end function bonds_line
+
     !> Warning text when the fastest disk moves farther than the alert distance in one step
     !> ('' when it does not): contacts could then be found late.
     function speed_warning(p, h, alert, t) result(line)

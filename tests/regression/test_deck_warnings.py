@@ -19,6 +19,10 @@ goes on, and a warning names the file, the line and the setting that turns it of
 - A static or dynamic beam or continuum run whose largest displacement exceeds 10 % of the
   model's extent (a modulus in MPa read as Pa) warns that linear theory does not hold, with
   exit 0; the threshold is checked on a cantilever's closed-form tip deflection.
+- A `[contacts] bond` record that bonds no pair at t = 0 (a loose deposit, a row with gaps of
+  1e-3 R, beyond the bond tolerance of 1e-6 R) is warned about at its line, under --check and
+  at the run's start; a touching row is not, and the run's summary counts its bonds at t = 0
+  (n - 1 = 4 for a row of 5 touching disks, 0 for the row with gaps).
 - A time function used by a load that is zero over the whole run (a step at 1.0 s of a run
   that ends at 0.5 s) is warned about at its line, with the line of the load, under --check
   and at the run's start, once per such function; not when it acts before the end (the
@@ -114,11 +118,12 @@ def rolling_length(exe, src, work):
               "\n".join(said) or proc.stderr.strip()[:300])
 
 
-def coupled(exe, work, name, deck_path, ends, extra=""):
+def coupled(exe, work, name, deck_path, ends, bonds, extra=""):
     """`deck_path` (ending at `ends`, with the solver lines `extra`) with method = coarse and
     cold_start = hydrostatic: two warnings, and the results of method = nlgs, cold_start =
     zero. The sweeps are many (`extra` keeps them at about 100 per step), so that a coarse
-    correction or another start of the first step would show in the results."""
+    correction or another start of the first step would show in the results. The summary
+    counts the `bonds` made at t = 0 (None: a deck without cohesion, no such line)."""
     base = re.sub(r"^\s*(method|cold_start|tolerance)\s*=.*\n", "", deck_path.read_text(), flags=re.M)
     base = re.sub(r"^end\s*=.*$", f"end = {ends}", base, count=1, flags=re.M)
     if "mesh = file " in base:
@@ -144,6 +149,9 @@ def coupled(exe, work, name, deck_path, ends, extra=""):
             # zero over the whole run, which is warned about and is not the point here)
             said = [w for w in said if "is zero at every time of the run" not in w]
             check(f"{name}: method = nlgs is not warned about", proc.returncode == 0 and not said, "\n".join(said))
+            line = f"bonds at t = 0: {bonds} (0 ruptures since" if bonds is not None else "bonds at t = 0"
+            check(f"{name}: the summary {'counts' if bonds is not None else 'has no line of'} the bonds at t = 0",
+                  (line in proc.stdout) == (bonds is not None), proc.stdout[-400:])
         with h5py.File(work / f"{name}_{variant}" / f"{name}_{variant}.h5", "r") as f:
             results[variant] = (f["dem/position"][...], f["dem/velocity"][...], f["dem/solver/sweeps"][...])
             named = tuple(f["dem/solver"].attrs[key] for key in ("method", "cold_start"))
@@ -373,6 +381,53 @@ load = 11 w -{load}
               f"exit {proc.returncode}; " + ("\n".join(said) or proc.stderr.strip()[:300]))
 
 
+BOND_DECK = """[run]
+analysis = dynamic
+[particles]
+material = 1 2500
+{disks}
+gravity = 0 -9.81
+{walls}
+[contacts]
+law = 1 1 0.3 0 1e5
+bond = 1 1 0.5
+[time]
+step = 1e-4
+end = 2e-3
+"""
+DEPOSIT_WALLS = "[walls]\nwall = 0 0 0.05 0\nwall = 0 0 0 0.2\nwall = 0.05 0 0.05 0.2"
+
+
+def bonds_without_pairs(exe, work):
+    """A bond record whose materials have no pair touching at t = 0 makes no bond: warned about
+    at its line. A row of 5 touching disks (R = 10 mm) is bonded: no warning, 4 bonds."""
+    cases = (("deposit", "deposit = 50 0 0.05 0.002 1e-3 2e-3 1 7", DEPOSIT_WALLS, None),
+             # gap 1e-5 m = 1e-3 R, beyond the bond's 1e-6 R
+             ("row_gap", "row = 5 0.01 0.1 0.01 1 1e-5", "", 0),
+             ("row_touching", "row = 5 0.01 0.1 0.01 1", "", 4))
+    for name, disks, walls, bonds in cases:
+        text = BOND_DECK.format(disks=disks, walls=walls)
+        deck = work / f"bond_{name}.dat"
+        deck.write_text(text)
+        warned = bonds != 4
+        expected = (f"warning: {deck}:{line_of(text, 'bond')}: [contacts] bond between materials 1 and 1 makes "
+                    "no bond: no two bodies of material 1 touch at t = 0")
+        proc = multicor(exe, "--check", deck)
+        said = warnings_of(proc.stdout)
+        check(f"bond record, {name}: --check {'warns at its line' if warned else 'says nothing'}",
+              proc.returncode == 0 and (len(said) == 1 and said[0].startswith(expected) if warned else not said),
+              "\n".join(said) or proc.stderr.strip()[:300])
+        if bonds is None:
+            continue
+        proc = multicor(exe, deck, "--output", work / f"bond_{name}")
+        said = warnings_of(proc.stdout)
+        check(f"bond record, {name}: the run {'warns' if warned else 'does not warn'} at its start and "
+              f"counts {bonds} bonds at t = 0",
+              proc.returncode == 0 and (len(said) == 1 and said[0].startswith(expected) if warned else not said)
+              and f"bonds at t = 0: {bonds} (0 ruptures since" in proc.stdout,
+              proc.stdout[-600:] + proc.stderr.strip()[:300])
+
+
 def idle_functions(exe, src, work):
     """input/cantilever.dat with its step moved to t0 = 1.0 s, after the end (0.5 s): the tip
     load is never applied; warned about at the function's line, naming the load's line. A
@@ -419,11 +474,13 @@ def main():
     coupling_thickness(exe, src, work)
     coupled_disks_off_the_beam(exe, src, work)
     large_displacements(exe, src, work)
+    bonds_without_pairs(exe, work)
     idle_functions(exe, src, work)
     # the hinged row of the reference work (20 steps; with nlgs at 1e-4: 108 to 172 sweeps per
-    # step) and the interface experiment (10 steps: 19 to 47 sweeps per step)
-    coupled(exe, work, "beam", src / "input" / "bending_hinged_row.dat", "2e-4", "tolerance = 1e-4\n")
-    coupled(exe, work, "continuum", src / "input" / "interface_shear.dat", "2e-4")
+    # step; 17 touching cohesive disks: 16 bonds) and the interface experiment (10 steps: 19 to
+    # 47 sweeps per step; no cohesion)
+    coupled(exe, work, "beam", src / "input" / "bending_hinged_row.dat", "2e-4", 16, "tolerance = 1e-4\n")
+    coupled(exe, work, "continuum", src / "input" / "interface_shear.dat", "2e-4", None)
     return summary()
 
 
