@@ -940,6 +940,7 @@ contains
                                    sum(sys%particles%radius(1:sys%particles%n))/real(sys%particles%n, wp)
             else
                 sys%scheme%alert = deck%get_real('contacts', 'alert')
+                if (.not. sys%scheme%alert > 0.0_wp) call warn_zero_alert()
             end if
             sys%solver%tol = deck%get_real('solver', 'tolerance')
             sys%solver%max_sweeps = deck%get_int('solver', 'max_sweeps')
@@ -981,6 +982,16 @@ contains
         end associate
         cfg%store_contacts = deck%get_word('output', 'contacts') == 'yes'
     contains
+        ! [contacts] alert = 0: the detection reaches no further than the round-off allowance
+        subroutine warn_zero_alert()
+            if (.not. allocated(cfg%warnings)) allocate (cfg%warnings(0))
+            cfg%warnings = [cfg%warnings, string_t('warning: '//deck%file//':'//to_str(deck%line('contacts', 'alert'))// &
+                                                   ': [contacts] alert = 0: a contact is seen only once its disks '// &
+                                                   'touch or overlap, so an approaching pair is found a step late '// &
+                                                   'and overlaps; give a positive alert distance (the default is '// &
+                                                   'a quarter of the mean radius) or leave the keyword out')]
+        end subroutine warn_zero_alert
+
         ! the schema refuses a word outside its list: one it allows that no case here builds is
         ! a bug (a word added to the schema without its kind)
         subroutine unknown_word(section, keyword)

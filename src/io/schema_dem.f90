@@ -155,7 +155,8 @@ contains
         call s%add_keyword('contacts', 'alert', [real_field('alert', 'm', lower=0.0_wp)], &
                            'Alert distance: pairs closer than this are candidate contacts of the step '// &
                            '(default 0.25 times the mean disk radius); it must exceed the distance a disk '// &
-                           'travels in one step (a warning says when it does not).')
+                           'travels in one step (a warning says when it does not); 0 is warned about: a '// &
+                           'contact is then seen only once its disks touch.')
     end subroutine add_contacts
 
     !> [solver]: non-linear Gauss-Seidel settings.

@@ -23,6 +23,7 @@ goes on, and a warning names the file, the line and the setting that turns it of
   1e-3 R, beyond the bond tolerance of 1e-6 R) is warned about at its line, under --check and
   at the run's start; a touching row is not, and the run's summary counts its bonds at t = 0
   (n - 1 = 4 for a row of 5 touching disks, 0 for the row with gaps).
+- `[contacts] alert = 0` is warned about at its line (contacts seen only once disks touch).
 - A time function used by a load that is zero over the whole run (a step at 1.0 s of a run
   that ends at 0.5 s) is warned about at its line, with the line of the load, under --check
   and at the run's start, once per such function; not when it acts before the end (the
@@ -428,6 +429,21 @@ def bonds_without_pairs(exe, work):
               proc.stdout[-600:] + proc.stderr.strip()[:300])
 
 
+def zero_alert(exe, src, work):
+    """`[contacts] alert = 0` is accepted and warned about at its line; the deposit's own
+    alert (1 mm) is not."""
+    base = (src / "input" / "deposit.dat").read_text()
+    text = re.sub(r"^alert\s*=.*$", "alert = 0", base, count=1, flags=re.M)
+    deck = work / "alert_zero.dat"
+    deck.write_text(text)
+    proc = multicor(exe, "--check", deck)
+    said = warnings_of(proc.stdout)
+    expected = (f"warning: {deck}:{line_of(text, 'alert')}: [contacts] alert = 0: a contact is seen only once "
+                "its disks touch or overlap")
+    check("alert = 0: warned about at its line", proc.returncode == 0 and len(said) == 1
+          and said[0].startswith(expected), "\n".join(said) or proc.stderr.strip()[:300])
+
+
 def idle_functions(exe, src, work):
     """input/cantilever.dat with its step moved to t0 = 1.0 s, after the end (0.5 s): the tip
     load is never applied; warned about at the function's line, naming the load's line. A
@@ -475,6 +491,7 @@ def main():
     coupled_disks_off_the_beam(exe, src, work)
     large_displacements(exe, src, work)
     bonds_without_pairs(exe, work)
+    zero_alert(exe, src, work)
     idle_functions(exe, src, work)
     # the hinged row of the reference work (20 steps; with nlgs at 1e-4: 108 to 172 sweeps per
     # step; 17 touching cohesive disks: 16 bonds) and the interface experiment (10 steps: 19 to
