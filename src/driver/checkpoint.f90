@@ -33,7 +33,7 @@
 module driver_checkpoint
     use driver_checkpoint_values, only: read_finite_attribute
     use driver_checkpoint_loop, only: loop_state_t, checkpoint_schedule_t, step_end_t, end_of_step, save_loop, &
-                                      load_loop
+                                      load_loop, rest_of_last_step
     use driver_checkpoint_file, only: checkpoint_name, deck_hash, checkpoint_run_t, checkpoint_create, &
                                       checkpoint_commit, checkpoint_open, checkpoint_discard, checkpoint_owner
     use driver_checkpoint_fem, only: save_integrator, load_integrator
@@ -48,5 +48,5 @@ module driver_checkpoint
     public :: save_integrator, load_integrator, save_dem, load_dem, save_coupled, load_coupled
     public :: save_results, load_results, save_dem_writer, load_dem_writer
     public :: save_coupled_writer, load_coupled_writer, save_loop, load_loop
-    public :: checkpoint_run_t, step_end_t, end_of_step, read_finite_attribute, checkpoint_owner
+    public :: checkpoint_run_t, step_end_t, end_of_step, rest_of_last_step, read_finite_attribute, checkpoint_owner
 end module driver_checkpoint

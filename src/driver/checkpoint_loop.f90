@@ -9,7 +9,7 @@ module driver_checkpoint_loop
     use driver_checkpoint_values, only: require_finite, require_range, damaged, real_text
     implicit none
     private
-    public :: loop_state_t, checkpoint_schedule_t, step_end_t, end_of_step, save_loop, load_loop
+    public :: loop_state_t, checkpoint_schedule_t, step_end_t, end_of_step, rest_of_last_step, save_loop, load_loop
 
     !> Counters of a time loop that the results depend on.
     type :: loop_state_t
@@ -114,6 +114,23 @@ contains
         if (.not. act%checkpoint) act%checkpoint = schedule%due(k)
         act%store_last = (k == n_steps .or. act%stop) .and. .not. act%store_first
     end function end_of_step
+
+    !> At a restart from the checkpoint of the last step (a run killed after its final
+    !> checkpoint, before its results file was closed): what `end_of_step` does after the
+    !> regular output of that step, which is in the records the checkpoint counts. The
+    !> checkpoint, written again from the state it holds (the one the restart read becomes
+    !> '.prev', deleted when the run ends), and the extra last output when the last step is not
+    !> an output step: the results are then those of the run that was not killed.
+    pure function rest_of_last_step(n_steps, output_interval) result(act)
+        !> Steps of the run (those of the checkpoint).
+        integer(i8), intent(in) :: n_steps
+        !> Steps between regular outputs.
+        integer, intent(in) :: output_interval
+        !> The actions due: `checkpoint` and perhaps `store_last`.
+        type(step_end_t) :: act
+        act%checkpoint = .true.
+        act%store_last = mod(n_steps, int(output_interval, i8)) /= 0
+    end function rest_of_last_step
 
     !> Write the loop counters (attributes of /loop).
     subroutine save_loop(file, loop, error)

@@ -40,7 +40,8 @@ module driver_coupled_loop
     use dem_contacts, only: status_cohesive
     use driver_guards, only: check_disks_state, check_walls_state, step_start_t, take_step_start, check_tunnelling, &
                              step_created_energy, creation_allowance, energy_creation_warning, energy_creation_summary
-    use driver_checkpoint, only: checkpoint_run_t, end_of_step, step_end_t, loop_state_t, checkpoint_create, &
+    use driver_checkpoint, only: checkpoint_run_t, end_of_step, rest_of_last_step, step_end_t, loop_state_t, &
+                                 checkpoint_create, &
                                  save_coupled, load_coupled, &
                                  save_results, load_results, save_dem_writer, load_dem_writer, &
                                  save_coupled_writer, load_coupled_writer
@@ -226,6 +227,14 @@ contains
         call lp%progress%start(lp%n_steps, self%settings%t_end, self%settings%progress_seconds)
         if (ck%restart) call lp%progress%resume(lp%k0, ck%start%wall_seconds, ck%start%runs)
         call ck%schedule%start()
+        if (ck%restart .and. lp%k0 == lp%n_steps) then
+            ! a checkpoint of the last step: the rest of that step's end (a run killed after it)
+            lp%k = lp%k0
+            act = rest_of_last_step(lp%n_steps, self%settings%output_interval)
+            if (act%checkpoint) call write_checkpoint(self, lp, out, ck, error)
+            if (act%store_last .and. .not. allocated(error)) call store_output(self, out, error)
+            if (allocated(error)) return
+        end if
         do k = lp%k0 + 1, lp%n_steps
             lp%k = k
             call take_step(self, lp, out, report, error)

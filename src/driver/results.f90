@@ -28,7 +28,7 @@ module driver_results
     use io_paths, only: rename_file, remove_file, copy_file, file_exists
     implicit none
     private
-    public :: results_writer_t
+    public :: results_writer_t, holds_run
 
     !> Writes the results of one run into one HDF5 file.
     type :: results_writer_t
@@ -200,8 +200,8 @@ contains
         self%set_aside = .false.
         self%companions = [string_t ::]
         self%own = [logical ::]
-        if (.not. belongs(self%partial_path)) then
-            if (.not. belongs(final_path)) then
+        if (.not. holds_run(self%partial_path, run_id)) then
+            if (.not. holds_run(final_path, run_id)) then
                 call make_error(error, "results: neither '"//self%partial_path//"' nor '"// &
                                 final_path//"' is the results file of the checkpoint's run (run_id "// &
                                 run_id//'): it was moved, deleted or replaced by another run')
@@ -225,22 +225,26 @@ contains
             error%message = 'results: '//error%message
             return
         end if
-    contains
-        !> Whether `path` is an HDF5 file whose 'run_id' attribute is `run_id`.
-        logical function belongs(path)
-            character(len=*), intent(in) :: path
-            type(h5_file_t) :: f
-            type(error_t), allocatable :: e
-            character(len=:), allocatable :: value
-            belongs = .false.
-            if (.not. file_exists(path)) return
-            call f%open(path, e)
-            if (allocated(e)) return
-            call f%read_attribute('/', 'run_id', value, e)
-            if (.not. allocated(e)) belongs = value == run_id
-            call f%close(e)
-        end function belongs
     end subroutine writer_resume
+
+    !> Whether `path` is an HDF5 file whose root attribute 'run_id' is `run_id` (the results
+    !> file of that run, finished or partial).
+    logical function holds_run(path, run_id)
+        !> Path of the file (need not exist).
+        character(len=*), intent(in) :: path
+        !> Root attribute 'run_id' of the run's results file (from its checkpoint).
+        character(len=*), intent(in) :: run_id
+        type(h5_file_t) :: f
+        type(error_t), allocatable :: e
+        character(len=:), allocatable :: value
+        holds_run = .false.
+        if (.not. file_exists(path)) return
+        call f%open(path, e)
+        if (allocated(e)) return
+        call f%read_attribute('/', 'run_id', value, e)
+        if (.not. allocated(e)) holds_run = value == run_id
+        call f%close(e)
+    end function holds_run
 
     !> Mark a resumed file as the file of a running run again (/summary finished = 0), once
     !> the checkpoint it continues from has been read and checked.

@@ -35,7 +35,7 @@ module driver_run
     use io_deck_schema, only: multicor_schema
     use io_deck, only: deck_t, read_deck
     use io_paths, only: stem, basename, mkdir_p, remove_empty_folders, file_exists, remove_file, rename_file
-    use driver_results, only: results_writer_t
+    use driver_results, only: results_writer_t, holds_run
     use driver_results_xdmf, only: write_results_xdmf
     use driver_simulation, only: simulation_t, report_iface
     use driver_simulations, only: select_simulation
@@ -426,7 +426,10 @@ contains
     end subroutine guard_other_run
 
     !> Option `--restart`: open the checkpoint and check it belongs to this deck, this code and this
-    !> kind of run, and that it leaves steps to do.
+    !> kind of run, and that it leaves steps to do, or that it is the checkpoint of the last step
+    !> of a run whose results file is still '.partial' (killed after its final checkpoint, before
+    !> the file was closed): the restart then does what the end of that step did after its
+    !> checkpoint, and closes the file.
     subroutine open_checkpoint(opts, report, run, error)
         !> The run's options (`--restart`).
         type(run_options_t), intent(in) :: opts
@@ -437,6 +440,7 @@ contains
         !> Set when the checkpoint cannot be continued by this run.
         type(error_t), allocatable, intent(out) :: error
         type(error_t), allocatable :: ignored
+        logical :: at_end
         if (.not. run%sim%has_time_loop()) then
             call make_error(error, '--restart: '//run%deck%file//' is not a dynamic analysis (only time '// &
                             'integrations have checkpoints)')
@@ -446,7 +450,9 @@ contains
             call checkpoint_open(ck%source, opts%restart, run%deck%file, ck%deck_text, run%kind, ck%start, &
                                  run%run_id, error)
             if (allocated(error)) return
-            if (ck%start%step >= sim%settings%n_steps) then
+            at_end = ck%start%step == sim%settings%n_steps
+            if (at_end) at_end = interrupted()
+            if (ck%start%step >= sim%settings%n_steps .and. .not. at_end) then
                 call ck%source%close(ignored)
                 call make_error(error, "--restart: checkpoint '"//opts%restart//"' is at step "// &
                                 to_str(ck%start%step)//', the end time '//num(sim%settings%t_end)// &
@@ -456,6 +462,9 @@ contains
             end if
             ck%restart = .true.
             call report('restart from '//opts%restart//' at step '//to_str(ck%start%step))
+            if (at_end) call report('note: the checkpoint is of the last step and the results file of its run '// &
+                                    'is still partial (the run was killed after its final checkpoint): no step '// &
+                                    'to do, the results are finished from the checkpoint')
             if (len(ck%start%threads) > 0 .and. ck%start%threads /= thread_setting()) &
                 call report('warning: the checkpoint was written with '//ck%start%threads//'; this run has '// &
                             thread_setting()//': the results go on correctly, but bit for bit they are '// &
@@ -467,5 +476,11 @@ contains
                                                           'runs before it: /summary wall_seconds counts from this '// &
                                                           'restart')
         end associate
+    contains
+        !> Whether the partial results file (perhaps set aside as '.prev') is the checkpoint's run's.
+        logical function interrupted()
+            interrupted = holds_run(run%path//'.partial', run%run_id)
+            if (.not. interrupted) interrupted = holds_run(run%path//'.partial.prev', run%run_id)
+        end function interrupted
     end subroutine open_checkpoint
 end module driver_run

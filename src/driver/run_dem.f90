@@ -26,7 +26,7 @@ module driver_run_dem
     use driver_guards, only: check_disks_state, check_walls_state, step_start_t, take_step_start, check_tunnelling, &
                              step_created_energy, creation_allowance, energy_creation_warning, energy_creation_summary
     use io_hdf5_file, only: h5_file_t
-    use driver_checkpoint, only: end_of_step, step_end_t, checkpoint_run_t, loop_state_t, checkpoint_create, &
+    use driver_checkpoint, only: end_of_step, rest_of_last_step, step_end_t, checkpoint_run_t, loop_state_t, checkpoint_create, &
                                  save_dem, load_dem, save_results, load_results, save_dem_writer, load_dem_writer
     implicit none
     private
@@ -105,6 +105,14 @@ contains
         call progress%start(n_steps, run%t_end, run%progress_seconds)
         if (ck%restart) call progress%resume(k0, ck%start%wall_seconds, ck%start%runs)
         call ck%schedule%start()
+        if (ck%restart .and. k0 == n_steps) then
+            ! a checkpoint of the last step: the rest of that step's end (a run killed after it)
+            k = k0
+            act = rest_of_last_step(n_steps, run%output_interval)
+            if (act%checkpoint) call checkpoint(error)
+            if (act%store_last .and. .not. allocated(error)) call store(error)
+            if (allocated(error)) return
+        end if
         do k = k0 + 1, n_steps
             call take_step_start(start, cfg%system%particles, cfg%system%walls, cfg%system%energies)
             if (k == cfg%fclib_step) then

@@ -10,7 +10,7 @@ module driver_simulation_beam_dynamic
     use fem_newmark, only: time_integrator_t, make_time_integrator, model_out_of_range
     use driver_config, only: run_config_t
     use driver_results, only: results_writer_t
-    use driver_checkpoint, only: end_of_step, step_end_t, checkpoint_run_t, loop_state_t, checkpoint_create, &
+    use driver_checkpoint, only: end_of_step, rest_of_last_step, step_end_t, checkpoint_run_t, loop_state_t, checkpoint_create, &
                                  save_integrator, load_integrator, save_results, load_results
     use io_hdf5_file, only: h5_file_t
     use driver_guards, only: check_beam_state
@@ -151,6 +151,14 @@ contains
         end if
         if (ck%restart) call progress%resume(k0, ck%start%wall_seconds, ck%start%runs)
         call ck%schedule%start()
+        if (ck%restart .and. k0 == n_steps) then
+            ! a checkpoint of the last step: the rest of that step's end (a run killed after it)
+            k = k0
+            act = rest_of_last_step(n_steps, run%output_interval)
+            if (act%checkpoint) call checkpoint(error)
+            if (act%store_last .and. .not. allocated(error)) call store(error)
+            if (allocated(error)) return
+        end if
         do k = k0 + 1, n_steps
             call integ%step(model, error)
             if (allocated(error)) return

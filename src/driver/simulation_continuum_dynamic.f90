@@ -14,7 +14,7 @@ module driver_simulation_continuum_dynamic
     use fem_newmark, only: time_integrator_t, make_time_integrator, model_out_of_range
     use driver_results, only: results_writer_t
     use io_hdf5_file, only: h5_file_t
-    use driver_checkpoint, only: checkpoint_run_t, end_of_step, step_end_t, loop_state_t, checkpoint_create, &
+    use driver_checkpoint, only: checkpoint_run_t, end_of_step, rest_of_last_step, step_end_t, loop_state_t, checkpoint_create, &
                                  save_integrator, load_integrator, save_results, load_results, &
                                  read_finite_attribute
     use driver_results_continuum, only: continuum_writer_t
@@ -177,6 +177,14 @@ contains
             if (allocated(error)) return
             if (ck%restart) call progress%resume(k0, ck%start%wall_seconds, ck%start%runs)
             call ck%schedule%start()
+            if (ck%restart .and. k0 == n_steps) then
+                ! a checkpoint of the last step: the rest of that step's end (a run killed after it)
+                k = k0
+                act = rest_of_last_step(n_steps, self%settings%output_interval)
+                if (act%checkpoint) call checkpoint(error)
+                if (act%store_last .and. .not. allocated(error)) call store(error)
+                if (allocated(error)) return
+            end if
             do k = k0 + 1, n_steps
                 call self%integ%step(self%ops, error)
                 if (allocated(error)) return

@@ -26,7 +26,11 @@ continues a finished run; the earlier finished result stays untouched when the c
 fails. A failing run leaves the folder as it found it: a finished result and its checkpoint,
 an interrupted run's partial file and checkpoint (the printed command still continues it),
 the checkpoint a failed restart started from. Another deck run into the folder of an
-interrupted run is refused (it would replace that run's checkpoint).
+interrupted run is refused (it would replace that run's checkpoint). A run killed after
+its final checkpoint, before its results file got its name (by strace at that rename or at the
+opening of the XDMF file, and for every kind of run as the files such a kill leaves) is
+finished by the same command: no step, the results and XDMF file bitwise the uninterrupted
+run's, nothing else left.
 Usage (ctest does this): test_restart.py --exe multicor --work DIR --source REPO
 """
 import argparse
@@ -694,6 +698,115 @@ def failed_runs_keep_state(exe, src, work):
     check("keep_partial: nothing set aside is left", not list(folder.glob("*.prev")), str(sorted(folder.iterdir())))
 
 
+def files_in(folder):
+    """The names of the files in a folder (hidden ones too: the lock)."""
+    return sorted(p.name for p in folder.iterdir())
+
+
+def killed_by_strace(exe, args, path, calls, name):
+    """Run multicor under strace, which kills it (SIGKILL, no cleanup) when it first enters one
+    of the system calls `calls` on `path`: the call is not done. True when the run was killed."""
+    trace = ",".join(calls)
+    proc = subprocess.run(["strace", "-f", "-o", os.devnull, "-P", str(path), "-e", f"trace={trace}",
+                           "-e", f"inject={trace}:signal=SIGKILL:when=1", str(exe)] + [str(a) for a in args],
+                          capture_output=True, text=True, timeout=300)
+    # strace ends with the signal that killed its child (-9 here; 137 through a shell)
+    return check(f"{name}: killed at {'/'.join(calls)} of {path.name}", proc.returncode in (-9, 128 + 9),
+                 f"exit {proc.returncode} {proc.stderr.strip()[-200:]}")
+
+
+def finish_after_kill(exe, deck, work, name, end, reference_file, args=()):
+    """The command of a run killed after its final checkpoint, run again: the run is finished
+    from the checkpoint with no step (doc/output.md, "Interrupted runs"), its results and XDMF
+    file bitwise those of the run that was not killed, the folder holds the results, the XDMF
+    file and the checkpoint, nothing else."""
+    folder = work / name
+    proc = run(exe, deck, "--output", folder, "--end", end, "--restart", folder / "checkpoint.h5", *args)
+    check(f"{name}: the same command again finishes the run: exit 0", proc.returncode == 0,
+          (proc.stdout + proc.stderr).strip()[-300:])
+    check(f"{name}: no step done, the run finished from the checkpoint",
+          "no step to do, the results are finished from the checkpoint" in proc.stdout and
+          "(0 in this run)" in proc.stdout, proc.stdout.strip()[-300:])
+    if proc.returncode != 0:
+        return
+    compare(name, folder / f"{deck.stem}.h5", reference_file)
+    compare_xdmf(name, folder / f"{deck.stem}.xdmf", reference_file.with_suffix(".xdmf"))
+    expected = sorted([f"{deck.stem}.h5", f"{deck.stem}.xdmf", "checkpoint.h5"])
+    check(f"{name}: only the results, the XDMF file and the checkpoint are left", files_in(folder) == expected,
+          str(files_in(folder)))
+    again = run(exe, deck, "--output", folder, "--end", end, "--restart", folder / "checkpoint.h5")
+    check(f"{name}: once finished, the same restart has nothing to do", again.returncode == 1 and
+          "nothing to do" in again.stderr, again.stderr.strip()[-300:])
+
+
+def killed_after_last_checkpoint(exe, src, work):
+    """A run killed after its final checkpoint (the step of the end time), before its results
+    file got its name: the end checkpoint and '<name>.h5.partial' are left, and the command of
+    the run, or the printed command to continue it, was refused with 'nothing to do' (exit 1),
+    the outputs stranded in the partial file. Now the restart does what the end of the last step
+    did after its checkpoint (the extra last output, the summary, the XDMF file, the renames)."""
+    beam = edit_deck(src / "input" / "cantilever.dat", work / "beam_last.dat", end=0.2)
+    # 503 steps, outputs every 5: the end of the last step stores an extra output after the checkpoint
+    end = 0.1006
+    ref_folder = work / "ref_beam_last"
+    proc = run(exe, beam, "--output", ref_folder, "--quiet", "--end", end)
+    assert proc.returncode == 0, proc.stderr
+    ref = ref_folder / "beam_last.h5"
+    if shutil.which("strace") is None:
+        print("skip   the kills at the renames and at the XDMF file of a run's end: no strace (Debian package "
+              "strace); the same state made by renaming files is tested below")
+    else:
+        # (a) killed where the results file was to be renamed (the state the audit found: lock,
+        # partial file, XDMF file '.partial', end checkpoint)
+        folder = work / "last_rename"
+        if killed_by_strace(exe, [beam, "--output", folder, "--quiet", "--end", end],
+                            folder / "beam_last.h5.partial", ["rename", "renameat", "renameat2"], "last_rename"):
+            check("last_rename: partial file, XDMF file and lock left", files_in(folder) == sorted(
+                [".multicor.lock", "beam_last.h5.partial", "beam_last.xdmf.partial", "checkpoint.h5"]),
+                str(files_in(folder)))
+            finish_after_kill(exe, beam, work, "last_rename", end, ref)
+        # (b) a finished run to 0.05 s continued to the end time, killed when it opened its XDMF
+        # file: the partial file has every output, /summary finished = 0; the earlier finished
+        # file, its XDMF file and the checkpoint it started from ('.prev') are still there
+        folder = work / "last_continued"
+        proc = run(exe, beam, "--output", folder, "--quiet", "--end", 0.05)
+        assert proc.returncode == 0, proc.stderr
+        if killed_by_strace(exe, [beam, "--output", folder, "--quiet", "--end", end, "--restart",
+                                  folder / "checkpoint.h5"], folder / "beam_last.xdmf.partial",
+                            ["open", "openat", "creat"], "last_continued"):
+            with h5py.File(folder / "beam_last.h5.partial", "r") as f:
+                finished = int(f["summary"].attrs["finished"])
+            check("last_continued: partial file (finished = 0), the earlier result, both checkpoints",
+                  finished == 0 and files_in(folder) == sorted(
+                      [".multicor.lock", "beam_last.h5", "beam_last.h5.partial", "beam_last.xdmf",
+                       "checkpoint.h5", "checkpoint.h5.prev"]), f"finished = {finished}, {files_in(folder)}")
+            finish_after_kill(exe, beam, work, "last_continued", end, ref)
+    # Without strace, for every kind of time loop: a run to its end, its results and XDMF files
+    # renamed back to '.partial', which is what a kill at the rename of the results file leaves
+    # (but the lock). Every end time here is not an output step.
+    spin = work / "spin_last.dat"
+    spin.write_text(SPIN)
+    piston = work / "piston_last.dat"
+    piston.write_text(PISTON)
+    cases = [(beam, end, "beam"), (spin, 0.1033, "spin"), (piston, 0.125, "piston"),
+             (edit_deck(src / "input" / "bending_stack.dat", work / "stack_last.dat", end=3.0e-4), 1.3e-4,
+              "coupled"),
+             (src / "input" / "continuum_cantilever_dynamic.dat", 0.2033, "continuum"),
+             (src / "tests" / "regression" / "decks" / "coupled2d_pushed.dat", 4.43e-4, "coupled2d")]
+    for deck, t_end, kind in cases:
+        name = f"last_renamed_{kind}"
+        folder = work / name
+        proc = run(exe, deck, "--output", folder, "--quiet", "--end", t_end)
+        assert proc.returncode == 0, proc.stderr
+        ref_folder = work / f"ref_{name}"
+        ref_folder.mkdir()
+        for suffix in (".h5", ".xdmf"):
+            done = folder / f"{deck.stem}{suffix}"
+            shutil.copy(done, ref_folder / done.name)
+            done.rename(done.with_name(done.name + ".partial"))
+        finish_after_kill(exe, deck, work, name, t_end, ref_folder / f"{deck.stem}.h5", args=["--quiet"])
+
+
 def new_end_time(exe, deck, work):
     """A finished run continued to a later end time equals the run to that end time; a
     continuation that fails leaves the earlier finished result as it was."""
@@ -1024,6 +1137,7 @@ def main():
     failed_runs_keep_state(exe, src, work)
     changed_mesh(exe, src, work)
     new_end_time(exe, beam, work)
+    killed_after_last_checkpoint(exe, src, work)
     sys.exit(summary())
 
 
