@@ -186,21 +186,24 @@ contains
         self%last_time = t
     end subroutine checkpoint_run_finish
 
-    !> Whose checkpoint lies at `path`: the hash of its deck and the name of its results file
-    !> ('' when the checkpoint does not record it); `found` is false when there is no
-    !> checkpoint there or it cannot be read (a restart from it says why).
-    subroutine checkpoint_owner(path, found, hash, results)
+    !> Whose checkpoint lies at `path`: the hash of its deck, the name of its results file
+    !> ('' when the checkpoint does not record it) and the run id of its results; `found` is
+    !> false when there is no checkpoint there or it cannot be read (a restart from it says why).
+    subroutine checkpoint_owner(path, found, hash, results, run_id)
         !> Path of the checkpoint.
         character(len=*), intent(in) :: path
         !> A checkpoint could be read there.
         logical, intent(out) :: found
         !> Its 'deck_hash' and 'results' root attributes.
         character(len=:), allocatable, intent(out) :: hash, results
+        !> Its 'run_id' root attribute, that of its results file ('' when not found).
+        character(len=:), allocatable, intent(out) :: run_id
         type(h5_file_t) :: file
         type(error_t), allocatable :: error, ignored
         found = .false.
         hash = ''
         results = ''
+        run_id = ''
         if (.not. file_exists(path)) return
         call file%open(path, error)
         if (allocated(error)) return
@@ -209,6 +212,8 @@ contains
         ! (a checkpoint of an older version has no 'results')
         if (found) call file%read_attribute('/', 'results', results, ignored)
         if (allocated(ignored)) results = ''
+        if (found) call file%read_attribute('/', 'run_id', run_id, ignored)
+        if (allocated(ignored)) run_id = ''
         call file%close(ignored)
     end subroutine checkpoint_owner
 

@@ -4,7 +4,9 @@
 !> when the run succeeded: an earlier result stays intact until then, and `abort` deletes the
 !> partial file. The partial file of an earlier run (interrupted, perhaps resumable) is set
 !> aside as '<final_path>.partial.prev' while this run writes its own: `abort` puts it back,
-!> `close` and `close_unfinished` (this run's own file takes its place) delete it. Files written
+!> `close` and `close_unfinished` (this run's own file takes its place) delete it, and
+!> `drop_earlier` one that a killed run set aside (unless it holds the results the folder's
+!> checkpoint continues). Files written
 !> beside the results (an FCLIB export, `companion`) follow the results file: written as
 !> '<path>.partial', renamed by `close` and `close_unfinished`, deleted by `abort`, so that a
 !> failed run leaves an earlier run's export as it was. /summary is written at creation with
@@ -103,6 +105,8 @@ module driver_results
         procedure :: companion => writer_companion
         !> Take over a file beside the results that a killed run left as '<path>.partial'.
         procedure :: adopt => writer_adopt
+        !> After the run ended or was stopped: delete the earlier partial file a killed run set aside.
+        procedure :: drop_earlier => writer_drop_earlier
     end type results_writer_t
 
 contains
@@ -204,7 +208,7 @@ contains
             if (.not. holds_run(final_path, run_id)) then
                 call make_error(error, "results: neither '"//self%partial_path//"' nor '"// &
                                 final_path//"' is the results file of the checkpoint's run (run_id "// &
-                                run_id//'): it was moved, deleted or replaced by another run')
+                                run_id//'): '//moved(self%partial_path//'.prev'))
                 return
             end if
             ! a copy: the finished file keeps the outputs, a failure removes the copy (and puts
@@ -225,6 +229,19 @@ contains
             error%message = 'results: '//error%message
             return
         end if
+    contains
+        !> Where the results went: set aside as `prev` by a later run started afresh and
+        !> killed before it ended (it would have put them back), or unknown.
+        function moved(prev) result(text)
+            character(len=*), intent(in) :: prev
+            character(len=:), allocatable :: text
+            if (holds_run(prev, run_id)) then
+                text = "they are in '"//prev//"', set aside by a later run that was killed: rename it to '"// &
+                       self%partial_path//"' and run this command again"
+            else
+                text = 'it was moved, deleted or replaced by another run'
+            end if
+        end function moved
     end subroutine writer_resume
 
     !> Whether `path` is an HDF5 file whose root attribute 'run_id' is `run_id` (the results
@@ -662,6 +679,23 @@ contains
         call remove_file(self%partial_path//'.prev')
         self%set_aside = .false.
     end subroutine drop_set_aside
+
+    !> After the run ended or was stopped (`close`, `close_unfinished`): delete
+    !> '<partial_path>.prev', the partial file of an earlier run that a run started afresh set
+    !> aside and, killed, never put back; unless it is the results file of the run `keep_run_id`
+    !> (that of the folder's checkpoint, when this run wrote none: a static or modal analysis),
+    !> which only it continues.
+    subroutine writer_drop_earlier(self, keep_run_id)
+        !> The writer, closed.
+        class(results_writer_t), intent(inout) :: self
+        !> Run id whose results file is kept ('': none).
+        character(len=*), intent(in) :: keep_run_id
+        if (.not. allocated(self%partial_path)) return
+        if (len(keep_run_id) > 0) then
+            if (holds_run(self%partial_path//'.prev', keep_run_id)) return
+        end if
+        call remove_file(self%partial_path//'.prev')
+    end subroutine writer_drop_earlier
 
     !> Register `path`, a file this run writes beside the results, and return the name to
     !> write it under, '<path>.partial': `close` and `close_unfinished` rename it to `path`,

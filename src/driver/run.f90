@@ -207,7 +207,8 @@ contains
     !> holds the folder's lock). A failed run leaves the folder's results, partial file and
     !> checkpoint as it found them (a resumed partial file keeps the outputs after its
     !> checkpoint, which the next restart cuts); a run that ends or is stopped by a signal
-    !> leaves its own.
+    !> leaves its own, and deletes the '.prev' files that killed runs left (but the results
+    !> the folder's checkpoint continues).
     subroutine write_results(opts, report, run, error, stopped_by)
         !> What to run.
         type(run_options_t), intent(in) :: opts
@@ -219,10 +220,13 @@ contains
         type(error_t), allocatable, intent(out) :: error
         !> Signal that stopped the run early (unchanged when none).
         integer, intent(inout), optional :: stopped_by
-        logical :: kept
+        logical :: kept, found
+        character(len=:), allocatable :: hash, results, run_id
         call run_and_close(opts, report, run, error, kept, stopped_by)
         if (kept) then
             call run%ck%settle()
+            call checkpoint_owner(run%ck%path, found, hash, results, run_id)
+            call run%out%drop_earlier(run_id)
         else
             call run%ck%revert()
         end if
@@ -406,9 +410,9 @@ contains
         type(deck_run_t), intent(in) :: run
         !> Set when the folder holds the checkpoint of another deck's interrupted run.
         type(error_t), allocatable, intent(out) :: error
-        character(len=:), allocatable :: hash, results
+        character(len=:), allocatable :: hash, results, run_id
         logical :: found
-        call checkpoint_owner(run%ck%path, found, hash, results)
+        call checkpoint_owner(run%ck%path, found, hash, results, run_id)
         if (.not. found) return
         if (hash == deck_hash(run%ck%deck_text) .or. results == basename(run%path)) return
         if (len(results) > 0) then

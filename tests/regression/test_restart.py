@@ -30,7 +30,9 @@ interrupted run is refused (it would replace that run's checkpoint). A run kille
 its final checkpoint, before its results file got its name (by strace at that rename or at the
 opening of the XDMF file, and for every kind of run as the files such a kill leaves) is
 finished by the same command: no step, the results and XDMF file bitwise the uninterrupted
-run's, nothing else left.
+run's, nothing else left. The partial file of an interrupted run set aside by a fresh run
+that was then killed ('.partial.prev') is deleted by the next run that ends, unless it holds
+the results of the folder's checkpoint: a restart then says to rename it back.
 Usage (ctest does this): test_restart.py --exe multicor --work DIR --source REPO
 """
 import argparse
@@ -807,6 +809,70 @@ def killed_after_last_checkpoint(exe, src, work):
         finish_after_kill(exe, deck, work, name, t_end, ref_folder / f"{deck.stem}.h5", args=["--quiet"])
 
 
+def set_aside_partial_files(exe, src, work):
+    """'<name>.h5.partial.prev': a run started afresh sets the partial file of an interrupted run
+    aside under that name and puts it back if it fails; killed, it cannot. Two fresh runs killed
+    after periodic checkpoints, then the second continued: the run that ends deletes the
+    partial file the second run set aside (it stayed, though doc/output.md says a run that ends
+    deletes the .prev files). When the set-aside file holds the results of the folder's
+    checkpoint (the second run killed before its first checkpoint), a restart says which file
+    to rename back, and a run that writes no checkpoint (a static analysis of a deck of the same
+    name) leaves it."""
+    deck = edit_deck(src / "input" / "cantilever.dat", work / "aside.dat", end=3.0, progress=0.02,
+                     extra_output=["checkpoint_interval = 100"])
+    ref = reference(exe, deck, work, "aside")
+    folder = work / "aside"
+    for attempt in ("first", "second"):
+        proc = start(exe, deck, folder)
+        # the progress line of step k comes after that step's checkpoint
+        if not wait_for_step(proc, 200, []):
+            check(f"aside: the {attempt} run reached step 200", False, proc.communicate()[1][-300:])
+            return
+        proc.send_signal(signal.SIGKILL)
+        proc.communicate()
+    check("aside: the first run's partial file set aside by the second",
+          (folder / "aside.h5.partial.prev").exists(), str(files_in(folder)))
+    proc = run(exe, deck, "--output", folder, "--quiet", "--restart", folder / "checkpoint.h5")
+    check("aside: the second run continued: exit 0", proc.returncode == 0, proc.stderr.strip()[-300:])
+    if proc.returncode == 0:
+        compare("aside", folder / "aside.h5", ref)
+    check("aside: the run that ended left no .prev file", files_in(folder) == ["aside.h5", "aside.xdmf",
+                                                                              "checkpoint.h5"],
+          str(files_in(folder)))
+
+    # A fresh run killed after setting the partial file aside, before creating its own (the
+    # state made by the rename it does): the checkpoint's results are only in the '.prev' file.
+    folder = work / "aside_only"
+    proc = start(exe, deck, folder)
+    if not wait_for_step(proc, 200, []):
+        check("aside_only: the run reached step 200", False, proc.communicate()[1][-300:])
+        return
+    proc.send_signal(signal.SIGKILL)
+    proc.communicate()
+    partial = folder / "aside.h5.partial"
+    partial.rename(folder / "aside.h5.partial.prev")
+    proc = run(exe, deck, "--output", folder, "--quiet", "--restart", folder / "checkpoint.h5")
+    check("aside_only: the restart names the file set aside and says to rename it back",
+          proc.returncode == 1 and f"they are in '{partial}.prev'" in proc.stderr and
+          f"rename it to '{partial}'" in proc.stderr, proc.stderr.strip()[-300:])
+    static = work / "aside_static" / "aside.dat"
+    static.parent.mkdir()
+    # the deck without its [time] and [output] sections, which a static analysis refuses
+    text = re.sub(r"^analysis\s*=.*$", "analysis = static", deck.read_text(), count=1, flags=re.M)
+    static.write_text(text[:text.index("[time]")])
+    proc = run(exe, static, "--output", folder, "--quiet")
+    check("aside_only: a static run of a deck of the same name: exit 0", proc.returncode == 0,
+          proc.stderr.strip()[-300:])
+    check("aside_only: the static run (no checkpoint) leaves the checkpoint's results set aside",
+          (folder / "aside.h5.partial.prev").exists(), str(files_in(folder)))
+    (folder / "aside.h5.partial.prev").rename(partial)
+    proc = run(exe, deck, "--output", folder, "--quiet", "--restart", folder / "checkpoint.h5")
+    check("aside_only: renamed back, the restart continues the run: exit 0", proc.returncode == 0,
+          proc.stderr.strip()[-300:])
+    if proc.returncode == 0:
+        compare("aside_only", folder / "aside.h5", ref)
+
+
 def new_end_time(exe, deck, work):
     """A finished run continued to a later end time equals the run to that end time; a
     continuation that fails leaves the earlier finished result as it was."""
@@ -1138,6 +1204,7 @@ def main():
     changed_mesh(exe, src, work)
     new_end_time(exe, beam, work)
     killed_after_last_checkpoint(exe, src, work)
+    set_aside_partial_files(exe, src, work)
     sys.exit(summary())
 
 
