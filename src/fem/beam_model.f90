@@ -85,8 +85,6 @@ module fem_beam_model
         real(wp), allocatable :: abscissa(:)
         !> True when mass, stiffness and self-weight were weighted by an Arlequin weight.
         logical :: weighted = .false.
-        !> Weight alpha at each node (1 when not weighted).
-        real(wp), allocatable :: node_weight(:)
         !> Weighted element stiffness matrices in global axes (6, 6, n_elements), kept for
         !> `reactions` (allocated only when weighted).
         real(wp), allocatable :: k_element(:, :, :)
@@ -151,7 +149,6 @@ contains
         type(error_t), allocatable, intent(out) :: error
         !> Arlequin weight alpha(s), s = `model%abscissa`; none = alpha = 1 everywhere.
         class(weight_function_t), intent(in), optional :: weight
-        integer :: i
         call check_mesh(config, error)
         if (allocated(error)) return
         call check_elements(config, error)
@@ -176,12 +173,8 @@ contains
         if (allocated(config%loads)) model%loads = config%loads
         if (allocated(config%functions)) model%functions = config%functions
         call compute_abscissa(model)
-        allocate (model%node_weight(model%n_nodes), source=1.0_wp)
         if (present(weight)) then
             model%weighted = .true.
-            do i = 1, model%n_nodes
-                model%node_weight(i) = weight%value(model%abscissa(i))
-            end do
             call assemble(model, error, weight)
             call build_element_loads(config, model, weight)
         else
