@@ -250,8 +250,9 @@ contains
     !> detection sees and the contacts did not create the energy that carried the disk: given
     !> the contacts' dissipation at the end of the step (`dissipated`, and at its start in
     !> `start`), a step in which they gave the bodies at least half the kinetic energy of the
-    !> crossing disk was a wrong solve (reactions that satisfy the contact laws dissipate), and
-    !> the message says so.
+    !> crossing disk was a wrong solve (reactions that satisfy the contact laws dissipate, but
+    !> for Newton's restitution with friction, which gives a disk at most a third of the energy
+    !> it leaves a single impact with, doc/theory.md 2.4), and the message says so.
     subroutine check_tunnelling(step, t, h, alert, start, p, w, cs, error, dissipated)
         !> Steps done.
         integer(i8), intent(in) :: step
@@ -447,14 +448,16 @@ contains
             real(wp) :: reach
             reach = max(alert, 0.1_wp*minval(p%radius(1:p%n)))
             if (created > 0.0_wp .and. created >= 0.5_wp*energy) then
-                ! reactions that satisfy the contact laws dissipate (theory.md 2.5): the contacts
-                ! of this step created the energy that carried the disk, a wrong solve (a stack
-                ! at rest at a mass ratio of 5e5, its steps at the cap of an unreachable
-                ! tolerance, sent a disk at 2 453 m/s through the floor, and the message said
-                ! to lower the step to 4e-7 s)
+                ! reactions that satisfy the contact laws dissipate, but for Newton's restitution
+                ! with friction, which gives a disk at most a third of the energy it leaves a
+                ! single impact with (e = 1, a wall turned vertical: KE+ = 1.5 KE-, theory.md
+                ! 2.4): at half of it the contacts of this step created the energy that carried
+                ! the disk, a wrong solve (a stack at rest at a mass ratio of 5e5, its steps at
+                ! the cap of an unreachable tolerance, sent a disk at 2 453 m/s through the
+                ! floor, and the message said to lower the step to 4e-7 s)
                 text = 'the time step is not the cause: the contact reactions of this step gave the bodies '// &
                        num(created)//' J/m of kinetic energy (the disk now carries '//num(energy)// &
-                       ' J/m), which reactions that satisfy the contact laws cannot do: the contact solve '// &
+                       ' J/m), more than reactions that satisfy the contact laws can give: the contact solve '// &
                        'of this step went wrong (/dem/solver of the results: an unconverged step; a [solver] '// &
                        'tolerance below what the solver can reach, or max_sweeps too low)'
                 return
