@@ -599,7 +599,7 @@ module dem_nlgs
             type(contact_set_t), intent(inout) :: cs
             integer, intent(in) :: list(:)
             real(wp), intent(in) :: im(:, :), vfree(:, :)
-            real(wp), intent(inout), contiguous :: vel(:, :)
+            real(wp), intent(inout) :: vel(:, :)
             type(nlgs_split_t), intent(in) :: split
             class(nlgs_bilateral_t), intent(inout), optional :: bilateral
             logical, intent(in) :: others
@@ -1132,7 +1132,7 @@ contains
         real(wp), intent(in) :: omega
         type(contact_set_t), intent(inout) :: cs
         real(wp), intent(in) :: im(:, :)
-        real(wp), intent(inout), contiguous :: vel(:, :)
+        real(wp), intent(inout) :: vel(:, :)
         integer, intent(in) :: list(:), first, last, step
         real(wp), intent(in), contiguous :: sc(:, :)
         real(wp), intent(out) :: num, den
@@ -1306,11 +1306,7 @@ contains
         real(wp), intent(in) :: omega
         type(contact_set_t), intent(inout) :: cs
         real(wp), intent(in) :: im(:, :)
-        ! (contiguous: the blocks' threads update vel in place through explicit-shape dummies;
-        ! a non-contiguous actual would give each thread a packed copy of its own, and the
-        ! copies written back would undo the other blocks' updates. Any copy is made here,
-        ! outside the parallel region.)
-        real(wp), intent(inout), contiguous :: vel(:, :)
+        real(wp), intent(inout) :: vel(:, :)
         real(wp), intent(in), contiguous :: sc(:, :)
         type(nlgs_split_t), intent(in) :: split
         logical, intent(in) :: forward

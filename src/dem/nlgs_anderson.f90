@@ -98,7 +98,7 @@ contains
         type(contact_set_t), intent(inout) :: cs
         integer, intent(in) :: list(:)
         real(wp), intent(in) :: im(:, :), vfree(:, :)
-        real(wp), intent(inout), contiguous :: vel(:, :)
+        real(wp), intent(inout) :: vel(:, :)
         type(nlgs_split_t), intent(in) :: split
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         logical, intent(in) :: others
