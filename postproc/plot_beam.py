@@ -7,8 +7,8 @@ Writes, depending on what the run stored: <name>_deflection.png (deflection alon
 beam, or the deformed shape of a frame, at the stored time nearest to T; default the last),
 <name>_history_node<ID>.png (w(t) and u(t) of node ID; default the tip), <name>_energy.png,
 <name>_static.png and <name>_modes.png. Exit code 1 with a message on a missing or invalid
-file, or one with no stored output (a run stopped before its first); a note on stderr for a
---time outside the stored outputs.
+file, or one with no stored output or solution (a run stopped before writing it); a note on
+stderr for a --time outside the stored outputs or given for a static or modal run (ignored).
 """
 import argparse
 import os
@@ -18,7 +18,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from multicor_post.beam import write_all  # noqa: E402
 from multicor_post.results import (ResultsError, file_contents, finite_float,  # noqa: E402
-                                   load_results, outside_time_note, scale_factor)
+                                   load_results, outside_time_note, scale_factor,
+                                   unused_time_note)
 
 
 def main(argv=None):
@@ -47,9 +48,10 @@ def main(argv=None):
     except ResultsError as exc:
         print(f"plot_beam.py: error: {exc}", file=sys.stderr)
         return 1
-    note = outside_time_note(args.time, None if res.dynamic is None else res.dynamic.time)
-    if note:
-        print(f"plot_beam.py: note: {note}", file=sys.stderr)
+    for note in (outside_time_note(args.time, None if res.dynamic is None else res.dynamic.time),
+                 unused_time_note(args.time, res.analysis)):
+        if note:
+            print(f"plot_beam.py: note: {note}", file=sys.stderr)
     for path in paths:
         print(path)
     return 0

@@ -17,9 +17,10 @@ nearest to T), and for a dynamic run <name>_continuum_energy.png and <name>_hist
 node --node, a 1-based mesh index; default the node with the largest displacement), for a modal run
 <name>_modes.png; coupled to disks (/coupling), <name>_coupling.png (the same diagnostics as a
 beam-coupled run's) and the particle plots too. Exit code 1 with a message on a missing or
-invalid file, or one with no stored output (a run stopped before its first); a note on stderr
-for a --time outside the stored outputs and for a figure left out because its series is
-empty.
+invalid file, or one with no stored output or solution (a run stopped before writing it); a
+note on stderr for a --time outside the stored outputs or given for a static or modal run
+(ignored), for a figure left out because its series is empty and for the per-step panels of
+<name>_coupling.png without a step.
 """
 import argparse
 import os
@@ -29,7 +30,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from multicor_post import beam, continuum, coupled, particles  # noqa: E402
 from multicor_post.results import (ResultsError, file_contents, finite_float,  # noqa: E402
-                                   load_results, outside_time_note, scale_factor)
+                                   load_results, outside_time_note, scale_factor,
+                                   unused_time_note)
 
 
 def contents(path):
@@ -64,22 +66,26 @@ def main(argv=None):
                                "MULTICOR results file")
         paths = []
         if args.results.endswith(".partial"):
-            print(f"plot_results.py: note: '{args.results}' is the partial file of a run that did not "
-                  "finish: the figures show the outputs stored so far", file=sys.stderr)
+            # printed with the figures (a file with nothing to plot gets its error alone)
+            notes.append(f"'{args.results}' is the partial file of a run that did not finish: "
+                         "the figures show the outputs stored so far")
         if has_continuum:
             res = continuum.load_continuum(args.results)
             notes.append(outside_time_note(args.time, res.time))
+            notes.append(unused_time_note(args.time, res.analysis))
             paths += continuum.write_all(res, out, time=args.time, scale=args.scale, node=args.node)
             if is_coupled:
-                paths += coupled.write_coupling(coupled.load_continuum_coupling(args.results), out)
+                paths += coupled.write_coupling(coupled.load_continuum_coupling(args.results), out,
+                                                notes=notes)
         if is_coupled and has_beam:
             res = coupled.load_coupled(args.results)
             notes.append(outside_time_note(args.time, res.time))
-            paths += coupled.write_all(res, out, time=args.time, scale=args.scale)
+            paths += coupled.write_all(res, out, time=args.time, scale=args.scale, notes=notes)
         if has_beam:
             res = load_results(args.results)
             notes.append(outside_time_note(args.time, None if res.dynamic is None
                                            else res.dynamic.time))
+            notes.append(unused_time_note(args.time, res.analysis))
             paths += beam.write_all(res, out, time=args.time, node_id=args.node, scale=args.scale)
         if has_particles:
             res = particles.load_dem(args.results)

@@ -24,7 +24,8 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
 from .beam import _time_unit
-from .results import FigureFiles, ResultsError, no_output_error
+from .results import (FigureFiles, ResultsError, no_output_error, no_results_error, shape_error,
+                      unfinished_status)
 
 
 @dataclass
@@ -96,26 +97,44 @@ def load_continuum(path) -> ContinuumResults:
             analysis = "modal"
             u = need("continuum/modal/shapes")
             frequency = need("continuum/modal/frequency")
+        elif analysis in ("static", "modal"):
+            # the mesh is written before the solution: a run killed in between
+            raise no_results_error(f, path, f"/continuum/{analysis}")
         else:
             analysis = "dynamic"
+            if "continuum/time" not in f and unfinished_status(f) is not None:
+                raise no_results_error(f, path, "/continuum/time")
             time = need("continuum/time")
             if time.size == 0:
                 raise no_output_error(f, path, "continuum/time")
-            u = need("continuum/displacement")
-            stress = need("continuum/stress")
-            energy = {name: need(f"continuum/energy/{name}") for name in ENERGY_TERMS}
-            energy["time"] = need("continuum/energy/time")
+            u = records(f, path, "continuum/displacement", time.size)
+            stress = records(f, path, "continuum/stress", time.size)
+            energy = {"time": need("continuum/energy/time")}
+            energy.update({name: records(f, path, f"continuum/energy/{name}", energy["time"].size)
+                           for name in ENERGY_TERMS})
         res = ContinuumResults(path, title, analysis, x, connectivity, kind, time, u, stress,
                                energy, frequency)
         if "dem/position" in f:
-            res.disk_position = f["dem/position"][...]
             res.disk_radius = need("dem/particles/radius")
             res.disk_time = need("dem/time")
             if res.disk_time.size == 0:
                 raise no_output_error(f, path, "dem/time")
+            res.disk_position = records(f, path, "dem/position", res.disk_time.size)
             if "dem/walls/position" in f:
-                res.walls = f["dem/walls/position"][...]
+                res.walls = records(f, path, "dem/walls/position", res.disk_time.size)
     return res
+
+
+def records(f, path: str, name: str, n_out: int) -> np.ndarray:
+    """The dataset ``name`` of the open results file ``path``, one record per stored output:
+    ResultsError (`shape_error`) unless it holds ``n_out`` of them, or when it is missing."""
+    if name not in f:
+        raise ResultsError(f"{path}: missing dataset '/{name}' (not a MULTICOR continuum "
+                           "results file, or one from another version)")
+    data = f[name][...]
+    if data.ndim == 0 or data.shape[0] != n_out:
+        raise shape_error(f, path, name, data.shape, (n_out,) + data.shape[1:])
+    return data
 
 
 def element_polygons(x, connectivity, kind, u=None, scale=1.0):

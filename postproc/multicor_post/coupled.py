@@ -54,6 +54,12 @@ class CouplingDiagnostics:
     attrs: dict                  # attributes of /coupling (time_step, rotation, ...)
     mediator: bool = False       # multipliers = nodes
 
+    @property
+    def no_step_yet(self) -> bool:
+        """True when the file holds the per-step series but no step in them: a run stopped
+        before its 4096th step (they are written in blocks of 4096 steps and at the end)."""
+        return bool(self.steps) and all(v.size == 0 for v in self.steps.values())
+
     def step_time(self) -> np.ndarray:
         """End time of each recorded step [s] (NaN without the time_step attribute)."""
         n = next((v.size for v in self.steps.values()), 0)
@@ -455,6 +461,16 @@ ENERGY_CURVES = ((("fe_kinetic", "fe_strain"), "{body}: kinetic + strain"),
                  (("balance",), "balance (0 = exact)"))
 
 
+#: What the per-step panels of the coupling figure say when the file holds no step yet.
+NO_STEP_YET = "no per-step record yet (written every 4096 steps and at the end)"
+
+
+def _note_no_step_yet(ax, what: str) -> None:
+    """Say on the axes that the per-step series ``what`` hold no step yet (`NO_STEP_YET`)."""
+    ax.text(0.5, 0.5, f"{what}: {NO_STEP_YET}", transform=ax.transAxes, ha="center",
+            va="center", fontsize="small", color="C3")
+
+
 def _note_absent(ax, names) -> None:
     """Say on the axes which datasets the file lacks (nothing is drawn for them)."""
     if names:
@@ -470,9 +486,13 @@ def _legend(ax) -> None:
 def plot_coupling(diag: CouplingDiagnostics) -> Figure:
     """Coupling diagnostics of a coupled run, beam or continuum: constraint residuals and
     sweeps of every step, multipliers at the outputs and their norm at every step, energy
-    audit at the outputs. A dataset the file lacks is named on its panel, not drawn."""
+    audit at the outputs. A dataset the file lacks is named on its panel, not drawn; so is
+    the absence of any step in the per-step series (`NO_STEP_YET`: a run stopped before its
+    4096th step), the panels then spanning the outputs' times."""
     fig, (ax_r, ax_l, ax_e) = _new_figure(8.0, 9.0, rows=3)
-    steps, e = diag.steps, diag.energy
+    e = diag.energy
+    # no step yet: nothing to draw per step (empty curves would only fill the legends)
+    steps = {} if diag.no_step_yet else diag.steps
     ft, ut = _time_unit(np.concatenate([diag.time, diag.energy.get("time", [])]))
     t = diag.step_time() * ft
     residuals = list(RESIDUALS)
@@ -482,7 +502,12 @@ def plot_coupling(diag: CouplingDiagnostics) -> Figure:
         if name in steps:
             # a residual of exactly 0 (the first step of a run at rest) has no logarithm: a gap
             ax_r.semilogy(t, np.where(steps[name] > 0, steps[name], np.nan), label=label)
-    _note_absent(ax_r, [name for name, _ in residuals + [("sweeps", "")] if name not in steps])
+    if diag.no_step_yet:
+        _note_no_step_yet(ax_r, "residuals, sweeps and ‖λ‖ of every step")
+        ax_r.set_yticks([])
+    else:
+        _note_absent(ax_r, [name for name, _ in residuals + [("sweeps", "")]
+                            if name not in steps])
     ax_r.set_ylabel("residual")
     _legend(ax_r)
     if "sweeps" in steps:
@@ -500,7 +525,11 @@ def plot_coupling(diag: CouplingDiagnostics) -> Figure:
         ax_l.plot(t, steps["lambda_norm"], "k", lw=1.2,
                   label="‖λ_m‖ of every step (mediator multipliers on the FE nodes)"
                   if diag.mediator else "‖λ‖ of every step")
-    _note_absent(ax_l, [] if "lambda_norm" in steps else ["lambda_norm"])
+    if diag.no_step_yet:
+        # the empty per-step panel spans the outputs' times, as the multipliers' panel
+        ax_r.set_xlim(ax_l.get_xlim())
+    else:
+        _note_absent(ax_l, [] if "lambda_norm" in steps else ["lambda_norm"])
     ax_l.set_ylabel("multipliers λ [N, N·m]" if diag.attrs.get("rotation", 0) == 1
                     else "multipliers λ [N]")
     _legend(ax_l)
@@ -525,20 +554,36 @@ def plot_coupling(diag: CouplingDiagnostics) -> Figure:
     return fig
 
 
-def write_coupling(diag: CouplingDiagnostics, out_dir, dpi: int = 120) -> list[str]:
-    """Write <name>_coupling.png (`plot_coupling`) in ``out_dir``; return its path in a list."""
-    files = FigureFiles(diag.path, out_dir, dpi)
+def _save_coupling(files: FigureFiles, diag: CouplingDiagnostics,
+                   notes: Optional[list]) -> None:
+    """Save <name>_coupling.png; a sentence in ``notes`` (when given) when its per-step
+    panels are empty (`CouplingDiagnostics.no_step_yet`)."""
     files.save(plot_coupling(diag), "coupling")
+    if diag.no_step_yet and notes is not None:
+        notes.append(f"{files.stem}_coupling.png has no per-step curves: /coupling holds no "
+                     "step (its per-step series are written every 4096 steps and at the end "
+                     "of a run: a run stopped before its 4096th step has none); the "
+                     "multipliers and the energy at the outputs are drawn")
+
+
+def write_coupling(diag: CouplingDiagnostics, out_dir, dpi: int = 120,
+                   notes: Optional[list] = None) -> list[str]:
+    """Write <name>_coupling.png (`plot_coupling`) in ``out_dir``; return its path in a list.
+    Per-step panels without a step get a sentence in ``notes``, when given."""
+    files = FigureFiles(diag.path, out_dir, dpi)
+    _save_coupling(files, diag, notes)
     return files.written
 
 
 def write_all(res: CoupledResults, out_dir, time: Optional[float] = None,
-              scale: Optional[float] = None, dpi: int = 120) -> list[str]:
+              scale: Optional[float] = None, dpi: int = 120,
+              notes: Optional[list] = None) -> list[str]:
     """Write the plots of one coupled run as PNG files in ``out_dir``; return their paths:
     <name>_profiles.png, <name>_configuration.png (at the output nearest to ``time``, default
-    the last) and <name>_coupling.png."""
+    the last) and <name>_coupling.png (per-step panels without a step: a sentence in
+    ``notes``, when given)."""
     files = FigureFiles(res.path, out_dir, dpi)
     files.save(plot_profiles(res, time), "profiles")
     files.save(plot_configuration(res, time, scale), "configuration")
-    files.save(plot_coupling(res.coupling), "coupling")
+    _save_coupling(files, res.coupling, notes)
     return files.written

@@ -101,12 +101,23 @@ def file_contents(path) -> tuple[bool, bool, bool, bool]:
         status = unfinished_status(f)
         if (not any(contents) and status is not None
                 and _decode_attrs(f.attrs).get("code_name") == "MULTICOR"):
-            raise ResultsError(f"'{path}' is the {STOPPED_BEFORE_OUTPUT} (status: {status})")
+            raise ResultsError(f"'{path}' is the {stopped_early(f)} (status: {status})")
         return contents
 
 
 #: What the scripts say of the file of a run that stopped before its first stored output.
 STOPPED_BEFORE_OUTPUT = "partial file of a run stopped before its first stored output: nothing to plot"
+#: What they say of the file of a static or modal run that stopped before its solution.
+STOPPED_BEFORE_SOLUTION = ("partial file of a run stopped before its solution was written: "
+                           "nothing to plot")
+
+
+def stopped_early(f) -> str:
+    """What the scripts say of an open partial file without results: STOPPED_BEFORE_SOLUTION
+    for a static or modal run (root attribute analysis), else STOPPED_BEFORE_OUTPUT."""
+    if _decode_attrs(f.attrs).get("analysis") in ("static", "modal"):
+        return STOPPED_BEFORE_SOLUTION
+    return STOPPED_BEFORE_OUTPUT
 
 
 def unfinished_status(f) -> Optional[str]:
@@ -129,6 +140,42 @@ def no_output_error(f, path: str, dataset: str) -> ResultsError:
         return ResultsError(f"'{path}' is the {STOPPED_BEFORE_OUTPUT} (/{dataset} holds none; "
                             f"status: {status})")
     return ResultsError(f"{path}: /{dataset} holds no stored output: nothing to plot")
+
+
+def no_results_error(f, path: str, what: str) -> ResultsError:
+    """The error for an open results file with a mesh but none of the results ``what`` names
+    (e.g. '/continuum/static'): for a partial file, that its run stopped before writing them
+    (a static or modal run is killed between its mesh and its solution), else that there is
+    nothing to plot."""
+    status = unfinished_status(f)
+    if status is not None:
+        return ResultsError(f"'{path}' is the {stopped_early(f)} (no {what}; status: {status})")
+    return ResultsError(f"{path}: holds no {what}: nothing to plot")
+
+
+def shape_error(f, path: str, name: str, got: tuple, want: tuple) -> ResultsError:
+    """The error for a dataset ``name`` of shape ``got`` where ``want`` was expected (None: any
+    extent). In a partial file whose datasets differ in their number of records only (the
+    first axis), the run was killed between writing two of them: the message says so."""
+    wanted = tuple("n" if s is None else s for s in want)
+    message = f"{path}: dataset '/{name}' has shape {tuple(got)}, expected {wanted}"
+    status = unfinished_status(f)
+    if (status is not None and len(got) == len(want) and len(got) > 0
+            and all(w is None or g == w for g, w in zip(got[1:], want[1:]))):
+        message += (f"; '{path}' is the partial file of a stopped run (status: {status}): "
+                    "the records of its last output are incomplete (the run was killed while "
+                    "writing them): nothing to plot")
+    return ResultsError(message)
+
+
+def unused_time_note(requested: Optional[float], analysis: str) -> Optional[str]:
+    """The note for a --time given for a static or modal run (one solution, no stored
+    outputs in time): ignored; None otherwise."""
+    if requested is None or analysis not in ("static", "modal"):
+        return None
+    holds = "one solution" if analysis == "static" else "mode shapes"
+    return (f"--time {requested:g} s is ignored: it applies to dynamic runs only, and this is "
+            f"a {analysis} run ({holds}, no stored outputs in time)")
 
 
 def outside_time_note(requested: Optional[float], times: Optional[np.ndarray]) -> Optional[str]:
@@ -251,6 +298,14 @@ class Results:
     def title(self) -> str:
         return self.attrs.get("title", "") or os.path.basename(self.path)
 
+    @property
+    def analysis(self) -> str:
+        """'dynamic' when the file holds time series, else 'static' or 'modal' by what it
+        holds ('' for none)."""
+        if self.dynamic is not None:
+            return "dynamic"
+        return "static" if self.static is not None else "modal" if self.modal is not None else ""
+
 
 def load_results(path) -> Results:
     """Read a results file. Raises ResultsError with a clear message when it is missing,
@@ -296,6 +351,11 @@ def load_results(path) -> Results:
                               shapes=reader.array("modal/shapes", shape=(omega.size, n, 3)))
         if "summary" in f:
             res.summary = _decode_attrs(f["summary"].attrs)
+        if res.dynamic is None and res.static is None and res.modal is None:
+            # the mesh is written first: a run killed before its solution or first output
+            missing = {"static": "/static", "modal": "/modal", "dynamic": "/fem/time"}
+            raise no_results_error(f, path, missing.get(res.attrs.get("analysis"),
+                                                         "/fem/time, /static or /modal"))
     return res
 
 
@@ -333,9 +393,7 @@ class _Reader:
                                f"expected {ndim}")
         if shape is not None and any(want is not None and got != want
                                      for got, want in zip(data.shape, shape)):
-            want = tuple("n" if s is None else s for s in shape)
-            raise ResultsError(f"{self.path}: dataset '/{name}' has shape {data.shape}, "
-                               f"expected {want}")
+            raise shape_error(self.f, self.path, name, data.shape, shape)
         return data
 
 
@@ -355,9 +413,7 @@ class _Getter:
         data = np.asarray(self.f[name][()])
         if data.ndim != len(shape) or any(w is not None and g != w
                                           for g, w in zip(data.shape, shape)):
-            want = tuple("n" if s is None else s for s in shape)
-            raise ResultsError(f"{self.path}: dataset '/{name}' has shape {data.shape}, "
-                               f"expected {want}")
+            raise shape_error(self.f, self.path, name, data.shape, shape)
         return data
 
 

@@ -6,31 +6,41 @@ first stored output, a run's partial file holds the root attributes and /summary
 (finished = 0, status = 'running (or killed)'); killed after the output datasets were
 created but before their first record, it holds time series of 0 records; killed before its
 4096th step (the solver statistics are written in blocks of 4096 steps), /dem/solver holds 0
-steps while the outputs are there.
+steps while the outputs are there, and so do the per-step series of /coupling.
+
+A static or modal run flushes its file once, at its end: killed before (checked with kill -9
+on a 1200 x 120 static continuum while it wrote its results and a 400 x 40 modal continuum
+during its eigensolve), its partial file holds the root attributes and /summary only, the
+mesh not yet visible. A mesh without a solution, or the
+datasets of two groups with different numbers of records (a kill between their writes), is
+what such a file shows when HDF5 has written its metadata out before the kill, which it may
+do at any time.
 """
 import h5py
 import numpy as np
 import pytest
+from synthetic_coupled import STEP_REALS, write_continuum_coupled, write_coupled
 from synthetic_dem import H, N_OUT, STEPS_PER_OUT, write_dem
 from test_continuum import write as write_continuum
 
 import plot_beam
 import plot_results
-from multicor_post import continuum, particles
+from multicor_post import continuum, coupled, particles
 from multicor_post.results import ResultsError, load_results, outside_time_note
 
 STOPPED = "partial file of a run stopped before its first stored output: nothing to plot"
+STOPPED_SOLUTION = "partial file of a run stopped before its solution was written: nothing to plot"
 #: The times of synthetic_dem's outputs: 0, 5 ms, 10 ms, 15 ms.
 T_LAST = H * STEPS_PER_OUT * (N_OUT - 1)
 
 
-def mark_killed(path):
+def mark_killed(path, analysis="dynamic"):
     """Give a results file the root attributes and /summary of a killed run's partial file
     (as written by multicor at the file's creation)."""
     with h5py.File(path, "a") as f:
         f.attrs["code_name"] = "MULTICOR"
         f.attrs["code_version"] = "0.1.0"
-        f.attrs["analysis"] = "dynamic"
+        f.attrs["analysis"] = analysis
         f.attrs["run_id"] = "2026-01-01T00:00:00+00:00 1"
         f.attrs["title"] = ""
         summary = f.require_group("summary")
@@ -207,3 +217,195 @@ def test_a_beam_time_outside_the_outputs_gets_a_note(script, cantilever_file, tm
     err = capsys.readouterr().err
     assert f"{script.__name__}.py: note: --time 1000 s is outside the stored outputs" in err
     assert f"the last one, t = {t_last:.6g} s" in err and err.count("\n") == 1
+
+
+# --------------------------------------------------------------------------------------------
+# Static and modal runs killed before their solution
+# --------------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("analysis", ["static", "modal"])
+@pytest.mark.parametrize("script", [plot_results, plot_beam])
+def test_a_static_run_killed_before_its_mesh_was_flushed(script, analysis, tmp_path, capsys):
+    # what the real kill -9 of a static or modal run during its solve leaves: it said
+    # "stopped before its first stored output", and a static run has no stored outputs
+    path = mark_killed(tmp_path / "big.h5.partial", analysis)
+    assert script.main([str(path), "--out", str(tmp_path / "png")]) == 1
+    assert_one_line_error(capsys.readouterr().err, f"{script.__name__}.py: error: ",
+                          STOPPED_SOLUTION, "running (or killed)")
+
+
+@pytest.mark.parametrize("analysis", ["static", "modal"])
+@pytest.mark.parametrize("script", [plot_results, plot_beam])
+def test_a_beam_killed_between_its_mesh_and_its_solution(script, analysis, cantilever_file,
+                                                           tmp_path, capsys):
+    # it said "nothing to plot (no /fem/time, /static or /modal)", not why
+    path = mark_killed(cantilever_file(parts=()), analysis)
+    with pytest.raises(ResultsError, match=STOPPED_SOLUTION):
+        load_results(path)
+    assert script.main([str(path), "--out", str(tmp_path / "png")]) == 1
+    assert_one_line_error(capsys.readouterr().err, f"{script.__name__}.py: error: ",
+                          STOPPED_SOLUTION, f"no /{analysis}", "running (or killed)")
+    # a finished file without its solution: said plainly, not as a stopped run
+    with h5py.File(path, "a") as f:
+        f["summary"].attrs["finished"] = np.int32(1)
+    assert script.main([str(path), "--out", str(tmp_path / "png")]) == 1
+    err = capsys.readouterr().err
+    assert_one_line_error(err, f"{script.__name__}.py: error: ",
+                          f"holds no /{analysis}: nothing to plot")
+    assert "partial file" not in err
+
+
+@pytest.mark.parametrize("analysis", ["static", "modal"])
+def test_a_continuum_killed_between_its_mesh_and_its_solution(analysis, tmp_path, capsys):
+    # it said "missing dataset '/continuum/time'": a static run has no time series
+    path = write_continuum(tmp_path / "plate.h5.partial", analysis)
+    with h5py.File(path, "a") as f:
+        del f[f"continuum/{analysis}"]
+    mark_killed(path, analysis)
+    with pytest.raises(ResultsError, match=STOPPED_SOLUTION):
+        continuum.load_continuum(path)
+    assert plot_results.main([str(path), "--out", str(tmp_path / "png")]) == 1
+    assert_one_line_error(capsys.readouterr().err, "plot_results.py: error: ", STOPPED_SOLUTION,
+                          f"no /continuum/{analysis}", "running (or killed)")
+    with h5py.File(path, "a") as f:
+        f["summary"].attrs["finished"] = np.int32(1)
+    assert plot_results.main([str(path), "--out", str(tmp_path / "png")]) == 1
+    err = capsys.readouterr().err
+    assert_one_line_error(err, "plot_results.py: error: ",
+                          f"holds no /continuum/{analysis}: nothing to plot")
+    assert "missing dataset" not in err and "partial file" not in err
+
+
+def test_a_dynamic_continuum_killed_before_its_series_were_created(tmp_path, capsys):
+    # the mesh alone in a dynamic run's partial file: said "missing dataset '/continuum/time'"
+    path = write_continuum(tmp_path / "plate.h5.partial")
+    with h5py.File(path, "a") as f:
+        for name in ("time", "displacement", "velocity", "stress", "energy"):
+            del f[f"continuum/{name}"]
+    mark_killed(path)
+    assert plot_results.main([str(path), "--out", str(tmp_path / "png")]) == 1
+    assert_one_line_error(capsys.readouterr().err, "plot_results.py: error: ", STOPPED,
+                          "no /continuum/time")
+
+
+# --------------------------------------------------------------------------------------------
+# --time for a static or modal run
+# --------------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("analysis", ["static", "modal"])
+@pytest.mark.parametrize("script", [plot_results, plot_beam])
+def test_a_time_for_a_static_beam_gets_a_note(script, analysis, cantilever_file, tmp_path,
+                                              capsys):
+    # --time 0.5 on a static run was ignored without a word
+    path = cantilever_file(parts=(analysis,))
+    assert script.main([str(path), "--time", "0.5", "--out", str(tmp_path / "png")]) == 0
+    err = capsys.readouterr().err
+    assert err == (f"{script.__name__}.py: note: --time 0.5 s is ignored: it applies to dynamic "
+                   f"runs only, and this is a {analysis} run ("
+                   + ("one solution" if analysis == "static" else "mode shapes")
+                   + ", no stored outputs in time)\n")
+    # without --time, or for a dynamic run, no note
+    assert script.main([str(path), "--out", str(tmp_path / "png")]) == 0
+    assert capsys.readouterr().err == ""
+    dynamic = cantilever_file("dynamic.h5", parts=("dynamic", "energy"))
+    assert script.main([str(dynamic), "--time", "0.005", "--out", str(tmp_path / "png")]) == 0
+    assert capsys.readouterr().err == ""
+
+
+@pytest.mark.parametrize("analysis", ["static", "modal"])
+def test_a_time_for_a_static_continuum_gets_a_note(analysis, tmp_path, capsys):
+    path = write_continuum(tmp_path / "plate.h5", analysis)
+    assert plot_results.main([str(path), "--time", "2", "--out", str(tmp_path / "png")]) == 0
+    err = capsys.readouterr().err
+    assert err.startswith("plot_results.py: note: --time 2 s is ignored: it applies to "
+                          f"dynamic runs only, and this is a {analysis} run")
+    assert err.count("\n") == 1
+
+
+# --------------------------------------------------------------------------------------------
+# The coupling figure of a run killed before its 4096th step
+# --------------------------------------------------------------------------------------------
+
+COUPLED_KINDS = {"beam": (write_coupled, lambda path: coupled.load_coupled(path).coupling),
+                 "continuum": (write_continuum_coupled, coupled.load_continuum_coupling)}
+
+
+@pytest.mark.parametrize("kind", sorted(COUPLED_KINDS))
+def test_the_coupling_figure_without_steps_says_so(kind, tmp_path, capsys):
+    # the per-step panels were drawn empty (curves of no point in the legend, axes around 0)
+    # with nothing saying why
+    write, load = COUPLED_KINDS[kind]
+    path = write(tmp_path / "glued.h5.partial")
+    mark_killed(empty_series(path, [f"coupling/{n}" for n in STEP_REALS + ("sweeps",
+                                                                             "corrections")]))
+    diag = load(path)
+    assert diag.no_step_yet
+    fig = coupled.plot_coupling(diag)
+    ax_r, ax_l = fig.axes[0], fig.axes[1]
+    texts = [t.get_text() for ax in (ax_r, ax_l) for t in ax.texts]
+    assert texts == ["residuals, sweeps and ‖λ‖ of every step: " + coupled.NO_STEP_YET]
+    # no empty curve: the residual panel draws nothing, the multipliers' panel the outputs'
+    assert ax_r.get_lines() == [] and ax_r.get_legend() is None
+    assert all(line.get_xdata().size == N_OUT for line in ax_l.get_lines())
+    # the per-step panel spans the outputs' times (in ms) as the multipliers' panel does, not
+    # matplotlib's default [-0.05, 0.05]
+    lo, hi = ax_r.get_xlim()
+    assert (lo, hi) == ax_l.get_xlim() and lo <= 0.0 and hi >= T_LAST * 1e3
+    out = tmp_path / "png"
+    assert plot_results.main([str(path), "--out", str(out)]) == 0
+    printed = capsys.readouterr()
+    assert str(out / "glued_coupling.png") in printed.out.split()
+    assert ("plot_results.py: note: glued_coupling.png has no per-step curves: /coupling holds "
+            "no step" in printed.err)
+
+
+# --------------------------------------------------------------------------------------------
+# A kill between the records of two groups
+# --------------------------------------------------------------------------------------------
+
+def cut_last_record(path, names):
+    """Drop the last record of the datasets ``names`` (a kill after the other datasets of
+    the last output were extended, before these were)."""
+    with h5py.File(path, "a") as f:
+        for name in names:
+            f[name].resize(f[name].shape[0] - 1, axis=0)
+    return path
+
+
+INCOMPLETE = ("is the partial file of a stopped run (status: running (or killed)): the records "
+              "of its last output are incomplete")
+
+
+def test_particles_with_an_incomplete_last_output(tmp_path, capsys):
+    # /dem/time holds N_OUT records, /dem/position N_OUT - 1: the shape error did not say why
+    path = write_dem(tmp_path / "column.h5")
+    with h5py.File(path, "a") as f:     # extendible, as multicor creates the series
+        data = f["dem/position"][()]
+        del f["dem/position"]
+        f.create_dataset("dem/position", data=data, maxshape=(None,) + data.shape[1:])
+    cut_last_record(path, ["dem/position"])
+    assert plot_results.main([str(path), "--out", str(tmp_path / "png")]) == 1
+    err = capsys.readouterr().err
+    assert_one_line_error(err, "plot_results.py: error: ", "dataset '/dem/position' has shape")
+    assert "partial file" not in err        # a finished file: not explained by a kill
+    mark_killed(path)
+    assert plot_results.main([str(path), "--out", str(tmp_path / "png")]) == 1
+    assert_one_line_error(capsys.readouterr().err, "plot_results.py: error: ",
+                          f"dataset '/dem/position' has shape ({N_OUT - 1}, ", INCOMPLETE)
+
+
+def test_a_continuum_with_an_incomplete_last_output(tmp_path, capsys):
+    # continuum/displacement one record short of /continuum/time: a ValueError traceback
+    # from matplotlib (the history's x and y of different lengths)
+    path = write_continuum(tmp_path / "plate.h5")
+    with h5py.File(path, "a") as f:
+        data = f["continuum/displacement"][()]
+        del f["continuum/displacement"]
+        f["continuum/displacement"] = data[:-1]
+    mark_killed(path)
+    with pytest.raises(ResultsError, match="records of its last output are incomplete"):
+        continuum.load_continuum(path)
+    assert plot_results.main([str(path), "--out", str(tmp_path / "png")]) == 1
+    assert_one_line_error(capsys.readouterr().err, "plot_results.py: error: ",
+                          "dataset '/continuum/displacement' has shape (4, 7, 2), expected "
+                          "(5, 7, 2)", INCOMPLETE)
