@@ -481,8 +481,10 @@ contains
             creation_allowance(lp%start, self%sys%dem%energies, mj_load_energy(self%sys%dem))) then
             lp%creating = lp%creating + 1
             if (lp%creating == 1) &
-                call report(energy_creation_warning(lp%k, self%sys%fe%t, step_created_energy(lp%start, self%sys%dem%energies), &
-                                                    lp%start%kinetic, self%sys%dem%energies%kinetic))
+                call report(energy_creation_warning(lp%k, self%sys%fe%t, &
+                                                    step_created_energy(lp%start, self%sys%dem%energies), &
+                                                    lp%start%kinetic, self%sys%dem%energies%kinetic, &
+                                                    maxval(self%sys%dem%materials%restitution), lp%unconverged))
         end if
         if (self%sys%dem%bonds_lost > 0) then
             lp%lost_warnings = lp%lost_warnings + 1

@@ -517,10 +517,13 @@ contains
     end function creation_allowance
 
     !> Warning for step `step` (ending at time `t`), whose contacts created the energy
-    !> `created` while the disks' kinetic energy went from `kinetic0` to `kinetic`: the
-    !> reasons (Newton's restitution with Coulomb friction at oblique impacts; pairs pushed
-    !> together within a step at e close to 1; doc/theory.md 2.4) and what to change.
-    function energy_creation_warning(step, t, created, kinetic0, kinetic) result(line)
+    !> `created` while the disks' kinetic energy went from `kinetic0` to `kinetic`, with the
+    !> causes that apply and what to change: `unconverged` steps before it ended off the
+    !> contact laws (their reactions carry errors the later steps release); with restitution
+    !> (`e_max` > 0, the largest of the laws), Newton's restitution with Coulomb friction at
+    !> oblique impacts and pairs pushed together within a step (doc/theory.md 2.4). With
+    !> neither, the cause is not one the code knows of, and the message says so.
+    function energy_creation_warning(step, t, created, kinetic0, kinetic, e_max, unconverged) result(line)
         !> The step.
         integer(i8), intent(in) :: step
         !> Time at its end [s].
@@ -529,13 +532,28 @@ contains
         real(wp), intent(in) :: created
         !> Kinetic energy of the disks at the start and the end of the step [J/m].
         real(wp), intent(in) :: kinetic0, kinetic
-        character(len=:), allocatable :: line
+        !> Largest restitution coefficient of the contact laws.
+        real(wp), intent(in) :: e_max
+        !> Steps of the run so far whose contact solve did not converge.
+        integer, intent(in) :: unconverged
+        character(len=:), allocatable :: line, causes
+        causes = ''
+        if (unconverged > 0) causes = to_str(unconverged)//' earlier step(s) ended unconverged, their reactions '// &
+                                      'off the contact laws (raise [solver] max_sweeps or the tolerance until '// &
+                                      'every step converges)'
+        if (e_max > 0.0_wp) then
+            if (len(causes) > 0) causes = causes//'; '
+            causes = causes//"restitution e up to "//num(e_max)//": Newton's law with Coulomb friction can create "// &
+                     'energy at oblique impacts when e is close to 1, and with e close to 1 so can pairs that other '// &
+                     'disks push together within a step (doc/theory.md 2.4); a lower restitution ([contacts] law) '// &
+                     'avoids both, a shorter [time] step reduces the second'
+        end if
+        if (len(causes) == 0) causes = 'every step converged and every law has e = 0: not a cause the code knows '// &
+                                       'of (doc/theory.md 2.5); a shorter [time] step or a tighter [solver] '// &
+                                       'tolerance tells whether it is the scheme'
         line = 'warning: '//when(step, t)//'the contacts created '//num(created)//' J/m of energy (kinetic '// &
-               'energy of the disks '//num(kinetic0)//' -> '//num(kinetic)//' J/m): restitution e with '// &
-               "friction: Newton's law with Coulomb friction can create energy at oblique impacts when e "// &
-               'is close to 1, and with e close to 1 so can pairs that other disks push together within '// &
-               'a step (doc/theory.md 2.4); a lower restitution ([contacts] law) avoids both, a shorter [time] '// &
-               'step reduces the second; further such steps are only counted (total in the summary)'
+               'energy of the disks '//num(kinetic0)//' -> '//num(kinetic)//' J/m): '//causes// &
+               '; further such steps are only counted (total in the summary)'
     end function energy_creation_warning
 
     !> Summary line: `n` of the `n_steps` steps created energy beyond `creation_allowance`.
@@ -546,7 +564,7 @@ contains
         integer(i8), intent(in) :: n_steps
         character(len=:), allocatable :: line
         line = 'steps whose contacts created energy: '//to_str(n)//' of '//to_str(n_steps)// &
-               ' (Newton restitution, doc/theory.md 2.4)'
+               ' (doc/theory.md 2.4 and 2.5)'
     end function energy_creation_summary
 
     !> Memory a model will need at its peak [bytes] (see bytes_per_disk, bytes_per_node,

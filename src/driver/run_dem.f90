@@ -264,7 +264,8 @@ contains
                 creating = creating + 1
                 if (creating > 1) return
                 call report(energy_creation_warning(k, sys%time, step_created_energy(start, sys%energies), &
-                                                    start%kinetic, sys%energies%kinetic))
+                                                    start%kinetic, sys%energies%kinetic, &
+                                                    maxval(sys%materials%restitution), unconverged))
             end associate
         end subroutine check_created_energy
 
