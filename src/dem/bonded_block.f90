@@ -120,6 +120,20 @@
 !> (7.2e-2 on a bonded row hit by a disk, at the cap of 50 000 iterations): the outer check
 !> never ran and no bond was released (doc/theory.md 7.10, "The stopping test of a pass").
 !>
+!> Cap and energy guard (`bonded_block_solve`; doc/theory.md 7.10): config%max_sweeps bounds the
+!> block iterations of the step, all passes together; a step out of them with a bond still
+!> outside its cone ends unconverged. The norm of the passes is relative to sum |W r|^2, which
+!> the self-stresses of a lattice's loops inflate without any velocity: such a pass meets the
+!> tolerance after an iteration or two whatever its velocities, and a release then clips a
+!> bond's share of the self-stress and throws the rest of the loop apart (a bonded lattice
+!> thrown into a corner: 1.3 J/m of free kinetic energy, 2.5e7 J/m after 67 passes of one
+!> step, each at the tolerance). After each pass the energy the reactions created,
+!> |v|_M^2/2 - |v_free|_M^2/2 + r.s = r.u - |H r|^2_{M^-1}/2 (s the solver shifts), at most
+!> -|H r|^2_{M^-1}/2 at a solution, is compared with created_fraction of the kinetic energy;
+!> above it the block is given up for the step, which the plain sweeps solve again from the
+!> free velocities and zero reactions (the warm start carries the self-stresses) with a cap
+!> of their own. Not with bilateral constraints (their multipliers work on the disks too).
+!>
 !> Released bonds that hold a part alone (`condense`): a released bond whose two bodies are
 !> not connected through B carries the part beyond it by itself, a rigid body or a structure
 !> of B. The plain sweep updates it with its own block W_kk (its two disks), where the part
@@ -190,6 +204,9 @@ module dem_bonded_block
     !> the digits of S/W_kk; the floor keeps it definite and changes the step of a component
     !> by released_floor/(S_ii/W_ii), 2.3e-4 for the row above.
     real(wp), parameter :: released_floor = 1.0e-6_wp
+    !> Energy guard (module header, "Cap and energy guard"): a pass may create at most this fraction of the larger
+    !> kinetic energy of the free and the end velocities (created_energy).
+    real(wp), parameter :: created_fraction = 0.1_wp
 
     !> Counts since the block was created (for statistics and benchmarks).
     type :: bonded_block_counts_t
@@ -212,6 +229,8 @@ module dem_bonded_block
         integer(i8) :: deletions = 0
         !> Set-ups whose factorisation failed (the bonds were then swept as by the NLGS).
         integer(i8) :: failures = 0
+        !> Steps whose block solve was given up (energy guard) and solved by the plain sweeps.
+        integer(i8) :: give_ups = 0
     end type bonded_block_counts_t
 
     !> The bonded block and its factor (kept from step to step: see the module header).
@@ -372,8 +391,12 @@ contains
 
     !> Solve the contact problem of one step with the intact bonds as a direct block and
     !> the NLGS sweeps over the other contacts (block Gauss-Seidel), then the outer check of
-    !> the bonds' cones (module header). Arguments as nlgs_solve; stats%sweeps counts the
-    !> block iterations of every pass, and the sweep limit applies to each pass.
+    !> the bonds' cones (module header). Arguments as nlgs_solve; config%max_sweeps bounds the
+    !> block iterations of the whole step, every pass included, and stats%sweeps counts them.
+    !> A pass whose reactions created energy (created_energy above created_fraction of the
+    !> kinetic energy) is given up: the step is solved again from its free velocities and zero
+    !> reactions by the plain sweeps (as method = nlgs), with a cap of its own (module header,
+    !> "Cap and energy guard").
     subroutine bonded_block_solve(self, config, cs, im, vel, stats, bilateral)
         !> The strategy and its block (kept between steps).
         class(bonded_block_method_t), intent(inout) :: self
@@ -390,9 +413,12 @@ contains
         !> Bilateral constraints kept satisfied (default: none).
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         type(nlgs_stats_t) :: pass
+        type(nlgs_config_t) :: left
         integer :: k, released, n_blocked, sweeps, worst
-        real(wp) :: excess
+        real(wp) :: excess, kfree, created
         integer(i8) :: updates, local
+        real(wp), allocatable :: vfree(:, :)
+        logical :: give_up_block
         associate (block => self%block)
             if (allocated(block%excluded)) then
                 if (size(block%excluded) < cs%n) deallocate (block%excluded)
@@ -401,17 +427,28 @@ contains
             block%excluded = .false.
             block%local_tol = config%local_tol
             block%local_max_iter = config%local_max_iter
+            ! the start of the step, for the plain sweeps if the block is given up
+            vfree = vel
+            kfree = kinetic_energy(im, vfree)
+            left = config
             sweeps = 0
             updates = 0_i8
             local = 0_i8
             n_blocked = -1
+            give_up_block = .false.
             block%resolving = .false.
             do
-                call nlgs_solve(config, cs, im, vel, pass, bilateral, block)
+                left%max_sweeps = config%max_sweeps - sweeps
+                call nlgs_solve(left, cs, im, vel, pass, bilateral, block)
                 if (n_blocked < 0) n_blocked = pass%n_blocked
                 sweeps = sweeps + pass%sweeps
                 updates = updates + pass%updates
                 local = local + pass%local_iterations
+                created = created_energy(cs, im, vel, kfree)
+                if (.not. present(bilateral) .and. .not. created <= created_fraction*max(kfree, kinetic_energy(im, vel))) then
+                    give_up_block = .true.
+                    exit
+                end if
                 if (.not. pass%converged) exit
                 ! release only the bond farthest outside its cone: the others may come back inside
                 ! once it yields, and bonds released together are swept against the rigid rest of
@@ -447,6 +484,16 @@ contains
                     released = 1
                 end if
                 block%counts%releases = block%counts%releases + released
+                if (sweeps >= config%max_sweeps) then
+                    ! no iteration left for the step solved again: it ends unconverged, the bonds
+                    ! outside their cones held (contacts_finish judges no bond of such a step),
+                    ! its error at least their largest relative excess over their bounds
+                    pass%converged = .false.
+                    do k = 1, cs%n
+                        if (block%member(k)) pass%error = max(pass%error, relative_excess(cs, k))
+                    end do
+                    exit
+                end if
                 block%counts%resolves = block%counts%resolves + 1
                 block%resolving = .true.
                 ! back to the velocities without the contact impulses (nlgs_solve applies the
@@ -456,6 +503,21 @@ contains
                 cs%r(:, 1:cs%n) = -cs%r(:, 1:cs%n)
             end do
             block%resolving = .false.
+            if (give_up_block) then
+                ! the plain sweeps from the free velocities (the bonds swept with their cones),
+                ! from zero reactions: the block's carry self-stresses (the kernel of W_BB) that
+                ! the sweeps, clipping them to the cones, turn into kinetic energy (the lattice of
+                ! the module header: 1.0 J/m created from a warm start, 0.14 J/m free)
+                block%counts%give_ups = block%counts%give_ups + 1
+                block%member = .false.
+                vel = vfree
+                cs%r(:, 1:cs%n) = 0.0_wp
+                left%max_sweeps = config%max_sweeps
+                call nlgs_solve(left, cs, im, vel, pass, bilateral)
+                sweeps = sweeps + pass%sweeps
+                updates = updates + pass%updates
+                local = local + pass%local_iterations
+            end if
             stats = pass
             stats%n_blocked = n_blocked
             stats%sweeps = sweeps
@@ -463,6 +525,28 @@ contains
             stats%local_iterations = local
         end associate
     end subroutine bonded_block_solve
+
+    !> Kinetic energy 1/2 v^T M v of the disks [J/m] (the DOFs with a mass: im > 0).
+    pure real(wp) function kinetic_energy(im, vel) result(e)
+        real(wp), intent(in) :: im(:, :), vel(:, :)
+        e = 0.5_wp*sum(vel**2/max(im, tiny(1.0_wp)), mask=im > 0.0_wp)
+    end function kinetic_energy
+
+    !> Energy the reactions created [J/m] (module header, "Cap and energy guard"): the kinetic energy
+    !> of the velocities `vel` less that of the free velocities, `kfree`, and less the work
+    !> -r.s of the contacts' shifts s (a wall's motion, a restitution target, a gap term),
+    !> i.e. sum_k r_k . u_k - 1/2 |M^-1/2 H r|^2 for the velocities vel = v_free + M^-1 H r:
+    !> at most -1/2 |M^-1/2 H r|^2 <= 0 at a solution, whose every reaction dissipates
+    !> (r_k . u_k <= 0, doc/theory.md 2.5).
+    pure real(wp) function created_energy(cs, im, vel, kfree) result(created)
+        type(contact_set_t), intent(in) :: cs
+        real(wp), intent(in) :: im(:, :), vel(:, :), kfree
+        integer :: k
+        created = kinetic_energy(im, vel) - kfree
+        do k = 1, cs%n
+            if (cs%active(k)) created = created + cs%r(1, k)*cs%shift(1, k) + cs%r(2, k)*cs%shift(2, k)
+        end do
+    end function created_energy
 
     !> The reaction of bond k lies outside its cone (a bound with a zero coefficient locks
     !> nothing and is not checked).
@@ -495,6 +579,22 @@ contains
         if (cs%erol(k) > 0.0_wp .and. abs(cs%r(3, k)) > cs%erol(k)*rn) &
             excess = max(excess, abs(cs%r(3, k))/max(cs%erol(k)*rn, tiny(1.0_wp)) - 1.0_wp)
     end function cone_excess
+
+    !> How far the reaction of bond k lies outside its cone, relative to the bound it exceeds
+    !> (largest ratio of a component to its bound, minus 1; a tension beyond the cohesion by
+    !> its excess over r_cohe h; 0 inside the cone).
+    pure real(wp) function relative_excess(cs, k) result(excess)
+        type(contact_set_t), intent(in) :: cs
+        integer, intent(in) :: k
+        real(wp) :: rn
+        rn = cs%r(1, k) + cs%coh(k)
+        if (rn < 0.0_wp) then
+            excess = huge(1.0_wp)
+            if (cs%coh(k) > 0.0_wp) excess = min(huge(1.0_wp), -rn/cs%coh(k))
+        else
+            excess = cone_excess(cs, k)
+        end if
+    end function relative_excess
 
     !> Case of the reaction of bond k of the block, which lies inside its cone: on a bound
     !> (within on_bound of it, relative) case_slip, case_roll or case_slip_roll, else

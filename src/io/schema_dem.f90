@@ -186,10 +186,13 @@ contains
                            'to W r (quadratic mean over the active contacts).', default='1.666e-4')
         call s%add_keyword('solver', 'max_sweeps', [int_field('max_sweeps', lower=1)], &
                            'Largest number of sweeps per step (with `method = block`: block iterations, each a '// &
-                           'direct solve of the bonds and a sweep over the other contacts, per pass: a bond '// &
-                           'released by the check of the bonds'' cones starts a new pass of the step with its own '// &
-                           'cap, and the warnings and results count the iterations of all passes); a step that '// &
-                           'reaches it without converging is reported (warning) and counted.', default='1000')
+                           'direct solve of the bonds and a sweep over the other contacts, over all the passes '// &
+                           'of the step: a bond released by the check of the bonds'' cones starts a new pass '// &
+                           'with the iterations left, and a step out of them with a bond still outside its cone '// &
+                           'ends unconverged, its error at least the bond''s relative excess over its bound; a '// &
+                           'step whose block solve created energy is solved again by plain sweeps from zero '// &
+                           'reactions, which take up to max_sweeps more, counted too: doc/theory.md 7.10); a '// &
+                           'step that reaches it without converging is reported (warning) and counted.', default='1000')
         call s%add_keyword('solver', 'local_tolerance', [real_field('local_tolerance', '', lower=0.0_wp, &
                                                                     upper=1.0_wp, lower_strict=.true., &
                                                                     upper_strict=.true.)], &
