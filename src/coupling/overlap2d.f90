@@ -232,14 +232,6 @@ contains
                 return
             end if
         end do
-        area = 0.0_wp
-        do k = 1, n
-            area = area + cross(vertex(:, k), vertex(:, modulo(k, n) + 1))
-        end do
-        if (.not. abs(area) > 0) then
-            call make_error(error, 'overlap polygon: zero area')
-            return
-        end if
         ! The inside test, the distances to the tagged edges and the triangulation all take the
         ! boundary for a simple closed curve: a bow-tie would weight its two lobes as one region.
         crossing = crossing_edges(vertex)
@@ -254,6 +246,16 @@ contains
                             'vertices given in order around it (either direction), no edge meeting another '// &
                             'except its neighbours at their common vertex; reorder the vertices, or split the '// &
                             'region into several region lines')
+            return
+        end if
+        ! (after the crossing test: the lobes of a symmetric bow-tie have opposite signed areas
+        ! that cancel, and 'zero area' named no edge)
+        area = 0.0_wp
+        do k = 1, n
+            area = area + cross(vertex(:, k), vertex(:, modulo(k, n) + 1))
+        end do
+        if (.not. abs(area) > 0) then
+            call make_error(error, 'overlap polygon: zero area')
             return
         end if
         allocate (region%fe_edge(n), region%particle_edge(n), source=.false.)
