@@ -11,8 +11,9 @@
 !> are timed one by one; at the end the detection alone is timed again on the last
 !> configuration of each N, the sizes taking turns (time_detection). Printed per N:
 !>   contacts found by the detection (gap <= alert) and active in the solver (bonded, predicted
-!>   gap within a round-off allowance of closing, or loaded at the previous step), sweeps per step, wall-clock time per step of the detection (broad + narrow
-!>   phase + warm-start matching) and of the solver (laws, frames, NLGS sweeps, residual):
+!>   gap within a round-off allowance of closing, or loaded at the previous step), sweeps per
+!>   step, wall-clock time per step of the detection (broad + narrow phase + warm-start
+!>   matching) and of the solver (laws, frames, NLGS sweeps, residual):
 !>   median and best over the timed steps, and median and best of the repeated detection
 !>   (per call);
 !>   solver contact updates per second = active contacts x sweeps / solver time of a step

@@ -2,7 +2,9 @@
 """The project's text files hold no control character other than the line feed (and the tab
 in decks, where the syntax allows it: tests/data has decks with tabs on purpose): a tab or
 BEL in a Markdown formula is the trace of a backslash eaten by an escape (\\t of \\text, \\a
-of \\alpha), and a stray byte in a deck or a source is invisible in an editor.
+of \\alpha), and a stray byte in a deck or a source is invisible in an editor. Fortran lines
+(.f90, .fypp, .pf; fypp directives aside) hold at most 132 characters, gfortran's default and
+the project's hard limit: fprettify's format test leaves comment lines alone.
 Usage (ctest does this): check_text_files.py ROOT. Exit 1 with file:line:column of each."""
 import pathlib
 import re
@@ -13,6 +15,8 @@ SUFFIXES = {".md", ".f90", ".fypp", ".pf", ".py", ".dat", ".geo", ".msh", ".cmak
 FOLDERS = ["doc", "input", "src", "tests", "bench", "postproc", "scripts", ".ci"]
 CONTROL = re.compile(r"[\x00-\x09\x0b-\x1f\x7f]")
 DECK_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f]")
+FORTRAN = {".f90", ".fypp", ".pf"}
+MAX_FORTRAN = 132
 
 
 def files(root):
@@ -35,7 +39,10 @@ def main():
                 bad += 1
                 print(f"{path.relative_to(root)}:{number}:{m.start() + 1}: control character "
                       f"0x{ord(m.group()):02x}")
-    print(f"{checked} files checked, {bad} control characters")
+            if path.suffix in FORTRAN and len(line) > MAX_FORTRAN and not line.lstrip().startswith("#:"):
+                bad += 1
+                print(f"{path.relative_to(root)}:{number}: {len(line)} characters, more than {MAX_FORTRAN}")
+    print(f"{checked} files checked, {bad} control characters or long Fortran lines")
     return 1 if bad or not checked else 0
 
 

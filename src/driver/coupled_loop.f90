@@ -16,9 +16,10 @@
 !> Warnings go through the report callback: steps whose joint solve did not converge (the
 !> first `max_warnings`, then only the count), once, a disk moving farther than the alert
 !> distance in a step, and once, then counted in the summary, a converged step whose contacts
-!> created energy (driver_guards::creation_allowance; doc/theory.md 2.4). The initial state (step 0) and the state after every step are checked
-!> as in the uncoupled runs (driver_guards): the finite-element side by `check_part`, then the
-!> disks (non-finite values, beyond the representable box), then tunnelling (after a step).
+!> created energy (driver_guards::creation_allowance; doc/theory.md 2.4). The initial state
+!> (step 0) and the state after every step are checked as in the uncoupled runs
+!> (driver_guards): the finite-element side by `check_part`, then the disks (non-finite
+!> values, beyond the representable box), then tunnelling (after a step).
 module driver_coupled_loop
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
