@@ -396,7 +396,7 @@ contains
     !> A pass whose reactions created energy (created_energy above created_fraction of the
     !> kinetic energy) is given up: the step is solved again from its free velocities and zero
     !> reactions by the plain sweeps (as method = nlgs), with a cap of its own (module header,
-    !> "Cap and energy guard").
+    !> "Cap and energy guard"), and stats%block_given_up is set.
     subroutine bonded_block_solve(self, config, cs, im, vel, stats, bilateral)
         !> The strategy and its block (kept between steps).
         class(bonded_block_method_t), intent(inout) :: self
@@ -519,6 +519,7 @@ contains
                 local = local + pass%local_iterations
             end if
             stats = pass
+            stats%block_given_up = give_up_block
             stats%n_blocked = n_blocked
             stats%sweeps = sweeps
             stats%updates = updates

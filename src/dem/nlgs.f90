@@ -254,6 +254,9 @@ module dem_nlgs
         integer :: n_block = 0
         !> Corrections done (config%correction).
         integer :: corrections = 0
+        !> The bonded block was given up for the step (its energy guard, dem_bonded_block) and
+        !> the step solved again by the plain sweeps; never set by the other methods.
+        logical :: block_given_up = .false.
     end type nlgs_stats_t
 
     !> History of the Anderson acceleration: differences of the sweep map's outputs g and

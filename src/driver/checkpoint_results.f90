@@ -166,7 +166,8 @@ contains
         call file%create_group('/writers', error)
         if (allocated(error)) return
         call file%write_attribute('/writers', 'dem', real([writer%n_out, writer%n_contacts_stored, &
-                                                           writer%n_steps, writer%n_buffered, writer%n_ruptures], wp), error)
+                                                           writer%n_steps, writer%n_buffered, writer%n_ruptures, &
+                                                           writer%n_block_given_up], wp), error)
     end subroutine save_dem_writer
 
     !> Read the counters of the particle writer (begun again: its buffers exist).
@@ -180,11 +181,14 @@ contains
         integer, allocatable :: c(:)
         call read_int_attr_1d(file, '/writers', 'dem', c, error)
         if (allocated(error)) return
-        if (size(c) /= 5) then
+        if (size(c) /= 6) then
             call make_error(error, 'checkpoint: /writers: wrong number of particle writer counters')
             return
         end if
         call require_range(c, 0, huge(0), '/writers@dem', error)
+        if (allocated(error)) return
+        call require_range(c(6:6), 0, c(3), '/writers@dem value 6 (steps whose bonded block was given up, at most '// &
+                           'the steps recorded)', error)
         if (allocated(error)) return
         if (c(4) /= 0) then
             call make_error(error, 'checkpoint: the particle writer had unwritten statistics')
@@ -195,6 +199,7 @@ contains
         writer%n_steps = c(3)
         writer%n_buffered = 0
         writer%n_ruptures = c(5)
+        writer%n_block_given_up = c(6)
     end subroutine load_dem_writer
 
     !> Write the counters and running maxima of the coupling writer (nothing buffered).

@@ -44,9 +44,11 @@ module driver_results_dem
         integer :: n_buffered = 0, n_steps = 0
         !> Bond ruptures written so far.
         integer :: n_ruptures = 0
+        !> Steps recorded so far whose bonded block was given up (nlgs_stats_t%block_given_up).
+        integer :: n_block_given_up = 0
         !> Buffered statistics per step: sweeps, contacts in the list, active contacts,
-        !> converged (1) or not (0).
-        integer, allocatable :: sweeps(:), contacts(:), active(:), blocked(:), converged(:)
+        !> converged (1) or not (0), bonded block given up (1) or not (0).
+        integer, allocatable :: sweeps(:), contacts(:), active(:), blocked(:), converged(:), given_up(:)
         !> Buffered convergence norms and Signorini-Coulomb residuals per step.
         real(wp), allocatable :: norm(:), residual(:)
         !> Buffered Siconos errors per step (dem_nlgs, nlgs_siconos_error).
@@ -93,9 +95,10 @@ contains
         self%n_buffered = 0
         self%n_steps = 0
         self%n_ruptures = 0
+        self%n_block_given_up = 0
         allocate (self%sweeps(stats_buffer), self%contacts(stats_buffer), &
                   self%active(stats_buffer), self%blocked(stats_buffer), self%converged(stats_buffer), &
-                  self%norm(stats_buffer), &
+                  self%given_up(stats_buffer), self%norm(stats_buffer), &
                   self%residual(stats_buffer), self%siconos(stats_buffer))
         call properties(error)
         if (allocated(error)) return
@@ -163,8 +166,8 @@ contains
             !&<
             character(len=*), parameter :: energies(7) = [character(len=13) :: 'kinetic', &
                 'potential', 'external_work', 'drive_work', 'dissipated', 'numerical', 'balance']
-            character(len=*), parameter :: stats_int(5) = [character(len=9) :: 'sweeps', &
-                'contacts', 'active', 'blocked', 'converged']
+            character(len=*), parameter :: stats_int(6) = [character(len=14) :: 'sweeps', &
+                'contacts', 'active', 'blocked', 'converged', 'block_given_up']
             character(len=*), parameter :: bond_ints(4) = [character(len=4) :: 'i', 'j', 'step', 'mode']
             !&>
             integer :: k
@@ -370,6 +373,8 @@ contains
         self%active(k) = stats%n_active
         self%blocked(k) = stats%n_blocked
         self%converged(k) = merge(1, 0, stats%converged)
+        self%given_up(k) = merge(1, 0, stats%block_given_up)
+        if (stats%block_given_up) self%n_block_given_up = self%n_block_given_up + 1
         self%norm(k) = stats%error
         self%residual(k) = stats%residual
         self%siconos(k) = stats%siconos_error
@@ -406,12 +411,15 @@ contains
         self%n_buffered = 0
         self%n_steps = 0
         self%n_ruptures = 0
+        self%n_block_given_up = 0
         if (allocated(self%sweeps)) deallocate (self%sweeps, self%contacts, self%active, self%blocked, &
                                                 self%converged, self%norm, self%residual)
         if (allocated(self%siconos)) deallocate (self%siconos)
+        if (allocated(self%given_up)) deallocate (self%given_up)
         allocate (self%sweeps(stats_buffer), self%contacts(stats_buffer), &
                   self%active(stats_buffer), self%blocked(stats_buffer), self%converged(stats_buffer), &
-                  self%norm(stats_buffer), self%residual(stats_buffer), self%siconos(stats_buffer))
+                  self%given_up(stats_buffer), self%norm(stats_buffer), self%residual(stats_buffer), &
+                  self%siconos(stats_buffer))
     end subroutine writer_resume
 
     !> Write the buffered solver statistics.
@@ -431,6 +439,8 @@ contains
         if (allocated(error)) return
         call file%append_chunk('/dem/solver/converged', self%converged(:k), error)
         if (allocated(error)) return
+        call file%append_chunk('/dem/solver/block_given_up', self%given_up(:k), error)
+        if (allocated(error)) return
         call file%append_chunk('/dem/solver/error', self%norm(:k), error)
         if (allocated(error)) return
         call file%append_chunk('/dem/solver/residual', self%residual(:k), error)
@@ -443,7 +453,8 @@ contains
     end subroutine flush_stats
 
     !> Write the buffered statistics and the closing attributes of /dem/solver (steps,
-    !> unconverged steps, time spent in detection and in the solver).
+    !> unconverged steps, steps whose bonded block was given up, time spent in detection and
+    !> in the solver).
     subroutine writer_finish(self, file, sys, unconverged, error)
         !> The writer.
         class(dem_writer_t), intent(inout) :: self
@@ -460,6 +471,8 @@ contains
         call file%write_attribute('/dem/solver', 'steps', self%n_steps, error)
         if (allocated(error)) return
         call file%write_attribute('/dem/solver', 'unconverged_steps', unconverged, error)
+        if (allocated(error)) return
+        call file%write_attribute('/dem/solver', 'block_given_up_steps', self%n_block_given_up, error)
         if (allocated(error)) return
         call file%write_attribute('/dem/solver', 'detection_seconds', sys%time_detection, error)
         if (allocated(error)) return

@@ -5,7 +5,9 @@
 !> (the first `max_warnings` ones, then only the count in the summary), once, a step in
 !> which a disk moved farther than the alert distance (contacts may then be found late), and
 !> once, then counted in the summary, a converged step whose contacts created energy
-!> (driver_guards::creation_allowance; Newton's restitution, doc/theory.md 2.4).
+!> (driver_guards::creation_allowance; Newton's restitution, doc/theory.md 2.4), and once,
+!> then counted in the summary, a step whose bonded block was given up by its energy guard
+!> (dem_bonded_block; doc/theory.md 7.10).
 !> After every step the state is checked (driver_guards): a non-finite value, a disk beyond
 !> the representable box, or a disk that passed through a wall or another disk stops the run
 !> with an error.
@@ -33,6 +35,7 @@ module driver_run_dem
     public :: run_dem, max_warnings, report_line_iface, speed_warning, last_unconverged_warning
     public :: tolerance_floor_hint
     public :: fclib_path, fclib_after_end_warning, fclib_no_contacts_warning, lost_bonds_warning, bonds_line
+    public :: block_given_up_warning, block_given_up_summary
 
     !> Unconverged steps reported one by one; later ones are only counted.
     integer, parameter :: max_warnings = 5
@@ -126,6 +129,9 @@ contains
             call writer%record_step(out%file, cfg%system%stats, error)
             if (allocated(error)) return
             if (.not. cfg%system%stats%converged) call warn_unconverged()
+            ! the first step whose bonded block was given up (the writer's count survives a restart)
+            if (cfg%system%stats%block_given_up .and. writer%n_block_given_up == 1) &
+                call report(block_given_up_warning(k, cfg%system%time))
             call check_created_energy()
             if (cfg%system%stats%n_blocked > 0 .and. .not. blocked_warned) then
                 call report('warning: contacts between bodies that cannot move (fixed or imposed '// &
@@ -297,6 +303,7 @@ contains
                     sys%energies%contact_dissipation, ' J/m)'
                 call report(trim(buf))
                 if (creating > 0) call report(energy_creation_summary(creating, n_steps))
+                if (writer%n_block_given_up > 0) call report(block_given_up_summary(writer%n_block_given_up, n_steps))
             end associate
             call report(progress%summary_line(n_steps, cfg%system%time, out%stopped()))
         end subroutine summary
@@ -353,6 +360,38 @@ contains
                'alert), which a bond holding the velocity allows under spin; logged in /dem/bonds with mode 5 '// &
                '(lost); a larger alert distance or a shorter step keeps them'
     end function lost_bonds_warning
+
+    !> Warning for the first step whose bonded block ([solver] method = block) was given up by
+    !> its energy guard (dem_bonded_block, doc/theory.md 7.10): what happened, why, and what
+    !> the settings measured on the lattice of theory.md 7.10 did.
+    function block_given_up_warning(k, t) result(line)
+        !> Step.
+        integer(i8), intent(in) :: k
+        !> Time at its end [s].
+        real(wp), intent(in) :: t
+        character(len=:), allocatable :: line
+        character(len=16) :: tbuf
+        write (tbuf, '(es11.4e2)') t
+        line = 'warning: step '//to_str(k)//' (t = '//trim(adjustl(tbuf))//' s): the bonded block ([solver] '// &
+               'method = block) was given up: a pass created more than 0.1 of the kinetic energy, its reactions '// &
+               'carrying self-stresses of the loops of the bonded lattice, which the convergence norm does not '// &
+               'bound and which released bonds set free (doc/theory.md 7.10); the step was solved again by '// &
+               'plain sweeps from zero reactions. Further such steps are only counted (total in the summary, '// &
+               'per step in /dem/solver/block_given_up). A [solver] max_sweeps large enough for every step to '// &
+               'converge avoids it (100000 on the lattice of theory.md 7.10, where 1000 did not); criterion = '// &
+               'siconos, anderson = 0 or tolerance = 1e-5 kept the block there but left its steps unconverged'
+    end function block_given_up_warning
+
+    !> Summary line of the steps whose bonded block was given up (its energy guard).
+    function block_given_up_summary(n, n_steps) result(line)
+        !> Steps given up.
+        integer, intent(in) :: n
+        !> Steps of the run.
+        integer(i8), intent(in) :: n_steps
+        character(len=:), allocatable :: line
+        line = 'bonded block given up (energy guard, solved by plain sweeps): '//to_str(n)//' of '// &
+               to_str(n_steps)//' steps (/dem/solver/block_given_up)'
+    end function block_given_up_summary
 
     !> Text added to an unconverged step's warning when the tolerance is more than ten times
     !> below the estimated round-off floor of the Siconos error (nlgs_stats_t%siconos_floor; 0

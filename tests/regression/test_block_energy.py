@@ -14,9 +14,20 @@ Checks:
   - every step takes at most max_sweeps block iterations over all its passes, or, when the
     energy guard gave the block up, max_sweeps more of the plain sweeps (2 max_sweeps);
   - the mechanical energy (kinetic + gravity potential) never exceeds its initial value plus
-    the work of the loads and of the driven wall.
+    the work of the loads and of the driven wall;
+  - /dem/solver/block_given_up marks exactly the steps whose block was given up, steps 6 and 7
+    (doc/theory.md 7.10), among them every step with more than max_sweeps iterations (the block
+    passes of a step take at most max_sweeps: only the plain sweeps of a step given up add
+    more), and /dem/solver@block_given_up_steps is their number; the run warns once, at step
+    6, and its summary counts 2 of 10 steps;
+  - stopped after step 6 and restarted, the run records the same steps and does not warn again
+    (the count is in the checkpoint);
+  - the same deck with anderson = 0, with criterion = siconos and with max_sweeps = 100000
+    (doc/theory.md 7.10) never gives the block up: the dataset holds zeros, the attribute is 0,
+    no warning, no summary line.
 Usage (ctest does this): test_block_energy.py --exe multicor --work DIR --source REPO
 """
+import re
 import subprocess
 import sys
 
@@ -26,6 +37,77 @@ import numpy as np
 from checks import arguments, check, summary
 
 MAX_SWEEPS = 100
+GIVEN_UP_STEPS = [6, 7]
+WARNING = "the bonded block ([solver] method = block) was given up"
+SUMMARY = "bonded block given up (energy guard, solved by plain sweeps):"
+
+
+def run(exe, deck, out, *extra):
+    return subprocess.run([str(exe), str(deck), "--output", str(out), "--quiet", *extra], capture_output=True,
+                          text=True)
+
+
+def given_up_record(path):
+    """Per-step flags (steps from 1 where set), their attribute, and the sweeps per step."""
+    with h5py.File(path, "r") as f:
+        s = f["dem/solver"]
+        flags = s["block_given_up"][...]
+        return flags, int(s.attrs["block_given_up_steps"]), s["sweeps"][...]
+
+
+def check_given_up(exe, deck, out, proc):
+    """The record, warning and summary of the steps given up on the deck."""
+    flags, total, sweeps = given_up_record(out / f"{deck.stem}.h5")
+    marked = (np.flatnonzero(flags) + 1).tolist()
+    check("/dem/solver/block_given_up holds 0 or 1 per step", set(flags.tolist()) <= {0, 1} and
+          flags.size == sweeps.size, f"{flags.tolist()}")
+    check(f"block_given_up marks steps {GIVEN_UP_STEPS}", marked == GIVEN_UP_STEPS, f"marked {marked}")
+    over = (np.flatnonzero(sweeps > MAX_SWEEPS) + 1).tolist()
+    check(f"every step with more than max_sweeps = {MAX_SWEEPS} iterations is marked",
+          over and set(over) <= set(marked), f"steps over the cap {over}, sweeps {sweeps.tolist()}")
+    check("block_given_up_steps is the number of steps marked", total == len(marked), f"{total}")
+    warnings = [line for line in proc.stdout.splitlines() if WARNING in line]
+    check("one warning, at step 6, naming the cause and the settings",
+          len(warnings) == 1 and warnings[0].startswith("warning: step 6 ") and "self-stresses" in warnings[0] and
+          "doc/theory.md 7.10" in warnings[0] and "max_sweeps" in warnings[0] and "criterion = siconos" in warnings[0]
+          and "anderson = 0" in warnings[0], "\n".join(warnings))
+    line = [line for line in proc.stdout.splitlines() if line.startswith(SUMMARY)]
+    check("the summary counts 2 of 10 steps", len(line) == 1 and re.search(r": 2 of 10 steps", line[0]), f"{line}")
+    return flags
+
+
+def restarted(exe, deck, work, flags):
+    """Stopped after step 6 (the first given up), then restarted to the end."""
+    out = work / "restarted"
+    first = run(exe, deck, out, "--end", "1.2e-4")
+    if not check("stopped after step 6: exit 0", first.returncode == 0, first.stderr.strip()[-300:]):
+        return
+    check("the first part warns at step 6", sum(WARNING in x for x in first.stdout.splitlines()) == 1, "")
+    second = run(exe, deck, out, "--restart", out / "checkpoint.h5")
+    if not check("restart: exit 0", second.returncode == 0, second.stderr.strip()[-300:]):
+        return
+    again, total, _ = given_up_record(out / f"{deck.stem}.h5")
+    check("restarted: the same steps marked", np.array_equal(again, flags), f"{again.tolist()}")
+    check("restarted: block_given_up_steps 2", total == 2, f"{total}")
+    check("restarted: no second warning (step 7 is only counted)", WARNING not in second.stdout, second.stdout[-600:])
+    check("restarted: the summary counts 2 of 10 steps", f"{SUMMARY} 2 of 10 steps" in second.stdout, "")
+
+
+def never_given_up(exe, deck, work, setting):
+    """The deck with one [solver] setting changed (doc/theory.md 7.10): the block kept."""
+    key = setting.split("=")[0].strip()
+    text = deck.read_text()
+    lines = [x for x in text.splitlines() if not x.startswith(key + " ")]
+    variant = work / f"lattice_{key}.dat"
+    variant.write_text("\n".join(lines).replace("[solver]", f"[solver]\n{setting}") + "\n")
+    out = work / variant.stem
+    proc = run(exe, variant, out)
+    if not check(f"{setting}: the run ends", proc.returncode == 0, proc.stderr.strip()[-300:]):
+        return
+    flags, total, _ = given_up_record(out / f"{variant.stem}.h5")
+    check(f"{setting}: no step given up, no warning, no summary line",
+          not flags.any() and total == 0 and WARNING not in proc.stdout and SUMMARY not in proc.stdout,
+          f"{flags.tolist()}, attribute {total}")
 
 
 def main():
@@ -55,6 +137,10 @@ def main():
     excess = mech - supplied
     check("mechanical energy at most the initial energy plus the work supplied (+ 1e-3 of it)",
           np.all(excess <= 1e-3 * mech[0]), f"largest excess {excess.max():.3e} J/m of {mech[0]:.3e} J/m")
+    flags = check_given_up(exe, deck, out, proc)
+    restarted(exe, deck, work, flags)
+    for setting in ("anderson = 0", "criterion = siconos", "max_sweeps = 100000"):
+        never_given_up(exe, deck, work, setting)
     return summary()
 
 
