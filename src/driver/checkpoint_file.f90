@@ -24,8 +24,11 @@ module driver_checkpoint_file
 
     !> File name of the checkpoint in the results folder.
     character(len=*), parameter :: checkpoint_name = 'checkpoint.h5'
-    !> Format tag written in every checkpoint.
-    character(len=*), parameter :: format_tag = 'MULTICOR checkpoint 1'
+    !> Format tag written in every checkpoint: its layout number goes up when the layout
+    !> changes within a code version (2: the particle writer's count of steps whose bonded
+    !> block was given up), so that a checkpoint of an earlier build is refused by name.
+    character(len=*), parameter :: format_stem = 'MULTICOR checkpoint '
+    character(len=*), parameter :: format_tag = format_stem//'2'
     !> States of `checkpoint_run_t%found`.
     integer, parameter :: found_unknown = 0, found_kept = 1, found_none = 2
     !> Checkpoints of one run: where and when to write them, and the checkpoint a restart
@@ -278,7 +281,13 @@ contains
         call file%read_attribute('/', 'format', tag, error)
         if (allocated(error)) tag = ''
         if (tag /= format_tag) then
-            call refuse("'"//path//"' is not a MULTICOR checkpoint")
+            if (index(tag, format_stem) == 1) then
+                call refuse("checkpoint '"//path//"' has the layout of an earlier build ('"//trim(tag)// &
+                            "', this build reads '"//format_tag//"'): continue the run with the build that "// &
+                            'wrote it, or run the deck from the start')
+            else
+                call refuse("'"//path//"' is not a MULTICOR checkpoint")
+            end if
             return
         end if
         call file%read_attribute('/', 'code_version', version, error)

@@ -328,6 +328,15 @@ def refusals(exe, deck, work):
     proc = run(exe, deck, "--output", folder, "--restart", old, "--end", 0.1)
     check("another code version refused", proc.returncode == 1 and
           "written by MULTICOR 0.0.1" in proc.stderr, proc.stderr.strip())
+    # The same code version, an earlier layout (a build of the day before the particle writer
+    # counted the steps whose bonded block was given up): refused by name, not as damaged.
+    layout = work / "old_layout.h5"
+    shutil.copy(ckpt, layout)
+    with h5py.File(layout, "r+") as f:
+        f.attrs["format"] = "MULTICOR checkpoint 1"
+    proc = run(exe, deck, "--output", folder, "--restart", layout, "--end", 0.1)
+    check("an earlier checkpoint layout refused by name", proc.returncode == 1 and
+          "has the layout of an earlier build ('MULTICOR checkpoint 1'" in proc.stderr, proc.stderr.strip())
     beam_deck = work / "not_a_checkpoint.h5"
     shutil.copy(result, beam_deck)
     proc = run(exe, deck, "--output", folder, "--restart", beam_deck, "--end", 0.1)
