@@ -3,10 +3,10 @@
 !> The file is written as '<final_path>.partial' and renamed to `final_path` by `close` only
 !> when the run succeeded: an earlier result stays intact until then, and `abort` deletes the
 !> partial file. The partial file of an earlier run (interrupted, perhaps resumable) is set
-!> aside as '<final_path>.partial.prev' while this run writes its own: `abort` puts it back,
-!> `close` and `close_unfinished` (this run's own file takes its place) delete it, and
-!> `drop_earlier` one that a killed run set aside (unless it holds the results the folder's
-!> checkpoint continues). Files written
+!> aside as '<final_path>.partial.prev' while this run writes its own: `abort` puts it back;
+!> after `close` or `close_unfinished`, `settle_earlier` deletes it, or one a killed run set
+!> aside, unless it holds the results the folder's checkpoint continues (this run wrote no
+!> checkpoint: a static or modal analysis), which it gives back their name. Files written
 !> beside the results (an FCLIB export, `companion`) follow the results file: written as
 !> '<path>.partial', renamed by `close` and `close_unfinished`, deleted by `abort`, so that a
 !> failed run leaves an earlier run's export as it was. /summary is written at creation with
@@ -105,8 +105,9 @@ module driver_results
         procedure :: companion => writer_companion
         !> Take over a file beside the results that a killed run left as '<path>.partial'.
         procedure :: adopt => writer_adopt
-        !> After the run ended or was stopped: delete the earlier partial file a killed run set aside.
-        procedure :: drop_earlier => writer_drop_earlier
+        !> After the run ended or was stopped: delete the earlier partial file set aside, or put back
+        !> the results of the folder's checkpoint.
+        procedure :: settle_earlier => writer_settle_earlier
     end type results_writer_t
 
 contains
@@ -595,7 +596,8 @@ contains
                             self%partial_path//"')"
             return
         end if
-        call drop_set_aside(self)
+        ! the earlier partial file set aside is settled by `settle_earlier`
+        self%set_aside = .false.
         call keep_companions(self, error)
     end subroutine writer_close
 
@@ -622,7 +624,8 @@ contains
             error%message = 'results: '//error%message
             return
         end if
-        call drop_set_aside(self)
+        ! the earlier partial file set aside is settled by `settle_earlier`
+        self%set_aside = .false.
         call keep_companions(self, error)
     end subroutine writer_close_unfinished
 
@@ -671,31 +674,30 @@ contains
         self%set_aside = .false.
     end subroutine put_back_partial
 
-    !> Delete the earlier partial file set aside (this run's own file took its place).
-    subroutine drop_set_aside(self)
-        !> The writer.
-        class(results_writer_t), intent(inout) :: self
-        if (.not. self%set_aside) return
-        call remove_file(self%partial_path//'.prev')
-        self%set_aside = .false.
-    end subroutine drop_set_aside
-
-    !> After the run ended or was stopped (`close`, `close_unfinished`): delete
-    !> '<partial_path>.prev', the partial file of an earlier run that a run started afresh set
-    !> aside and, killed, never put back; unless it is the results file of the run `keep_run_id`
-    !> (that of the folder's checkpoint, when this run wrote none: a static or modal analysis),
-    !> which only it continues.
-    subroutine writer_drop_earlier(self, keep_run_id)
+    !> After the run ended or was stopped (`close`, `close_unfinished`): settle
+    !> '<partial_path>.prev', the partial file of an earlier run that this run set aside, or that
+    !> a run started afresh set aside and, killed, never put back. It is deleted, unless it is
+    !> the results file of the run `keep_run_id` (that of the folder's checkpoint, when this run
+    !> wrote none: a static or modal analysis), which a restart from that checkpoint continues:
+    !> it gets its name '<partial_path>' back (this run's file was renamed to its final name), so
+    !> that the command the interrupted run printed still continues it.
+    subroutine writer_settle_earlier(self, keep_run_id)
         !> The writer, closed.
         class(results_writer_t), intent(inout) :: self
         !> Run id whose results file is kept ('': none).
         character(len=*), intent(in) :: keep_run_id
+        type(error_t), allocatable :: ignored
         if (.not. allocated(self%partial_path)) return
         if (len(keep_run_id) > 0) then
-            if (holds_run(self%partial_path//'.prev', keep_run_id)) return
+            if (holds_run(self%partial_path//'.prev', keep_run_id)) then
+                ! kept as '.prev' if the name is taken or the rename fails: a restart names it
+                if (.not. file_exists(self%partial_path)) &
+                    call rename_file(self%partial_path//'.prev', self%partial_path, ignored)
+                return
+            end if
         end if
         call remove_file(self%partial_path//'.prev')
-    end subroutine writer_drop_earlier
+    end subroutine writer_settle_earlier
 
     !> Register `path`, a file this run writes beside the results, and return the name to
     !> write it under, '<path>.partial': `close` and `close_unfinished` rename it to `path`,

@@ -207,8 +207,9 @@ contains
     !> holds the folder's lock). A failed run leaves the folder's results, partial file and
     !> checkpoint as it found them (a resumed partial file keeps the outputs after its
     !> checkpoint, which the next restart cuts); a run that ends or is stopped by a signal
-    !> leaves its own, and deletes the '.prev' files that killed runs left (but the results
-    !> the folder's checkpoint continues).
+    !> leaves its own, and deletes the '.prev' files it or killed runs set aside, but gives the
+    !> results the folder's checkpoint continues their name back (a static or modal analysis
+    !> writes no checkpoint).
     subroutine write_results(opts, report, run, error, stopped_by)
         !> What to run.
         type(run_options_t), intent(in) :: opts
@@ -226,7 +227,7 @@ contains
         if (kept) then
             call run%ck%settle()
             call checkpoint_owner(run%ck%path, found, hash, results, run_id)
-            call run%out%drop_earlier(run_id)
+            call run%out%settle_earlier(run_id)
         else
             call run%ck%revert()
         end if

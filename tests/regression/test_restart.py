@@ -32,7 +32,9 @@ opening of the XDMF file, and for every kind of run as the files such a kill lea
 finished by the same command: no step, the results and XDMF file bitwise the uninterrupted
 run's, nothing else left. The partial file of an interrupted run set aside by a fresh run
 that was then killed ('.partial.prev') is deleted by the next run that ends, unless it holds
-the results of the folder's checkpoint: a restart then says to rename it back.
+the results of the folder's checkpoint: a restart then says to rename it back; a static run
+(which writes no checkpoint) that ends gives the checkpoint's partial file its name back, also
+one it set aside itself.
 Usage (ctest does this): test_restart.py --exe multicor --work DIR --source REPO
 """
 import argparse
@@ -826,7 +828,9 @@ def set_aside_partial_files(exe, src, work):
     deletes the .prev files). When the set-aside file holds the results of the folder's
     checkpoint (the second run killed before its first checkpoint), a restart says which file
     to rename back, and a run that writes no checkpoint (a static analysis of a deck of the same
-    name) leaves it."""
+    name) gives it its name back. A static run of a deck of the same name into the folder of a
+    run stopped by SIGTERM (it sets the partial file aside itself) deleted that run's partial
+    file when it ended: the command the stopped run printed was refused; it now continues it."""
     deck = edit_deck(src / "input" / "cantilever.dat", work / "aside.dat", end=3.0, progress=0.02,
                      extra_output=["checkpoint_interval = 100"])
     ref = reference(exe, deck, work, "aside")
@@ -872,14 +876,46 @@ def set_aside_partial_files(exe, src, work):
     proc = run(exe, static, "--output", folder, "--quiet")
     check("aside_only: a static run of a deck of the same name: exit 0", proc.returncode == 0,
           proc.stderr.strip()[-300:])
-    check("aside_only: the static run (no checkpoint) leaves the checkpoint's results set aside",
-          (folder / "aside.h5.partial.prev").exists(), str(files_in(folder)))
-    (folder / "aside.h5.partial.prev").rename(partial)
+    check("aside_only: the static run (no checkpoint) gives the checkpoint's results their name back",
+          files_in(folder) == ["aside.h5", "aside.h5.partial", "aside.xdmf", "checkpoint.h5"],
+          str(files_in(folder)))
     proc = run(exe, deck, "--output", folder, "--quiet", "--restart", folder / "checkpoint.h5")
-    check("aside_only: renamed back, the restart continues the run: exit 0", proc.returncode == 0,
+    check("aside_only: the restart continues the run: exit 0", proc.returncode == 0,
           proc.stderr.strip()[-300:])
     if proc.returncode == 0:
         compare("aside_only", folder / "aside.h5", ref)
+
+    # The static run sets the interrupted run's partial file aside itself (the reviewer's
+    # case): it deleted it when it ended, and the checkpoint it leaves (it writes none) could no
+    # longer be continued ("neither ... is the results file of the checkpoint's run").
+    folder = work / "aside_static_own"
+    stopped = stopped_after(exe, deck, folder, 200, "aside_static_own")
+    if stopped is None:
+        return
+    code, out = stopped
+    c = re.search(r"^to continue: (multicor .*)$", out, flags=re.M)
+    check("aside_static_own: SIGTERM stops the run with the command to continue", code == 143 and c is not None,
+          f"exit {code}")
+    if c is None:
+        return
+    proc = run(exe, static, "--output", folder, "--quiet")
+    check("aside_static_own: a static run of a deck of the same name: exit 0", proc.returncode == 0,
+          proc.stderr.strip()[-300:])
+    check("aside_static_own: the static result beside the interrupted run's partial file, nothing set aside",
+          files_in(folder) == ["aside.h5", "aside.h5.partial", "aside.xdmf", "checkpoint.h5"],
+          str(files_in(folder)))
+    if (folder / "aside.h5").exists():
+        with h5py.File(folder / "aside.h5", "r") as f:
+            analysis = f.attrs["analysis"]
+            analysis = analysis.decode() if isinstance(analysis, bytes) else str(analysis)
+        check("aside_static_own: aside.h5 is the static run's", analysis == "static", analysis)
+    proc = run(exe, *c.group(1).split()[1:], "--quiet")
+    check("aside_static_own: the command the interrupted run printed continues it: exit 0", proc.returncode == 0,
+          proc.stderr.strip()[-300:])
+    if proc.returncode == 0:
+        compare("aside_static_own", folder / "aside.h5", ref)
+    check("aside_static_own: the continued run left the results, the XDMF file and the checkpoint",
+          files_in(folder) == ["aside.h5", "aside.xdmf", "checkpoint.h5"], str(files_in(folder)))
 
 
 def new_end_time(exe, deck, work):
