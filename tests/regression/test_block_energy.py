@@ -24,7 +24,10 @@ Checks:
     (the count is in the checkpoint);
   - the same deck with anderson = 0, with criterion = siconos and with max_sweeps = 100000
     (doc/theory.md 7.10) never gives the block up: the dataset holds zeros, the attribute is 0,
-    no warning, no summary line.
+    no warning, no summary line;
+  - a lattice pulled apart (dem_bonded_pull_lattice.dat: rigid bonds under an imposed pull, the
+    block's equalities without a solution at step 1, its reactions of order 1/eps until every
+    bond is released) is not given up: the guard judges only blocks that have a solution.
 Usage (ctest does this): test_block_energy.py --exe multicor --work DIR --source REPO
 """
 import re
@@ -141,7 +144,20 @@ def main():
     restarted(exe, deck, work, flags)
     for setting in ("anderson = 0", "criterion = siconos", "max_sweeps = 100000"):
         never_given_up(exe, deck, work, setting)
+    pulled(exe, src, work)
     return summary()
+
+
+def pulled(exe, src, work):
+    """The pulled lattice: its block has no solution at step 1 and releases every bond; the
+    guard, judging that pass's reactions (of order 1/eps), gave the block up instead."""
+    deck = src / "tests" / "regression" / "decks" / "dem_bonded_pull_lattice.dat"
+    out = work / deck.stem
+    proc = run(exe, deck, out)
+    if not check("pulled lattice: the run ends", proc.returncode == 0, proc.stderr.strip()[-300:]):
+        return
+    flags, total, _ = given_up_record(out / f"{deck.stem}.h5")
+    check("pulled lattice: no step given up", not flags.any() and total == 0, f"{flags.tolist()}")
 
 
 if __name__ == "__main__":
