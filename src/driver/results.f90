@@ -6,7 +6,9 @@
 !> aside as '<final_path>.partial.prev' while this run writes its own: `abort` puts it back;
 !> after `close` or `close_unfinished`, `settle_earlier` deletes it, or one a killed run set
 !> aside, unless it holds the results the folder's checkpoint continues (this run wrote no
-!> checkpoint: a static or modal analysis), which it gives back their name. Files written
+!> checkpoint: a static or modal analysis), which it gives back their name. A '.prev' file
+!> holding those results is never replaced: the partial file of a killed run found beside it
+!> (not the checkpoint's run, so no restart continues it) is deleted instead. Files written
 !> beside the results (an FCLIB export, `companion`) follow the results file: written as
 !> '<path>.partial', renamed by `close` and `close_unfinished`, deleted by `abort`, so that a
 !> failed run leaves an earlier run's export as it was. /summary is written at creation with
@@ -113,7 +115,7 @@ module driver_results
 contains
 
     !> Create '<final_path>.partial' and write the root attributes (code, deck, title, date).
-    subroutine writer_open(self, final_path, deck_file, deck_text, title, analysis, error)
+    subroutine writer_open(self, final_path, deck_file, deck_text, title, analysis, keep_run_id, error)
         !> The writer; must not be open.
         class(results_writer_t), intent(inout) :: self
         !> Name of the results file on success (its folder must exist).
@@ -126,6 +128,8 @@ contains
         character(len=*), intent(in) :: title
         !> Analysis type ('static', 'modal', 'dynamic').
         character(len=*), intent(in) :: analysis
+        !> Run id of the folder's checkpoint ('': none), whose results set aside are kept.
+        character(len=*), intent(in) :: keep_run_id
         !> Set when the file cannot be created or written.
         type(error_t), allocatable, intent(out) :: error
         if (self%is_open()) then
@@ -145,7 +149,7 @@ contains
         self%resumed = .false.
         self%companions = [string_t ::]
         self%own = [logical ::]
-        call set_aside_partial(self, error)
+        call set_aside_partial(self, keep_run_id, error)
         if (allocated(error)) return
         call self%file%create(self%partial_path, error)
         if (allocated(error)) return
@@ -215,7 +219,7 @@ contains
             ! a copy: the finished file keeps the outputs, a failure removes the copy (and puts
             ! back the partial file of another run it set aside)
             self%resumed = .false.
-            call set_aside_partial(self, error)
+            call set_aside_partial(self, run_id, error)
             if (allocated(error)) return
             call copy_file(final_path, self%partial_path, error)
             if (allocated(error)) then
@@ -647,14 +651,30 @@ contains
     end subroutine writer_abort
 
     !> Before this run creates '<partial_path>': rename the partial file of an earlier run,
-    !> if any, to '<partial_path>.prev' (`abort` puts it back).
-    subroutine set_aside_partial(self, error)
+    !> if any, to '<partial_path>.prev' (`abort` puts it back). When '<partial_path>.prev'
+    !> already holds the results of the run `keep_run_id` (that of the folder's checkpoint,
+    !> set aside by a run that was then killed) and the partial file does not, the partial file
+    !> is deleted instead: it is a killed run's that no restart continues (a restart continues
+    !> only the results file of its checkpoint's run), and the rename would replace the only
+    !> copy of the results the checkpoint continues.
+    subroutine set_aside_partial(self, keep_run_id, error)
         !> The writer, partial_path set, not open.
         class(results_writer_t), intent(inout) :: self
+        !> Run id whose results file set aside is kept ('': none).
+        character(len=*), intent(in) :: keep_run_id
         !> Set if the rename fails.
         type(error_t), allocatable, intent(out) :: error
         self%set_aside = .false.
         if (.not. file_exists(self%partial_path)) return
+        if (len(keep_run_id) > 0) then
+            if (holds_run(self%partial_path//'.prev', keep_run_id) .and. &
+                .not. holds_run(self%partial_path, keep_run_id)) then
+                call remove_file(self%partial_path)
+                if (file_exists(self%partial_path)) &
+                    call make_error(error, "results: cannot delete '"//self%partial_path//"', the partial file of a killed run")
+                return
+            end if
+        end if
         call rename_file(self%partial_path, self%partial_path//'.prev', error)
         if (allocated(error)) then
             error%message = 'results: '//error%message//' (the partial file of an earlier run, kept '// &

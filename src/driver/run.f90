@@ -249,13 +249,17 @@ contains
         !> Signal that stopped the run early (unchanged when none).
         integer, intent(inout), optional :: stopped_by
         type(error_t), allocatable :: ignored
+        logical :: found
+        character(len=:), allocatable :: hash, results, run_id
         kept = .false.
         if (run%ck%restart) then
             call run%out%resume(run%path, run%run_id, error)
             if (allocated(error)) call run%ck%source%close(ignored)
         else
+            ! the folder's checkpoint (this run has written none yet): its results are kept
+            call checkpoint_owner(run%ck%path, found, hash, results, run_id)
             call run%out%open(run%path, opts%deck_path, run%deck%text, run%deck%get_text('run', 'title'), &
-                              run%deck%get_word('run', 'analysis'), error)
+                              run%deck%get_word('run', 'analysis'), run_id, error)
         end if
         if (allocated(error)) return
         call run%sim%run(run%out, opts%quiet, report, run%ck, error)

@@ -830,7 +830,10 @@ def set_aside_partial_files(exe, src, work):
     to rename back, and a run that writes no checkpoint (a static analysis of a deck of the same
     name) gives it its name back. A static run of a deck of the same name into the folder of a
     run stopped by SIGTERM (it sets the partial file aside itself) deleted that run's partial
-    file when it ended: the command the stopped run printed was refused; it now continues it."""
+    file when it ended: the command the stopped run printed was refused; it now continues it.
+    A static run killed after setting that file aside and writing its own partial file: the next
+    run set its partial file aside over the '.prev' file and the checkpoint's results were gone;
+    now the killed run's partial file is deleted and the printed command continues the run."""
     deck = edit_deck(src / "input" / "cantilever.dat", work / "aside.dat", end=3.0, progress=0.02,
                      extra_output=["checkpoint_interval = 100"])
     ref = reference(exe, deck, work, "aside")
@@ -916,6 +919,45 @@ def set_aside_partial_files(exe, src, work):
         compare("aside_static_own", folder / "aside.h5", ref)
     check("aside_static_own: the continued run left the results, the XDMF file and the checkpoint",
           files_in(folder) == ["aside.h5", "aside.xdmf", "checkpoint.h5"], str(files_in(folder)))
+
+    # A static run killed (kill -9) after it set the interrupted run's partial file aside and
+    # wrote its own: the checkpoint's results are in '.prev' beside the killed run's partial
+    # file. The next run set that partial file aside over the '.prev' file (a rename replaces
+    # its target): the checkpoint's results were gone and the printed command was refused.
+    folder = work / "aside_static_killed"
+    stopped = stopped_after(exe, deck, folder, 200, "aside_static_killed")
+    if stopped is None:
+        return
+    code, out = stopped
+    c = re.search(r"^to continue: (multicor .*)$", out, flags=re.M)
+    check("aside_static_killed: SIGTERM stops the run with the command to continue", code == 143 and c is not None,
+          f"exit {code}")
+    if c is None:
+        return
+    if shutil.which("strace") is not None:
+        # killed when it opens its XDMF file: its results are written, not yet renamed
+        killed_by_strace(exe, [static, "--output", folder, "--quiet"], folder / "aside.xdmf.partial",
+                         ["open", "openat", "creat"], "aside_static_killed")
+    else:
+        # the same state by renames: the interrupted run's file set aside, a static run's
+        # results (not the checkpoint's run) as the killed run's partial file
+        (folder / "aside.h5.partial").rename(folder / "aside.h5.partial.prev")
+        proc = run(exe, static, "--output", work / "aside_static_other", "--quiet")
+        assert proc.returncode == 0, proc.stderr
+        shutil.copy(work / "aside_static_other" / "aside.h5", folder / "aside.h5.partial")
+    check("aside_static_killed: the checkpoint's results set aside beside the killed static run's partial file",
+          {"aside.h5.partial", "aside.h5.partial.prev", "checkpoint.h5"} <= set(files_in(folder)),
+          str(files_in(folder)))
+    proc = run(exe, static, "--output", folder, "--quiet")
+    check("aside_static_killed: the static run again: exit 0", proc.returncode == 0, proc.stderr.strip()[-300:])
+    check("aside_static_killed: the checkpoint's results kept under their name, the killed run's file deleted",
+          files_in(folder) == ["aside.h5", "aside.h5.partial", "aside.xdmf", "checkpoint.h5"],
+          str(files_in(folder)))
+    proc = run(exe, *c.group(1).split()[1:], "--quiet")
+    check("aside_static_killed: the command the interrupted run printed continues it: exit 0",
+          proc.returncode == 0, proc.stderr.strip()[-300:])
+    if proc.returncode == 0:
+        compare("aside_static_killed", folder / "aside.h5", ref)
 
 
 def new_end_time(exe, deck, work):
