@@ -708,7 +708,10 @@ contains
         character(len=*), intent(in) :: keep_run_id
         type(error_t), allocatable :: ignored
         if (.not. allocated(self%partial_path)) return
-        if (len(keep_run_id) > 0) then
+        ! (not this run's own id: a run that ends holds the results of its own checkpoint under
+        ! the final name, and a '.prev' of the same run is an earlier copy of it; given its name
+        ! back it was continued by the next restart instead of the finished file)
+        if (len(keep_run_id) > 0 .and. keep_run_id /= self%run_id) then
             if (holds_run(self%partial_path//'.prev', keep_run_id)) then
                 ! kept as '.prev' if the name is taken or the rename fails: a restart names it
                 if (.not. file_exists(self%partial_path)) &

@@ -206,7 +206,9 @@ contains
     !> Run the analysis into '<path>.partial', renamed to `path` on success (the caller
     !> holds the folder's lock). A failed run leaves the folder's results, partial file and
     !> checkpoint as it found them (a resumed partial file keeps the outputs after its
-    !> checkpoint, which the next restart cuts); a run that ends or is stopped by a signal
+    !> checkpoint, which the next restart cuts), but for the partial file of a killed run that
+    !> it deleted because the '.prev' beside it holds the folder's checkpoint's results (no
+    !> restart can continue it: results.f90, set_aside_partial); a run that ends or is stopped by a signal
     !> leaves its own, and deletes the '.prev' files it or killed runs set aside, but gives the
     !> results the folder's checkpoint continues their name back (a static or modal analysis
     !> writes no checkpoint).

@@ -820,6 +820,39 @@ def killed_after_last_checkpoint(exe, src, work):
         finish_after_kill(exe, deck, work, name, t_end, ref_folder / f"{deck.stem}.h5", args=["--quiet"])
 
 
+def stale_prev_of_the_same_run(exe, src, work):
+    """A finished run X continued to a later end, that continuation killed after a checkpoint
+    (its partial file holds X's run_id), then a fresh run of the same deck name killed before
+    its first checkpoint: it set X's partial aside as '.prev' and left its own '.partial'. The
+    state is made by copying files as those kills leave them (the partial of X's continuation:
+    a copy of its finished file of an earlier end; the killed fresh run's: another run's file).
+    Restarting X deletes the killed run's partial, resumes from the finished file and ends; the
+    '.prev', an earlier copy of X itself, must then go: given its name back beside the finished
+    file, it was what the next restart continued ('the checkpoint is damaged')."""
+    deck = work / "stale_col.dat"
+    deck.write_text((src / "tests" / "regression" / "decks" / "dem_column.dat").read_text()
+                    + "[output]\ninterval = 1\n")
+    other = work / "stale_other"
+    folder = work / "stale_x"
+    for path, end in ((other, 0.005), (folder, 0.01)):
+        proc = run(exe, deck, "--output", path, "--quiet", "--end", end)
+        if not check(f"stale prev: run to {end} s exits 0", proc.returncode == 0, proc.stderr.strip()):
+            return
+    shutil.copy(folder / "stale_col.h5", folder / "stale_col.h5.partial.prev")
+    shutil.copy(other / "stale_col.h5", folder / "stale_col.h5.partial")
+    first = run(exe, deck, "--output", folder, "--restart", folder / "checkpoint.h5", "--end", 0.015)
+    check("stale prev: the restart of X exits 0", first.returncode == 0, first.stderr.strip())
+    left = sorted(p.name for p in folder.iterdir() if not p.name.startswith("."))
+    check("stale prev: only the results, the XDMF file and the checkpoint are left",
+          left == ["checkpoint.h5", "stale_col.h5", "stale_col.xdmf"], f"{left}")
+    second = run(exe, deck, "--output", folder, "--restart", folder / "checkpoint.h5", "--end", 0.02)
+    check("stale prev: the next restart exits 0", second.returncode == 0, second.stderr.strip())
+    ref = work / "stale_ref"
+    proc = run(exe, deck, "--output", ref, "--quiet", "--end", 0.02)
+    if second.returncode == 0 and check("stale prev: the uninterrupted run exits 0", proc.returncode == 0, ""):
+        compare("stale prev", folder / "stale_col.h5", ref / "stale_col.h5")
+
+
 def set_aside_partial_files(exe, src, work):
     """'<name>.h5.partial.prev': a run started afresh sets the partial file of an interrupted run
     aside under that name and puts it back if it fails; killed, it cannot. Two fresh runs killed
@@ -1292,6 +1325,7 @@ def main():
     new_end_time(exe, beam, work)
     killed_after_last_checkpoint(exe, src, work)
     set_aside_partial_files(exe, src, work)
+    stale_prev_of_the_same_run(exe, src, work)
     sys.exit(summary())
 
 
