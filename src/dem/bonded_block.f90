@@ -488,7 +488,6 @@ contains
                     block%excluded(worst) = .true.
                     released = 1
                 end if
-                block%counts%releases = block%counts%releases + released
                 if (sweeps >= config%max_sweeps) then
                     ! no iteration left for the step solved again: it ends unconverged, the bonds
                     ! outside their cones held (contacts_finish judges no bond of such a step),
@@ -499,6 +498,8 @@ contains
                     end do
                     exit
                 end if
+                ! (counted here, once the step is solved again: at the cap no pass runs them)
+                block%counts%releases = block%counts%releases + released
                 block%counts%resolves = block%counts%resolves + 1
                 block%resolving = .true.
                 ! back to the velocities without the contact impulses (nlgs_solve applies the
