@@ -31,7 +31,6 @@ module driver_coupled_loop
     use coupling_coupled_step, only: coupled_system_t, coupled_energies_t, arlequin_step, coupled_energies, &
                                      velocity_mismatch_t, velocity_mismatch
     use driver_results, only: results_writer_t
-    use dem_moreau_jean, only: mj_load_energy
     use driver_results_dem, only: dem_writer_t
     use driver_results_coupled, only: coupled_writer_t
     use driver_run_dem, only: max_warnings, speed_warning, last_unconverged_warning, fclib_path, tolerance_floor_hint, &
@@ -40,7 +39,7 @@ module driver_coupled_loop
     use dem_local_problem, only: local_problem_t
     use dem_contacts, only: status_cohesive
     use driver_guards, only: check_disks_state, check_walls_state, step_start_t, take_step_start, check_tunnelling, &
-                             step_created_energy, creation_allowance, energy_creation_warning, energy_creation_summary
+                             step_created_energy, step_creates_energy, energy_creation_warning, energy_creation_summary
     use driver_checkpoint, only: checkpoint_run_t, end_of_step, rest_of_last_step, step_end_t, loop_state_t, &
                                  checkpoint_create, &
                                  save_coupled, load_coupled, &
@@ -478,8 +477,7 @@ contains
         !> Where the warnings go.
         procedure(report_iface) :: report
         if (.not. self%sys%stats%converged) call warn_unconverged(self, lp, report)
-        if (self%sys%stats%converged .and. step_created_energy(lp%start, self%sys%dem%energies) > &
-            creation_allowance(lp%start, self%sys%dem%energies, mj_load_energy(self%sys%dem))) then
+        if (self%sys%stats%converged .and. step_creates_energy(lp%start, self%sys%dem)) then
             lp%creating = lp%creating + 1
             if (lp%creating == 1) &
                 call report(energy_creation_warning(lp%k, self%sys%fe%t, &

@@ -28,13 +28,14 @@ module driver_guards
     use dem_particles, only: particles_t
     use dem_walls, only: walls_t
     use dem_contacts, only: contact_set_t
-    use dem_moreau_jean, only: energies_t
+    use dem_moreau_jean, only: energies_t, dem_system_t, mj_load_energy
     use dem_detection, only: coordinate_limit
     use core_sort, only: sort_index
     implicit none
     private
     public :: check_beam_state, check_disks_state, check_walls_state, step_start_t, take_step_start, check_tunnelling
-    public :: step_created_energy, creation_allowance, energy_creation_warning, energy_creation_summary
+    public :: step_created_energy, creation_allowance, step_creates_energy, energy_creation_warning, &
+              energy_creation_summary
     public :: model_size_t, model_memory_bytes, check_memory
     public :: bytes_per_disk, bytes_per_node, bytes_per_element, bytes_per_q4, bytes_per_t3
 
@@ -515,6 +516,22 @@ contains
         allowance = creation_tolerance*max(start%kinetic, energies%kinetic) + load_energy + &
                     8.0_wp*epsilon(1.0_wp)*(abs(energies%contact_dissipation) + abs(energies%numerical_dissipation))
     end function creation_allowance
+
+    !> Whether the step just done by `sys` (its record at the start in `start`) created energy
+    !> beyond `creation_allowance`: the time loops report such a step. The allowance's pass
+    !> over the disks (mj_load_energy) is made only for a step that created energy at all,
+    !> seldom: most steps dissipate.
+    logical function step_creates_energy(start, sys) result(creates)
+        !> The record of the start of the step.
+        type(step_start_t), intent(in) :: start
+        !> The particle system after the step.
+        type(dem_system_t), intent(in) :: sys
+        real(wp) :: created
+        created = step_created_energy(start, sys%energies)
+        creates = .false.
+        if (.not. created > 0.0_wp) return
+        creates = created > creation_allowance(start, sys%energies, mj_load_energy(sys))
+    end function step_creates_energy
 
     !> Warning for step `step` (ending at time `t`), whose contacts created the energy
     !> `created` while the disks' kinetic energy went from `kinetic0` to `kinetic`, with the

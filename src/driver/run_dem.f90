@@ -19,14 +19,14 @@ module driver_run_dem
     use io_progress, only: progress_t
     use dem_particles, only: particles_t
     use dem_moreau_jean, only: dem_system_t, mj_init, mj_step, energies_balance, mj_free_velocities, mj_detect, &
-                               mj_solve, mj_end_step, mj_load_energy, mj_bonds_made
+                               mj_solve, mj_end_step, mj_bonds_made
     use dem_local_problem, only: local_problem_t, local_problem_build
     use driver_config, only: run_config_t
     use driver_config_dem, only: dem_config_t
     use driver_results, only: results_writer_t
     use driver_results_dem, only: dem_writer_t, write_fclib_local
     use driver_guards, only: check_disks_state, check_walls_state, step_start_t, take_step_start, check_tunnelling, &
-                             step_created_energy, creation_allowance, energy_creation_warning, energy_creation_summary
+                             step_created_energy, step_creates_energy, energy_creation_warning, energy_creation_summary
     use io_hdf5_file, only: h5_file_t
     use driver_checkpoint, only: end_of_step, rest_of_last_step, step_end_t, checkpoint_run_t, loop_state_t, checkpoint_create, &
                                  save_dem, load_dem, save_results, load_results, save_dem_writer, load_dem_writer
@@ -265,8 +265,7 @@ contains
         subroutine check_created_energy()
             associate (sys => cfg%system)
                 if (.not. sys%stats%converged) return
-                if (.not. step_created_energy(start, sys%energies) > &
-                    creation_allowance(start, sys%energies, mj_load_energy(sys))) return
+                if (.not. step_creates_energy(start, sys)) return
                 creating = creating + 1
                 if (creating > 1) return
                 call report(energy_creation_warning(k, sys%time, step_created_energy(start, sys%energies), &
