@@ -604,7 +604,9 @@ contains
         call closest_match(key, local, best_local, d_local)
         call closest_match(key, everywhere, best_all, d_all)
         message = 'unknown keyword in section ['//section//']'
-        if (best_all > 0 .and. d_all < d_local .and. d_all <= tolerance(key)) then
+        if (len(schema%hint(section, key)) > 0) then
+            message = message//'; '//schema%hint(section, key)
+        else if (best_all > 0 .and. d_all < d_local .and. d_all <= tolerance(key)) then
             ! A better match in another section.
             if (everywhere(best_all)%s == key) then
                 message = message//"; keyword '"//key//"' belongs to section ["// &

@@ -159,12 +159,25 @@ module io_deck_schema
         character(len=:), allocatable :: description
     end type section_spec_t
 
+    !> A word that is not a keyword of a section but that users write for one (`moment` for a
+    !> particle `force ... rot`): the error on it says what to write instead.
+    type :: hint_spec_t
+        !> Section.
+        character(len=:), allocatable :: section
+        !> The word written.
+        character(len=:), allocatable :: word
+        !> What to write instead.
+        character(len=:), allocatable :: text
+    end type hint_spec_t
+
     !> The whole schema: sections and keywords in documentation order.
     type :: schema_t
         !> Sections.
         type(section_spec_t), allocatable :: sections(:)
         !> Keywords.
         type(keyword_spec_t), allocatable :: keywords(:)
+        !> Words that are not keywords, with what to write instead.
+        type(hint_spec_t), allocatable :: hints(:)
     contains
         !> Declare a section.
         procedure :: add_section => schema_add_section
@@ -174,6 +187,10 @@ module io_deck_schema
         procedure :: find_section => schema_find_section
         !> Index of a keyword in a section (0 if unknown).
         procedure :: find_keyword => schema_find_keyword
+        !> Declare a word that is not a keyword, with what to write instead.
+        procedure :: add_hint => schema_add_hint
+        !> What to write instead of a word that is not a keyword ('' if none declared).
+        procedure :: hint => schema_hint
     end type schema_t
 
     interface
@@ -490,6 +507,46 @@ contains
         if (present(effective_when)) kw%effective_when = effective_when
         self%keywords = [self%keywords, kw]
     end subroutine schema_add_keyword
+
+    !> Declare a word of an already declared section that is not one of its keywords, with
+    !> what to write instead (the unknown-keyword error gives it rather than the closest name).
+    subroutine schema_add_hint(self, section, word, text)
+        !> The schema.
+        class(schema_t), intent(inout) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        !> The word users write.
+        character(len=*), intent(in) :: word
+        !> What to write instead.
+        character(len=*), intent(in) :: text
+        type(hint_spec_t) :: h
+        if (.not. allocated(self%hints)) allocate (self%hints(0))
+        h%section = section
+        h%word = word
+        h%text = text
+        self%hints = [self%hints, h]
+    end subroutine schema_add_hint
+
+    !> What to write instead of `word` in `section` ('' when no hint is declared for it).
+    pure function schema_hint(self, section, word) result(text)
+        !> The schema.
+        class(schema_t), intent(in) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        !> The word written.
+        character(len=*), intent(in) :: word
+        !> The hint.
+        character(len=:), allocatable :: text
+        integer :: k
+        text = ''
+        if (.not. allocated(self%hints)) return
+        do k = 1, size(self%hints)
+            if (self%hints(k)%section == section .and. self%hints(k)%word == word) then
+                text = self%hints(k)%text
+                return
+            end if
+        end do
+    end function schema_hint
 
     !> Index of a section in the schema (0 if unknown).
     pure integer function schema_find_section(self, name) result(k)

@@ -58,6 +58,8 @@ contains
                            'and is an error.', &
                            tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true., &
                            effective_when=unless('run', 'analysis', 'modal'))
+        call s%add_hint('continuum', 'force', "a force on nodes is 'load = <node_set> x|y <value> "// &
+                        "[function]' (on an edge: 'traction')")
         call s%add_keyword('continuum', 'traction', [name_field('edge_set'), &
                                                      real_field('tx', 'Pa'), real_field('ty', 'Pa')], &
                            'Traction on the edges of a set: uniform, or parabolic (1.5 t (1 - s^2) with s from '// &

@@ -87,6 +87,10 @@ contains
                            'Force per unit thickness (x, y) or torque (rot) on each selected disk, times a '// &
                            'time function (none: constant 1); forces on the same DOF add up.', &
                            tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true.)
+        call s%add_hint('particles', 'moment', "a torque on disks is a force on their rotation: "// &
+                        "'force = <disks> rot <value> [function]'")
+        call s%add_hint('particles', 'torque', "a torque on disks is a force on their rotation: "// &
+                        "'force = <disks> rot <value> [function]'")
         call s%add_keyword('particles', 'initial_velocity', [selection_field('particles'), &
                                                              word_field('dof', dof_words), real_field('value', 'm/s or rad/s')], &
                            'Velocity at t = 0 of one free DOF of the selected disks (the others start at '// &

@@ -59,6 +59,10 @@ contains
                            'constant 1; a static analysis takes its value at t = 0).', &
                            tails=[tail([int_field('function', lower=1)], 0, 1)], repeatable=.true., &
                            effective_when=unless('run', 'analysis', 'modal'))
+        call s%add_hint('beam', 'force', "a nodal force is 'load = <node> x|y <value> [function]' "// &
+                        "(a force along the elements: 'distributed')")
+        call s%add_hint('beam', 'moment', "a nodal moment is 'load = <node> rot <value> [function]'")
+        call s%add_hint('beam', 'torque', "a nodal moment is 'load = <node> rot <value> [function]'")
         call s%add_keyword('beam', 'distributed', [int_field('node_a', lower=1), &
                                                    int_field('node_b', lower=1), word_field('direction', 'x y axial transverse'), &
                                                    real_field('q_a', 'N/m')], &
