@@ -16,6 +16,7 @@
 !> - listed coupled disks exist, are listed once, and lie inside the overlap (alpha strictly
 !>   between 0 and 1), within max_offset of the axis when it is given; with coupled = auto at
 !>   least one disk centre lies in the overlap;
+!> - thickness within a factor 100 of the beam section's width (`warn_thickness`, a warning);
 !> - without max_offset, a coupled disk off the beam's section (farther from the axis than its
 !>   radius plus the section's half-height) is warned about (`warn_far_disks`).
 !> Each error names the deck file, the line and the keyword concerned, and the disk by its
@@ -123,6 +124,7 @@ contains
             c%multipliers = merge(multipliers_nodes, multipliers_particles, &
                                   deck%get_word('coupling', 'multipliers') == 'nodes')
         end associate
+        call warn_thickness(deck, beam, setup)
         ! The unweighted beam gives the abscissas (it was built without error before).
         call build_beam_model(beam, model, error)
         if (allocated(error)) return
@@ -148,6 +150,44 @@ contains
         if (allocated(error)) return
         call select_coupled(deck, setup, weight, dem, s, off, model%ea, model%ei, error)
     end subroutine build_coupling_config
+
+    !> A warning when [coupling] thickness is more than `ratio` times off the width of every
+    !> section of the beam: a depth typed in mm instead of m makes the disks' masses and
+    !> forces (per unit thickness) 1000 times too large, and nothing else catches it. The
+    !> section gives A and I, not its width: the width taken is that of the rectangle with
+    !> the same A and I, A / sqrt(12 I / A). It differs from the depth a user means by a
+    !> factor of a few for other shapes (an I-section's flanges: about 10 for an IPE 200, a
+    !> thin tube of radius 20 times its wall: about 15), hence the wide `ratio`.
+    subroutine warn_thickness(deck, beam, setup)
+        !> The deck.
+        type(deck_t), intent(in) :: deck
+        !> The beam (its sections).
+        type(beam_config_t), intent(in) :: beam
+        !> The coupling: the warning is added to its warnings.
+        type(coupled_setup_t), intent(inout) :: setup
+        real(wp), parameter :: ratio = 100.0_wp
+        real(wp), allocatable :: width(:)
+        character(len=:), allocatable :: message
+        integer :: k
+        if (.not. allocated(beam%sections)) return
+        if (size(beam%sections) == 0) return
+        allocate (width(size(beam%sections)))
+        do k = 1, size(beam%sections)
+            associate (a => beam%sections(k)%area, i => beam%sections(k)%inertia)
+                width(k) = a/sqrt(12*i/a)
+            end associate
+        end do
+        associate (t => setup%config%thickness)
+            if (t <= ratio*maxval(width) .and. t >= minval(width)/ratio) return
+            message = 'warning: '//deck%file//':'//to_str(deck%line('coupling', 'thickness'))// &
+                      ': [coupling] thickness = '//to_str(t)//' m is more than '//to_str(ratio)// &
+                      ' times off the width of the beam''s section ('//to_str(minval(width))
+            if (maxval(width) > minval(width)) message = message//' to '//to_str(maxval(width))
+            message = message//' m, the width of the rectangle with its A and I): the disks'' masses '// &
+                      'and forces scale with thickness (per unit thickness); check its unit (m)'
+        end associate
+        setup%warnings = [setup%warnings, string_t(message)]
+    end subroutine warn_thickness
 
     !> First line of the [coupling] entries (0 if none).
     pure integer function coupling_first_line(deck) result(line)

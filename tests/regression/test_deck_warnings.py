@@ -13,6 +13,8 @@ goes on, and a warning names the file, the line and the setting that turns it of
   about at the law's line (the moment's arm would be longer than the disk).
 - A [coupling] thickness other than the thickness of the continuum's material under the
   regions is warned about at its line, naming that material's line (--check and the run).
+- A beam coupling's thickness more than 100 times off the width of the beam's section (the
+  rectangle with its A and I; a depth typed in mm) is warned about at its line.
 - Without max_offset, coupled disks off the beam's section (farther from the axis than their
   radius plus sqrt(3 I / A), the section's half-height) are warned about, naming the
   farthest; disks within it, or any distance once max_offset is set, are not.
@@ -277,6 +279,33 @@ def coupling_thickness(exe, src, work):
           f"exit {proc.returncode}; " + ("\n".join(said) or proc.stderr.strip()[:300]))
 
 
+def beam_coupling_thickness(exe, src, work):
+    """input/bending_case1.dat (a 10 mm square beam section: A = 1e-4 m^2, I = 8.33e-10 m^4,
+    the width of the rectangle with that A and I, A / sqrt(12 I / A), is 0.01 m) with its
+    thickness typed in mm (10) or as 1e-5 m: warned at the thickness line, naming 0.01 m,
+    exit 0 (--check and a run of 2 steps); at 0.9 m and 1.1e-4 m (inside the factor 100 that
+    other section shapes need, 90 and 1/91 of the width) and at the deck's 0.01 m: quiet."""
+    base = (src / "input" / "bending_case1.dat").read_text()
+    for value, warned in (("10", True), ("1e-5", True), ("0.9", False), ("1.1e-4", False), ("0.01", False)):
+        text = re.sub(r"^thickness\s*=.*$", f"thickness = {value}", base, count=1, flags=re.M)
+        text = re.sub(r"^end\s*=.*$", "end = 2e-5", text, count=1, flags=re.M)
+        deck = work / f"beam_thickness_{value}.dat"
+        deck.write_text(text)
+        expected = (f"warning: {deck}:{line_of(text, 'thickness')}: [coupling] thickness = {value} m is more "
+                    "than 100 times off the width of the beam's section (0.01 m, the width of the rectangle "
+                    "with its A and I)")
+        runs = (("--check", ("--check", deck)),)
+        if warned:
+            runs += (("run", (deck, "--output", work / f"beam_thickness_{value}", "--quiet")),)
+        for mode, args in runs:
+            proc = multicor(exe, *args)
+            said = warnings_of(proc.stdout)
+            check(f"beam coupling thickness {value} m on a 0.01 m wide section ({mode}): exit 0, "
+                  f"{'one warning' if warned else 'no warning'}",
+                  proc.returncode == 0 and (len(said) == 1 and said[0].startswith(expected) if warned else not said),
+                  f"exit {proc.returncode}; " + ("\n".join(said) or proc.stderr.strip()[:300]))
+
+
 def coupled_disks_off_the_beam(exe, src, work):
     """The coupled example of doc/input.md (beam section A = 1e-4 m^2, I = 8.33e-10 m^4: the
     10 mm square, half-height sqrt(3 I / A) = 5 mm; disks of radius 5 mm in a row from
@@ -488,6 +517,7 @@ def main():
     solver_values(exe, src, work)
     rolling_length(exe, src, work)
     coupling_thickness(exe, src, work)
+    beam_coupling_thickness(exe, src, work)
     coupled_disks_off_the_beam(exe, src, work)
     large_displacements(exe, src, work)
     bonds_without_pairs(exe, work)
