@@ -40,13 +40,13 @@ module driver_checkpoint
     use driver_checkpoint_dem, only: save_dem, load_dem
     use driver_checkpoint_coupling, only: save_coupled, load_coupled
     use driver_checkpoint_results, only: save_results, load_results, save_dem_writer, load_dem_writer, &
-                                         save_coupled_writer, load_coupled_writer
+                                         save_coupled_writer, load_coupled_writer, checkpoint_results_mark
     implicit none
     private
     public :: checkpoint_name, deck_hash, loop_state_t, checkpoint_schedule_t
     public :: checkpoint_create, checkpoint_commit, checkpoint_open, checkpoint_discard
     public :: save_integrator, load_integrator, save_dem, load_dem, save_coupled, load_coupled
     public :: save_results, load_results, save_dem_writer, load_dem_writer
-    public :: save_coupled_writer, load_coupled_writer, save_loop, load_loop
+    public :: save_coupled_writer, load_coupled_writer, save_loop, load_loop, checkpoint_results_mark
     public :: checkpoint_run_t, step_end_t, end_of_step, rest_of_last_step, read_finite_attribute, checkpoint_owner
 end module driver_checkpoint

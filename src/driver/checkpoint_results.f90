@@ -4,9 +4,11 @@
 module driver_checkpoint_results
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
-    use core_strings, only: to_str
+    use core_strings, only: to_str, string_t
+    use io_paths, only: file_exists
     use io_hdf5_file, only: h5_file_t
     use driver_results, only: results_writer_t
+    use driver_results_mark, only: results_mark_t
     use driver_results_dem, only: dem_writer_t
     use driver_results_coupled, only: coupled_writer_t
     use driver_checkpoint_values, only: read_int_attr_1d, read_finite_attribute, require_finite, require_range, &
@@ -14,7 +16,7 @@ module driver_checkpoint_results
     implicit none
     private
     public :: save_results, load_results, save_dem_writer, load_dem_writer
-    public :: save_coupled_writer, load_coupled_writer
+    public :: save_coupled_writer, load_coupled_writer, checkpoint_results_mark
 
 contains
 
@@ -154,6 +156,51 @@ contains
             end do
         end function find
     end subroutine load_results
+
+    !> The results the checkpoint at `path` continues: its run id and the record count of every
+    !> dataset of its results file. The run id is '' when there is no checkpoint there or it
+    !> cannot be read; the lists are empty when it records no datasets or they cannot be read
+    !> (a file then holds its results by its run id alone). The values are not checked: a
+    !> restart checks them as it reads the checkpoint (`load_results`).
+    function checkpoint_results_mark(path) result(mark)
+        !> Path of the checkpoint.
+        character(len=*), intent(in) :: path
+        type(results_mark_t) :: mark
+        type(h5_file_t) :: file
+        type(error_t), allocatable :: error, ignored
+        character(len=:), allocatable :: joined
+        integer, allocatable :: saved(:)
+        integer :: k, start
+        mark%run_id = ''
+        mark%paths = [string_t ::]
+        mark%counts = [integer ::]
+        if (.not. file_exists(path)) return
+        call file%open(path, error)
+        if (allocated(error)) return
+        call file%read_attribute('/', 'run_id', joined, error)
+        if (.not. allocated(error)) then
+            mark%run_id = joined
+            call file%read_attribute('/results', 'datasets', joined, error)
+        end if
+        if (.not. allocated(error)) then
+            allocate (saved(0))
+            if (index(joined, new_line('a')) > 0) call file%read_dataset('/results/records', saved, error)
+        end if
+        if (.not. allocated(error)) then
+            start = 1
+            do k = 1, len(joined)
+                if (joined(k:k) /= new_line('a')) cycle
+                mark%paths = [mark%paths, string_t(joined(start:k - 1))]
+                start = k + 1
+            end do
+            if (size(saved) == size(mark%paths)) then
+                mark%counts = saved
+            else
+                mark%paths = [string_t ::]
+            end if
+        end if
+        call file%close(ignored)
+    end function checkpoint_results_mark
 
     !> Write the counters of the particle writer (its buffered statistics written before).
     subroutine save_dem_writer(file, writer, error)

@@ -7,8 +7,10 @@
 !> after `close` or `close_unfinished`, `settle_earlier` deletes it, or one a killed run set
 !> aside, unless it holds the results the folder's checkpoint continues (this run wrote no
 !> checkpoint: a static or modal analysis), which it gives back their name. A '.prev' file
-!> holding those results is never replaced: the partial file of a killed run found beside it
-!> (not the checkpoint's run, so no restart continues it) is deleted instead. Files written
+!> holding those results (the checkpoint's run id and at least its records: driver_results_mark)
+!> is never replaced: a partial file found beside it that does not hold them (a killed run's, or
+!> an earlier state of the checkpoint's run, so no restart continues it) is deleted instead; a
+!> restart continues the '.prev' file itself (`resume`). Files written
 !> beside the results (an FCLIB export, `companion`) follow the results file: written as
 !> '<path>.partial', renamed by `close` and `close_unfinished`, deleted by `abort`, so that a
 !> failed run leaves an earlier run's export as it was. /summary is written at creation with
@@ -30,9 +32,10 @@ module driver_results
     use io_hdf5_file, only: h5_file_t
     use io_progress, only: progress_t
     use io_paths, only: rename_file, remove_file, copy_file, file_exists
+    use driver_results_mark, only: results_mark_t
     implicit none
     private
-    public :: results_writer_t, holds_run
+    public :: results_writer_t
 
     !> Writes the results of one run into one HDF5 file.
     type :: results_writer_t
@@ -63,6 +66,9 @@ module driver_results
         !> Whether an earlier partial file was set aside as '<partial_path>.prev' (`abort`
         !> puts it back).
         logical :: set_aside = .false.
+        !> Whether `resume` continues the checkpoint's results from '<partial_path>.prev', where a
+        !> run that was then killed had set them aside (given their name back).
+        logical :: from_set_aside = .false.
         !> Final paths of the files written beside the results by this run (`companion`), and
         !> of those an interrupted run wrote before its checkpoint (`adopt`).
         type(string_t), allocatable :: companions(:)
@@ -115,7 +121,7 @@ module driver_results
 contains
 
     !> Create '<final_path>.partial' and write the root attributes (code, deck, title, date).
-    subroutine writer_open(self, final_path, deck_file, deck_text, title, analysis, keep_run_id, error)
+    subroutine writer_open(self, final_path, deck_file, deck_text, title, analysis, keep, error)
         !> The writer; must not be open.
         class(results_writer_t), intent(inout) :: self
         !> Name of the results file on success (its folder must exist).
@@ -128,8 +134,8 @@ contains
         character(len=*), intent(in) :: title
         !> Analysis type ('static', 'modal', 'dynamic').
         character(len=*), intent(in) :: analysis
-        !> Run id of the folder's checkpoint ('': none), whose results set aside are kept.
-        character(len=*), intent(in) :: keep_run_id
+        !> The results of the folder's checkpoint (run id '': none), which are kept when set aside.
+        type(results_mark_t), intent(in) :: keep
         !> Set when the file cannot be created or written.
         type(error_t), allocatable, intent(out) :: error
         if (self%is_open()) then
@@ -149,7 +155,7 @@ contains
         self%resumed = .false.
         self%companions = [string_t ::]
         self%own = [logical ::]
-        call set_aside_partial(self, keep_run_id, error)
+        call set_aside_partial(self, keep, error)
         if (allocated(error)) return
         call self%file%create(self%partial_path, error)
         if (allocated(error)) return
@@ -181,20 +187,27 @@ contains
         end subroutine root_attributes
     end subroutine writer_open
 
-    !> Open the results file of a run to continue it (restart): '<final_path>.partial' when
-    !> it exists and belongs to that run, else a copy of `final_path` made as the partial file
-    !> (the finished file stays as it is until the continued run ends normally). The run is
-    !> recognised by the root attribute 'run_id'. Nothing is written to it until the
-    !> checkpoint is read (`mark_running`).
-    subroutine writer_resume(self, final_path, run_id, error)
+    !> Open the results file of a run to continue it (restart). The file continued is the
+    !> first of these that holds the checkpoint's results (its run id and at least the records
+    !> of the checkpoint, `results_mark_t`): '<final_path>.partial', continued in place;
+    !> '<final_path>.partial.prev', where a run started afresh and then killed set it aside,
+    !> given its name back and continued in place (the partial file of that killed run, or an
+    !> earlier copy of the run's results, is deleted first: no restart continues it); a copy of
+    !> `final_path` made as the partial file (the finished file stays as it is until the
+    !> continued run ends normally). Failing that, the partial file or the finished file of the
+    !> run (its run id, fewer records), which the reading of the checkpoint then refuses with the
+    !> counts. Nothing is written to it until the checkpoint is read (`mark_running`).
+    subroutine writer_resume(self, final_path, mark, error)
         !> The writer; must not be open.
         class(results_writer_t), intent(inout) :: self
         !> Name of the results file on success.
         character(len=*), intent(in) :: final_path
-        !> Root attribute 'run_id' of the run's file (from the checkpoint).
-        character(len=*), intent(in) :: run_id
-        !> Set when neither file belongs to the run, or it cannot be opened for writing.
+        !> The checkpoint's results: run id and record counts.
+        type(results_mark_t), intent(in) :: mark
+        !> Set when no file belongs to the run, or it cannot be opened for writing.
         type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: prev
+        logical :: copy
         if (self%is_open()) then
             call make_error(error, "results: cannot resume '"//final_path//"': '" &
                             //self%final_path//"' is still open")
@@ -204,22 +217,36 @@ contains
         self%partial_path = final_path//'.partial'
         self%stop_reason = ''
         self%stop_time = 0.0_wp
-        self%run_id = run_id
+        self%run_id = mark%run_id
         self%resumed = .true.
         self%set_aside = .false.
+        self%from_set_aside = .false.
         self%companions = [string_t ::]
         self%own = [logical ::]
-        if (.not. holds_run(self%partial_path, run_id)) then
-            if (.not. holds_run(final_path, run_id)) then
-                call make_error(error, "results: neither '"//self%partial_path//"' nor '"// &
-                                final_path//"' is the results file of the checkpoint's run (run_id "// &
-                                run_id//'): '//moved(self%partial_path//'.prev'))
-                return
-            end if
+        prev = self%partial_path//'.prev'
+        if (mark%held_by(self%partial_path)) then
+            copy = .false.
+        else if (mark%held_by(prev)) then
+            copy = .false.
+            call take_back_set_aside(error)
+            if (allocated(error)) return
+        else if (mark%held_by(final_path)) then
+            copy = .true.
+        else if (holds_run(self%partial_path, mark%run_id)) then
+            copy = .false.
+        else if (holds_run(final_path, mark%run_id)) then
+            copy = .true.
+        else
+            call make_error(error, "results: neither '"//self%partial_path//"' nor '"// &
+                            final_path//"' is the results file of the checkpoint's run (run_id "// &
+                            mark%run_id//'): '//moved())
+            return
+        end if
+        if (copy) then
             ! a copy: the finished file keeps the outputs, a failure removes the copy (and puts
             ! back the partial file of another run it set aside)
             self%resumed = .false.
-            call set_aside_partial(self, run_id, error)
+            call set_aside_partial(self, mark, error)
             if (allocated(error)) return
             call copy_file(final_path, self%partial_path, error)
             if (allocated(error)) then
@@ -235,14 +262,32 @@ contains
             return
         end if
     contains
-        !> Where the results went: set aside as `prev` by a later run started afresh and
-        !> killed before it ended (it would have put them back), or unknown.
-        function moved(prev) result(text)
-            character(len=*), intent(in) :: prev
+        !> Give '<partial_path>.prev' its name back, deleting the partial file found under it.
+        subroutine take_back_set_aside(error)
+            type(error_t), allocatable, intent(out) :: error
+            if (file_exists(self%partial_path)) then
+                call remove_file(self%partial_path)
+                if (file_exists(self%partial_path)) then
+                    call make_error(error, "results: cannot delete '"//self%partial_path//"', the partial file "// &
+                                    "of a killed run, to continue the checkpoint's results set aside as '"//prev//"'")
+                    return
+                end if
+            end if
+            call rename_file(prev, self%partial_path, error)
+            if (allocated(error)) then
+                error%message = 'results: '//error%message//" (the checkpoint's results, set aside by a run "// &
+                                'that was killed)'
+                return
+            end if
+            self%from_set_aside = .true.
+        end subroutine take_back_set_aside
+
+        !> Where the results went: an earlier state of the run set aside as '.prev', or unknown.
+        function moved() result(text)
             character(len=:), allocatable :: text
-            if (holds_run(prev, run_id)) then
-                text = "they are in '"//prev//"', set aside by a later run that was killed: rename it to '"// &
-                       self%partial_path//"' and run this command again"
+            if (holds_run(prev, mark%run_id)) then
+                text = "'"//prev//"' is that run's but holds fewer records than the checkpoint (an earlier "// &
+                       'state of the run, from which the checkpoint cannot be continued)'
             else
                 text = 'it was moved, deleted or replaced by another run'
             end if
@@ -652,23 +697,23 @@ contains
 
     !> Before this run creates '<partial_path>': rename the partial file of an earlier run,
     !> if any, to '<partial_path>.prev' (`abort` puts it back). When '<partial_path>.prev'
-    !> already holds the results of the run `keep_run_id` (that of the folder's checkpoint,
-    !> set aside by a run that was then killed) and the partial file does not, the partial file
-    !> is deleted instead: it is a killed run's that no restart continues (a restart continues
-    !> only the results file of its checkpoint's run), and the rename would replace the only
-    !> copy of the results the checkpoint continues.
-    subroutine set_aside_partial(self, keep_run_id, error)
+    !> already holds the results `keep` (those of the folder's checkpoint, set aside by a run
+    !> that was then killed) and the partial file does not, the partial file is deleted
+    !> instead: it is a killed run's, or an earlier state of the checkpoint's run with fewer
+    !> records than the checkpoint (a copy of its finished file that a restart killed before it
+    !> ended left), which no restart continues; the rename would replace the only copy of the
+    !> results the checkpoint continues.
+    subroutine set_aside_partial(self, keep, error)
         !> The writer, partial_path set, not open.
         class(results_writer_t), intent(inout) :: self
-        !> Run id whose results file set aside is kept ('': none).
-        character(len=*), intent(in) :: keep_run_id
+        !> The results whose file set aside is kept (run id '': none).
+        type(results_mark_t), intent(in) :: keep
         !> Set if the rename fails.
         type(error_t), allocatable, intent(out) :: error
         self%set_aside = .false.
         if (.not. file_exists(self%partial_path)) return
-        if (len(keep_run_id) > 0) then
-            if (holds_run(self%partial_path//'.prev', keep_run_id) .and. &
-                .not. holds_run(self%partial_path, keep_run_id)) then
+        if (keep%held_by(self%partial_path//'.prev')) then
+            if (.not. keep%held_by(self%partial_path)) then
                 call remove_file(self%partial_path)
                 if (file_exists(self%partial_path)) &
                     call make_error(error, "results: cannot delete '"//self%partial_path//"', the partial file of a killed run")
@@ -696,24 +741,25 @@ contains
 
     !> After the run ended or was stopped (`close`, `close_unfinished`): settle
     !> '<partial_path>.prev', the partial file of an earlier run that this run set aside, or that
-    !> a run started afresh set aside and, killed, never put back. It is deleted, unless it is
-    !> the results file of the run `keep_run_id` (that of the folder's checkpoint, when this run
-    !> wrote none: a static or modal analysis), which a restart from that checkpoint continues:
-    !> it gets its name '<partial_path>' back (this run's file was renamed to its final name), so
-    !> that the command the interrupted run printed still continues it.
-    subroutine writer_settle_earlier(self, keep_run_id)
+    !> a run started afresh set aside and, killed, never put back. It is deleted, unless it holds
+    !> the results `keep` (those of the folder's checkpoint, when this run wrote none: a static or
+    !> modal analysis), which a restart from that checkpoint continues: it gets its name
+    !> '<partial_path>' back (this run's file was renamed to its final name), so that the command
+    !> the interrupted run printed still continues it.
+    subroutine writer_settle_earlier(self, keep)
         !> The writer, closed.
         class(results_writer_t), intent(inout) :: self
-        !> Run id whose results file is kept ('': none).
-        character(len=*), intent(in) :: keep_run_id
+        !> The results whose file is kept (run id '': none).
+        type(results_mark_t), intent(in) :: keep
         type(error_t), allocatable :: ignored
         if (.not. allocated(self%partial_path)) return
-        ! (not this run's own id: a run that ends holds the results of its own checkpoint under
-        ! the final name, and a '.prev' of the same run is an earlier copy of it; given its name
-        ! back it was continued by the next restart instead of the finished file)
-        if (len(keep_run_id) > 0 .and. keep_run_id /= self%run_id) then
-            if (holds_run(self%partial_path//'.prev', keep_run_id)) then
-                ! kept as '.prev' if the name is taken or the rename fails: a restart names it
+        if (keep%held_by(self%partial_path//'.prev')) then
+            ! (not this run's own results: a run that ends holds the results of its own
+            ! checkpoint under the final name, and a '.prev' of the same run is an earlier copy of
+            ! it; given its name back it was continued by the next restart instead of the
+            ! finished file)
+            if (keep%run_id /= self%run_id) then
+                ! kept as '.prev' if the name is taken or the rename fails: a restart continues it
                 if (.not. file_exists(self%partial_path)) &
                     call rename_file(self%partial_path//'.prev', self%partial_path, ignored)
                 return

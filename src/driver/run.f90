@@ -35,12 +35,14 @@ module driver_run
     use io_deck_schema, only: multicor_schema
     use io_deck, only: deck_t, read_deck
     use io_paths, only: stem, basename, mkdir_p, remove_empty_folders, file_exists, remove_file, rename_file
-    use driver_results, only: results_writer_t, holds_run
+    use driver_results, only: results_writer_t
+    use driver_results_mark, only: results_mark_t
     use driver_results_xdmf, only: write_results_xdmf
     use driver_simulation, only: simulation_t, report_iface
     use driver_simulations, only: select_simulation
     use driver_run_checks, only: check_model_size, apply_end_time, warn_about_deck, warn_fclib_after_end
-    use driver_checkpoint, only: checkpoint_run_t, checkpoint_name, checkpoint_open, checkpoint_owner, deck_hash
+    use driver_checkpoint, only: checkpoint_run_t, checkpoint_name, checkpoint_open, checkpoint_owner, deck_hash, &
+                                 checkpoint_results_mark
     implicit none
     private
     public :: run_options_t, run_deck, report_iface
@@ -82,6 +84,8 @@ module driver_run
         character(len=:), allocatable :: kind
         !> Root attribute 'run_id' of the results file a restart continues.
         character(len=:), allocatable :: run_id
+        !> The results a restart continues: run id and record counts of its checkpoint.
+        type(results_mark_t) :: mark
         !> Wall time of a static or modal analysis, from the model's build (`init`: assembly,
         !> factorisations, and for some kinds the solve) to its results written.
         type(progress_t) :: clock
@@ -223,13 +227,11 @@ contains
         type(error_t), allocatable, intent(out) :: error
         !> Signal that stopped the run early (unchanged when none).
         integer, intent(inout), optional :: stopped_by
-        logical :: kept, found
-        character(len=:), allocatable :: hash, results, run_id
+        logical :: kept
         call run_and_close(opts, report, run, error, kept, stopped_by)
         if (kept) then
             call run%ck%settle()
-            call checkpoint_owner(run%ck%path, found, hash, results, run_id)
-            call run%out%settle_earlier(run_id)
+            call run%out%settle_earlier(checkpoint_results_mark(run%ck%path))
         else
             call run%ck%revert()
         end if
@@ -251,17 +253,18 @@ contains
         !> Signal that stopped the run early (unchanged when none).
         integer, intent(inout), optional :: stopped_by
         type(error_t), allocatable :: ignored
-        logical :: found
-        character(len=:), allocatable :: hash, results, run_id
         kept = .false.
         if (run%ck%restart) then
-            call run%out%resume(run%path, run%run_id, error)
+            call run%out%resume(run%path, run%mark, error)
             if (allocated(error)) call run%ck%source%close(ignored)
+            if (run%out%from_set_aside) call report("note: the results of the checkpoint's run were in "// &
+                                                    run%out%partial_path//'.prev, set aside by a run that was '// &
+                                                    'killed: they are continued under their name '// &
+                                                    run%out%partial_path)
         else
             ! the folder's checkpoint (this run has written none yet): its results are kept
-            call checkpoint_owner(run%ck%path, found, hash, results, run_id)
             call run%out%open(run%path, opts%deck_path, run%deck%text, run%deck%get_text('run', 'title'), &
-                              run%deck%get_word('run', 'analysis'), run_id, error)
+                              run%deck%get_word('run', 'analysis'), checkpoint_results_mark(run%ck%path), error)
         end if
         if (allocated(error)) return
         call run%sim%run(run%out, opts%quiet, report, run%ck, error)
@@ -457,10 +460,14 @@ contains
                             'integrations have checkpoints)')
             return
         end if
+        ! what the checkpoint records of its results file (read before its checks, not trusted
+        ! until the restart reads it again: `load_results`)
+        run%mark = checkpoint_results_mark(opts%restart)
         associate (ck => run%ck, sim => run%sim)
             call checkpoint_open(ck%source, opts%restart, run%deck%file, ck%deck_text, run%kind, ck%start, &
                                  run%run_id, error)
             if (allocated(error)) return
+            run%mark%run_id = run%run_id
             at_end = ck%start%step == sim%settings%n_steps
             if (at_end) at_end = interrupted()
             if (ck%start%step >= sim%settings%n_steps .and. .not. at_end) then
@@ -488,10 +495,11 @@ contains
                                                           'restart')
         end associate
     contains
-        !> Whether the partial results file (perhaps set aside as '.prev') is the checkpoint's run's.
+        !> Whether the partial results file (perhaps set aside as '.prev') holds the checkpoint's
+        !> results.
         logical function interrupted()
-            interrupted = holds_run(run%path//'.partial', run%run_id)
-            if (.not. interrupted) interrupted = holds_run(run%path//'.partial.prev', run%run_id)
+            interrupted = run%mark%held_by(run%path//'.partial')
+            if (.not. interrupted) interrupted = run%mark%held_by(run%path//'.partial.prev')
         end function interrupted
     end subroutine open_checkpoint
 end module driver_run

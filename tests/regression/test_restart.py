@@ -32,9 +32,11 @@ opening of the XDMF file, and for every kind of run as the files such a kill lea
 finished by the same command: no step, the results and XDMF file bitwise the uninterrupted
 run's, nothing else left. The partial file of an interrupted run set aside by a fresh run
 that was then killed ('.partial.prev') is deleted by the next run that ends, unless it holds
-the results of the folder's checkpoint: a restart then says to rename it back; a static run
-(which writes no checkpoint) that ends gives the checkpoint's partial file its name back, also
-one it set aside itself.
+the results of the folder's checkpoint (its run_id and at least its records): a restart then
+continues it under its name; a static run (which writes no checkpoint) that ends gives the
+checkpoint's partial file its name back, also one it set aside itself. A finished run
+continued, the continuation killed and its file set aside: the restart continues that file,
+not the finished one (fewer records); an earlier copy of the finished file never replaces it.
 Usage (ctest does this): test_restart.py --exe multicor --work DIR --source REPO
 """
 import argparse
@@ -900,10 +902,19 @@ def set_aside_partial_files(exe, src, work):
     proc.communicate()
     partial = folder / "aside.h5.partial"
     partial.rename(folder / "aside.h5.partial.prev")
-    proc = run(exe, deck, "--output", folder, "--quiet", "--restart", folder / "checkpoint.h5")
-    check("aside_only: the restart names the file set aside and says to rename it back",
-          proc.returncode == 1 and f"they are in '{partial}.prev'" in proc.stderr and
-          f"rename it to '{partial}'" in proc.stderr, proc.stderr.strip()[-300:])
+    # The restart continues the checkpoint's results from the file set aside, given its name
+    # back (it said to rename it back and stopped); tried on a copy of the folder, the rest
+    # goes on from the state as the kill left it.
+    copy = work / "aside_only_restart"
+    shutil.copytree(folder, copy)
+    proc = run(exe, deck, "--output", copy, "--quiet", "--restart", copy / "checkpoint.h5")
+    check("aside_only: the restart continues the file set aside, under its name: exit 0",
+          proc.returncode == 0 and f"were in {copy / 'aside.h5.partial'}.prev" in proc.stdout,
+          (proc.stdout + proc.stderr).strip()[-300:])
+    if proc.returncode == 0:
+        compare("aside_only restart", copy / "aside.h5", ref)
+    check("aside_only: the restart left the results, the XDMF file and the checkpoint",
+          files_in(copy) == ["aside.h5", "aside.xdmf", "checkpoint.h5"], str(files_in(copy)))
     static = work / "aside_static" / "aside.dat"
     static.parent.mkdir()
     # the deck without its [time] and [output] sections, which a static analysis refuses
@@ -991,6 +1002,91 @@ def set_aside_partial_files(exe, src, work):
           proc.returncode == 0, proc.stderr.strip()[-300:])
     if proc.returncode == 0:
         compare("aside_static_killed", folder / "aside.h5", ref)
+
+
+def continuation_set_aside(exe, src, work):
+    """A finished run X (to 0.1 s) continued to the deck's end, that continuation killed
+    (kill -9) after a checkpoint at step 900 or later: its partial file holds X's run_id and more
+    records than the finished file. A static run of a deck of the same name killed (SIGKILL, by
+    strace, when it opens its XDMF file) after it set that partial file aside as '.prev' and
+    wrote its own. (a) The restart (the checkpoint's command) resumed from the finished file,
+    which holds fewer records than the checkpoint, and was refused ('the checkpoint is damaged
+    or not of these results'); it now continues the '.prev' file, the latest state the
+    checkpoint describes, and ends bitwise as the uninterrupted run. (b) A restart of the
+    previous build killed after it copied the finished file to the partial file (as it did,
+    then failed; the state here made by that copy): that copy holds X's run_id, so the next run
+    (the static run again) set it aside over the '.prev' file, and the checkpoint's results were
+    gone. Now a file of the run with fewer records than the checkpoint does not count as its
+    results: it is deleted, the '.prev' file gets its name back, the restart continues it."""
+    deck = edit_deck(src / "input" / "cantilever.dat", work / "cont.dat", end=3.0, progress=0.02,
+                     extra_output=["checkpoint_interval = 100"])
+    ref = reference(exe, deck, work, "cont")
+    static = work / "cont_static" / "cont.dat"
+    static.parent.mkdir()
+    text = re.sub(r"^analysis\s*=.*$", "analysis = static", deck.read_text(), count=1, flags=re.M)
+    static.write_text(text[:text.index("[time]")])
+    folder = work / "cont"
+    proc = run(exe, deck, "--output", folder, "--quiet", "--end", 0.1)
+    assert proc.returncode == 0, proc.stderr
+    proc = subprocess.Popen([str(exe), deck, "--output", folder, "--restart", folder / "checkpoint.h5"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # the progress line of step k comes after that step's checkpoint
+    if not wait_for_step(proc, 900, []):
+        check("cont: the continuation reached step 900", False, proc.communicate()[1][-300:])
+        return
+    proc.send_signal(signal.SIGKILL)
+    proc.communicate()
+    if shutil.which("strace") is not None:
+        killed_by_strace(exe, [static, "--output", folder, "--quiet"], folder / "cont.xdmf.partial",
+                         ["open", "openat", "creat"], "cont")
+    else:
+        # the same state by renames: the continuation's file set aside, a static run's results
+        # as the killed run's partial file
+        (folder / "cont.h5.partial").rename(folder / "cont.h5.partial.prev")
+        proc = run(exe, static, "--output", work / "cont_static_other", "--quiet")
+        assert proc.returncode == 0, proc.stderr
+        shutil.copy(work / "cont_static_other" / "cont.h5", folder / "cont.h5.partial")
+    with h5py.File(folder / "checkpoint.h5", "r") as f:
+        run_id, step = f.attrs["run_id"], int(np.ravel(f["loop"].attrs["step"])[0])
+
+    def records(path):
+        with h5py.File(path, "r") as f:
+            return (f.attrs["run_id"] == run_id, f["fem/time"].shape[0] if "fem/time" in f else 0)
+
+    # outputs every 5 steps and at step 0
+    check("cont: the finished file of X (0.1 s, 101 outputs), the continuation's set aside (a checkpoint "
+          "at step 900 or later: at least 181 outputs), the static run's partial file",
+          step >= 900 and records(folder / "cont.h5") == (True, 101) and
+          records(folder / "cont.h5.partial.prev")[0] and
+          records(folder / "cont.h5.partial.prev")[1] >= step // 5 + 1 and
+          not records(folder / "cont.h5.partial")[0],
+          f"checkpoint at step {step}; {files_in(folder)}")
+    # (a) the restart
+    copy = work / "cont_restart"
+    shutil.copytree(folder, copy)
+    proc = run(exe, deck, "--output", copy, "--restart", copy / "checkpoint.h5")
+    check("cont: the restart continues the continuation's file set aside: exit 0",
+          proc.returncode == 0 and "they are continued under their name" in proc.stdout,
+          (proc.stdout + proc.stderr).strip()[-300:])
+    if proc.returncode == 0:
+        compare("cont restart", copy / "cont.h5", ref)
+    check("cont: the restart left the results, the XDMF file and the checkpoint",
+          files_in(copy) == ["checkpoint.h5", "cont.h5", "cont.xdmf"], str(files_in(copy)))
+    # (b) a copy of the finished file as the partial file, then the static run
+    copy = work / "cont_stale"
+    shutil.copytree(folder, copy)
+    shutil.copy(copy / "cont.h5", copy / "cont.h5.partial")
+    proc = run(exe, static, "--output", copy, "--quiet")
+    check("cont stale copy: the static run again: exit 0", proc.returncode == 0, proc.stderr.strip()[-300:])
+    kept = records(copy / "cont.h5.partial") if (copy / "cont.h5.partial").exists() else (False, 0)
+    check("cont stale copy: the checkpoint's results kept under their name, the earlier copy deleted",
+          kept[0] and kept[1] >= step // 5 + 1 and not (copy / "cont.h5.partial.prev").exists(),
+          f"{kept}; {files_in(copy)}")
+    proc = run(exe, deck, "--output", copy, "--quiet", "--restart", copy / "checkpoint.h5")
+    check("cont stale copy: the restart continues the run: exit 0", proc.returncode == 0,
+          proc.stderr.strip()[-300:])
+    if proc.returncode == 0:
+        compare("cont stale copy", copy / "cont.h5", ref)
 
 
 def new_end_time(exe, deck, work):
@@ -1326,6 +1422,7 @@ def main():
     killed_after_last_checkpoint(exe, src, work)
     set_aside_partial_files(exe, src, work)
     stale_prev_of_the_same_run(exe, src, work)
+    continuation_set_aside(exe, src, work)
     sys.exit(summary())
 
 
