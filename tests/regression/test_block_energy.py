@@ -27,7 +27,10 @@ Checks:
     no warning, no summary line;
   - a lattice pulled apart (dem_bonded_pull_lattice.dat: rigid bonds under an imposed pull, the
     block's equalities without a solution at step 1, its reactions of order 1/eps until every
-    bond is released) is not given up: the guard judges only blocks that have a solution.
+    bond is released) is not given up: the guard judges only blocks that have a solution;
+  - a lattice at rest after its load is removed (dem_bonded_unloaded_lattice.dat: no gravity,
+    its velocities and the energy its reactions create round-off alone) is not given up and
+    creates no energy: the guard allows for the round-off of the energies it compares.
 Usage (ctest does this): test_block_energy.py --exe multicor --work DIR --source REPO
 """
 import re
@@ -145,6 +148,7 @@ def main():
     for setting in ("anderson = 0", "criterion = siconos", "max_sweeps = 100000"):
         never_given_up(exe, deck, work, setting)
     pulled(exe, src, work)
+    unloaded(exe, src, work)
     return summary()
 
 
@@ -158,6 +162,24 @@ def pulled(exe, src, work):
         return
     flags, total, _ = given_up_record(out / f"{deck.stem}.h5")
     check("pulled lattice: no step given up", not flags.any() and total == 0, f"{flags.tolist()}")
+
+
+def unloaded(exe, src, work):
+    """The lattice at rest after its load is removed: the round-off of its velocities, 1e-60 J/m
+    of kinetic energy from 1e-66 J/m free, exceeded 0.1 of the kinetic energy, and the block was
+    given up at steps 14, 20 and 26 (the plain sweeps from zero reactions then created 3e-28
+    J/m, a second warning)."""
+    deck = src / "tests" / "regression" / "decks" / "dem_bonded_unloaded_lattice.dat"
+    out = work / deck.stem
+    proc = run(exe, deck, out)
+    if not check("unloaded lattice: the run ends", proc.returncode == 0, proc.stderr.strip()[-300:]):
+        return
+    flags, total, _ = given_up_record(out / f"{deck.stem}.h5")
+    check("unloaded lattice: no step given up, no warning, no summary line",
+          not flags.any() and total == 0 and WARNING not in proc.stdout and SUMMARY not in proc.stdout,
+          f"marked {(np.flatnonzero(flags) + 1).tolist()}")
+    check("unloaded lattice: no energy created (no warning, no summary line)",
+          "created" not in proc.stdout, proc.stdout[-600:])
 
 
 if __name__ == "__main__":
