@@ -30,6 +30,10 @@ module driver_checkpoint_loop
         !> Parallel setting of the run that wrote the checkpoint (core_threads; '' when the
         !> checkpoint does not record it). Not written with the loop: read by checkpoint_open.
         character(len=:), allocatable :: threads
+        !> Converged steps so far whose contacts created energy (driver_guards::step_creates_energy;
+        !> the first one warned about, the count in the summary). A checkpoint of an earlier build
+        !> does not record it: read as 0.
+        integer(i8) :: creating = 0
     end type loop_state_t
 
     !> When a time loop writes a checkpoint (besides signals and the end of the run).
@@ -147,6 +151,9 @@ contains
         if (allocated(error)) return
         call file%write_attribute('/loop', 'unconverged', loop%unconverged, error)
         if (allocated(error)) return
+        ! (at most the steps done)
+        call file%write_attribute('/loop', 'creating', int(loop%creating), error)
+        if (allocated(error)) return
         call file%write_attribute('/loop', 'speed_warned', merge(1, 0, loop%speed_warned), error)
         if (allocated(error)) return
         call file%write_attribute('/loop', 'blocked_warned', merge(1, 0, loop%blocked_warned), error)
@@ -176,11 +183,26 @@ contains
         if (allocated(error)) return
         call require_range([loop%unconverged], 0, k, '/loop@unconverged (at most the steps done)', error)
         if (allocated(error)) return
-        call read_flag('speed_warned', loop%speed_warned, error)
+        call read_creating(error)
+        if (.not. allocated(error)) call read_flag('speed_warned', loop%speed_warned, error)
         if (.not. allocated(error)) call read_flag('blocked_warned', loop%blocked_warned, error)
         if (.not. allocated(error)) call read_flag('rotation_warned', loop%rotation_warned, error)
         if (.not. allocated(error)) call read_wall_time(error)
     contains
+        !> Converged steps whose contacts created energy; absent in a checkpoint of an earlier
+        !> build (its loop counted them from the restart only): 0.
+        subroutine read_creating(error)
+            !> Set on a damaged value.
+            type(error_t), allocatable, intent(out) :: error
+            type(error_t), allocatable :: absent
+            integer :: n
+            loop%creating = 0
+            call file%read_attribute('/loop', 'creating', n, absent)
+            if (allocated(absent)) return
+            call require_range([n], 0, k, '/loop@creating (at most the steps done)', error)
+            if (.not. allocated(error)) loop%creating = int(n, i8)
+        end subroutine read_creating
+
         !> Wall time and runs up to the checkpoint; both absent in a checkpoint of an earlier
         !> build (`wall_recorded` false, counted as 0 s and 1 run).
         subroutine read_wall_time(error)

@@ -318,6 +318,7 @@ contains
         if (allocated(error)) return
         lp%k0 = ck%start%step
         lp%unconverged = ck%start%unconverged
+        lp%creating = ck%start%creating
         lp%speed_warned = ck%start%speed_warned
         lp%rotation_warned = ck%start%rotation_warned
         ! an export before the checkpoint that a killed run left unrenamed
@@ -413,6 +414,7 @@ contains
         if (allocated(error)) return
         call checkpoint_create(f, ck%path, ck%deck_text, self%checkpoint_kind(), &
                                loop_state_t(lp%k, lp%unconverged, lp%speed_warned, .false., lp%rotation_warned, &
+                                            creating=lp%creating, &
                                             wall_seconds=lp%progress%analysis_seconds(), runs=lp%progress%runs), &
                                self%sys%fe%t, &
                                out%run_id, error)

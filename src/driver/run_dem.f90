@@ -179,6 +179,7 @@ contains
             if (allocated(error)) return
             k0 = ck%start%step
             unconverged = ck%start%unconverged
+            creating = ck%start%creating
             speed_warned = ck%start%speed_warned
             blocked_warned = ck%start%blocked_warned
             ! an export before the checkpoint that a killed run left unrenamed
@@ -192,7 +193,7 @@ contains
             call writer%flush_buffer(out%file, error)
             if (allocated(error)) return
             call checkpoint_create(f, ck%path, ck%deck_text, 'particles', &
-                                   loop_state_t(k, unconverged, speed_warned, blocked_warned, &
+                                   loop_state_t(k, unconverged, speed_warned, blocked_warned, creating=creating, &
                                                 wall_seconds=progress%analysis_seconds(), runs=progress%runs), &
                                    cfg%system%time, out%run_id, error)
             if (.not. allocated(error)) call save_dem(f, '/dem', cfg%system, error)

@@ -37,6 +37,12 @@ continues it under its name; a static run (which writes no checkpoint) that ends
 checkpoint's partial file its name back, also one it set aside itself. A finished run
 continued, the continuation killed and its file set aside: the restart continues that file,
 not the finished one (fewer records); an earlier copy of the finished file never replaces it.
+The count of steps whose contacts created energy (two disks, each
+hitting its inclined wall with e = 1 and friction, Kane's paradox, at steps 1 and 11) is in
+the checkpoint: stopped at step 5 (--end), or killed by SIGKILL at the commit of its checkpoint
+of step 10 (under strace) and restarted from that of step 5, the run warns once in all and its
+summary counts 2 of 20 steps, as the uninterrupted run's; a checkpoint of the previous build
+(no /loop@creating) is accepted and counts from the restart.
 Usage (ctest does this): test_restart.py --exe multicor --work DIR --source REPO
 """
 import argparse
@@ -104,6 +110,32 @@ step = 1e-3
 end  = 0.2
 [output]
 interval = 10
+progress = 0
+"""
+
+# Two disks held in x fall at 1 m/s, each onto its wall inclined at 45 degrees (R = 0.02 m, the
+# second 1.05 mm higher): Newton's restitution e = 1 with friction mu = 0.5 sticks and creates
+# energy (Kane's paradox, tests/regression/test_kane_paradox.py) at steps 1 and 11.
+KANE_TWO = """[run]
+analysis = dynamic
+[particles]
+material = 1 2500
+disk = -0.0141421356237309 0.014142135623731 0.02 1
+disk = 0.485857864376269 0.015192135623731 0.02 1
+fix = 1:2 x
+initial_velocity = 1:2 y -1.0
+[walls]
+wall = -0.0353553390593274 -0.0353553390593274 0.0353553390593274 0.0353553390593274
+wall = 0.464644660940673 -0.0353553390593274 0.535355339059327 0.0353553390593274
+[contacts]
+law = 1 1 0.5 1 0
+[solver]
+tolerance = 1e-14
+[time]
+step = 1e-4
+end = 2e-3
+[output]
+interval = 1
 progress = 0
 """
 
@@ -483,6 +515,8 @@ interval = 5
          "/loop@step is -5"),
         (beam_deck, folder, "a step not the integrator's", attribute("loop", "step", np.int32(400)),
          "/fe@step_count"),
+        (beam_deck, folder, "more steps that created energy than steps done",
+         attribute("loop", "creating", np.int32(10**6)), "/loop@creating (at most the steps done)"),
         (beam_deck, folder, "a writer counter beyond the integers",
          attribute("results", "writer", np.array([-1.0, 1e30, 0.0])), "not a 32-bit integer"),
         (dem_deck, dem_folder, "a wall coordinate NaN", entry("dem/walls/x1", np.nan),
@@ -1298,6 +1332,71 @@ def other_threads(exe, src, work):
           f"exits {first.returncode}, {same.returncode}, {other.returncode}; {warned}; /summary {recorded!r}")
 
 
+def created_energy_counts(exe, work):
+    """The warning of a converged step whose contacts created energy (once, then counted) and
+    the summary's count over a restart: both from the checkpoint (/loop@creating). Before, the
+    restarted run warned again at step 11 and its summary counted 1 of 20 steps."""
+    warning = "J/m of energy"
+    counted = "steps whose contacts created energy: 2 of 20"
+    deck = work / "kane_two.dat"
+    deck.write_text(KANE_TWO)
+    ref_folder = work / "ref_kane_two"
+    ref = run(exe, deck, "--output", ref_folder, "--quiet")
+    check("kane_two: uninterrupted run, one warning (step 1), 2 of 20 steps counted",
+          ref.returncode == 0 and ref.stdout.count(warning) == 1 and "warning: step 1 " in ref.stdout and
+          counted in ref.stdout, ref.stdout.strip()[-400:])
+
+    def restarted(name, folder, killed_output, the_deck=deck, reference_file=ref_folder / "kane_two.h5"):
+        second = run(exe, the_deck, "--output", folder, "--restart", folder / "checkpoint.h5")
+        if not check(f"{name}: restart exit 0", second.returncode == 0, (second.stdout + second.stderr)[-300:]):
+            return
+        check(f"{name}: one warning in all (the first part's, step 1)",
+              killed_output.count(warning) == 1 and second.stdout.count(warning) == 0,
+              f"{killed_output.count(warning)} before the stop, {second.stdout.count(warning)} after")
+        check(f"{name}: the summary counts 2 of 20 steps", counted in second.stdout,
+              [x for x in second.stdout.splitlines() if "steps whose" in x])
+        compare(name, folder / f"{the_deck.stem}.h5", reference_file)
+
+    # stopped at step 5 (--end), between the two impacts
+    folder = work / "kane_two_end"
+    first = run(exe, deck, "--output", folder, "--end", 5e-4)
+    if check("kane_two_end: first part exit 0", first.returncode == 0, first.stderr.strip()[-300:]):
+        restarted("kane_two_end", folder, first.stdout)
+    # killed (SIGKILL) at the commit of the checkpoint of step 10: the restart is from step 5
+    if shutil.which("strace") is None:
+        print("skip   kane_two_kill9: no strace (Debian package strace)")
+    else:
+        kdeck = edit_deck(deck, work / "kane_two_kill.dat", extra_output=["checkpoint_interval = 5"])
+        folder = work / "kane_two_kill9"
+        trace = "rename,renameat,renameat2"
+        proc = subprocess.run(["strace", "-f", "-o", os.devnull, "-P", str(folder / "checkpoint.h5.tmp"),
+                               "-e", f"trace={trace}", "-e", f"inject={trace}:signal=SIGKILL:when=2", str(exe),
+                               str(kdeck), "--output", str(folder)], capture_output=True, text=True, timeout=300)
+        if check("kane_two_kill9: killed at the commit of the second checkpoint", proc.returncode in (-9, 128 + 9),
+                 f"exit {proc.returncode} {proc.stderr.strip()[-200:]}"):
+            with h5py.File(folder / "checkpoint.h5", "r") as f:
+                step = int(f["loop"].attrs["step"])
+            check("kane_two_kill9: the checkpoint left is that of step 5", step == 5, f"step {step}")
+            # the deck's own uninterrupted run (the same results, but for the deck's text)
+            kref = run(exe, kdeck, "--output", work / "ref_kane_two_kill", "--quiet")
+            assert kref.returncode == 0, kref.stderr
+            restarted("kane_two_kill9", folder, proc.stdout, kdeck, work / "ref_kane_two_kill" / "kane_two_kill.h5")
+    # a checkpoint of the previous build, without the count: accepted, counted from the restart
+    # (the second impact alone, warned about again)
+    folder = work / "kane_two_old"
+    first = run(exe, deck, "--output", folder, "--end", 5e-4, "--quiet")
+    assert first.returncode == 0, first.stderr
+    with h5py.File(folder / "checkpoint.h5", "r+") as f:
+        creating = f["loop"].attrs.get("creating")
+        check("kane_two_old: the checkpoint of step 5 records one step that created energy", creating == 1,
+              f"/loop@creating {creating}")
+        if creating is not None:
+            del f["loop"].attrs["creating"]
+    second = run(exe, deck, "--output", folder, "--restart", folder / "checkpoint.h5")
+    check("kane_two_old: a checkpoint without /loop@creating is accepted, the count from the restart",
+          second.returncode == 0 and "steps whose contacts created energy: 1 of 20" in second.stdout,
+          (second.stdout + second.stderr).strip()[-400:])
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--exe", required=True)
@@ -1426,6 +1525,7 @@ def main():
     set_aside_partial_files(exe, src, work)
     stale_prev_of_the_same_run(exe, src, work)
     continuation_set_aside(exe, src, work)
+    created_energy_counts(exe, work)
     sys.exit(summary())
 
 
