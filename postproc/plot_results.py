@@ -29,7 +29,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from multicor_post import beam, continuum, coupled, particles  # noqa: E402
-from multicor_post.results import (ResultsError, file_contents, finite_float,  # noqa: E402
+from multicor_post.results import (ResultsError, damaged_file_error, file_contents, finite_float,  # noqa: E402
                                    load_results, outside_time_note, scale_factor,
                                    unused_time_note)
 
@@ -93,6 +93,12 @@ def main(argv=None):
             paths += particles.write_all(res, out, time=args.time, notes=notes)
     except ResultsError as exc:
         print(f"plot_results.py: error: {exc}", file=sys.stderr)
+        return 1
+    except (KeyError, RuntimeError, OSError, ValueError) as exc:
+        damaged = damaged_file_error(exc, args.results)
+        if damaged is None:
+            raise
+        print(f"plot_results.py: error: {damaged}", file=sys.stderr)
         return 1
     if args.node is not None and not any("_history" in os.path.basename(p) for p in paths):
         notes.append(f"--node {args.node} is not used: '{args.results}' has no node history to "

@@ -373,6 +373,24 @@ def _open_results(path: str) -> h5py.File:
         raise ResultsError(f"'{path}' is not a readable HDF5 file ({exc})") from None
 
 
+def damaged_file_error(exc: BaseException, path) -> Optional[ResultsError]:
+    """The ResultsError to report for an exception raised by h5py while reading `path`
+    (an HDF5 error inside a file that opened: metadata of a run killed while HDF5 wrote
+    them), or None when the exception did not come from h5py (a bug, raised as it is)."""
+    tb = exc.__traceback__
+    while tb is not None:
+        module = tb.tb_frame.f_globals.get("__name__", "")
+        if module == "h5py" or module.startswith("h5py."):
+            break
+        tb = tb.tb_next
+    if tb is None and not type(exc).__module__.startswith("h5py"):
+        return None
+    return ResultsError(f"'{os.fspath(path)}' is damaged: HDF5 cannot read part of it "
+                        f"({str(exc).strip(chr(39))}). A run killed while HDF5 wrote the file "
+                        "leaves it so; run the deck again (its checkpoint, if any, says "
+                        "whether --restart can continue it)")
+
+
 class _Reader:
     """Reads datasets with shape checks and messages that name the file and the dataset."""
 

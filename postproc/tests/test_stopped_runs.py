@@ -14,7 +14,8 @@ during its eigensolve), its partial file holds the root attributes and /summary 
 mesh not yet visible. A mesh without a solution, or the
 datasets of two groups with different numbers of records (a kill between their writes), is
 what such a file shows when HDF5 has written its metadata out before the kill, which it may
-do at any time.
+do at any time. A kill inside those metadata writes can leave an object unreadable (an
+object header overwritten here): the scripts say the file is damaged, in one line.
 """
 import h5py
 import numpy as np
@@ -409,3 +410,44 @@ def test_a_continuum_with_an_incomplete_last_output(tmp_path, capsys):
     assert_one_line_error(capsys.readouterr().err, "plot_results.py: error: ",
                           "dataset '/continuum/displacement' has shape (4, 7, 2), expected "
                           "(5, 7, 2)", INCOMPLETE)
+
+
+# --------------------------------------------------------------------------------------------
+# Metadata damaged by a kill inside HDF5's writes: the file opens, a group does not
+# --------------------------------------------------------------------------------------------
+
+def damage_object_header(path, name):
+    """Overwrite the first bytes of the object header of `name` with zeros, as a kill -9
+    between HDF5's metadata writes can leave it (a header whose version byte is 0: h5py
+    raises from inside h5py, e.g. KeyError 'bad object header version number' or
+    RuntimeError 'bad version number for attribute message', as the audit's damaged files)."""
+    with h5py.File(path, "r") as f:
+        address = h5py.h5o.get_info(f[name].id).addr
+    with open(path, "r+b") as raw:
+        raw.seek(address)
+        raw.write(bytes(16))
+    return path
+
+
+@pytest.mark.parametrize("script", [plot_results, plot_beam])
+def test_a_file_with_a_damaged_group_is_reported_without_a_traceback(script, cantilever_file, tmp_path,
+                                                                     capsys):
+    # plot_results.py and plot_beam.py printed h5py's traceback (KeyError 'Unable to
+    # synchronously open object (addr overflow ...)') for a partial file a kill left so
+    path = tmp_path / "cantilever.h5.partial"
+    path.write_bytes(cantilever_file().read_bytes())
+    mark_killed(path, analysis="static")
+    damage_object_header(path, "fem/mesh")
+    assert script.main([str(path), "--out", str(tmp_path / "png")]) == 1
+    assert_one_line_error(capsys.readouterr().err, f"{script.__name__}.py: error: ", str(path),
+                          "is damaged: HDF5 cannot read part of it", "run the deck again")
+    assert not (tmp_path / "png").exists()
+
+
+def test_an_error_not_from_h5py_is_not_called_damage():
+    # a bug of the scripts (an exception raised outside h5py) keeps its traceback
+    from multicor_post.results import damaged_file_error
+    try:
+        {}["x"]
+    except KeyError as exc:
+        assert damaged_file_error(exc, "f.h5") is None
