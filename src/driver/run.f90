@@ -363,8 +363,8 @@ contains
     end subroutine close_finished
 
     !> The command that continues this run from its checkpoint; with `same_end`, to the end
-    !> time this run was given: `--end T` again when the run had one (17 significant
-    !> digits: read back as the same double, the same step count), else the deck's end.
+    !> time this run was given: `--end T` again when the run had one (in the fewest digits
+    !> that read back as the same double, hence the same step count), else the deck's end.
     function continue_command(opts, ck, same_end) result(command)
         !> The run's options.
         type(run_options_t), intent(in) :: opts
@@ -374,11 +374,17 @@ contains
         logical, intent(in) :: same_end
         character(len=:), allocatable :: command
         character(len=32) :: end_text
+        real(wp) :: back
+        integer :: ios
         command = 'multicor '//shell_word(opts%deck_path)
         if (allocated(opts%output_dir)) command = command//' --output '//shell_word(opts%output_dir)
         command = command//' --restart '//shell_word(ck%path)
         if (same_end .and. opts%end_time >= 0.0_wp) then
-            write (end_text, '(es25.17e3)') opts%end_time
+            ! as the user wrote it when its shortest form reads back as the same double
+            ! (0.4, not 4.00000000000000022E-001), else all 17 digits
+            end_text = to_str(opts%end_time)
+            read (end_text, *, iostat=ios) back
+            if (ios /= 0 .or. back /= opts%end_time) write (end_text, '(es25.17e3)') opts%end_time
             command = command//' --end '//trim(adjustl(end_text))
         end if
     end function continue_command

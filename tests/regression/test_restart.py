@@ -1187,8 +1187,10 @@ def signal_with_end(exe, deck_src, work, name, end, t_stop, min_step):
     if c is None:
         return
     command = c.group(1).split()
-    check(f"{name}: the command gives --end again", command[-2:-1] == ["--end"] and
-          float(command[-1]) == t_stop, c.group(1))
+    # as the user wrote it (it printed 4.00000000000000022E-001 for 0.4; the shortest text
+    # that reads back as the same double, as Python's str of a float, is the same step count)
+    check(f"{name}: the command gives --end again, as written", command[-2:-1] == ["--end"] and
+          float(command[-1]) == t_stop and command[-1] == str(t_stop), c.group(1))
     second = run(exe, *command[1:])
     check(f"{name}: the command continues the run", second.returncode == 0, (second.stdout + second.stderr)[-300:])
     later = re.search(r"to go on to a later end time: (multicor .*) --end T\)", second.stdout)
@@ -1476,8 +1478,8 @@ def main():
     by_end_time(exe, stack, work, "coupled_end", 1.3e-4)
     by_signal(exe, src / "input" / "cantilever.dat", work, "beam_term", signal.SIGTERM, 3.0, 1000)
     by_signal(exe, src / "input" / "incline.dat", work, "dem_usr1", signal.SIGUSR1, 20.0, 2000)
-    # Started with --end 2.0 s (the deck says 3.0 s): the printed command ends at 2.0 s too.
-    signal_with_end(exe, src / "input" / "cantilever.dat", work, "beam_term_end", 3.0, 2.0, 1000)
+    # Started with --end 2.4 s (the deck says 3.0 s): the printed command ends at 2.4 s too.
+    signal_with_end(exe, src / "input" / "cantilever.dat", work, "beam_term_end", 3.0, 2.4, 1000)
     by_signal(exe, decks / "coupled_rigid_translation.dat", work, "coupled_term", signal.SIGTERM,
               0.05, 1000)
     by_kill_9(exe, src / "input" / "cantilever.dat", work, "beam_kill9", 3.0, 700, 2000)
