@@ -164,9 +164,29 @@ contains
         if (.not. allocated(error)) call self%file%write_attribute('/summary', 'finished', 0, error)
         if (.not. allocated(error)) call self%file%write_attribute('/summary', 'status', &
                                                                    'running (or killed)', error)
+        if (.not. allocated(error)) call summary_placeholders(error)
         if (.not. allocated(error)) call self%flush(error)
         if (allocated(error)) call self%abort()
     contains
+        !> The attributes `write_summary` sets at the end, created now with their types (steps
+        !> and runs 0, times 0, strings empty) so that the end of the run, or of a restart,
+        !> overwrites them in place: a kill while the file is closed leaves it readable
+        !> (doc/output.md, restart).
+        subroutine summary_placeholders(error)
+            type(error_t), allocatable, intent(out) :: error
+            call self%file%write_attribute('/summary', 'steps', 0, error)
+            if (allocated(error)) return
+            call self%file%write_attribute('/summary', 'wall_seconds', 0.0_wp, error)
+            if (allocated(error)) return
+            call self%file%write_attribute('/summary', 'wall_seconds_last_run', 0.0_wp, error)
+            if (allocated(error)) return
+            call self%file%write_attribute('/summary', 'runs', 0, error)
+            if (allocated(error)) return
+            call self%file%write_attribute('/summary', 'ended', '', error)
+            if (allocated(error)) return
+            call self%file%write_attribute('/summary', 'threads', '', error)
+        end subroutine summary_placeholders
+
         subroutine root_attributes(error)
             type(error_t), allocatable, intent(out) :: error
             call self%file%write_attribute('/', 'code_name', multicor_name, error)

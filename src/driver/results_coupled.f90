@@ -139,6 +139,19 @@ contains
                                       merge(1, 0, sys%op%rows_per_point == 3), error)
             if (allocated(error)) return
             call file%write_attribute('/coupling', 'time_step', sys%fe%h, error)
+            if (allocated(error)) return
+            ! the closing attributes (`finish`), created now with their types so that the end of
+            ! the run overwrites them in place (a kill while the file is closed leaves it readable:
+            ! doc/output.md, restart)
+            call file%write_attribute('/coupling', 'steps', 0, error)
+            if (allocated(error)) return
+            call file%write_attribute('/coupling', 'max_position_residual', 0.0_wp, error)
+            if (allocated(error)) return
+            call file%write_attribute('/coupling', 'max_velocity_residual', 0.0_wp, error)
+            if (allocated(error)) return
+            call file%write_attribute('/coupling', 'max_coordinate_residual', 0.0_wp, error)
+            if (allocated(error)) return
+            call file%write_attribute('/coupling', 'max_abs_balance', 0.0_wp, error)
         end subroutine attributes
 
         subroutine real_dataset(path, values, units, error)

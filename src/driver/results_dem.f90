@@ -159,6 +159,21 @@ contains
             call file%write_attribute('/dem/solver', 'anderson_after', sys%solver%anderson_after, error)
             if (allocated(error)) return
             call file%write_attribute('/dem/solver', 'anderson_sweeps', sys%solver%anderson_sweeps, error)
+            if (allocated(error)) return
+            ! the closing attributes (`finish`), created now with their types so that the end of
+            ! the run overwrites them in place (a kill while the file is closed leaves it readable:
+            ! doc/output.md, restart)
+            call file%write_attribute('/dem/solver', 'steps', 0, error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem/solver', 'unconverged_steps', 0, error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem/solver', 'block_given_up_steps', 0, error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem/solver', 'detection_seconds', 0.0_wp, error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem/solver', 'solver_seconds', 0.0_wp, error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem/solver', 'bond_ruptures', 0, error)
         end subroutine settings
 
         subroutine series(error)

@@ -1399,6 +1399,69 @@ def created_energy_counts(exe, work):
           second.returncode == 0 and "steps whose contacts created energy: 1 of 20" in second.stdout,
           (second.stdout + second.stderr).strip()[-400:])
 
+def pwrites(exe, args, counts):
+    """The pwrite64 calls of a run (strace -c): the numbers of the kill points below."""
+    subprocess.run(["strace", "-f", "-c", "-o", str(counts), "-e", "trace=pwrite64", str(exe)] +
+                   [str(a) for a in args], capture_output=True, text=True, timeout=300)
+    rows = [line.split() for line in counts.read_text().splitlines() if line.strip().endswith("pwrite64")]
+    return int(rows[0][3])
+
+
+def killed_in_metadata_writes(exe, src, work):
+    """A SIGKILL inside HDF5's metadata writes, where the results file is changed in place: the
+    restart's first flush (/summary finished and status set back to a running run) and the end
+    of the run (/summary and /dem/solver closing attributes). Before, an attribute written again
+    was deleted and created anew: /summary's object header got a new continuation block at the
+    end of the file, written after the header that points to it, and a kill between the two
+    writes (pwrite 23-28 of the restart, the last 3 of a run) left '/' unlistable and the
+    checkpoint useless for good. Every kill here must leave the same command able to finish the
+    run, bitwise as the uninterrupted one (doc/output.md, restart)."""
+    if shutil.which("strace") is None:
+        print("skip   killed_in_metadata_writes: no strace (Debian package strace)")
+        return
+    deck = src / "input" / "cantilever.dat"
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    ref = work / "ref_meta_kill"
+    proc = run(exe, deck, "--output", ref, "--quiet", env=env)
+    assert proc.returncode == 0, proc.stderr
+
+    def kill_at(args, when, sig="SIGKILL"):
+        return subprocess.run(["strace", "-f", "-qq", "-o", os.devnull, "-e", "trace=pwrite64", "-e",
+                               f"inject=pwrite64:signal={sig}:when={when}", str(exe)] + [str(a) for a in args],
+                              capture_output=True, text=True, timeout=300, env=env)
+
+    def finishes(name, folder, restart):
+        again = run(exe, deck, "--output", folder, "--quiet",
+                    *(["--restart", folder / "checkpoint.h5"] if restart else []), env=env)
+        if check(f"{name}: the same command finishes the run", again.returncode == 0,
+                 (again.stdout + again.stderr).strip()[-300:]):
+            compare(name, folder / "cantilever.h5", ref / "cantilever.h5")
+
+    # (a) stopped by SIGTERM in the time loop (at its 3000th pwrite: step 1141 of 2500), then
+    # its restart killed in its first flush (pwrite 22 is the first of the metadata, 28 the
+    # superblock that ends it)
+    seed = work / "meta_seed"
+    proc = kill_at([deck, "--output", seed, "--quiet"], 3000, "SIGTERM")
+    assert proc.returncode == 128 + 15, proc.stderr
+    for when in (23, 25, 27):
+        name = f"meta_restart_{when}"
+        folder = work / name
+        shutil.copytree(seed, folder)
+        proc = kill_at([deck, "--output", folder, "--quiet", "--restart", folder / "checkpoint.h5"], when)
+        if check(f"{name}: restart killed at its pwrite {when}", proc.returncode in (-9, 128 + 9),
+                 f"exit {proc.returncode}"):
+            finishes(name, folder, True)
+    # (b) killed in the last writes of a run, after its final checkpoint: the results file is closed
+    n = pwrites(exe, [deck, "--output", work / "meta_count", "--quiet"], work / "meta_count.txt")
+    for back in (1, 2, 3):
+        name = f"meta_close_{back}"
+        folder = work / name
+        proc = kill_at([deck, "--output", folder, "--quiet"], n - back)
+        if check(f"{name}: killed at pwrite {n - back} of {n}", proc.returncode in (-9, 128 + 9),
+                 f"exit {proc.returncode}"):
+            finishes(name, folder, True)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--exe", required=True)
@@ -1528,6 +1591,7 @@ def main():
     stale_prev_of_the_same_run(exe, src, work)
     continuation_set_aside(exe, src, work)
     created_energy_counts(exe, work)
+    killed_in_metadata_writes(exe, src, work)
     sys.exit(summary())
 
 
