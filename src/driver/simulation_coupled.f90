@@ -23,6 +23,7 @@ module driver_simulation_coupled
     use driver_simulation, only: report_iface
     use driver_simulation_beam, only: check_initial_energy
     use driver_coupled_loop, only: arlequin_simulation_t
+    use driver_displacement_scale, only: largest_displacement, model_extent, large_displacement_warning
     implicit none
     private
     public :: coupled_simulation_t, build_coupled
@@ -38,6 +39,9 @@ module driver_simulation_coupled
         !> The weighted beam of the coupled system (constant), to expand the free DOFs to the
         !> nodes.
         type(beam_model_t) :: model
+        !> Largest displacement of the stored states, their mean translation removed [m]
+        !> (driver_displacement_scale: a units check at the end of the run).
+        real(wp) :: u_max = 0.0_wp
     contains
         !> See `simulation_t%init`.
         procedure :: init => coupled_init
@@ -205,6 +209,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         real(wp), allocatable :: d(:, :), v(:, :), a(:, :)
         call nodal_state(self, d, v, a)
+        self%u_max = max(self%u_max, largest_displacement(d(1:2, :) - spread(sum(d(1:2, :), dim=2)/size(d, 2), 2, size(d, 2))))
         call out%append_state(self%sys%fe%t, d, v, a, error)
     end subroutine coupled_store_part
 
@@ -240,6 +245,7 @@ contains
         integer, intent(in) :: unconverged
         !> Where the lines go.
         procedure(report_iface) :: report
+        character(len=:), allocatable :: warning
         call report(self%run_line(counted(self%model%n_nodes, 'beam node'), n_steps))
         if (self%sys%on_nodes) then
             ! Only the projection on the mediator space is imposed: the per-disk residual from
@@ -251,5 +257,8 @@ contains
         end if
         call report('unconverged steps: '//to_str(unconverged)//' of '//to_str(n_steps)//' (tolerance '// &
                     to_str(self%sys%dem%solver%tol)//', at most '//to_str(self%sys%dem%solver%max_sweeps)//' sweeps)')
+        warning = large_displacement_warning(self%u_max, model_extent(self%model%x, self%model%y), &
+                                             '[beam] section, load, distributed, gravity, line, node, [particles]')
+        if (len(warning) > 0) call report(warning)
     end subroutine coupled_summary_lines
 end module driver_simulation_coupled

@@ -34,6 +34,7 @@ module driver_simulation_coupled2d
     use driver_simulation_dem, only: dem_simulation_t
     use driver_coupled_loop, only: arlequin_simulation_t
     use driver_checkpoint, only: read_finite_attribute
+    use driver_displacement_scale, only: largest_displacement, model_extent, large_displacement_warning
     implicit none
     private
     public :: coupled2d_simulation_t
@@ -48,6 +49,9 @@ module driver_simulation_coupled2d
         type(coupled2d_setup_t) :: coupling
         !> Writer of /continuum.
         type(continuum_writer_t) :: fe_out
+        !> Largest displacement of the stored states, their mean translation removed [m]
+        !> (driver_displacement_scale: a units check at the end of the run).
+        real(wp) :: u_max = 0.0_wp
     contains
         !> See `simulation_t%init`.
         procedure :: init => coupled2d_init
@@ -302,6 +306,9 @@ contains
                 call make_error(error, trim(buf))
                 return
             end if
+            associate (un => reshape(u, [2, n]))
+                self%u_max = max(self%u_max, largest_displacement(un - spread(sum(un, dim=2)/n, 2, n)))
+            end associate
             call self%fe_out%store(out%file, sys%fe%t, reshape(u, [2, n]), reshape(v, [2, n]), stress, error)
             if (allocated(error)) return
             call self%fe_out%store_energy(out%file, sys%fe%t, au%kinetic, au%strain, au%load_work, au%damping, &
@@ -328,9 +335,16 @@ contains
         integer, intent(in) :: unconverged
         !> Where the lines go.
         procedure(report_iface) :: report
+        character(len=:), allocatable :: warning
         call report(self%run_line(counted(self%continuum%model%mesh%element_count(), 'element'), n_steps))
         call report(self%constraint_line('constraint: max |Pi (q - C u)|', 'per disk, from the coordinates'))
         call report('unconverged steps: '//to_str(unconverged)//' of '//to_str(n_steps))
+        associate (x => self%continuum%model%mesh%x)
+            warning = large_displacement_warning(self%u_max, model_extent(x(1, :), x(2, :)), &
+                                                 '[continuum] material, load, traction, gravity, displacement, '// &
+                                                 'mesh, [particles]')
+        end associate
+        if (len(warning) > 0) call report(warning)
     end subroutine coupled2d_summary_lines
 
     !> The continuum's accumulated works (the rest of its audit follows from the state) and the

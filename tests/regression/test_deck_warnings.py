@@ -18,8 +18,8 @@ goes on, and a warning names the file, the line and the setting that turns it of
 - Without max_offset, coupled disks off the beam's section (farther from the axis than their
   radius plus sqrt(3 I / A), the section's half-height) are warned about, naming the
   farthest; disks within it, or any distance once max_offset is set, are not.
-- A static or dynamic beam or continuum run whose largest displacement exceeds 10 % of the
-  model's extent (a modulus in MPa read as Pa) warns that linear theory does not hold, with
+- A static or dynamic beam or continuum run, coupled to disks or not, whose largest
+  displacement exceeds 10 % of the model's extent (a modulus in MPa read as Pa) warns that linear theory does not hold, with
   exit 0; the threshold is checked on a cantilever's closed-form tip deflection.
 - A `[contacts] bond` record that bonds no pair at t = 0 (a loose deposit, a row with gaps of
   1e-3 R, beyond the bond tolerance of 1e-6 R) is warned about at its line, under --check and
@@ -409,6 +409,81 @@ load = 11 w -{load}
               proc.returncode == 0 and (len(said) == 1 and said[0].startswith(lead)
                                         and "([continuum] material, load" in said[0] if warned else not said),
               f"exit {proc.returncode}; " + ("\n".join(said) or proc.stderr.strip()[:300]))
+
+    # coupled runs check the same: a 0.2 m cantilever clamped at x = 0 with 5 bonded disks
+    # glued at its free end, under gravity, 0.1 s; E = 2.1e5 Pa (2.1e11 written in MPa): the
+    # beam is so soft that it nearly falls freely, g t^2 / 2 = 4.9 cm at 0.1 s, beyond 10 % of
+    # its 0.2 m extent (4.0 cm measured); E = 2.1e11 Pa moves it by 2e-7 m: quiet
+    for young, warned in (("2.1e5", True), ("2.1e11", False)):
+        deck = work / f"coupled_beam_{young}.dat"
+        deck.write_text(COUPLED_BEAM.format(young=young))
+        proc = multicor(exe, deck, "--output", work / deck.stem, "--quiet")
+        said = [w for w in warnings_of(proc.stdout) if "bonded coupled disks have turned" not in w]
+        check(f"beam-coupled run, E = {young} Pa: {'warned' if warned else 'no warning'} at the end, exit 0",
+              proc.returncode == 0 and (len(said) == 1 and said[0].startswith(lead)
+                                        and "([beam] section, load" in said[0] if warned else not said),
+              f"exit {proc.returncode}; " + ("\n".join(said) or proc.stderr.strip()[:300]))
+    # an elastic block pressed (1e5 Pa) on a rigid wall through a glued row of disks: with
+    # E = 1e2 Pa (1e8 in the wrong unit) it sinks by metres within 6 ms (an audit's deck:
+    # 3.2 m at 12 ms, through the wall, exit 0 without a word); with 1e8 Pa by micrometres
+    for young, warned in (("1e2", True), ("1e8", False)):
+        deck = work / f"coupled_block_{young}.dat"
+        deck.write_text(COUPLED_BLOCK.format(young=young))
+        proc = multicor(exe, deck, "--output", work / deck.stem, "--quiet")
+        said = warnings_of(proc.stdout)
+        check(f"continuum-coupled run, E = {young} Pa: {'warned' if warned else 'no warning'} at the end, exit 0",
+              proc.returncode == 0 and (len(said) == 1 and said[0].startswith(lead)
+                                        and "([continuum] material, load" in said[0] if warned else not said),
+              f"exit {proc.returncode}; " + ("\n".join(said) or proc.stderr.strip()[:300]))
+
+
+COUPLED_BEAM = """[run]
+analysis = dynamic
+[beam]
+section = 1 {young} 7800 1.0e-4 8.333333333333333e-10
+line = 1 0 0 0.2 0 20 1
+fix = 1 all
+gravity = 0 -9.81
+[particles]
+material = 1 7800
+row = 5 0.155 0 0.005 1
+gravity = 0 -9.81
+[contacts]
+law = 1 1 0 0 1e8
+bond = 1 1 1.0
+[coupling]
+overlap = 0.15 0.2
+thickness = 0.01
+rotation = on
+[time]
+step = 1e-4
+end = 0.1
+"""
+COUPLED_BLOCK = """[run]
+analysis = dynamic
+[continuum]
+mesh = rectangle 0 0 0.1 0.05 20 10 q4
+material = {young} 0.3 1000 0.01 plane_strain
+traction = top 0 -1e5 uniform 1
+rayleigh = 0 1e-4
+[particles]
+material = 1 1000
+row = 20 0.0025 0.0025 0.0025 1
+[walls]
+wall = -0.05 0 0.2 0
+[contacts]
+law = 1 1 0.3 0 0
+[coupling]
+region = box 0 0.1 0 0.005 top bottom
+alpha_min = 0.05
+thickness = 0.01
+rotation = on
+[functions]
+function = 1 ramp 1e-3
+[time]
+step = 2e-5
+end = 6e-3
+"""
 
 
 BOND_DECK = """[run]
