@@ -23,6 +23,7 @@ module driver_simulation_coupled
     use driver_simulation, only: report_iface
     use driver_simulation_beam, only: check_initial_energy
     use driver_coupled_loop, only: arlequin_simulation_t
+    use driver_coupled_rolling, only: free_rolling_warning
     use driver_displacement_scale, only: largest_displacement, model_extent, large_displacement_warning
     implicit none
     private
@@ -105,6 +106,9 @@ contains
             end if
             return
         end if
+        message = free_rolling_warning(deck, self%coupling%config%rotation_row, self%sys%coupled, self%dem%system, &
+                                       self%dem%material_id)
+        if (len(message) > 0) call report(message)
         call coupled_beam(self%sys, self%model, error)
         if (allocated(error)) return
         call check_initial_energy(deck, self%settings, self%model, error)

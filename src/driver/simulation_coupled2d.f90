@@ -33,6 +33,7 @@ module driver_simulation_coupled2d
     use driver_simulation_continuum_dynamic, only: continuum_dynamic_t
     use driver_simulation_dem, only: dem_simulation_t
     use driver_coupled_loop, only: arlequin_simulation_t
+    use driver_coupled_rolling, only: free_rolling_warning
     use driver_checkpoint, only: read_finite_attribute
     use driver_displacement_scale, only: largest_displacement, model_extent, large_displacement_warning
     implicit none
@@ -140,6 +141,9 @@ contains
             end if
             return
         end if
+        message = free_rolling_warning(deck, self%coupling%config%rotation_row, self%sys%coupled, &
+                                       self%particles%dem%system, self%particles%dem%material_id)
+        if (len(message) > 0) call report(message)
         self%fclib_step = self%particles%dem%fclib_step
     end subroutine coupled2d_init
 

@@ -21,6 +21,8 @@ goes on, and a warning names the file, the line and the setting that turns it of
 - A static or dynamic beam or continuum run, coupled to disks or not, whose largest
   displacement exceeds 10 % of the model's extent (a modulus in MPa read as Pa) warns that linear theory does not hold, with
   exit 0; the threshold is checked on a cantilever's closed-form tip deflection.
+- Coupled disks free to turn (`[coupling] rotation = off`, the default) with a law of friction
+  and no rolling resistance are warned about: they roll instead of transmitting friction.
 - A `[contacts] bond` record that bonds no pair at t = 0 (a loose deposit, a row with gaps of
   1e-3 R, beyond the bond tolerance of 1e-6 R) is warned about at its line, under --check and
   at the run's start; a touching row is not, and the run's summary counts its bonds at t = 0
@@ -437,6 +439,36 @@ load = 11 w -{load}
               f"exit {proc.returncode}; " + ("\n".join(said) or proc.stderr.strip()[:300]))
 
 
+def free_rolling(exe, work):
+    """Coupled disks glued by their centres only (rotation = off, the default) in a contact
+    with friction and no rolling resistance roll instead of transmitting their friction (an
+    audit's block on a rigid wall through a glued row, mu = 0.3: T/N = 0.0000 with off, 0.3000
+    with on): warned at the rotation line (at the thickness line when rotation is not
+    written), in a continuum coupling and a beam coupling; not with rotation = on, mu = 0, or
+    a rolling resistance."""
+    block = COUPLED_BLOCK.format(young="1e8")
+    beam = COUPLED_BEAM.format(young="2.1e11").replace("law = 1 1 0 0 1e8", "law = 1 1 0.3 0 1e8")
+    cases = (("block_off", block.replace("rotation = on", "rotation = off"), "rotation", True),
+             ("block_default", block.replace("rotation = on\n", ""), "thickness", True),
+             ("block_on", block, None, False),
+             ("block_mu0", block.replace("rotation = on", "rotation = off").replace("law = 1 1 0.3 0 0",
+                                                                                     "law = 1 1 0 0 0"), None, False),
+             ("block_rolling", block.replace("rotation = on", "rotation = off").replace(
+                 "law = 1 1 0.3 0 0", "law = 1 1 0.3 0 0 0.001"), None, False),
+             ("beam_default", beam.replace("rotation = on\n", ""), "thickness", True))
+    for name, text, at, warned in cases:
+        deck = work / f"rolling_{name}.dat"
+        deck.write_text(text)
+        proc = multicor(exe, "--check", deck)
+        said = [w for w in warnings_of(proc.stdout) if "free to turn" in w]
+        expected = (f"warning: {deck}:{line_of(text, at)}: [coupling] rotation = off (the default) leaves the "
+                    "coupled disks free to turn: in a contact with friction and no rolling resistance (the law "
+                    "of materials 1 and 1, mu = 0.3)" if warned else "")
+        check(f"coupled disks free to turn ({name}): {'warned' if warned else 'no warning'}, exit 0",
+              proc.returncode == 0 and (len(said) == 1 and said[0].startswith(expected) if warned else not said),
+              f"exit {proc.returncode}; " + ("\n".join(said) or proc.stderr.strip()[:300]))
+
+
 COUPLED_BEAM = """[run]
 analysis = dynamic
 [beam]
@@ -595,6 +627,7 @@ def main():
     beam_coupling_thickness(exe, src, work)
     coupled_disks_off_the_beam(exe, src, work)
     large_displacements(exe, src, work)
+    free_rolling(exe, work)
     bonds_without_pairs(exe, work)
     zero_alert(exe, src, work)
     idle_functions(exe, src, work)
