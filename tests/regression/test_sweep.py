@@ -162,6 +162,34 @@ def sequential_run(src, folder):
         check(f"{r['point']}: energy balance collected", 0 <= float(r["balance"]) < 1e-9,
               r["balance"])
     check("results.png drawn", (folder / "results.png").exists(), "")
+    killed_point(src, folder)
+
+
+def killed_point(src, folder):
+    """A point whose run was killed after a restart: its partial file holds the closing
+    /summary attributes of the stop it continued (here those of the finished run), which are
+    not the killed run's: collect leaves their cells empty, keeps the status."""
+    import shutil
+    import h5py
+    import numpy as np
+    copy = folder.parent / (folder.name + "_killed")
+    shutil.rmtree(copy, ignore_errors=True)
+    shutil.copytree(folder, copy)
+    out = copy / "runs" / "p001"
+    finished = out / "p001.h5"
+    with h5py.File(finished, "a") as f:
+        f["summary"].attrs["finished"] = np.int32(0)
+        f["summary"].attrs["status"] = "running (or killed)"
+    finished.rename(out / "p001.h5.partial")
+    sweep_tool(src, ["collect", "--no-plot", copy])
+    rows = {r["point"]: r for r in read_table(copy / "results.csv")}
+    closing = ("summary.steps", "summary.wall_seconds", "summary.wall_seconds_last_run", "summary.runs",
+               "summary.ended", "summary.threads")
+    check("collect: a killed point's closing /summary cells empty, its status kept",
+          rows["p001"]["summary.status"] == "running (or killed)" and rows["p001"]["summary.finished"] == "0"
+          and all(rows["p001"][c] == "" for c in closing)
+          and all(rows["p002"][c] != "" for c in closing),
+          str({k: v for k, v in rows["p001"].items() if k.startswith("summary")}))
 
 
 def failing_point(src, exe, work):
