@@ -385,6 +385,8 @@ def damaged_file_error(exc: BaseException, path) -> Optional[ResultsError]:
         tb = tb.tb_next
     if tb is None and not type(exc).__module__.startswith("h5py"):
         return None
+    if "doesn't exist" in str(exc):
+        return None     # a missing object (a script asking for what the file lacks), not damage
     return ResultsError(f"'{os.fspath(path)}' is damaged: HDF5 cannot read part of it "
                         f"({str(exc).strip(chr(39))}). A run killed while HDF5 wrote the file "
                         "leaves it so; run the deck again (its checkpoint, if any, says "

@@ -444,10 +444,18 @@ def test_a_file_with_a_damaged_group_is_reported_without_a_traceback(script, can
     assert not (tmp_path / "png").exists()
 
 
-def test_an_error_not_from_h5py_is_not_called_damage():
+def test_an_error_not_from_h5py_is_not_called_damage(tmp_path):
     # a bug of the scripts (an exception raised outside h5py) keeps its traceback
     from multicor_post.results import damaged_file_error
     try:
         {}["x"]
     except KeyError as exc:
         assert damaged_file_error(exc, "f.h5") is None
+    # so does h5py's error for an object the file does not have (a script asking for it)
+    path = tmp_path / "plain.h5"
+    with h5py.File(path, "w") as f:
+        f.create_group("dem")
+    with h5py.File(path, "r") as f:
+        with pytest.raises(KeyError) as info:
+            f["dem/position"]
+    assert damaged_file_error(info.value, path) is None

@@ -165,6 +165,7 @@ contains
     function checkpoint_results_mark(path) result(mark)
         !> Path of the checkpoint.
         character(len=*), intent(in) :: path
+        !> Its results' run id and record counts.
         type(results_mark_t) :: mark
         type(h5_file_t) :: file
         type(error_t), allocatable :: error, ignored

@@ -593,7 +593,7 @@ contains
         character(len=*), intent(in) :: section
         !> The unknown keyword.
         character(len=*), intent(in) :: key
-        character(len=:), allocatable :: message
+        character(len=:), allocatable :: message, hint
         type(string_t), allocatable :: local(:), everywhere(:)
         integer :: k, best_local, d_local, best_all, d_all
         allocate (local(0), everywhere(size(schema%keywords)))
@@ -604,8 +604,9 @@ contains
         call closest_match(key, local, best_local, d_local)
         call closest_match(key, everywhere, best_all, d_all)
         message = 'unknown keyword in section ['//section//']'
-        if (len(schema%hint(section, key)) > 0) then
-            message = message//'; '//schema%hint(section, key)
+        hint = schema%hint(section, key)
+        if (len(hint) > 0) then
+            message = message//'; '//hint
         else if (best_all > 0 .and. d_all < d_local .and. d_all <= tolerance(key)) then
             ! A better match in another section.
             if (everywhere(best_all)%s == key) then

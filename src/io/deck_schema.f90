@@ -24,7 +24,8 @@
 !> is checked when the model is built.
 module io_deck_schema
     use core_kinds, only: wp
-    use core_strings, only: string_t, split_words, join_words, to_str, parse_real, parse_int, shorten, is_real_syntax
+    use core_strings, only: string_t, split_words, join_words, to_str, parse_real, parse_int, shorten, is_real_syntax, &
+                            to_lower
     implicit none
     private
     public :: field_spec_t, tail_spec_t, condition_t, keyword_spec_t, section_spec_t, schema_t
@@ -527,7 +528,8 @@ contains
         self%hints = [self%hints, h]
     end subroutine schema_add_hint
 
-    !> What to write instead of `word` in `section` ('' when no hint is declared for it).
+    !> What to write instead of `word` in `section` ('' when no hint is declared for it): the
+    !> word compared in lower case and without a final 's' (`Moment`, `moments`).
     pure function schema_hint(self, section, word) result(text)
         !> The schema.
         class(schema_t), intent(in) :: self
@@ -537,11 +539,16 @@ contains
         character(len=*), intent(in) :: word
         !> The hint.
         character(len=:), allocatable :: text
+        character(len=:), allocatable :: singular
         integer :: k
         text = ''
         if (.not. allocated(self%hints)) return
+        singular = to_lower(word)
+        if (len(singular) > 1) then
+            if (singular(len(singular):) == 's') singular = singular(:len(singular) - 1)
+        end if
         do k = 1, size(self%hints)
-            if (self%hints(k)%section == section .and. self%hints(k)%word == word) then
+            if (self%hints(k)%section == section .and. self%hints(k)%word == singular) then
                 text = self%hints(k)%text
                 return
             end if

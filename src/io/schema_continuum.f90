@@ -60,6 +60,10 @@ contains
                            effective_when=unless('run', 'analysis', 'modal'))
         call s%add_hint('continuum', 'force', "a force on nodes is 'load = <node_set> x|y <value> "// &
                         "[function]' (on an edge: 'traction')")
+        call s%add_hint('continuum', 'moment', "the continuum's nodes have no rotation: apply a moment as "// &
+                        "opposite forces on two node sets ('load') or as tractions on edges ('traction')")
+        call s%add_hint('continuum', 'torque', "the continuum's nodes have no rotation: apply a moment as "// &
+                        "opposite forces on two node sets ('load') or as tractions on edges ('traction')")
         call s%add_keyword('continuum', 'traction', [name_field('edge_set'), &
                                                      real_field('tx', 'Pa'), real_field('ty', 'Pa')], &
                            'Traction on the edges of a set: uniform, or parabolic (1.5 t (1 - s^2) with s from '// &
