@@ -227,6 +227,7 @@ contains
         !> Set when no file belongs to the run, or it cannot be opened for writing.
         type(error_t), allocatable, intent(out) :: error
         character(len=:), allocatable :: prev
+        type(results_mark_t) :: same_run
         logical :: copy
         if (self%is_open()) then
             call make_error(error, "results: cannot resume '"//final_path//"': '" &
@@ -244,6 +245,8 @@ contains
         self%companions = [string_t ::]
         self%own = [logical ::]
         prev = self%partial_path//'.prev'
+        ! a file of the checkpoint's run whatever its records (finished or partial, any state)
+        same_run%run_id = mark%run_id
         if (mark%held_by(self%partial_path)) then
             copy = .false.
         else if (mark%held_by(prev)) then
@@ -252,9 +255,9 @@ contains
             if (allocated(error)) return
         else if (mark%held_by(final_path)) then
             copy = .true.
-        else if (holds_run(self%partial_path, mark%run_id)) then
+        else if (same_run%held_by(self%partial_path)) then
             copy = .false.
-        else if (holds_run(final_path, mark%run_id)) then
+        else if (same_run%held_by(final_path)) then
             copy = .true.
         else
             call make_error(error, "results: neither '"//self%partial_path//"' nor '"// &
@@ -305,7 +308,7 @@ contains
         !> Where the results went: an earlier state of the run set aside as '.prev', or unknown.
         function moved() result(text)
             character(len=:), allocatable :: text
-            if (holds_run(prev, mark%run_id)) then
+            if (same_run%held_by(prev)) then
                 text = "'"//prev//"' is that run's but holds fewer records than the checkpoint (an earlier "// &
                        'state of the run, from which the checkpoint cannot be continued)'
             else
@@ -313,25 +316,6 @@ contains
             end if
         end function moved
     end subroutine writer_resume
-
-    !> Whether `path` is an HDF5 file whose root attribute 'run_id' is `run_id` (the results
-    !> file of that run, finished or partial).
-    logical function holds_run(path, run_id)
-        !> Path of the file (need not exist).
-        character(len=*), intent(in) :: path
-        !> Root attribute 'run_id' of the run's results file (from its checkpoint).
-        character(len=*), intent(in) :: run_id
-        type(h5_file_t) :: f
-        type(error_t), allocatable :: e
-        character(len=:), allocatable :: value
-        holds_run = .false.
-        if (.not. file_exists(path)) return
-        call f%open(path, e)
-        if (allocated(e)) return
-        call f%read_attribute('/', 'run_id', value, e)
-        if (.not. allocated(e)) holds_run = value == run_id
-        call f%close(e)
-    end function holds_run
 
     !> Mark a resumed file as the file of a running run again (/summary finished = 0), once
     !> the checkpoint it continues from has been read and checked.
