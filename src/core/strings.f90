@@ -6,7 +6,7 @@ module core_strings
     use core_kinds, only: wp, i8
     implicit none
     private
-    public :: string_t, to_lower, strip, is_blank_char, split_words, join_words
+    public :: string_t, to_lower, strip, is_blank_char, split_words, split_lines, join_words
     public :: levenshtein, closest_match, parse_real, parse_int, to_str, shorten, max_echo, is_real_syntax
     public :: gib, counted, sci_to_str, sci_text, quoted_name, same_name
 
@@ -113,6 +113,25 @@ contains
             words(n)%s = text(start:i - 1)
         end do
     end subroutine split_words
+
+    !> The lines of a text, each ended by a new_line character (what follows the last one is
+    !> not a line): 'a\nb\n' gives 'a' and 'b', '' none, 'a' none.
+    pure subroutine split_lines(text, lines)
+        !> Text to split.
+        character(len=*), intent(in) :: text
+        !> The lines, without their new_line, in order.
+        type(string_t), allocatable, intent(out) :: lines(:)
+        integer :: i, start, n
+        allocate (lines(count([(text(i:i) == new_line('a'), i=1, len(text))])))
+        n = 0
+        start = 1
+        do i = 1, len(text)
+            if (text(i:i) /= new_line('a')) cycle
+            n = n + 1
+            lines(n)%s = text(start:i - 1)
+            start = i + 1
+        end do
+    end subroutine split_lines
 
     !> A name as a deck writes it, for messages: as is, or between double quotes when it holds
     !> a blank or a '#' (`left` stays `left`, `left edge` becomes `"left edge"`).

@@ -4,7 +4,7 @@
 module driver_checkpoint_results
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
-    use core_strings, only: to_str, string_t
+    use core_strings, only: to_str, string_t, split_lines
     use io_paths, only: file_exists
     use io_hdf5_file, only: h5_file_t
     use driver_results, only: results_writer_t
@@ -65,7 +65,8 @@ contains
         character(len=256), allocatable :: paths(:)
         integer, allocatable :: counts(:), saved(:), w(:)
         character(len=:), allocatable :: joined
-        integer :: k, j, start, n_saved
+        type(string_t), allocatable :: names(:)
+        integer :: k, j, n_saved
         real(wp) :: energy0
         call read_int_attr_1d(file, '/results', 'writer', w, error)
         if (allocated(error)) return
@@ -92,7 +93,8 @@ contains
                             'checkpoint is damaged')
             return
         end if
-        n_saved = count([(joined(k:k) == new_line('a'), k=1, len(joined))])
+        call split_lines(joined, names)
+        n_saved = size(names)
         allocate (saved(0))
         if (n_saved > 0) call file%read_dataset('/results/records', saved, error)
         if (allocated(error)) return
@@ -115,15 +117,12 @@ contains
             return
         end do
         ! Every dataset of the checkpoint must be there.
-        start = 1
-        do k = 1, len(joined)
-            if (joined(k:k) /= new_line('a')) cycle
-            if (.not. any(paths == joined(start:k - 1))) then
+        do k = 1, size(names)
+            if (.not. any(paths == names(k)%s)) then
                 call make_error(error, "checkpoint: the results file '"//out%file%path// &
-                                "' has no dataset '"//joined(start:k - 1)//"'")
+                                "' has no dataset '"//names(k)%s//"'")
                 return
             end if
-            start = k + 1
         end do
         call out%mark_running(error)
         if (allocated(error)) return
@@ -141,19 +140,10 @@ contains
         !> Index of `path` in the checkpoint's list (0: not there).
         integer function find(path)
             character(len=*), intent(in) :: path
-            integer :: i, s0, idx
-            find = 0
-            s0 = 1
-            idx = 0
-            do i = 1, len(joined)
-                if (joined(i:i) /= new_line('a')) cycle
-                idx = idx + 1
-                if (joined(s0:i - 1) == path) then
-                    find = idx
-                    return
-                end if
-                s0 = i + 1
+            do find = 1, size(names)
+                if (names(find)%s == path) return
             end do
+            find = 0
         end function find
     end subroutine load_results
 
@@ -171,7 +161,6 @@ contains
         type(error_t), allocatable :: error, ignored
         character(len=:), allocatable :: joined
         integer, allocatable :: saved(:)
-        integer :: k, start
         mark%run_id = ''
         mark%paths = [string_t ::]
         mark%counts = [integer ::]
@@ -188,12 +177,7 @@ contains
             if (index(joined, new_line('a')) > 0) call file%read_dataset('/results/records', saved, error)
         end if
         if (.not. allocated(error)) then
-            start = 1
-            do k = 1, len(joined)
-                if (joined(k:k) /= new_line('a')) cycle
-                mark%paths = [mark%paths, string_t(joined(start:k - 1))]
-                start = k + 1
-            end do
+            call split_lines(joined, mark%paths)
             if (size(saved) == size(mark%paths)) then
                 mark%counts = saved
             else
