@@ -111,6 +111,34 @@ def load_continuum_coupling(path) -> CouplingDiagnostics:
         return _read_coupling(f, get, path, time, body="continuum")
 
 
+def region_forces(path) -> tuple[np.ndarray, np.ndarray]:
+    """(time [s], forces [N]) of a 2D continuum coupled to disks: forces[k, r, c] is the sum
+    of the multipliers of region r + 1 (the deck's region lines in order) in direction c (0 =
+    x, 1 = y) at output k, i.e. the force the continuum exerts on the glued disks of that
+    region through the glue (the sign of /coupling/lambda, doc/output.md; the continuum
+    receives its opposite). From /coupling/rows/region; the
+    multipliers alternate from step to step around their mean in impacts and sliding, so
+    average two successive outputs for a resultant (multicor_post.interface.pair_mean).
+    ResultsError when the file has no /coupling/rows/region (a beam coupling, or a file of an
+    earlier build)."""
+    path = os.fspath(path)
+    f = _open_results(path)
+    with f:
+        if "coupling/rows/region" not in f:
+            raise ResultsError(f"{path}: no /coupling/rows/region (not a continuum coupled to "
+                               "disks, or a results file of an earlier build)")
+        get = _Getter(f, path, kind="coupled continuum results file")
+        time = get("coupling/time", (None,))
+        region = get("coupling/rows/region", (None,)).astype(int)
+        dof = get("coupling/rows/dof", (region.size,)).astype(int)
+        lam = get("coupling/lambda", (time.size, region.size))
+    forces = np.zeros((time.size, max(region.max(initial=0), 0), 2))
+    for r in range(forces.shape[1]):
+        for c in range(2):
+            forces[:, r, c] = lam[:, (region == r + 1) & (dof == c + 1)].sum(axis=1)
+    return time, forces
+
+
 @dataclass
 class CoupledResults:
     """The three parts of a coupled results file, at the stored outputs."""

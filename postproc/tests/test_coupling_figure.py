@@ -205,3 +205,21 @@ def test_the_norm_of_the_mediator_multipliers_says_so(tmp_path):
         f["coupling/mediator_nodes"] = np.array([2, 3, 5, 6], np.int32)
     label = figure(path, "continuum").axes[1].get_lines()[-1].get_label()
     assert label == "‖λ_m‖ of every step (mediator multipliers on the FE nodes)"
+
+
+def test_region_forces_sum_the_rows_of_each_region(tmp_path):
+    # the synthetic multipliers are 0.1 k j at output k, row j (rows x, y of 3 disks); rows
+    # 0-1 in region 2, rows 2-5 in region 1: region 1's x sums rows 2 and 4, its y rows 3 and 5
+    path = write_continuum_coupled(tmp_path / "block.h5")
+    with pytest.raises(ResultsError, match="no /coupling/rows/region"):
+        coupled.region_forces(path)
+    with h5py.File(path, "a") as f:
+        f.create_dataset("coupling/rows/region", data=np.array([2, 2, 1, 1, 1, 1], np.int32))
+    time, forces = coupled.region_forces(path)
+    k = np.arange(N_OUT)
+    assert forces.shape == (N_OUT, 2, 2) and time.size == N_OUT
+    # sums of at most two values 0.1 k j: exact up to one rounding (1e-15 relative)
+    np.testing.assert_allclose(forces[:, 0, 0], 0.1 * k * (2 + 4), rtol=1e-15)
+    np.testing.assert_allclose(forces[:, 0, 1], 0.1 * k * (3 + 5), rtol=1e-15)
+    np.testing.assert_allclose(forces[:, 1, 0], 0.1 * k * 0, rtol=1e-15)
+    np.testing.assert_allclose(forces[:, 1, 1], 0.1 * k * 1, rtol=1e-15)

@@ -48,9 +48,21 @@ module coupling_overlap2d
         procedure(weight_ramp_iface), deferred :: ramp
         !> Points just outside the particle-side edges, where the continuum must not go on.
         procedure(weight_probes_iface), deferred :: particle_side_probes
+        !> Number of the region holding a point, in the order of the deck's region lines (0:
+        !> none).
+        procedure(region_of_iface), deferred :: region_of
     end type weight_field_t
 
     abstract interface
+        !> The region holding a point.
+        pure integer function region_of_iface(self, x, y) result(k)
+            import :: weight_field_t, wp
+            !> The weight field.
+            class(weight_field_t), intent(in) :: self
+            !> The point [m].
+            real(wp), intent(in) :: x, y
+        end function region_of_iface
+
         !> A weight at a point.
         pure real(wp) function weight_at_iface(self, x, y) result(alpha)
             import :: weight_field_t, wp
@@ -121,6 +133,8 @@ module coupling_overlap2d
         procedure :: ramp => overlap_ramp
         !> Probes just outside the region's particle-side edges (region number 0).
         procedure :: particle_side_probes => overlap_particle_side_probes
+        !> 1 for a point of the region, 0 outside.
+        procedure :: region_of => overlap_region_of
     end type overlap2d_t
 
     !> Disjoint overlap regions (see the module description).
@@ -138,6 +152,8 @@ module coupling_overlap2d
         procedure :: ramp => set_ramp
         !> The probes of every region in turn, with its number.
         procedure :: particle_side_probes => set_particle_side_probes
+        !> The first region holding the point (0: none).
+        procedure :: region_of => set_region_of
     end type overlap_set_t
 
     !> Names of the edges of a box, in edge order.
@@ -492,6 +508,15 @@ contains
         d = norm2(p - a - t*ab)
     end function segment_distance
 
+    !> 1 for a point of the region (boundary included), 0 outside.
+    pure integer function overlap_region_of(self, x, y) result(k)
+        !> The region.
+        class(overlap2d_t), intent(in) :: self
+        !> The point [m].
+        real(wp), intent(in) :: x, y
+        k = merge(1, 0, self%contains(x, y))
+    end function overlap_region_of
+
     !> Inside test (crossing number), the boundary included.
     pure logical function overlap_contains(self, x, y) result(inside)
         !> The region.
@@ -627,6 +652,18 @@ contains
             return
         end do
     end function set_alpha_disk
+
+    !> Number of the first region holding the point (0: none).
+    pure integer function set_region_of(self, x, y) result(k)
+        !> The regions.
+        class(overlap_set_t), intent(in) :: self
+        !> The point [m].
+        real(wp), intent(in) :: x, y
+        do k = 1, size(self%regions)
+            if (self%regions(k)%contains(x, y)) return
+        end do
+        k = 0
+    end function set_region_of
 
     !> True when the box misses every region.
     pure logical function set_misses(self, box)

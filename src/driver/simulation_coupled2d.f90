@@ -204,7 +204,19 @@ contains
         type(results_writer_t), intent(inout) :: out
         !> Set on a write failure.
         type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: region(:)
+        integer :: r
         call self%fe_out%begin(out%file, self%continuum%model%mesh, 'dynamic', error)
+        if (allocated(error)) return
+        ! the region of each multiplier row (that of its disk's centre at t = 0), so that a
+        ! region's resultant is the sum of its rows of /coupling/lambda
+        associate (p => self%sys%dem%particles, owner => self%sys%rows%owner)
+            allocate (region(size(owner)))
+            do r = 1, size(owner)
+                region(r) = self%coupling%config%region%region_of(p%x(owner(r)), p%y(owner(r)))
+            end do
+        end associate
+        call out%file%write_dataset('/coupling/rows/region', region, error)
         if (allocated(error)) return
         if (size(self%sys%mediator_nodes) > 0) then
             call out%file%write_dataset('/coupling/mediator_nodes', self%sys%mediator_nodes, error)

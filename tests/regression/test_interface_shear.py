@@ -25,7 +25,8 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "postproc"))
-from multicor_post.interface import InterfaceRun, sliding_over_disks  # noqa: E402
+from multicor_post.coupled import region_forces  # noqa: E402
+from multicor_post.interface import InterfaceRun, pair_mean, sliding_over_disks  # noqa: E402
 
 from checks import arguments, check, summary
 
@@ -67,6 +68,19 @@ def main():
     h5 = reduced_case(exe, src, work)
     run = InterfaceRun(h5)
     t_top, n_top, t_bot, n_bot = run.band_resultants()
+    # /coupling/rows/region: region 1 is the bottom band (the deck's first region line),
+    # region 2 the top one; the rows' regions are those the test finds by the disks' heights,
+    # and region_forces sums the same multipliers as band_resultants (pair-averaged here): equal
+    # to round-off (the same numbers added in another order: 1e-12 of p w t)
+    with h5py.File(h5, "r") as f:
+        region = f["coupling/rows/region"][...]
+    check("rows/region: 2 for the top band's rows, 1 for the bottom's",
+          np.array_equal(region, np.where(run.top_rows, 2, 1)), f"{np.bincount(region)}")
+    _, forces = region_forces(h5)
+    load = P * WIDTH * THICK
+    same = max(np.abs(pair_mean(forces[:, 1, 0]) - t_top).max(), np.abs(pair_mean(forces[:, 1, 1]) - n_top).max(),
+               np.abs(pair_mean(forces[:, 0, 0]) - t_bot).max(), np.abs(pair_mean(forces[:, 0, 1]) - n_bot).max())
+    check("region_forces: the bands' resultants", same <= 1e-12 * load, f"largest difference {same:.2e} N")
     s = run.slip()
     load = P * WIDTH * THICK
 
