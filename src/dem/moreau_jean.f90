@@ -49,7 +49,8 @@ module dem_moreau_jean
     implicit none
     private
     public :: mj_config_t, energies_t, dem_system_t, mj_init, mj_step, energies_balance, dem_system_bytes
-    public :: mj_free_velocities, mj_detect, mj_solve, mj_end_step, mj_load_energy, mj_bonds_at_start, mj_bonds_made
+    public :: mj_free_velocities, mj_detect, mj_solve, mj_end_step, mj_load_energy, mj_velocity_error_energy, &
+              mj_bonds_at_start, mj_bonds_made
 
     !> Time-stepping settings.
     type :: mj_config_t
@@ -551,6 +552,49 @@ contains
             end do
         end associate
     end function mj_load_energy
+
+    !> Kinetic energy [J/m] of velocity errors of `relative` times the sizes of the terms that
+    !> make up the end velocities of the step just done, v+ = v + M^-1 (h F_theta + coupling
+    !> impulse) + sum_k M^-1 H_k r_k: per free DOF |v| + |M^-1 (h F_theta + coupling impulse)|
+    !> + sum_k |M^-1 H_k| |r_k| over the active contacts (|n_x r_n - n_y r_t| <= |r_n| + |r_t|,
+    !> and the same for y; the rotation |lever r_t| + |r_m|). A solve stopped at a relative
+    !> tolerance, and rounded, leaves velocities in error by about that much: when reactions
+    !> that cancel on every disk (a self-stress at rest) make terms far larger than v+, that is
+    !> the scale of the energy the step's contacts seem to create (doc/theory.md 2.5).
+    pure real(wp) function mj_velocity_error_energy(sys, relative) result(e)
+        !> System, after a step.
+        type(dem_system_t), intent(in) :: sys
+        !> Relative error of the velocities (e.g. the solver's tolerance plus round-off).
+        real(wp), intent(in) :: relative
+        real(wp), allocatable :: a(:, :)
+        real(wp) :: p
+        integer :: i, j, k
+        e = 0.0_wp
+        if (.not. allocated(sys%vel0)) return
+        associate (pt => sys%particles, cs => sys%contacts)
+            a = abs(sys%vel0)
+            do i = 1, pt%n
+                a(:, i) = a(:, i) + sys%im(:, i)*abs(sys%scheme%h*(sys%load(:, i) + [pt%mass(i)*pt%gravity, 0.0_wp]) &
+                                                     + sys%coupling_impulse(:, i))
+            end do
+            do k = 1, cs%n
+                if (.not. cs%active(k)) cycle
+                p = abs(cs%r(1, k)) + abs(cs%r(2, k))
+                j = cs%i2(k)
+                a(1:2, j) = a(1:2, j) + sys%im(1:2, j)*p
+                a(3, j) = a(3, j) + sys%im(3, j)*(abs(cs%lever(2, k)*cs%r(2, k)) + abs(cs%r(3, k)))
+                i = cs%i1(k)
+                if (i <= 0) cycle
+                a(1:2, i) = a(1:2, i) + sys%im(1:2, i)*p
+                a(3, i) = a(3, i) + sys%im(3, i)*(abs(cs%lever(1, k)*cs%r(2, k)) + abs(cs%r(3, k)))
+            end do
+            do i = 1, pt%n
+                do j = 1, 3
+                    if (sys%im(j, i) > 0.0_wp) e = e + 0.5_wp*(relative*a(j, i))**2/sys%im(j, i)
+                end do
+            end do
+        end associate
+    end function mj_velocity_error_energy
 
     !> Closing error of the energy audit [J/m] (zero up to round-off).
     pure real(wp) function energies_balance(e) result(b)
