@@ -8,7 +8,7 @@
 !> checkpoint it found (an earlier run's, or the one it restarts from) for the first time,
 !> that one gets the second name '<path>.prev' (a hard link): a run that fails puts it back
 !> (`checkpoint_run_t%revert`), a run that ends or is stopped by a signal deletes it
-!> (`settle`).
+!> (`settle`), with a '<path>.tmp' that a run killed during a write left.
 module driver_checkpoint_file
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
@@ -240,11 +240,14 @@ contains
     end subroutine checkpoint_run_revert
 
     !> After a run that ended or was stopped by a signal: its own last checkpoint stays at
-    !> `path`, the one it found there is deleted.
+    !> `path`, the one it found there is deleted, and so is a '<path>.tmp' left by a run
+    !> killed while it wrote a checkpoint (kill -9, a crash): nothing reads it, and the run's
+    !> own '.tmp' files were each renamed or deleted (one run at a time writes a folder).
     subroutine checkpoint_run_settle(self)
         !> The run's checkpoints.
         class(checkpoint_run_t), intent(inout) :: self
         if (self%found == found_kept) call remove_file(self%path//'.prev')
+        if (allocated(self%path)) call remove_file(self%path//'.tmp')
         self%found = found_unknown
     end subroutine checkpoint_run_settle
 
