@@ -124,6 +124,16 @@ contains
                 return
             end if
         end do
+        ! the outputs stored whole at the checkpoint: the fewest records of the outputs' time
+        ! series (/dem/bonds/time lists rupture events, not outputs)
+        out%outputs = huge(0)
+        do k = 1, size(names)
+            associate (name => names(k)%s)
+                if (len(name) < 5 .or. name == '/dem/bonds/time') cycle
+                if (name(len(name) - 4:) == '/time') out%outputs = min(out%outputs, saved(k))
+            end associate
+        end do
+        if (out%outputs == huge(0)) out%outputs = 0
         call out%mark_running(error)
         if (allocated(error)) return
         ! Every dataset of the file: kept (series cut to the checkpoint) or deleted.

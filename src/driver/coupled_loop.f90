@@ -465,7 +465,7 @@ contains
         if (allocated(error)) return
         call self%cpl_out%store(out%file, self%sys, error)
         if (allocated(error)) return
-        call out%flush(error)
+        call out%flush_output(error)
     end subroutine store_output
 
     !> The warnings after step `lp%k`: unconverged solve, lost bonds, a disk faster than the

@@ -74,6 +74,8 @@ module driver_results
         type(string_t), allocatable :: companions(:)
         !> For each companion, whether this run wrote it (`abort` deletes only those).
         logical, allocatable :: own(:)
+        !> Stored outputs flushed whole so far (/summary@outputs).
+        integer :: outputs = 0
     contains
         !> Create the results file (written as .partial until `close`).
         procedure :: open => writer_open
@@ -97,6 +99,8 @@ module driver_results
         procedure :: write_summary => writer_write_summary
         !> Flush the file so that a killed run leaves every stored output readable.
         procedure :: flush => writer_flush
+        !> Flush a stored output, then count it in /summary@outputs (flushed again).
+        procedure :: flush_output => writer_flush_output
         !> Record why and when the run stops before its end (a signal).
         procedure :: stop_at => writer_stop_at
         !> True when `stop_at` was called.
@@ -164,6 +168,8 @@ contains
         if (.not. allocated(error)) call self%file%write_attribute('/summary', 'finished', 0, error)
         if (.not. allocated(error)) call self%file%write_attribute('/summary', 'status', &
                                                                    'running (or killed)', error)
+        self%outputs = 0
+        if (.not. allocated(error)) call self%file%write_attribute('/summary', 'outputs', 0, error)
         if (.not. allocated(error)) call summary_placeholders(error)
         if (.not. allocated(error)) call self%flush(error)
         if (allocated(error)) call self%abort()
@@ -329,6 +335,7 @@ contains
         call self%file%write_attribute('/summary', 'finished', 0, error)
         if (.not. allocated(error)) call self%file%write_attribute('/summary', 'status', &
                                                                    'running (or killed)', error)
+        if (.not. allocated(error)) call self%file%write_attribute('/summary', 'outputs', self%outputs, error)
         if (allocated(error)) error%message = 'results: '//error%message
     end subroutine writer_mark_running
 
@@ -591,6 +598,28 @@ contains
         call self%file%flush(error)
         if (allocated(error)) error%message = 'results: '//error%message
     end subroutine writer_flush
+
+    !> Flush the output just stored, then count it: /summary@outputs, overwritten in place
+    !> and flushed again. A kill inside the first flush can leave that output incomplete
+    !> (HDF5 writes the flush's metadata and values in its own order: a series may count the
+    !> record before its values are written); the count then still names the outputs before
+    !> it, which the first flush of each had written whole. The second flush writes that
+    !> attribute's header alone.
+    subroutine writer_flush_output(self, error)
+        !> An open writer.
+        class(results_writer_t), intent(inout) :: self
+        !> Set when the data cannot be written (disk full, quota, file size limit).
+        type(error_t), allocatable, intent(out) :: error
+        call self%flush(error)
+        if (allocated(error)) return
+        self%outputs = self%outputs + 1
+        call self%file%write_attribute('/summary', 'outputs', self%outputs, error)
+        if (allocated(error)) then
+            error%message = 'results: '//error%message
+            return
+        end if
+        call self%flush(error)
+    end subroutine writer_flush_output
 
     !> Record that the run stops early (a signal) after storing its state at time `t`.
     subroutine writer_stop_at(self, signal, step, t)

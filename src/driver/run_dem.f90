@@ -246,7 +246,7 @@ contains
             type(error_t), allocatable, intent(out) :: error
             call writer%store(out%file, cfg%system, error)
             if (allocated(error)) return
-            call out%flush(error)
+            call out%flush_output(error)
         end subroutine store
 
         !> Warning for an unconverged step (the first max_warnings ones).

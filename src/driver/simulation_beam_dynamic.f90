@@ -237,7 +237,7 @@ contains
             call out%append_energy(integ%t, integ%kinetic, integ%strain, integ%external_work, &
                                    integ%damping_dissipation, error)
             if (allocated(error)) return
-            call out%flush(error)
+            call out%flush_output(error)
         end subroutine store
     end subroutine run_dynamic
 end module driver_simulation_beam_dynamic

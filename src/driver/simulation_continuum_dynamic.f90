@@ -286,7 +286,7 @@ contains
                                          energies(5), error, au%reaction_work, au%reaction_resultant)
             end associate
             if (allocated(error)) return
-            call out%flush(error)
+            call out%flush_output(error)
         end subroutine store
     end subroutine dynamic_run
 

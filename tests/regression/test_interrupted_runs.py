@@ -71,26 +71,26 @@ def series_key(f):
 
 def compare_prefix(name, partial, reference, complete):
     """Every dataset of the partial file equals the start of the same dataset of the
-    reference (bit for bit: same code, same inputs, same steps), over every output of the
-    partial file but its last. `complete`: the partial file must also hold every dataset of
-    the reference.
+    reference (bit for bit: same code, same inputs, same steps), over the outputs the file
+    counts as flushed whole (/summary@outputs). `complete`: the partial file must also hold
+    every dataset of the reference.
 
     A kill inside the flush of an output can leave that output incomplete: HDF5 writes the
-    flush's metadata and data in its own order, so that a series may show the output's record
-    before its values are written. A scan of SIGKILL at every 7th pwrite of
+    flush's metadata and values in its own order, so that a series may show the output's
+    record before its values are written. A scan of SIGKILL at every 7th pwrite of
     input/coupled2d_block.dat found 21 such files of 443: /dem/time one output ahead of
     /continuum/time; the last output's contact lists zero from a chunk's start (entry 1024 or
-    2048) with every group holding the output; its /dem/position record differing. Nothing
-    in the file tells such an output from a complete one (doc/output.md says so), so the
-    last output is left out: series of a group with a `time` series are compared over the
-    fewest outputs of any group less one, the contact lists up to that output's offset."""
+    2048) with every group holding the output; its /dem/position record differing. The
+    count, written after each output's flush and flushed again, leaves such an output out:
+    series of a group with a `time` series are compared over that many outputs, the contact
+    lists up to that output's offset."""
     bad, n = [], 0
     with h5py.File(partial, "r") as p, h5py.File(reference, "r") as r:
         names = []
         r.visititems(lambda k, o: names.append(k) if isinstance(o, h5py.Dataset) else None)
         # the outputs' times (/dem/bonds/time is the list of rupture events, not outputs)
         times = [k for k in names if k.endswith("/time") and k != "dem/bonds/time" and k in p]
-        outputs = max(min(len(p[k]) for k in times) - 1, 0) if times else None
+        outputs = int(p["summary"].attrs["outputs"]) if times else None
         for k in names:
             if k not in p:
                 if complete:
