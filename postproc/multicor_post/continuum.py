@@ -24,8 +24,8 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
 from .beam import _time_unit
-from .results import (FigureFiles, ResultsError, no_output_error, no_results_error, shape_error,
-                      unfinished_status)
+from .results import (FigureFiles, ResultsError, complete_records, no_output_error,
+                      no_results_error, shape_error, unfinished_status)
 
 
 @dataclass
@@ -81,7 +81,7 @@ def load_continuum(path) -> ContinuumResults:
             if name not in f:
                 raise ResultsError(f"{path}: missing dataset '/{name}' (not a MULTICOR continuum "
                                    "results file, or one from another version)")
-            return f[name][...]
+            return complete_records(f, name, f[name][...])
 
         x = need("continuum/mesh/coordinates")
         connectivity = need("continuum/mesh/connectivity")

@@ -393,6 +393,38 @@ def damaged_file_error(exc: BaseException, path) -> Optional[ResultsError]:
                         "whether --restart can continue it)")
 
 
+#: Series that grow by step, not by output (their own count), or by event: never cut.
+_NOT_OUTPUT_SERIES = ("dem/solver/", "dem/bonds/", "coupling/g_norm", "coupling/position_residual",
+                      "coupling/velocity_residual", "coupling/rotation_residual",
+                      "coupling/coordinate_residual", "coupling/lambda_norm", "coupling/sweeps",
+                      "coupling/corrections")
+
+
+def complete_records(f, name: str, data: np.ndarray) -> np.ndarray:
+    """The records of dataset `name` (read as `data`) that belong to the outputs a killed
+    run wrote whole. A run counts each output in /summary@outputs after flushing it (and
+    flushes again); a kill inside an output's flush can leave that output's records partly
+    written (doc/output.md, "Every output is flushed"). In the partial file of a run that did
+    not finish, the series of stored outputs (extendible datasets, but the per-step and event
+    series) are cut to that many records, and the contact lists of /dem/contacts to that
+    output's offset. Other datasets, finished files and files without the count are returned
+    as they are."""
+    summary = f.get("summary")
+    if summary is None or "outputs" not in summary.attrs or data.ndim == 0:
+        return data
+    if int(summary.attrs.get("finished", 1)) != 0:
+        return data
+    if f[name].maxshape[0] is not None or name.startswith(_NOT_OUTPUT_SERIES):
+        return data
+    n = int(summary.attrs["outputs"])
+    if name == "dem/contacts/offset":
+        return data[:n + 1]
+    if name.startswith("dem/contacts/"):
+        offset = f["dem/contacts/offset"]
+        return data[:int(offset[min(n, len(offset) - 1)])] if len(offset) else data
+    return data[:n]
+
+
 class _Reader:
     """Reads datasets with shape checks and messages that name the file and the dataset."""
 
@@ -406,6 +438,7 @@ class _Reader:
                                "results file, or one from another version)")
         data = np.asarray(self.f[name][()], dtype=float if self.f[name].dtype.kind == "f"
                           else None)
+        data = complete_records(self.f, name, data)
         if shape is not None:
             ndim = len(shape)
         if ndim is not None and data.ndim != ndim:
@@ -430,7 +463,7 @@ class _Getter:
         if name not in self.f or not isinstance(self.f[name], h5py.Dataset):
             raise ResultsError(f"{self.path}: missing dataset '/{name}' (not a MULTICOR "
                                f"{self.kind}, or one from another version)")
-        data = np.asarray(self.f[name][()])
+        data = complete_records(self.f, name, np.asarray(self.f[name][()]))
         if data.ndim != len(shape) or any(w is not None and g != w
                                           for g, w in zip(data.shape, shape)):
             raise shape_error(self.f, self.path, name, data.shape, shape)

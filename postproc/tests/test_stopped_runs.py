@@ -395,6 +395,46 @@ def test_particles_with_an_incomplete_last_output(tmp_path, capsys):
                           f"dataset '/dem/position' has shape ({N_OUT - 1}, ", INCOMPLETE)
 
 
+def extendible(path, names):
+    """Make the datasets ``names`` extendible along their first axis, as multicor creates
+    its series (the synthetic writer does not)."""
+    with h5py.File(path, "a") as f:
+        for name in names:
+            data = f[name][()]
+            del f[name]
+            f.create_dataset(name, data=data, maxshape=(None,) + data.shape[1:])
+    return path
+
+
+def test_a_killed_file_is_read_up_to_its_count_of_whole_outputs(tmp_path, capsys):
+    # /summary@outputs counts the outputs a run flushed whole: a kill inside the flush of
+    # the next one left /dem/position one record short (out of step) and the last record of
+    # /dem/velocity zero (in step, but not written): both are left out, the figures drawn
+    path = write_dem(tmp_path / "column.h5.partial")
+    extendible(path, dem_series(path) + [f"dem/contacts/{n}" for n in CONTACT_LISTS + ("offset",)])
+    with h5py.File(path, "r") as f:
+        velocity = f["dem/velocity"][()]
+    cut_last_record(mark_killed(path), ["dem/position"])
+    with h5py.File(path, "a") as f:
+        f["dem/velocity"][-1] = 0.0
+    # without the count (a file of an earlier build): the out-of-step error, as before
+    with pytest.raises(ResultsError, match="records of its last output are incomplete"):
+        particles.load_dem(path)
+    with h5py.File(path, "a") as f:
+        f["summary"].attrs["outputs"] = np.int32(N_OUT - 1)
+    res = particles.load_dem(path)
+    assert res.time.size == N_OUT - 1 and res.position.shape[0] == N_OUT - 1
+    assert np.array_equal(res.velocity, velocity[:N_OUT - 1])
+    assert plot_results.main([str(path), "--out", str(tmp_path / "png")]) == 0
+    assert "error" not in capsys.readouterr().err
+    # a finished file is read whole: the count does not cut it
+    with h5py.File(path, "a") as f:
+        f["summary"].attrs["finished"] = np.int32(1)
+        f["summary"].attrs["outputs"] = np.int32(1)
+    with pytest.raises(ResultsError, match="has shape"):
+        particles.load_dem(path)
+
+
 def test_a_continuum_with_an_incomplete_last_output(tmp_path, capsys):
     # continuum/displacement one record short of /continuum/time: a ValueError traceback
     # from matplotlib (the history's x and y of different lengths)
