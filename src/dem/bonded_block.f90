@@ -665,9 +665,9 @@ contains
         integer, intent(in) :: k
         real(wp) :: rn
         rn = cs%r(1, k) + cs%coh(k)
-        if (rn < 0.0_wp) then
-            excess = huge(1.0_wp)
-            if (cs%coh(k) > 0.0_wp) excess = min(huge(1.0_wp), -rn/cs%coh(k))
+        ! a tension beyond the cohesion: its excess itself (cone_excess ranks it first, scaled)
+        if (rn < 0.0_wp .and. cs%coh(k) > 0.0_wp) then
+            excess = min(huge(1.0_wp), -rn/cs%coh(k))
         else
             excess = cone_excess(cs, k)
         end if
