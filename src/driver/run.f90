@@ -31,7 +31,7 @@ module driver_run
     use io_lock, only: lock_t, lock_acquire, lock_release
     use io_progress, only: progress_t
     use core_signals, only: caught_signal, signal_name, install_signal_handlers
-    use core_threads, only: thread_setting
+    use core_threads, only: single_thread_blas, thread_setting
     use io_deck_schema, only: multicor_schema
     use io_deck, only: deck_t, read_deck
     use io_paths, only: stem, basename, mkdir_p, remove_empty_folders, file_exists, remove_file, rename_file
@@ -111,6 +111,8 @@ contains
         type(deck_run_t) :: run
 
         if (present(stopped_by)) stopped_by = 0
+        ! Before any factorisation: results that do not depend on the threads OpenBLAS is given
+        call single_thread_blas()
         call build_run(opts, report, run, error)
         if (allocated(error)) return
         if (opts%check_only) then
@@ -492,9 +494,8 @@ contains
             if (len(ck%start%threads) > 0 .and. ck%start%threads /= thread_setting()) &
                 call report('warning: the checkpoint was written with '//ck%start%threads//'; this run has '// &
                             thread_setting()//': the results go on correctly, but bit for bit they are '// &
-                            'those of neither uninterrupted run (the split sweeps from 4 000 contacts, and '// &
-                            'OpenBLAS in the sparse factorisations, depend on the threads); set the same '// &
-                            'values to reproduce the run exactly')
+                            'those of neither uninterrupted run (the split sweeps from 4 000 contacts depend on '// &
+                            'the threads); set the same OMP_NUM_THREADS to reproduce the run exactly')
             if (.not. ck%start%wall_recorded) call report('note: the checkpoint, written by an earlier '// &
                                                           'MULTICOR build, does not record the wall time of the '// &
                                                           'runs before it: /summary wall_seconds counts from this '// &

@@ -1316,26 +1316,31 @@ def earlier_results(exe, src, work):
 
 
 def other_threads(exe, src, work):
-    """A restart under another parallel setting (OMP_NUM_THREADS, OPENBLAS_NUM_THREADS) goes
-    on with a warning naming both settings: its results are those of neither uninterrupted run
-    bit for bit (doc/output.md, "Bitwise"); under the same setting, no warning. /summary
-    records the setting."""
+    """A restart under another OMP_NUM_THREADS goes on with a warning naming both settings:
+    its results are those of neither uninterrupted run bit for bit (doc/output.md,
+    "Bitwise"); under the same setting, or another OPENBLAS_NUM_THREADS (the program runs
+    OpenBLAS on one thread), no warning. /summary records the setting."""
     folder = work / "other_threads"
     deck = edit_deck(src / "input" / "cantilever.dat", work / "threads.dat", end=0.02)
     env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
     first = run(exe, deck, "--quiet", "--output", folder, "--end", "0.01", env=env)
     same = run(exe, deck, "--output", folder, "--restart", folder / "checkpoint.h5", "--end", "0.015", env=env)
+    blas = run(exe, deck, "--output", folder, "--restart", folder / "checkpoint.h5", "--end", "0.0175",
+               env=dict(env, OPENBLAS_NUM_THREADS="4"))
     other = run(exe, deck, "--output", folder, "--restart", folder / "checkpoint.h5", "--end", "0.02",
                 env=dict(env, OMP_NUM_THREADS="2"))
     with h5py.File(folder / "threads.h5", "r") as f:
         recorded = f["summary"].attrs["threads"]
     warned = [line for line in other.stdout.splitlines() if line.startswith("warning: the checkpoint was written with")]
-    check("restart under the same thread setting: no warning; under another: one naming both",
+    check("restart under the same thread setting, or another OPENBLAS_NUM_THREADS (the program runs OpenBLAS "
+          "on one thread): no warning; under another OMP_NUM_THREADS: one naming both",
           first.returncode == 0 and same.returncode == 0 and "warning: the checkpoint" not in same.stdout
+          and blas.returncode == 0 and "warning: the checkpoint" not in blas.stdout
           and other.returncode == 0 and len(warned) == 1
-          and "OpenMP threads 1, OPENBLAS_NUM_THREADS 1; this run has OpenMP threads 2, OPENBLAS_NUM_THREADS 1"
-          in warned[0] and recorded == "OpenMP threads 2, OPENBLAS_NUM_THREADS 1",
-          f"exits {first.returncode}, {same.returncode}, {other.returncode}; {warned}; /summary {recorded!r}")
+          and "OpenMP threads 1, OpenBLAS 1 thread; this run has OpenMP threads 2, OpenBLAS 1 thread"
+          in warned[0] and recorded == "OpenMP threads 2, OpenBLAS 1 thread",
+          f"exits {first.returncode}, {same.returncode}, {blas.returncode}, {other.returncode}; {warned}; "
+          f"/summary {recorded!r}")
 
 
 def created_energy_counts(exe, work):
