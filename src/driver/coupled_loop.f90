@@ -46,6 +46,7 @@ module driver_coupled_loop
                                  save_results, load_results, save_dem_writer, load_dem_writer, &
                                  save_coupled_writer, load_coupled_writer
     use driver_simulation, only: simulation_t, report_iface
+    use driver_swept_bonds, only: swept_bonds_warning
     implicit none
     private
     public :: arlequin_simulation_t
@@ -69,7 +70,7 @@ module driver_coupled_loop
         !> See `simulation_t%check_deck`: both models' keywords are used.
         procedure :: check_deck => arlequin_check_deck
         !> See `simulation_t%deck_warnings`: the solver settings that do not act on the
-        !> coupling rows.
+        !> coupling rows, and bonds swept one contact at a time.
         procedure :: deck_warnings => arlequin_deck_warnings
         !> Material ids of the disks and whether contacts are stored (for /dem).
         procedure(particle_output_iface), deferred :: particle_output
@@ -716,7 +717,8 @@ contains
     !> Warnings for the solver settings that a coupled run accepts and does not use, as
     !> 'warning: file:line: ...': `method = coarse` (a coupled run sweeps as with `nlgs`) and
     !> `cold_start = hydrostatic` (its estimate leaves out the coupling rows); documented
-    !> fallbacks, so warnings rather than errors.
+    !> fallbacks, so warnings rather than errors. Also bonds swept one contact at a time
+    !> (driver_swept_bonds).
     function arlequin_deck_warnings(self, deck) result(warnings)
         !> The simulation.
         class(arlequin_simulation_t), intent(in) :: self
@@ -724,6 +726,7 @@ contains
         type(deck_t), intent(in) :: deck
         !> The warnings.
         type(string_t), allocatable :: warnings(:)
+        character(len=:), allocatable :: message
         allocate (warnings(0))
         if (set_to('method', 'coarse')) &
             warnings = [warnings, string_t('warning: '//deck%file//':'//to_str(deck%line('solver', 'method'))// &
@@ -735,6 +738,8 @@ contains
                                            ': [solver] cold_start = hydrostatic has no effect in a coupled run: '// &
                                            'the hydrostatic estimate leaves out the coupling rows, and a step without '// &
                                            'reactions starts from zero')]
+        message = swept_bonds_warning(deck)
+        if (len(message) > 0) warnings = [warnings, string_t(message)]
     contains
         ! whether the deck itself sets [solver] keyword to value
         logical function set_to(keyword, value)

@@ -11,6 +11,7 @@ module driver_simulation_dem
     use driver_checkpoint, only: checkpoint_run_t
     use driver_simulation, only: simulation_t, report_iface
     use driver_run_kind, only: check_beam_keywords_unused
+    use driver_swept_bonds, only: swept_bonds_warning
     implicit none
     private
     public :: dem_simulation_t
@@ -34,7 +35,7 @@ module driver_simulation_dem
         procedure :: has_time_loop => dem_has_time_loop
         !> See `simulation_t%check_deck`: no beam settings.
         procedure :: check_deck => dem_check_deck
-        !> See `simulation_t%deck_warnings`: none.
+        !> See `simulation_t%deck_warnings`: bonds swept one contact at a time.
         procedure :: deck_warnings => dem_deck_warnings
     end type dem_simulation_t
 
@@ -114,14 +115,17 @@ contains
         call check_beam_keywords_unused(deck, error)
     end subroutine dem_check_deck
 
-    !> No warning.
+    !> A warning for bonds swept one contact at a time (`method = nlgs` or `coarse`).
     function dem_deck_warnings(self, deck) result(warnings)
         !> The simulation.
         class(dem_simulation_t), intent(in) :: self
         !> The validated deck.
         type(deck_t), intent(in) :: deck
-        !> None.
+        !> Bonds swept one contact at a time (driver_swept_bonds).
         type(string_t), allocatable :: warnings(:)
+        character(len=:), allocatable :: message
         allocate (warnings(0))
+        message = swept_bonds_warning(deck)
+        if (len(message) > 0) warnings = [warnings, string_t(message)]
     end function dem_deck_warnings
 end module driver_simulation_dem

@@ -181,7 +181,10 @@ contains
                            'packings away from rest and deposits, doc/performance.md; it changes nothing at a '// &
                            'solution, and a step stops correcting once the error at a correction is larger '// &
                            'than at the previous one; not with the Arlequin coupling rows: a coupled run '// &
-                           'sweeps as with `nlgs`, and says so in a warning). Every '// &
+                           'sweeps as with `nlgs`, and says so in a warning; its aggregates leave bonds out). '// &
+                           'With `[contacts] bond` records, `nlgs` and `coarse` sweep the bonds one contact at '// &
+                           'a time: along a bonded chain the sweeps converge slowly, and their stopping test can '// &
+                           'be met far from the solution (a warning says so). Every '// &
                            'unilateral or frictional contact uses the bi-potential local solver in all three.', &
                            default='block')
         call s%add_keyword('solver', 'tolerance', [real_field('tolerance', '', lower=0.0_wp, upper=1.0_wp, &

@@ -27,6 +27,10 @@ goes on, and a warning names the file, the line and the setting that turns it of
   1e-3 R, beyond the bond tolerance of 1e-6 R) is warned about at its line, under --check and
   at the run's start; a touching row is not, and the run's summary counts its bonds at t = 0
   (n - 1 = 4 for a row of 5 touching disks, 0 for the row with gaps).
+- `[contacts] bond` records with `[solver] method = nlgs` or `coarse` (the bonds swept one
+  contact at a time, whose stopping test can be met far from the solution) are warned about
+  at the method's line, for particles alone and coupled to a beam; `method = block` (the
+  default) and `nlgs` without bonds are not.
 - `[contacts] alert = 0` is warned about at its line (contacts seen only once disks touch).
 - A time function used by a load that is zero over the whole run (a step at 1.0 s of a run
   that ends at 0.5 s) is warned about at its line, with the line of the load, under --check
@@ -565,6 +569,37 @@ def bonds_without_pairs(exe, work):
               proc.stdout[-600:] + proc.stderr.strip()[:300])
 
 
+def swept_bonds(exe, src, work):
+    """Bonds swept one contact at a time (`method = nlgs` or `coarse` with `[contacts] bond`)
+    are warned about at the method's line, naming the bond record's line, for particles alone
+    (a row of 5 bonded disks) and coupled to a beam (input/bending_case1.dat); `method = block`
+    written out, or left to its default, is not; `nlgs` without bond records is not."""
+    row = BOND_DECK.format(disks="row = 5 0.01 0.1 0.01 1", walls="")
+    case1 = (src / "input" / "bending_case1.dat").read_text()
+    case1 = re.sub(r"^\s*method\s*=.*\n", "", case1, flags=re.M)
+    no_bond = re.sub(r"^bond\s*=.*\n", "", row, flags=re.M)
+    cases = (("row_nlgs", row, "method = nlgs\n", True), ("row_coarse", row, "method = coarse\n", True),
+             ("row_block", row, "method = block\n", False), ("row_default", row, "", False),
+             ("case1_nlgs", case1, "method = nlgs\n", True), ("case1_default", case1, "", False),
+             ("no_bond_nlgs", no_bond, "method = nlgs\n", False))
+    for name, base, lines, warned in cases:
+        text = with_solver(base, lines) if lines else base
+        deck = work / f"swept_{name}.dat"
+        deck.write_text(text)
+        proc = multicor(exe, "--check", deck)
+        said = [w for w in warnings_of(proc.stdout) if "sweeps the bonds" in w]
+        if warned:
+            method = re.search(r"method = (\w+)", lines).group(1)
+            expected = (f"warning: {deck}:{line_of(text, 'method')}: [solver] method = {method} sweeps the bonds "
+                        f"of [contacts] bond (line {line_of(text, 'bond')}) one contact at a time")
+            ok = proc.returncode == 0 and len(said) == 1 and said[0].startswith(expected) \
+                and said[0].endswith("method = block (the default) solves the intact bonds directly")
+        else:
+            ok = proc.returncode == 0 and not said
+        check(f"bonds swept, {name}: {'warned at the method line' if warned else 'no warning'}", ok,
+              "\n".join(said) or proc.stderr.strip()[:300])
+
+
 def zero_alert(exe, src, work):
     """`[contacts] alert = 0` is accepted and warned about at its line; the deposit's own
     alert (1 mm) is not."""
@@ -629,6 +664,7 @@ def main():
     large_displacements(exe, src, work)
     free_rolling(exe, work)
     bonds_without_pairs(exe, work)
+    swept_bonds(exe, src, work)
     zero_alert(exe, src, work)
     idle_functions(exe, src, work)
     # the hinged row of the reference work (20 steps; with nlgs at 1e-4: 108 to 172 sweeps per
