@@ -811,8 +811,53 @@ contains
                 if (e%has('rolling')) call warn_rolling_length(e, a, b)
             end associate
         end do
+        if (size(list) > 0) call warn_missing_laws(list(1)%line)
         call build_bonds(deck, cfg, law_line, error)
     contains
+        !> A pair of materials whose bodies may touch (walls of one and disks of the other, or
+        !> two disks of one material) and that has no law, in a deck that gives laws to other
+        !> pairs: its contacts are frictionless, without restitution or cohesion (the default),
+        !> which is also what a forgotten record gives (an audit's floor of another material
+        !> than its disks, silently frictionless). Disks of two materials are left out: laws
+        !> between them are often left out on purpose (disks that never meet, as in
+        !> input/incline.dat). Warned about at the first law's line, once per pair.
+        subroutine warn_missing_laws(line)
+            integer, intent(in) :: line
+            integer, allocatable :: disks(:)
+            logical, allocatable :: on_walls(:)
+            character(len=:), allocatable :: bodies
+            integer :: a, b
+            allocate (disks(size(cfg%material_id)), source=0)
+            allocate (on_walls(size(cfg%material_id)), source=.false.)
+            associate (p => cfg%system%particles, w => cfg%system%walls)
+                do a = 1, p%n
+                    disks(p%mat(a)) = disks(p%mat(a)) + 1
+                end do
+                if (w%n > 0) on_walls(w%mat(1:w%n)) = .true.
+            end associate
+            do a = 1, size(cfg%material_id)
+                do b = a, size(cfg%material_id)
+                    if (law_line(a, b) > 0) cycle
+                    bodies = ''
+                    if (a == b .and. disks(a) >= 2) bodies = ', disks of '//to_str(cfg%material_id(a))
+                    if (disks(a) > 0 .and. on_walls(b)) bodies = bodies//', disks of '//to_str(cfg%material_id(a))// &
+                                                                 ' on walls of '//to_str(cfg%material_id(b))
+                    if (a /= b .and. disks(b) > 0 .and. on_walls(a)) bodies = bodies//', disks of '// &
+                                                                              to_str(cfg%material_id(b))// &
+                                                                              ' on walls of '//to_str(cfg%material_id(a))
+                    if (len(bodies) == 0) cycle
+                    cfg%warnings = [cfg%warnings, string_t('warning: '//deck%file//':'//to_str(line)// &
+                                                           ': [contacts] no law for materials '// &
+                                                           to_str(cfg%material_id(a))//' and '// &
+                                                           to_str(cfg%material_id(b))//' ('//bodies(3:)// &
+                                                           '): their contacts are frictionless, without '// &
+                                                           'restitution or cohesion (the default); add law = '// &
+                                                           to_str(cfg%material_id(a))//' '// &
+                                                           to_str(cfg%material_id(b))//' 0 0 0 if that is meant')]
+                end do
+            end do
+        end subroutine warn_missing_laws
+
         !> A rolling length beyond the radius of the largest disk of the pair's materials: the
         !> moment |M| <= e_r r_n then has an arm longer than the disk (e_r is a fraction of the
         !> radius in rolling-resistance models), and the sweeps may stop converging.

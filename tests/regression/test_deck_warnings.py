@@ -31,6 +31,9 @@ goes on, and a warning names the file, the line and the setting that turns it of
   contact at a time, whose stopping test can be met far from the solution) are warned about
   at the method's line, for particles alone and coupled to a beam; `method = block` (the
   default) and `nlgs` without bonds are not.
+- In a deck with laws, a pair of materials without one whose bodies may touch (disks of one
+  on walls of the other, two disks of one material) is warned about at the first law's line;
+  disks of two materials, or a deck without any law, are not.
 - `[contacts] alert = 0` is warned about at its line (contacts seen only once disks touch).
 - A time function used by a load that is zero over the whole run (a step at 1.0 s of a run
   that ends at 0.5 s) is warned about at its line, with the line of the load, under --check
@@ -600,6 +603,51 @@ def swept_bonds(exe, src, work):
               "\n".join(said) or proc.stderr.strip()[:300])
 
 
+LAWLESS = """[run]
+analysis = dynamic
+[particles]
+material = 1 2500
+material = 2 7800
+{disks}
+gravity = 0 -9.81
+[walls]
+wall = -1 0 1 0 2
+[contacts]
+{laws}
+[time]
+step = 1e-4
+end = 2e-3
+"""
+
+
+def missing_laws(exe, work):
+    """In a deck with laws, a pair of materials without one whose bodies may touch (a disk of
+    material 1 on a floor of material 2; two disks of material 1) is warned about at the first
+    law's line, once per pair; pairs with laws, and disks of two materials, are not."""
+    one = "disk = 0 0.05 0.05 1"
+    two = "disk = 0 0.05 0.05 1\ndisk = 0.5 0.05 0.05 1"
+    mixed = "disk = 0 0.05 0.05 1\ndisk = 0.5 0.05 0.05 2"
+    cases = (("floor", one, "law = 1 1 0.3 0 0", ["1 and 2 (disks of 1 on walls of 2)"]),
+             ("floor_and_pair", two, "law = 2 2 0.3 0 0",
+              ["1 and 1 (disks of 1)", "1 and 2 (disks of 1 on walls of 2)"]),
+             ("all_given", two, "law = 1 1 0.3 0 0\nlaw = 1 2 0 0 0", []),
+             ("two_materials", mixed, "law = 1 2 0.3 0 0\nlaw = 2 2 0.3 0 0", []),
+             ("no_law_at_all", one, "", []))
+    for name, disks, laws, pairs in cases:
+        text = LAWLESS.format(disks=disks, laws=laws)
+        if not laws:  # (an empty section is an error)
+            text = text.replace("[contacts]\n\n", "")
+        deck = work / f"lawless_{name}.dat"
+        deck.write_text(text)
+        proc = multicor(exe, "--check", deck)
+        said = [w for w in warnings_of(proc.stdout) if "[contacts] no law for" in w]
+        expected = [f"warning: {deck}:{line_of(text, 'law')}: [contacts] no law for materials {p}: their contacts "
+                    "are frictionless, without restitution or cohesion (the default); add law = "
+                    f"{p.split()[0]} {p.split()[2]} 0 0 0 if that is meant" for p in pairs]
+        check(f"pairs without a law, {name}: {len(pairs)} warning(s)", proc.returncode == 0 and said == expected,
+              "\n".join(said) or proc.stderr.strip()[:300])
+
+
 def zero_alert(exe, src, work):
     """`[contacts] alert = 0` is accepted and warned about at its line; the deposit's own
     alert (1 mm) is not."""
@@ -665,6 +713,7 @@ def main():
     free_rolling(exe, work)
     bonds_without_pairs(exe, work)
     swept_bonds(exe, src, work)
+    missing_laws(exe, work)
     zero_alert(exe, src, work)
     idle_functions(exe, src, work)
     # the hinged row of the reference work (20 steps; with nlgs at 1e-4: 108 to 172 sweeps per
