@@ -185,8 +185,9 @@ contains
     end subroutine write_into_folder
 
     !> The run's checkpoints: where and when they are written; with `--restart`, the
-    !> checkpoint the run continues from, else the guard of another deck's checkpoint in the
-    !> folder.
+    !> checkpoint the run continues from, else, for a run that writes checkpoints (a time
+    !> loop), the guard of another deck's checkpoint in the folder (a static or modal analysis
+    !> writes none: it leaves the folder's checkpoint as it is).
     subroutine start_checkpoints(opts, report, run, error)
         !> What to run and where to write.
         type(run_options_t), intent(in) :: opts
@@ -204,7 +205,7 @@ contains
         run%ck%results = basename(run%path)
         if (allocated(opts%restart)) then
             call open_checkpoint(opts, report, run, error)
-        else
+        else if (run%sim%has_time_loop()) then
             call guard_other_run(report, run, error)
         end if
     end subroutine start_checkpoints
@@ -416,7 +417,7 @@ contains
         word = word//"'"
     end function shell_word
 
-    !> A fresh run replaces the folder's checkpoint (at its first commit). When that
+    !> A fresh run with a time loop replaces the folder's checkpoint (at its first commit). When that
     !> checkpoint is another deck's and its run is interrupted (its results file still
     !> '.partial'), the interrupted run could no longer be continued by the command it
     !> printed: refused. Another deck's finished run only loses the checkpoint that would

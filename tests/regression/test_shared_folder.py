@@ -1,0 +1,149 @@
+#!/usr/bin/env python3
+"""A static or modal analysis run into a folder holding another deck's checkpoint: it writes
+no checkpoint, so it neither warns that it replaces that checkpoint nor refuses to run when
+that checkpoint's run is interrupted (doc/output.md, "Checkpoints and restart"). The
+checkpoint stays byte for byte, and the run it belongs to is still extended (`--restart
+--end`) or continued (the command it printed) from it. A dynamic run of another deck still
+gets the warning (it does replace the checkpoint).
+
+Before: every fresh run checked the folder's checkpoint, and a static beam run after a
+particle run printed "warning: this run replaces shared/checkpoint.h5, the checkpoint of
+another deck's run (dyn_disks.h5), which can then no longer be extended", which was false.
+Usage (ctest does this): test_shared_folder.py --exe multicor --work DIR --source REPO
+"""
+import hashlib
+import signal
+import subprocess
+import sys
+import time
+
+import h5py
+
+from checks import arguments, check, summary
+
+PARTICLES = """[run]
+analysis = dynamic
+[particles]
+material = 1 2500
+row = 5 0 0.01 0.01 1
+gravity = 0 -9.81
+[walls]
+wall = -1 0 1 0
+[contacts]
+law = 1 1 0.5 0 0
+[time]
+step = 1e-3
+end = 0.01
+"""
+
+BEAM = """[beam]
+section = 1 2.1e11 7800 2.0e-4 1.6666666666666667e-9
+line = 1 0 0 1 0 10 1
+fix = 1 all
+"""
+
+CONTINUUM = """[continuum]
+mesh = rectangle 0 -0.1 1 0.2 10 2 q4
+material = 70e9 0.3 2700 0.1 plane_stress
+fix = left x y
+"""
+
+# The four analyses without a time loop: beam and continuum, static and modal.
+NO_TIME_LOOP = {
+    "static_beam": "[run]\nanalysis = static\n" + BEAM + "load = 11 w -10\n",
+    "modal_beam": "[run]\nanalysis = modal\n" + BEAM + "[modal]\nmodes = 2\n",
+    "static_continuum": "[run]\nanalysis = static\n" + CONTINUUM + "traction = right 0 1000 uniform\n",
+    "modal_continuum": "[run]\nanalysis = modal\n" + CONTINUUM + "[modal]\nmodes = 2\n",
+}
+
+DYNAMIC_BEAM = "[run]\nanalysis = dynamic\n" + BEAM + "load = 11 w -10\n[time]\nstep = 2e-4\nend = 2e-3\n"
+
+
+def multicor(exe, *args):
+    return subprocess.run([str(exe), *map(str, args)], capture_output=True, text=True, timeout=300)
+
+
+def digest(path):
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def finished(path):
+    with h5py.File(path, "r") as f:
+        return int(f["summary"].attrs["finished"]) == 1
+
+
+def after_finished_run(exe, work):
+    """The folder's checkpoint is that of a finished particle run: each analysis without a
+    time loop runs without the warning and leaves it; `--restart --end` then extends it."""
+    folder = work / "finished"
+    (work / "dyn_disks.dat").write_text(PARTICLES)
+    first = multicor(exe, work / "dyn_disks.dat", "--output", folder, "--quiet")
+    if not check("particle run", first.returncode == 0, first.stderr.strip()[-300:]):
+        return
+    checkpoint = folder / "checkpoint.h5"
+    before = digest(checkpoint)
+    for name, text in NO_TIME_LOOP.items():
+        (work / f"{name}.dat").write_text(text)
+        proc = multicor(exe, work / f"{name}.dat", "--output", folder)
+        check(f"{name}: exit 0, no warning about the checkpoint",
+              proc.returncode == 0 and "checkpoint" not in proc.stdout + proc.stderr
+              and finished(folder / f"{name}.h5"),
+              f"exit {proc.returncode}, {(proc.stdout + proc.stderr).strip()[:300]!r}")
+        check(f"{name}: checkpoint unchanged", digest(checkpoint) == before, "")
+    extend = multicor(exe, work / "dyn_disks.dat", "--output", folder, "--restart", checkpoint, "--end", "0.02",
+                      "--quiet")
+    with h5py.File(folder / "dyn_disks.h5", "r") as f:
+        steps = int(f["summary"].attrs["steps"])
+    check("the particle run is extended to 0.02 s", extend.returncode == 0 and steps == 20,
+          f"exit {extend.returncode}, steps {steps}, {extend.stderr.strip()[-300:]!r}")
+    # a run with a time loop does replace it: the warning stays
+    (work / "dynamic_beam.dat").write_text(DYNAMIC_BEAM)
+    proc = multicor(exe, work / "dynamic_beam.dat", "--output", folder, "--quiet")
+    check("a dynamic beam run still warns", proc.returncode == 0 and "warning: this run replaces" in proc.stdout,
+          f"exit {proc.returncode}, {proc.stdout.strip()[:300]!r}")
+
+
+def after_interrupted_run(exe, work):
+    """The folder's checkpoint is that of a particle run stopped by SIGTERM (its results
+    still '.partial'): a static or modal run is not refused, leaves the checkpoint and the
+    partial file, and the particle run is continued to its end from them."""
+    folder = work / "interrupted"
+    deck = work / "long_disks.dat"
+    deck.write_text(PARTICLES.replace("end = 0.01", "end = 2.0"))
+    partial = folder / "long_disks.h5.partial"
+    proc = subprocess.Popen([str(exe), str(deck), "--output", str(folder), "--quiet"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while not partial.exists() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.01)
+    proc.send_signal(signal.SIGTERM)
+    out, err = proc.communicate(timeout=300)
+    if not check("particle run stopped by SIGTERM", proc.returncode == 143 and partial.exists(),
+                 f"exit {proc.returncode}, {err.strip()[-300:]!r}"):
+        return
+    checkpoint = folder / "checkpoint.h5"
+    before = digest(checkpoint)
+    for name in ("static_beam", "modal_continuum"):
+        (work / f"{name}.dat").write_text(NO_TIME_LOOP[name])
+        run = multicor(exe, work / f"{name}.dat", "--output", folder, "--quiet")
+        check(f"{name} beside an interrupted run: exit 0, checkpoint and partial file kept",
+              run.returncode == 0 and digest(checkpoint) == before and partial.exists(),
+              f"exit {run.returncode}, {(run.stdout + run.stderr).strip()[:300]!r}")
+    run = multicor(exe, deck, "--output", folder, "--restart", checkpoint, "--quiet")
+    steps = -1
+    if run.returncode == 0 and (folder / "long_disks.h5").exists():
+        with h5py.File(folder / "long_disks.h5", "r") as f:
+            steps = int(f["summary"].attrs["steps"])
+    check("the interrupted particle run is continued to its end (2000 steps)", steps == 2000,
+          f"exit {run.returncode}, steps {steps}, {run.stderr.strip()[-300:]!r}")
+
+
+def main():
+    exe, work, _ = arguments(fresh=True)
+    after_finished_run(exe, work)
+    after_interrupted_run(exe, work)
+    return summary()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
