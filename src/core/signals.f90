@@ -9,13 +9,21 @@
 !> program at once. SIGXFSZ is ignored, so that a file size limit (`ulimit -f`) gives a write
 !> error instead of killing the program. The flag lives in the C file (a signal handler can
 !> only set a `volatile sig_atomic_t`); this module keeps no state.
+!>
+!> SIGPIPE, a write to a pipe whose reader has gone (`multicor deck.dat | head -1`, a `tee`
+!> that died), is caught from the program's start (`catch_broken_pipe`) and recorded apart:
+!> the write fails instead of killing the program, which leaves its results folder locked
+!> and its results '.partial'. `broken_pipe()` then tells the printing routine to print no
+!> more (the lines are progress, not results; gfortran keeps every line that failed in the
+!> unit's buffer): the run goes on to its end, or to a stop signal, as if `--quiet`.
 module core_signals
     use, intrinsic :: iso_c_binding, only: c_int
     use core_error, only: error_t, make_error
     implicit none
     private
     public :: install_signal_handlers, caught_signal, signal_name, clear_caught_signal, &
-              signal_exit_code, stop_signals
+              signal_exit_code, stop_signals, catch_broken_pipe, broken_pipe, clear_broken_pipe, &
+              broken_pipe_signal
 
     interface
         !> Install the handlers (0 on success).
@@ -29,6 +37,21 @@ module core_signals
         !> Forget the caught signal.
         subroutine c_clear() bind(c, name='multicor_signals_clear')
         end subroutine c_clear
+        !> Install the SIGPIPE handler (0 on success).
+        integer(c_int) function c_sigpipe_install() bind(c, name='multicor_sigpipe_install')
+            import :: c_int
+        end function c_sigpipe_install
+        !> 1 once a SIGPIPE was caught, else 0.
+        integer(c_int) function c_pipe_broken() bind(c, name='multicor_pipe_broken_get')
+            import :: c_int
+        end function c_pipe_broken
+        !> Forget a caught SIGPIPE.
+        subroutine c_pipe_clear() bind(c, name='multicor_pipe_broken_clear')
+        end subroutine c_pipe_clear
+        !> SIGPIPE of this platform.
+        integer(c_int) function c_sigpipe() bind(c, name='multicor_sigpipe')
+            import :: c_int
+        end function c_sigpipe
         !> SIGTERM of this platform.
         integer(c_int) function c_sigterm() bind(c, name='multicor_sigterm')
             import :: c_int
@@ -52,6 +75,29 @@ contains
         if (c_install() /= 0) call make_error(error, 'cannot install the signal handlers '// &
                                               '(SIGTERM, SIGINT, SIGUSR1)')
     end subroutine install_signal_handlers
+
+    !> Catch SIGPIPE from now on: a write to a pipe without reader fails (EPIPE) and is
+    !> recorded (`broken_pipe`) instead of killing the program.
+    subroutine catch_broken_pipe(error)
+        !> Set when the operating system refuses the handler.
+        type(error_t), allocatable, intent(out) :: error
+        if (c_sigpipe_install() /= 0) call make_error(error, 'cannot install the signal handler (SIGPIPE)')
+    end subroutine catch_broken_pipe
+
+    !> Whether a write went to a pipe whose reader has gone (SIGPIPE caught) since the start.
+    logical function broken_pipe()
+        broken_pipe = c_pipe_broken() /= 0
+    end function broken_pipe
+
+    !> Forget a caught SIGPIPE (for tests).
+    subroutine clear_broken_pipe()
+        call c_pipe_clear()
+    end subroutine clear_broken_pipe
+
+    !> SIGPIPE's number on this platform (for tests).
+    integer function broken_pipe_signal()
+        broken_pipe_signal = int(c_sigpipe())
+    end function broken_pipe_signal
 
     !> Number of the first stop signal caught since the start (0: none).
     integer function caught_signal()

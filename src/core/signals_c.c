@@ -5,15 +5,27 @@
  * the signal back its default action after the first delivery: a second SIGTERM or Ctrl-C
  * kills the program at once (the results file stays readable up to its last flush).
  * SIGXFSZ (file size limit, `ulimit -f`) is ignored, so that exceeding the limit makes the
- * write fail with EFBIG and is reported like a full disk instead of killing the process. */
+ * write fail with EFBIG and is reported like a full disk instead of killing the process.
+ *
+ * SIGPIPE (a write to a pipe whose reader is gone: `multicor deck.dat | head -1`) sets a
+ * flag of its own and keeps its handler: the write fails with EPIPE instead of killing the
+ * program, and the program stops printing (its lines are not its results) and goes on. A
+ * handler rather than SIG_IGN: an ignored signal would stay ignored in child processes. */
 #include <signal.h>
 #include <string.h>
 
 static volatile sig_atomic_t multicor_caught = 0;
+static volatile sig_atomic_t multicor_pipe_broken = 0;
 
 static void multicor_on_signal(int sig)
 {
     if (multicor_caught == 0) multicor_caught = sig;
+}
+
+static void multicor_on_sigpipe(int sig)
+{
+    (void)sig;
+    multicor_pipe_broken = 1;
 }
 
 /* Install the handlers; 0 on success, -1 when sigaction fails. */
@@ -35,6 +47,27 @@ int multicor_signals_install(void)
     if (sigaction(SIGXFSZ, &sa, NULL) != 0) return -1;
     return 0;
 }
+
+/* Catch SIGPIPE from now on (every delivery: no SA_RESETHAND); 0 on success, -1 when
+ * sigaction fails. */
+int multicor_sigpipe_install(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = multicor_on_sigpipe;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESTART;
+    return sigaction(SIGPIPE, &sa, NULL) == 0 ? 0 : -1;
+}
+
+/* 1 once a SIGPIPE was caught, else 0. */
+int multicor_pipe_broken_get(void) { return (int)multicor_pipe_broken; }
+
+/* Forget a caught SIGPIPE (tests only). */
+void multicor_pipe_broken_clear(void) { multicor_pipe_broken = 0; }
+
+/* SIGPIPE of this platform. */
+int multicor_sigpipe(void) { return SIGPIPE; }
 
 /* Number of the first signal caught (0: none). */
 int multicor_signals_caught(void) { return (int)multicor_caught; }

@@ -17,7 +17,7 @@ program multicor
     use core_kinds, only: wp
     use core_error, only: error_t, error_internal
     use core_version, only: multicor_version
-    use core_signals, only: signal_exit_code
+    use core_signals, only: signal_exit_code, catch_broken_pipe
     use core_strings, only: parse_real
     use io_deck_schema, only: multicor_schema, schema_markdown
     use driver_run, only: run_options_t, run_deck
@@ -31,6 +31,14 @@ program multicor
     integer :: i, n, stopped_by
     logical :: take_output, take_restart, take_end, ok
 
+    ! A closed pipe on standard output (`multicor deck.dat | head -1`) must not kill the run
+    ! (its folder would stay locked, its results '.partial'): from here on such a write fails
+    ! and the run goes on without printing (driver_simulation, report_to_stdout).
+    call catch_broken_pipe(error)
+    if (allocated(error)) then
+        write (error_unit, '(a)') 'multicor: error: '//error%message
+        stop 1, quiet = .true.
+    end if
     n = command_argument_count()
     take_output = .false.
     take_restart = .false.

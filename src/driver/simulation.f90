@@ -13,6 +13,7 @@
 module driver_simulation
     use, intrinsic :: iso_fortran_env, only: output_unit
     use core_error, only: error_t
+    use core_signals, only: broken_pipe
     use core_strings, only: string_t
     use io_deck, only: deck_t
     use driver_results, only: results_writer_t
@@ -142,10 +143,12 @@ module driver_simulation
 contains
 
     !> The report of the command line program (a `report_iface`): the line on standard output,
-    !> flushed, so that a batch log follows the run.
+    !> flushed, so that a batch log follows the run. Once standard output is a pipe whose reader
+    !> has gone (SIGPIPE caught, core_signals), nothing more is printed: the run goes on.
     subroutine report_to_stdout(line)
         !> The line.
         character(len=*), intent(in) :: line
+        if (broken_pipe()) return
         write (output_unit, '(a)') line
         flush (output_unit)
     end subroutine report_to_stdout
