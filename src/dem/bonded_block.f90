@@ -137,7 +137,9 @@
 !> J/m free, was given up at a step in six);
 !> above it the block is given up for the step, which the plain sweeps solve again from the
 !> free velocities and zero reactions (the warm start carries the self-stresses) with a cap
-!> of their own. Not with bilateral constraints (their multipliers work on the disks too).
+!> of their own. Not with bilateral constraints (their multipliers work on the disks too),
+!> and only in a step whose block held bonds: without intact bonds the step is method =
+!> nlgs's, bit for bit, its unconverged steps included.
 !>
 !> Released bonds that hold a part alone (`condense`): a released bond whose two bodies are
 !> not connected through B carries the part beyond it by itself, a rigid body or a structure
@@ -398,10 +400,12 @@ contains
     !> the NLGS sweeps over the other contacts (block Gauss-Seidel), then the outer check of
     !> the bonds' cones (module header). Arguments as nlgs_solve; config%max_sweeps bounds the
     !> block iterations of the whole step, every pass included, and stats%sweeps counts them.
-    !> A pass whose reactions created energy (created_energy above created_fraction of the
-    !> kinetic energy) is given up: the step is solved again from its free velocities and zero
-    !> reactions by the plain sweeps (as method = nlgs), with a cap of its own (module header,
-    !> "Cap and energy guard"), and stats%block_given_up is set.
+    !> In a step whose block held intact bonds, a pass whose reactions created energy
+    !> (created_energy above created_fraction of the kinetic energy) is given up: the step is
+    !> solved again from its free velocities and zero reactions by the plain sweeps (as method
+    !> = nlgs), with a cap of its own (module header, "Cap and energy guard"), and
+    !> stats%block_given_up is set. A step without intact bonds (none in the deck, or all
+    !> broken) is the sweeps of method = nlgs, bit for bit, converged or not.
     subroutine bonded_block_solve(self, config, cs, im, vel, stats, bilateral)
         !> The strategy and its block (kept between steps).
         class(bonded_block_method_t), intent(inout) :: self
@@ -423,7 +427,7 @@ contains
         real(wp) :: excess
         integer(i8) :: updates, local
         real(wp), allocatable :: vfree(:, :)
-        logical :: give_up_block
+        logical :: give_up_block, held
         associate (block => self%block)
             if (allocated(block%excluded)) then
                 if (size(block%excluded) < cs%n) deallocate (block%excluded)
@@ -440,6 +444,7 @@ contains
             local = 0_i8
             n_blocked = -1
             give_up_block = .false.
+            held = .false.
             block%resolving = .false.
             do
                 left%max_sweeps = config%max_sweeps - sweeps
@@ -448,10 +453,16 @@ contains
                 sweeps = sweeps + pass%sweeps
                 updates = updates + pass%updates
                 local = local + pass%local_iterations
+                ! the guard judges a step whose block held bonds (at its first pass: the passes
+                ! after a release start from the block's reactions); without intact bonds the
+                ! passes are the sweeps of method = nlgs, and so is the step, bit for bit (a
+                ! bond-free hexagonal stack at max_sweeps = 2 was given up at step 16, its plain
+                ! sweeps restarted from zero reactions, where nlgs keeps its warm start)
+                held = held .or. pass%n_block > 0
                 ! (not judged when the block's equalities have no solution: its reactions are of
                 ! order 1/eps by construction, and the releases below set them free; a lattice
                 ! pulled apart at step 1 was given up there, its bonds never released)
-                if (.not. present(bilateral) .and. block%consistent) then
+                if (held .and. .not. present(bilateral) .and. block%consistent) then
                     if (bonded_block_creates_energy(cs, im, vel, vfree)) then
                         give_up_block = .true.
                         exit

@@ -177,7 +177,8 @@ contains
                            'intact bonds (with the coupling rows) are solved exactly as one sparse block '// &
                            '(CHOLMOD), alternating with sweeps over the other contacts (block Gauss-Seidel); a '// &
                            'bond whose reaction leaves its cone is released and the step solved again, so the '// &
-                           'bonds break as with `nlgs`. Without bonds both are the same sweeps. `coarse`: the '// &
+                           'bonds break as with `nlgs`. A step without intact bonds (none in the deck, or all '// &
+                           'broken) is the same sweeps with both, bit for bit, converged or not. `coarse`: the '// &
                            'sweeps of `nlgs` with a coarse correction every `coarse_every` sweeps, which scales '// &
                            'the reactions of aggregates of `coarse_size` consecutive contacts at once (for tall '// &
                            'packings away from rest and deposits, doc/performance.md; it changes nothing at a '// &
@@ -199,7 +200,7 @@ contains
                            'of the step: a bond released by the check of the bonds'' cones starts a new pass '// &
                            'with the iterations left, and a step out of them with a bond still outside its cone '// &
                            'ends unconverged, its error at least the bond''s relative excess over its bound; a '// &
-                           'step whose block solve created energy is solved again by plain sweeps from zero '// &
+                           'step whose block of intact bonds created energy is solved again by plain sweeps from zero '// &
                            'reactions, which take up to max_sweeps more, counted too: doc/theory.md 7.10); a '// &
                            'step that reaches it without converging is reported (warning) and counted.', default='1000')
         call s%add_keyword('solver', 'local_tolerance', [real_field('local_tolerance', '', lower=0.0_wp, &
