@@ -36,11 +36,12 @@ Checks:
     tolerance times the sizes of their terms (the self-stress's cancelling impulses).
   - a hexagonal stack of 10 x 10 disks on a floor without cohesion, so without bonds, at
     max_sweeps = 2 (every step unconverged; an audit's deck): method = block gives the same
-    results as method = nlgs, bit for bit (doc/input.md: "Without bonds both are the same
-    sweeps"), and no 'bonded block' warning or summary line. The guard judged the steps of
-    an empty block too: at step 16 a pass of the plain sweeps, unconverged, created energy,
-    and the step was solved again from zero reactions where nlgs keeps its warm start, with
-    a warning about the self-stresses of a bonded lattice the deck does not have.
+    results as method = nlgs, bit for bit (doc/input.md, [solver] method: a step without
+    intact bonds is the same sweeps with both), and no 'bonded block' warning or summary
+    line. The guard judged the steps of an empty block too: at step 16 a pass of the plain
+    sweeps, unconverged, created energy, and the step was solved again from zero reactions
+    where nlgs keeps its warm start, with a warning about the self-stresses of a bonded
+    lattice the deck does not have.
 Usage (ctest does this): test_block_energy.py --exe multicor --work DIR --source REPO
 """
 import re
