@@ -1,5 +1,6 @@
 !> Stop requests from the operating system: SIGTERM (Slurm at the time limit, `kill`),
-!> SIGINT (Ctrl-C) and SIGUSR1 (`sbatch --signal=USR1@120`, sent before the time limit).
+!> SIGINT (Ctrl-C), SIGUSR1 (`sbatch --signal=USR1@120`, sent before the time limit) and
+!> SIGHUP (the terminal of an interactive run closed, an ssh session lost).
 !>
 !> `install_signal_handlers` installs a handler (src/core/signals_c.c) that only records the
 !> first signal caught; the time loops poll `caught_signal()` once per step, finish the step,
@@ -64,16 +65,20 @@ module core_signals
         integer(c_int) function c_sigusr1() bind(c, name='multicor_sigusr1')
             import :: c_int
         end function c_sigusr1
+        !> SIGHUP of this platform.
+        integer(c_int) function c_sighup() bind(c, name='multicor_sighup')
+            import :: c_int
+        end function c_sighup
     end interface
 
 contains
 
-    !> Catch SIGTERM, SIGINT and SIGUSR1 (and ignore SIGXFSZ) from now on.
+    !> Catch SIGTERM, SIGINT, SIGUSR1 and SIGHUP (and ignore SIGXFSZ) from now on.
     subroutine install_signal_handlers(error)
         !> Set when the operating system refuses a handler.
         type(error_t), allocatable, intent(out) :: error
         if (c_install() /= 0) call make_error(error, 'cannot install the signal handlers '// &
-                                              '(SIGTERM, SIGINT, SIGUSR1)')
+                                              '(SIGTERM, SIGINT, SIGUSR1, SIGHUP)')
     end subroutine install_signal_handlers
 
     !> Catch SIGPIPE from now on: a write to a pipe without reader fails (EPIPE) and is
@@ -109,7 +114,7 @@ contains
         call c_clear()
     end subroutine clear_caught_signal
 
-    !> Name of a signal number: 'SIGTERM', 'SIGINT', 'SIGUSR1', or 'signal <n>'.
+    !> Name of a signal number: 'SIGTERM', 'SIGINT', 'SIGUSR1', 'SIGHUP', or 'signal <n>'.
     function signal_name(sig) result(name)
         !> Signal number.
         integer, intent(in) :: sig
@@ -122,21 +127,23 @@ contains
             name = 'SIGINT'
         else if (sig == int(c_sigusr1())) then
             name = 'SIGUSR1'
+        else if (sig == int(c_sighup())) then
+            name = 'SIGHUP'
         else
             write (buf, '(a,i0)') 'signal ', sig
             name = trim(buf)
         end if
     end function signal_name
 
-    !> Numbers of the stop signals of this platform: SIGTERM, SIGINT, SIGUSR1.
+    !> Numbers of the stop signals of this platform: SIGTERM, SIGINT, SIGUSR1, SIGHUP.
     function stop_signals() result(sigs)
-        !> The three numbers, in that order.
-        integer :: sigs(3)
-        sigs = [int(c_sigterm()), int(c_sigint()), int(c_sigusr1())]
+        !> The four numbers, in that order.
+        integer :: sigs(4)
+        sigs = [int(c_sigterm()), int(c_sigint()), int(c_sigusr1()), int(c_sighup())]
     end function stop_signals
 
     !> Exit code of a run stopped by a signal: 128 + the signal number, the shell's
-    !> convention (SIGTERM 143, SIGINT 130, SIGUSR1 138 on Linux).
+    !> convention (SIGTERM 143, SIGINT 130, SIGUSR1 138, SIGHUP 129 on Linux).
     pure integer function signal_exit_code(sig)
         !> Signal number.
         integer, intent(in) :: sig

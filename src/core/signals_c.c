@@ -1,9 +1,10 @@
-/* Signal handling for core_signals (src/core/signals.f90): the only C in MULTICOR.
+/* Signal handling for core_signals (src/core/signals.f90).
  *
- * SIGTERM, SIGINT and SIGUSR1 set a flag and nothing else (the only thing a handler may
+ * SIGTERM, SIGINT, SIGUSR1 and SIGHUP set a flag and nothing else (the only thing a handler may
  * safely do); the time loops poll it once per step and stop cleanly. SA_RESETHAND gives
  * the signal back its default action after the first delivery: a second SIGTERM or Ctrl-C
- * kills the program at once (the results file stays readable up to its last flush).
+ * kills the program at once. SIGHUP (the terminal of an interactive run closed, an ssh
+ * session lost) stops the run as SIGTERM does, with its checkpoint, instead of killing it (the results file stays readable up to its last flush).
  * SIGXFSZ (file size limit, `ulimit -f`) is ignored, so that exceeding the limit makes the
  * write fail with EFBIG and is reported like a full disk instead of killing the process.
  *
@@ -31,7 +32,7 @@ static void multicor_on_sigpipe(int sig)
 /* Install the handlers; 0 on success, -1 when sigaction fails. */
 int multicor_signals_install(void)
 {
-    static const int handled[] = {SIGTERM, SIGINT, SIGUSR1};
+    static const int handled[] = {SIGTERM, SIGINT, SIGUSR1, SIGHUP};
     struct sigaction sa;
     size_t k;
     memset(&sa, 0, sizeof sa);
@@ -79,3 +80,4 @@ void multicor_signals_clear(void) { multicor_caught = 0; }
 int multicor_sigterm(void) { return SIGTERM; }
 int multicor_sigint(void) { return SIGINT; }
 int multicor_sigusr1(void) { return SIGUSR1; }
+int multicor_sighup(void) { return SIGHUP; }

@@ -95,7 +95,7 @@ contains
 
     !> Read, check and run a deck; write results unless only checking.
     !>
-    !> From the opening of the results file on, SIGTERM, SIGINT and SIGUSR1 stop a time loop
+    !> From the opening of the results file on, SIGTERM, SIGINT, SIGUSR1 and SIGHUP stop a time loop
     !> after the step under way: that step is stored, the file is closed as
     !> '<name>.h5.partial' with /summary finished = 0, and `error` says what was saved
     !> (`stopped_by` is then the signal number).

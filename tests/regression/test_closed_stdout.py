@@ -90,12 +90,14 @@ def reader_leaves(exe, work):
     finished_folder("head -1", folder, "dynamic_long", True)
 
 
-def stopped_after_reader_left(exe, work):
+def stopped_after_reader_left(exe, work, sig=signal.SIGTERM):
     """Standard output and error closed, then SIGTERM: the documented stop (exit 143, the
-    partial file and the checkpoint of the stop step, the lock released)."""
+    partial file and the checkpoint of the stop step, the lock released). SIGHUP, the
+    terminal of an interactive run closed, stops it the same way (exit 129), where it killed
+    the program before (exit -1 to Python: no checkpoint of the stop step, the lock left)."""
     deck = work / "dynamic_stop.dat"
     deck.write_text(DYNAMIC.format(end="100.0"))
-    folder = work / "stop"
+    folder = work / f"stop_{sig.name}"
     partial = folder / "dynamic_stop.h5.partial"
     w = closed_pipe()
     proc = subprocess.Popen([str(exe), str(deck), "--output", str(folder)], stdout=w, stderr=w)
@@ -106,16 +108,22 @@ def stopped_after_reader_left(exe, work):
     while not partial.exists() and proc.poll() is None and time.monotonic() < deadline:
         time.sleep(0.01)
     time.sleep(0.1)
-    proc.send_signal(signal.SIGTERM)
+    proc.send_signal(sig)
     proc.wait(timeout=300)
     left = sorted(p.name for p in folder.iterdir()) if folder.exists() else []
-    step = -1
+    step, status = -1, ""
     if (folder / "checkpoint.h5").exists():
         with h5py.File(folder / "checkpoint.h5", "r") as f:
             step = int(f["loop"].attrs["step"])
-    check("stopped by SIGTERM with stdout closed: exit 143, partial file and checkpoint, no lock",
-          proc.returncode == 143 and left == ["checkpoint.h5", "dynamic_stop.h5.partial"] and step > 0,
-          f"exit {proc.returncode}, folder {left}, checkpoint step {step}")
+    if partial.exists():
+        with h5py.File(partial, "r") as f:
+            status = f["summary"].attrs["status"]
+            status = status.decode() if isinstance(status, bytes) else status
+    check(f"stopped by {sig.name} with stdout closed: exit {128 + sig.value}, partial file and checkpoint of "
+          "the stop step, no lock",
+          proc.returncode == 128 + sig.value and left == ["checkpoint.h5", "dynamic_stop.h5.partial"] and step > 0
+          and status.startswith(f"signal {sig.name} at step {step},"),
+          f"exit {proc.returncode}, folder {left}, checkpoint step {step}, status {status!r}")
 
 
 def main():
@@ -123,6 +131,7 @@ def main():
     closed_from_the_start(exe, work)
     reader_leaves(exe, work)
     stopped_after_reader_left(exe, work)
+    stopped_after_reader_left(exe, work, signal.SIGHUP)
     return summary()
 
 
