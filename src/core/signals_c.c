@@ -4,7 +4,9 @@
  * safely do); the time loops poll it once per step and stop cleanly. SA_RESETHAND gives
  * the signal back its default action after the first delivery: a second SIGTERM or Ctrl-C
  * kills the program at once. SIGHUP (the terminal of an interactive run closed, an ssh
- * session lost) stops the run as SIGTERM does, with its checkpoint, instead of killing it (the results file stays readable up to its last flush).
+ * session lost) stops the run as SIGTERM does, with its checkpoint, instead of killing it;
+ * under `nohup` (SIGHUP ignored when the program starts) it stays ignored, and so does a
+ * SIGINT ignored at the start (the results file stays readable up to its last flush).
  * SIGXFSZ (file size limit, `ulimit -f`) is ignored, so that exceeding the limit makes the
  * write fail with EFBIG and is reported like a full disk instead of killing the process.
  *
@@ -40,6 +42,14 @@ int multicor_signals_install(void)
     sigemptyset(&sa.sa_mask);
     sa.sa_flags = SA_RESETHAND | SA_RESTART;
     for (k = 0; k < sizeof handled / sizeof handled[0]; ++k) {
+        /* A SIGHUP or SIGINT ignored by whoever started the program stays ignored: `nohup`
+         * (a run meant to outlive its terminal), a job started in the background by a
+         * non-interactive shell (Ctrl-C in the terminal is not for it). */
+        if (handled[k] == SIGHUP || handled[k] == SIGINT) {
+            struct sigaction old;
+            if (sigaction(handled[k], NULL, &old) != 0) return -1;
+            if (old.sa_handler == SIG_IGN) continue;
+        }
         if (sigaction(handled[k], &sa, NULL) != 0) return -1;
     }
     memset(&sa, 0, sizeof sa);

@@ -126,12 +126,34 @@ def stopped_after_reader_left(exe, work, sig=signal.SIGTERM):
           f"exit {proc.returncode}, folder {left}, checkpoint step {step}, status {status!r}")
 
 
+def nohup(exe, work):
+    """Under `nohup` (SIGHUP ignored when the program starts) a SIGHUP does not stop the run:
+    the program leaves an ignored SIGHUP ignored (a run meant to outlive its terminal). The
+    run (4 000 steps to 0.4 s) then ends as it would have."""
+    deck = work / "dynamic_nohup.dat"
+    deck.write_text(DYNAMIC.format(end="0.4"))
+    folder = work / "nohup"
+    w = closed_pipe()
+    proc = subprocess.Popen([str(exe), str(deck), "--output", str(folder)], stdout=w, stderr=w,
+                            preexec_fn=lambda: signal.signal(signal.SIGHUP, signal.SIG_IGN))
+    os.close(w)
+    deadline = time.monotonic() + 60
+    while not (folder / "dynamic_nohup.h5.partial").exists() and proc.poll() is None \
+            and time.monotonic() < deadline:
+        time.sleep(0.01)
+    proc.send_signal(signal.SIGHUP)
+    proc.wait(timeout=300)
+    check("nohup: SIGHUP ignored, exit 0", proc.returncode == 0, f"exit {proc.returncode}")
+    finished_folder("nohup", folder, "dynamic_nohup", True)
+
+
 def main():
     exe, work, _ = arguments(fresh=True)
     closed_from_the_start(exe, work)
     reader_leaves(exe, work)
     stopped_after_reader_left(exe, work)
     stopped_after_reader_left(exe, work, signal.SIGHUP)
+    nohup(exe, work)
     return summary()
 
 
