@@ -215,7 +215,7 @@ contains
             end do
             write (buf, '(a,i0,a,es13.5e3,a,es11.3e3,a)') 'dynamic run: ', n_steps, ' steps to t = ', &
                 self%integ%t, ' s; energy balance residual ', self%audit%balance(), ' J'
-            call report(trim(buf))
+            call report(trim(buf)//self%settings%balance_note())
             associate (x => self%model%mesh%x)
                 warning = large_displacement_warning(u_max, model_extent(x(1, :), x(2, :)), &
                                                      '[continuum] material, load, traction, gravity, '// &
