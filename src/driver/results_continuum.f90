@@ -4,9 +4,14 @@
 !> a triangle's 3 nodes), kind (1 = T3, 2 = Q4: the kind ids of fem_element_registry),
 !> topology (the 0-based XDMF connectivity: (3 or 4, n_elements) for one kind of element, a
 !> flat mixed list otherwise; the topology names and codes are the element kinds');
-!> /continuum/sets/{nodes,elements}/<name> (1-based indices) and /continuum/sets/edges/<name>
-!> (2, n_edges). A static run writes /continuum/static/{displacement (2, n_nodes), stress
-!> (3, n_elements: xx, yy, xy at element centres), strain_energy}; a modal run
+!> material (n_elements: the element's material, 1-based index into /continuum/materials);
+!> /continuum/materials/{young, poisson, density, thickness, plane_strain} (one value per
+!> `material` record of the deck, in deck order; plane_strain 1 for plane strain, 0 for plane
+!> stress); /continuum/sets/{nodes,elements}/<name> (1-based indices) and
+!> /continuum/sets/edges/<name> (2, n_edges). A static run writes
+!> /continuum/static/{displacement (2, n_nodes), stress (3, n_elements: xx, yy, xy at element
+!> centres), reactions (2, n_nodes: K u - f on the prescribed dofs, N; 0 on the free ones),
+!> strain_energy}; a modal run
 !> /continuum/modal/{omega, frequency, shapes (2, n_nodes, n_modes)}; a dynamic run the
 !> series /continuum/{time, displacement, velocity, stress} and /continuum/energy/{time,
 !> kinetic, strain, external_work, damping, balance, reaction_work} (h5py: one row per stored
@@ -21,6 +26,7 @@ module driver_results_continuum
     use core_error, only: error_t, make_error
     use io_hdf5_file, only: h5_file_t
     use fem_mesh2d, only: mesh2d_t
+    use fem_continuum_model, only: continuum_model_t
     use fem_element_registry, only: element_slot_t, element_family
     implicit none
     private
@@ -55,60 +61,62 @@ module driver_results_continuum
 
 contains
 
-    !> Mesh, sets and the series of a dynamic run.
-    subroutine writer_begin(self, file, mesh, analysis, error)
+    !> Mesh, materials, sets and the series of a dynamic run.
+    subroutine writer_begin(self, file, model, analysis, error)
         !> The writer.
         class(continuum_writer_t), intent(inout) :: self
         !> The open results file.
         type(h5_file_t), intent(inout) :: file
-        !> The mesh.
-        type(mesh2d_t), intent(in) :: mesh
+        !> The continuum (its mesh and materials).
+        type(continuum_model_t), intent(in) :: model
         !> 'static', 'modal' or 'dynamic'.
         character(len=*), intent(in) :: analysis
         !> Set on a write failure.
         type(error_t), allocatable, intent(out) :: error
         integer, allocatable :: topo(:)
         integer :: k, n
-        self%n_nodes = mesh%node_count()
-        self%n_elements = mesh%element_count()
+        self%n_nodes = model%mesh%node_count()
+        self%n_elements = model%mesh%element_count()
         self%analysis = analysis
         self%n_out = 0
         call file%create_group('/continuum', error)
         if (allocated(error)) return
         call file%create_group('/continuum/mesh', error)
         if (allocated(error)) return
-        call file%write_dataset('/continuum/mesh/coordinates', mesh%x, error)
+        call file%write_dataset('/continuum/mesh/coordinates', model%mesh%x, error)
         if (allocated(error)) return
         call file%write_attribute('/continuum/mesh/coordinates', 'units', 'm', error)
         if (allocated(error)) return
-        call file%write_dataset('/continuum/mesh/connectivity', mesh%connectivity, error)
+        call file%write_dataset('/continuum/mesh/connectivity', model%mesh%connectivity, error)
         if (allocated(error)) return
-        call file%write_dataset('/continuum/mesh/kind', mesh%kind, error)
+        call file%write_dataset('/continuum/mesh/kind', model%mesh%kind, error)
         if (allocated(error)) return
-        call set_topology(self, mesh, topo)
+        call set_topology(self, model%mesh, topo)
         if (self%topology /= 'Mixed') then
-            n = size(mesh%element_nodes(1))
+            n = size(model%mesh%element_nodes(1))
             call file%write_dataset('/continuum/mesh/topology', reshape(topo, [n, self%n_elements]), error)
         else
             call file%write_dataset('/continuum/mesh/topology', topo, error)
         end if
+        if (allocated(error)) return
+        call write_materials(file, model, error)
         if (allocated(error)) return
         call file%create_group('/continuum/sets', error)
         if (.not. allocated(error)) call file%create_group('/continuum/sets/nodes', error)
         if (.not. allocated(error)) call file%create_group('/continuum/sets/elements', error)
         if (.not. allocated(error)) call file%create_group('/continuum/sets/edges', error)
         if (allocated(error)) return
-        do k = 1, size(mesh%node_sets)
-            call file%write_dataset('/continuum/sets/nodes/'//mesh%node_sets(k)%name, mesh%node_sets(k)%ids, error)
+        do k = 1, size(model%mesh%node_sets)
+            call file%write_dataset('/continuum/sets/nodes/'//model%mesh%node_sets(k)%name, model%mesh%node_sets(k)%ids, error)
             if (allocated(error)) return
         end do
-        do k = 1, size(mesh%element_sets)
-            call file%write_dataset('/continuum/sets/elements/'//mesh%element_sets(k)%name, &
-                                    mesh%element_sets(k)%ids, error)
+        do k = 1, size(model%mesh%element_sets)
+            call file%write_dataset('/continuum/sets/elements/'//model%mesh%element_sets(k)%name, &
+                                    model%mesh%element_sets(k)%ids, error)
             if (allocated(error)) return
         end do
-        do k = 1, size(mesh%edge_sets)
-            call file%write_dataset('/continuum/sets/edges/'//mesh%edge_sets(k)%name, mesh%edge_sets(k)%nodes, error)
+        do k = 1, size(model%mesh%edge_sets)
+            call file%write_dataset('/continuum/sets/edges/'//model%mesh%edge_sets(k)%name, model%mesh%edge_sets(k)%nodes, error)
             if (allocated(error)) return
         end do
         if (analysis /= 'dynamic') return
@@ -135,6 +143,44 @@ contains
             call file%write_attribute(path, 'units', units, error)
         end subroutine series
     end subroutine writer_begin
+
+    !> /continuum/mesh/material (each element's material) and /continuum/materials (the
+    !> properties of each material, in the order of the deck's `material` records).
+    subroutine write_materials(file, model, error)
+        type(h5_file_t), intent(inout) :: file
+        type(continuum_model_t), intent(in) :: model
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: values(:)
+        integer, allocatable :: plane_strain(:)
+        call file%write_dataset('/continuum/mesh/material', model%element_material, error)
+        if (.not. allocated(error)) call file%create_group('/continuum/materials', error)
+        if (allocated(error)) return
+        ! (the components copied into an array first: passed directly they would be copied at
+        ! the call, a temporary that -fcheck=all reports)
+        values = model%materials%young
+        call real_set('young', values, 'Pa', error)
+        if (allocated(error)) return
+        values = model%materials%poisson
+        call real_set('poisson', values, '', error)
+        if (allocated(error)) return
+        values = model%materials%density
+        call real_set('density', values, 'kg/m^3', error)
+        if (allocated(error)) return
+        values = model%materials%thickness
+        call real_set('thickness', values, 'm', error)
+        if (allocated(error)) return
+        plane_strain = merge(1, 0, model%materials%plane_strain)
+        call file%write_dataset('/continuum/materials/plane_strain', plane_strain, error)
+    contains
+        subroutine real_set(name, values, units, error)
+            character(len=*), intent(in) :: name, units
+            real(wp), intent(in) :: values(:)
+            type(error_t), allocatable, intent(out) :: error
+            call file%write_dataset('/continuum/materials/'//name, values, error)
+            if (allocated(error) .or. len(units) == 0) return
+            call file%write_attribute('/continuum/materials/'//name, 'units', units, error)
+        end subroutine real_set
+    end subroutine write_materials
 
     !> The XDMF topology of a mesh: its name and the 0-based connectivity, flat (one kind of
     !> element: the kind's topology, n nodes per element, element after element; mixed: each
@@ -187,8 +233,9 @@ contains
         self%n_out = dims(1)
     end subroutine writer_resume
 
-    !> Static displacements (2, n_nodes), centre stresses (3, n_elements) and strain energy.
-    subroutine writer_write_static(self, file, d, stress, strain_energy, error)
+    !> Static displacements (2, n_nodes), centre stresses (3, n_elements), reactions (2, n_nodes)
+    !> and strain energy.
+    subroutine writer_write_static(self, file, d, stress, reactions, strain_energy, error)
         !> The writer.
         class(continuum_writer_t), intent(inout) :: self
         !> The open results file.
@@ -197,17 +244,25 @@ contains
         real(wp), intent(in) :: d(:, :)
         !> Stresses [Pa].
         real(wp), intent(in) :: stress(:, :)
+        !> Reactions of the supports on the prescribed dofs, 0 on the free ones [N].
+        real(wp), intent(in) :: reactions(:, :)
         !> Strain energy [J].
         real(wp), intent(in) :: strain_energy
         !> Set on a write failure.
         type(error_t), allocatable, intent(out) :: error
         call check_shapes(self, d, stress, error)
         if (allocated(error)) return
+        if (any(shape(reactions) /= shape(d))) then
+            call make_error(error, 'results: continuum reactions do not match the mesh')
+            return
+        end if
         call file%create_group('/continuum/static', error)
         if (.not. allocated(error)) call file%write_dataset('/continuum/static/displacement', d, error)
         if (.not. allocated(error)) call file%write_attribute('/continuum/static/displacement', 'units', 'm', error)
         if (.not. allocated(error)) call file%write_dataset('/continuum/static/stress', stress, error)
         if (.not. allocated(error)) call file%write_attribute('/continuum/static/stress', 'units', 'Pa', error)
+        if (.not. allocated(error)) call file%write_dataset('/continuum/static/reactions', reactions, error)
+        if (.not. allocated(error)) call file%write_attribute('/continuum/static/reactions', 'units', 'N', error)
         if (.not. allocated(error)) call file%write_attribute('/continuum/static', 'strain_energy', strain_energy, error)
     end subroutine writer_write_static
 

@@ -7,8 +7,9 @@
 !> - a beam (/fem/mesh): a polyline grid "beam" of the nodes (reference coordinates) with the
 !>   displacement (x, y; ParaView adds z = 0, so that Warp By Vector applies), the rotation,
 !>   and the velocity and acceleration when stored; the node ids;
-!> - a 2D continuum (/continuum/mesh): its mesh "continuum" with displacement, velocity and the
-!>   centre stresses as the scalars sigma_xx, sigma_yy, sigma_xy;
+!> - a 2D continuum (/continuum/mesh): its mesh "continuum" with displacement, velocity, the
+!>   static reactions, the centre stresses as the scalars sigma_xx, sigma_yy, sigma_xy and
+!>   each element's material;
 !> - disks (/dem/position): a point grid "disks" (the centres) with radius, material, velocity,
 !>   rotation and angular velocity; walls (/dem/walls/position): segments "walls";
 !> - static: one grid; modal: a temporal collection per part with one grid per mode, at the
@@ -42,6 +43,9 @@ module driver_results_xdmf
         integer, allocatable :: topology_dims(:)
         !> XDMF topology of the continuum ('Triangle', 'Quadrilateral', 'Mixed').
         character(len=:), allocatable :: topology
+        !> The continuum's /continuum/mesh/material and /continuum/static/reactions are stored
+        !> (a file of an earlier build, continued by a restart, may lack them).
+        logical :: mesh_material = .false., static_reactions = .false.
         !> Disks and walls.
         integer :: n_disks = 0, n_walls = 0
         !> Stored states (dynamic) or modes (modal).
@@ -137,6 +141,8 @@ contains
             call shape_of(file, '/continuum/mesh/kind', d, error)
             if (allocated(error)) return
             s%mesh_elements = d(1)
+            s%mesh_material = file%exists('/continuum/mesh/material')
+            s%static_reactions = file%exists('/continuum/static/reactions')
             call shape_of(file, '/continuum/mesh/topology', s%topology_dims, error)
             if (allocated(error)) return
             if (size(s%topology_dims) == 1) then
@@ -247,9 +253,13 @@ contains
         call begin_part(x, s, part, k)
         call x%topology(s%topology, e, xdmf_whole('/continuum/mesh/topology', s%topology_dims, is_integer=.true.))
         call x%geometry('XY', xdmf_whole('/continuum/mesh/coordinates', [n, 2]))
+        if (s%mesh_material) &
+            call x%attribute('material', 'Scalar', 'Cell', xdmf_whole('/continuum/mesh/material', [e], is_integer=.true.))
         select case (s%analysis)
         case ('static')
             call x%attribute('displacement', 'Vector', 'Node', xdmf_whole('/continuum/static/displacement', [n, 2]))
+            if (s%static_reactions) &
+                call x%attribute('reaction', 'Vector', 'Node', xdmf_whole('/continuum/static/reactions', [n, 2]))
             do c = 1, 3
                 call x%attribute(stress_names(c), 'Scalar', 'Cell', &
                                  xdmf_slab('/continuum/static/stress', [e, 3], [0, c - 1], [e, 1]))

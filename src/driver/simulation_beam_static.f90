@@ -103,6 +103,7 @@ contains
         procedure(report_iface) :: report
         type(error_t), allocatable, intent(out) :: error
         real(wp), allocatable :: u(:), d(:, :), r(:, :)
+        real(wp) :: u_max
         character(len=120) :: buf
         character(len=:), allocatable :: warning
         call solve_static(model, 0.0_wp, u, error)
@@ -118,10 +119,11 @@ contains
         end if
         call out%write_static(d, r, error)
         if (allocated(error)) return
-        write (buf, '(a,es13.5e3,a)') 'static solution: max |displacement| = ', &
-            maxval(abs(d(1:2, :))), ' m'
+        ! The largest nodal displacement sqrt(u^2 + w^2), the measure the warning below uses.
+        u_max = largest_displacement(d(1:2, :))
+        write (buf, '(a,es13.5e3,a)') 'static solution: max |displacement| = ', u_max, ' m'
         call report(trim(buf))
-        warning = large_displacement_warning(largest_displacement(d(1:2, :)), model_extent(model%x, model%y), &
+        warning = large_displacement_warning(u_max, model_extent(model%x, model%y), &
                                              '[beam] section, load, distributed, gravity, line, node')
         if (len(warning) > 0) call report(warning)
     end subroutine run_static

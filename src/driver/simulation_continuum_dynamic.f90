@@ -138,7 +138,7 @@ contains
         real(wp) :: u_max
         u_max = 0.0_wp
         ! At a restart the file has the mesh and the series already (restore).
-        if (.not. ck%restart) call writer%begin(out%file, self%model%mesh, self%settings%analysis, error)
+        if (.not. ck%restart) call writer%begin(out%file, self%model, self%settings%analysis, error)
         if (allocated(error)) return
         call run_dynamic(error)
 

@@ -1,5 +1,5 @@
 !> Static analysis of a 2D continuum: K_ff u_f = f_f - K_fp u_p at t = 0 (CHOLMOD), the
-!> displacements, the element-centre stresses and the strain energy.
+!> displacements, the element-centre stresses, the support reactions and the strain energy.
 module driver_simulation_continuum_static
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp
@@ -180,19 +180,19 @@ contains
         !> Set on a run or write failure.
         type(error_t), allocatable, intent(out) :: error
         type(continuum_writer_t) :: writer
-        call writer%begin(out%file, self%model%mesh, self%settings%analysis, error)
+        call writer%begin(out%file, self%model, self%settings%analysis, error)
         if (allocated(error)) return
         call run_static(error)
 
     contains
 
-        !> Stresses and energy of the solution, written.
+        !> Stresses, reactions and energy of the solution, written.
         subroutine run_static(error)
             type(error_t), allocatable, intent(out) :: error
-            real(wp), allocatable :: u(:), stress(:, :)
+            real(wp), allocatable :: u(:), stress(:, :), r(:), rest(:)
             character(len=160) :: buf
             character(len=:), allocatable :: warning
-            real(wp) :: energy
+            real(wp) :: energy, u_max
             u = self%model%expand(self%uf)
             call self%model%centre_stresses(u, stress, error)
             if (allocated(error)) return
@@ -201,20 +201,29 @@ contains
                                 'finite; likely cause: loads or moduli far too large or too small')
                 return
             end if
+            ! Reactions r = K u - f(0) on the prescribed dofs (the forces the supports apply to
+            ! the body, as /continuum/energy/reaction of a dynamic run); on the free dofs K u - f
+            ! is the solve's residual, not a force of the supports: 0 there.
+            allocate (rest(size(u)), source=0.0_wp)
+            r = self%ops%reactions(0.0_wp, u, rest, rest)
+            r = merge(r, 0.0_wp, self%model%prescribed)
             energy = self%ops%total_strain_energy(u)
-            if (.not. ieee_is_finite(energy)) then
-                call make_error(error, 'static solution of the continuum: the strain energy is not finite; likely '// &
+            if (.not. (ieee_is_finite(energy) .and. all(ieee_is_finite(r)))) then
+                call make_error(error, 'static solution of the continuum: the strain energy or a reaction is not '// &
+                                'finite; likely '// &
                                 'cause: loads or moduli far too large or too small')
                 return
             end if
-            call writer%write_static(out%file, reshape(u, [2, size(u)/2]), stress, energy, error)
+            call writer%write_static(out%file, reshape(u, [2, size(u)/2]), stress, reshape(r, [2, size(r)/2]), &
+                                     energy, error)
             if (allocated(error)) return
-            write (buf, '(a,es13.5e3,a,es13.5e3,a)') 'static solution: max |displacement| = ', maxval(abs(u)), &
+            ! The largest nodal displacement sqrt(ux^2 + uy^2), the measure the warning below uses.
+            u_max = largest_displacement(reshape(u, [2, size(u)/2]))
+            write (buf, '(a,es13.5e3,a,es13.5e3,a)') 'static solution: max |displacement| = ', u_max, &
                 ' m, strain energy = ', energy, ' J'
             call report(trim(buf))
             associate (x => self%model%mesh%x)
-                warning = large_displacement_warning(largest_displacement(reshape(u, [2, size(u)/2])), &
-                                                     model_extent(x(1, :), x(2, :)), &
+                warning = large_displacement_warning(u_max, model_extent(x(1, :), x(2, :)), &
                                                      '[continuum] material, load, traction, gravity, '// &
                                                      'displacement, mesh')
             end associate

@@ -17,6 +17,11 @@
   function id is an input error;
 - the XDMF file opened by ParaView (pvpython, the 'XDMF Reader') when installed, else meshio
   (static file only: meshio does not read XDMF hyperslabs);
+- the support reactions of a static run (/continuum/static/reactions): a column's weight
+  rho g W H t carried by its rollers, a bar stretched by a prescribed end displacement
+  (E t D delta / L at each end), a prescribed rigid translation (no reaction); the materials
+  stored (/continuum/materials, /continuum/mesh/material) and the summary's largest
+  displacement (the nodal vector norm, as the large-displacement warning measures it);
 - postproc/plot_results.py, as ./run.sh calls it, on the static, dynamic and modal files.
 Usage (ctest does this): test_continuum_runs.py --exe multicor --work DIR --source REPO
 """
@@ -211,7 +216,6 @@ def energy_balance(exe, src, work):
               f"{line.strip()}; balance {balance:.3e} J of {work_:.3e} J")
 
 
-
 def gmsh_block(exe, src, work):
     gmsh = shutil.which("gmsh")
     if gmsh is None:
@@ -316,8 +320,11 @@ def xdmf_paraview(h5_static, h5_dynamic, work):
         n_out = f["continuum/time"].shape[0]
         last = f["continuum/displacement"][-1]
         last_stress = f["continuum/stress"][-1]
+        dynamic_material = f["continuum/mesh/material"][...]
     with h5py.File(h5_static, "r") as f:
         static_stress = f["continuum/static/stress"][...]
+        static_reactions = f["continuum/static/reactions"][...]
+        static_material = f["continuum/mesh/material"][...]
     if shutil.which("pvpython") is not None:
         rows = read_paraview([xdmf_static, xdmf_dynamic], work, "ParaView (pvpython) opens both XDMF files")
         if rows is not None:
@@ -335,12 +342,100 @@ def xdmf_paraview(h5_static, h5_dynamic, work):
                        and static_block["cell_data"][n] == static_stress[:, c].tolist() for c, n in enumerate(names))
             check("ParaView reads the stresses as sigma_xx, sigma_yy, sigma_xy",
                   all(n in block["cell_data"] for n in names) and same, sorted(block["cell_data"]))
+            # the static reactions (point vector, ParaView adds z = 0) and each element's
+            # material (cell scalar), equal to the HDF5 datasets bit for bit
+            reaction = [row[:2] for row in static_block["data"].get("reaction", [])]
+            check("ParaView reads the static reactions and the elements' materials",
+                  reaction == static_reactions.tolist() and static_block["cell_data"].get("material") ==
+                  static_material.tolist() and block["cell_data"].get("material") == dynamic_material.tolist(),
+                  f"{sorted(static_block['data'])}, {sorted(static_block['cell_data'])}, {sorted(block['cell_data'])}")
         return
     import meshio  # noqa: E402 (postproc/requirements.txt)
     m = meshio.read(xdmf_static)
     with h5py.File(h5_static, "r") as f:
         d = f["continuum/static/displacement"][...]
     check("meshio opens the static XDMF (no pvpython)", np.array_equal(m.point_data["displacement"], d), "meshio")
+
+
+def static_reactions(exe, work):
+    """Reactions of the supports in a static run, K u - f on the prescribed dofs (N, 0 on the
+    free dofs), against closed forms; the materials stored; the summary's max |displacement|."""
+    # A column W x H under its weight on rollers (bottom: y; left: x). Two material records on
+    # the whole mesh, the second (plane strain) overriding the first: every element's material
+    # is record 2, and /continuum/materials lists both in deck order.
+    W, H, t, rho, g = 0.5, 3.0, 0.2, 2500.0, 9.81
+    deck = write_deck(work, "column_weight", f"""[run]
+analysis = static
+[continuum]
+mesh = rectangle 0 0 {W} {H} 3 12 q4
+material = 30e9 0.3 2500 0.2 plane_stress
+material = 25e9 0.2 {rho} {t} plane_strain
+fix = bottom y
+fix = left x
+gravity = 0 -{g}
+""")
+    with h5py.File(run(exe, deck, work), "r") as f:
+        x = f["continuum/mesh/coordinates"][...]
+        r = f["continuum/static/reactions"][...] if "continuum/static/reactions" in f else None
+        units = f["continuum/static/reactions"].attrs.get("units") if r is not None else None
+        mat = {k: f["continuum/materials"][k][...].tolist() for k in f["continuum/materials"]} \
+            if "continuum/materials" in f else {}
+        index = f["continuum/mesh/material"][...] if "continuum/mesh/material" in f else None
+    if not check("static reactions stored (n_nodes, 2) [N]", r is not None and r.shape == x.shape and units == "N",
+                 f"{None if r is None else r.shape}, units {units}"):
+        return
+    weight = rho * g * W * H * t
+    # Equilibrium of the whole body: the reactions carry the weight up to the solve's residual
+    # (|K u - f| / |f| about 1e-16 here) and the round-off of the sum: 1e-9 relative.
+    check("column: reactions carry the weight rho g W H t", abs(r[:, 1].sum() / weight - 1) < 1e-9
+          and abs(r[:, 0].sum()) < 1e-9 * weight, f"{r.sum(axis=0)} N vs (0, {weight}) N")
+    bottom, left = np.isclose(x[:, 1], 0.0), np.isclose(x[:, 0], 0.0)
+    check("column: reactions only on the prescribed dofs", not r[~bottom, 1].any() and not r[~left, 0].any()
+          and (r[bottom, 1] > 0).all(), f"{np.count_nonzero(r)} nonzero")
+    check("materials stored in deck order, each element's the last record", mat == {
+        "young": [30e9, 25e9], "poisson": [0.3, 0.2], "density": [2500.0, rho], "thickness": [0.2, t],
+        "plane_strain": [0, 1]} and index is not None and (index == 2).all(), f"{mat}, {index}")
+    # A bar (nu = 0) stretched by delta on its right side (rollers left and bottom): the
+    # stress E delta / L is uniform, which Q4 represents exactly; each end carries E t D
+    # delta / L (outward on the right, inward on the left) up to round-off: 1e-9 relative.
+    E, L, D, delta = 2e11, 2.0, 0.4, 1e-4
+    deck = write_deck(work, "bar_stretched", f"""[run]
+analysis = static
+[continuum]
+mesh = rectangle 0 0 {L} {D} 8 2 q4
+material = {E} 0 7800 {t} plane_stress
+fix = left x
+fix = bottom y
+displacement = right x {delta}
+""")
+    with h5py.File(run(exe, deck, work), "r") as f:
+        x = f["continuum/mesh/coordinates"][...]
+        r = f["continuum/static/reactions"][...]
+    force = E * t * D * delta / L
+    right, left = np.isclose(x[:, 0], L), np.isclose(x[:, 0], 0.0)
+    check("bar: end reactions E t D delta / L", abs(r[right, 0].sum() / force - 1) < 1e-9
+          and abs(r[left, 0].sum() / force + 1) < 1e-9 and np.abs(r[:, 1]).max() < 1e-9 * force,
+          f"{r[right, 0].sum()}, {r[left, 0].sum()} N vs +-{force} N")
+    # A rigid translation (delta, delta) prescribed on the left side: no reaction (round-off of
+    # K u against E t delta: 1e-9), and the summary's max |displacement| is the nodal vector
+    # norm sqrt(2) delta, the measure of the large-displacement warning (the largest component,
+    # delta, was printed before), to the printed 6 digits.
+    deck = write_deck(work, "block_translated", f"""[run]
+analysis = static
+[continuum]
+mesh = rectangle 0 0 {L} {D} 4 2 t3
+material = {E} 0.25 7800 {t} plane_stress
+displacement = left x {delta}
+displacement = left y {delta}
+""")
+    h5, proc = multicor(exe, deck, work, quiet=False)
+    with h5py.File(h5, "r") as f:
+        r = f["continuum/static/reactions"][...]
+    check("translation: no reaction", np.abs(r).max() < 1e-9 * E * t * delta, f"max |r| {np.abs(r).max():.3e} N")
+    m = re.search(r"max \|displacement\| = +(\S+) m", proc.stdout)
+    printed = float(m.group(1)) if m else math.nan
+    check("summary max |displacement| is the largest nodal norm", abs(printed / (math.sqrt(2) * delta) - 1) < 1e-5,
+          f"{printed} vs {math.sqrt(2) * delta:.6e}")
 
 
 def summary_without_steps(exe, src, work):
@@ -364,19 +459,21 @@ def main():
     energy_balance(exe, src, work)
     gmsh_block(exe, src, work)
     timed_loads(exe, work)
+    static_reactions(exe, work)
     summary_without_steps(exe, src, work)
     h5_dynamic = work / "continuum_cantilever_dynamic" / "continuum_cantilever_dynamic.h5"
     xdmf_paraview(h5_static, h5_dynamic, work)
     # every dataset with a physical unit carries it (doc/output.md), static and modal too
     units = {}
-    for h5, names in ((h5_static, ["continuum/static/displacement", "continuum/static/stress"]),
+    for h5, names in ((h5_static, ["continuum/static/displacement", "continuum/static/stress",
+                                   "continuum/static/reactions", "continuum/materials/young"]),
                       (work / "strip_160x4" / "strip_160x4.h5",
                        ["continuum/modal/omega", "continuum/modal/frequency", "continuum/modal/shapes"])):
         with h5py.File(h5, "r") as f:
             units.update({n: f[n].attrs.get("units", b"").decode() if isinstance(f[n].attrs.get("units", ""), bytes)
                           else str(f[n].attrs.get("units", "")) for n in names})
     check("static and modal datasets carry their units",
-          list(units.values()) == ["m", "Pa", "rad/s", "Hz", "kg^-1/2 (mass-normalised)"], str(units))
+          list(units.values()) == ["m", "Pa", "N", "Pa", "rad/s", "Hz", "kg^-1/2 (mass-normalised)"], str(units))
     # the plots ./run.sh draws after a continuum run: static, dynamic and modal
     plots(src, h5_static, work / "png", ["stress"])
     plots(src, h5_dynamic, work / "png", ["stress", "continuum_energy", "history"])

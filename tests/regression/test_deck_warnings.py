@@ -20,7 +20,9 @@ goes on, and a warning names the file, the line and the setting that turns it of
   farthest; disks within it, or any distance once max_offset is set, are not.
 - A static or dynamic beam or continuum run, coupled to disks or not, whose largest
   displacement exceeds 10 % of the model's extent (a modulus in MPa read as Pa) warns that linear theory does not hold, with
-  exit 0; the threshold is checked on a cantilever's closed-form tip deflection.
+  exit 0; the threshold is checked on a cantilever's closed-form tip deflection. A static
+  beam run's summary prints as max |displacement| that same measure, the largest nodal
+  sqrt(u^2 + w^2) (a cantilever at 45 degrees: sqrt(2) times its largest component).
 - Coupled disks free to turn (`[coupling] rotation = off`, the default) with a law of friction
   and no rolling resistance are warned about: they roll instead of transmitting friction.
 - A `[contacts] bond` record that bonds no pair at t = 0 (a loose deposit, a row with gaps of
@@ -45,6 +47,7 @@ goes on, and a warning names the file, the line and the setting that turns it of
 
 Usage (ctest does this): test_deck_warnings.py --exe multicor --work DIR --source REPO
 """
+import math
 import re
 import subprocess
 import sys
@@ -387,6 +390,20 @@ load = 11 w -{load}
               proc.returncode == 0 and (len(said) == 1 and said[0].startswith(lead) and said[0].endswith(tail)
                                         if warned else not said),
               f"exit {proc.returncode}; " + ("\n".join(said) or proc.stderr.strip()[:300]))
+    # the summary's max |displacement| is the largest nodal norm, the measure of the warning:
+    # a cantilever at 45 degrees under a vertical end load deflects across its axis by
+    # (P / sqrt 2) L^3 / (3 E I) exactly (cubic elements); the axial shortening P L / (sqrt 2
+    # E A), 2.5e-5 of it and at right angles, adds 3e-10 to the norm; the components are
+    # 1/sqrt 2 of it. To the 6 printed digits: 1e-5
+    deck = work / "beam_45_degrees.dat"
+    deck.write_text(beam.format(young="2.1e11", load="10").replace("1.0 0.0 10 1", "0.7071067811865476 "
+                                                                   "0.7071067811865476 10 1"))
+    proc = multicor(exe, deck, "--output", work / deck.stem)
+    m = re.search(r"max \|displacement\| = +(\S+) m", proc.stdout)
+    printed = float(m.group(1)) if m else math.nan
+    across = 10 / math.sqrt(2) / (3 * 2.1e11 * 1.6666666666666667e-9)
+    check("static beam: the summary's max |displacement| is the largest nodal norm",
+          abs(printed / across - 1) < 1e-5, f"{printed} vs {across:.6e} m (largest component {across / math.sqrt(2):.6e})")
     text = re.sub(r"^(section\s*=\s*1\s+)2.1e11", r"\g<1>2.1e5", (src / "input" / "cantilever.dat").read_text(),
                   count=1, flags=re.M)
     deck = work / "cantilever_mpa.dat"
