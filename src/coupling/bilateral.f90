@@ -1,5 +1,5 @@
 !> The Arlequin coupling rows as bilateral velocity constraints inside the NLGS contact solve
-!> (THEORY.md section 4; used by coupling_arlequin).
+!> (doc/theory.md section 6.7; used by coupling_arlequin).
 !>
 !> Unknowns of a coupled step: the contact impulses r and the multipliers lambda (one per
 !> row of C). With G selecting the coupled particle DOFs, the end-of-step constraint is

@@ -1,4 +1,4 @@
-!> Local solver of the Signorini-Coulomb law with De Saxce's bi-potential (THEORY.md 1).
+!> Local solver of the Signorini-Coulomb law with De Saxce's bi-potential (doc/theory.md section 3).
 !>
 !> Local unknowns of one contact: reaction r = (r_n, r_t) (impulse) and relative velocity
 !> u = (u_n, u_t) = b + W r, with W the 2x2 local Delassus block. Convention: r_n >= 0 is

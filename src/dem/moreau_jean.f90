@@ -1,4 +1,4 @@
-!> Moreau-Jean theta-scheme for the discrete domain (THEORY.md 2), and the system that holds
+!> Moreau-Jean theta-scheme for the discrete domain (doc/theory.md section 2), and the system that holds
 !> everything one simulation of disks needs (no module state: two systems can coexist).
 !>
 !> One step from t to t + h:

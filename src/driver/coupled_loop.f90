@@ -16,7 +16,7 @@
 !> Warnings go through the report callback: steps whose joint solve did not converge (the
 !> first `max_warnings`, then only the count), once, a disk moving farther than the alert
 !> distance in a step, and once, then counted in the summary, a converged step whose contacts
-!> created energy (driver_guards::creation_allowance; doc/theory.md 2.4). The initial state
+!> created energy (driver_guards::creation_allowance; doc/theory.md 2.5). The initial state
 !> (step 0) and the state after every step are checked as in the uncoupled runs
 !> (driver_guards): the finite-element side by `check_part`, then the disks (non-finite
 !> values, beyond the representable box), then tunnelling (after a step).

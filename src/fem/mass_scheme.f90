@@ -1,4 +1,4 @@
-!> How an element's mass enters the assembled mass matrix (doc/theory.md, sections 5.4-5.5), as
+!> How an element's mass enters the assembled mass matrix (doc/theory.md, section 5.2), as
 !> a family of behaviour chosen once from the deck word `mass` of [beam] and [continuum]:
 !> - `consistent_mass_t`: the consistent element mass, whole (M = int rho N^T N);
 !> - `lumped_mass_t`: the element's lumped diagonal only (row sums for the 2D elements, HRZ

@@ -210,8 +210,9 @@ contains
                            default='1e-10')
         call s%add_keyword('solver', 'local_iterations', [int_field('local_iterations', lower=1)], &
                            'Largest number of local prediction-correction iterations per contact visit (a '// &
-                           'contact with rolling resistance or a bond that reaches it is then solved exactly, '// &
-                           'branch by branch, doc/theory.md 7.4).', &
+                           'contact with a moment length, rolling resistance or a bond with e_b > 0, that '// &
+                           'reaches it is then solved exactly, branch by branch, doc/theory.md 7.4; another '// &
+                           'contact stops at the cap).', &
                            default='8')
         call s%add_keyword('solver', 'criterion', [word_field('criterion', 'lmgc90 siconos')], &
                            'Which error stops the sweeps: lmgc90 (the change of W r over a sweep, see '// &
