@@ -4,7 +4,9 @@
 !> that runs to the end of the line; blank lines and tabs are fine. Lines end with LF, CR LF
 !> or a lone CR (old Mac files); a UTF-8 byte-order mark at the start of the file is skipped;
 !> another control character outside a comment is an error, and a NUL byte anywhere (the
-!> deck is stored in the results as a C string). A value is a word; a name (schema
+!> deck is stored in the results as a C string), as are bytes that are not UTF-8 anywhere and
+!> invisible Unicode spaces (core_utf8) outside a comment, a quoted name or the text of a text
+!> keyword. A value is a word; a name (schema
 !> `field_name`: a path, a set of a mesh) may instead be written between double quotes, which
 !> makes blanks and `#` part of it; quotes elsewhere, left open, empty or glued to a word are
 !> errors naming the column. A text keyword (`title`) keeps the rest of the line up to the
@@ -37,6 +39,7 @@ module io_deck
     use core_error, only: error_t, make_input_error, make_internal_error
     use core_strings, only: string_t, strip, split_words, join_words, is_blank_char, &
                             closest_match, parse_real, parse_int, to_str, shorten
+    use core_utf8, only: invalid_utf8_column, find_invisible_space, byte_hex
     use io_deck_schema, only: schema_t, keyword_spec_t, field_spec_t, condition_t, field_text, field_name, &
                               type_name
     implicit none
@@ -253,6 +256,41 @@ contains
             end do
         end subroutine check_control
 
+        !> An invisible Unicode space (no-break, thin, zero width, ...) in a line up to its
+        !> comment is an error naming it and its column: it looks like a blank but does not end
+        !> a word (`11<no-break space> w` is one value). A quoted name and the text of a text
+        !> keyword (title) may hold one: it is part of that text.
+        subroutine check_invisible(line)
+            character(len=*), intent(in) :: line
+            character(len=len(line)) :: seen
+            character(len=:), allocatable :: what
+            integer :: i, eq_col, k, column
+            logical :: inside, is_text
+            seen = line
+            eq_col = index(line, '=')
+            if (index(strip(line), '[') == 1) eq_col = 0
+            if (eq_col > 0) then
+                k = 0
+                if (len(current) > 0) k = schema%find_keyword(current, strip(line(:eq_col - 1)))
+                is_text = .false.
+                if (k > 0) is_text = schema%keywords(k)%fields(1)%value_type == field_text
+                if (is_text) then
+                    seen(eq_col + 1:) = ' '
+                else
+                    inside = .false.
+                    do i = eq_col + 1, len(line)
+                        if (line(i:i) == '"') inside = .not. inside
+                        if (inside .or. line(i:i) == '"') seen(i:i) = ' '
+                    end do
+                end if
+            end if
+            call find_invisible_space(seen, column, what)
+            if (column == 0) return
+            call make_input_error(error, file, line_no, '', what//' at column '//to_str(column)// &
+                                  ': an invisible character that looks like a blank but does not separate '// &
+                                  'words; replace it with a plain space (or delete it)')
+        end subroutine check_invisible
+
         !> Validate one line and store its entry.
         subroutine parse_line(raw)
             character(len=*), intent(in) :: raw
@@ -290,11 +328,22 @@ contains
                     return
                 end if
             end if
+            ! Not UTF-8, even in a comment: the deck is stored in the results as UTF-8 text
+            ! (/deck_text, the title), which the readers of the results then fail to decode.
+            k = invalid_utf8_column(raw)
+            if (k > 0) then
+                call make_input_error(error, file, line_no, '', 'byte '//byte_hex(raw(k:k))//' at column '// &
+                                      to_str(k)//' is not UTF-8 text: save the deck as UTF-8 (it was '// &
+                                      'most likely saved as Latin-1 or Windows-1252)')
+                return
+            end if
             if (len(s) == 0) return
             if (hash > 0) then
                 call check_control(raw(:hash - 1))
+                if (.not. allocated(error)) call check_invisible(raw(:hash - 1))
             else
                 call check_control(raw)
+                if (.not. allocated(error)) call check_invisible(raw)
             end if
             if (allocated(error)) return
             if (s(1:1) == '[') then

@@ -1,0 +1,171 @@
+!> Checks of text a user typed (a deck, the names of a mesh) against UTF-8: the first byte
+!> that is not UTF-8 (a file saved as Latin-1 or Windows-1252: `é` is the single byte 0xE9),
+!> and the invisible Unicode spaces that an editor shows as a blank but that do not separate
+!> words (a no-break space typed with AltGr+Space, a thin space pasted from a document).
+!> Columns are counted in bytes, as the other messages of the deck reader count them.
+module core_utf8
+    implicit none
+    private
+    public :: invalid_utf8_column, find_invisible_space, byte_hex
+
+    !> An invisible Unicode space: its code point and its Unicode name.
+    type :: invisible_t
+        !> Code point.
+        integer :: code = 0
+        !> Unicode name, lowercase.
+        character(len=48) :: name = ''
+    end type invisible_t
+
+    !> The spaces that look like a blank (or like nothing) in an editor: no-break, typographic,
+    !> zero width and ideographic spaces, the word joiner and a byte-order mark inside the text
+    !> (the one at the start of a file is the reader's to skip).
+    type(invisible_t), parameter :: invisible(17) = [ &
+                                    invisible_t(int(z'00A0'), 'no-break space'), &
+                                    invisible_t(int(z'2000'), 'en quad'), &
+                                    invisible_t(int(z'2001'), 'em quad'), &
+                                    invisible_t(int(z'2002'), 'en space'), &
+                                    invisible_t(int(z'2003'), 'em space'), &
+                                    invisible_t(int(z'2004'), 'three-per-em space'), &
+                                    invisible_t(int(z'2005'), 'four-per-em space'), &
+                                    invisible_t(int(z'2006'), 'six-per-em space'), &
+                                    invisible_t(int(z'2007'), 'figure space'), &
+                                    invisible_t(int(z'2008'), 'punctuation space'), &
+                                    invisible_t(int(z'2009'), 'thin space'), &
+                                    invisible_t(int(z'200A'), 'hair space'), &
+                                    invisible_t(int(z'200B'), 'zero width space'), &
+                                    invisible_t(int(z'202F'), 'narrow no-break space'), &
+                                    invisible_t(int(z'2060'), 'word joiner'), &
+                                    invisible_t(int(z'3000'), 'ideographic space'), &
+                                    invisible_t(int(z'FEFF'), 'zero width no-break space (byte-order mark)')]
+
+contains
+
+    !> Column (in bytes) of the first byte of `text` that does not begin or continue a
+    !> well-formed UTF-8 sequence (RFC 3629: no overlong form, no surrogate, nothing beyond
+    !> U+10FFFF); 0 when the text is UTF-8 throughout.
+    pure integer function invalid_utf8_column(text) result(column)
+        !> The text.
+        character(len=*), intent(in) :: text
+        integer :: i, n
+        i = 1
+        do while (i <= len(text))
+            n = sequence_length(text, i)
+            if (n == 0) then
+                column = i
+                return
+            end if
+            i = i + n
+        end do
+        column = 0
+    end function invalid_utf8_column
+
+    !> Column (in bytes) of the first invisible Unicode space of `text` (a no-break, thin,
+    !> narrow no-break or zero width space, ...; 0 when there is none), with its Unicode name
+    !> and code point in `what`. Bytes that are not UTF-8 are passed over.
+    pure subroutine find_invisible_space(text, column, what)
+        !> The text.
+        character(len=*), intent(in) :: text
+        !> Column of the first byte of the space (0: none).
+        integer, intent(out) :: column
+        !> "no-break space (U+00A0)" for the space found ('' when none).
+        character(len=:), allocatable, intent(out) :: what
+        integer :: i, n, code, k
+        character(len=4) :: hex
+        what = ''
+        i = 1
+        do while (i <= len(text))
+            n = sequence_length(text, i)
+            if (n < 2) then
+                i = i + 1
+                cycle
+            end if
+            code = code_point(text(i:i + n - 1))
+            write (hex, '(z4.4)') code
+            do k = 1, size(invisible)
+                if (invisible(k)%code /= code) cycle
+                what = trim(invisible(k)%name)//' (U+'//hex//')'
+                column = i
+                return
+            end do
+            i = i + n
+        end do
+        column = 0
+    end subroutine find_invisible_space
+
+    !> A byte as `0xE9`.
+    pure function byte_hex(c) result(text)
+        !> The byte.
+        character(len=1), intent(in) :: c
+        character(len=4) :: text
+        write (text, '(a,z2.2)') '0x', ichar(c)
+    end function byte_hex
+
+    !> Length of the well-formed UTF-8 sequence starting at byte i of text (1 to 4), 0 when
+    !> the bytes there are not one.
+    pure integer function sequence_length(text, i) result(n)
+        character(len=*), intent(in) :: text
+        integer, intent(in) :: i
+        integer :: lead, lo, hi, k, c
+        lead = ichar(text(i:i))
+        lo = 128
+        hi = 191
+        select case (lead)
+        case (0:127)
+            n = 1
+            return
+        case (194:223)
+            n = 2
+        case (224)
+            n = 3
+            lo = 160
+        case (225:236, 238:239)
+            n = 3
+        case (237)
+            n = 3
+            hi = 159
+        case (240)
+            n = 4
+            lo = 144
+        case (241:243)
+            n = 4
+        case (244)
+            n = 4
+            hi = 143
+        case default
+            n = 0
+            return
+        end select
+        if (i + n - 1 > len(text)) then
+            n = 0
+            return
+        end if
+        do k = 1, n - 1
+            c = ichar(text(i + k:i + k))
+            if (k > 1) then
+                lo = 128
+                hi = 191
+            end if
+            if (c < lo .or. c > hi) then
+                n = 0
+                return
+            end if
+        end do
+    end function sequence_length
+
+    !> Code point of one well-formed UTF-8 sequence of 2 to 4 bytes.
+    pure integer function code_point(bytes) result(code)
+        character(len=*), intent(in) :: bytes
+        integer :: k
+        select case (len(bytes))
+        case (2)
+            code = iand(ichar(bytes(1:1)), int(z'1F'))
+        case (3)
+            code = iand(ichar(bytes(1:1)), int(z'0F'))
+        case default
+            code = iand(ichar(bytes(1:1)), int(z'07'))
+        end select
+        do k = 2, len(bytes)
+            code = ior(ishft(code, 6), iand(ichar(bytes(k:k)), int(z'3F')))
+        end do
+    end function code_point
+end module core_utf8
