@@ -40,8 +40,9 @@ module io_deck
     use core_strings, only: string_t, strip, split_words, join_words, is_blank_char, &
                             closest_match, parse_real, parse_int, to_str, shorten
     use core_utf8, only: invalid_utf8_column, find_invisible_space, byte_hex
+    use io_unit_words, only: unit_hint
     use io_deck_schema, only: schema_t, keyword_spec_t, field_spec_t, condition_t, field_text, field_name, &
-                              type_name
+                              field_real, field_int, type_name
     implicit none
     private
     public :: deck_t, deck_entry_t, read_deck, read_deck_text
@@ -780,8 +781,12 @@ contains
                 return
             end if
             call field%check(tokens(k)%s, ok, message)
-            if (.not. ok) call make_input_error(error, file, line, spec%name, 'value '//to_str(k)// &
-                                                ' ('//field%name//'): '//message//name_hint(k - 1, k))
+            if (ok) return
+            ! `1 210e9 Pa 7800`: a unit where a number is expected
+            if (field%value_type == field_real .or. field%value_type == field_int) &
+                message = message//unit_hint(tokens(k)%s)
+            call make_input_error(error, file, line, spec%name, 'value '//to_str(k)// &
+                                  ' ('//field%name//'): '//message//name_hint(k - 1, k))
         end subroutine check_one
 
         !> Error for a wrong number of values, with the expected usage.
@@ -803,6 +808,13 @@ contains
                         if (len(hint) > 0) exit
                         if (fits_joined(p, extra)) hint = name_hint(p, p + extra)
                     end do
+                end do
+            end if
+            ! `step = 1e-3 s`: the value's unit taken for one more value
+            if (what == 'too many' .and. len(hint) == 0) then
+                do p = min(ntok, last_expected + 1), ntok
+                    hint = unit_hint(tokens(p)%s)
+                    if (len(hint) > 0) exit
                 end do
             end if
             call make_input_error(error, file, line, spec%name, what//' values (got '// &
