@@ -18,7 +18,7 @@ program multicor
     use core_error, only: error_t, error_internal
     use core_version, only: multicor_version
     use core_signals, only: signal_exit_code, catch_broken_pipe
-    use core_strings, only: parse_real
+    use core_strings, only: parse_real, is_real_syntax, to_lower
     use io_deck_schema, only: multicor_schema, schema_markdown
     use driver_run, only: run_options_t, run_deck
     use driver_simulation, only: report_to_stdout
@@ -55,6 +55,8 @@ program multicor
             ! parse_real checks the magnitude before reading: a plain read of '1e999' raises
             ! a floating-point overflow (a crash where it traps), of 'inf'/'nan' a non-finite time
             call parse_real(trim(arg), opts%end_time, ok)
+            if (.not. (is_real_syntax(trim(arg)) .or. is_infinity(arg))) &
+                call usage_error("--end needs a time in seconds, got '"//arg(:min(len(arg), 40))//"', which is not a number")
             if (.not. ok) call usage_error("--end needs a finite time in seconds, got '"// &
                                            arg(:min(len(arg), 40))//"'")
             if (.not. (opts%end_time > 0.0_wp .and. opts%end_time <= huge(1.0_wp))) &
@@ -142,11 +144,24 @@ contains
         call get_command_argument(i, value)
     end subroutine get_arg
 
+    !> Whether `text` spells an infinity as a Fortran read takes it (`inf`, `-Infinity`).
+    pure logical function is_infinity(text)
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: word
+        word = to_lower(trim(adjustl(text)))
+        if (len(word) > 0) then
+            if (scan(word(1:1), '+-') == 1) word = word(2:)
+        end if
+        is_infinity = word == 'inf' .or. word == 'infinity'
+    end function is_infinity
+
     subroutine usage_error(message)
         character(len=*), intent(in) :: message
         write (error_unit, '(a)') 'multicor: error: '//message
-        write (error_unit, '(a)') "usage: multicor [--check] [--output DIR] [--quiet] deck.dat; " &
-            //"'multicor --help' for more"
+        ! every option of --help (print_help), in its order
+        write (error_unit, '(a)') 'usage: multicor [-o DIR] [-q] [--check] [--restart FILE] [--end T] deck.dat', &
+            '       multicor --schema-markdown | -V | -h', &
+            "('multicor --help' says what each option does)"
         stop 2, quiet = .true.
     end subroutine usage_error
 

@@ -3,7 +3,7 @@
 cleanly: guards on the initial state and after every step (non-finite state, disks beyond
 the representable box, a driven wall with one end beyond it, tunnelling), the warning of a
 disk moving farther than the alert distance in one step, one writer per results folder (lock file), --output '',
---end 1e999, no empty folder left by a failed run, three-digit exponents in messages, decks
+--end 1e999 or abc and the usage line of a bad command line, no empty folder left by a failed run, three-digit exponents in messages, decks
 with a UTF-8 byte-order mark or CR-only line endings.
 
 Each failed run must exit 1 with a message naming the deck, the step and the body, and leave
@@ -339,6 +339,21 @@ def end_option(exe, work):
         check(f"{name} twice: bad command line (exit 2)", proc.returncode == 2 and f"{name} given twice" in proc.stderr,
               f"exit {proc.returncode} {proc.stderr.strip()[:200]}")
     check("repeated options: nothing written", not folder.exists() and not (work / "other").exists(), "")
+    # A word is not a number (it said "needs a finite time"); an infinity is not finite.
+    for value, expect in (("abc", "--end needs a time in seconds, got 'abc', which is not a number"),
+                          ("1x", "got '1x', which is not a number"),
+                          ("-Infinity", "--end needs a finite time in seconds, got '-Infinity'")):
+        proc = multicor(exe, deck, "--output", folder, "--end", value)
+        check(f"--end {value}: '{expect}'", proc.returncode == 2 and expect in proc.stderr,
+              f"exit {proc.returncode} {proc.stderr.strip()[:300]}")
+    # The usage line of a bad command line names every option of --help (it left out --end,
+    # --restart and -q).
+    usage = multicor(exe, "--bogus").stderr
+    helped = multicor(exe, "--help").stdout
+    options = re.findall(r"^  (?:(-\w), )?\s*(--[\w-]+)", helped, flags=re.M)
+    check("--help lists the options", len(options) >= 8, helped[:300])
+    missing = [long for short, long in options if long not in usage and not (short and short in usage)]
+    check("usage line: every option of --help", not missing, f"missing {missing}: {usage}")
 
 
 def no_empty_folder(exe, work):
