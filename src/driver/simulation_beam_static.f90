@@ -42,13 +42,18 @@ contains
         call beam_setup(self, deck, error)
         if (allocated(error)) return
         ! A static solve needs supports that stop every rigid-body motion: the error names the
-        ! first `fix` of the deck (the supports as a whole; the message names the part), or
-        ! the first `line` when there is none.
+        ! first `fix` of the deck (the supports as a whole; the message names the part), or,
+        ! when there is none, the [beam] header with the missing supports as the cause.
         call self%model%check_supports(error)
         if (allocated(error)) then
             message = error%message
             line = deck%line('beam', 'fix')
-            if (line == 0) line = deck%line('beam', 'line')
+            if (line == 0) then
+                call make_input_error(error, deck%file, deck%header_line('beam'), '', '[beam] has no support (no '// &
+                                      'fix record): a static analysis needs fixed DOFs that stop the frame''s '// &
+                                      'rigid motions (x, y and rotation), e.g. fix = <node> all at a clamped end')
+                return
+            end if
             call make_input_error(error, deck%file, line, 'fix', message)
             return
         end if

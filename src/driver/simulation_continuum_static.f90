@@ -47,18 +47,31 @@ contains
         integer :: line, unheld, n_bodies, e
         integer, allocatable :: body(:)
         real(wp), allocatable :: xb(:, :)
-        character(len=:), allocatable :: where_
+        character(len=:), allocatable :: where_, kw
         call continuum_setup(self, deck, error)
         if (allocated(error)) return
+        ! the keyword named: the first fix, or the first displacement when there is no fix
+        kw = 'fix'
         line = deck%line('continuum', 'fix')
-        if (line == 0) line = deck%line('continuum', 'mesh')
+        if (line == 0) then
+            kw = 'displacement'
+            line = deck%line('continuum', 'displacement')
+        end if
         ! Supports are checked per body (connected part of the mesh): a body held by nothing
         ! leaves K_ff singular whatever holds the others, and the factorisation does not
         ! always notice (a round-off pivot may come out positive: displacements of 1e11 m).
         call self%model%mesh%bodies(body, n_bodies)
         unheld = self%model%unheld_body(body)
+        if (unheld > 0 .and. line == 0) then
+            call make_input_error(error, deck%file, deck%header_line('continuum'), '', '[continuum] has no '// &
+                                  'support (no fix or displacement record): a static analysis needs supports '// &
+                                  'that stop the rigid motions (two translations and the rotation) of every body, '// &
+                                  'e.g. fix = <node set> x y on a clamped edge')
+            return
+        end if
+        if (line == 0) line = deck%line('continuum', 'mesh')
         if (unheld > 0 .and. n_bodies == 1) then
-            call make_input_error(error, deck%file, line, 'fix', 'the supports (fix, displacement) do not '// &
+            call make_input_error(error, deck%file, line, kw, 'the supports (fix, displacement) do not '// &
                                   'stop every rigid motion (two translations and the rotation): the stiffness '// &
                                   'on the free dofs is singular')
             return
@@ -67,7 +80,7 @@ contains
             e = findloc(body(self%model%mesh%connectivity(1, :)), unheld, dim=1)
             where_ = ''
             if (e > 0) where_ = ' with '//self%model%mesh%element_label(e)
-            call make_input_error(error, deck%file, line, 'fix', 'the supports (fix, displacement) do not '// &
+            call make_input_error(error, deck%file, line, kw, 'the supports (fix, displacement) do not '// &
                                   'stop every rigid motion (two translations and the rotation) of body '// &
                                   to_str(unheld)//' of the mesh''s '//to_str(n_bodies)//' (parts that share no node), '// &
                                   'the one spanning ['//to_str(minval(xb(1, :)))//', '//to_str(maxval(xb(1, :)))// &
@@ -82,7 +95,7 @@ contains
             if (index(error%message, 'not positive definite') == 0) return
             ! Every body is held: a part joined to the rest of its body by one node turns
             ! about it freely (a hinge), or the stiffnesses span more than double precision.
-            call make_input_error(error, deck%file, line, 'fix', 'the supports (fix, displacement) do not '// &
+            call make_input_error(error, deck%file, line, kw, 'the supports (fix, displacement) do not '// &
                                   'stop every rigid motion: the stiffness on the free dofs is not positive '// &
                                   'definite although the supports hold every body; likely cause: a part joined '// &
                                   'to the rest of its body by a single node turns freely about it (a hinge), '// &

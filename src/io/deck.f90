@@ -95,6 +95,8 @@ module io_deck
         type(deck_entry_t), allocatable :: entries(:)
         !> Schema the deck was validated against (defaults come from it).
         type(schema_t) :: schema
+        !> Line of the first header of each schema section (0: absent), in schema order.
+        integer, allocatable :: header_lines(:)
     contains
         !> Whether a keyword appears in the deck.
         procedure :: has => deck_has
@@ -108,6 +110,8 @@ module io_deck
         procedure :: records => deck_records
         !> Whether any keyword of a section appears in the deck.
         procedure :: has_section => deck_has_section
+        !> Line of the first `[section]` header (0 if absent).
+        procedure :: header_line => deck_header_line
         procedure, private :: deck_get_real, deck_get_real_named
         procedure, private :: deck_get_int, deck_get_int_named
         procedure, private :: deck_get_word, deck_get_word_named
@@ -213,6 +217,7 @@ contains
         end do
         call close_header()
         deck%entries = entries(:n)
+        deck%header_lines = section_line
         if (n == 0) then
             call make_input_error(error, file, 0, '', 'the deck is empty (no keyword found); '// &
                                   'it needs at least '//required_list(schema))
@@ -1056,6 +1061,19 @@ contains
             end if
         end do
     end function deck_has_section
+
+    !> Line of the first `[section]` header of the deck (0 if the section is absent).
+    pure integer function deck_header_line(self, section) result(line)
+        !> The deck.
+        class(deck_t), intent(in) :: self
+        !> Section.
+        character(len=*), intent(in) :: section
+        integer :: k
+        line = 0
+        if (.not. allocated(self%header_lines)) return
+        k = self%schema%find_section(section)
+        if (k > 0 .and. k <= size(self%header_lines)) line = self%header_lines(k)
+    end function deck_header_line
 
     !> Whether a keyword appears in the deck.
     pure logical function deck_has(self, section, keyword)
