@@ -6,7 +6,8 @@
 !> 3, 4-node quadrangle) become elements, 1 (2-node line) and 15 (point) only feed named sets.
 !> A physical group becomes a node set with the nodes of its elements, an element set when it
 !> is 2D and an edge set when it is 1D; it is named by its $PhysicalNames entry, or
-!> 'physical_<dim>_<tag>' when it has none. Nodes that belong to no triangle or quadrangle are
+!> 'physical_<dim>_<tag>' when it has none; one name for groups of two dimensions is refused
+!> (their nodes would make one node set). Nodes that belong to no triangle or quadrangle are
 !> dropped; elements are turned counter-clockwise and edges are
 !> oriented with the body on their left. Malformed input gives an error naming file and line;
 !> a count read from the file is checked against the file's size before it sizes an array, and
@@ -41,6 +42,8 @@ module fem_gmsh_reader
     type :: physical_name_t
         integer :: dim = 0
         integer :: tag = 0
+        !> Line of the name in $PhysicalNames.
+        integer :: line = 0
         character(len=:), allocatable :: name
     end type physical_name_t
 
@@ -370,7 +373,7 @@ contains
         type(physical_name_t), allocatable, intent(out) :: names(:)
         type(error_t), allocatable, intent(out) :: error
         character(len=:), allocatable :: text, message
-        integer :: n(1), k, dt(2), q1, q2
+        integer :: n(1), k, j, dt(2), q1, q2
         call section_line(cur, text, error)
         if (allocated(error)) return
         call read_ints(cur, text, 1, n, error)
@@ -406,12 +409,24 @@ contains
             names(k)%dim = dt(1)
             names(k)%tag = dt(2)
             names(k)%name = text(q1 + 1:q2 - 1)
+            names(k)%line = cur%line
             message = set_name_problem(names(k)%name)
             if (len(message) > 0) then
                 call fail(cur, error, 'physical group "'//names(k)%name//'" (dimension '//to_str(dt(1))// &
                           ', tag '//to_str(dt(2))//'): '//message//'; rename the group in the .geo file')
                 return
             end if
+            ! One name for groups of two dimensions (Physical Surface("a") and Physical
+            ! Curve("a")) made one node set of both: `fix = a x` held the whole surface.
+            do j = 1, k - 1
+                if (names(j)%dim == names(k)%dim .or. .not. same_name(names(j)%name, names(k)%name)) cycle
+                call fail(cur, error, 'physical group "'//names(k)%name//'" of dimension '//to_str(dt(1))// &
+                          ' (tag '//to_str(dt(2))//') has the name of the group of dimension '// &
+                          to_str(names(j)%dim)//' (tag '//to_str(names(j)%tag)//', line '//to_str(names(j)%line)// &
+                          '): a set name stands for one group, and their nodes would make one node set (a fix '// &
+                          'on it would hold both); give the groups different names in the .geo file')
+                return
+            end do
         end do
     end subroutine read_physical_names
 

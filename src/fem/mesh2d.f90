@@ -11,6 +11,7 @@ module fem_mesh2d
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
     use core_strings, only: to_str, same_name
+    use core_utf8, only: invalid_utf8_column, byte_hex
     use fem_element_registry, only: kind_node_count
     implicit none
     private
@@ -227,14 +228,21 @@ contains
     !> name: a name with '/' was stored under another name ('a/b' as dataset b of a group a) or
     !> failed the write, '.' failed it, 'a ' was stored as 'a'. HDF5 stores '..', but tools that
     !> resolve paths (Python's posixpath.normpath) read it as the parent group: refused with '.'.
-    !> A blank name (blanks and tabs only) is refused too. Leading blanks and tabs are kept.
+    !> A blank name (blanks and tabs only) is refused too, and so is a name that is not UTF-8
+    !> text (h5py returns it as bytes, not as a string). Leading blanks and tabs are kept.
     pure function set_name_problem(name) result(why)
         !> The name, as written.
         character(len=*), intent(in) :: name
         character(len=:), allocatable :: why
         character(len=*), parameter :: stored = 'the results file stores each set as an HDF5 link named after it'
+        integer :: bad
         why = ''
-        if (verify(name, ' '//achar(9)) == 0) then
+        bad = invalid_utf8_column(name)
+        if (bad > 0) then
+            why = 'the name holds byte '//byte_hex(name(bad:bad))//' (its byte '//to_str(bad)//'), which is not UTF-8 '// &
+                  'text (a .geo file saved as Latin-1 or Windows-1252?): '//stored//', which readers such as h5py '// &
+                  'decode as UTF-8 (they return such a name as raw bytes); save the .geo file as UTF-8 and mesh it again'
+        else if (verify(name, ' '//achar(9)) == 0) then
             why = 'the name is blank: a set name needs a character other than a blank'
         else if (index(name, '/') > 0) then
             why = 'the name holds a ''/'': '//stored//', where ''/'' separates groups'
