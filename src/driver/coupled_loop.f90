@@ -38,7 +38,8 @@ module driver_coupled_loop
     use driver_results_dem, only: write_fclib_local
     use dem_local_problem, only: local_problem_t
     use dem_contacts, only: status_cohesive
-    use driver_guards, only: check_disks_state, check_walls_state, step_start_t, take_step_start, check_tunnelling, &
+    use driver_guards, only: check_disks_state, largest_speed, check_walls_state, step_start_t, take_step_start, &
+                             check_tunnelling, &
                              step_created_energy, step_creates_energy, energy_creation_warning, energy_creation_summary
     use driver_checkpoint, only: checkpoint_run_t, end_of_step, rest_of_last_step, step_end_t, loop_state_t, &
                                  checkpoint_create, &
@@ -108,6 +109,8 @@ module driver_coupled_loop
         integer(i8) :: k = 0
         !> Steps done at the start (those of the checkpoint of a restart).
         integer(i8) :: k0 = 0
+        !> Largest speed of a disk at t = 0, from the deck (the guards' likely causes) [m/s].
+        real(wp) :: initial_speed = 0.0_wp
         !> Steps with lost bonds warned about so far.
         integer :: lost_warnings = 0
         !> Unconverged steps so far.
@@ -218,6 +221,7 @@ contains
 
         lp%n_steps = self%settings%n_steps
         call self%particle_output(lp%material_id, lp%store_contacts)
+        lp%initial_speed = largest_speed(self%sys%dem%particles)
         if (ck%restart) then
             call restore(self, lp, out, ck, error)
         else
@@ -441,7 +445,7 @@ contains
         call self%check_part(k, error)
         if (allocated(error)) return
         associate (sys => self%sys)
-            call check_disks_state(k, sys%fe%t, sys%dem%particles, sys%dem%energies, error)
+            call check_disks_state(k, sys%fe%t, sys%dem%particles, sys%dem%energies, lp%initial_speed, error)
             if (allocated(error)) return
             call check_walls_state(k, sys%fe%t, sys%dem%particles, sys%dem%walls, error)
             if (allocated(error)) return

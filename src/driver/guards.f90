@@ -33,7 +33,8 @@ module driver_guards
     use core_sort, only: sort_index
     implicit none
     private
-    public :: check_beam_state, check_disks_state, check_walls_state, step_start_t, take_step_start, check_tunnelling
+    public :: check_beam_state, check_disks_state, largest_speed, check_walls_state
+    public :: step_start_t, take_step_start, check_tunnelling
     public :: step_created_energy, creation_allowance, step_creates_energy, energy_creation_warning, &
               energy_creation_summary
     public :: model_size_t, model_memory_bytes, check_memory
@@ -147,7 +148,7 @@ contains
 
     !> Error at the first disk with a non-finite position, rotation or velocity, or a centre
     !> beyond the representable box, or at a non-finite energy account.
-    subroutine check_disks_state(step, t, p, en, error)
+    subroutine check_disks_state(step, t, p, en, initial_speed, error)
         !> Steps done.
         integer(i8), intent(in) :: step
         !> Time reached [s].
@@ -156,16 +157,24 @@ contains
         type(particles_t), intent(in) :: p
         !> Energy accounts of the particles.
         type(energies_t), intent(in) :: en
+        !> Largest speed of a disk at t = 0 (`largest_speed` of the initial state) [m/s]: when
+        !> it is not 0 the likely causes name the initial velocity, with it.
+        real(wp), intent(in) :: initial_speed
         !> Set at the first problem found.
         type(error_t), allocatable, intent(out) :: error
-        character(len=*), parameter :: cause = 'likely cause: a force, an imposed velocity or '// &
-                                       'gravity far too large (check the magnitudes in [particles]), or a '// &
-                                       'time step too large (lower [time] step)'
+        character(len=:), allocatable :: cause, initial
         real(wp) :: limit, value(6)
         character(len=16), parameter :: names(6) = [character(len=16) :: &
                                                     'x', 'y', 'rotation', 'velocity x', 'velocity y', 'angular velocity']
         integer :: i, k
         if (p%n == 0) return
+        ! The deck's initial velocities are a likely cause as much as its forces: 1e150 m/s
+        ! carries a disk 1e147 m in a step of 1e-3 s.
+        initial = ''
+        if (initial_speed > 0.0_wp) initial = 'an initial velocity (the disks start at up to '//num(initial_speed)// &
+                                              ' m/s: [particles] initial_velocity, initial_rigid), '
+        cause = 'likely cause: '//initial//'a force, an imposed velocity or gravity far too large (check the '// &
+                'magnitudes in [particles]), or a time step too large (lower [time] step)'
         limit = coordinate_limit(minval(p%radius(1:p%n)))
         do i = 1, p%n
             value = [p%x(i), p%y(i), p%rot(i), p%vx(i), p%vy(i), p%w(i)]
@@ -179,8 +188,8 @@ contains
                 call make_error(error, when(step, t)//'disk '//to_str(i)//' is at ('//num(p%x(i))// &
                                 ', '//num(p%y(i))//') m, beyond the box the run can represent (|x|, '// &
                                 '|y| <= '//num(limit)//' m: 4.5e9 times the smallest radius); likely '// &
-                                'cause: a disk escaping with no wall to stop it, or a force or gravity far '// &
-                                'too large')
+                                'cause: a disk escaping with no wall to stop it, or '//initial//'a force or '// &
+                                'gravity far too large')
                 return
             end if
         end do
@@ -189,6 +198,15 @@ contains
             call make_error(error, when(step, t)//'particles: an energy account is not finite; '//cause)
         end if
     end subroutine check_disks_state
+
+    !> Largest speed of the disks [m/s] (0 when there are none): that of the initial state is
+    !> the `initial_speed` of check_disks_state.
+    pure real(wp) function largest_speed(p) result(speed)
+        !> The disks.
+        type(particles_t), intent(in) :: p
+        speed = 0.0_wp
+        if (p%n > 0) speed = maxval(hypot(p%vx(1:p%n), p%vy(1:p%n)))
+    end function largest_speed
 
     !> Error at the first wall with an end point that is not finite or lies beyond the box
     !> of check_disks_state (the box of the deck's walls, dem_detection::coordinate_limit):

@@ -25,7 +25,8 @@ module driver_run_dem
     use driver_config_dem, only: dem_config_t
     use driver_results, only: results_writer_t
     use driver_results_dem, only: dem_writer_t, write_fclib_local
-    use driver_guards, only: check_disks_state, check_walls_state, step_start_t, take_step_start, check_tunnelling, &
+    use driver_guards, only: check_disks_state, largest_speed, check_walls_state, step_start_t, take_step_start, &
+                             check_tunnelling, &
                              step_created_energy, step_creates_energy, energy_creation_warning, energy_creation_summary
     use io_hdf5_file, only: h5_file_t
     use driver_checkpoint, only: end_of_step, rest_of_last_step, step_end_t, checkpoint_run_t, loop_state_t, checkpoint_create, &
@@ -75,6 +76,8 @@ contains
         integer(i8) :: creating
         logical :: blocked_warned
         logical :: speed_warned
+        ! largest speed of a disk at t = 0 [m/s] (the guards' likely causes)
+        real(wp) :: initial_speed
         type(step_end_t) :: act
         character(len=:), allocatable :: message
         character(len=512) :: buf
@@ -92,13 +95,16 @@ contains
         speed_warned = .false.
         blocked_warned = .false.
         k0 = 0
+        ! the deck's initial state, before a restart replaces it (for the guards' causes)
+        initial_speed = largest_speed(cfg%system%particles)
         if (ck%restart) then
             call restore(error)
             if (allocated(error)) return
         else
             call writer%begin(out%file, cfg%system, cfg%material_id, cfg%store_contacts, error)
             if (allocated(error)) return
-            call check_disks_state(0_i8, cfg%system%time, cfg%system%particles, cfg%system%energies, error)
+            call check_disks_state(0_i8, cfg%system%time, cfg%system%particles, cfg%system%energies, initial_speed, &
+                                   error)
             if (allocated(error)) return
             call store(error)
             if (allocated(error)) return
@@ -232,7 +238,7 @@ contains
         subroutine check_step(error)
             type(error_t), allocatable, intent(out) :: error
             associate (sys => cfg%system)
-                call check_disks_state(k, sys%time, sys%particles, sys%energies, error)
+                call check_disks_state(k, sys%time, sys%particles, sys%energies, initial_speed, error)
                 if (allocated(error)) return
                 call check_walls_state(k, sys%time, sys%particles, sys%walls, error)
                 if (allocated(error)) return

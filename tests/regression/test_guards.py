@@ -98,8 +98,16 @@ def non_finite(exe, work):
     """Loads and gravity of 1e300 ran to the end writing NaN/Inf with exit 0."""
     failing_run(exe, work, "beam_load_1e300", beam_deck(load="-1e300"),
                 r"step 1 \(t = 2\.00000E-004 s\): beam", beam_deck())
-    failing_run(exe, work, "dem_gravity_1e300", dem_deck(gravity="0 -1e300"),
-                r"step 1 \(t = 1\.00000E-003 s\): disk \d+ is at .* beyond the box", dem_deck())
+    gravity = failing_run(exe, work, "dem_gravity_1e300", dem_deck(gravity="0 -1e300"),
+                          r"step 1 \(t = 1\.00000E-003 s\): disk \d+ is at .* beyond the box", dem_deck())
+    check("dem_gravity_1e300: no initial velocity among the causes (the disks start at rest)",
+          "initial velocity" not in gravity, gravity.strip()[:400])
+    # An initial velocity of 1e150 m/s: the causes named forces and gravity only.
+    fast_start = dem_deck().replace("gravity = 0 -9.81\n", "gravity = 0 -9.81\ninitial_velocity = 1 x 1e150\n", 1)
+    failing_run(exe, work, "dem_initial_velocity_1e150", fast_start,
+                r"step 1 \(t = 1\.00000E-003 s\): disk 1 is at .* beyond the box .*likely cause: a disk escaping "
+                r"with no wall to stop it, or an initial velocity \(the disks start at up to 1\.000E\+150 m/s: "
+                r"\[particles\] initial_velocity, initial_rigid\), a force or gravity far too large", dem_deck())
     # a floor sliding along itself at 1e300 m/s: finite, but 1e297 m away after a step (the
     # run ended with exit 0, its walls beyond the box; at 9e307 m/s and a longer run they
     # were written as Inf)
