@@ -126,12 +126,13 @@ def load_continuum(path) -> ContinuumResults:
 
 
 def records(f, path: str, name: str, n_out: int) -> np.ndarray:
-    """The dataset ``name`` of the open results file ``path``, one record per stored output:
+    """The dataset ``name`` of the open results file ``path``, one record per stored output
+    (in a killed run's partial file, those of the outputs it wrote whole: `complete_records`):
     ResultsError (`shape_error`) unless it holds ``n_out`` of them, or when it is missing."""
     if name not in f:
         raise ResultsError(f"{path}: missing dataset '/{name}' (not a MULTICOR continuum "
                            "results file, or one from another version)")
-    data = f[name][...]
+    data = complete_records(f, name, f[name][...])
     if data.ndim == 0 or data.shape[0] != n_out:
         raise shape_error(f, path, name, data.shape, (n_out,) + data.shape[1:])
     return data

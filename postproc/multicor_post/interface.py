@@ -28,7 +28,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
 from .continuum import element_polygons
-from .results import ResultsError
+from .results import ResultsError, complete_records
 
 
 class InterfaceRun:
@@ -44,24 +44,28 @@ class InterfaceRun:
             for name in ("coupling/lambda", "continuum/displacement", "dem/position"):
                 if name not in f:
                     raise ResultsError(f"{self.path}: no {name} (not a coupled continuum run)")
-            self.time = f["coupling/time"][...]
-            self.lam = f["coupling/lambda"][...]
-            self.row_dof = f["coupling/rows/dof"][...]
-            self.row_disk = f["coupling/rows/particle"][...] - 1
-            self.position = f["dem/position"][...]
-            self.radius = f["dem/particles/radius"][...]
-            self.x = f["continuum/mesh/coordinates"][...]
-            self.connectivity = f["continuum/mesh/connectivity"][...]
-            self.kind = f["continuum/mesh/kind"][...]
-            self.u = f["continuum/displacement"][...]
-            self.stress = f["continuum/stress"][...]
+            def read(name):
+                # a killed run's partial file: the records of the outputs it wrote whole
+                return complete_records(f, name, f[name][...])
+
+            self.time = read("coupling/time")
+            self.lam = read("coupling/lambda")
+            self.row_dof = read("coupling/rows/dof")
+            self.row_disk = read("coupling/rows/particle") - 1
+            self.position = read("dem/position")
+            self.radius = read("dem/particles/radius")
+            self.x = read("continuum/mesh/coordinates")
+            self.connectivity = read("continuum/mesh/connectivity")
+            self.kind = read("continuum/mesh/kind")
+            self.u = read("continuum/displacement")
+            self.stress = read("continuum/stress")
             self.sets = {k: f["continuum/sets/nodes"][k][...] - 1 for k in f["continuum/sets/nodes"]}
-            self.balance = f["coupling/energy/balance"][...]
-            self.fe_balance = f["continuum/energy/balance"][...]
-            self.reaction_work = f["continuum/energy/reaction_work"][...]
+            self.balance = read("coupling/energy/balance")
+            self.fe_balance = read("continuum/energy/balance")
+            self.reaction_work = read("continuum/energy/reaction_work")
             self.contacts = None
             if "dem/contacts/offset" in f:
-                self.contacts = {k: f["dem/contacts"][k][...] for k in ("i", "j", "rn", "offset")}
+                self.contacts = {k: read(f"dem/contacts/{k}") for k in ("i", "j", "rn", "offset")}
         y0 = self.position[0, self.row_disk, 1]
         self.top_rows = y0 > 0.5 * (y0.min() + y0.max())
 

@@ -80,3 +80,24 @@ def test_figures_are_drawn(interface_file):
     assert len(fig.axes[0].lines) == 3                # the run, the theory and its legend entry
     assert interface.plot_configuration(run, N_OUT - 1) is not None
     assert interface.plot_stress(run, N_OUT - 1, "vm") is not None
+
+
+def test_a_killed_run_is_read_up_to_its_count_of_whole_outputs(interface_file):
+    # the reader took every record of a killed run's partial file, those of the output the
+    # kill cut too (its multipliers, displacements, contacts partly written), where the other
+    # loaders stop at /summary@outputs
+    with h5py.File(interface_file, "a") as f:
+        for name in ("coupling/time", "coupling/lambda", "dem/position", "continuum/displacement",
+                     "continuum/stress", "coupling/energy/balance", "continuum/energy/balance",
+                     "continuum/energy/reaction_work"):
+            data = f[name][()]
+            del f[name]      # extendible, as multicor creates its series
+            f.create_dataset(name, data=data, maxshape=(None,) + data.shape[1:])
+        f.create_group("summary")
+        f["summary"].attrs["finished"] = np.int32(0)
+        f["summary"].attrs["outputs"] = np.int32(N_OUT - 2)
+    run = interface.InterfaceRun(interface_file)
+    assert run.time.size == N_OUT - 2 and run.lam.shape[0] == N_OUT - 2
+    assert run.position.shape[0] == N_OUT - 2 and run.u.shape[0] == N_OUT - 2
+    assert run.stress.shape[0] == N_OUT - 2 and run.balance.size == N_OUT - 2
+    assert np.array_equal(run.slip(), SLIP[:N_OUT - 2])

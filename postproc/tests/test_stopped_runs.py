@@ -435,6 +435,61 @@ def test_a_killed_file_is_read_up_to_its_count_of_whole_outputs(tmp_path, capsys
         particles.load_dem(path)
 
 
+#: Groups of datasets written once (not one record per output): never made extendible.
+_FIXED = ("continuum/mesh/", "continuum/sets/", "dem/particles/", "dem/walls/material",
+          "dem/solver/", "coupling/rows/", "coupling/particles", "coupling/alpha",
+          "coupling/overlap", "coupling/abscissa", "coupling/offset")
+
+
+def killed_after(path, whole):
+    """The file of a run killed inside the flush of its output `whole` + 1: every series of
+    outputs made extendible (as multicor creates them; the synthetic writers do not), the
+    per-step series of /coupling too, and /summary@outputs = `whole`, below the records the
+    file holds (the audit's files cut by hand: a finished file with its count decremented)."""
+    names = []
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda name, obj: names.append(name)
+                     if isinstance(obj, h5py.Dataset) and obj.ndim > 0
+                     and not name.startswith(_FIXED) else None)
+    extendible(path, names)
+    mark_killed(path)
+    with h5py.File(path, "a") as f:
+        f["summary"].attrs["outputs"] = np.int32(whole)
+    return path
+
+
+@pytest.mark.parametrize("kind", ["continuum", "coupled continuum"])
+def test_a_killed_continuum_is_read_up_to_its_count_of_whole_outputs(kind, tmp_path, capsys):
+    # the continuum loader cut /continuum/time to /summary@outputs but not the series read
+    # against it (displacement, stress, energy terms, /dem/position, /dem/walls/position):
+    # "records of its last output are incomplete ... nothing to plot" for the partial file of
+    # every continuum run killed inside a flush
+    if kind == "coupled continuum":
+        path = write_continuum_coupled(tmp_path / "block.h5.partial")
+    else:
+        path = write_continuum(tmp_path / "block.h5.partial")
+    with h5py.File(path, "r") as f:
+        n_out = f["continuum/time"].shape[0]
+        full = {name: f[name][()] for name in ("continuum/displacement", "continuum/stress")}
+    killed_after(path, n_out - 1)
+    res = continuum.load_continuum(path)
+    assert res.time.size == n_out - 1
+    assert np.array_equal(res.u, full["continuum/displacement"][:n_out - 1])
+    assert np.array_equal(res.stress, full["continuum/stress"][:n_out - 1])
+    assert all(res.energy[name].size == n_out - 1 for name in continuum.ENERGY_TERMS + ("time",))
+    if kind == "coupled continuum":
+        # the disks drawn on the mesh, and the coupling figure's multipliers: cut likewise
+        assert res.disk_time.size == n_out - 1
+        assert res.disk_position.shape[0] == n_out - 1 and res.walls.shape[0] == n_out - 1
+        diag = coupled.load_continuum_coupling(path)
+        assert diag.time.size == n_out - 1 and diag.lam.shape[0] == n_out - 1
+    out = tmp_path / "png"
+    assert plot_results.main([str(path), "--out", str(out)]) == 0
+    printed = capsys.readouterr()
+    assert "error" not in printed.err and str(out / "block_stress.png") in printed.out.split()
+    assert str(out / "block_history.png") in printed.out.split()
+
+
 def test_a_continuum_with_an_incomplete_last_output(tmp_path, capsys):
     # continuum/displacement one record short of /continuum/time: a ValueError traceback
     # from matplotlib (the history's x and y of different lengths)
