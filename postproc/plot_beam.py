@@ -6,7 +6,8 @@
 Writes, depending on what the run stored: <name>_deflection.png (deflection along a straight
 beam, or the deformed shape of a frame, at the stored time nearest to T; default the last),
 <name>_history_node<ID>.png (w(t) and u(t) of node ID; default the tip), <name>_energy.png,
-<name>_static.png and <name>_modes.png. Exit code 1 with a message on a missing or invalid
+<name>_static.png and <name>_modes.png (along a straight beam w, and u of an axial mode,
+marked '(axial)'). Exit code 1 with a message on a missing or invalid
 file, or one with no stored output or solution (a run stopped before writing it); a note on
 stderr for a --time outside the stored outputs or given for a static or modal run (ignored).
 """

@@ -231,8 +231,35 @@ def plot_energy(res: Results) -> Figure:
     return fig
 
 
+def axial_modes(res: Results) -> np.ndarray:
+    """Whether each mode of a modal run is axial: labelled 'axial' in /modal/axial_fraction@kind,
+    or, without that label ('mixed', 'rigid', or a file of an earlier build), when its largest
+    nodal axial displacement exceeds its largest transverse one (in each element's axes)."""
+    modal = res.modal
+    flags = np.zeros(modal.omega.size, bool)
+    for k in range(modal.omega.size):
+        label = modal.kind[k] if modal.kind is not None else ""
+        if label in ("axial", "bending"):
+            flags[k] = label == "axial"
+            continue
+        axial = transverse = 0.0
+        for a, b in res.mesh.connectivity:
+            ex, ey = res.mesh.x[b] - res.mesh.x[a], res.mesh.y[b] - res.mesh.y[a]
+            length = float(np.hypot(ex, ey))
+            c, s = ex / length, ey / length
+            for n in (a, b):
+                d = modal.shapes[k, n]
+                axial = max(axial, abs(c * d[U] + s * d[W]))
+                transverse = max(transverse, abs(-s * d[U] + c * d[W]))
+        flags[k] = axial > transverse
+    return flags
+
+
 def plot_modes(res: Results, max_modes: int = 6) -> Figure:
-    """Mode shapes (each scaled to a unit largest displacement) with their frequencies."""
+    """Mode shapes (each scaled to a unit largest displacement) with their frequencies. Along
+    a straight beam the deflection w of each mode is drawn against x, and the axial
+    displacement u of an axial mode (`axial_modes`; its w is zero), dashed, marked '(axial)'
+    in the legend; a frame's modes are drawn as deformed shapes."""
     if res.modal is None:
         raise ResultsError(f"{res.path}: no /modal group in these results")
     mesh, modal = res.mesh, res.modal
@@ -240,24 +267,29 @@ def plot_modes(res: Results, max_modes: int = 6) -> Figure:
     fig = _new_figure(height=4.8)
     ax = fig.subplots()
     straight = mesh.is_straight_along_x()
+    axial = axial_modes(res) if straight else np.zeros(modal.omega.size, bool)
     fx, ux = _length_unit(np.concatenate([mesh.x, mesh.y]))
     size = max(np.ptp(mesh.x), np.ptp(mesh.y))
     for k in range(n):
         shape = modal.shapes[k]
         peak = float(np.max(np.hypot(shape[:, U], shape[:, W])))
         shape = shape / peak if peak > 0 else shape
-        label = f"mode {k + 1}: f = {modal.frequency[k]:.5g} Hz"
+        label = f"mode {k + 1}: f = {modal.frequency[k]:.5g} Hz" + (" (axial)" if axial[k] else "")
         curves = element_fields(mesh, shape)
         for j, (x, y, dx, dy) in enumerate(curves):
             if straight:
-                ax.plot(x * fx, dy, color=f"C{k}", label=label if j == 0 else None)
+                ax.plot(x * fx, dx if axial[k] else dy, "--" if axial[k] else "-",
+                        color=f"C{k}", label=label if j == 0 else None)
             else:
                 s = 0.15 * size
                 ax.plot((x + s * dx) * fx, (y + s * dy) * fx, color=f"C{k}",
                         label=label if j == 0 else None)
     if straight:
         ax.axhline(0.0, color="0.5", lw=0.8)
-        ax.set_ylabel("w / max |displacement| [-]")
+        if axial[:n].any():
+            ax.set_ylabel("w, or u of an axial mode (dashed) / max |displacement| [-]")
+        else:
+            ax.set_ylabel("w / max |displacement| [-]")
     else:
         for x, y, _, _ in element_fields(mesh, np.zeros((mesh.n_nodes, 3))):
             ax.plot(x * fx, y * fx, "--", color="0.6", lw=1.0)

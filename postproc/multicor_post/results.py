@@ -279,6 +279,9 @@ class Modal:
     omega: np.ndarray          # (n_modes,) [rad/s]
     frequency: np.ndarray      # (n_modes,) [Hz]
     shapes: np.ndarray         # (n_modes, n_nodes, 3), arbitrary scale
+    #: one label per mode ('axial', 'bending', 'mixed', 'rigid': /modal/axial_fraction@kind);
+    #: None for a file without them (an earlier build)
+    kind: Optional[list] = None
 
 
 @dataclass
@@ -348,7 +351,8 @@ def load_results(path) -> Results:
             omega = reader.array("modal/omega", ndim=1)
             res.modal = Modal(omega=omega,
                               frequency=reader.array("modal/frequency", shape=omega.shape),
-                              shapes=reader.array("modal/shapes", shape=(omega.size, n, 3)))
+                              shapes=reader.array("modal/shapes", shape=(omega.size, n, 3)),
+                              kind=_mode_kinds(f, omega.size))
         if "summary" in f:
             res.summary = _decode_attrs(f["summary"].attrs)
         if res.dynamic is None and res.static is None and res.modal is None:
@@ -357,6 +361,18 @@ def load_results(path) -> Results:
             raise no_results_error(f, path, missing.get(res.attrs.get("analysis"),
                                                          "/fem/time, /static or /modal"))
     return res
+
+
+def _mode_kinds(f, n_modes: int) -> Optional[list]:
+    """The labels of /modal/axial_fraction@kind (one word per mode), or None when the file
+    has none or not one per mode."""
+    if "modal/axial_fraction" not in f:
+        return None
+    kind = f["modal/axial_fraction"].attrs.get("kind")
+    if isinstance(kind, (bytes, np.bytes_)):
+        kind = kind.decode("utf-8", errors="replace")
+    words = str(kind).split() if kind is not None else []
+    return words if len(words) == n_modes else None
 
 
 def _open_results(path: str) -> h5py.File:

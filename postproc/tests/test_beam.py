@@ -138,3 +138,42 @@ def test_cli_reports_a_missing_dataset_and_exits_1(cantilever_file, capsys):
     path = cantilever_file(drop=("energy/balance",))
     assert plot_beam.main([str(path)]) == 1
     assert "missing dataset '/energy/balance'" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("labelled", [True, False])
+def test_an_axial_mode_of_a_straight_beam_draws_its_axial_displacement(labelled, tmp_path):
+    # an axial mode (w = 0, u = sin(pi x / 2L): the first mode of a clamped-free bar) was
+    # drawn as a flat line at zero: the figure plotted w only. Now its u, dashed, '(axial)'
+    # in the legend; with /modal/axial_fraction@kind or, in a file without it, because u
+    # dominates
+    import h5py
+    from synthetic import write_results
+    from multicor_post.beam import plot_modes
+    ids, xy, conn, d = cantilever_layout()
+    path = write_results(tmp_path / "bar.h5", ids, xy, conn, d, parts=("modal",))
+    x = xy[:, 0]
+    bar = np.zeros_like(d)
+    bar[:, 0] = 3.0 * np.sin(np.pi * x / (2 * L))       # arbitrary scale, as the solver's
+    with h5py.File(path, "a") as f:
+        f["modal/shapes"][1] = bar
+        if labelled:
+            f.create_dataset("modal/axial_fraction", data=[0.0, 1.0])
+            f["modal/axial_fraction"].attrs["kind"] = "bending axial "
+    fig = plot_modes(load_results(path))
+    ax = fig.axes[0]
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert legend[0].endswith("Hz") and legend[1].endswith("Hz (axial)")
+    # the curves of mode 2 (colour C1): u / max|u| element by element, linear between the
+    # nodes, so at each element's ends the nodal values (to round-off of the interpolation:
+    # a few ulps of 1)
+    lines = [line for line in ax.get_lines() if line.get_color() == "C1"]
+    assert len(lines) == conn.shape[0] and all(line.get_linestyle() == "--" for line in lines)
+    for line, (a, b) in zip(lines, conn - 1):
+        y = line.get_ydata()
+        assert abs(y[0] - np.sin(np.pi * x[a] / (2 * L))) < 1e-14
+        assert abs(y[-1] - np.sin(np.pi * x[b] / (2 * L))) < 1e-14
+    # the bending mode keeps its w, solid
+    w_lines = [line for line in ax.get_lines() if line.get_color() == "C0"]
+    assert w_lines[-1].get_linestyle() == "-"
+    assert w_lines[-1].get_ydata()[-1] == pytest.approx(-1.0, abs=1e-14)  # tip w / max|d|
+    assert "axial mode" in ax.get_ylabel()
