@@ -231,7 +231,8 @@ def plot_configuration(res: DemResults, k: Optional[int] = None) -> Figure:
     proportional to |r_n| (MAX_FORCE_WIDTH for the largest force of the snapshot; forces
     below NOISE times the largest of the run are left out); intact bonds as thin blue lines,
     broken bonds as grey crosses at the contact point, and contact moments as orange rings
-    at the contact point, their area proportional to |m|."""
+    at the contact point, their area proportional to |m|. The title counts the contacts, or
+    says 'contacts not stored' for a run without /dem/contacts ([output] contacts = no)."""
     if k is None:
         k = res.time.size - 1
     pos = res.position[k]
@@ -312,9 +313,13 @@ def plot_configuration(res: DemResults, k: Optional[int] = None) -> Figure:
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ft, ut = _time_unit(res.time)
-    n_contacts = int(np.size(rn))
-    ax.set_title(f"{res.title}\nt = {res.time[k] * ft:.6g} {ut}: {res.n} disks, "
-                 f"{n_contacts} contacts ({int(np.count_nonzero(carrying))} carrying a force)")
+    if res.contacts is None:
+        # [output] contacts = no: no /dem/contacts, not a snapshot without contacts
+        network = "contacts not stored"
+    else:
+        network = (f"{int(np.size(rn))} contacts ({int(np.count_nonzero(carrying))} carrying a "
+                   "force)")
+    ax.set_title(f"{res.title}\nt = {res.time[k] * ft:.6g} {ut}: {res.n} disks, {network}")
     if handles:
         ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.1),
                   ncol=2, fontsize="small", frameon=False)

@@ -71,6 +71,16 @@ def test_configuration_draws_disks_forces_and_walls(tmp_path):
     assert "4 contacts (4 carrying a force)" in ax.get_title()
     # output 0 has no contact: only disks, rotation marks and walls
     assert len(plot_configuration(res, 0).axes[0].collections) == 3
+    assert "0 contacts (0 carrying a force)" in plot_configuration(res, 0).axes[0].get_title()
+
+
+def test_configuration_of_a_run_without_stored_contacts_says_so(tmp_path):
+    # [output] contacts = no (no /dem/contacts): the title said "2 disks, 0 contacts (0
+    # carrying a force)", as if the disks touched nothing
+    res = load_dem(write_dem(tmp_path / "bare.h5", with_contacts=False))
+    title = plot_configuration(res, 2).axes[0].get_title()
+    assert title.endswith(f": {N_DISKS + 2} disks, contacts not stored")
+    assert "0 contacts" not in title
 
 
 def test_solver_plot_marks_the_unconverged_step(tmp_path):
