@@ -9,7 +9,8 @@ beam, or the deformed shape of a frame, at the stored time nearest to T; default
 <name>_static.png and <name>_modes.png (along a straight beam w, and u of an axial mode,
 marked '(axial)'). Exit code 1 with a message on a missing or invalid
 file, or one with no stored output or solution (a run stopped before writing it); a note on
-stderr for a --time outside the stored outputs or given for a static or modal run (ignored).
+stderr for a --time outside the stored outputs or given for a static or modal run (ignored),
+and for a --scale that no figure uses (a straight beam's deflection is in length units).
 """
 import argparse
 import os
@@ -17,10 +18,10 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from multicor_post.beam import write_all  # noqa: E402
+from multicor_post.beam import uses_scale, write_all  # noqa: E402
 from multicor_post.results import (ResultsError, damaged_file_error, file_contents, finite_float,  # noqa: E402
                                    load_results, outside_time_note, scale_factor,
-                                   unused_time_note)
+                                   unused_scale_note, unused_time_note)
 
 
 def main(argv=None):
@@ -56,7 +57,8 @@ def main(argv=None):
         print(f"plot_beam.py: error: {damaged}", file=sys.stderr)
         return 1
     for note in (outside_time_note(args.time, None if res.dynamic is None else res.dynamic.time),
-                 unused_time_note(args.time, res.analysis)):
+                 unused_time_note(args.time, res.analysis),
+                 unused_scale_note(args.scale, args.results, uses_scale(res))):
         if note:
             print(f"plot_beam.py: note: {note}", file=sys.stderr)
     for path in paths:

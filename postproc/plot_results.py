@@ -19,8 +19,8 @@ node --node, a 1-based mesh index; default the node with the largest displacemen
 beam-coupled run's) and the particle plots too. Exit code 1 with a message on a missing or
 invalid file, or one with no stored output or solution (a run stopped before writing it); a
 note on stderr for a --time outside the stored outputs or given for a static or modal run
-(ignored), for a figure left out because its series is empty and for the per-step panels of
-<name>_coupling.png without a step.
+(ignored), for a --node or --scale that no figure uses, for a figure left out because its
+series is empty and for the per-step panels of <name>_coupling.png without a step.
 """
 import argparse
 import os
@@ -31,7 +31,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from multicor_post import beam, continuum, coupled, particles  # noqa: E402
 from multicor_post.results import (ResultsError, damaged_file_error, file_contents, finite_float,  # noqa: E402
                                    load_results, outside_time_note, scale_factor,
-                                   unused_time_note)
+                                   unused_scale_note, unused_time_note)
 
 
 def contents(path):
@@ -69,6 +69,9 @@ def main(argv=None):
             # printed with the figures (a file with nothing to plot gets its error alone)
             notes.append(f"'{args.results}' is the partial file of a run that did not finish: "
                          "the figures show the outputs stored so far")
+        # a deformed shape that --scale magnifies: a continuum's, a beam-coupled run's
+        # configuration, a frame's (beam.uses_scale)
+        scaled = has_continuum or (is_coupled and has_beam)
         if has_continuum:
             res = continuum.load_continuum(args.results)
             notes.append(outside_time_note(args.time, res.time))
@@ -86,6 +89,7 @@ def main(argv=None):
             notes.append(outside_time_note(args.time, None if res.dynamic is None
                                            else res.dynamic.time))
             notes.append(unused_time_note(args.time, res.analysis))
+            scaled = scaled or beam.uses_scale(res)
             paths += beam.write_all(res, out, time=args.time, node_id=args.node, scale=args.scale)
         if has_particles:
             res = particles.load_dem(args.results)
@@ -103,6 +107,7 @@ def main(argv=None):
     if args.node is not None and not any("_history" in os.path.basename(p) for p in paths):
         notes.append(f"--node {args.node} is not used: '{args.results}' has no node history to "
                      "plot (dynamic beam and continuum runs have one)")
+    notes.append(unused_scale_note(args.scale, args.results, scaled))
     # the parts of a coupled run share their outputs: one note each
     for note in dict.fromkeys(n for n in notes if n):
         print(f"plot_results.py: note: {note}", file=sys.stderr)

@@ -162,6 +162,14 @@ def plot_field(res: Results, d: np.ndarray, what: str, scale: Optional[float] = 
     return fig
 
 
+def uses_scale(res: Results) -> bool:
+    """Whether `write_all` draws a deformed shape magnified by its ``scale``: that of a frame
+    (not a straight beam along x, drawn as its deflection) at an output or its static
+    solution."""
+    return (not res.mesh.is_straight_along_x()
+            and (res.dynamic is not None or res.static is not None))
+
+
 def plot_deflection(res: Results, time: Optional[float] = None,
                     scale: Optional[float] = None) -> tuple[Figure, int]:
     """Deflection (or deformed shape) at the stored output nearest to ``time`` (default: the

@@ -14,18 +14,18 @@ Figures (``write_all``):
 """
 from dataclasses import dataclass
 import os
+import textwrap
 from typing import Optional
 
-import h5py
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection, PatchCollection, PolyCollection
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
-from .beam import _time_unit
-from .results import (FigureFiles, ResultsError, complete_records, no_output_error,
-                      no_results_error, shape_error, unfinished_status)
+from .beam import _length_unit, _time_unit
+from .results import (FigureFiles, ResultsError, _open_results, complete_records,
+                      no_output_error, no_results_error, shape_error, unfinished_status)
 
 
 @dataclass
@@ -56,6 +56,10 @@ class ContinuumResults:
         return int(np.argmin(np.abs(self.time - t)))
 
 
+#: Characters of a title line that fit across a figure 8 inches wide (at matplotlib's 'large'
+#: font about 6.6 points a character, 576 points): a longer line is wrapped.
+TITLE_CHARACTERS = 80
+
 #: Relative level below which a stress component is round-off of the largest one.
 ROUNDOFF = 1e-9
 
@@ -63,19 +67,18 @@ ENERGY_TERMS = ("kinetic", "strain", "external_work", "damping", "reaction_work"
 
 
 def has_continuum(path) -> bool:
-    """Whether the results file holds a 2D continuum."""
-    with h5py.File(path, "r") as f:
+    """Whether the results file holds a 2D continuum; ResultsError when it is missing, not a
+    results file or unreadable (`_open_results`)."""
+    with _open_results(os.fspath(path)) as f:
         return "continuum/mesh/coordinates" in f
 
 
 def load_continuum(path) -> ContinuumResults:
-    """Read the /continuum group (and the disks of a coupled run); ResultsError when a dataset
-    the file's kind of run must hold is missing."""
+    """Read the /continuum group (and the disks of a coupled run); ResultsError when the file
+    is missing, not a results file (`_open_results`) or lacks a dataset its kind of run must
+    hold."""
     path = os.fspath(path)
-    try:
-        f = h5py.File(path, "r")
-    except OSError as exc:
-        raise ResultsError(f"'{path}' is not a readable HDF5 file ({exc})") from None
+    f = _open_results(path)
     with f:
         def need(name):
             if name not in f:
@@ -234,7 +237,10 @@ def plot_stress(res: ContinuumResults, time: Optional[float] = None,
         ft, ut = _time_unit(res.time)
         when = f", t = {res.time[k] * ft:.6g} {ut}"
     magnified = "true scale" if s == 1.0 else f"displacements × {s:.3g}"
-    axes[0].set_title(f"{res.title}\nstress per element on the deformed mesh{when} ({magnified})")
+    # over the figure, not over the panels: those of a tall body are narrower than its title
+    # (which the figure clipped); a title line longer than the figure is wide is wrapped
+    title = f"{res.title}\nstress per element on the deformed mesh{when} ({magnified})"
+    fig.suptitle("\n".join(textwrap.fill(line, TITLE_CHARACTERS) for line in title.split("\n")))
     return fig
 
 
@@ -252,12 +258,14 @@ def plot_history(res: ContinuumResults, node: Optional[int] = None) -> tuple[Fig
     if not 0 <= n < res.x.shape[0]:
         raise ResultsError(f"{res.path}: no node {node} (the mesh has {res.x.shape[0]} nodes)")
     ft, ut = _time_unit(res.time)
+    # the unit of the beam plots (m, mm or µm by the largest value)
+    fl, ul = _length_unit(res.u[:, n])
     fig = _figure(height=4.5)
     ax = fig.subplots()
-    ax.plot(res.time * ft, res.u[:, n, 0], label="u_x")
-    ax.plot(res.time * ft, res.u[:, n, 1], label="u_y")
+    ax.plot(res.time * ft, res.u[:, n, 0] * fl, label="u_x")
+    ax.plot(res.time * ft, res.u[:, n, 1] * fl, label="u_y")
     ax.set_xlabel(f"time [{ut}]")
-    ax.set_ylabel("displacement [m]")
+    ax.set_ylabel(f"displacement [{ul}]")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize="small")
     ax.set_title(f"{res.title}\nnode {n + 1} at ({res.x[n, 0]:.4g}, {res.x[n, 1]:.4g}) m")

@@ -18,7 +18,6 @@ import os
 from dataclasses import dataclass
 from typing import Optional, Sequence
 
-import h5py
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import EllipseCollection
@@ -196,8 +195,9 @@ class CoupledResults:
 
 
 def is_coupled(path) -> bool:
-    """Whether a results file holds a coupled run (a /coupling group)."""
-    with h5py.File(os.fspath(path), "r") as f:
+    """Whether a results file holds a coupled run (a /coupling group); ResultsError when it is
+    missing, not a results file or unreadable (`_open_results`)."""
+    with _open_results(os.fspath(path)) as f:
         return "coupling" in f
 
 
@@ -298,6 +298,13 @@ def _unit(values, base: str) -> tuple[float, str]:
     return 1e9, "n" + base
 
 
+def _time_text(t: float, times: np.ndarray) -> str:
+    """A stored time in the unit of the run's times (s, ms or µs: beam._time_unit), as the
+    other figures' titles give it."""
+    factor, unit = _time_unit(times)
+    return f"{t * factor:.6g} {unit}"
+
+
 def _shade_overlap(ax, res: CoupledResults, label: bool = True):
     a, b = res.overlap_x()
     ax.axvspan(min(a, b), max(a, b), color=OVERLAP_COLOUR, zorder=0,
@@ -330,7 +337,7 @@ def plot_profiles(res: CoupledResults, time: Optional[float] = None,
         ax.grid(True, alpha=0.3)
     ax_v.set_xlabel("x at t = 0 [m]")
     ax_d.legend(loc="best", fontsize="small")
-    ax_d.set_title(f"{res.title}\nt = {p.time * 1e3:.3g} ms")
+    ax_d.set_title(f"{res.title}\nt = {_time_text(p.time, res.time)}")
     return fig
 
 
@@ -388,7 +395,8 @@ def plot_configuration(res: CoupledResults, time: Optional[float] = None,
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.legend(loc="lower left", fontsize="small")
-    ax.set_title(f"{res.title}\nt = {res.time[k] * 1e3:.3g} ms, displacements x {scale:.3g}")
+    ax.set_title(f"{res.title}\nt = {_time_text(res.time[k], res.time)}, "
+                 f"displacements x {scale:.3g}")
     return fig
 
 
@@ -470,7 +478,7 @@ def plot_compare_profiles(runs: Sequence[CoupledResults], labels: Sequence[str],
         ax.grid(True, alpha=0.3)
     ax_v.set_xlabel("x at t = 0 [m]")
     ax_d.legend(loc="best", fontsize="small")
-    ax_d.set_title(f"t = {profiles[0].time * 1e3:.3g} ms")
+    ax_d.set_title(f"t = {_time_text(profiles[0].time, runs[0].time)}")
     return fig
 
 

@@ -21,14 +21,13 @@ apparent friction is tan(atan(mu) - phi) (`sliding_over_disks`): mu at the start
 as the upper row passes over the crest of the row below.
 """
 import numpy as np
-import h5py
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection, PatchCollection, PolyCollection
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
 from .continuum import element_polygons
-from .results import ResultsError, complete_records
+from .results import ResultsError, _open_results, complete_records
 
 
 class InterfaceRun:
@@ -36,10 +35,7 @@ class InterfaceRun:
 
     def __init__(self, path):
         self.path = str(path)
-        try:
-            f = h5py.File(self.path, "r")
-        except OSError as e:
-            raise ResultsError(f"{self.path}: cannot open ({e})") from None
+        f = _open_results(self.path)
         with f:
             for name in ("coupling/lambda", "continuum/displacement", "dem/position"):
                 if name not in f:

@@ -10,7 +10,6 @@ import os
 from dataclasses import dataclass
 from typing import Optional
 
-import h5py
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import EllipseCollection, LineCollection
@@ -118,8 +117,9 @@ class DemResults:
 
 
 def has_particles(path) -> bool:
-    """Whether a results file holds discrete-element results (a /dem group)."""
-    with h5py.File(os.fspath(path), "r") as f:
+    """Whether a results file holds discrete-element results (a /dem group); ResultsError when
+    it is missing, not a results file or unreadable (`_open_results`)."""
+    with _open_results(os.fspath(path)) as f:
         return "dem" in f
 
 

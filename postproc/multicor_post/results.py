@@ -88,14 +88,9 @@ def file_contents(path) -> tuple[bool, bool, bool, bool]:
     results file; ResultsError saying what the file is when it is missing, not HDF5, a
     checkpoint or an FCLIB export."""
     path = os.fspath(path)
+    # the other HDF5 files multicor writes (a checkpoint, an FCLIB export): _open_results says
+    # what they are and where the results are
     with _open_results(path) as f:
-        # the other HDF5 files multicor writes: say what they are and where the results are
-        if str(f.attrs.get("format", "")).startswith("MULTICOR checkpoint"):
-            raise ResultsError(f"'{path}' is a MULTICOR checkpoint (for --restart), not a "
-                               "results file: plot the <deck name>.h5 next to it")
-        if "fclib_local" in f:
-            raise ResultsError(f"'{path}' is a contact problem exported in FCLIB's format "
-                               "([solver] fclib_step), not a results file")
         contents = ("fem/mesh" in f, "dem" in f, "coupling" in f, "continuum/mesh" in f)
         # a run killed before its first stored output leaves the root attributes and /summary
         status = unfinished_status(f)
@@ -176,6 +171,17 @@ def unused_time_note(requested: Optional[float], analysis: str) -> Optional[str]
     holds = "one solution" if analysis == "static" else "mode shapes"
     return (f"--time {requested:g} s is ignored: it applies to dynamic runs only, and this is "
             f"a {analysis} run ({holds}, no stored outputs in time)")
+
+
+def unused_scale_note(scale: Optional[float], path, drawn: bool) -> Optional[str]:
+    """The note for a --scale given for a file none of whose figures magnifies displacements
+    (``drawn`` False: particles only, a straight beam, whose deflection is drawn in length
+    units, or a beam's mode shapes); None otherwise."""
+    if scale is None or drawn:
+        return None
+    return (f"--scale {scale:g} is not used: '{os.fspath(path)}' has no deformed shape to "
+            "magnify (frames, 2D continua and beam-coupled runs have one; a straight beam's "
+            "deflection is drawn in length units)")
 
 
 def outside_time_note(requested: Optional[float], times: Optional[np.ndarray]) -> Optional[str]:
@@ -376,17 +382,36 @@ def _mode_kinds(f, n_modes: int) -> Optional[list]:
 
 
 def _open_results(path: str) -> h5py.File:
-    """Open a results file for reading. Raises ResultsError when it is missing (saying so
-    when the run left a '.partial' file) or is not a readable HDF5 file."""
+    """Open a results file for reading. Raises ResultsError, in one line, when it is missing
+    (saying so when the run left a '.partial' file), a folder, not a readable HDF5 file, or one
+    of the other HDF5 files multicor writes: a checkpoint or an FCLIB export (saying what it
+    is and where the results are)."""
+    path = os.fspath(path)
     if not os.path.exists(path):
         hint = ""
         if os.path.exists(path + ".partial"):
             hint = f" ('{path}.partial' exists: the run did not finish)"
         raise ResultsError(f"results file '{path}' does not exist{hint}")
+    if os.path.isdir(path):
+        raise ResultsError(f"'{path}' is a folder, not a results file: give the <deck name>.h5 "
+                           "in it")
     try:
-        return h5py.File(path, "r")
+        f = h5py.File(path, "r")
     except OSError as exc:
-        raise ResultsError(f"'{path}' is not a readable HDF5 file ({exc})") from None
+        # HDF5's message spans lines (its 'time = ...' field ends with one): joined
+        raise ResultsError(f"'{path}' is not a readable HDF5 file ({' '.join(str(exc).split())})"
+                           ) from None
+    try:
+        if str(f.attrs.get("format", "")).startswith("MULTICOR checkpoint"):
+            raise ResultsError(f"'{path}' is a MULTICOR checkpoint (for --restart), not a "
+                               "results file: plot the <deck name>.h5 next to it")
+        if "fclib_local" in f:
+            raise ResultsError(f"'{path}' is a contact problem exported in FCLIB's format "
+                               "([solver] fclib_step), not a results file")
+    except BaseException:
+        f.close()
+        raise
+    return f
 
 
 def damaged_file_error(exc: BaseException, path) -> Optional[ResultsError]:

@@ -173,3 +173,39 @@ def test_a_node_without_a_history_to_plot_is_said_to_be_unused(cantilever_file, 
     dynamic = cantilever_file("dynamic.h5")
     assert plot_results.main([str(dynamic), "--node", "50", "--out", str(tmp_path / "c")]) == 0
     assert "not used" not in capsys.readouterr().err
+
+
+def test_a_scale_without_a_deformed_shape_to_magnify_is_said_to_be_unused(cantilever_file,
+                                                                          tmp_path, capsys):
+    # --scale was silently ignored where no figure magnifies displacements: a straight beam
+    # (its deflection drawn in length units), its mode shapes, particles only
+    from test_continuum import write as write_continuum
+    straight = cantilever_file("straight.h5")
+    for script in (plot_results, plot_beam):
+        assert script.main([str(straight), "--scale", "100", "--out", str(tmp_path / "a")]) == 0
+        err = capsys.readouterr().err
+        assert err == (f"{script.__name__}.py: note: --scale 100 is not used: '{straight}' has "
+                       "no deformed shape to magnify (frames, 2D continua and beam-coupled runs "
+                       "have one; a straight beam's deflection is drawn in length units)\n")
+    dem = write_dem(tmp_path / "dem.h5")
+    assert plot_results.main([str(dem), "--scale", "5", "--out", str(tmp_path / "b")]) == 0
+    assert "--scale 5 is not used" in capsys.readouterr().err
+    # where a deformed shape is drawn (a frame, a continuum, a beam-coupled run), no note
+    frame = cantilever_file("frame.h5", angle=0.5)
+    plate = write_continuum(tmp_path / "plate.h5")
+    glued = write_coupled(tmp_path / "glued.h5")
+    for path in (frame, plate, glued):
+        assert plot_results.main([str(path), "--scale", "100", "--out", str(tmp_path / "c")]) == 0
+        assert "not used" not in capsys.readouterr().err
+    assert plot_beam.main([str(frame), "--scale", "100", "--out", str(tmp_path / "c")]) == 0
+    assert "not used" not in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("script", [plot_results, plot_beam])
+def test_a_folder_given_as_the_results_file_is_a_one_line_error(script, tmp_path, capsys):
+    # h5py's message ('Is a directory', with HDF5's 'time = ...' field ending in a newline)
+    # made it two lines
+    assert script.main([str(tmp_path)]) == 1
+    err = capsys.readouterr().err
+    assert err == (f"{script.__name__}.py: error: '{tmp_path}' is a folder, not a results file: "
+                   "give the <deck name>.h5 in it\n")

@@ -110,7 +110,26 @@ def test_stress_plot_colours_each_element_on_the_deformed_mesh(tmp_path):
             expected = X[CONN[e, :n] - 1] + 50.0 * field(k)[CONN[e, :n] - 1]
             np.testing.assert_allclose(path.vertices[:n], expected, rtol=0, atol=1e-12)
         np.testing.assert_allclose(outline.get_paths()[1].vertices[:4], X[CONN[1] - 1], atol=0)
-    assert "t = 3 ms" in fig.axes[0].get_title() and "× 50" in fig.axes[0].get_title()
+    assert "t = 3 ms" in fig.get_suptitle() and "× 50" in fig.get_suptitle()
+
+
+def test_the_stress_title_of_a_tall_body_fits_in_the_figure(tmp_path):
+    # the title was that of the top panel, centred over it: over the narrow panels of a tall
+    # body (the interface experiment's blocks, 0.5 x 0.45 m) a long title ran out of the
+    # figure on both sides and was clipped
+    res = continuum.load_continuum(write(tmp_path / "d.h5"))
+    res.x = res.x * [0.1, 3.0]                       # 0.3 m wide, 3 m high
+    res.title = ("contact interface: disk layer between two blocks, normal then tangential "
+                 "loading, and a title longer than the figure is wide")
+    fig = continuum.plot_stress(res)
+    fig.canvas.draw()
+    box = fig.bbox
+    for text in [fig._suptitle] + [ax.title for ax in fig.axes]:
+        if text is not None and text.get_text():
+            extent = text.get_window_extent()
+            # whole pixels: the renderer rounds the text's box
+            assert box.x0 - 1 <= extent.x0 and extent.x1 <= box.x1 + 1, text.get_text()
+    assert "stress per element on the deformed mesh" in fig.get_suptitle()
 
 
 def test_disks_of_a_coupled_run_move_with_the_same_magnification(tmp_path):
@@ -136,8 +155,12 @@ def test_history_of_the_node_that_moves_most(tmp_path):
     fig, node = continuum.plot_history(res)
     assert node == 7                                 # x = 3: u_y = A k 9, the largest
     ux, uy = fig.axes[0].get_lines()
-    np.testing.assert_allclose(uy.get_ydata(), [field(k)[6, 1] for k in range(N_OUT)], rtol=1e-12)
-    np.testing.assert_allclose(ux.get_ydata(), [field(k)[6, 0] for k in range(N_OUT)], rtol=1e-12)
+    # in mm, as the beam plots give a largest value of 3.6 mm (it said [m] whatever the size)
+    assert fig.axes[0].get_ylabel() == "displacement [mm]"
+    np.testing.assert_allclose(uy.get_ydata(), [1e3 * field(k)[6, 1] for k in range(N_OUT)],
+                               rtol=1e-12)
+    np.testing.assert_allclose(ux.get_ydata(), [1e3 * field(k)[6, 0] for k in range(N_OUT)],
+                               rtol=1e-12)
     assert continuum.plot_history(res, node=2)[1] == 2
     # the default is the largest displacement over the run, not at the last state
     res.u[-1] = 0.0

@@ -158,3 +158,19 @@ def test_experiments_summary_names_the_stored_time_it_reads(coupled_file):
     assert f"  case: no output at t = 100 s; the nearest, t = {float(res.time[-1]):g} s:" in late
     assert any(line.startswith(f"  case at t = {float(res.time[-1]):g} s: beam end w") for line in late)
     assert float(res.time[-1]) == pytest.approx((N_OUT - 1) * dt, rel=1e-12)
+
+
+def test_titles_give_the_time_in_the_unit_of_the_run(coupled_file):
+    # '{t * 1e3:.3g} ms' gave 't = 1.23e+03 ms' for a run over 1 s: now the unit of the other
+    # figures (s from 1 s on, ms, µs) and their 6 significant digits
+    res = coupled.load_coupled(coupled_file)
+    res.time = res.time * 1e2 + 0.1234567             # 0.1234567 .. 1.6234567 s
+    title = coupled.plot_profiles(res).axes[0].get_title()
+    assert title.endswith("\nt = 1.62346 s")
+    config = coupled.plot_configuration(res, time=0.0).axes[0].get_title()
+    assert "\nt = 0.123457 s, displacements x " in config
+    compare = coupled.plot_compare_profiles([res], ["a"]).axes[0].get_title()
+    assert compare == "t = 1.62346 s"
+    # a run of a few ms keeps its ms (the synthetic outputs: 0 .. 15 ms)
+    short = coupled.load_coupled(coupled_file)
+    assert coupled.plot_profiles(short).axes[0].get_title().endswith("\nt = 15 ms")

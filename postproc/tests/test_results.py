@@ -86,3 +86,29 @@ def test_unknown_node_id_is_a_clear_error(cantilever_file):
     assert res.mesh.index_of(90) == 8
     with pytest.raises(ResultsError, match="no node with id 7"):
         res.mesh.index_of(7)
+
+
+def _loaders():
+    from multicor_post import continuum, coupled, particles
+    return [load_results, particles.load_dem, continuum.load_continuum, coupled.load_coupled,
+            coupled.load_continuum_coupling, particles.has_particles, continuum.has_continuum,
+            coupled.is_coupled]
+
+
+@pytest.mark.parametrize("loader", _loaders(), ids=lambda f: f.__name__)
+def test_every_loader_says_what_a_checkpoint_or_a_missing_file_is(loader, tmp_path):
+    # on a checkpoint the loaders said "missing dataset" (the scripts said what it is);
+    # has_particles and has_continuum raised FileNotFoundError on a missing file, and
+    # load_continuum said "not a readable HDF5 file ([Errno 2] ...)"
+    import h5py
+    with h5py.File(tmp_path / "checkpoint.h5", "w") as f:
+        f.attrs["format"] = "MULTICOR checkpoint 2"
+        f.create_group("fem/mesh")
+        f.create_group("continuum/mesh")
+    with pytest.raises(ResultsError, match=r"is a MULTICOR checkpoint \(for --restart\), not a "
+                                           "results file"):
+        loader(tmp_path / "checkpoint.h5")
+    with pytest.raises(ResultsError, match="results file '.*none.h5' does not exist$"):
+        loader(tmp_path / "none.h5")
+    with pytest.raises(ResultsError, match="is a folder, not a results file"):
+        loader(tmp_path)
