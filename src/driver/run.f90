@@ -31,7 +31,7 @@ module driver_run
     use io_lock, only: lock_t, lock_acquire, lock_release
     use io_progress, only: progress_t
     use core_signals, only: caught_signal, signal_name, install_signal_handlers
-    use core_threads, only: single_thread_blas, thread_setting
+    use core_threads, only: openmp_part, single_thread_blas, thread_setting
     use io_deck_schema, only: multicor_schema
     use io_deck, only: deck_t, read_deck
     use io_paths, only: stem, basename, mkdir_p, remove_empty_folders, file_exists, remove_file, rename_file
@@ -492,7 +492,7 @@ contains
             if (at_end) call report('note: the checkpoint is of the last step and the results file of its run '// &
                                     'is still partial (the run was killed after its final checkpoint): no step '// &
                                     'to do, the results are finished from the checkpoint')
-            if (len(ck%start%threads) > 0 .and. ck%start%threads /= thread_setting()) &
+            if (len(ck%start%threads) > 0 .and. openmp_part(ck%start%threads) /= openmp_part(thread_setting())) &
                 call report('warning: the checkpoint was written with '//ck%start%threads//'; this run has '// &
                             thread_setting()//': the results go on correctly, but bit for bit they are '// &
                             'those of neither uninterrupted run (the split sweeps from 4 000 contacts depend on '// &
