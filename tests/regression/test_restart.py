@@ -1332,6 +1332,15 @@ def other_threads(exe, src, work):
     with h5py.File(folder / "threads.h5", "r") as f:
         recorded = f["summary"].attrs["threads"]
     warned = [line for line in other.stdout.splitlines() if line.startswith("warning: the checkpoint was written with")]
+    # a checkpoint of an earlier build records 'OpenMP threads N, OPENBLAS_NUM_THREADS V': only
+    # the OpenMP part counts (OpenBLAS now runs on one thread)
+    with h5py.File(folder / "checkpoint.h5", "r+") as f:
+        f.attrs["threads"] = "OpenMP threads 2, OPENBLAS_NUM_THREADS unset"
+    earlier = run(exe, deck, "--output", folder, "--restart", folder / "checkpoint.h5", "--end", "0.0225",
+                  env=dict(env, OMP_NUM_THREADS="2"))
+    check("restart from a checkpoint of an earlier build's format, the same OMP_NUM_THREADS: no warning",
+          earlier.returncode == 0 and "warning: the checkpoint was written with" not in earlier.stdout,
+          f"exit {earlier.returncode}; {earlier.stdout[-300:]}{earlier.stderr[-300:]}")
     check("restart under the same thread setting, or another OPENBLAS_NUM_THREADS (the program runs OpenBLAS "
           "on one thread): no warning; under another OMP_NUM_THREADS: one naming both",
           first.returncode == 0 and same.returncode == 0 and "warning: the checkpoint" not in same.stdout
