@@ -814,49 +814,70 @@ contains
         if (size(list) > 0) call warn_missing_laws(list(1)%line)
         call build_bonds(deck, cfg, law_line, error)
     contains
-        !> A pair of materials whose bodies may touch (walls of one and disks of the other, or
-        !> two disks of one material) and that has no law, in a deck that gives laws to other
-        !> pairs: its contacts are frictionless, without restitution or cohesion (the default),
-        !> which is also what a forgotten record gives (an audit's floor of another material
-        !> than its disks, silently frictionless). Disks of two materials are left out: laws
-        !> between them are often left out on purpose (disks that never meet, as in
-        !> input/incline.dat). Warned about at the first law's line, once per pair.
+        !> Walls of a material that has a law with no material of the disks, or disks of a
+        !> material that has one with no material of the walls, in a deck that gives laws to
+        !> other pairs: their contacts are frictionless, without restitution or cohesion (the
+        !> default), which is also what a forgotten record gives (an audit's floor of another
+        !> material than its disks, silently frictionless). Pairs are not judged one by one:
+        !> laws are often left out on purpose for bodies that never meet (the two disks and two
+        !> inclines of input/incline.dat, each disk with its own incline's material), and so are
+        !> laws between disks. Warned about at the first law's line, once per material.
         subroutine warn_missing_laws(line)
             integer, intent(in) :: line
-            integer, allocatable :: disks(:)
-            logical, allocatable :: on_walls(:)
-            character(len=:), allocatable :: bodies
+            logical, allocatable :: on_disks(:), on_walls(:), wall_alone(:)
             integer :: a, b
-            allocate (disks(size(cfg%material_id)), source=0)
-            allocate (on_walls(size(cfg%material_id)), source=.false.)
+            allocate (on_disks(size(cfg%material_id)), on_walls(size(cfg%material_id)), source=.false.)
             associate (p => cfg%system%particles, w => cfg%system%walls)
-                do a = 1, p%n
-                    disks(p%mat(a)) = disks(p%mat(a)) + 1
-                end do
+                on_disks(p%mat(1:p%n)) = .true.
                 if (w%n > 0) on_walls(w%mat(1:w%n)) = .true.
             end associate
+            allocate (wall_alone(size(cfg%material_id)), source=.false.)
+            do b = 1, size(cfg%material_id)
+                if (.not. on_walls(b) .or. any(law_line(:, b) > 0 .and. on_disks)) cycle
+                wall_alone(b) = .true.
+                call warn('the walls of material '//to_str(cfg%material_id(b))//' have no law with the disks of', &
+                          on_disks, b, .true., line)
+            end do
+            ! disks without a law with any wall: unless every wall material is named already
+            if (all(wall_alone .or. .not. on_walls)) return
             do a = 1, size(cfg%material_id)
-                do b = a, size(cfg%material_id)
-                    if (law_line(a, b) > 0) cycle
-                    bodies = ''
-                    if (a == b .and. disks(a) >= 2) bodies = ', disks of '//to_str(cfg%material_id(a))
-                    if (disks(a) > 0 .and. on_walls(b)) bodies = bodies//', disks of '//to_str(cfg%material_id(a))// &
-                                                                 ' on walls of '//to_str(cfg%material_id(b))
-                    if (a /= b .and. disks(b) > 0 .and. on_walls(a)) bodies = bodies//', disks of '// &
-                                                                              to_str(cfg%material_id(b))// &
-                                                                              ' on walls of '//to_str(cfg%material_id(a))
-                    if (len(bodies) == 0) cycle
-                    cfg%warnings = [cfg%warnings, string_t('warning: '//deck%file//':'//to_str(line)// &
-                                                           ': [contacts] no law for materials '// &
-                                                           to_str(cfg%material_id(a))//' and '// &
-                                                           to_str(cfg%material_id(b))//' ('//bodies(3:)// &
-                                                           '): their contacts are frictionless, without '// &
-                                                           'restitution or cohesion (the default); add law = '// &
-                                                           to_str(cfg%material_id(a))//' '// &
-                                                           to_str(cfg%material_id(b))//' 0 0 0 if that is meant')]
-                end do
+                if (.not. on_disks(a) .or. any(law_line(a, :) > 0 .and. on_walls)) cycle
+                call warn('the disks of material '//to_str(cfg%material_id(a))//' have no law with the walls of', &
+                          on_walls, a, .false., line)
             end do
         end subroutine warn_missing_laws
+
+        !> The warning for material `m`, whose bodies have no law with those of the materials
+        !> flagged in `others` (`m` of walls when `walls`, of disks otherwise).
+        subroutine warn(what, others, m, walls, line)
+            character(len=*), intent(in) :: what
+            logical, intent(in) :: others(:)
+            integer, intent(in) :: m, line
+            logical, intent(in) :: walls
+            character(len=:), allocatable :: ids, first
+            integer :: k
+            ids = ''
+            first = ''
+            do k = 1, size(others)
+                if (.not. others(k)) cycle
+                if (len(first) == 0) first = to_str(cfg%material_id(k))
+                ids = ids//', '//to_str(cfg%material_id(k))
+            end do
+            if (count(others) == 1) then
+                ids = ', material '//ids(3:)
+            else
+                ids = ', materials '//ids(3:)
+            end if
+            if (walls) then
+                first = first//' '//to_str(cfg%material_id(m))
+            else
+                first = to_str(cfg%material_id(m))//' '//first
+            end if
+            cfg%warnings = [cfg%warnings, string_t('warning: '//deck%file//':'//to_str(line)//': [contacts] '// &
+                                                   what//' '//ids(3:)//': their contacts are '// &
+                                                   'frictionless, without restitution or cohesion (the default); '// &
+                                                   'add law = '//first//' 0 0 0 if that is meant')]
+        end subroutine warn
 
         !> A rolling length beyond the radius of the largest disk of the pair's materials: the
         !> moment |M| <= e_r r_n then has an arm longer than the disk (e_r is a fraction of the

@@ -128,8 +128,9 @@ contains
         call s%add_section('contacts', 'Contact laws between materials (Signorini, Coulomb '// &
                            'friction, Newton restitution, cohesion) and contact detection. A pair of '// &
                            'materials without a law is frictionless, perfectly plastic (e = 0), not cohesive; '// &
-                           'in a deck that gives laws to other pairs, such a pair whose bodies may touch '// &
-                           '(disks of one on walls of the other, two disks of one material) is warned about.')
+                           'in a deck that gives laws to other pairs, walls of a material without a law with '// &
+                           'any material of the disks, or disks of one without a law with any material of the '// &
+                           'walls, are warned about.')
         call s%add_keyword('contacts', 'law', [int_field('material1', lower=1), &
                                                int_field('material2', lower=1), &
                                                real_field('mu', '', lower=0.0_wp, upper=max_friction), &

@@ -33,9 +33,10 @@ goes on, and a warning names the file, the line and the setting that turns it of
   contact at a time, whose stopping test can be met far from the solution) are warned about
   at the method's line, for particles alone and coupled to a beam; `method = block` (the
   default) and `nlgs` without bonds are not.
-- In a deck with laws, a pair of materials without one whose bodies may touch (disks of one
-  on walls of the other, two disks of one material) is warned about at the first law's line;
-  disks of two materials, or a deck without any law, are not.
+- In a deck with laws, walls of a material without a law with any disk material, or disks
+  of a material without one with any wall material, are warned about at the first law's
+  line; pairs that are one of several (input/incline.dat's inclines), laws between disks, or
+  a deck without any law, are not.
 - `[contacts] alert = 0` is warned about at its line (contacts seen only once disks touch).
 - A time function used by a load that is zero over the whole run (a step at 1.0 s of a run
   that ends at 0.5 s) is warned about at its line, with the line of the load, under --check
@@ -625,10 +626,12 @@ analysis = dynamic
 [particles]
 material = 1 2500
 material = 2 7800
+material = 3 2500
+material = 4 7800
 {disks}
 gravity = 0 -9.81
 [walls]
-wall = -1 0 1 0 2
+{walls}
 [contacts]
 {laws}
 [time]
@@ -638,32 +641,41 @@ end = 2e-3
 
 
 def missing_laws(exe, work):
-    """In a deck with laws, a pair of materials without one whose bodies may touch (a disk of
-    material 1 on a floor of material 2; two disks of material 1) is warned about at the first
-    law's line, once per pair; pairs with laws, and disks of two materials, are not."""
+    """In a deck with laws, walls of a material without a law with any disk material (a floor
+    of material 2 under disks of material 1), or disks of a material without one with any wall
+    material while other disks have one, are warned about at the first law's line, once per
+    material, with the law to add. Not: pairs that are only one of several (the two inclines
+    of input/incline.dat, materials 3 and 4, each with its own disk: laws 1-3 and 2-4), laws
+    between disks, a deck without any law."""
     one = "disk = 0 0.05 0.05 1"
     two = "disk = 0 0.05 0.05 1\ndisk = 0.5 0.05 0.05 1"
     mixed = "disk = 0 0.05 0.05 1\ndisk = 0.5 0.05 0.05 2"
-    cases = (("floor", one, "law = 1 1 0.3 0 0", ["1 and 2 (disks of 1 on walls of 2)"]),
-             ("floor_and_pair", two, "law = 2 2 0.3 0 0",
-              ["1 and 1 (disks of 1)", "1 and 2 (disks of 1 on walls of 2)"]),
-             ("all_given", two, "law = 1 1 0.3 0 0\nlaw = 1 2 0 0 0", []),
-             ("two_materials", mixed, "law = 1 2 0.3 0 0\nlaw = 2 2 0.3 0 0", []),
-             ("no_law_at_all", one, "", []))
-    for name, disks, laws, pairs in cases:
-        text = LAWLESS.format(disks=disks, laws=laws)
+    floor = "wall = -1 0 1 0 2"
+    inclines = "wall = -0.8 0.6 0.8 -0.6 3\nwall = -0.8 -0.4 0.8 -1.6 4"
+    cases = (("floor", one, floor, "law = 1 1 0.3 0 0",
+              ["the walls of material 2 have no law with the disks of material 1", "1 2"]),
+             ("floor_and_pair", two, floor, "law = 2 2 0.3 0 0",
+              ["the walls of material 2 have no law with the disks of material 1", "1 2"]),
+             ("all_given", two, floor, "law = 1 2 0 0 0", []),
+             ("two_materials", mixed, floor, "law = 1 2 0.3 0 0\nlaw = 2 2 0.3 0 0", []),
+             ("inclines", "disk = 0.03 0.04 0.05 1\ndisk = 0.03 -0.96 0.05 2", inclines,
+              "law = 1 3 0.5 0 0\nlaw = 2 4 0.1 0 0", []),
+             ("disks_without", mixed, "wall = -1 0 1 0 3", "law = 1 3 0.5 0 0",
+              ["the disks of material 2 have no law with the walls of material 3", "2 3"]),
+             ("no_law_at_all", one, floor, "", []))
+    for name, disks, walls, laws, warned in cases:
+        text = LAWLESS.format(disks=disks, walls=walls, laws=laws)
         if not laws:  # (an empty section is an error)
             text = text.replace("[contacts]\n\n", "")
         deck = work / f"lawless_{name}.dat"
         deck.write_text(text)
         proc = multicor(exe, "--check", deck)
-        said = [w for w in warnings_of(proc.stdout) if "[contacts] no law for" in w]
-        expected = [f"warning: {deck}:{line_of(text, 'law')}: [contacts] no law for materials {p}: their contacts "
-                    "are frictionless, without restitution or cohesion (the default); add law = "
-                    f"{p.split()[0]} {p.split()[2]} 0 0 0 if that is meant" for p in pairs]
-        check(f"pairs without a law, {name}: {len(pairs)} warning(s)", proc.returncode == 0 and said == expected,
+        said = [w for w in warnings_of(proc.stdout) if "have no law with the" in w]
+        expected = [f"warning: {deck}:{line_of(text, 'law')}: [contacts] {warned[0]}: their contacts are "
+                    "frictionless, without restitution or cohesion (the default); add law = "
+                    f"{warned[1]} 0 0 0 if that is meant"] if warned else []
+        check(f"materials without a law, {name}: {len(expected)} warning(s)", proc.returncode == 0 and said == expected,
               "\n".join(said) or proc.stderr.strip()[:300])
-
 
 def zero_alert(exe, src, work):
     """`[contacts] alert = 0` is accepted and warned about at its line; the deposit's own
