@@ -188,7 +188,7 @@ contains
                            'sweeps as with `nlgs`, and says so in a warning; its aggregates leave bonds out). '// &
                            'With `[contacts] bond` records, `nlgs` and `coarse` sweep the bonds one contact at '// &
                            'a time: along a bonded chain the sweeps converge slowly, and their stopping test can '// &
-                           'be met far from the solution (a warning says so). Every '// &
+                           'be met far from the solution (a warning says so above a tolerance of 1e-8). Every '// &
                            'unilateral or frictional contact uses the bi-potential local solver in all three.', &
                            default='block')
         call s%add_keyword('solver', 'tolerance', [real_field('tolerance', '', lower=0.0_wp, upper=1.0_wp, &

@@ -87,3 +87,14 @@ def plots(src, h5, out, names):
           proc.returncode == 0 and not proc.stderr and printed == expected
           and all(pathlib.Path(p).stat().st_size > 0 for p in printed),
           f"exit {proc.returncode}, stderr {proc.stderr.strip()[-300:]!r}, printed {printed}")
+
+
+def datasets(path, group="/"):
+    """Every dataset below `group` of the HDF5 file `path`, by its name relative to the group:
+    name -> array."""
+    import h5py
+    found = {}
+    with h5py.File(path, "r") as f:
+        f[group].visititems(lambda name, obj: found.update({name: obj[()]}) if isinstance(obj, h5py.Dataset)
+                            else None)
+    return found

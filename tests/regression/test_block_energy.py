@@ -51,7 +51,7 @@ import sys
 import h5py
 import numpy as np
 
-from checks import arguments, check, summary
+from checks import arguments, check, datasets, summary
 
 MAX_SWEEPS = 100
 GIVEN_UP_STEPS = [6, 7]
@@ -185,15 +185,6 @@ tolerance = 1e-12
 """
 
 
-def datasets(path):
-    """Every dataset of /dem by name (the results of the steps: no timings are stored there)."""
-    found = {}
-    with h5py.File(path, "r") as f:
-        f["dem"].visititems(lambda name, obj: found.update({name: obj[...]}) if isinstance(obj, h5py.Dataset)
-                            else None)
-    return found
-
-
 def bond_free(exe, work):
     """A stack without bonds, every step unconverged: method = block is method = nlgs, bit for bit."""
     results = {}
@@ -205,7 +196,8 @@ def bond_free(exe, work):
         if not check(f"bond-free stack, method = {method}: the run ends", proc.returncode == 0,
                      proc.stderr.strip()[-300:]):
             return
-        results[method] = datasets(out / f"{deck.stem}.h5"), proc.stdout
+        # every dataset of /dem (the results of the steps: no timings are stored there)
+        results[method] = datasets(out / f"{deck.stem}.h5", "dem"), proc.stdout
     (block, said), (nlgs, _) = results["block"], results["nlgs"]
     check("bond-free stack: no bond, every step unconverged (the guard's path with an empty block)",
           block["bonds/i"].size == 0 and block["solver/converged"].size == 200 and not block["solver/converged"].any(),

@@ -22,23 +22,14 @@ import subprocess
 import sys
 
 import h5py
-import numpy as np
 
-from checks import arguments, check, summary
+from checks import arguments, check, datasets, summary
 
 SETTINGS = {
     "serial": {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"},
     "openblas_4": {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "4"},
     "openmp_2": {"OMP_NUM_THREADS": "2"},
 }
-
-
-def datasets(path):
-    """Every dataset of the file: name -> array."""
-    found = {}
-    with h5py.File(path, "r") as f:
-        f.visititems(lambda name, obj: found.__setitem__(name, obj[()]) if isinstance(obj, h5py.Dataset) else None)
-    return found
 
 
 def main():
