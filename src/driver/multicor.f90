@@ -20,6 +20,7 @@ program multicor
     use core_signals, only: signal_exit_code, catch_broken_pipe
     use core_strings, only: parse_real, is_real_syntax, to_lower
     use io_deck_schema, only: multicor_schema, schema_markdown
+    use io_unit_words, only: unit_hint
     use driver_run, only: run_options_t, run_deck
     use driver_simulation, only: report_to_stdout
     implicit none
@@ -54,9 +55,11 @@ program multicor
         if (take_end) then
             ! parse_real checks the magnitude before reading: a plain read of '1e999' raises
             ! a floating-point overflow (a crash where it traps), of 'inf'/'nan' a non-finite time
-            call parse_real(trim(arg), opts%end_time, ok)
-            if (.not. (is_real_syntax(trim(arg)) .or. is_infinity(arg))) &
-                call usage_error("--end needs a time in seconds, got '"//arg(:min(len(arg), 40))//"', which is not a number")
+            ! blanks around the value are no part of it (`--end ' 5'`)
+            call parse_real(trim(adjustl(arg)), opts%end_time, ok)
+            if (.not. (is_real_syntax(trim(adjustl(arg))) .or. is_infinity(arg))) &
+                call usage_error("--end needs a time in seconds, got '"//arg(:min(len(arg), 40))// &
+                                 "', which is not a number"//unit_hint(trim(adjustl(arg)), '', '--end', 's'))
             if (.not. ok) call usage_error("--end needs a finite time in seconds, got '"// &
                                            arg(:min(len(arg), 40))//"'")
             if (.not. (opts%end_time > 0.0_wp .and. opts%end_time <= huge(1.0_wp))) &

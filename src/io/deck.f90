@@ -40,7 +40,7 @@ module io_deck
     use core_strings, only: string_t, strip, split_words, join_words, is_blank_char, &
                             closest_match, parse_real, parse_int, to_str, shorten
     use core_utf8, only: invalid_utf8_column, find_invisible_space, byte_hex
-    use io_unit_words, only: unit_hint
+    use io_unit_words, only: unit_hint, looks_like_unit
     use io_deck_schema, only: schema_t, keyword_spec_t, field_spec_t, condition_t, field_text, field_name, &
                               field_real, field_int, type_name
     implicit none
@@ -763,7 +763,7 @@ contains
                 call make_input_error(error, file, line, spec%name, "incomplete group: '"// &
                                       spec%usage(selector)//"' takes values after '"// &
                                       spec%fields(nf)%name//"' in groups of "//to_str(g)// &
-                                      ', got '//to_str(ntok - nf))
+                                      ', got '//to_str(ntok - nf)//record_unit_hint(0))
                 return
             end if
             do i = 1, ntok - nf
@@ -788,8 +788,7 @@ contains
             call field%check(tokens(k)%s, ok, message)
             if (ok) return
             ! `1 210e9 Pa 7800`: a unit where a number is expected
-            if (field%value_type == field_real .or. field%value_type == field_int) &
-                message = message//unit_hint(tokens(k)%s)
+            message = message//record_unit_hint(k)
             call make_input_error(error, file, line, spec%name, 'value '//to_str(k)// &
                                   ' ('//field%name//'): '//message//name_hint(k - 1, k))
         end subroutine check_one
@@ -816,15 +815,101 @@ contains
                 end do
             end if
             ! `step = 1e-3 s`: the value's unit taken for one more value
-            if (what == 'too many' .and. len(hint) == 0) then
-                do p = min(ntok, last_expected + 1), ntok
-                    hint = unit_hint(tokens(p)%s)
-                    if (len(hint) > 0) exit
-                end do
-            end if
+            if (len(hint) == 0) hint = record_unit_hint(0)
             call make_input_error(error, file, line, spec%name, what//' values (got '// &
                                   to_str(ntok)//"): expected '"//spec%usage(selector)//"'"//hint)
         end subroutine count_error
+
+        !> The hint of a record refused while it holds a unit (`-90 deg`, `210GPa`): from value
+        !> k when it is one (0: none), else from the first value of the record that is one (a
+        !> quoted value and one that a name or word field takes as it is, a set named `m`,
+        !> aside); '' when there is none. The unit belongs to the value before it, or to the
+        !> value it is glued to, and to the last value expected when the record has too many;
+        !> the hint uses that value's unit in the schema (unit_hint).
+        function record_unit_hint(k) result(hint)
+            integer, intent(in) :: k
+            character(len=:), allocatable :: hint, previous
+            type(field_spec_t) :: f
+            logical :: found
+            integer :: p, q
+            hint = ''
+            do p = 0, ntok
+                if (p == 0) then
+                    q = k
+                    if (q == 0) cycle
+                else
+                    q = p
+                    if (q == k) cycle
+                end if
+                if (is_unit_value(q)) exit
+            end do
+            if (p > ntok) return
+            ! the value the unit belongs to: the one before a unit alone, within those expected
+            if (scan(tokens(q)%s(1:1), '+-.0123456789') == 0) then
+                previous = ''
+                if (q > 1) previous = tokens(q - 1)%s
+                p = max(q - 1, 1)
+            else
+                previous = ''
+                p = q
+            end if
+            p = min(p, n_expected())
+            call field_at(p, f, found)
+            if (found) then
+                hint = unit_hint(tokens(q)%s, previous, 'value '//to_str(p)//' ('//f%name//')', f%unit)
+            else
+                hint = unit_hint(tokens(q)%s, previous, '', '')
+            end if
+        end function record_unit_hint
+
+        !> Whether value q looks like a unit and is no value its field takes as it is.
+        function is_unit_value(q) result(is_unit)
+            integer, intent(in) :: q
+            logical :: is_unit, found, fits
+            character(len=:), allocatable :: why
+            type(field_spec_t) :: f
+            is_unit = .false.
+            if (quoted(q)) return
+            if (.not. looks_like_unit(tokens(q)%s)) return
+            call field_at(q, f, found)
+            if (found) then
+                if (f%value_type /= field_real .and. f%value_type /= field_int) then
+                    call f%check(tokens(q)%s, fits, why)
+                    if (fits) return
+                end if
+            end if
+            is_unit = .true.
+        end function is_unit_value
+
+        !> Number of values the line may have (fixed fields and the tail its selector chooses);
+        !> ntok when the tail has no limit.
+        integer function n_expected()
+            integer :: kt_here
+            n_expected = nf
+            kt_here = spec%tail_index(selector)
+            if (kt_here == 0) return
+            if (spec%tails(kt_here)%max_values < 0) then
+                n_expected = max(nf, ntok)
+            else
+                n_expected = nf + spec%tails(kt_here)%max_values
+            end if
+        end function n_expected
+
+        !> The field of value q (found false when the line has no value q).
+        subroutine field_at(q, f, found)
+            integer, intent(in) :: q
+            type(field_spec_t), intent(out) :: f
+            logical, intent(out) :: found
+            integer :: kt_here
+            found = q >= 1 .and. q <= n_expected()
+            if (.not. found) return
+            if (q <= nf) then
+                f = spec%fields(q)
+                return
+            end if
+            kt_here = spec%tail_index(selector)
+            f = spec%tails(kt_here)%field(q - nf)
+        end subroutine field_at
 
         !> Whether the values would fit the fields if value p, a name written without quotes,
         !> took the `extra` values after it (their count, types and words; no selector among

@@ -3,8 +3,8 @@
 cleanly: guards on the initial state and after every step (non-finite state, disks beyond
 the representable box, a driven wall with one end beyond it, tunnelling), the warning of a
 disk moving farther than the alert distance in one step, one writer per results folder (lock file), --output '',
---end 1e999 or abc and the usage line of a bad command line, no empty folder left by a failed run, three-digit exponents in messages, decks
-with a UTF-8 byte-order mark or CR-only line endings.
+--end 1e999, abc, 5s or ' 5' and the usage line of a bad command line, no empty folder left by a failed run, three-digit
+exponents in messages, decks with a UTF-8 byte-order mark or CR-only line endings.
 
 Each failed run must exit 1 with a message naming the deck, the step and the body, and leave
 an earlier finished result in the folder byte for byte.
@@ -350,10 +350,22 @@ def end_option(exe, work):
     # A word is not a number (it said "needs a finite time"); an infinity is not finite.
     for value, expect in (("abc", "--end needs a time in seconds, got 'abc', which is not a number"),
                           ("1x", "got '1x', which is not a number"),
-                          ("-Infinity", "--end needs a finite time in seconds, got '-Infinity'")):
+                          ("-Infinity", "--end needs a finite time in seconds, got '-Infinity'"),
+                          # a time with its unit: the deck's hint on units
+                          ("5s", "got '5s', which is not a number; '5s' looks like a number with its unit: "
+                                 "a value is a plain number in SI units")):
         proc = multicor(exe, deck, "--output", folder, "--end", value)
         check(f"--end {value}: '{expect}'", proc.returncode == 2 and expect in proc.stderr,
               f"exit {proc.returncode} {proc.stderr.strip()[:300]}")
+    # Blanks around the number (a quoted shell variable) are no part of it: it said 'not a number'.
+    blanks = work / "end_option_blanks"
+    proc = multicor(exe, deck, "--output", blanks, "--quiet", "--end", " 1e-3 ")
+    check("--end ' 1e-3 ': runs to 1e-3 s", proc.returncode == 0 and (blanks / "end_option.h5").exists(),
+          f"exit {proc.returncode} {proc.stderr.strip()[:300]}")
+    if proc.returncode == 0:
+        with h5py.File(blanks / "end_option.h5", "r") as f:
+            # steps of 2e-4 s: 5 to the end time read, 10 to the deck's
+            check("--end ' 1e-3 ': 5 steps", int(f["summary"].attrs["steps"]) == 5, str(dict(f["summary"].attrs)))
     # The usage line of a bad command line names every option of --help (it left out --end,
     # --restart and -q).
     usage = multicor(exe, "--bogus").stderr
