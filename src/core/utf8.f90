@@ -36,7 +36,7 @@ module core_utf8
                                     invisible_t(int(z'202F'), 'narrow no-break space'), &
                                     invisible_t(int(z'2060'), 'word joiner'), &
                                     invisible_t(int(z'3000'), 'ideographic space'), &
-                                    invisible_t(int(z'FEFF'), 'zero width no-break space (byte-order mark)')]
+                                    invisible_t(int(z'FEFF'), 'byte-order mark, zero width no-break space')]
 
 contains
 

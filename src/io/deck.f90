@@ -247,14 +247,12 @@ contains
         !> would not show it in the message, and it means a binary or damaged file.
         subroutine check_control(s)
             character(len=*), intent(in) :: s
-            character(len=8) :: code
             integer :: i, c
             do i = 1, len(s)
                 c = iachar(s(i:i))
                 if (c == 13 .and. i == len(s)) cycle  ! the CR of a CR LF line end
                 if ((c < 32 .and. c /= 9) .or. c == 127) then
-                    write (code, '(a,z2.2)') '0x', c
-                    call make_input_error(error, file, line_no, '', 'control character '//trim(code)// &
+                    call make_input_error(error, file, line_no, '', 'control character '//byte_hex(s(i:i))// &
                                           ' at column '//to_str(i)//': a deck is plain text '// &
                                           '(a binary or damaged file?)')
                     return
