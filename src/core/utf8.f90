@@ -6,7 +6,7 @@
 module core_utf8
     implicit none
     private
-    public :: invalid_utf8_column, find_invisible_space, byte_hex
+    public :: invalid_utf8_column, find_invisible_space, byte_hex, replace_invalid_utf8
 
     !> An invisible Unicode space: its code point and its Unicode name.
     type :: invisible_t
@@ -91,6 +91,41 @@ contains
         end do
         column = 0
     end subroutine find_invisible_space
+
+    !> `text` with each byte that does not begin or continue a well-formed UTF-8 sequence
+    !> replaced by the replacement character U+FFFD (three bytes, shown as a question mark in
+    !> a box): text that may be stored as UTF-8 (the deck in the results); `text` itself when
+    !> it is UTF-8 throughout.
+    pure function replace_invalid_utf8(text) result(utf8)
+        !> The text.
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: utf8
+        character(len=*), parameter :: replacement = char(int(z'EF'))//char(int(z'BF'))//char(int(z'BD'))
+        integer :: i, n, k, first
+        first = invalid_utf8_column(text)
+        if (first == 0) then
+            utf8 = text
+            return
+        end if
+        ! at most three bytes for each byte of the text
+        allocate (character(len=3*len(text)) :: utf8)
+        utf8(:first - 1) = text(:first - 1)
+        k = first - 1
+        i = first
+        do while (i <= len(text))
+            n = sequence_length(text, i)
+            if (n == 0) then
+                utf8(k + 1:k + 3) = replacement
+                k = k + 3
+                i = i + 1
+            else
+                utf8(k + 1:k + n) = text(i:i + n - 1)
+                k = k + n
+                i = i + n
+            end if
+        end do
+        utf8 = utf8(:k)
+    end function replace_invalid_utf8
 
     !> A byte as `0xE9`.
     pure function byte_hex(c) result(text)

@@ -198,8 +198,9 @@ contains
         !> Set when the checkpoint cannot be continued, or the folder's may not be replaced.
         type(error_t), allocatable, intent(out) :: error
         run%ck%path = run%dir//'/'//checkpoint_name
-        ! The deck and the files it reads (a mesh): a restart must find them unchanged.
-        run%ck%deck_text = run%deck%text//run%sim%inputs_text()
+        ! The deck and the files it reads (a mesh): a restart must find them unchanged. The
+        ! deck's bytes as read (the results store a comment that is not UTF-8 otherwise).
+        run%ck%deck_text = run%deck%source_text//run%sim%inputs_text()
         run%ck%schedule%every = run%sim%settings%checkpoint_interval
         run%ck%schedule%seconds = run%sim%settings%checkpoint_seconds
         run%ck%results = basename(run%path)

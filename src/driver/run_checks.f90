@@ -21,7 +21,8 @@ module driver_run_checks
 
 contains
 
-    !> The deck's warnings, in this order: settings without effect, harmonic functions the
+    !> The deck's warnings, in this order: its text (comments that are not UTF-8), settings
+    !> without effect, harmonic functions the
     !> time step aliases, time functions zero over the whole run, an end time that is not a
     !> whole number of steps.
     subroutine warn_about_deck(end_time, deck, sim, report)
@@ -33,6 +34,10 @@ contains
         class(simulation_t), intent(in) :: sim
         !> Where the warnings go.
         procedure(report_iface) :: report
+        integer :: i
+        do i = 1, size(deck%warnings)
+            call report(deck%warnings(i)%s)
+        end do
         call warn_keywords_without_effect(deck, sim, report)
         call warn_aliased_functions(deck, sim, report)
         call warn_idle_functions(deck, sim, report)

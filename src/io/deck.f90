@@ -4,9 +4,10 @@
 !> that runs to the end of the line; blank lines and tabs are fine. Lines end with LF, CR LF
 !> or a lone CR (old Mac files); a UTF-8 byte-order mark at the start of the file is skipped;
 !> another control character outside a comment is an error, and a NUL byte anywhere (the
-!> deck is stored in the results as a C string), as are bytes that are not UTF-8 anywhere and
-!> invisible Unicode spaces (core_utf8) outside a comment, a quoted name or the text of a text
-!> keyword. A value is a word; a name (schema
+!> deck is stored in the results as a C string), as are bytes that are not UTF-8 outside a
+!> comment (in a comment they are a warning, `deck%warnings`, and U+FFFD in the text stored
+!> with the results) and invisible Unicode spaces (core_utf8) outside a comment, a quoted name
+!> or the text of a text keyword. A value is a word; a name (schema
 !> `field_name`: a path, a set of a mesh) may instead be written between double quotes, which
 !> makes blanks and `#` part of it; quotes elsewhere, left open, empty or glued to a word are
 !> errors naming the column. A text keyword (`title`) keeps the rest of the line up to the
@@ -39,7 +40,7 @@ module io_deck
     use core_error, only: error_t, make_input_error, make_internal_error
     use core_strings, only: string_t, strip, split_words, join_words, is_blank_char, &
                             closest_match, parse_real, parse_int, to_str, shorten
-    use core_utf8, only: invalid_utf8_column, find_invisible_space, byte_hex
+    use core_utf8, only: invalid_utf8_column, find_invisible_space, byte_hex, replace_invalid_utf8
     use io_unit_words, only: unit_hint, looks_like_unit
     use io_deck_schema, only: schema_t, keyword_spec_t, field_spec_t, condition_t, field_text, field_name, &
                               field_real, field_int, type_name
@@ -89,8 +90,17 @@ module io_deck
     type :: deck_t
         !> Deck file name as given to read_deck.
         character(len=:), allocatable :: file
-        !> Full text of the deck (to store with the results).
+        !> Full text of the deck, UTF-8 throughout (to store with the results): the text read,
+        !> where each byte of a comment that is not UTF-8 (a Latin-1 `é`) is the replacement
+        !> character U+FFFD.
         character(len=:), allocatable :: text
+        !> The text read, its bytes unchanged (a leading byte-order mark left out, lone CRs
+        !> made LFs): what the deck hash of a checkpoint covers, as it did before comments
+        !> that are not UTF-8 were replaced in `text`.
+        character(len=:), allocatable :: source_text
+        !> Warnings on the text, as 'warning: file:line: ...': bytes that are not UTF-8 in the
+        !> comments.
+        type(string_t), allocatable :: warnings(:)
         !> Validated entries, in file order.
         type(deck_entry_t), allocatable :: entries(:)
         !> Schema the deck was validated against (defaults come from it).
@@ -189,11 +199,20 @@ contains
         ! found with no keyword before the next header or the end (0: none).
         integer :: open_header, empty_header
         character(len=:), allocatable :: open_name, empty_name
+        ! Bytes that are not UTF-8 in the comments: the lines holding them, and the first one.
+        integer :: latin_lines, latin_line, latin_column
+        character(len=4) :: latin_byte
         text = normalized_text(raw_text)
         open_header = 0
         empty_header = 0
+        latin_lines = 0
+        latin_line = 0
+        latin_column = 0
+        latin_byte = ''
         deck%file = file
         deck%text = text
+        deck%source_text = text
+        allocate (deck%warnings(0))
         deck%schema = schema
         allocate (entries(16))
         allocate (first_line(size(schema%keywords)), section_line(size(schema%sections)))
@@ -216,6 +235,7 @@ contains
             start = lf + 1
         end do
         call close_header()
+        if (latin_lines > 0) call warn_comments_not_utf8()
         deck%entries = entries(:n)
         deck%header_lines = section_line
         if (n == 0) then
@@ -242,6 +262,23 @@ contains
             end if
             open_header = 0
         end subroutine close_header
+
+        !> Bytes that are not UTF-8 in comments are kept in the text that is hashed (a deck
+        !> that ran before they were refused continues its checkpoint) and replaced by U+FFFD
+        !> in the text stored with the results, with a warning at the first of them.
+        subroutine warn_comments_not_utf8()
+            character(len=:), allocatable :: more
+            deck%text = replace_invalid_utf8(text)
+            more = ''
+            if (latin_lines == 2) more = ' (1 more line has such bytes in its comment)'
+            if (latin_lines > 2) more = ' ('//to_str(latin_lines - 1)//' more lines have such bytes in their comments)'
+            deck%warnings = [string_t('warning: '//file//':'//to_str(latin_line)//': byte '//latin_byte// &
+                                      ' at column '//to_str(latin_column)//', in a comment, is not UTF-8 text'// &
+                                      more//': the results store the deck with U+FFFD in place of each; save the '// &
+                                      'deck as UTF-8 (it was most likely saved as Latin-1 or Windows-1252) once no '// &
+                                      'checkpoint of it is to be continued: --restart takes a checkpoint only with '// &
+                                      'the deck it was written for, byte for byte')]
+        end subroutine warn_comments_not_utf8
 
         !> A control character (other than a tab, or the CR of CR LF) outside a comment is an error: a terminal
         !> would not show it in the message, and it means a binary or damaged file.
@@ -332,9 +369,24 @@ contains
                     return
                 end if
             end if
-            ! Not UTF-8, even in a comment: the deck is stored in the results as UTF-8 text
-            ! (/deck_text, the title), which the readers of the results then fail to decode.
-            k = invalid_utf8_column(raw)
+            ! Not UTF-8 outside a comment: an error, since the results store the values and the
+            ! title as UTF-8 text (/deck_text, /title), which their readers would fail to decode.
+            ! In a comment, a warning: a deck with a Latin-1 comment ran before this check, and
+            ! its checkpoints are continued (warn_comments_not_utf8).
+            if (hash > 0) then
+                k = invalid_utf8_column(raw(hash:))
+                if (k > 0) then
+                    latin_lines = latin_lines + 1
+                    if (latin_lines == 1) then
+                        latin_line = line_no
+                        latin_column = hash + k - 1
+                        latin_byte = byte_hex(raw(hash + k - 1:hash + k - 1))
+                    end if
+                end if
+                k = invalid_utf8_column(raw(:hash - 1))
+            else
+                k = invalid_utf8_column(raw)
+            end if
             if (k > 0) then
                 call make_input_error(error, file, line_no, '', 'byte '//byte_hex(raw(k:k))//' at column '// &
                                       to_str(k)//' is not UTF-8 text: save the deck as UTF-8 (it was '// &

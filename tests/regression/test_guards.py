@@ -4,7 +4,7 @@ cleanly: guards on the initial state and after every step (non-finite state, dis
 the representable box, a driven wall with one end beyond it, tunnelling), the warning of a
 disk moving farther than the alert distance in one step, one writer per results folder (lock file), --output '',
 --end 1e999, abc, 5s or ' 5' and the usage line of a bad command line, no empty folder left by a failed run, three-digit
-exponents in messages, decks with a UTF-8 byte-order mark or CR-only line endings.
+exponents in messages, decks with a UTF-8 byte-order mark or CR-only line endings, a deck with Latin-1 comments.
 
 Each failed run must exit 1 with a message naming the deck, the step and the body, and leave
 an earlier finished result in the folder byte for byte.
@@ -426,6 +426,68 @@ def line_endings(exe, work):
                   np.array_equal(results[name], results["plain"]), "")
 
 
+def deck_hash(text):
+    """The deck hash of a checkpoint (driver_checkpoint_file deck_hash), computed here from
+    the file's bytes: two polynomial hashes modulo primes below 2**31, seeded with the length."""
+    p1, p2 = 2147483647, 2147483629
+    h1, h2 = len(text), 7
+    for b in text:
+        h1 = (h1 * 257 + b) % p1
+        h2 = (h2 * 263 + b + 1) % p2
+    return f"{h1:08X}{h2:08X}"
+
+
+def latin1_comment(exe, work):
+    """A deck saved as Latin-1 with accents in comments only ran before bytes that are not
+    UTF-8 were refused, and its checkpoint could be continued; saving it again as UTF-8 makes
+    it another deck for --restart. Such comments are a warning: the run goes on, the results
+    store the deck as UTF-8 (U+FFFD in place of each such byte: the plotting scripts decode it),
+    the checkpoint's deck hash is that of the file's bytes (as before the check), and the
+    results equal those of the deck without the accents. Outside a comment (the title) such a
+    byte is still an error."""
+    plain = beam_deck().replace("[run]", "# poutre de test\n[run]").replace("[time]", "[time] # pas de temps")
+    latin = plain.replace("poutre de test", "poutre d\xe9pos\xe9e").replace("pas de temps", "\xe0 voir").encode("latin-1")
+    folder = work / "latin1"
+    for name, data in (("plain", plain.encode()), ("latin", latin)):
+        (work / f"latin1_{name}.dat").write_bytes(data)
+    proc = multicor(exe, work / "latin1_latin.dat", "--output", folder)
+    check("latin-1 comment: runs", proc.returncode == 0, proc.stderr.strip()[:300])
+    expect = ("warning: " + str(work / "latin1_latin.dat") + ":1: byte 0xE9 at column 11, in a comment, is not "
+              "UTF-8 text (1 more line has such bytes in its comment): the results store the deck with U+FFFD")
+    check("latin-1 comment: warned at its line and column", expect in proc.stdout + proc.stderr,
+          (proc.stdout + proc.stderr)[:600])
+    if proc.returncode == 0:
+        with h5py.File(folder / "latin1_latin.h5", "r") as f:
+            try:
+                text = f.attrs["deck_text"]
+                text = text if isinstance(text, str) else text.decode("utf-8")
+            except UnicodeDecodeError as e:
+                text = f"not UTF-8: {e}"
+            displacement = f["fem/displacement"][...]
+        check("latin-1 comment: the stored deck is UTF-8, U+FFFD for each byte",
+              text == latin.decode("utf-8", errors="replace") and text.count("\ufffd") == 3, text[:200])
+        with h5py.File(folder / "checkpoint.h5", "r") as f:
+            hashed = f.attrs["deck_hash"]
+            hashed = hashed if isinstance(hashed, str) else hashed.decode()
+        check("latin-1 comment: the checkpoint hashes the file's bytes", hashed == deck_hash(latin),
+              f"checkpoint {hashed}, bytes {deck_hash(latin)}")
+        proc = multicor(exe, work / "latin1_latin.dat", "--output", folder, "--quiet",
+                        "--restart", folder / "checkpoint.h5", "--end", "4e-3")
+        check("latin-1 comment: its checkpoint is continued", proc.returncode == 0, proc.stderr.strip()[:300])
+        proc = multicor(exe, work / "latin1_plain.dat", "--output", work / "latin1_plain", "--quiet")
+        if check("latin-1 comment: the deck without accents runs", proc.returncode == 0, proc.stderr.strip()[:300]):
+            with h5py.File(work / "latin1_plain" / "latin1_plain.h5", "r") as f:
+                # a comment changes nothing computed: the same results bit for bit
+                check("latin-1 comment: same results as without the accents",
+                      np.array_equal(f["fem/displacement"][...], displacement), "")
+    title = beam_deck().replace("[run]", "[run]\ntitle = poutre d\xe9pos\xe9e # ok").encode("latin-1")
+    (work / "latin1_title.dat").write_bytes(title)
+    proc = multicor(exe, work / "latin1_title.dat", "--output", work / "latin1_title", "--quiet")
+    check("latin-1 title: refused", proc.returncode == 1 and
+          "latin1_title.dat:2: byte 0xE9 at column 17 is not UTF-8 text: save the deck as UTF-8" in proc.stderr,
+          f"exit {proc.returncode} {proc.stderr.strip()[:300]}")
+
+
 def end_off_the_steps(exe, work):
     """An end time that is not a whole number of steps: the run goes to the next step, and says
     so once; a whole number (2e-3 s of 2e-4 s steps, a quotient rounded in floating point) is
@@ -526,6 +588,7 @@ def main():
     speed_warning(exe, work)
     wall_end_beyond_box(exe, work)
     line_endings(exe, work)
+    latin1_comment(exe, work)
     end_off_the_steps(exe, work)
     return summary()
 
