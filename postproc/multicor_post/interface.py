@@ -59,6 +59,14 @@ class InterfaceRun:
             self.balance = read("coupling/energy/balance")
             self.fe_balance = read("continuum/energy/balance")
             self.reaction_work = read("continuum/energy/reaction_work")
+            # sigma_zz = nu (sigma_xx + sigma_yy) of a plane-strain element, 0 in plane stress:
+            # the element's nu where it is in plane strain, else 0 (None: a file of a build
+            # before /continuum/materials, which does not say the hypothesis)
+            self.plane_strain_nu = None
+            if "continuum/materials/poisson" in f and "continuum/mesh/material" in f:
+                m = f["continuum/mesh/material"][...] - 1
+                nu = f["continuum/materials/poisson"][...] * (f["continuum/materials/plane_strain"][...] == 1)
+                self.plane_strain_nu = nu[m]
             self.contacts = None
             if "dem/contacts/offset" in f:
                 self.contacts = {k: read(f"dem/contacts/{k}") for k in ("i", "j", "rn", "offset")}
@@ -114,8 +122,8 @@ def peak_and_residual(s, mu_app, last=1.0e-3):
 
 
 def von_mises(stress, plane_strain_nu=None):
-    """Von Mises stress of (xx, yy, xy) (plane stress; sigma_zz = nu (xx + yy) in plane strain
-    when nu is given) [Pa]."""
+    """Von Mises stress of (xx, yy, xy) [Pa]: sigma_zz = nu (xx + yy) in plane strain, with nu
+    given per element (0 for an element in plane stress), or 0 when nu is None."""
     sxx, syy, sxy = stress[..., 0], stress[..., 1], stress[..., 2]
     szz = 0 if plane_strain_nu is None else plane_strain_nu * (sxx + syy)
     return np.sqrt(0.5 * ((sxx - syy) ** 2 + (syy - szz) ** 2 + (szz - sxx) ** 2) + 3 * sxy ** 2)
@@ -195,7 +203,7 @@ def plot_stress(run, k, component="xy"):
     """Stress field in the blocks at output k: sigma_xy, or von Mises ('vm'), per element
     (centre values) on the deformed mesh [MPa]."""
     s = run.stress[k]
-    values = s[:, 2] if component == "xy" else von_mises(s)
+    values = s[:, 2] if component == "xy" else von_mises(s, run.plane_strain_nu)
     fig, ax = _figure((7, 5))
     pc = PolyCollection(_element_polygons(run, k), array=values / 1e6, cmap="RdBu_r" if component == "xy"
                         else "viridis", edgecolor="none")
@@ -205,7 +213,9 @@ def plot_stress(run, k, component="xy"):
     ax.add_collection(pc)
     ax.autoscale_view()
     ax.set_aspect("equal")
-    fig.colorbar(pc, ax=ax, label=("sigma_xy" if component == "xy" else "von Mises") + " [MPa]")
+    label = "sigma_xy" if component == "xy" else \
+        "von Mises" if run.plane_strain_nu is not None else "von Mises (sigma_zz taken as 0)"
+    fig.colorbar(pc, ax=ax, label=label + " [MPa]")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_title(f"t = {run.time[k] * 1e3:.2f} ms, slip {run.slip()[k] * 1e3:.2f} mm")

@@ -101,3 +101,28 @@ def test_a_killed_run_is_read_up_to_its_count_of_whole_outputs(interface_file):
     assert run.position.shape[0] == N_OUT - 2 and run.u.shape[0] == N_OUT - 2
     assert run.stress.shape[0] == N_OUT - 2 and run.balance.size == N_OUT - 2
     assert np.array_equal(run.slip(), SLIP[:N_OUT - 2])
+
+
+def test_von_mises_of_the_stress_plot_takes_sigma_zz_in_plane_strain(interface_file):
+    """An element in plane strain has sigma_zz = nu (sigma_xx + sigma_yy): with sigma_xx =
+    sigma_yy = 1 MPa and nu = 0.3, sigma_zz = 0.6 MPa and von Mises sqrt(((0)^2 + 0.4^2 +
+    0.4^2) / 2) = 0.4 MPa, where the plane-stress formula gives 1 MPa (the interface
+    experiment's blocks are in plane strain). The second element is in plane stress: 1 MPa.
+    A file without /continuum/materials keeps sigma_zz = 0 and says so."""
+    with h5py.File(interface_file, "r+") as f:
+        stress = np.zeros((N_OUT, 2, 3))
+        stress[:, :, 0] = stress[:, :, 1] = 1e6
+        f["continuum/stress"][...] = stress
+    run = interface.InterfaceRun(interface_file)
+    fig = interface.plot_stress(run, N_OUT - 1, "vm")
+    assert fig.axes[1].get_ylabel() == "von Mises (sigma_zz taken as 0) [MPa]"
+    with h5py.File(interface_file, "r+") as f:
+        f["continuum/mesh/material"] = np.array([1, 2], np.int32)
+        f["continuum/materials/poisson"] = np.array([0.3, 0.3])
+        f["continuum/materials/plane_strain"] = np.array([1, 0], np.int32)
+    run = interface.InterfaceRun(interface_file)
+    fig = interface.plot_stress(run, N_OUT - 1, "vm")
+    values = fig.axes[0].collections[0].get_array()
+    # the formula's arithmetic in double precision: 1e-12 relative
+    np.testing.assert_allclose(values, [0.4, 1.0], rtol=1e-12)
+    assert fig.axes[1].get_ylabel() == "von Mises [MPa]"
