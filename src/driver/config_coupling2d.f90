@@ -26,10 +26,15 @@ module driver_config_coupling2d
     use fem_mass_scheme, only: make_mass_scheme
     use fem_continuum_model, only: continuum_model_t
     use coupling_arlequin2d, only: coupling2d_config_t
-    use driver_config, only: run_config_t
     implicit none
     private
-    public :: coupled2d_setup_t, build_coupling2d_config
+    public :: coupled2d_setup_t, build_coupling2d_config, check_coupled2d_scheme
+
+    !> Why a coupled run needs average acceleration and theta = 1/2.
+    character(len=*), parameter :: scheme_why = 'the coupling exchanges the impulse h ((1 - gamma) '// &
+                                   'lambda_n + gamma lambda_{n+1}) between the continuum and the '// &
+                                   'disks, which conserves momentum and energy only with beta = 1/4, '// &
+                                   'gamma = 1/2 and theta = 1/2'
 
     !> The 2D coupling of a deck, with what the driver reports about it.
     type :: coupled2d_setup_t
@@ -43,12 +48,36 @@ module driver_config_coupling2d
 
 contains
 
-    !> Build and check the coupling of a deck with [continuum], [particles] and [coupling].
-    subroutine build_coupling2d_config(deck, run, model, particle_gravity, x, y, setup, error)
+    !> A coupled run of a continuum and disks is a time integration with average acceleration
+    !> (Newmark beta = 1/4, gamma = 1/2): checked on the deck before the continuum is built,
+    !> whose own checks (the lumped mass and the critical step of central differences) would
+    !> otherwise come first and ask for changes that this check then refuses.
+    subroutine check_coupled2d_scheme(deck, error)
         !> Deck read with the MULTICOR schema.
         type(deck_t), intent(in) :: deck
-        !> Run settings of the continuum (analysis, scheme, beta, gamma).
-        type(run_config_t), intent(in) :: run
+        !> Error naming file, line and keyword, if any.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: scheme
+        logical :: ok
+        if (deck%get_word('run', 'analysis') /= 'dynamic') then
+            call make_input_error(error, deck%file, deck%line('run', 'analysis'), 'analysis', &
+                                  'a coupled run (continuum, particles and [coupling]) is a time integration: '// &
+                                  'set analysis = dynamic')
+            return
+        end if
+        scheme = deck%get_word('time', 'scheme')
+        ok = scheme == 'average_acceleration'
+        if (scheme == 'newmark') ok = abs(deck%get_real('time', 'beta') - 0.25_wp) <= 0 .and. &
+                                      abs(deck%get_real('time', 'gamma') - 0.5_wp) <= 0
+        if (.not. ok) call make_input_error(error, deck%file, deck%line('time', 'scheme'), 'scheme', &
+                                            'coupled runs need scheme = average_acceleration (beta = 0.25, '// &
+                                            'gamma = 0.5); '//scheme_why)
+    end subroutine check_coupled2d_scheme
+
+    !> Build and check the coupling of a deck with [continuum], [particles] and [coupling].
+    subroutine build_coupling2d_config(deck, model, particle_gravity, x, y, setup, error)
+        !> Deck read with the MULTICOR schema.
+        type(deck_t), intent(in) :: deck
         !> The continuum (its mesh and materials: the thickness under the regions).
         type(continuum_model_t), intent(in) :: model
         !> Gravity of [particles] [m/s^2].
@@ -208,29 +237,15 @@ contains
             in_regions = any([(parts(r)%contains(px, py), r=1, size(parts))])
         end function in_regions
 
-        !> Analysis, Newmark and Moreau-Jean parameters.
+        !> The analysis and the scheme (check_coupled2d_scheme), and theta.
         subroutine check_schemes(error)
             type(error_t), allocatable, intent(out) :: error
-            character(len=*), parameter :: why = 'the coupling exchanges the impulse h ((1 - gamma) lambda_n + '// &
-                                           'gamma lambda_{n+1}) between the continuum and the disks, which conserves '// &
-                                           'momentum and energy only with beta = 1/4, gamma = 1/2 and theta = 1/2'
-            if (run%analysis /= 'dynamic') then
-                call make_input_error(error, deck%file, deck%line('run', 'analysis'), 'analysis', &
-                                      'a coupled run (continuum, particles and [coupling]) is a time integration: '// &
-                                      'set analysis = dynamic')
-                return
-            end if
-            if (run%scheme == 'central_difference' .or. abs(run%beta - 0.25_wp) > 0 .or. &
-                abs(run%gamma - 0.5_wp) > 0) then
-                call make_input_error(error, deck%file, deck%line('time', 'scheme'), 'scheme', &
-                                      'coupled runs need scheme = average_acceleration (beta = 0.25, gamma = 0.5); '// &
-                                      why)
-                return
-            end if
+            call check_coupled2d_scheme(deck, error)
+            if (allocated(error)) return
             theta = deck%get_real('time', 'theta')
             if (abs(theta - 0.5_wp) > 0) then
                 message = 'warning: '//deck%file//':'//to_str(deck%line('time', 'theta'))//': [time] theta = '// &
-                          to_str(theta)//' in a coupled run: the energy balance does not close; '//why
+                          to_str(theta)//' in a coupled run: the energy balance does not close; '//scheme_why
                 setup%warnings = [setup%warnings, string_t(message)]
             end if
         end subroutine check_schemes

@@ -26,7 +26,7 @@ module driver_simulation_coupled2d
     use coupling_coupled_step, only: coupled_energies_t, coupled_energies, fe_whole_t
     use coupling_operator2d, only: continuum_operator_t
     use coupling_arlequin2d, only: build_coupled2d
-    use driver_config_coupling2d, only: coupled2d_setup_t, build_coupling2d_config
+    use driver_config_coupling2d, only: coupled2d_setup_t, build_coupling2d_config, check_coupled2d_scheme
     use driver_results, only: results_writer_t
     use driver_results_continuum, only: continuum_writer_t
     use driver_simulation, only: report_iface
@@ -99,12 +99,10 @@ contains
         type(deck_t) :: part
         character(len=:), allocatable :: message
         integer :: i
-        if (deck%get_word('run', 'analysis') /= 'dynamic') then
-            call make_input_error(error, deck%file, deck%line('run', 'analysis'), 'analysis', &
-                                  'a coupled run (continuum, particles and [coupling]) is a time integration: '// &
-                                  'set analysis = dynamic')
-            return
-        end if
+        ! the analysis and the scheme first: the continuum's own checks would ask for changes
+        ! (a lumped mass, a shorter step of central differences) that they refuse
+        call check_coupled2d_scheme(deck, error)
+        if (allocated(error)) return
         ! The continuum without particles, coupling and gravity (weighted by the coupling).
         part = without(deck, [character(len=24) :: 'particles', 'walls', 'contacts', 'solver', 'coupling', &
                               'time theta', 'output contacts', 'continuum gravity'])
@@ -117,7 +115,7 @@ contains
         call self%particles%init(part, report, error)
         if (allocated(error)) return
         associate (p => self%particles%dem%system%particles)
-            call build_coupling2d_config(deck, self%settings, self%continuum%model, p%gravity, p%x(1:p%n), p%y(1:p%n), &
+            call build_coupling2d_config(deck, self%continuum%model, p%gravity, p%x(1:p%n), p%y(1:p%n), &
                                          self%coupling, error)
         end associate
         if (allocated(error)) return
