@@ -188,6 +188,7 @@ contains
         integer(i8), parameter :: bytes_per_candidate = 500
         integer(i8), allocatable :: key(:)
         integer, allocatable :: order(:)
+        character(len=:), allocatable :: advice
         real(wp) :: reach, x0, y0, pairs
         integer :: i, run_start
         if (available < 0) return
@@ -213,13 +214,18 @@ contains
             end do
             pairs = min(pairs, 0.5_wp*real(p%n, wp)*real(p%n - 1, wp))
             if (pairs*real(bytes_per_candidate, wp) <= real(available, wp)) return
+            ! an alert already below the largest radius is not the cause: the disks are too many
+            advice = 'use an alert distance of a fraction of the radius'
+            if (cfg%system%scheme%alert <= maxval(p%radius(1:p%n))) &
+                advice = 'the alert is already below the largest radius ('// &
+                         length_text(maxval(p%radius(1:p%n)))//' m): the deck has too many disks for '// &
+                         'this machine ('//to_str(p%n)//')'
             call make_input_error(error, deck%file, deck%line('contacts', 'alert'), 'alert', &
                                   '[contacts] alert = '//length_text(cfg%system%scheme%alert)// &
                                   ' m makes up to about '//length_text(pairs)//' disk pairs contact '// &
                                   'candidates (disks within 2 r_max + alert of each other), about '// &
                                   length_text(pairs*real(bytes_per_candidate, wp)/1024.0_wp**3)// &
-                                  ' GiB, more than the memory available: use an alert distance of a '// &
-                                  'fraction of the radius')
+                                  ' GiB, more than the memory available: '//advice)
         end associate
     end subroutine check_alert_reach
 
