@@ -19,7 +19,8 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from multicor_post.beam import uses_scale, write_all  # noqa: E402
-from multicor_post.results import (ResultsError, damaged_file_error, file_contents, finite_float,  # noqa: E402
+from multicor_post.results import (READ_ERRORS, ResultsError, file_contents, finite_float,  # noqa: E402
+                                   report_read_error,
                                    load_results, outside_time_note, scale_factor,
                                    unused_scale_note, unused_time_note)
 
@@ -47,15 +48,8 @@ def main(argv=None):
                                "with plot_results.py")
         res = load_results(args.results)
         paths = write_all(res, out, time=args.time, node_id=args.node, scale=args.scale)
-    except ResultsError as exc:
-        print(f"plot_beam.py: error: {exc}", file=sys.stderr)
-        return 1
-    except (KeyError, RuntimeError, OSError, ValueError) as exc:
-        damaged = damaged_file_error(exc, args.results)
-        if damaged is None:
-            raise
-        print(f"plot_beam.py: error: {damaged}", file=sys.stderr)
-        return 1
+    except READ_ERRORS as exc:
+        return report_read_error("plot_beam.py", exc, args.results)
     for note in (outside_time_note(args.time, None if res.dynamic is None else res.dynamic.time),
                  unused_time_note(args.time, res.analysis),
                  unused_scale_note(args.scale, args.results, uses_scale(res))):

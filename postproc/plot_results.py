@@ -29,7 +29,8 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from multicor_post import beam, continuum, coupled, particles  # noqa: E402
-from multicor_post.results import (ResultsError, damaged_file_error, file_contents, finite_float,  # noqa: E402
+from multicor_post.results import (READ_ERRORS, ResultsError, file_contents, finite_float,  # noqa: E402
+                                   report_read_error,
                                    load_results, outside_time_note, scale_factor,
                                    unused_scale_note, unused_time_note)
 
@@ -95,15 +96,8 @@ def main(argv=None):
             res = particles.load_dem(args.results)
             notes.append(outside_time_note(args.time, res.time))
             paths += particles.write_all(res, out, time=args.time, notes=notes)
-    except ResultsError as exc:
-        print(f"plot_results.py: error: {exc}", file=sys.stderr)
-        return 1
-    except (KeyError, RuntimeError, OSError, ValueError) as exc:
-        damaged = damaged_file_error(exc, args.results)
-        if damaged is None:
-            raise
-        print(f"plot_results.py: error: {damaged}", file=sys.stderr)
-        return 1
+    except READ_ERRORS as exc:
+        return report_read_error("plot_results.py", exc, args.results)
     if args.node is not None and not any("_history" in os.path.basename(p) for p in paths):
         notes.append(f"--node {args.node} is not used: '{args.results}' has no node history to "
                      "plot (dynamic beam and continuum runs have one)")

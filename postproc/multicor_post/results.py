@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import sys
 from dataclasses import dataclass, field
 from typing import Optional
 
@@ -432,6 +433,21 @@ def damaged_file_error(exc: BaseException, path) -> Optional[ResultsError]:
                         f"({str(exc).strip(chr(39))}). A run killed while HDF5 wrote the file "
                         "leaves it so; run the deck again (its checkpoint, if any, says "
                         "whether --restart can continue it)")
+
+
+#: What a plotting script catches around reading a results file (report_read_error).
+READ_ERRORS = (ResultsError, KeyError, RuntimeError, OSError, ValueError)
+
+
+def report_read_error(prog: str, exc: BaseException, path) -> int:
+    """Exit code 1 of script `prog` after printing its one-line message for `exc`, raised while
+    reading the results file `path`: a ResultsError as it is, an h5py error as the file's
+    damage (damaged_file_error); any other exception (a bug) is raised again."""
+    error = exc if isinstance(exc, ResultsError) else damaged_file_error(exc, path)
+    if error is None:
+        raise exc
+    print(f"{prog}: error: {error}", file=sys.stderr)
+    return 1
 
 
 #: Series that grow by step, not by output (their own count), or by event: never cut.
