@@ -113,6 +113,25 @@ def truncated(line):
     return bool(rest) and not rest.startswith(b'!')
 
 
+def code_outside_literals(line):
+    """`line` before its comment, with the contents of its character literals blanked
+    (a literal may hold '@assert' or '!': pFUnit copies such a line unchanged and it compiles)."""
+    out, quote = [], None
+    for c in line:
+        if quote:
+            if c == quote:
+                quote = None
+            out.append(c if quote is None else ' ')
+        elif c in "'\"":
+            quote = c
+            out.append(c)
+        elif c == '!':
+            break
+        else:
+            out.append(c)
+    return ''.join(out)
+
+
 def check_arguments(args, where):
     """Balanced parentheses and no '!' outside character literals."""
     depth, quote = 0, None
@@ -194,7 +213,8 @@ def parse(path):
                               f"it unchanged and the compiler would reject it): {line.strip()}")
             out.append('')
             continue
-        if '@assert' in line.lower().split('!')[0]:
+        if '@assert' in code_outside_literals(line).lower():
+            # pFUnit copies the line unchanged; the compiler would reject the '@'
             raise PfError(f"{where}: an @assert must stand alone on its line")
         if truncated(line):
             raise PfError(f"{where}: code past column {MAX_LINE} ({columns(line)} characters), "

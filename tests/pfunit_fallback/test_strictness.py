@@ -104,6 +104,9 @@ ACCEPT = [
     # gfortran (default 132) ignores what a comment puts past column 132; pFUnit copies the line
     ('strict_tail_comment', module('strict_tail_comment', "        integer :: n\n        n = 1  ! "
                                    + 'c' * 140 + "\n        @assertEqual(1, n)")),
+    # pFUnit matches an @assert at the start of a line only: one inside a literal is text
+    ('strict_literal_at', module('strict_literal_at', "        character(len=*), parameter :: s = "
+                                 "'see @assertTrue; !'\n        @assertEqual(18, len(s))")),
     # pFUnit's suite function declares `suite` and `t` only: a module may export other names
     ('strict_suite_names', module('strict_suite_names', "        @assertEqual(1, method)",
                                   ).replace('contains\n', '    integer, public :: method = 1, '
