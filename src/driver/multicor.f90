@@ -1,7 +1,7 @@
 !> MULTICOR command-line driver: parses the command line and runs a deck.
 !>
 !>     multicor [--output DIR] [--quiet] deck.dat
-!>     multicor [--output DIR] deck.dat --restart DIR/checkpoint.h5 [--end T]
+!>     multicor deck.dat --restart DIR/checkpoint.h5 [--end T] (results in DIR unless --output)
 !>     multicor --check deck.dat
 !>     multicor --help | --version | --schema-markdown
 !>
@@ -174,7 +174,8 @@ contains
             '', &
             'usage: multicor [options] deck.dat', &
             '', &
-            '  -o, --output DIR     results folder (default: results/<deck name>)', &
+            '  -o, --output DIR     results folder (default: results/<deck name>; with --restart,', &
+            '                       the checkpoint''s folder)', &
             '  -q, --quiet          no progress lines', &
             '      --check          validate the deck only (nothing is written)', &
             '      --restart FILE   continue the run from a checkpoint (DIR/checkpoint.h5)', &

@@ -34,7 +34,7 @@ module driver_run
     use core_threads, only: openmp_part, single_thread_blas, thread_setting
     use io_deck_schema, only: multicor_schema
     use io_deck, only: deck_t, read_deck
-    use io_paths, only: stem, basename, mkdir_p, remove_empty_folders, file_exists, remove_file, rename_file
+    use io_paths, only: stem, basename, dirname, mkdir_p, remove_empty_folders, file_exists, remove_file, rename_file
     use driver_results, only: results_writer_t
     use driver_results_mark, only: results_mark_t
     use driver_results_xdmf, only: write_results_xdmf
@@ -51,7 +51,8 @@ module driver_run
     type :: run_options_t
         !> Path of the deck.
         character(len=:), allocatable :: deck_path
-        !> Results folder ('' = results/<deck name>).
+        !> Results folder (unallocated: the folder of the `restart` checkpoint, else
+        !> results/<deck name>).
         character(len=:), allocatable :: output_dir
         !> Validate only.
         logical :: check_only = .false.
@@ -121,8 +122,14 @@ contains
             return
         end if
 
-        run%dir = 'results/'//stem(opts%deck_path)
-        if (allocated(opts%output_dir)) run%dir = opts%output_dir
+        ! A restart continues the results next to its checkpoint unless told otherwise.
+        if (allocated(opts%output_dir)) then
+            run%dir = opts%output_dir
+        else if (allocated(opts%restart)) then
+            run%dir = dirname(opts%restart)
+        else
+            run%dir = 'results/'//stem(opts%deck_path)
+        end if
         call mkdir_p(run%dir, error, run%created)
         if (allocated(error)) return
         call write_into_folder(opts, report, run, error, stopped_by)

@@ -5,7 +5,7 @@ module io_paths
     use core_error, only: error_t, make_error
     implicit none
     private
-    public :: basename, stem, mkdir_p, remove_empty_folders, file_exists, remove_file, rename_file, copy_file
+    public :: basename, dirname, stem, mkdir_p, remove_empty_folders, file_exists, remove_file, rename_file, copy_file
     public :: link_or_copy_file
     public :: read_file_text
 
@@ -44,6 +44,22 @@ contains
         i = index(path, '/', back=.true.)
         name = path(i + 1:)
     end function basename
+
+    !> Folder of a path ('results/a/checkpoint.h5' -> 'results/a', 'a.h5' -> '.', '/a.h5' -> '/').
+    pure function dirname(path) result(name)
+        !> A file path.
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: name
+        integer :: i
+        i = index(path, '/', back=.true.)
+        if (i == 0) then
+            name = '.'
+        else if (i == 1) then
+            name = '/'
+        else
+            name = path(:i - 1)
+        end if
+    end function dirname
 
     !> File name without folder and without its last extension ('input/a.dat' -> 'a').
     pure function stem(path) result(name)

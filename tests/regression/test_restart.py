@@ -228,8 +228,14 @@ def by_end_time(exe, deck, work, name, t_stop):
     check(f"{name}: checkpoint at {ckpt.relative_to(work)}", ckpt.is_file(), "")
     if ckpt.is_file():
         shutil.copy(ckpt, work / f"{name}_first_checkpoint.h5")
-    second = run(exe, deck, "--output", folder, "--restart", ckpt)
+    # no --output: the results are continued in the checkpoint's folder (the default folder,
+    # results/<deck name> of the working directory, is not created)
+    home = work / f"{name}_cwd"
+    home.mkdir(exist_ok=True)
+    second = run(exe, deck.resolve(), "--restart", ckpt.resolve(), cwd=home)
     check(f"{name}: restart exit 0", second.returncode == 0, (second.stdout + second.stderr)[-300:])
+    check(f"{name}: restart without --output writes nothing in the working directory",
+          not any(home.iterdir()), str(list(home.iterdir())))
     if second.returncode == 0:
         compare(name, folder / f"{deck.stem}.h5", ref)
         compare_xdmf(name, folder / f"{deck.stem}.xdmf", ref.with_suffix(".xdmf"))
