@@ -772,7 +772,7 @@ contains
         ! the map is then block Gauss-Seidel, its reactions those of the swept contacts,
         ! released bonds included, also when the block released all its bonds: a lattice
         ! pulled apart by imposed velocities, whose block has no solution, took 1 564 plain
-        ! sweeps for its released bonds, 340 mixed); not when intact bonds are swept with no
+        ! sweeps for its released bonds, under 300 mixed); not when intact bonds are swept with no
         ! block, method = nlgs (on a bonded row the mixed iterates stop 4e-10 of the load away
         ! at a tolerance of 1e-14, plain sweeps within 1e-10; method = block solves them)
         accelerate = config%anderson > 0 .and. n_swept > 0

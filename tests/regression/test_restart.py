@@ -1492,7 +1492,7 @@ def main():
     ap.add_argument("--work", required=True)
     ap.add_argument("--source", required=True)
     a = ap.parse_args()
-    exe, src, work = pathlib.Path(a.exe), pathlib.Path(a.source), pathlib.Path(a.work)
+    exe, src, work = pathlib.Path(a.exe).resolve(), pathlib.Path(a.source), pathlib.Path(a.work)
     shutil.rmtree(work, ignore_errors=True)
     work.mkdir(parents=True)
     decks = src / "tests" / "regression" / "decks"
