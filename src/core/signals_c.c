@@ -1,9 +1,12 @@
 /* Signal handling for core_signals (src/core/signals.f90).
  *
  * SIGTERM, SIGINT, SIGUSR1 and SIGHUP set a flag and nothing else (the only thing a handler may
- * safely do); the time loops poll it once per step and stop cleanly. SA_RESETHAND gives
- * the signal back its default action after the first delivery: a second SIGTERM or Ctrl-C
- * kills the program at once. SIGHUP (the terminal of an interactive run closed, an ssh
+ * safely do); the time loops poll it once per step and stop cleanly. SIGINT alone has
+ * SA_RESETHAND, its default action back after the first delivery: a second Ctrl-C kills the
+ * program at once. A repeated SIGTERM, SIGUSR1 or SIGHUP is only the same request again:
+ * Slurm at a job's time limit sends a step's processes SIGTERM twice within milliseconds
+ * (slurmstepd and srun), which killed the run before its checkpoint; SIGKILL is the way to
+ * stop at once (Slurm sends it after KillWait). SIGHUP (the terminal of an interactive run closed, an ssh
  * session lost) stops the run as SIGTERM does, with its checkpoint, instead of killing it;
  * under `nohup` (SIGHUP ignored when the program starts) it stays ignored, and so does a
  * SIGINT ignored at the start (the results file stays readable up to its last flush).
@@ -40,8 +43,8 @@ int multicor_signals_install(void)
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = multicor_on_signal;
     sigemptyset(&sa.sa_mask);
-    sa.sa_flags = SA_RESETHAND | SA_RESTART;
     for (k = 0; k < sizeof handled / sizeof handled[0]; ++k) {
+        sa.sa_flags = handled[k] == SIGINT ? SA_RESETHAND | SA_RESTART : SA_RESTART;
         /* A SIGHUP or SIGINT ignored by whoever started the program stays ignored: `nohup`
          * (a run meant to outlive its terminal), a job started in the background by a
          * non-interactive shell (Ctrl-C in the terminal is not for it). */
@@ -83,7 +86,7 @@ int multicor_sigpipe(void) { return SIGPIPE; }
 /* Number of the first signal caught (0: none). */
 int multicor_signals_caught(void) { return (int)multicor_caught; }
 
-/* Forget a caught signal (tests only; the handler stays reset after its first delivery). */
+/* Forget a caught signal (tests only; SIGINT's handler stays reset after its first delivery). */
 void multicor_signals_clear(void) { multicor_caught = 0; }
 
 /* Signal numbers of this platform. */

@@ -4,7 +4,7 @@ SIGUSR1, write errors reported at the write (doc/output.md, "Interrupted runs").
 
 Long versions of example decks (input/cantilever.dat, input/incline.dat,
 input/bending_case2.dat with a far end time) are started, left to write a few outputs, then
-killed or signalled. The '.partial' file must open in h5py and h5dump, say finished = 0 in
+killed or signalled (input/deposit.dat with SIGTERM twice, as Slurm at a time limit). The '.partial' file must open in h5py and h5dump, say finished = 0 in
 /summary, and hold exactly (bit for bit) the values of an uninterrupted run of the same deck
 at the same steps; an earlier finished result in the same folder must stay untouched. A file
 size limit (RLIMIT_FSIZE, as `ulimit -f`, unprivileged) and, where root can mount one, a
@@ -269,22 +269,26 @@ def readable_while_running(name, partial):
     check(f"{name}: the partial file opens in h5py while the run goes on", False, errors[-1][:300])
 
 
-def stop_by_signal(exe, src, work, deck_name, sig, name):
-    """Send `sig` to a long run: exit 128 + sig, message, partial closed with finished = 0
-    and every output up to the step of the stop, equal to an uninterrupted run."""
+def stop_by_signal(exe, src, work, deck_name, sig, name, repeat=1, min_step=100):
+    """Send `sig` to a long run (`repeat` times, 5 ms apart: Slurm sends SIGTERM twice at a
+    time limit): exit 128 + sig, message, partial closed with finished = 0 and every output up
+    to the step of the stop, equal to an uninterrupted run."""
     deck_src = src / "input" / deck_name
     folder = work / name
     deck = deck_with_end(deck_src, work / f"{name}.dat", 1000.0, progress=0.02)
     partial = folder / f"{name}.h5.partial"
     proc = start(exe, deck, folder)
     lines = []
-    # Past step 100: at least 10 outputs in these decks (an output every 5 or 10 steps).
-    if not wait_for_step(proc, 100, lines):
+    # Past min_step: at least 10 outputs (an output every 5 or 10 steps, 30 in the deposit).
+    if not wait_for_step(proc, min_step, lines):
         check(f"{name}: run reached a few outputs", False, proc.communicate()[1][-300:])
         return
     readable_while_running(name, partial)
     t0 = time.monotonic()
     proc.send_signal(sig)
+    for _ in range(repeat - 1):
+        time.sleep(0.005)
+        proc.send_signal(sig)
     out, err = proc.communicate()
     out = "".join(lines) + out
     delay = time.monotonic() - t0
@@ -408,6 +412,10 @@ def main():
     kill_9_loop(exe, src, work, "continuum_cantilever_dynamic.dat", "continuum", min_step=100)
     kill_9_loop(exe, src, work, "coupled2d_block.dat", "continuum and disks", min_step=100)
     stop_by_signal(exe, src, work, "cantilever.dat", signal.SIGTERM, "term_beam")
+    # a deposit's step takes longer than the 5 ms between the two: the second SIGTERM finds
+    # the run still stopping (it killed it, without its checkpoint, before)
+    stop_by_signal(exe, src, work, "deposit.dat", signal.SIGTERM, "term_twice_dem", repeat=2,
+                   min_step=300)
     stop_by_signal(exe, src, work, "incline.dat", signal.SIGUSR1, "usr1_dem")
     stop_by_signal(exe, src, work, "bending_case2.dat", signal.SIGINT, "int_coupled")
     write_error(exe, src, work)
