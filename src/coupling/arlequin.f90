@@ -11,8 +11,9 @@
 !>
 !> Build (`build_coupled_system`): the beam is assembled with the weight alpha(s) (mass,
 !> stiffness and self-weight integrated with alpha; its nodal and distributed loads in full);
-!> every disk gets the weight alpha at the abscissa of its centre (projection on the nearest
-!> element, extended past the beam's ends) and its mass and inertia are scaled by (1 - alpha),
+!> every disk gets the weight alpha at the abscissa of its centre (fem_beam_projection: the
+!> nearest point of the beam's axis, continued straight past the beam's ends; the projection
+!> C is built with) and its mass and inertia are scaled by (1 - alpha),
 !> its loads applied in full (alpha = 0 beyond the overlap: unchanged; a disk in the FE-only
 !> zone, alpha = 1, is an error). A load is given to one model only, the other carries no
 !> share of it: weighting it would drop the other share. The coupled disks are those
@@ -25,6 +26,7 @@ module coupling_arlequin
     use core_error, only: error_t, make_error, make_internal_error
     use fem_beam_config, only: beam_config_t
     use fem_beam_model, only: beam_model_t, build_beam_model
+    use fem_beam_projection, only: beam_point_t, project_on_beam
     use dem_moreau_jean, only: dem_system_t
     use coupling_weights, only: weight_config_t, make_weight
     use coupling_operator, only: coupling_operator_t, build_coupling_operator, mediator_t, &
@@ -38,7 +40,7 @@ module coupling_arlequin
     private
     public :: coupling_config_t, coupled_system_t, coupled_stats_t, coupled_energies_t
     public :: build_coupled_system, arlequin_step, coupled_energies, coordinate_residual
-    public :: multipliers_particles, multipliers_nodes, nearest_abscissa
+    public :: multipliers_particles, multipliers_nodes
     public :: coupled_beam, coupled_beam_operator
 
     !> Description of the coupling, as read from the deck ([coupling] section).
@@ -238,21 +240,22 @@ contains
         call model%restrict(d, v)
     end subroutine nodal_to_free
 
-    !> Weight alpha of every disk at the abscissa of its centre (projection on the nearest
-    !> element, extended linearly past the beam's ends) and its signed offset from the axis;
-    !> a disk in the FE-only zone (alpha = 1) is an error.
+    !> Weight alpha of every disk at the abscissa of its centre and its signed offset from the
+    !> axis (fem_beam_projection, as for C); a disk in the FE-only zone (alpha = 1) is an error.
     subroutine disk_weights(sys, model, s, off, error)
         type(coupled_system_t), intent(inout) :: sys
         type(beam_model_t), intent(in) :: model
         real(wp), allocatable, intent(out) :: s(:), off(:)
         type(error_t), allocatable, intent(out) :: error
+        type(beam_point_t) :: at
         integer :: i, n
         character(len=300) :: buf
         n = sys%dem%particles%n
         allocate (s(n), off(n), sys%alpha(n))
         do i = 1, n
-            call nearest_abscissa(model, sys%dem%particles%x(i), sys%dem%particles%y(i), &
-                                  s(i), off(i))
+            at = project_on_beam(model, sys%dem%particles%x(i), sys%dem%particles%y(i))
+            s(i) = at%abscissa
+            off(i) = at%offset()
             sys%alpha(i) = sys%weight%value(s(i))
             if (sys%alpha(i) < 1) cycle
             write (buf, '(a,i0,a,es13.5e3,a,es13.5e3,a,es13.5e3,a)') 'coupling: disk ', i, ' at (', &
@@ -264,35 +267,6 @@ contains
             return
         end do
     end subroutine disk_weights
-
-    !> Curvilinear abscissa and signed offset of (px, py) on the nearest element (distance to
-    !> the segment; the first in element order on ties); the abscissa is linear in the reduced
-    !> coordinate, also past the element's ends.
-    pure subroutine nearest_abscissa(model, px, py, s, off)
-        !> The beam model.
-        type(beam_model_t), intent(in) :: model
-        !> The point [m].
-        real(wp), intent(in) :: px, py
-        !> Abscissa [m] and signed offset [m] (positive to the left of the element's direction).
-        real(wp), intent(out) :: s, off
-        integer :: e, n1
-        real(wp) :: dx, dy, xi, o, d, d_best
-        d_best = huge(1.0_wp)
-        s = 0.0_wp
-        off = 0.0_wp
-        do e = 1, model%n_elements
-            n1 = model%conn(1, e)
-            dx = px - model%x(n1)
-            dy = py - model%y(n1)
-            xi = (dx*model%cosine(e) + dy*model%sine(e))/model%length(e)
-            o = -dx*model%sine(e) + dy*model%cosine(e)
-            d = hypot(max(0.0_wp, -xi, xi - 1)*model%length(e), o)
-            if (d >= d_best) cycle
-            d_best = d
-            s = model%abscissa_at(e, xi)
-            off = o
-        end do
-    end subroutine nearest_abscissa
 
     !> The coupled disks: the explicit list, or every disk with 0 < alpha < 1 (centre in the
     !> overlap) within max_offset of the axis.

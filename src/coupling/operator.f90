@@ -1,10 +1,14 @@
 !> Coupling operator C of the Arlequin method (doc/theory.md sections 6.3, 6.6): the beam's displacement
 !> field interpolated at the coupled points (particle centres).
 !>
-!> Each point (x_p, y_p) is projected on the beam axis: element e, reduced coordinate xi in
-!> [0, 1] and signed offset d from the axis (positive on the left of the element's direction,
-!> i.e. along n = (-sin, cos)). In the element's local axes (t along the element, n across):
-!>   u_t = (1 - xi) u1 + xi u2 - d theta(xi),  u_n = w(xi) (Hermite),  phi = theta(xi),
+!> Each point (x_p, y_p) is projected on the beam axis (fem_beam_projection, the projection
+!> that also gives the disks their weight alpha): element e, reduced coordinate xi in [0, 1]
+!> of its nearest point and the rigid arm (a, d) from there to the point in the element's
+!> local axes (t along the element, n = (-sin, cos) across; a = 0 unless the point lies
+!> beyond a joint, in the outer corner of a bend). The point moves with the section at xi
+!> through that arm:
+!>   u_t = (1 - xi) u1 + xi u2 - d theta(xi),  u_n = w(xi) (Hermite) + a theta(xi),
+!>   phi = theta(xi),
 !> rotated to global x, y; the rotation row (phi) is optional. Every row involves the six
 !> DOFs of one element: C is stored as 6 (column, value) pairs per row, in the model's
 !> free-DOF numbering (column 0 = a fixed DOF, value 0, skipped). Rows are ordered point by
@@ -23,6 +27,7 @@ module coupling_operator
     use core_weight, only: weight_function_t
     use fem_beam_model, only: beam_model_t
     use fem_beam_element, only: element_interpolation, rotation_matrix
+    use fem_beam_projection, only: beam_point_t, project_on_beam
     use coupling_map, only: coupling_map_t
     implicit none
     private
@@ -42,8 +47,11 @@ module coupling_operator
         integer, allocatable :: element(:)
         !> Reduced coordinate on that element, in [0, 1] (n_points).
         real(wp), allocatable :: xi(:)
-        !> Signed distance from the beam axis [m] (n_points).
+        !> Signed distance from the beam axis [m] (n_points): the length of the arm, with the
+        !> sign of its component across the element (fem_beam_projection's offset).
         real(wp), allocatable :: offset(:)
+        !> Components of the arm along and across the element [m] (2, n_points).
+        real(wp), allocatable :: arm(:, :)
         !> Curvilinear abscissa of the projection [m] (n_points), for the weight alpha.
         real(wp), allocatable :: abscissa(:)
         !> Free-DOF column of each non-zero (6, n_rows); 0 for a fixed DOF.
@@ -156,7 +164,7 @@ contains
         end do
     end subroutine build_mediator
 
-    !> Project the points on the beam and build C.
+    !> Project the points on the beam (fem_beam_projection) and build C.
     subroutine build_coupling_operator(model, x, y, op, error, with_rotation, max_offset)
         !> The beam model.
         type(beam_model_t), intent(in) :: model
@@ -164,14 +172,15 @@ contains
         real(wp), intent(in) :: x(:), y(:)
         !> The operator built.
         type(coupling_operator_t), intent(out) :: op
-        !> Set when a point is not over the beam or too far from its axis.
+        !> Set when a point's nearest point on the axis lies past an end of the beam, or the
+        !> point is too far from the axis.
         type(error_t), allocatable, intent(out) :: error
         !> Add a rotation row phi = theta(xi) per point (default: no).
         logical, intent(in), optional :: with_rotation
         !> Largest accepted |offset| [m] (default: any).
         real(wp), intent(in), optional :: max_offset
         integer :: p, e, k, r
-        real(wp) :: xi, off
+        type(beam_point_t) :: at
         real(wp) :: rows(3, 6)
         character(len=240) :: buf
         if (size(x) /= size(y)) then
@@ -187,31 +196,34 @@ contains
         op%n_rows = op%n_points*op%rows_per_point
         op%n_free = model%n_free
         allocate (op%element(op%n_points), op%xi(op%n_points), op%offset(op%n_points))
+        allocate (op%arm(2, op%n_points))
         allocate (op%abscissa(op%n_points), op%col(6, op%n_rows), op%val(6, op%n_rows))
         do p = 1, op%n_points
-            call project(model, x(p), y(p), e, xi, off)
-            if (e == 0) then
+            at = project_on_beam(model, x(p), y(p))
+            if (at%element == 0 .or. at%past_end()) then
                 write (buf, '(a,i0,a,es13.5e3,a,es13.5e3,a)') 'coupling operator: coupled point ', &
-                    p, ' at (', x(p), ', ', y(p), ') m is not over the beam (its projection '// &
-                    'on the axis falls outside every element); move it or extend the beam'
+                    p, ' at (', x(p), ', ', y(p), ') m is not over the beam (its nearest point '// &
+                    'on the axis lies past an end of the beam); move it or extend the beam'
                 call make_error(error, trim(buf))
                 return
             end if
             if (present(max_offset)) then
-                if (abs(off) > max_offset) then
+                if (abs(at%offset()) > max_offset) then
                     write (buf, '(a,i0,a,es13.5e3,a,es13.5e3,a,es11.3e3,a,es11.3e3,a)') &
                         'coupling operator: coupled point ', p, ' at (', x(p), ', ', y(p), &
-                        ') m is ', abs(off), ' m from the beam axis, more than the ', &
+                        ') m is ', abs(at%offset()), ' m from the beam axis, more than the ', &
                         max_offset, ' m allowed'
                     call make_error(error, trim(buf))
                     return
                 end if
             end if
+            e = at%element
             op%element(p) = e
-            op%xi(p) = xi
-            op%offset(p) = off
-            op%abscissa(p) = model%abscissa_at(e, xi)
-            rows = point_rows(model, e, xi, off)
+            op%xi(p) = at%xi
+            op%offset(p) = at%offset()
+            op%arm(:, p) = [at%along, at%across]
+            op%abscissa(p) = at%abscissa
+            rows = point_rows(model, e, at%xi, at%along, at%across)
             do k = 1, op%rows_per_point
                 r = (p - 1)*op%rows_per_point + k
                 op%col(1:3, r) = model%eq(:, model%conn(1, e))
@@ -221,50 +233,20 @@ contains
         end do
     end subroutine build_coupling_operator
 
-    !> Element over which (px, py) projects, reduced coordinate and signed offset; among
-    !> several candidates (a point near a joint or over two branches) the one nearest to its
-    !> axis, the first in element order on ties. e = 0 when there is none.
-    pure subroutine project(model, px, py, e_best, xi_best, off_best)
-        type(beam_model_t), intent(in) :: model
-        real(wp), intent(in) :: px, py
-        integer, intent(out) :: e_best
-        real(wp), intent(out) :: xi_best, off_best
-        ! A projection within 1e-10 L outside an element (rounding of a point placed on an
-        ! end node) still belongs to it, clamped to the end.
-        real(wp), parameter :: tol = 1.0e-10_wp
-        integer :: e, n1
-        real(wp) :: dx, dy, xi, off
-        e_best = 0
-        xi_best = 0.0_wp
-        off_best = huge(1.0_wp)
-        do e = 1, model%n_elements
-            n1 = model%conn(1, e)
-            dx = px - model%x(n1)
-            dy = py - model%y(n1)
-            xi = (dx*model%cosine(e) + dy*model%sine(e))/model%length(e)
-            off = -dx*model%sine(e) + dy*model%cosine(e)
-            if (xi < -tol .or. xi > 1 + tol) cycle
-            if (abs(off) >= abs(off_best)) cycle
-            e_best = e
-            xi_best = min(max(xi, 0.0_wp), 1.0_wp)
-            off_best = off
-        end do
-        if (e_best == 0) off_best = 0.0_wp
-    end subroutine project
-
-    !> Rows (x, y, phi) acting on the six global DOFs of element e for a point at xi with
-    !> offset off: local rows (u_t - off theta, w, theta) rotated by R^T and applied to T.
-    pure function point_rows(model, e, xi, off) result(rows)
+    !> Rows (x, y, phi) acting on the six global DOFs of element e for a point at xi with the
+    !> arm (along, across): local rows (u_t - across theta, w + along theta, theta) rotated by
+    !> R^T and applied to T.
+    pure function point_rows(model, e, xi, along, across) result(rows)
         type(beam_model_t), intent(in) :: model
         integer, intent(in) :: e
-        real(wp), intent(in) :: xi, off
+        real(wp), intent(in) :: xi, along, across
         real(wp) :: rows(3, 6)
         real(wp) :: n(3, 6), t(6, 6), rt(6), rn(6)
         associate (c => model%cosine(e), s => model%sine(e))
             n = element_interpolation(xi, model%length(e))
             t = rotation_matrix(c, s)
-            rt = matmul(n(1, :) - off*n(3, :), t)
-            rn = matmul(n(2, :), t)
+            rt = matmul(n(1, :) - across*n(3, :), t)
+            rn = matmul(n(2, :) + along*n(3, :), t)
             rows(1, :) = c*rt - s*rn
             rows(2, :) = s*rt + c*rn
             rows(3, :) = matmul(n(3, :), t)

@@ -31,15 +31,15 @@ module driver_config_coupling
     use io_deck_schema, only: parse_selection
     use fem_beam_config, only: beam_config_t
     use fem_beam_model, only: beam_model_t, build_beam_model
-    use coupling_weights, only: weight_config_t, overlap_weight_t, make_weight
     ! The deck checks project disks on the beam exactly as the coupling library does.
-    use coupling_arlequin, only: coupling_config_t, multipliers_particles, multipliers_nodes, &
-                                 disk_abscissa => nearest_abscissa
+    use fem_beam_projection, only: beam_point_t, project_on_beam
+    use coupling_weights, only: weight_config_t, overlap_weight_t, make_weight
+    use coupling_arlequin, only: coupling_config_t, multipliers_particles, multipliers_nodes
     use driver_config, only: run_config_t
     use driver_config_dem, only: dem_config_t
     implicit none
     private
-    public :: coupled_setup_t, build_coupling_config, disk_abscissa
+    public :: coupled_setup_t, build_coupling_config
 
     !> The coupling of a deck, with what the driver reports and stores about it.
     type :: coupled_setup_t
@@ -82,6 +82,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         type(beam_model_t) :: model
         type(overlap_weight_t) :: weight
+        type(beam_point_t) :: at
         real(wp), allocatable :: s(:), off(:)
         integer :: first_line, i
         allocate (setup%warnings(0))
@@ -143,7 +144,9 @@ contains
         associate (p => dem%system%particles)
             allocate (s(p%n), off(p%n))
             do i = 1, p%n
-                call disk_abscissa(model, p%x(i), p%y(i), s(i), off(i))
+                at = project_on_beam(model, p%x(i), p%y(i))
+                s(i) = at%abscissa
+                off(i) = at%offset()
             end do
         end associate
         call check_fe_zone(deck, setup, weight, dem, s, error)

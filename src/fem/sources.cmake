@@ -5,6 +5,7 @@ set(MULTICOR_FEM_SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/mass_scheme.f90
     ${CMAKE_CURRENT_LIST_DIR}/dynamic_operator.f90
     ${CMAKE_CURRENT_LIST_DIR}/beam_model.f90
+    ${CMAKE_CURRENT_LIST_DIR}/beam_projection.f90
     ${CMAKE_CURRENT_LIST_DIR}/newmark.f90
     ${CMAKE_CURRENT_LIST_DIR}/modal.f90
     ${CMAKE_CURRENT_LIST_DIR}/static.f90
