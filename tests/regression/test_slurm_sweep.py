@@ -11,7 +11,9 @@ velocity of disk 2 equal to the closed form, and the same values as the same swe
 locally (`run -j 2`); its folder has a space in its path. scripts/multicor.slurm runs one
 deck as a job. A resubmission keeps the cap of --max-running and skips the points that an
 earlier job holds pending; a point submitted twice (--force) while it runs is refused by the
-folder lock without changing its exit_status; cancelled, the point keeps 'running' there. (test_sweep.py tests
+folder lock without changing its exit_status; cancelled, the point keeps 'running' there.
+The collect job goes to the partition given to submit, within the array's time limit.
+(test_sweep.py tests
 the tool without Slurm: keys refused, decks written, failures.)
 Skips (exit 77, reason printed) when not root or when slurm-wlm / munge are missing.
 Usage (ctest does this): test_slurm_sweep.py --exe multicor --work DIR --source REPO
@@ -137,6 +139,7 @@ def on_slurm(src, exe, work):
               and (single / "incline.h5").stat().st_mtime_ns > first, log[-400:])
         resubmission(src, exe, work, cluster)
         duplicate(src, exe, work, cluster)
+        collect_partition(src, exe, work, cluster)
     finally:
         cluster.stop()
     try:
@@ -229,6 +232,36 @@ def duplicate(src, exe, work, cluster):
     rows = read_table(folder / "results.csv")
     check("collect: one start, exit_status running", rows and rows[0]["starts"] == "1"
           and rows[0]["exit_status"] == "running", str(rows))
+
+
+def collect_partition(src, exe, work, cluster):
+    """`submit SWEEP --partition=other` on a cluster whose default partition is inactive:
+    the collect job must go to the array's partition, with a time limit the partition allows
+    (the array's 3 minutes under MaxTime=5). Before: the collect job went to the default
+    partition with --time=10, sbatch refused it ('Required partition not available'), and
+    the array, submitted, was not recorded in sweep.json. Both jobs held: nothing runs."""
+    folder = work / "collect partition"
+    sweep_tool(src, ["create", src / "input" / "incline.dat", "--exe", exe,
+                     "--set", "time.end=0.1,0.2", "--time", "3", "--dir", folder])
+    cluster.query(["scontrol", "create", "PartitionName=other", f"Nodes={cluster.NODE}",
+                   "MaxTime=5"],
+                  check=True)
+    cluster.query(["scontrol", "update", f"PartitionName={cluster.PARTITION}", "State=INACTIVE"],
+                  check=True)
+    try:
+        proc = sweep_tool(src, ["submit", folder, "--partition=other", "--hold"], env=cluster.env,
+                          expect=None)
+        jobs = cluster.query(["squeue", "-h", "-o", "%i %j %P %l"])
+        print(jobs.strip())
+        collect = [line.split() for line in jobs.splitlines() if "multicor-collect" in line]
+        check("submit --partition=other: the collect job in partition other, its time limit the "
+              "array's (3:00, MaxTime 5)", proc.returncode == 0 and len(collect) == 1
+              and collect[0][2:] == ["other", "3:00"], proc.stdout + proc.stderr + jobs)
+    finally:
+        cluster.query(["scancel", "--partition=other"])
+        wait_idle(cluster, 30)
+        cluster.query(["scontrol", "update", f"PartitionName={cluster.PARTITION}", "State=UP"])
+        cluster.query(["scontrol", "delete", "PartitionName=other"])
 
 
 def locally(src, exe, work):

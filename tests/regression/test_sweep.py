@@ -20,10 +20,14 @@
 - Records selected by a quoted name (`[edge_set="right #end"]`, in --set and in a grid
   file), matched exactly (a trailing blank is another name); a bare value with '#' or a
   blank, or a quote left open: refused, the message showing the quotes.
-- create refuses a --time that is no Slurm time limit, --max-running 0, a --dir that is a
-  file; `submit` and `status` with stand-ins for sbatch and squeue (no Slurm daemon): the
-  cap of --max-running kept by a resubmission, points still pending or running in an earlier
-  job not submitted again, squeue out of reach (submit refuses unless --force).
+- A restart that fails (exit 1) keeps its checkpoint: status calls the point failed.
+- create refuses a --time that is no Slurm time limit or not longer than --signal-seconds,
+  --max-running 0, a --dir that is a file; `submit` and `status` with stand-ins for sbatch
+  and squeue (no Slurm daemon): the cap of --max-running kept by a resubmission, points
+  still pending or running in an earlier job not submitted again, squeue out of reach
+  (submit refuses unless --force); the collect job with the array's partition, account and
+  qos and a time limit within the array's; a collect job refused: the array recorded,
+  not submitted again.
 Usage (ctest does this): test_sweep.py --exe multicor --work DIR --source REPO
 """
 import csv
@@ -208,6 +212,20 @@ def failing_point(src, exe, work):
     again = sweep_tool(src, ["run", folder, "--no-collect"], expect=1)
     check("the next run retries the failed point only",
           "1 points finished before, 1 to run" in again.stdout, again.stdout.strip())
+    # A restart that fails keeps its checkpoint: p001 as if stopped by SIGUSR1 (exit 138, the
+    # checkpoint of its end), its deck changed since (a comment): the restart is refused, exit
+    # 1. status must call it failed, as doc/cluster.md defines it (before: 'checkpoint').
+    out = folder / "runs" / "p001"
+    (out / "exit_status").write_text("138\n")
+    check("p001 as if stopped: a checkpoint, status says so", (out / "checkpoint.h5").exists()
+          and "p001 checkpoint" in sweep_tool(src, ["status", folder]).stdout, "")
+    with open(folder / "decks" / "p001.dat", "a") as fh:
+        fh.write("# changed after the checkpoint\n")
+    sweep_tool(src, ["run", folder, "--no-collect"], expect=1)
+    status = sweep_tool(src, ["status", folder]).stdout
+    check("a failed restart (exit 1, its checkpoint kept): status says failed",
+          (out / "exit_status").read_text().strip() == "1" and (out / "checkpoint.h5").exists()
+          and "p001 failed" in status and "2 failed" in status, status.strip())
 
 
 def wrong_scalar(src, exe, work):
@@ -233,13 +251,17 @@ def refused_options(src, exe, work):
     (work / "a_file").write_text("")
     for options, said in ((["--time", "1 hour"], "--time '1 hour': not a Slurm time limit"),
                           (["--max-running", "0"], "--max-running 0: at least 1"),
+                          # SIGUSR1 at the first time-limit check of every start (before: accepted)
+                          (["--time", "1"], "--time 1 (60 s) is not longer than --signal-seconds 120"),
+                          (["--time", "00:30", "--signal-seconds", "60"],
+                           "--time 00:30 (60 s) is not longer than --signal-seconds 60"),
                           (["--dir", work / "a_file"], "exists and is not a folder"),
                           (["--dir", work / "a_file" / "x"], "cannot create the sweep folder")):
         args = ["create", deck, "--exe", exe, "--set", "time.end=0.1,0.2"] + options
         if "--dir" not in options:
             args += ["--dir", work / "refused_option"]
         proc = sweep_tool(src, args, expect=None)
-        check(f"create refuses {options[0]} {options[1]}", proc.returncode == 1
+        check(f"create refuses {' '.join(map(str, options))}", proc.returncode == 1
               and f"multicor-sweep: error: " in proc.stderr and said in proc.stderr
               and "Traceback" not in proc.stderr and not (work / "refused_option").exists(),
               proc.stderr.strip()[-300:])
@@ -413,8 +435,14 @@ def quoted_selectors(src, exe, work, deck):
 
 
 SBATCH = """#!/bin/bash
+# stand-in for sbatch: logs its arguments, answers job ${FAKE_JOB:-42}; FAKE_COLLECT_FAIL:
+# refuses the collect job (--wrap)
 echo "$*" >> "$FAKE_LOG"
-echo 42
+if [ -n "${FAKE_COLLECT_FAIL:-}" ] && [[ " $* " == *" --wrap "* ]]; then
+    echo "sbatch: error: Batch job submission failed: Required partition not available" >&2
+    exit 1
+fi
+echo "${FAKE_JOB:-42}"
 """
 SQUEUE = """#!/bin/bash
 # stand-in for squeue -h -r -o '%F|%K|%T' -j JOBS: prints $FAKE_SQUEUE; FAKE_SQUEUE_FAIL: fails
@@ -493,6 +521,60 @@ def submission(src, exe, work):
     proc = tool(["status", folder])
     check("status once the jobs ended: advises submit", "continue the others: multicor-sweep "
           f"submit {shlex.quote(str(folder))}" in proc.stdout, proc.stdout)
+    collect_job(src, exe, work, tool, calls)
+
+
+def collect_job(src, exe, work, tool, calls):
+    """The collect job gets the array's partition, account, qos (create --sbatch, overridden
+    by submit's options), not its --cpus-per-task, and a time limit of 10 minutes or the
+    array's when shorter (before: none of them, --time=10 always). A collect job that sbatch
+    refuses: the array stays recorded in sweep.json (before: "jobs": [], and the next submit
+    started the running points again), the message gives the commands to collect later."""
+    import json
+    import shlex
+    folder = work / "collect job"
+    sweep_tool(src, ["create", src / "input" / "incline.dat", "--exe", exe, "--set",
+                     "time.end=0.1,0.2", "--time", "3", "--sbatch=--partition=short",
+                     "--sbatch", "-A me", "--sbatch=--cpus-per-task=4", "--sbatch=--qos=low",
+                     "--dir", folder])
+    proc = tool(["submit", folder, "--qos=high", "-c", "2"], FAKE_JOB="51")
+    array, collect = calls()[-2:] if len(calls()) >= 2 else ("", "")
+    options = collect.split(" --wrap ")[0].split()
+    check("collect job: the array's partition, account, qos (submit's over create's), the "
+          "array's time (3 min, under 10), no --cpus-per-task",
+          proc.returncode == 0 and "--qos=high -c 2 " in array and "--dependency=afterany:51" in options
+          and {"--partition=short", "--account=me", "--qos=high", "--time=3"} <= set(options)
+          and "--time=10" not in options and not any(o.startswith(("-c", "--cpus")) for o in options),
+          f"{proc.stdout}{proc.stderr}\n{collect}")
+    proc = tool(["submit", "--force", folder, "--time", "01:00:00", "-p", "long"], FAKE_JOB="52")
+    options = calls()[-1].split(" --wrap ")[0].split()
+    check("collect job: --time=10 under a longer array's limit, submit's -p",
+          {"--partition=long", "--time=10"} <= set(options), calls()[-1])
+    # the collect job refused: the array recorded at once, the way to collect later given
+    folder = work / "collect refused"
+    sweep_tool(src, ["create", src / "input" / "incline.dat", "--exe", exe, "--set",
+                     "time.end=0.1,0.2", "--time", "5", "--dir", folder])
+    proc = tool(["submit", folder, "--partition=other"], expect=1, FAKE_JOB="61",
+                FAKE_COLLECT_FAIL="1")
+    jobs = json.loads((folder / "sweep.json").read_text())["jobs"]
+    q = shlex.quote(str(folder))
+    check("collect job refused: exit 1, said, the array 61 recorded, the commands given",
+          proc.returncode == 1 and jobs == ["61"] and "job array 61: 2 points" in proc.stdout
+          and "the collect job was not submitted: sbatch: error: Batch job submission failed: "
+          "Required partition not available" in proc.stderr
+          and "job array 61 is submitted and recorded in" in proc.stderr
+          and "--dependency=afterany:61" in proc.stderr and f"collect {q}" in proc.stderr
+          and "Traceback" not in proc.stderr, f"{jobs}\n{proc.stdout}{proc.stderr}")
+    queued = "61|1|RUNNING\n61|2|RUNNING\n"
+    proc = tool(["status", folder], FAKE_SQUEUE=queued)
+    check("collect job refused: status shows the points running, advises to wait",
+          "p001 running" in proc.stdout and "wait for them" in proc.stdout
+          and "submit" not in proc.stdout, proc.stdout)
+    n = len(calls())
+    proc = tool(["submit", folder], FAKE_SQUEUE=queued)
+    check("collect job refused: a second submit starts nothing again",
+          proc.returncode == 0 and "nothing to submit" in proc.stdout and len(calls()) == n,
+          proc.stdout + proc.stderr)
 
 
 def main():
