@@ -182,6 +182,13 @@ contains
         limit = real(4*n + 64, wp)
         det%cell = 2.0_wp*maxval(radius) + alert
         det%cell = max(det%cell, sqrt((ex + det%cell)*(ey + det%cell)/limit))
+        ! That bounds the cells of a box wide both ways; a box thinner than a cell one way (disks
+        ! in a line: a row falling freely for 1e7 m made 2.8e5 cells for 104) takes the smallest
+        ! cell with (ex/cell + 1)(ey/cell + 1) <= limit: the positive root c of
+        ! (limit - 1) c^2 - (ex + ey) c - ex ey, times 1 + 1e-12 against its rounding.
+        if ((aint(ex/det%cell) + 1.0_wp)*(aint(ey/det%cell) + 1.0_wp) > limit) &
+            det%cell = max(det%cell, (1.0_wp + 1.0e-12_wp)*((ex + ey) + sqrt((ex + ey)**2 + 4.0_wp*(limit - 1.0_wp)*ex*ey)) &
+                           /(2.0_wp*(limit - 1.0_wp)))
         det%inv_cell = 1.0_wp/det%cell
         det%ncx = int(ex/det%cell) + 1
         det%ncy = int(ey/det%cell) + 1
