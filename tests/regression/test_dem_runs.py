@@ -39,6 +39,7 @@ def incline(exe, src, work):
     with f:
         t = f["dem/time"][...]
         v = f["dem/velocity"][...]            # (n_out, 2, 3)
+        rot = f["dem/position"][:, :, 2]       # (n_out, 2)
         status = f["dem/contacts/status"][...]
     # Speed down the slope (0.8, -0.6); accelerations from the last 40 outputs (after the
     # first step, whose contact activation may lag by one step).
@@ -58,6 +59,20 @@ def incline(exe, src, work):
     w_slip = -2 * 0.1 * G * cos_phi / radius
     check("incline: slipping disk omega' = -2 mu g cos/R", abs(spin[1] / w_slip - 1) < 1e-8,
           f"{spin[1]:.10g} vs {w_slip:.10g} rad/s^2")
+    # Rotations, from rest at theta = 0: theta = omega' t^2 / 2 at every output. The theta-scheme
+    # with theta = 1/2 is the trapezoidal rule on a velocity linear in time, exact; each disk's
+    # one contact is solved exactly up to round-off (the spins within 1e-13 rad/s of omega' t).
+    # Round-off only: 500 steps each adding to |theta| <= 9.81 rad (1.1e-16 relative: at most
+    # 5e-13 rad) an increment from spins of |omega| <= 39 rad/s that carry their own round-off
+    # (at most 500 * 1.1e-16 * 39 = 2e-12 rad/s, over 0.5 s 1e-12 rad); 1e-10 rad allows
+    # that sum 70 times (3.4e-14 measured, Debug and Release). The rotation is checked nowhere
+    # else: a spin stored in its place (-a t / R) would be 29 rad off at t = 0.5 s.
+    rot_exact = 0.5 * np.outer(t**2, [-a_roll / radius, w_slip])
+    worst = np.abs(rot - rot_exact).max(axis=0)
+    check("incline: rolling disk theta = -(a/R) t^2/2", worst[0] < 1e-10,
+          f"{rot[-1, 0]:.16g} vs {rot_exact[-1, 0]:.16g} rad at t = {t[-1]:g} s, worst {worst[0]:.3g} rad")
+    check("incline: slipping disk theta = omega' t^2/2", worst[1] < 1e-10,
+          f"{rot[-1, 1]:.16g} vs {rot_exact[-1, 1]:.16g} rad at t = {t[-1]:g} s, worst {worst[1]:.3g} rad")
     # Contact statuses of the stored outputs: stick for the rolling disk, slip for the other
     # (contacts are ordered by disk: disk 1 first).
     check("incline: statuses stick / slip", bool(np.all(status.reshape(-1, 2) == [1, 2])),
