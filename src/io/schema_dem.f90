@@ -225,7 +225,10 @@ contains
                                                                lower_strict=.true., upper_strict=.true.)], &
                            'Over-relaxation factor omega of the sweeps: each contact takes P_K(r + omega '// &
                            '(r_local - r)). Every `check_every` sweeps the error is compared with the one '// &
-                           'before; omega falls back to 1 for the rest of the step when it rose.', default='1')
+                           'before; omega falls back to 1 for the rest of the step when it rose. An omega '// &
+                           'past the best one can slow the sweeps while the error still falls (a column of '// &
+                           '20 disks: 5568 sweeps at 1.9 against 4248 at 1, 2128 at 1.5): try it on the '// &
+                           'deck first.', default='1')
         call s%add_keyword('solver', 'anderson', [int_field('anderson', lower=0, upper=20)], &
                            'Anderson acceleration of the sweeps: the number of previous sweeps mixed; 0: '// &
                            'plain sweeps (the default, 5, is the fastest measured on deposits and tall '// &
