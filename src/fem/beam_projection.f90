@@ -17,10 +17,13 @@
 !> and o across when it lies beyond a joint of the element (a point in the outer corner of a
 !> bend, whose nearest point of the polyline is the joint node itself).
 !>
-!> The element kept is the one whose arm is shortest; on a tie (lengths within 1e-10 of the
-!> element's length: two elements meeting at the node nearest to the point, or a point
-!> equidistant from two branches) the lower element index. A point beyond a bend has the
-!> abscissa of the bend's node whichever element holds it.
+!> The element kept is the one nearest to the point as a segment (its distance to the point
+!> with xi clamped to [0, 1]: the continuation past a free end is not counted in the choice,
+!> so that the line continued from one cantilever's end never takes a point that lies beside
+!> another element); on a tie (distances within 1e-10 of the element's length: two elements
+!> meeting at the node nearest to the point, or a point equidistant from two branches) the
+!> lower element index. A point beyond a bend has the abscissa of the bend's node whichever
+!> element holds it.
 module fem_beam_projection
     use core_kinds, only: wp
     use fem_beam_model, only: beam_model_t
@@ -93,7 +96,8 @@ contains
                 xs = xc
                 along = (xi - xc)*model%length(e)
             end if
-            d = hypot(along, across)
+            ! distance to the element as a segment (also past a free end)
+            d = hypot((xi - min(max(xi, 0.0_wp), 1.0_wp))*model%length(e), across)
             if (.not. d < d_best - snap*model%length(e)) cycle
             d_best = d
             point%element = e
