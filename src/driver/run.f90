@@ -110,6 +110,7 @@ contains
         !> Signal that stopped the run early (0: none).
         integer, intent(out), optional :: stopped_by
         type(deck_run_t) :: run
+        character(len=:), allocatable :: folder
 
         if (present(stopped_by)) stopped_by = 0
         ! Before any factorisation: results that do not depend on the threads OpenBLAS is given
@@ -126,6 +127,21 @@ contains
         if (allocated(opts%output_dir)) then
             run%dir = opts%output_dir
         else if (allocated(opts%restart)) then
+            ! the checkpoint file itself (its folder is the results folder): checked before a
+            ! folder is made from its name
+            if (file_exists(opts%restart//'/.')) then
+                folder = opts%restart
+                do while (len(folder) > 1 .and. folder(len(folder):) == '/')
+                    folder = folder(:len(folder) - 1)
+                end do
+                call make_error(error, "--restart: '"//opts%restart//"' is a folder: give the checkpoint "// &
+                                "file in it ('"//folder//'/'//checkpoint_name//"')")
+                return
+            end if
+            if (.not. file_exists(opts%restart)) then
+                call make_error(error, "--restart: no checkpoint '"//opts%restart//"'")
+                return
+            end if
             run%dir = dirname(opts%restart)
         else
             run%dir = 'results/'//stem(opts%deck_path)

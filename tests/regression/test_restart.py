@@ -359,6 +359,17 @@ def refusals(exe, deck, work):
     proc = run(exe, other, "--output", folder, "--restart", ckpt, "--end", 0.1)
     check("another deck refused", proc.returncode == 1 and
           "was written for another deck" in proc.stderr, proc.stderr.strip())
+    # Without --output the folder is the checkpoint's: a folder or a missing file given to
+    # --restart is refused by name, before any folder is made from it (before: 'runX/' made
+    # runX and called it 'not an HDF5 file'; the results folder itself blamed --output).
+    for given, said in [(folder, f"'{folder}' is a folder: give the checkpoint file in it ('{ckpt}')"),
+                        (f"{folder}/", f"is a folder: give the checkpoint file in it ('{ckpt}')"),
+                        (f"{ckpt}/", f"no checkpoint '{ckpt}/'"),
+                        (work / "no_such_run" / "checkpoint.h5", "no checkpoint '")]:
+        proc = run(exe, deck, "--restart", given, "--end", 0.1, cwd=work)
+        check(f"--restart {given} refused by name", proc.returncode == 1 and said in proc.stderr
+              and not (work / "no_such_run").exists() and not (work / "results").exists(),
+              proc.stderr.strip())
     proc = run(exe, deck, "--output", folder, "--restart", ckpt, "--end", 0.05)
     check("nothing left to do refused", proc.returncode == 1 and "nothing to do" in proc.stderr,
           proc.stderr.strip())
@@ -1492,7 +1503,7 @@ def main():
     ap.add_argument("--work", required=True)
     ap.add_argument("--source", required=True)
     a = ap.parse_args()
-    exe, src, work = pathlib.Path(a.exe).resolve(), pathlib.Path(a.source), pathlib.Path(a.work)
+    exe, src, work = pathlib.Path(a.exe).resolve(), pathlib.Path(a.source), pathlib.Path(a.work).resolve()
     shutil.rmtree(work, ignore_errors=True)
     work.mkdir(parents=True)
     decks = src / "tests" / "regression" / "decks"
