@@ -32,6 +32,7 @@ Usage (ctest does this): test_sweep.py --exe multicor --work DIR --source REPO
 """
 import csv
 import importlib.machinery
+import json
 import math
 import re
 import subprocess
@@ -226,6 +227,29 @@ def failing_point(src, exe, work):
     check("a failed restart (exit 1, its checkpoint kept): status says failed",
           (out / "exit_status").read_text().strip() == "1" and (out / "checkpoint.h5").exists()
           and "p001 failed" in status and "2 failed" in status, status.strip())
+
+
+def killed_local_point(src, exe, work):
+    """A point of a local run killed by a signal (kill -9) after its first checkpoint: the
+    runner records the shell's code, 128 + 9, and status calls it 'checkpoint' (before:
+    Python's -9, and 'failed'). The executable is a stand-in that leaves a checkpoint in its
+    --output folder and kills itself."""
+    folder = work / "killed_local"
+    sweep_tool(src, ["create", src / "input" / "incline.dat", "--exe", exe,
+                     "--set", "particles.gravity.gy=-9.81", "--dir", folder])
+    fake = work / "killed_multicor.sh"
+    fake.write_text('#!/bin/sh\nwhile [ $# -gt 0 ]; do [ "$1" = --output ] && out=$2; shift; done\n'
+                    ': > "$out/checkpoint.h5"\nkill -9 $$\n')
+    fake.chmod(0o755)
+    manifest = json.loads((folder / "sweep.json").read_text())
+    manifest["exe"] = str(fake)
+    (folder / "sweep.json").write_text(json.dumps(manifest))
+    sweep_tool(src, ["run", folder, "--no-collect"], expect=1)
+    out = folder / "runs" / "p001"
+    status = sweep_tool(src, ["status", folder]).stdout
+    check("a local point killed by kill -9: exit_status 137, status 'checkpoint'",
+          (out / "exit_status").read_text().strip() == "137" and "p001 checkpoint" in status,
+          (out / "exit_status").read_text().strip() + " / " + status.strip())
 
 
 def wrong_scalar(src, exe, work):
@@ -586,6 +610,7 @@ def main():
     folder = generated_decks(src, exe, work)
     sequential_run(src, folder)
     failing_point(src, exe, work)
+    killed_local_point(src, exe, work)
     wrong_scalar(src, exe, work)
     deck = relative_meshes(src, exe, work)
     if deck is not None:
