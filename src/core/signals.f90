@@ -5,9 +5,9 @@
 !> `install_signal_handlers` installs a handler (src/core/signals_c.c) that only records the
 !> first signal caught; the time loops poll `caught_signal()` once per step, finish the step,
 !> write a checkpoint, store the step and close the results (doc/output.md, "Interrupted
-!> runs"). After the first
-!> delivery a signal has its default action again: a second Ctrl-C or SIGTERM stops the
-!> program at once. SIGXFSZ is ignored, so that a file size limit (`ulimit -f`) gives a write
+!> runs"). A second Ctrl-C (SIGINT) stops the program at once (its default action again after
+!> the first delivery); a second SIGTERM, SIGUSR1 or SIGHUP is the same request again (Slurm
+!> sends SIGTERM twice at a time limit). SIGXFSZ is ignored, so that a file size limit (`ulimit -f`) gives a write
 !> error instead of killing the program. The flag lives in the C file (a signal handler can
 !> only set a `volatile sig_atomic_t`); this module keeps no state.
 !>

@@ -113,10 +113,15 @@ def truncated(line):
     return bool(rest) and not rest.startswith(b'!')
 
 
-def code_outside_literals(line):
+def code_outside_literals(line, quote=None):
     """`line` before its comment, with the contents of its character literals blanked
-    (a literal may hold '@assert' or '!': pFUnit copies such a line unchanged and it compiles)."""
-    out, quote = [], None
+    (a literal may hold '@assert' or '!': pFUnit copies such a line unchanged and it
+    compiles), and the quote of a literal continued on the next line ('...&' at the end), else
+    None. `quote`: the literal this line continues (its leading blanks and '&' skipped)."""
+    out = []
+    if quote:
+        line = line.lstrip()
+        line = line[1:] if line.startswith('&') else line
     for c in line:
         if quote:
             if c == quote:
@@ -129,7 +134,8 @@ def code_outside_literals(line):
             break
         else:
             out.append(c)
-    return ''.join(out)
+    continued = quote if quote and line.rstrip().endswith('&') else None
+    return ''.join(out), continued
 
 
 def check_arguments(args, where):
@@ -165,6 +171,7 @@ def parse(path):
     looking_for_test = False
     expect_sub = None      # 'before'/'after': next non-comment line must be the subroutine
     out = []
+    literal = None         # quote of a character literal continued from the line before
     for number, line in enumerate(lines, start=1):
         where = f"{base}:{number}"
         if COMMENT.match(line):
@@ -213,7 +220,8 @@ def parse(path):
                               f"it unchanged and the compiler would reject it): {line.strip()}")
             out.append('')
             continue
-        if '@assert' in code_outside_literals(line).lower():
+        code, literal = code_outside_literals(line, literal)
+        if '@assert' in code.lower():
             # pFUnit copies the line unchanged; the compiler would reject the '@'
             raise PfError(f"{where}: an @assert must stand alone on its line")
         if truncated(line):

@@ -107,6 +107,10 @@ ACCEPT = [
     # pFUnit matches an @assert at the start of a line only: one inside a literal is text
     ('strict_literal_at', module('strict_literal_at', "        character(len=*), parameter :: s = "
                                  "'see @assertTrue; !'\n        @assertEqual(18, len(s))")),
+    # ... also in a literal continued on the next line (pFUnit copies a line starting with '&')
+    ('strict_literal_continued', module('strict_literal_continued', "        character(len=*), "
+                                        "parameter :: s = 'abc &\n            &@assertTrue(x)'\n"
+                                        "        @assertEqual(18, len(s))")),
     # pFUnit's suite function declares `suite` and `t` only: a module may export other names
     ('strict_suite_names', module('strict_suite_names', "        @assertEqual(1, method)",
                                   ).replace('contains\n', '    integer, public :: method = 1, '
