@@ -65,6 +65,18 @@ def test_slip_and_apparent_friction(interface_file):
     # the ratio of the means, to rounding.
     assert s[0] == SLIP[1]
     assert np.allclose(mu[s > SLIP[1]], T_MEAN / -N_MEAN, rtol=1e-14)
+    # Blocks sheared through their height (u_x linear in y): the slip is taken where the
+    # blocks face each other, the top block's lower edge (y = 2, u_x = SLIP) and the bottom
+    # block's upper edge (y = 1, u_x = 0), not on their other edges (y = 3: SLIP + gamma,
+    # y = 0: -gamma). Exact: gamma * 0 = 0, and the mean of two equal doubles is that double.
+    gamma = 2.0e-4
+    with h5py.File(interface_file, "r+") as f:
+        x = f["continuum/mesh/coordinates"][...]
+        u = f["continuum/displacement"][...]
+        u[:, 4:, 0] = SLIP[:, None] + gamma * (x[4:, 1] - 2.0)
+        u[:, :4, 0] = gamma * (x[:4, 1] - 1.0)
+        f["continuum/displacement"][...] = u
+    assert np.array_equal(interface.InterfaceRun(interface_file).slip(), SLIP)
 
 
 def test_sliding_over_disks_starts_at_mu_and_vanishes_at_the_crest():
@@ -126,3 +138,20 @@ def test_von_mises_of_the_stress_plot_takes_sigma_zz_in_plane_strain(interface_f
     # the formula's arithmetic in double precision: 1e-12 relative
     np.testing.assert_allclose(values, [0.4, 1.0], rtol=1e-12)
     assert fig.axes[1].get_ylabel() == "von Mises [MPa]"
+
+
+def test_von_mises_counts_the_shear_three_times():
+    """Von Mises of a pure shear tau is sqrt(3) tau; with normal stresses and shear in plane
+    strain, the same value as from the deviator of the full 3-D stress tensor, sqrt(3/2 s:s),
+    with sigma_zz = nu (sigma_xx + sigma_yy): (1, 1, 0.5) MPa, nu = 0.3 gives sigma_zz = 0.6
+    MPa and sqrt(0.4^2 + 3 x 0.5^2) = sqrt(0.91) = 0.954 MPa (2 sxy^2 would give 0.812)."""
+    tau = 2.5e6
+    # a square root and a few products of doubles: a few ulps, 1e-14 relative
+    assert interface.von_mises(np.array([0.0, 0.0, tau])) == pytest.approx(np.sqrt(3) * tau, rel=1e-14)
+    sxx, syy, sxy, nu = 1.0e6, 1.0e6, 0.5e6, 0.3
+    szz = nu * (sxx + syy)
+    sigma = np.array([[sxx, sxy, 0.0], [sxy, syy, 0.0], [0.0, 0.0, szz]])
+    dev = sigma - np.trace(sigma) / 3 * np.eye(3)
+    expected = np.sqrt(1.5 * np.sum(dev * dev))
+    assert expected == pytest.approx(np.sqrt(0.91e12), rel=1e-14)
+    assert interface.von_mises(np.array([sxx, syy, sxy]), nu) == pytest.approx(expected, rel=1e-14)

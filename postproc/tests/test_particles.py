@@ -27,6 +27,7 @@ def test_loader_reads_the_documented_layout(tmp_path):
     assert res.solver.time[0] == pytest.approx(1e-3, rel=1e-12)   # step 1 ends at h
     assert int(np.count_nonzero(~res.solver.converged)) == 1
     assert res.nearest_index(0.0126) == 3                           # outputs every 5 ms
+    assert res.nearest_index(0.0112) == 2                           # 10 ms nearer than 15 ms
     assert res.title == "synthetic column"
 
 
@@ -52,6 +53,28 @@ def test_line_width_grows_in_proportion_to_the_normal_force():
     np.testing.assert_allclose(widths, MAX_FORCE_WIDTH * np.array([1.0, 0.5, 0.25, 0.0]),
                                rtol=1e-15)
     assert np.all(force_widths(np.zeros(3)) == 0.0)
+
+
+def test_force_scale_is_the_largest_tension_when_it_exceeds_the_compressions(tmp_path):
+    """A cohesive contact pulled at twice the largest compression: the scale of the run is
+    that |r_n|, the widths at that scale stay within MAX_FORCE_WIDTH, the widest being the
+    bond; a compression between NOISE times the largest compression and NOISE times the
+    scale is round-off, not drawn."""
+    import h5py
+    from multicor_post.particles import NOISE, force_scale
+    path = write_dem(tmp_path / "col.h5")
+    with h5py.File(path, "r+") as f:
+        rn = f["dem/contacts/rn"][...]
+        pull = -2.0 * rn.max()                       # the bond: 2 x (3 m g), in tension
+        rn[N_DISKS::N_DISKS + 1] = pull
+        rn[N_DISKS - 1::N_DISKS + 1] = 0.75 * NOISE * -pull    # the top pair of the column
+        f["dem/contacts/rn"][...] = rn
+    res = load_dem(path)
+    assert force_scale(res) == -pull                 # |r_n| of a stored double: exact
+    widths = force_widths(res.contacts.rn, force_scale(res))
+    assert widths.max() <= MAX_FORCE_WIDTH and widths[N_DISKS] == MAX_FORCE_WIDTH
+    assert int(np.argmax(widths)) == N_DISKS
+    assert "4 contacts (3 carrying a force)" in plot_configuration(res, 2).axes[0].get_title()
 
 
 def test_configuration_draws_disks_forces_and_walls(tmp_path):

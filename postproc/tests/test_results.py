@@ -112,3 +112,19 @@ def test_every_loader_says_what_a_checkpoint_or_a_missing_file_is(loader, tmp_pa
         loader(tmp_path / "none.h5")
     with pytest.raises(ResultsError, match="is a folder, not a results file"):
         loader(tmp_path)
+
+
+def test_mode_labels_not_one_per_mode_are_ignored(tmp_path):
+    """/modal/axial_fraction@kind with three words for two modes: no labels (the file does not
+    say which word is which mode's), and axial_modes falls back to the geometry: both synthetic
+    modes are the cantilever's bending shape (w only), so neither is axial."""
+    import h5py
+    from synthetic import write_results
+    from multicor_post.beam import axial_modes
+    path = write_results(tmp_path / "modes.h5", *cantilever_layout(), parts=("modal",))
+    with h5py.File(path, "a") as f:
+        f.create_dataset("modal/axial_fraction", data=[0.0, 0.0])
+        f["modal/axial_fraction"].attrs["kind"] = "axial bending bending"
+    res = load_results(path)
+    assert res.modal.omega.size == 2 and res.modal.kind is None
+    assert axial_modes(res).tolist() == [False, False]
