@@ -8,9 +8,16 @@
 - A grid file selecting a record by its values (`contacts.law[material1=2 material2=3].mu`)
   and a positional field: the generated decks differ from the deck only in the swept tokens
   (comments and layout kept).
+- Two values of one record swept together, the first written longer than the deck's
+  (mu 0.1 -> 0.25, and cohesion), the record chosen by numbers written otherwise (2.0, 2d0):
+  both values in their own fields.
+- Functions called directly: Slurm time limits in minutes (days, seconds rounded up), sbatch
+  short options with attached values (-pdebug), a point with Python's -15 and a checkpoint.
 - A sequential local run of input/incline.dat over mu of the slipping disk in {0.1, 0.2}:
   the table gives the closed-form final velocity g (sin phi - mu cos phi) cos phi t of
-  disk 2, and reductions (absmax of the energy balance) next to indexed values.
+  disk 2, and reductions (absmax of the energy balance, absmax of a negative velocity = -min
+  read with h5py) next to indexed values; `starts` counts the starts of job.log but those
+  refused by the folder lock.
 - A point that fails at run time (gravity 1e300: the run stops with exit code 1) is
   reported as failed; the next `run` runs only that point again.
 - Decks whose Gmsh mesh path is relative to their folder, quoted ("My Meshes/bar #1.msh")
@@ -114,7 +121,8 @@ def generated_decks(src, exe, work):
     sweep_tool(src, ["create", deck, "--exe", exe, "--grid", grid, "--dir", folder,
                      "--scalar", "v2x=dem/velocity[-1,1,0]",
                      "--scalar", "balance=absmax(dem/energy/balance)",
-                     "--scalar", "vmax=max(dem/velocity[:,1,0])"])
+                     "--scalar", "vmax=max(dem/velocity[:,1,0])",
+                     "--scalar", "vy=absmax(dem/velocity[:,1,1])"])
     original = deck.read_text().splitlines()
     for name, mu in (("p001", "0.1"), ("p002", "0.2")):
         lines = (folder / "decks" / f"{name}.dat").read_text().splitlines()
@@ -132,12 +140,18 @@ def generated_decks(src, exe, work):
     return folder
 
 
-def quoted_names(src):
-    """The deck parser of multicor-sweep reads names in double quotes as multicor does: one
-    value each, blanks and '#' inside; the value after such a name is the one a key names."""
+def sweep_module(src):
+    """scripts/multicor-sweep loaded as a module, to call its functions."""
     loader = importlib.machinery.SourceFileLoader("multicor_sweep", str(src / "scripts" / "multicor-sweep"))
     sweep = types.ModuleType(loader.name)
     loader.exec_module(sweep)
+    return sweep
+
+
+def quoted_names(src):
+    """The deck parser of multicor-sweep reads names in double quotes as multicor does: one
+    value each, blanks and '#' inside; the value after such a name is the one a key names."""
+    sweep = sweep_module(src)
     lines = ["[run]", 'title = a "quoted # title', "analysis = static", "[continuum]",
              'mesh = file "My Meshes/bar #1.msh"  # "an open quote in a comment',
              'load = "loaded  end #2" x 1e3   # the load',
@@ -148,6 +162,53 @@ def quoted_names(src):
           tokens["mesh"] == ["file", '"My Meshes/bar #1.msh"'] and tokens["load"] == ['"loaded  end #2"', "x", "1e3"]
           and tokens["fix"] == ["left", "x", "y"] and tokens["title"] == ["a", '"quoted'], str(tokens))
     check("multicor-sweep: a quoted name matches a selector's value", sweep.same_value('"left"', "left"), "")
+
+
+def script_functions(src, work):
+    """Functions of multicor-sweep called directly: Slurm's time limits in minutes, sbatch's
+    short options with their value attached, the state of a point killed by a signal."""
+    sweep = sweep_module(src)
+    # Slurm (parse_time.c, time_str2mins): D days of 24 h, the seconds rounded up to the
+    # minute as (s + 59) / 60: 2-03:04:05 = 183845 s -> 3065 min, 2-03:04:00 -> 3064 min
+    expected = {"1-00": 1440, "2-03": 3060, "2-03:04": 3064, "2-03:04:00": 3064,
+                "2-03:04:05": 3065}
+    got = {t: sweep.time_minutes(t) for t in expected}
+    check("time_minutes: a day is 24 h, seconds rounded up to the minute", got == expected, str(got))
+    got = sweep.sbatch_values(["-pdebug", "-Aacct", "--time=5"])
+    check("sbatch_values: short options with their value attached (-pdebug, -Aacct)",
+          got == {"--partition": "debug", "--account": "acct", "--time": "5"}, str(got))
+    # a folder written by a local run before it recorded the shell's code: Python's -15 for
+    # SIGTERM, and the checkpoint of the stop
+    folder = work / "killed_before"
+    out = folder / "runs" / "p001"
+    out.mkdir(parents=True)
+    (out / "exit_status").write_text("-15\n")
+    (out / sweep.CHECKPOINT_NAME).write_text("")
+    state = sweep.point_state(folder, {"name": "p001"})
+    check("point_state: exit_status -15 (Python's code of SIGTERM) with a checkpoint: 'checkpoint'",
+          state == "checkpoint", state)
+
+
+def same_record(src, exe, work):
+    """Two values of one record swept together, the first longer than the text it replaces
+    (mu 0.1 -> 0.25), the record chosen by a selector whose numbers are written otherwise
+    than in the deck (material1 = 2.0, 2d0 for the deck's 2): both values land in their own
+    fields of the incline's second law (before: edits applied from the left, the shift of the
+    first moved the second: '0.25  0 20'; or the selector matched nothing)."""
+    deck = src / "input" / "incline.dat"
+    folder = work / "same_record"
+    proc = sweep_tool(src, ["create", deck, "--exe", exe,
+                            "--set", "contacts.law[material1=2.0 material2=3].mu=0.25,0.125",
+                            "--set", "contacts.law[material1=2d0 material2=3].cohesion=2",
+                            "--dir", folder], expect=None)
+    decks = sorted((folder / "decks").glob("*.dat")) if proc.returncode == 0 else []
+    check("selectors 2.0 and 2d0 match the law of materials 2 and 3: 2 decks",
+          [d.name for d in decks] == ["p001.dat", "p002.dat"], proc.stderr.strip()[-300:])
+    for path, mu in zip(decks, ("0.25", "0.125")):
+        laws = [line.split("#")[0].split("=", 1)[1].split()
+                for line in path.read_text().splitlines() if line.startswith("law")]
+        check(f"{path.stem}: mu = {mu} and cohesion = 2 in the second law, the first unchanged",
+              laws == [["1", "3", "0.5", "0", "0"], ["2", "3", mu, "0", "2"]], str(laws))
 
 
 def sequential_run(src, folder):
@@ -166,6 +227,13 @@ def sequential_run(src, folder):
         # the energy audit closes to round-off: |balance| <= 1e-9 J/m on ~20 J/m moved
         check(f"{r['point']}: energy balance collected", 0 <= float(r["balance"]) < 1e-9,
               r["balance"])
+        # vy of disk 2 is <= 0 at every output (it slides down from rest): absmax is -min,
+        # read with h5py; the table's repr of a double reads back exactly
+        import h5py
+        with h5py.File(folder / r["file"], "r") as f:
+            vy = f["dem/velocity"][:, 1, 1]
+        check(f"{r['point']}: absmax of a negative series is -min", float(r["vy"]) == -vy.min()
+              and vy.max() <= 0 < -vy.min(), f"vy={r['vy']} -min={float(-vy.min())!r}")
     check("results.png drawn", (folder / "results.png").exists(), "")
     killed_point(src, folder)
 
@@ -186,6 +254,13 @@ def killed_point(src, folder):
         f["summary"].attrs["finished"] = np.int32(0)
         f["summary"].attrs["status"] = "running (or killed)"
     finished.rename(out / "p001.h5.partial")
+    # p002 started twice more by Slurm jobs, the second refused by the first's folder lock
+    # (the job script's lines): 3 starts, 1 refused, so 2 starts counted
+    with open(copy / "runs" / "p002" / "job.log", "a") as log:
+        log.write("2026-01-01T00:00:00+00:00 p002 start 71 restart_count=0: --quiet p002.dat\n"
+                  "2026-01-01T00:00:01+00:00 p002 start 72 restart_count=0: --quiet p002.dat\n"
+                  "2026-01-01T00:00:02+00:00 p002 refused 72: another run holds the folder "
+                  "(71); exit_status left to it\n")
     sweep_tool(src, ["collect", "--no-plot", copy])
     rows = {r["point"]: r for r in read_table(copy / "results.csv")}
     closing = ("summary.steps", "summary.wall_seconds", "summary.wall_seconds_last_run", "summary.runs",
@@ -195,6 +270,9 @@ def killed_point(src, folder):
           and all(rows["p001"][c] == "" for c in closing)
           and all(rows["p002"][c] != "" for c in closing),
           str({k: v for k, v in rows["p001"].items() if k.startswith("summary")}))
+    check("collect: starts counted from job.log, a start refused by the lock not counted",
+          rows["p001"].get("starts") == "1" and rows["p002"].get("starts") == "2",
+          str([rows[p].get("starts") for p in ("p001", "p002")]))
 
 
 def failing_point(src, exe, work):
@@ -604,7 +682,9 @@ def collect_job(src, exe, work, tool, calls):
 def main():
     exe, work, src = arguments(fresh=True)
     quoted_names(src)
+    script_functions(src, work)
     refused_keys(src, exe, work)
+    same_record(src, exe, work)
     refused_options(src, exe, work)
     submission(src, exe, work)
     folder = generated_decks(src, exe, work)
