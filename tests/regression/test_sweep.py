@@ -168,10 +168,11 @@ def script_functions(src, work):
     """Functions of multicor-sweep called directly: Slurm's time limits in minutes, sbatch's
     short options with their value attached, the state of a point killed by a signal."""
     sweep = sweep_module(src)
-    # Slurm (parse_time.c, time_str2mins): D days of 24 h, the seconds rounded up to the
-    # minute as (s + 59) / 60: 2-03:04:05 = 183845 s -> 3065 min, 2-03:04:00 -> 3064 min
+    # Slurm (parse_time.c, time_str2mins): D days of 24 h, the total seconds rounded up to
+    # the minute as (s + 59) / 60: 2-03:04:05 = 183845 s -> 3065 min, 2-03:04:00 -> 3064 min;
+    # 10:75 = 675 s -> 12 min, 1:30:90 = 5490 s -> 92 min (the script gave 11 and 91)
     expected = {"1-00": 1440, "2-03": 3060, "2-03:04": 3064, "2-03:04:00": 3064,
-                "2-03:04:05": 3065}
+                "2-03:04:05": 3065, "10:75": 12, "1:30:90": 92, "10:00": 10, "10:01": 11}
     got = {t: sweep.time_minutes(t) for t in expected}
     check("time_minutes: a day is 24 h, seconds rounded up to the minute", got == expected, str(got))
     got = sweep.sbatch_values(["-pdebug", "-Aacct", "--time=5"])
