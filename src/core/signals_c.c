@@ -6,8 +6,8 @@
  * program at once. A repeated SIGTERM, SIGUSR1 or SIGHUP is only the same request again:
  * Slurm at a job's time limit sends a step's processes SIGTERM twice within milliseconds
  * (slurmstepd and srun), which killed the run before its checkpoint; SIGKILL is the way to
- * stop at once (Slurm sends it after KillWait). SIGHUP (the terminal of an interactive run closed, an ssh
- * session lost) stops the run as SIGTERM does, with its checkpoint, instead of killing it;
+ * stop at once (Slurm sends it after KillWait). SIGHUP (the terminal of an interactive run
+ * closed, an ssh session lost) stops the run as SIGTERM does, with its checkpoint, instead of killing it;
  * under `nohup` (SIGHUP ignored when the program starts) it stays ignored, and so does a
  * SIGINT ignored at the start (the results file stays readable up to its last flush).
  * SIGXFSZ (file size limit, `ulimit -f`) is ignored, so that exceeding the limit makes the

@@ -110,7 +110,6 @@ contains
         !> Signal that stopped the run early (0: none).
         integer, intent(out), optional :: stopped_by
         type(deck_run_t) :: run
-        character(len=:), allocatable :: folder
 
         if (present(stopped_by)) stopped_by = 0
         ! Before any factorisation: results that do not depend on the threads OpenBLAS is given
@@ -123,29 +122,8 @@ contains
             return
         end if
 
-        ! A restart continues the results next to its checkpoint unless told otherwise.
-        if (allocated(opts%output_dir)) then
-            run%dir = opts%output_dir
-        else if (allocated(opts%restart)) then
-            ! the checkpoint file itself (its folder is the results folder): checked before a
-            ! folder is made from its name
-            if (file_exists(opts%restart//'/.')) then
-                folder = opts%restart
-                do while (len(folder) > 1 .and. folder(len(folder):) == '/')
-                    folder = folder(:len(folder) - 1)
-                end do
-                call make_error(error, "--restart: '"//opts%restart//"' is a folder: give the checkpoint "// &
-                                "file in it ('"//folder//'/'//checkpoint_name//"')")
-                return
-            end if
-            if (.not. file_exists(opts%restart)) then
-                call make_error(error, "--restart: no checkpoint '"//opts%restart//"'")
-                return
-            end if
-            run%dir = dirname(opts%restart)
-        else
-            run%dir = 'results/'//stem(opts%deck_path)
-        end if
+        call results_folder(opts, run%dir, error)
+        if (allocated(error)) return
         call mkdir_p(run%dir, error, run%created)
         if (allocated(error)) return
         call write_into_folder(opts, report, run, error, stopped_by)
@@ -177,6 +155,37 @@ contains
         if (allocated(error)) return
         call warn_about_deck(opts%end_time, run%deck, run%sim, report)
     end subroutine build_run
+
+    !> The results folder of a run: `--output`, else the folder of the `--restart` checkpoint
+    !> (a restart continues the results next to its checkpoint), else results/<deck name>.
+    subroutine results_folder(opts, dir, error)
+        !> What to run and where to write.
+        type(run_options_t), intent(in) :: opts
+        !> The results folder.
+        character(len=:), allocatable, intent(out) :: dir
+        !> Set when `--restart` names a folder or no file (checked before a folder is made
+        !> from its name).
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: folder
+        if (allocated(opts%output_dir)) then
+            dir = opts%output_dir
+        else if (allocated(opts%restart)) then
+            if (file_exists(opts%restart//'/.')) then
+                folder = opts%restart
+                do while (len(folder) > 1 .and. folder(len(folder):) == '/')
+                    folder = folder(:len(folder) - 1)
+                end do
+                call make_error(error, "--restart: '"//opts%restart//"' is a folder: give the checkpoint "// &
+                                "file in it ('"//folder//'/'//checkpoint_name//"')")
+            else if (.not. file_exists(opts%restart)) then
+                call make_error(error, "--restart: no checkpoint '"//opts%restart//"'")
+            else
+                dir = dirname(opts%restart)
+            end if
+        else
+            dir = 'results/'//stem(opts%deck_path)
+        end if
+    end subroutine results_folder
 
     !> Lock the results folder `run%dir` (it exists), run and write the results, report them.
     subroutine write_into_folder(opts, report, run, error, stopped_by)
