@@ -6,7 +6,7 @@ as their shortest repr, so they compare bit for bit with the HDF5 datasets).
                                         #               "warped": points (when a displacement)}}
 
 A block is {"points": [[x, y, z], ...], "cells": n, "data": {point array: values},
-"cell_data": {cell array: values}}; a file with one part gives one block named "". Used by
+"cell_data": {cell array: values}, "cell_points": [[0-based point ids of each cell], ...]}; a file with one part gives one block named "". Used by
 the regression scripts that check the XDMF files (test_xdmf_runs.py, test_continuum_runs.py,
 test_coupled2d_runs.py); the caller checks pvpython is installed (`shutil.which("pvpython")`).
 """
@@ -36,7 +36,9 @@ for path in sys.argv[1:]:
         w = dsa.WrapDataObject(g)
         out["blocks"][name] = {"points": w.Points.tolist(), "cells": g.GetNumberOfCells(),
                                "data": {k: w.PointData[k].tolist() for k in w.PointData.keys()},
-                               "cell_data": {k: w.CellData[k].tolist() for k in w.CellData.keys()}}
+                               "cell_data": {k: w.CellData[k].tolist() for k in w.CellData.keys()},
+                               "cell_points": [[g.GetCell(c).GetPointId(k) for k in range(g.GetCell(c).GetNumberOfPoints())]
+                                               for c in range(g.GetNumberOfCells())]}
     if "displacement" in out["blocks"].get("", {}).get("data", {}):
         warp = WarpByVector(Input=r, Vectors=["POINTS", "displacement"])
         warp.UpdatePipeline(times[-1])

@@ -2,7 +2,8 @@
 """The XDMF file next to the results file of every kind of run, read as ParaView reads it.
 
 Short decks written here (a column of disks falling on a floor; a 4-element cantilever in
-static, dynamic and modal analysis) and the reference experiment input/bending_case1.dat cut
+static, dynamic and modal analysis; a 4 x 2 Q4 plate, static, whose cells' point ids must be
+its 1-based connectivity less 1) and the reference experiment input/bending_case1.dat cut
 to 2 ms (beam-particle coupled). For each, ParaView's pvpython (the 'XDMF Reader') opens
 `<deck>.xdmf` and the values it reads must equal the HDF5 datasets, bit for bit (the XDMF
 file only points into the HDF5 file: no value is copied or converted): the number of stored
@@ -71,6 +72,18 @@ end = {end}
 interval = 2
 """
 
+CONTINUUM = """# A 2 m x 1 m plate of 4 x 2 Q4, clamped on the left, pulled on the right.
+[run]
+title = XDMF test: continuum plate
+analysis = static
+[continuum]
+mesh = rectangle 0 0 2 1 4 2 q4
+material = 70e9 0.3 2700 0.1 plane_stress
+fix = left x y
+traction = right 1e5 0
+"""
+
+
 def item_values(item, folder):
     """The values of an XDMF DataItem (an HDF5 dataset or a hyperslab of one), by h5py."""
     if item.get("ItemType") == "HyperSlab":
@@ -105,8 +118,16 @@ def read_xml(paths, work):
                     v = np.column_stack([v.reshape(-1, 2), np.zeros(v.size // 2)])
                 data[a.get("Name")] = v.tolist()
             name = part.get("Name") if len(domain.findall("Grid")) > 1 else ""
-            out["blocks"][name] = {"points": points.tolist(), "cells": int(g.find("Topology").get(
-                "NumberOfElements")), "data": data}
+            topo = g.find("Topology")
+            cells = int(topo.get("NumberOfElements"))
+            # The 0-based point ids of each cell, as an XDMF reader takes them from the
+            # Topology's DataItem and BaseOffset (one kind of cell: n_elements rows).
+            item = topo.find("DataItem")
+            cell_points = None
+            if item is not None:
+                ids = item_values(item, path.parent).reshape(cells, -1) - int(topo.get("BaseOffset", "0"))
+                cell_points = ids.tolist()
+            out["blocks"][name] = {"points": points.tolist(), "cells": cells, "data": data, "cell_points": cell_points}
         if "displacement" in out["blocks"].get("", {}).get("data", {}):
             b = out["blocks"][""]
             out["warped"] = (np.array(b["points"]) + np.array(b["data"]["displacement"])).tolist()
@@ -168,6 +189,7 @@ def main():
         "xdmf_beam_static": BEAM.format(analysis="static", function="", extra=""),
         "xdmf_beam_dynamic": BEAM.format(analysis="dynamic", function="1", extra=DYNAMIC.format(end="0.01")),
         "xdmf_beam_modal": BEAM.format(analysis="modal", function="", extra="[modal]\nmodes = 3\n"),
+        "xdmf_continuum": CONTINUUM,
         # XML's markup characters in the deck's name, hence in the HDF5 file's name that the
         # XDMF file quotes: they must be written as entities (else the XML ends there)
         "xdmf_a&b<c>": BEAM.format(analysis="static", function="", extra=""),
@@ -279,6 +301,18 @@ def main():
     s = r["xdmf_beam_modal"]
     check("beam modal: one time step per mode", s["times"] == len(shapes), f"{s['times']} vs {len(shapes)}")
     same("beam modal: last mode shape", s["blocks"][""]["data"]["mode_shape"], xyz(shapes[-1]))
+
+    # The cells' node ids: XDMF counts points from 0, the 1-based connectivity less 1
+    # (integers, compared exactly).
+    with h5py.File(h5["xdmf_continuum"], "r") as f:
+        conn, topo = f["continuum/mesh/connectivity"][...], f["continuum/mesh/topology"][...]
+        n_nodes = len(f["continuum/mesh/coordinates"])
+    b = r["xdmf_continuum"]["blocks"][""]
+    check("continuum: topology is the connectivity less 1, ids 0 to n_nodes - 1",
+          topo.shape == conn.shape == (8, 4) and np.array_equal(topo, conn - 1) and topo.min() == 0
+          and topo.max() == n_nodes - 1, f"topology {topo.min()}..{topo.max()}, {n_nodes} nodes")
+    check("continuum: each cell's point ids as the reader reads them", b["cells"] == 8 and
+          np.array_equal(np.asarray(b["cell_points"]), conn - 1), f"{b['cell_points']} vs {(conn - 1).tolist()}")
 
     with h5py.File(h5["coupled"], "r") as f:
         t, x = f["coupling/time"][...], f["fem/mesh/coordinates"][...]
