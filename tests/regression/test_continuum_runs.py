@@ -22,6 +22,8 @@
   (E t D delta / L at each end), a prescribed rigid translation (no reaction); the materials
   stored (/continuum/materials, /continuum/mesh/material) and the summary's largest
   displacement (the nodal vector norm, as the large-displacement warning measures it);
+- the reaction resultant of a dynamic run (/continuum/energy/reaction): a block falling on
+  rollers, the mean of two successive states = its weight plus the inertia sum m_j dv_j / h;
 - postproc/plot_results.py, as ./run.sh calls it, on the static, dynamic and modal files.
 Usage (ctest does this): test_continuum_runs.py --exe multicor --work DIR --source REPO
 """
@@ -438,6 +440,48 @@ displacement = left y {delta}
           f"{printed} vs {math.sqrt(2) * delta:.6e}")
 
 
+def dynamic_reaction(exe, work):
+    """A block on rollers (y fixed along the bottom, x along the left side) falling onto them
+    under gravity: /continuum/energy/reaction is the resultant of the supports' forces on all
+    their dofs. Summed over all the y (x) dofs, K u vanishes (a rigid translation is in the
+    kernel of the symmetric K), the free dofs are in balance and the mass matrix's row sums are
+    the lumped masses m_j, so R = sum_j m_j a_j - (0, -M g). Average acceleration gives
+    (a_n + a_n+1)/2 = (v_n+1 - v_n)/h, so the mean of two successive resultants is
+    (sum_j m_j (v_n+1 - v_n)/h, M g + sum_j m_j (v_n+1 - v_n)_y/h), the weight carried and
+    the block's inertia."""
+    W, H, t, rho, g, h = 0.4, 1.0, 0.1, 1000.0, 9.81, 1e-3
+    deck = write_deck(work, "block_on_rollers", f"""[run]
+analysis = dynamic
+[continuum]
+mesh = rectangle 0 0 {W} {H} 2 4 q4
+material = 1e6 0.3 {rho} {t} plane_stress
+gravity = 0 -{g}
+fix = bottom y
+fix = left x
+[time]
+step = {h}
+end = 0.05
+[output]
+interval = 1
+""")
+    with h5py.File(run(exe, deck, work), "r") as f:
+        x, conn = f["continuum/mesh/coordinates"][...], f["continuum/mesh/connectivity"][...]
+        v, r = f["continuum/velocity"][...], f["continuum/energy/reaction"][...]
+    m = np.zeros(len(x))          # row sums of the Q4 mass: a quarter of each element's mass
+    for e in conn:
+        m[e - 1] += rho * t * (W / 2) * (H / 4) / 4
+    weight = rho * t * W * H * g
+    inertia = np.einsum("j,njc->nc", m, np.diff(v, axis=0)) / h
+    want = inertia + [0.0, weight]
+    got = 0.5 * (r[1:] + r[:-1])
+    # round-off of the solve and of the sums against the weight (392 N; measured 7e-13 N): 1e-9 of it
+    err = np.abs(got - want).max()
+    check("block on rollers: reaction resultant (x, y) = the inertia + (0, M g)", len(r) == 51 and
+          np.abs(inertia[:, 1]).max() > 1e-2 * weight and err < 1e-9 * weight,
+          f"{len(r)} states, largest difference {err:.3e} N, weight {weight} N, "
+          f"largest inertia {np.abs(inertia).max():.3e} N")
+
+
 def summary_without_steps(exe, src, work):
     """A static and a modal analysis write /summary as a time loop does: steps (0),
     wall_seconds and ended (a sweep over them gets its wall-time column)."""
@@ -460,6 +504,7 @@ def main():
     gmsh_block(exe, src, work)
     timed_loads(exe, work)
     static_reactions(exe, work)
+    dynamic_reaction(exe, work)
     summary_without_steps(exe, src, work)
     h5_dynamic = work / "continuum_cantilever_dynamic" / "continuum_cantilever_dynamic.h5"
     xdmf_paraview(h5_static, h5_dynamic, work)
