@@ -282,6 +282,12 @@ progress = 0
 """
     failing_run(exe, work, "dem_tunnelling_falling_through", through.format(h="0.05"),
                 r"disks 1 and 2 passed through each other within one step", through.format(h="1e-4"))
+    # The same with a lateral offset of 0.4 of the radius sum (0.008 m): the relative path
+    # comes closer than (r_i + r_j)/2 = 0.01 m, so the disks passed through each other (a
+    # threshold of a quarter of the sum, 0.005 m, would miss it).
+    offset = through.replace("disk = 0.102 0.5 0.01 1", "disk = 0.108 0.5 0.01 1")
+    failing_run(exe, work, "dem_tunnelling_falling_offset", offset.format(h="0.05"),
+                r"disks 1 and 2 passed through each other within one step", offset.format(h="1e-4"))
 
 
 def lock(exe, work):
