@@ -209,7 +209,7 @@ def kill_9_loop(exe, src, work, deck_name, label, min_step=300):
     """kill -9 a particle, coupled, continuum or continuum-disk run at three moments: the partial file opens and
     holds the outputs so far, equal to those of an uninterrupted run (every time loop
     flushes the file after each output, as the beam loop does). Outputs every 10 steps."""
-    deck_src = src / "input" / deck_name
+    deck_src = deck_name if isinstance(deck_name, pathlib.Path) else src / "input" / deck_name
     stem = f"long_{deck_src.stem}"
     folder = work / f"kill9_{deck_src.stem}"
     deck = deck_with_end(deck_src, work / f"{stem}.dat", 1000.0, progress=0.02)
@@ -270,7 +270,7 @@ def readable_while_running(name, partial):
 
 
 def stop_by_signal(exe, src, work, deck_name, sig, name, repeat=1, min_step=100):
-    """Send `sig` to a long run (`repeat` times, 5 ms apart: Slurm sends SIGTERM twice at a
+    """Send `sig` to a long run (`repeat` times, 1 ms apart: Slurm sends SIGTERM twice at a
     time limit): exit 128 + sig, message, partial closed with finished = 0 and every output up
     to the step of the stop, equal to an uninterrupted run."""
     deck_src = src / "input" / deck_name
@@ -279,7 +279,7 @@ def stop_by_signal(exe, src, work, deck_name, sig, name, repeat=1, min_step=100)
     partial = folder / f"{name}.h5.partial"
     proc = start(exe, deck, folder)
     lines = []
-    # Past min_step: at least 10 outputs (an output every 5 or 10 steps, 30 in the deposit).
+    # Past min_step: at least 10 outputs (an output every 5 or 10 steps, 3 in the deposit).
     if not wait_for_step(proc, min_step, lines):
         check(f"{name}: run reached a few outputs", False, proc.communicate()[1][-300:])
         return
@@ -287,7 +287,7 @@ def stop_by_signal(exe, src, work, deck_name, sig, name, repeat=1, min_step=100)
     t0 = time.monotonic()
     proc.send_signal(sig)
     for _ in range(repeat - 1):
-        time.sleep(0.005)
+        time.sleep(0.001)
         proc.send_signal(sig)
     out, err = proc.communicate()
     out = "".join(lines) + out
@@ -412,10 +412,13 @@ def main():
     kill_9_loop(exe, src, work, "continuum_cantilever_dynamic.dat", "continuum", min_step=100)
     kill_9_loop(exe, src, work, "coupled2d_block.dat", "continuum and disks", min_step=100)
     stop_by_signal(exe, src, work, "cantilever.dat", signal.SIGTERM, "term_beam")
-    # a deposit's step takes longer than the 5 ms between the two: the second SIGTERM finds
-    # the run still stopping (it killed it, without its checkpoint, before)
-    stop_by_signal(exe, src, work, "deposit.dat", signal.SIGTERM, "term_twice_dem", repeat=2,
-                   min_step=300)
+    # a deposit's stop takes longer than the 1 ms between the two (10 ms in Debug): the second
+    # SIGTERM finds the run still stopping (it killed it, without its checkpoint, before); an
+    # output every 3 steps, so that 10 outputs cost 30 steps, not 300
+    deposit = work / "deposit_every3.dat"
+    deposit.write_text(re.sub(r"^interval\s*=.*$", "interval = 3", (src / "input" / "deposit.dat").read_text(),
+                              count=1, flags=re.M))
+    stop_by_signal(exe, src, work, deposit, signal.SIGTERM, "term_twice_dem", repeat=2, min_step=30)
     stop_by_signal(exe, src, work, "incline.dat", signal.SIGUSR1, "usr1_dem")
     stop_by_signal(exe, src, work, "bending_case2.dat", signal.SIGINT, "int_coupled")
     write_error(exe, src, work)
