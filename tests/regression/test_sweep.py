@@ -34,7 +34,7 @@
   still pending or running in an earlier job not submitted again, squeue out of reach
   (submit refuses unless --force); the collect job with the array's partition, account and
   qos and a time limit within the array's; a collect job refused: the array recorded,
-  not submitted again.
+  not submitted again; an array on another cluster (--clusters) asked of it (squeue -M).
 Usage (ctest does this): test_sweep.py --exe multicor --work DIR --source REPO
 """
 import csv
@@ -548,10 +548,19 @@ fi
 echo "${FAKE_JOB:-42}"
 """
 SQUEUE = """#!/bin/bash
-# stand-in for squeue -h -r -o '%F|%K|%T' -j JOBS: prints $FAKE_SQUEUE; FAKE_SQUEUE_FAIL: fails
+# stand-in for squeue [-M CLUSTER] -h -r -o '%F|%K|%T' -j JOBS: prints $FAKE_SQUEUE;
+# FAKE_SQUEUE_FAIL: fails; FAKE_CLUSTER: the jobs are on that cluster, which only -M asks
+# (as Slurm: the local cluster does not know them; -M prints a 'CLUSTER: name' line first)
 if [ -n "${FAKE_SQUEUE_FAIL:-}" ]; then
     echo "slurm_load_jobs error: Unable to contact slurm controller (connect failure)" >&2
     exit 1
+fi
+if [ -n "${FAKE_CLUSTER:-}" ]; then
+    if [ "$1" != -M ] || [ "$2" != "$FAKE_CLUSTER" ]; then
+        echo "slurm_load_jobs error: Invalid job id specified" >&2
+        exit 1
+    fi
+    echo "CLUSTER: $FAKE_CLUSTER"
 fi
 printf "%b" "${FAKE_SQUEUE:-}"
 """
@@ -676,6 +685,34 @@ def collect_job(src, exe, work, tool, calls):
     n = len(calls())
     proc = tool(["submit", folder], FAKE_SQUEUE=queued)
     check("collect job refused: a second submit starts nothing again",
+          proc.returncode == 0 and "nothing to submit" in proc.stdout and len(calls()) == n,
+          proc.stdout + proc.stderr)
+    other_cluster(src, exe, work, tool, calls)
+
+
+def other_cluster(src, exe, work, tool, calls):
+    """An array sent to another cluster (sbatch answers 'JOB;CLUSTER'): its cluster recorded
+    with the job, and squeue asked with -M (before, squeue asked the local cluster, which
+    does not know the job: status called the running points not started, and a second
+    submit started them again)."""
+    import json
+    folder = work / "other cluster"
+    sweep_tool(src, ["create", src / "input" / "incline.dat", "--exe", exe, "--set",
+                     "time.end=0.1,0.2", "--time", "5", "--dir", folder])
+    proc = tool(["submit", folder, "--clusters=far"], FAKE_JOB="71;far")
+    manifest = json.loads((folder / "sweep.json").read_text())
+    check("other cluster: the array and the collect job recorded with their cluster",
+          proc.returncode == 0 and manifest["jobs"] == ["71", "71"]
+          and manifest.get("clusters") == {"71": "far"}
+          and "--clusters=far" in calls()[-1], f"{manifest}\n{proc.stdout}{proc.stderr}")
+    queued = "71|1|RUNNING\n71|2|PENDING\n"
+    proc = tool(["status", folder], FAKE_SQUEUE=queued, FAKE_CLUSTER="far")
+    check("other cluster: status asks it (-M far): p001 running, p002 pending",
+          "p001 running" in proc.stdout and "p002 pending" in proc.stdout
+          and "wait for them" in proc.stdout, proc.stdout + proc.stderr)
+    n = len(calls())
+    proc = tool(["submit", folder], FAKE_SQUEUE=queued, FAKE_CLUSTER="far")
+    check("other cluster: a second submit starts nothing again",
           proc.returncode == 0 and "nothing to submit" in proc.stdout and len(calls()) == n,
           proc.stdout + proc.stderr)
 
