@@ -1495,6 +1495,82 @@ def killed_in_metadata_writes(exe, src, work):
         if check(f"{name}: killed at pwrite {n - back} of {n}", proc.returncode in (-9, 128 + 9),
                  f"exit {proc.returncode}"):
             finishes(name, folder, True)
+    killed_before_superblock(exe, work, env)
+
+
+# 100 disks dropped into a box, every contact stored: time series of several chunks each,
+# new chunks at most outputs' flushes.
+FLUSH_DECK = """[run]
+analysis = dynamic
+[particles]
+material = 1 2500
+deposit = 100 0 0.2 0 0.002 0.003 1 7 0.05
+gravity = 0 -9.81
+[walls]
+wall = 0 0 0.2 0
+wall = 0 0 0 0.3
+wall = 0.2 0 0.2 0.3
+[contacts]
+law = 1 1 0.4 0.2 0
+alert = 1e-3
+[time]
+step = 5e-4
+end = 0.1
+[output]
+interval = 5
+progress = 0
+contacts = yes
+checkpoint_interval = 40
+"""
+
+
+def killed_before_superblock(exe, work, env):
+    """A SIGKILL inside an output's flush, at the write of the superblock that ends it (HDF5
+    writes the superblock, which holds the file's end of allocation, last). The flush's new
+    chunks and index blocks are on disk beyond the end of allocation the file then records.
+    Before, the restart allocated from that stale end, over those blocks: a contact series'
+    index overwritten by a heap block, so values of outputs kept from the checkpoint read
+    back wrong, or the restart failed (exit 1), on every flush of this run that grew the
+    file (audit of 2026-11-28; 600 disks: records of /dem/contacts/status replaced by the
+    bytes of 'GCOL', exit 0). Now the restart's allocations start past the file's end."""
+    deck = work / "flush_deposit.dat"
+    deck.write_text(FLUSH_DECK)
+    ref = work / "ref_flush"
+    proc = run(exe, deck, "--output", ref, "--quiet", env=env)
+    assert proc.returncode == 0, proc.stderr
+    # the results file's pwrites of a run (strace -P: that file alone, as the kills below)
+    trace = work / "flush_trace.txt"
+    partial = work / "flush_trace" / "flush_deposit.h5.partial"
+    subprocess.run(["strace", "-f", "-qq", "-o", str(trace), "-P", str(partial), "-e", "trace=pwrite64", str(exe),
+                    str(deck), "--output", str(partial.parent), "--quiet"], capture_output=True, timeout=300, env=env)
+    writes = [(int(m.group(2)), int(m.group(1))) for m in
+              (re.search(r"pwrite64\(\d+, .*, (\d+), (\d+)\) = ", line) for line in trace.read_text().splitlines())
+              if m]
+    # superblock writes (offset 0) ending a flush that wrote past the file's extent at the
+    # flush before: kill points in the second half of the run (checkpoints before them)
+    points, end, end_before, last = [], 0, 0, 0
+    for k, (offset, size) in enumerate(writes, start=1):
+        if offset == 0:
+            if last and any(o >= end_before for o, _ in writes[last:k - 1]):
+                points.append(k)
+            last, end_before = k, end
+        end = max(end, offset + size)
+    points = [k for k in points if 2 * k > len(writes) and k < len(writes) - 10]
+    check("flush kill points: flushes that grow the file in the run's second half", len(points) >= 2,
+          f"{len(writes)} pwrites, kill points {points}")
+    for when in points[-2:]:
+        name = f"meta_superblock_{when}"
+        folder = work / name
+        proc = subprocess.run(["strace", "-f", "-qq", "-o", os.devnull, "-P", str(folder / partial.name), "-e",
+                               "trace=pwrite64", "-e", f"inject=pwrite64:signal=SIGKILL:when={when}", str(exe), str(deck),
+                               "--output", str(folder), "--quiet"], capture_output=True, text=True, timeout=300, env=env)
+        if not check(f"{name}: killed at the superblock write {when} of {len(writes)}",
+                     proc.returncode in (-9, 128 + 9), f"exit {proc.returncode}"):
+            continue
+        again = run(exe, deck, "--output", folder, "--quiet", "--restart", folder / "checkpoint.h5", env=env)
+        if check(f"{name}: the same command finishes the run", again.returncode == 0,
+                 (again.stdout + again.stderr).strip()[-300:]):
+            compare(name, folder / "flush_deposit.h5", ref / "flush_deposit.h5")
 
 
 def main():
