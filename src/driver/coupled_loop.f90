@@ -34,7 +34,7 @@ module driver_coupled_loop
     use driver_results_dem, only: dem_writer_t
     use driver_results_coupled, only: coupled_writer_t
     use driver_run_dem, only: max_warnings, speed_warning, last_unconverged_warning, fclib_path, tolerance_floor_hint, &
-                              fclib_after_end_warning, fclib_no_contacts_warning, lost_bonds_warning, bonds_line
+                              fclib_moment_note, fclib_after_end_warning, fclib_no_contacts_warning, lost_bonds_warning, bonds_line
     use driver_results_dem, only: write_fclib_local
     use dem_local_problem, only: local_problem_t
     use dem_contacts, only: status_cohesive
@@ -399,6 +399,7 @@ contains
         call out%companion(fclib_path(out%final_path, int(k)), path)
         call write_fclib_local(path, self%settings%title, lp, int(k), self%sys%fe%t, &
                                self%sys%dem%stats%siconos_error, error)
+        if (.not. allocated(error) .and. lp%dim == 3) call report(fclib_moment_note(fclib_path(out%final_path, int(k))))
     end subroutine step_with_export
 
     !> Write a checkpoint after step `lp%k` (the buffered per-step values are written first).

@@ -35,7 +35,8 @@ module driver_run_dem
     private
     public :: run_dem, max_warnings, report_line_iface, speed_warning, last_unconverged_warning
     public :: tolerance_floor_hint
-    public :: fclib_path, fclib_after_end_warning, fclib_no_contacts_warning, lost_bonds_warning, bonds_line
+    public :: fclib_path, fclib_after_end_warning, fclib_no_contacts_warning, fclib_moment_note, lost_bonds_warning
+    public :: bonds_line
     public :: block_given_up_warning, block_given_up_summary
 
     !> Unconverged steps reported one by one; later ones are only counted.
@@ -229,6 +230,7 @@ contains
                     call write_fclib_local(path, run%title, lp, sys%step + 1, sys%time + sys%scheme%h, &
                                            sys%stats%siconos_error, error)
                     if (allocated(error)) return
+                    if (lp%dim == 3) call report(fclib_moment_note(fclib_path(out%final_path, sys%step + 1)))
                 end if
                 call mj_end_step(sys)
             end associate
@@ -461,4 +463,15 @@ contains
         line = 'warning: [solver] fclib_step = '//to_str(step)//': the step has no active contact, '// &
                'no FCLIB problem written (FCLIB refuses a problem without contacts)'
     end function fclib_no_contacts_warning
+
+    !> Note for an FCLIB export with a moment per contact (spacedim = 3): FCLIB's 3D problem is
+    !> another one (a second tangent and a circular cone), so a 3D Coulomb solver must not read it.
+    function fclib_moment_note(path) result(line)
+        !> The file written (its final name).
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: line
+        line = "note: '"//path//"' has spacedim = 3: the third component of each contact is its moment, with "// &
+               "MULTICOR's cone (doc/theory.md 7.3), not a second tangent: a 3D Coulomb solver of FCLIB would "// &
+               'solve another problem'
+    end function fclib_moment_note
 end module driver_run_dem

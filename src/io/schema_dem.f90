@@ -285,6 +285,10 @@ contains
                            '(doc/theory.md, "Siconos error"). In a coupled run: the problem the contacts see, '// &
                            'the coupling rows condensed (W dense among the contacts on coupled disks). '// &
                            'A step without active contacts is not written (FCLIB refuses an empty problem): a '// &
-                           'warning, as for a step after the end (which --check reports too). Default: none.')
+                           'warning, as for a step after the end (which --check reports too). When a contact has a '// &
+                           'moment (rolling resistance, a bond with a moment) the file has spacedim = 3: the '// &
+                           'third component is the moment, with the cone of doc/theory.md 7.3, and a 3D Coulomb '// &
+                           'solver of FCLIB reads another problem (a second tangent, a circular cone); the run '// &
+                           'then says so. Default: none.')
     end subroutine add_solver
 end module io_schema_dem

@@ -123,7 +123,7 @@ def case(exe, deck, step, work, expect_dim, extra=(), replace=None, name=None, e
         # a shorter run, with the mesh file of the deck's folder
         text = re.sub(r"^end\s*=.*$", f"end = {end}", deck.read_text(), count=1, flags=re.M)
         deck.write_text(text.replace("mesh = file ", f"mesh = file {folder}/"))
-    results = run(exe, deck, work)
+    results, proc = multicor(exe, deck, work)
     fclib = results.parent / f"{deck.stem}_fclib_{step}.h5"
     with h5py.File(results, "r") as f:
         stored = f["dem/solver/siconos_error"][step - 1]
@@ -143,6 +143,10 @@ def case(exe, deck, step, work, expect_dim, extra=(), replace=None, name=None, e
     check(f"{name}: layout", nz == -1 and m == n == dim * len(mu) and len(p) == n + 1
           and p[-1] == len(i) == len(x) and dim == expect_dim,
           f"spacedim {dim}, {len(mu)} contacts, nnz {len(x)}")
+    # a file with a moment per contact is not FCLIB's 3D problem: the run says so, and only then
+    noted = f"note: '{fclib}' has spacedim = 3: the third component of each contact is its moment" in proc.stdout
+    check(f"{name}: the note on spacedim 3 when, and only when, it is 3", noted == (dim == 3),
+          f"spacedim {dim}, output {proc.stdout.strip()[-300:]!r}")
     W = np.zeros((m, n))
     for col in range(n):
         W[i[p[col]:p[col + 1]], col] = x[p[col]:p[col + 1]]
