@@ -56,6 +56,7 @@ program bench_dem
     use core_kinds, only: wp, i8
     use core_error, only: error_t
     use core_sort, only: sort_in_place
+    use core_threads, only: thread_setting
     use dem_particles, only: particles_add_disks
     use dem_walls, only: walls_add
     use dem_materials, only: materials_init, materials_set_pair
@@ -229,11 +230,13 @@ program bench_dem
     end do
     if (siconos_n > 0) then
         if (len_trim(scheme_word) == 0) scheme_word = 'siconos'
+        write (output_unit, '(a)') '# threads:  '//thread_setting()
         write (output_unit, '(a)') '# compiler: '//compiler_version()
         call siconos_deposit(siconos_n)
         stop
     end if
-    write (output_unit, '(a)') '# DEM kernel benchmark, 1 core: dense random packing in a box under gravity'
+    write (output_unit, '(a)') '# DEM kernel benchmark: dense random packing in a box under gravity'
+    write (output_unit, '(a)') '# threads:  '//thread_setting()
     write (output_unit, '(a)') '# compiler: '//compiler_version()
     write (output_unit, '(a)') '# options:  '//compiler_options()
     write (output_unit, '(a, f0.3, a, i0, a)') '# solver: relaxation ', relaxation, &

@@ -527,9 +527,10 @@ contains
                                     'to do, the results are finished from the checkpoint')
             if (len(ck%start%threads) > 0 .and. openmp_part(ck%start%threads) /= openmp_part(thread_setting())) &
                 call report('warning: the checkpoint was written with '//ck%start%threads//'; this run has '// &
-                            thread_setting()//': the results go on correctly, but bit for bit they are '// &
-                            'those of neither uninterrupted run (the split sweeps from 4 000 contacts depend on '// &
-                            'the threads); set the same OMP_NUM_THREADS to reproduce the run exactly')
+                            thread_setting()//': the results go on correctly, bit for bit as both '// &
+                            'uninterrupted runs while no step sweeps 4 000 contacts or more (2 000 per '// &
+                            'thread); from such a step the split sweeps depend on the threads, and the results '// &
+                            'are those of neither run: set the same OMP_NUM_THREADS to reproduce the run exactly')
             if (.not. ck%start%wall_recorded) call report('note: the checkpoint, written by an earlier '// &
                                                           'MULTICOR build, does not record the wall time of the '// &
                                                           'runs before it: /summary wall_seconds counts from this '// &
