@@ -113,6 +113,12 @@
 !> bond outside its cone is released at once. A bond left in B on a bound is judged at it
 !> (bound_case). This is the problem the plain NLGS solves, so the
 !> judgement of dem_contacts (contacts_finish) then breaks it exactly as after the NLGS.
+!> Stall: a pass whose problem has no solution with the bonds held (a wall of imposed velocity
+!> pushing a stack that its bonds hold on the floor) never converges, its reactions growing by
+!> a fixed step per iteration; dem_nlgs stops it (`nlgs_stats_t%stalled`, when a bond lies
+!> outside its cone, `must_yield`) and it is judged as a converged pass, the step solved again
+!> from the reactions at its start (before: every step at the cap, no bond released, the wall
+!> through the disks; doc/theory.md 7.10, "Stall").
 !> A pass is converged by the error of the problem it solves, the bonds of B held: the norm of
 !> the sweeps with the block's share |u_B|^2, or with criterion = siconos the Siconos error
 !> with the members measured by their equalities (nlgs criterion `begin`, `held`). Measured
@@ -340,6 +346,8 @@ module dem_bonded_block
         procedure :: solve
         !> See `nlgs_block_t%measure`.
         procedure :: measure
+        !> See `nlgs_block_t%must_yield`.
+        procedure :: must_yield
     end type bonded_block_t
 
     !> The global strategy `[solver] method = block` (dem_solve_method): the bonded block,
@@ -426,7 +434,7 @@ contains
         integer :: k, released, n_blocked, sweeps, worst
         real(wp) :: excess
         integer(i8) :: updates, local
-        real(wp), allocatable :: vfree(:, :)
+        real(wp), allocatable :: vfree(:, :), r_start(:, :)
         logical :: give_up_block, held
         associate (block => self%block)
             if (allocated(block%excluded)) then
@@ -448,6 +456,8 @@ contains
             block%resolving = .false.
             do
                 left%max_sweeps = config%max_sweeps - sweeps
+                ! the start of the pass, to which a stalled one returns
+                r_start = cs%r(:, 1:cs%n)
                 call nlgs_solve(left, cs, im, vel, pass, bilateral, block)
                 if (n_blocked < 0) n_blocked = pass%n_blocked
                 sweeps = sweeps + pass%sweeps
@@ -468,7 +478,10 @@ contains
                         exit
                     end if
                 end if
-                if (.not. pass%converged) exit
+                ! a stalled pass has no solution with its bonds held: its reactions grow without
+                ! bound along a direction that loads some bond outside its cone (module header,
+                ! "Stall"), and no number of iterations converges it; it is judged as a converged one
+                if (.not. (pass%converged .or. pass%stalled)) exit
                 ! release only the bond farthest outside its cone: the others may come back inside
                 ! once it yields, and bonds released together are swept against the rigid rest of
                 ! the block, whose Gauss-Seidel converges too slowly to judge them (module header)
@@ -517,10 +530,15 @@ contains
                 block%counts%resolves = block%counts%resolves + 1
                 block%resolving = .true.
                 ! back to the velocities without the contact impulses (nlgs_solve applies the
-                ! current reactions again: the warm start of the next pass)
+                ! current reactions again: the warm start of the next pass; after a stall those
+                ! at the start of the pass, the stalled ones having grown by its iterations)
                 cs%r(:, 1:cs%n) = -cs%r(:, 1:cs%n)
                 call nlgs_apply_reactions(cs, im, vel)
-                cs%r(:, 1:cs%n) = -cs%r(:, 1:cs%n)
+                if (pass%stalled) then
+                    cs%r(:, 1:cs%n) = r_start
+                else
+                    cs%r(:, 1:cs%n) = -cs%r(:, 1:cs%n)
+                end if
             end do
             block%resolving = .false.
             if (give_up_block) then
@@ -1358,6 +1376,24 @@ contains
             den = den + wr(1)**2 + wr(2)**2 + (cs%amoy(k)*wr(3))**2
         end do
     end subroutine measure
+
+    !> A bond of B lies outside its cone (outside_cone): the problem with it held may have no
+    !> solution, and the outer check of bonded_block_solve would release one.
+    pure logical function must_yield(self, cs)
+        !> The block.
+        class(bonded_block_t), intent(in) :: self
+        !> Contacts (their reactions).
+        type(contact_set_t), intent(in) :: cs
+        integer :: k
+        must_yield = .false.
+        do k = 1, cs%n
+            if (.not. self%member(k)) cycle
+            if (outside_cone(cs, k)) then
+                must_yield = .true.
+                return
+            end if
+        end do
+    end function must_yield
 
     !> Solve the block for the current velocities (module header): (W_BB + eps I) dr = -u_B
     !> with iterative refinement, r += dr, vel += M_eff^-1 H_B dr. Then each bond released

@@ -77,6 +77,17 @@
 !> steps stops at the cap of 20 000 iterations instead of 12 (doc/performance.md, "Anderson
 !> with the bonded block").
 !>
+!> Stall: with the members held the problem may have no solution (a wall of imposed velocity
+!> pushing a bonded stack held on the floor by its bonds: the wall's contact asks a motion
+!> the held block forbids). The block Gauss-Seidel then adds the same impulses at every
+!> iteration: the reactions grow by a fixed step, the velocities and the norm's numerator stay
+!> put, and the relative error falls only as the reactions grow (as 1/sweeps: 20 000 sweeps
+!> left it at 1.9e-5 on that stack). At sweeps 2 stall_first, 4 stall_first, ... the solve
+!> compares the norm with its state at half as many: a numerator not halved and a denominator
+!> sum |W r|^2 grown by stall_growth (4 for a linear growth), while `must_yield` finds a member
+!> outside what it can hold, stop the solve, unconverged, with `stalled` set: the strategy
+!> releases a member and solves again (dem_bonded_block).
+!>
 !> Correction (`correction`, an extension of `nlgs_correction_t`; none by default): before
 !> the first sweep and after every `correction%every` sweeps it changes the reactions of the
 !> swept contacts, e.g. the coarse correction of dem_coarse (`[solver] method = coarse`),
@@ -111,6 +122,14 @@ module dem_nlgs
     public :: nlgs_split_t, nlgs_split_build
     public :: nlgs_criterion_t, lmgc90_criterion_t, siconos_criterion_t, nlgs_criterion_name, nlgs_start_name
 
+    !> Stall of a solve with a block (module header, "Stall"): the test runs at sweeps
+    !> 2 stall_first, 4 stall_first, ..., against the state at half as many sweeps.
+    integer, parameter :: stall_first = 32
+    !> ... when the norm's denominator sum |W r|^2 grew by at least this factor (reactions
+    !> growing by a fixed step per sweep: |r|^2 quadruples when the sweeps double) ...
+    real(wp), parameter :: stall_growth = 3.0_wp
+    !> ... while its numerator (absolute) kept at least this fraction of its value.
+    real(wp), parameter :: stall_residual = 0.5_wp
     !> A contact is blocked when W_nn <= blocked_ratio (W_nn + W_tt) (the floor of the scaled
     !> frame in dem_bipotential: below it the normal reaction would be unbounded).
     real(wp), parameter :: blocked_ratio = diagonal_floor
@@ -257,6 +276,10 @@ module dem_nlgs
         !> The bonded block was given up for the step (its energy guard, dem_bonded_block) and
         !> the step solved again by the plain sweeps; never set by the other methods.
         logical :: block_given_up = .false.
+        !> The solve stopped before its cap because its problem, the block's members held, has
+        !> no solution (module header, "Stall"): the reactions grew by a fixed step per
+        !> sweep, the error unchanged, and a member must yield (nlgs_block_t%must_yield).
+        logical :: stalled = .false.
     end type nlgs_stats_t
 
     !> History of the Anderson acceleration: differences of the sweep map's outputs g and
@@ -521,6 +544,8 @@ module dem_nlgs
         procedure(block_solve), deferred :: solve
         !> The members' share of the convergence norm.
         procedure(block_measure), deferred :: measure
+        !> A member's reaction lies outside what it can hold as a bilateral constraint.
+        procedure(block_must_yield), deferred :: must_yield
     end type nlgs_block_t
 
     abstract interface
@@ -568,6 +593,17 @@ module dem_nlgs
             !> Contributions to the convergence norm.
             real(wp), intent(out) :: num, den
         end subroutine block_measure
+
+        !> Some member's reaction lies outside the set it can take while held (e.g. a bond
+        !> outside its cone): the problem with the members held may then have no solution,
+        !> and the strategy that chose them must release one.
+        pure logical function block_must_yield(self, cs)
+            import :: nlgs_block_t, contact_set_t
+            !> The block.
+            class(nlgs_block_t), intent(in) :: self
+            !> Contacts (their reactions).
+            type(contact_set_t), intent(in) :: cs
+        end function block_must_yield
     end interface
 
     ! The procedures of the submodules (module header) that this file calls. The submodules
@@ -699,6 +735,10 @@ contains
         real(wp) :: error_corrected
         logical :: mix_now
         integer :: s, k, n_swept, nb
+        ! the stall test (module header, "Stall"): its next sweep and the norm's numerator and
+        ! denominator at the one before
+        integer :: stall_at
+        real(wp) :: num_at, den_at
         stats%n_contacts = cs%n
         call skip_blocked(cs, stats%n_blocked)
         stats%n_active = count(cs%active(1:cs%n))
@@ -789,6 +829,9 @@ contains
             call config%correction%correct(cs, list, im, vel)
             stats%corrections = 1
         end if
+        stall_at = stall_first
+        num_at = 0.0_wp
+        den_at = 0.0_wp
         if (stats%n_active > 0) then
             stats%converged = .false.
             do s = 1, config%max_sweeps
@@ -824,6 +867,21 @@ contains
                 if (evaluated .and. stats%error <= config%tol) then
                     stats%converged = .true.
                     exit
+                end if
+                if (s == stall_at) then
+                    ! with the block's members held the problem has no solution: the reactions
+                    ! grow by a fixed step per sweep and the error falls only by their growth (the
+                    ! first test at 2 stall_first sweeps, against the state at stall_first)
+                    if (s > stall_first .and. stats%n_block > 0 .and. num >= stall_residual*num_at .and. &
+                        den >= stall_growth*den_at) then
+                        if (block%must_yield(cs)) then
+                            stats%stalled = .true.
+                            exit
+                        end if
+                    end if
+                    num_at = num
+                    den_at = den
+                    stall_at = 2*s
                 end if
                 mix_now = accelerate .and. s > config%anderson_after
                 if (mix_now) mix_now = aa%swept == max(config%anderson_sweeps, 1)
