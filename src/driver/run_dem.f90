@@ -265,7 +265,8 @@ contains
                 ' (t = ', cfg%system%time, ' s): the contact solver did not converge in ', &
                 cfg%system%stats%sweeps, ' sweeps (error ', cfg%system%stats%error, &
                 ' > tolerance ', cfg%system%solver%tol, ')'
-            call report(trim(buf)//tolerance_floor_hint(cfg%system%stats%siconos_floor, cfg%system%solver%tol))
+            call report(trim(buf)//tolerance_floor_hint(cfg%system%stats%siconos_floor, cfg%system%solver%tol)// &
+                        stall_hint(cfg%system%stats%stalled))
             if (unconverged == max_warnings) call report(last_unconverged_warning())
         end subroutine warn_unconverged
 
@@ -420,6 +421,19 @@ contains
                'state (estimated '//trim(adjustl(fbuf))//'; u = W r + q cancels terms far larger than u): '// &
                'no number of sweeps reaches it, raise [solver] tolerance'
     end function tolerance_floor_hint
+
+    !> Text appended to an unconverged step's warning when its last pass stalled (the bonded
+    !> block's, nlgs_stats_t%stalled): with its bonds held the problem had no solution, and
+    !> the iterations ran out before the step was solved again with the bond released.
+    pure function stall_hint(stalled) result(text)
+        !> The step's last pass stalled.
+        logical, intent(in) :: stalled
+        character(len=:), allocatable :: text
+        text = ''
+        if (.not. stalled) return
+        text = '; with its intact bonds held the step had no solution (a bond must yield, doc/theory.md 7.10) '// &
+               'and no iteration was left to solve it again with the bond released: raise [solver] max_sweeps'
+    end function stall_hint
 
     !> Line closing the series of per-step warnings about unconverged steps.
     pure function last_unconverged_warning() result(line)

@@ -23,7 +23,9 @@ with method = nlgs (independent: every contact swept, each bond projected onto i
   - energy: the balance closes, the wall's work, the dissipated and the kinetic energies are
     those of nlgs, and the work is at most 2 M v_wall^2 (M the stack's mass: an inelastic
     push at v_wall costs M v_wall^2, the floor's friction and the bonds over a few steps a
-    fraction of it).
+    fraction of it);
+  - with max_sweeps = 64 the first pass of step 4 stalls at its first test (64 iterations)
+    with no iteration left: the step's warning says why and that more iterations help.
 Usage (ctest does this): test_block_stall.py --exe multicor --work DIR --source REPO
 """
 import sys
@@ -99,6 +101,11 @@ def main():
           f"difference {rel:.1e})")
     check("block: the wall's work is that of a push", blk["drive"] <= 2.0 * blk["mass"] * V_WALL**2,
           f"{blk['drive']:.4e} J/m, 2 M v^2 = {2.0 * blk['mass'] * V_WALL**2:.4e} J/m")
+    _, proc = multicor(exe, variant(src, work, "cap", [], cap=64), work)
+    line = next((ln for ln in proc.stderr.splitlines() + proc.stdout.splitlines()
+                 if ln.startswith(f"warning: step {CONTACT_STEP} ")), "")
+    check("max_sweeps = 64: the warning of the stalled step", "had no solution" in line
+          and line.endswith("raise [solver] max_sweeps"), line or "no warning for step 4")
     return summary()
 
 
