@@ -42,6 +42,9 @@ Checks:
     sweeps, unconverged, created energy, and the step was solved again from zero reactions
     where nlgs keeps its warm start, with a warning about the self-stresses of a bonded
     lattice the deck does not have.
+  - a bonded column jerked to 2 m/s by the wall it hangs from (the bond to the wall holds the
+    wall's velocity, a shift of the solver): the column's kinetic energy and the wall's work
+    from the closed form; the guard never gives the block up.
 Usage (ctest does this): test_block_energy.py --exe multicor --work DIR --source REPO
 """
 import re
@@ -161,7 +164,70 @@ def main():
     pulled(exe, src, work)
     unloaded(exe, src, work)
     bond_free(exe, work)
+    wall_pull(exe, work)
     return summary()
+
+
+# three bonded disks (R = 0.125 m, 1000 kg/m3) hanging from a wall that moves down at 2 m/s
+# from t = 0 (a mutation audit's deck): the bond to the wall carries the solver's shift of
+# the wall's velocity
+WALL_PULL_DECK = """[run]
+analysis = dynamic
+[particles]
+material = 1 1000
+disk = 0 -0.125 0.125 1
+disk = 0 -0.375 0.125 1
+disk = 0 -0.625 0.125 1
+gravity = 0 -9.81
+[walls]
+wall = -0.5 0 0.5 0 1 0 -2 1
+[contacts]
+law = 1 1 0.3 0 1e6
+bond = 1 1 0.5
+alert = 0.00125
+[functions]
+function = 1 step 0.0
+[time]
+step = 1e-3
+end = 0.02
+[solver]
+tolerance = 1e-12
+max_sweeps = 10000
+[output]
+interval = 1
+"""
+
+
+def wall_pull(exe, work):
+    """A bonded column jerked to 2 m/s by the wall it hangs from: the energy guard stays silent.
+    The column takes K = 3 (1/2) m v^2 = 294.5 J/m; the wall's bond, holding the jump of
+    velocity, does about twice that work (drive_work) and dissipates the other half: the
+    reactions create no energy, and the block is kept at every step (1 iteration each). The guard counts
+    the work of the shift the wall's velocity puts into the bond (r . shift); with its sign
+    flipped the guard saw 2 K created and gave the block up at step 1 (149 sweeps)."""
+    deck = work / "wall_pull.dat"
+    deck.write_text(WALL_PULL_DECK)
+    out = work / deck.stem
+    proc = run(exe, deck, out)
+    if not check("wall pull: the run ends", proc.returncode == 0, proc.stderr.strip()[-300:]):
+        return
+    flags, total, sweeps = given_up_record(out / f"{deck.stem}.h5")
+    with h5py.File(out / f"{deck.stem}.h5", "r") as f:
+        kinetic = f["dem/energy/kinetic"][...]
+        drive = f["dem/energy/drive_work"][...]
+    m, v, g, h = 1000.0 * np.pi * 0.125 ** 2, 2.0, 9.81, 1e-3
+    k_jump = 3 * 0.5 * m * v ** 2
+    # the bonds hold the column to the wall: from step 1 on it moves at the wall's 2 m/s, and
+    # the wall's impulse in step 1 is the momentum 3 m v less what gravity gave (3 m g h),
+    # its work that times v. Solves to 1e-12 relative on impulses of order m v: 1e-9 leaves
+    # a margin.
+    drive_1 = v * (3 * m * v - 3 * m * g * h)
+    check("wall pull: the column takes 3 (1/2) m v^2 at step 1, the wall's work v (3 m v - 3 m g h)",
+          abs(kinetic[1] - k_jump) <= 1e-9 * k_jump and abs(drive[1] - drive_1) <= 1e-9 * drive_1,
+          f"K {kinetic[1]:.10e} ({k_jump:.10e}), drive work {drive[1]:.10e} ({drive_1:.10e})")
+    check("wall pull: the block never given up, 1 iteration per step, no warning",
+          not flags.any() and total == 0 and sweeps.max() == 1 and WARNING not in proc.stdout,
+          f"given up {flags.tolist()}, sweeps {sweeps.tolist()}")
 
 
 BOND_FREE_DECK = """[run]
