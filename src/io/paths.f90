@@ -3,6 +3,7 @@ module io_paths
     use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
     use, intrinsic :: iso_fortran_env, only: int64
     use core_error, only: error_t, make_error
+    use io_file_writer, only: file_writer_t
     implicit none
     private
     public :: basename, dirname, stem, mkdir_p, remove_empty_folders, file_exists, remove_file, rename_file, copy_file
@@ -168,9 +169,10 @@ contains
         !> Set if the file cannot be read or the copy written.
         type(error_t), allocatable, intent(out) :: error
         integer, parameter :: block = 1048576
-        character(len=block) :: buf
+        character(len=:), allocatable :: buf
         character(len=256) :: msg
-        integer :: src, dst, ios, n
+        type(file_writer_t) :: dst
+        integer :: src, ios, n
         integer(int64) :: size_bytes, pos
         open (newunit=src, file=old, access='stream', form='unformatted', status='old', &
               action='read', iostat=ios, iomsg=msg)
@@ -179,29 +181,32 @@ contains
             return
         end if
         inquire (unit=src, size=size_bytes)
-        open (newunit=dst, file=new, access='stream', form='unformatted', status='replace', &
-              action='write', iostat=ios, iomsg=msg)
-        if (ios /= 0) then
+        ! written by io_file_writer: a Fortran unit's last buffered bytes could fail unreported
+        call dst%create(new, '', error)
+        if (allocated(error)) then
             close (src)
-            call make_error(error, "cannot create '"//new//"': "//trim(msg))
             return
         end if
+        allocate (character(len=block) :: buf)
         pos = 0
+        ios = 0
         do while (pos < size_bytes .and. ios == 0)
             n = int(min(int(block, int64), size_bytes - pos))
             read (src, iostat=ios, iomsg=msg) buf(:n)
-            if (ios == 0) write (dst, iostat=ios, iomsg=msg) buf(:n)
+            if (ios == 0) call dst%write(buf(:n))
             pos = pos + n
         end do
         close (src)
-        if (ios == 0) then
-            close (dst, iostat=ios, iomsg=msg)
-        else
-            close (dst, status='delete')
-        end if
         if (ios /= 0) then
+            call dst%discard()
             call remove_file(new)
             call make_error(error, "cannot copy '"//old//"' to '"//new//"': "//trim(msg))
+            return
+        end if
+        call dst%close(error)
+        if (allocated(error)) then
+            call remove_file(new)
+            error%message = "cannot copy '"//old//"' to '"//new//"': "//error%message
         end if
     end subroutine copy_file
 

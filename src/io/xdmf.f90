@@ -2,13 +2,15 @@
 !> file by reference: grids, temporal and spatial collections, topology, geometry and
 !> attributes whose data items are whole HDF5 datasets or hyperslabs of them (no data is
 !> copied into the XML). The caller opens a file, nests collections and grids, and closes it;
-!> the first write failure is kept and reported by `close`.
+!> the first write failure is kept and reported by `close` with the system's reason
+!> (io_file_writer: libgfortran's units did not report a full disk or a file size limit).
 !>
 !> Dimensions are given in XDMF (C, h5py) order: the reverse of the Fortran shape that
 !> io_hdf5_file's `dataset_shape` returns.
 module io_xdmf
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
+    use io_file_writer, only: file_writer_t
     implicit none
     private
     public :: xdmf_file_t, xdmf_item_t, xdmf_whole, xdmf_slab
@@ -27,12 +29,10 @@ module io_xdmf
 
     !> An XDMF file being written.
     type :: xdmf_file_t
-        !> Unit of the open file (-1 when closed).
-        integer, private :: unit = -1
+        !> The open file.
+        type(file_writer_t), private :: out
         !> Nesting depth (indentation).
         integer, private :: depth = 0
-        !> First write status that was not 0.
-        integer, private :: ios = 0
         !> Path of the XDMF file.
         character(len=:), allocatable, private :: path
         !> Name of the HDF5 file as seen from the XDMF file's folder.
@@ -99,8 +99,6 @@ contains
         character(len=*), intent(in) :: h5_name
         !> Set when the file cannot be created.
         type(error_t), allocatable, intent(out) :: error
-        integer :: ios
-        character(len=256) :: msg
         self%path = path
         ! a file name is element text: '&' and '<' (a deck named 'a&b.dat') would end the XML.
         ! ParaView's XDMF 2 reader strips the leading bytes <= ' ' of a reference, those of a
@@ -111,13 +109,8 @@ contains
             self%h5_name = xml_text('./'//h5_name)
         end if
         self%depth = 0
-        self%ios = 0
-        open (newunit=self%unit, file=path, status='replace', action='write', iostat=ios, iomsg=msg)
-        if (ios /= 0) then
-            self%unit = -1
-            call make_error(error, "cannot write the XDMF file '"//path//"': "//trim(msg))
-            return
-        end if
+        call self%out%create(path, 'the XDMF file', error)
+        if (allocated(error)) return
         call put(self, '<?xml version="1.0" ?>')
         call put(self, '<Xdmf Version="2.0">')
         call put(self, ' <Domain>')
@@ -130,21 +123,16 @@ contains
         class(xdmf_file_t), intent(inout) :: self
         !> Set when a write failed, a grid is still open, or the file cannot be closed.
         type(error_t), allocatable, intent(out) :: error
-        integer :: ios
-        if (self%unit == -1) return
+        if (.not. self%out%is_open()) return
         if (self%depth /= 2) then
             call make_error(error, "XDMF file '"//self%path//"': a grid is still open at the close")
-            close (self%unit, iostat=ios)
-            self%unit = -1
+            call self%out%discard()
             return
         end if
         self%depth = 0
         call put(self, ' </Domain>')
         call put(self, '</Xdmf>')
-        close (self%unit, iostat=ios)
-        self%unit = -1
-        if (self%ios == 0) self%ios = ios
-        if (self%ios /= 0) call make_error(error, "cannot write the XDMF file '"//self%path//"'")
+        call self%out%close(error)
     end subroutine xdmf_close
 
     !> `<Grid GridType="Collection" CollectionType="...">`, and its Time.
@@ -287,10 +275,7 @@ contains
     subroutine put(self, line)
         type(xdmf_file_t), intent(inout) :: self
         character(len=*), intent(in) :: line
-        integer :: ios
-        if (self%unit == -1) return
-        write (self%unit, '(a)', iostat=ios) repeat(' ', self%depth)//line
-        if (self%ios == 0) self%ios = ios
+        call self%out%write_line(repeat(' ', self%depth)//line)
     end subroutine put
 
     !> A time as text, every digit of the double ('1.0000000000000000E-003').

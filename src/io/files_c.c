@@ -1,0 +1,71 @@
+/* File-system calls whose every failure is reported, for io_file_writer
+ * (src/io/file_writer.f90).
+ *
+ * libgfortran does not report some write errors of a formatted or stream unit: what it keeps
+ * in its buffer and writes at a FLUSH or CLOSE fails without an error (writing to /dev/full,
+ * a full disk, a file size limit: iostat 0 from WRITE, FLUSH and CLOSE, and a truncated or
+ * empty file). These functions call write(2), fsync(2) and close(2) themselves and return the
+ * errno of the first that fails (0: none), for a message with its strerror text.
+ *
+ * Functions return 0 or a positive errno; a created file descriptor is returned as is, or as
+ * minus the errno. */
+#define _POSIX_C_SOURCE 200809L
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+/* Open `path` for writing, created with mode 0666 (less the umask); with `exclusive` /= 0 it
+ * must not exist (O_EXCL: EEXIST), else it is truncated. The descriptor, or -errno. */
+int multicor_file_create(const char *path, int exclusive)
+{
+    int flags = O_WRONLY | O_CREAT | O_CLOEXEC | (exclusive ? O_EXCL : O_TRUNC);
+    int fd;
+    do {
+        fd = open(path, flags, 0666);
+    } while (fd < 0 && errno == EINTR);
+    return fd >= 0 ? fd : -errno;
+}
+
+/* Write the `n` bytes of `buf` to `fd`, through short writes and interruptions; 0 or errno
+ * (a write that writes nothing without an error is reported as EIO). */
+int multicor_file_write(int fd, const char *buf, long n)
+{
+    while (n > 0) {
+        ssize_t done = write(fd, buf, (size_t)n);
+        if (done < 0) {
+            if (errno == EINTR) continue;
+            return errno;
+        }
+        if (done == 0) return EIO;
+        buf += done;
+        n -= (long)done;
+    }
+    return 0;
+}
+
+/* Commit `fd`'s data to the device (fsync: a network file system reports a full disk or a
+ * quota there, or at the close), then close it; 0 or the errno of the first call that failed.
+ * A file that cannot be synced (a device or a pipe: EINVAL; ENOTSUP) is only closed. */
+int multicor_file_close(int fd)
+{
+    int status = 0;
+    if (fsync(fd) != 0 && errno != EINVAL && errno != ENOTSUP && errno != EROFS) status = errno;
+    /* a close interrupted by a signal has closed the descriptor anyway (Linux): no retry */
+    if (close(fd) != 0 && status == 0 && errno != EINTR) status = errno;
+    return status;
+}
+
+/* Close `fd` without caring about errors (a file given up after a failure). */
+void multicor_file_discard(int fd) { (void)close(fd); }
+
+/* The system's text for an errno ('No space left on device'), NUL-terminated in buf[n]. */
+void multicor_errno_text(int err, char *buf, long n)
+{
+    if (n <= 0) return;
+    snprintf(buf, (size_t)n, "%s", strerror(err));
+}
+
+/* Errno values the callers test. */
+int multicor_eexist(void) { return EEXIST; }

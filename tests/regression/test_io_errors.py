@@ -1,0 +1,83 @@
+#!/usr/bin/env python3
+"""Errors of the files a run writes besides its HDF5 results, and of the files it finds
+(doc/output.md, "Write errors").
+
+- The XDMF file: libgfortran did not report its write errors (exit 0 with a truncated or
+  empty `.xdmf`). Its path '.partial' a link to /dev/full (every write ENOSPC), and a file
+  size limit (RLIMIT_FSIZE, as `ulimit -f`) between the sizes of the HDF5 and the XDMF file
+  of input/cantilever.dat: exit 1 with the system's reason, the folder's earlier result,
+  XDMF file and checkpoint untouched.
+Usage (ctest does this): test_io_errors.py --exe multicor --work DIR --source REPO
+"""
+import hashlib
+import os
+import resource
+import shutil
+import subprocess
+import sys
+
+from checks import arguments, check, summary
+
+
+def run(exe, *args, limit=None, user=None):
+    """multicor with `args`; under a file size limit of `limit` bytes, as user id `user`."""
+    def prepare():
+        if limit is not None:
+            resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+        if user is not None:
+            os.setgid(user)
+            os.setuid(user)
+    return subprocess.run([str(exe)] + [str(a) for a in args], capture_output=True, text=True,
+                          timeout=300, preexec_fn=prepare)
+
+
+def digests(folder):
+    """SHA-256 of every file of `folder`, by name."""
+    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(folder.iterdir())
+            if p.is_file() and not p.is_symlink()}
+
+
+def xdmf_write_errors(exe, deck, work):
+    folder = work / "xdmf_full"
+    first = run(exe, deck, "--output", folder, "--quiet", "--end", "0.02")
+    assert first.returncode == 0, first.stderr
+    before = digests(folder)
+    (folder / f"{deck.stem}.xdmf.partial").symlink_to("/dev/full")
+    proc = run(exe, deck, "--output", folder, "--quiet", "--end", "0.04")
+    err = proc.stderr.strip()
+    check("XDMF file on a full device: exit 1", proc.returncode == 1, f"exit {proc.returncode}: {err[-300:]}")
+    check("XDMF file on a full device: the error names the file and the reason",
+          f"cannot write the XDMF file '{folder}/{deck.stem}.xdmf.partial': No space left on device" in err,
+          err[-300:])
+    check("XDMF file on a full device: the earlier result, XDMF file and checkpoint untouched",
+          digests(folder) == before, f"{sorted(before)} -> {sorted(digests(folder))}")
+
+    # the whole deck: its XDMF file (one grid per output) is larger than its HDF5 file
+    folder = work / "xdmf_fsize"
+    ref = run(exe, deck, "--output", work / "xdmf_ref", "--quiet")
+    assert ref.returncode == 0, ref.stderr
+    h5 = (work / "xdmf_ref" / f"{deck.stem}.h5").stat().st_size
+    xdmf = (work / "xdmf_ref" / f"{deck.stem}.xdmf").stat().st_size
+    check("cantilever: the XDMF file is larger than the HDF5 file", xdmf > h5 + 65536, f"{xdmf} vs {h5} bytes")
+    limit = (h5 + xdmf) // 2
+    proc = run(exe, deck, "--output", folder, "--quiet", limit=limit)
+    err = proc.stderr.strip()
+    check(f"XDMF file beyond a file size limit of {limit} bytes: exit 1", proc.returncode == 1,
+          f"exit {proc.returncode}: {err[-300:]}")
+    check("XDMF file beyond the file size limit: the reason", "cannot write the XDMF file" in err and
+          "File too large" in err, err[-300:])
+    check("XDMF file beyond the file size limit: the folder it made removed", not folder.exists(),
+          str(sorted(p.name for p in folder.iterdir())) if folder.exists() else "")
+
+
+def main():
+    exe, work, src = arguments(fresh=True)
+    deck = work / "cantilever.dat"
+    shutil.copy(src / "input" / "cantilever.dat", deck)
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    xdmf_write_errors(exe, deck, work)
+    sys.exit(summary())
+
+
+if __name__ == "__main__":
+    main()
