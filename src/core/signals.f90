@@ -7,8 +7,9 @@
 !> write a checkpoint, store the step and close the results (doc/output.md, "Interrupted
 !> runs"). A second Ctrl-C (SIGINT) stops the program at once (its default action again after
 !> the first delivery); a second SIGTERM, SIGUSR1 or SIGHUP is the same request again (Slurm
-!> sends SIGTERM twice at a time limit). SIGXFSZ is ignored, so that a file size limit (`ulimit -f`) gives a write
-!> error instead of killing the program. The flag lives in the C file (a signal handler can
+!> sends SIGTERM twice at a time limit). SIGXFSZ is ignored from the program's start
+!> (`ignore_file_size_signal`), so that a file size limit (`ulimit -f`) gives a write error
+!> instead of killing the program. The flag lives in the C file (a signal handler can
 !> only set a `volatile sig_atomic_t`); this module keeps no state.
 !>
 !> SIGPIPE, a write to a pipe whose reader has gone (`multicor deck.dat | head -1`, a `tee`
@@ -24,7 +25,7 @@ module core_signals
     private
     public :: install_signal_handlers, caught_signal, signal_name, clear_caught_signal, &
               signal_exit_code, stop_signals, catch_broken_pipe, broken_pipe, clear_broken_pipe, &
-              broken_pipe_signal
+              broken_pipe_signal, ignore_file_size_signal
 
     interface
         !> Install the handlers (0 on success).
@@ -38,6 +39,10 @@ module core_signals
         !> Forget the caught signal.
         subroutine c_clear() bind(c, name='multicor_signals_clear')
         end subroutine c_clear
+        !> Ignore SIGXFSZ (0 on success).
+        integer(c_int) function c_sigxfsz_ignore() bind(c, name='multicor_sigxfsz_ignore')
+            import :: c_int
+        end function c_sigxfsz_ignore
         !> Install the SIGPIPE handler (0 on success).
         integer(c_int) function c_sigpipe_install() bind(c, name='multicor_sigpipe_install')
             import :: c_int
@@ -73,13 +78,21 @@ module core_signals
 
 contains
 
-    !> Catch SIGTERM, SIGINT, SIGUSR1 and SIGHUP (and ignore SIGXFSZ) from now on.
+    !> Catch SIGTERM, SIGINT, SIGUSR1 and SIGHUP from now on.
     subroutine install_signal_handlers(error)
         !> Set when the operating system refuses a handler.
         type(error_t), allocatable, intent(out) :: error
         if (c_install() /= 0) call make_error(error, 'cannot install the signal handlers '// &
                                               '(SIGTERM, SIGINT, SIGUSR1, SIGHUP)')
     end subroutine install_signal_handlers
+
+    !> Ignore SIGXFSZ from now on: a write beyond the file size limit (`ulimit -f`) fails
+    !> with EFBIG, reported as a write error, instead of killing the program.
+    subroutine ignore_file_size_signal(error)
+        !> Set when the operating system refuses it.
+        type(error_t), allocatable, intent(out) :: error
+        if (c_sigxfsz_ignore() /= 0) call make_error(error, 'cannot ignore the signal SIGXFSZ')
+    end subroutine ignore_file_size_signal
 
     !> Catch SIGPIPE from now on: a write to a pipe without reader fails (EPIPE) and is
     !> recorded (`broken_pipe`) instead of killing the program.

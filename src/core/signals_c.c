@@ -10,8 +10,10 @@
  * closed, an ssh session lost) stops the run as SIGTERM does, with its checkpoint, instead of killing it;
  * under `nohup` (SIGHUP ignored when the program starts) it stays ignored, and so does a
  * SIGINT ignored at the start (the results file stays readable up to its last flush).
- * SIGXFSZ (file size limit, `ulimit -f`) is ignored, so that exceeding the limit makes the
- * write fail with EFBIG and is reported like a full disk instead of killing the process.
+ * SIGXFSZ (file size limit, `ulimit -f`) is ignored from the program's start, so that
+ * exceeding the limit makes the write fail with EFBIG and is reported like a full disk instead
+ * of killing the process (ignored only once the handlers were installed, it killed a run under
+ * `ulimit -f 0` at the lock file's first write, which left that lock empty).
  *
  * SIGPIPE (a write to a pipe whose reader is gone: `multicor deck.dat | head -1`) sets a
  * flag of its own and keeps its handler: the write fails with EPIPE instead of killing the
@@ -55,11 +57,17 @@ int multicor_signals_install(void)
         }
         if (sigaction(handled[k], &sa, NULL) != 0) return -1;
     }
+    return 0;
+}
+
+/* Ignore SIGXFSZ from now on; 0 on success, -1 when sigaction fails. */
+int multicor_sigxfsz_ignore(void)
+{
+    struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = SIG_IGN;
     sigemptyset(&sa.sa_mask);
-    if (sigaction(SIGXFSZ, &sa, NULL) != 0) return -1;
-    return 0;
+    return sigaction(SIGXFSZ, &sa, NULL) == 0 ? 0 : -1;
 }
 
 /* Catch SIGPIPE from now on (every delivery: no SA_RESETHAND); 0 on success, -1 when

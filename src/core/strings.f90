@@ -8,7 +8,7 @@ module core_strings
     private
     public :: string_t, to_lower, strip, is_blank_char, split_words, split_lines, join_words
     public :: levenshtein, closest_match, parse_real, parse_int, to_str, shorten, max_echo, is_real_syntax
-    public :: gib, counted, sci_to_str, sci_text, quoted_name, same_name
+    public :: gib, counted, sci_to_str, sci_text, quoted_name, same_name, shell_word
 
     !> Longest token echoed whole in a message (see `shorten`).
     integer, parameter :: max_echo = 40
@@ -528,4 +528,29 @@ contains
         if (text(1:1) == '.') text = '0'//text
         text = text//' GiB'
     end function gib
+
+    !> A path as one word of a POSIX shell command, so that the printed command can be
+    !> pasted: as it is when it holds only safe characters, else in single quotes (a quote
+    !> inside written '\'').
+    pure function shell_word(path) result(word)
+        !> The path.
+        character(len=*), intent(in) :: path
+        character(len=:), allocatable :: word
+        character(len=*), parameter :: safe = 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789'// &
+                                       '_-./+=:,@%'
+        integer :: i
+        if (len(path) > 0 .and. verify(path, safe) == 0) then
+            word = path
+            return
+        end if
+        word = "'"
+        do i = 1, len(path)
+            if (path(i:i) == "'") then
+                word = word//"'\''"
+            else
+                word = word//path(i:i)
+            end if
+        end do
+        word = word//"'"
+    end function shell_word
 end module core_strings

@@ -17,7 +17,7 @@ program multicor
     use core_kinds, only: wp
     use core_error, only: error_t, error_internal
     use core_version, only: multicor_version
-    use core_signals, only: signal_exit_code, catch_broken_pipe
+    use core_signals, only: signal_exit_code, catch_broken_pipe, ignore_file_size_signal
     use core_strings, only: parse_real, is_real_syntax, to_lower
     use io_deck_schema, only: multicor_schema, schema_markdown
     use io_unit_words, only: unit_hint
@@ -36,6 +36,9 @@ program multicor
     ! (its folder would stay locked, its results '.partial'): from here on such a write fails
     ! and the run goes on without printing (driver_simulation, report_to_stdout).
     call catch_broken_pipe(error)
+    ! A file size limit (`ulimit -f`) makes a write fail (EFBIG, reported as a write error)
+    ! instead of killing the program before its first file is whole (an empty folder lock).
+    if (.not. allocated(error)) call ignore_file_size_signal(error)
     if (allocated(error)) then
         write (error_unit, '(a)') 'multicor: error: '//error%message
         stop 1, quiet = .true.

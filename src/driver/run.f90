@@ -27,7 +27,7 @@
 module driver_run
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
-    use core_strings, only: to_str, num => sci_text
+    use core_strings, only: to_str, num => sci_text, shell_word
     use io_lock, only: lock_t, lock_acquire, lock_release
     use io_progress, only: progress_t
     use core_signals, only: caught_signal, signal_name, install_signal_handlers
@@ -424,31 +424,6 @@ contains
             command = command//' --end '//trim(adjustl(end_text))
         end if
     end function continue_command
-
-    !> A path as one word of a POSIX shell command, so that the printed command can be
-    !> pasted: as it is when it holds only safe characters, else in single quotes (a quote
-    !> inside written '\'').
-    pure function shell_word(path) result(word)
-        !> The path.
-        character(len=*), intent(in) :: path
-        character(len=:), allocatable :: word
-        character(len=*), parameter :: safe = 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789'// &
-                                       '_-./+=:,@%'
-        integer :: i
-        if (len(path) > 0 .and. verify(path, safe) == 0) then
-            word = path
-            return
-        end if
-        word = "'"
-        do i = 1, len(path)
-            if (path(i:i) == "'") then
-                word = word//"'\''"
-            else
-                word = word//path(i:i)
-            end if
-        end do
-        word = word//"'"
-    end function shell_word
 
     !> A fresh run with a time loop replaces the folder's checkpoint (at its first commit). When that
     !> checkpoint is another deck's and its run is interrupted (its results file still

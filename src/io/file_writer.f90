@@ -1,5 +1,5 @@
-!> A file written with every write error reported: the XDMF file of a run and the copy of a
-!> results file.
+!> A file written with every write error reported: the text files of a run (the XDMF file,
+!> the folder's lock) and the copy of a results file.
 !>
 !> libgfortran does not report some write errors: what a formatted or stream unit keeps in
 !> its buffer and writes at a FLUSH or CLOSE fails without an error (to /dev/full, a full

@@ -1,5 +1,5 @@
-/* File-system calls whose every failure is reported, for io_file_writer
- * (src/io/file_writer.f90).
+/* File-system calls whose every failure is reported, for io_file_writer and io_lock
+ * (src/io/file_writer.f90, src/io/lock.f90).
  *
  * libgfortran does not report some write errors of a formatted or stream unit: what it keeps
  * in its buffer and writes at a FLUSH or CLOSE fails without an error (writing to /dev/full,
@@ -14,6 +14,7 @@
 #include <fcntl.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 /* Open `path` for writing, created with mode 0666 (less the umask); with `exclusive` /= 0 it
@@ -59,6 +60,26 @@ int multicor_file_close(int fd)
 
 /* Close `fd` without caring about errors (a file given up after a failure). */
 void multicor_file_discard(int fd) { (void)close(fd); }
+
+/* Give the file `old` the second name `new`, which must not exist (link(2): EEXIST); 0 or
+ * errno. On NFS a link that was made can still be reported as failed (the reply was lost and
+ * the retried request finds the name taken): the link count of `old` says whether it was made. */
+int multicor_link_new(const char *old, const char *new)
+{
+    struct stat st;
+    int err;
+    if (link(old, new) == 0) return 0;
+    err = errno;
+    if (stat(old, &st) == 0 && st.st_nlink == 2) return 0;
+    return err;
+}
+
+/* 1 when a failed link(2)'s errno says the file system has no hard links (FAT, some network
+ * shares: EPERM, ENOTSUP, ENOSYS), else 0. */
+int multicor_no_hard_links(int err)
+{
+    return err == EPERM || err == ENOTSUP || err == EOPNOTSUPP || err == ENOSYS;
+}
 
 /* The system's text for an errno ('No space left on device'), NUL-terminated in buf[n]. */
 void multicor_errno_text(int err, char *buf, long n)

@@ -1,18 +1,28 @@
 !> One writer per results folder: a lock file `<folder>/.multicor.lock`, independent of HDF5
 !> file locking (which is often off on NFS and Lustre).
 !>
-!> The lock is created with `open(status='new')`, which fails when the file exists (an
-!> exclusive create, atomic on a local file system). It holds one line `host pid start-time`
-!> naming its owner. A second run on the folder is refused with the owner's line. A lock left
+!> The lock holds one line `host pid start-time` naming its owner, and never exists without
+!> it: the line is written (and synced) to a file of this process's own,
+!> `.multicor.lock.<host>.<pid>`, which is then given the lock's name by link(2), which fails
+!> when the name exists (atomic, on NFS too), and its own name removed. Before, the lock was
+!> created empty and its line written after: a run killed in between (`ulimit -f 0` killed it
+!> there by SIGXFSZ) left an empty lock, which no later run could judge, and which refused
+!> them all. Where the file system has no hard links (link fails with EPERM, ENOTSUP or
+!> ENOSYS: FAT, some network shares) the lock is created exclusively and written (the
+!> earlier way). An empty lock (left by an earlier version, or by a kill in that fallback) is
+!> refused with a message saying how to remove it. A second run on the folder is refused
+!> with the owner's line. A lock left
 !> by a run that died without removing it (its pid no longer runs on this host) is stale: it is
 !> taken over, and the caller gets a warning to print. A lock from another host cannot be
 !> checked and is always respected. `lock_release` removes the file; the driver calls it on
 !> every way out of a run, errors included.
 module io_lock
     use, intrinsic :: iso_c_binding, only: c_char, c_int, c_size_t, c_null_char
+    use, intrinsic :: iso_fortran_env, only: int64
     use core_error, only: error_t, make_error
-    use core_strings, only: to_str, split_words, string_t, parse_int
+    use core_strings, only: to_str, split_words, string_t, parse_int, shell_word
     use io_paths, only: file_exists, remove_file
+    use io_file_writer, only: file_writer_t, system_error_text, errno_exists
     implicit none
     private
     public :: lock_t, lock_acquire, lock_release, lock_name, lock_owner_alive
@@ -33,6 +43,16 @@ module io_lock
             import :: c_int
             integer(c_int) :: pid
         end function c_getpid
+        function c_link_new(old, new) bind(C, name='multicor_link_new') result(err)
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: old(*), new(*)
+            integer(c_int) :: err
+        end function c_link_new
+        function c_no_hard_links(err) bind(C, name='multicor_no_hard_links') result(yes)
+            import :: c_int
+            integer(c_int), value :: err
+            integer(c_int) :: yes
+        end function c_no_hard_links
         function c_gethostname(name, length) bind(C, name='gethostname') result(rc)
             import :: c_char, c_int, c_size_t
             character(kind=c_char), intent(out) :: name(*)
@@ -66,12 +86,20 @@ contains
                 return
             end if
             owner = read_owner(lock%path)
+            if (len(owner) == 0 .and. .not. file_exists(lock%path)) cycle
             if (attempt == 2) exit
             if (lock_owner_alive(owner, host_name())) exit
             warning = "warning: taking over the stale lock '"//lock%path//"' of a run that no longer "// &
                       'runs (host pid start: '//owner//')'
             call remove_file(lock%path)
         end do
+        if (len(owner) == 0 .and. is_empty(lock%path)) then
+            call make_error(error, "results folder '"//dir//"' is locked by an empty lock file '"//lock%path// &
+                            "', which does not name its run: one killed as it created it (by an earlier "// &
+                            'multicor version, or on a file system without hard links). If no other run writes '// &
+                            'this folder, remove it (rm '//shell_word(lock%path)//') and start again')
+            return
+        end if
         if (len(owner) == 0) owner = 'unknown'
         call make_error(error, "results folder '"//dir//"' is in use by another run (host pid start: "//owner// &
                         "; lock file '"//lock%path//"'): choose another --output folder, or wait; "// &
@@ -107,29 +135,79 @@ contains
         alive = file_exists('/proc/'//to_str(pid))
     end function lock_owner_alive
 
-    !> Create the lock file exclusively and write the owner line; `created` is false when
-    !> it exists already.
+    !> Create the lock file with its owner line; `created` is false when it exists already.
+    !> The line goes to a file of this process's own, linked to the lock's name (link(2)
+    !> fails when the name exists), so that the lock never exists without its line.
     subroutine try_create(path, created, error)
         character(len=*), intent(in) :: path
         logical, intent(out) :: created
         type(error_t), allocatable, intent(out) :: error
-        integer :: unit, ios
-        character(len=256) :: msg
+        character(len=:), allocatable :: own, line
+        integer :: code
         character(len=8) :: date
         character(len=10) :: time
         created = .false.
-        open (newunit=unit, file=path, status='new', action='write', iostat=ios, iomsg=msg)
-        if (ios /= 0) then
-            if (file_exists(path)) return
-            call make_error(error, "cannot create the lock file '"//path//"': "//trim(msg))
+        call date_and_time(date, time)
+        line = host_name()//' '//to_str(int(c_getpid()))//' '// &
+               date(1:4)//'-'//date(5:6)//'-'//date(7:8)//'T'//time(1:2)//':'//time(3:4)//':'//time(5:6)
+        own = path//'.'//host_name()//'.'//to_str(int(c_getpid()))
+        call write_line_to(own, line, .false., code, error)
+        if (allocated(error)) then
+            error%message = "cannot create the lock file '"//path//"': "//error%message
             return
         end if
-        call date_and_time(date, time)
-        write (unit, '(a)', iostat=ios) host_name()//' '//to_str(int(c_getpid()))//' '// &
-            date(1:4)//'-'//date(5:6)//'-'//date(7:8)//'T'//time(1:2)//':'//time(3:4)//':'//time(5:6)
-        close (unit)
-        created = .true.
+        code = int(c_link_new(own//c_null_char, path//c_null_char))
+        call remove_file(own)
+        if (code == 0) then
+            created = .true.
+        else if (errno_exists(code)) then
+            return
+        else if (c_no_hard_links(int(code, c_int)) /= 0) then
+            ! no hard links here: an exclusive create, then the line
+            call write_line_to(path, line, .true., code, error)
+            if (errno_exists(code)) return
+            if (allocated(error)) then
+                error%message = "cannot create the lock file '"//path//"': "//error%message
+                return
+            end if
+            created = .true.
+        else
+            call make_error(error, "cannot create the lock file '"//path//"': "//system_error_text(code))
+        end if
     end subroutine try_create
+
+    !> Create `path` (when `exclusive`, only if it does not exist: `code` is then EEXIST) and
+    !> write `line` into it; on a failure the file is removed and `error` gives the reason.
+    subroutine write_line_to(path, line, exclusive, code, error)
+        character(len=*), intent(in) :: path, line
+        logical, intent(in) :: exclusive
+        integer, intent(out) :: code
+        type(error_t), allocatable, intent(out) :: error
+        type(file_writer_t) :: w
+        call w%create(path, '', error, exclusive=exclusive, code=code)
+        if (errno_exists(code) .and. exclusive) then
+            deallocate (error)
+            return
+        end if
+        if (allocated(error)) then
+            error%message = system_error_text(code)
+            return
+        end if
+        call w%write_line(line)
+        call w%close(error, code)
+        if (allocated(error)) then
+            call remove_file(path)
+            error%message = system_error_text(code)
+        end if
+    end subroutine write_line_to
+
+    !> Whether the file `path` exists and holds no byte.
+    logical function is_empty(path)
+        character(len=*), intent(in) :: path
+        integer(int64) :: size_bytes
+        inquire (file=path, size=size_bytes)
+        is_empty = size_bytes == 0
+    end function is_empty
 
     !> The owner line of a lock file ('' when it cannot be read).
     function read_owner(path) result(owner)

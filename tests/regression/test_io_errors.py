@@ -1,12 +1,16 @@
 #!/usr/bin/env python3
 """Errors of the files a run writes besides its HDF5 results, and of the files it finds
-(doc/output.md, "Write errors").
+(doc/output.md, "Write errors", the folder lock).
 
 - The XDMF file: libgfortran did not report its write errors (exit 0 with a truncated or
   empty `.xdmf`). Its path '.partial' a link to /dev/full (every write ENOSPC), and a file
   size limit (RLIMIT_FSIZE, as `ulimit -f`) between the sizes of the HDF5 and the XDMF file
   of input/cantilever.dat: exit 1 with the system's reason, the folder's earlier result,
   XDMF file and checkpoint untouched.
+- A file size limit of 0 (`ulimit -f 0`): SIGXFSZ killed the run (exit -25) at the lock's
+  first write and left an empty lock that refused every later run. Now exit 1 with the
+  reason, no lock and no folder left, and the next run works. An empty lock (left so by an
+  earlier version) is refused with how to remove it.
 Usage (ctest does this): test_io_errors.py --exe multicor --work DIR --source REPO
 """
 import hashlib
@@ -70,12 +74,37 @@ def xdmf_write_errors(exe, deck, work):
           str(sorted(p.name for p in folder.iterdir())) if folder.exists() else "")
 
 
+def zero_file_size(exe, deck, work):
+    folder = work / "fsize0"
+    proc = run(exe, deck, "--output", folder, "--quiet", "--end", "0.01", limit=0)
+    err = proc.stderr.strip()
+    check("file size limit 0: exit 1 (not killed by SIGXFSZ)", proc.returncode == 1,
+          f"exit {proc.returncode}: {err[-300:]}")
+    check("file size limit 0: the lock file cannot be written, with the reason",
+          f"cannot create the lock file '{folder}/.multicor.lock': File too large" in err, err[-300:])
+    check("file size limit 0: no lock, no folder left", not folder.exists(),
+          str(sorted(p.name for p in folder.iterdir())) if folder.exists() else "")
+    proc = run(exe, deck, "--output", folder, "--quiet", "--end", "0.01")
+    check("file size limit 0: the next run works", proc.returncode == 0, proc.stderr.strip()[-300:])
+    lock = folder / ".multicor.lock"
+    lock.write_bytes(b"")
+    proc = run(exe, deck, "--output", folder, "--quiet", "--end", "0.01")
+    err = proc.stderr.strip()
+    check("empty lock: exit 1", proc.returncode == 1, f"exit {proc.returncode}")
+    check("empty lock: says it is empty and how to remove it",
+          f"locked by an empty lock file '{lock}'" in err and f"rm {lock})" in err, err[-300:])
+    lock.unlink()
+    left = sorted(p.name for p in folder.iterdir() if p.name.startswith(".multicor"))
+    check("the lock's own temporary files are gone", left == [], str(left))
+
+
 def main():
     exe, work, src = arguments(fresh=True)
     deck = work / "cantilever.dat"
     shutil.copy(src / "input" / "cantilever.dat", deck)
     os.environ.setdefault("OMP_NUM_THREADS", "1")
     xdmf_write_errors(exe, deck, work)
+    zero_file_size(exe, deck, work)
     sys.exit(summary())
 
 
