@@ -28,11 +28,11 @@ module driver_results
     use core_error, only: error_t, make_error, make_internal_error
     use core_version, only: multicor_version, multicor_name
     use core_threads, only: thread_setting
-    use core_strings, only: string_t
+    use core_strings, only: string_t, shell_word
     use io_hdf5_file, only: h5_file_t
     use io_progress, only: progress_t
     use io_paths, only: rename_file, remove_file, copy_file, file_exists
-    use driver_results_mark, only: results_mark_t
+    use driver_results_mark, only: results_mark_t, results_file_damage
     implicit none
     private
     public :: results_writer_t
@@ -232,7 +232,7 @@ contains
         type(results_mark_t), intent(in) :: mark
         !> Set when no file belongs to the run, or it cannot be opened for writing.
         type(error_t), allocatable, intent(out) :: error
-        character(len=:), allocatable :: prev
+        character(len=:), allocatable :: prev, source
         type(results_mark_t) :: same_run
         logical :: copy
         if (self%is_open()) then
@@ -266,11 +266,21 @@ contains
         else if (same_run%held_by(final_path)) then
             copy = .true.
         else
-            call make_error(error, "results: neither '"//self%partial_path//"' nor '"// &
-                            final_path//"' is the results file of the checkpoint's run (run_id "// &
-                            mark%run_id//'): '//moved())
+            ! a file there that HDF5 cannot read is damaged, not another run's
+            call refuse_damaged(self%partial_path, error)
+            if (.not. allocated(error)) call refuse_damaged(final_path, error)
+            if (.not. allocated(error)) &
+                call make_error(error, "results: neither '"//self%partial_path//"' nor '"// &
+                                final_path//"' is the results file of the checkpoint's run (run_id "// &
+                                mark%run_id//'): '//moved())
             return
         end if
+        ! read whole before it is copied or written: a damaged file (truncated, overwritten in
+        ! part) is named as such, not as a copy that a failed run deletes
+        source = self%partial_path
+        if (copy) source = final_path
+        call refuse_damaged(source, error)
+        if (allocated(error)) return
         if (copy) then
             ! a copy: the finished file keeps the outputs, a failure removes the copy (and puts
             ! back the partial file of another run it set aside)
@@ -291,6 +301,20 @@ contains
             return
         end if
     contains
+        !> An error when the file `path` exists and HDF5 cannot read it whole.
+        subroutine refuse_damaged(path, error)
+            character(len=*), intent(in) :: path
+            type(error_t), allocatable, intent(out) :: error
+            character(len=:), allocatable :: reason
+            if (.not. file_exists(path)) return
+            reason = results_file_damage(path)
+            if (len(reason) == 0) return
+            call make_error(error, "results: the results file '"//path//"' of the checkpoint's run is "// &
+                            'damaged, truncated or overwritten in part ('//reason//'): a restart cannot '// &
+                            'continue it; put back a good copy of it, or run the deck again without '// &
+                            '--restart (h5dump -H '//shell_word(path)//' shows what can still be read)')
+        end subroutine refuse_damaged
+
         !> Give '<partial_path>.prev' its name back, deleting the partial file found under it.
         subroutine take_back_set_aside(error)
             type(error_t), allocatable, intent(out) :: error

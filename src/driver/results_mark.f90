@@ -4,6 +4,10 @@
 !> a restart cuts it back to the checkpoint. A file of the same run with fewer records (the
 !> finished file of an earlier end time, after a continuation went further; a copy of it) is
 !> an earlier state of that run, from which the checkpoint cannot be continued.
+!>
+!> `results_file_damage` tells a damaged file (truncated, overwritten in part: HDF5 cannot
+!> open it, read its run id or list its datasets) from one of another run, so that a restart
+!> says which it is.
 module driver_results_mark
     use core_error, only: error_t
     use core_strings, only: string_t
@@ -11,7 +15,7 @@ module driver_results_mark
     use io_paths, only: file_exists
     implicit none
     private
-    public :: results_mark_t
+    public :: results_mark_t, results_file_damage
 
     !> The results of a checkpoint: run id, datasets and their record counts.
     type :: results_mark_t
@@ -64,4 +68,27 @@ contains
         end if
         call f%close(e)
     end function mark_held_by
+
+    !> Why the existing HDF5 file `path` is damaged (HDF5's message), or '' when it opens and
+    !> every dataset's shape reads (a file without run id is not called damaged: it may be
+    !> another program's).
+    function results_file_damage(path) result(reason)
+        !> Path of the file.
+        character(len=*), intent(in) :: path
+        !> HDF5's message, or ''.
+        character(len=:), allocatable :: reason
+        type(h5_file_t) :: f
+        type(error_t), allocatable :: e, ignored
+        character(len=256), allocatable :: names(:)
+        integer, allocatable :: records(:)
+        reason = ''
+        call f%open(path, e)
+        if (allocated(e)) then
+            reason = e%message
+            return
+        end if
+        call f%list_datasets(names, records, e)
+        if (allocated(e)) reason = e%message
+        call f%close(ignored)
+    end function results_file_damage
 end module driver_results_mark

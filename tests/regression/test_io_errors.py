@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Errors of the files a run writes besides its HDF5 results, and of the files it finds
-(doc/output.md, "Write errors", the folder lock).
+(doc/output.md, "Write errors", the folder lock, "Checkpoints and restart").
 
 - The XDMF file: libgfortran did not report its write errors (exit 0 with a truncated or
   empty `.xdmf`). Its path '.partial' a link to /dev/full (every write ENOSPC), and a file
@@ -11,6 +11,10 @@
   first write and left an empty lock that refused every later run. Now exit 1 with the
   reason, no lock and no folder left, and the next run works. An empty lock (left so by an
   earlier version) is refused with how to remove it.
+- A damaged results file continued by --restart (truncated, its first bytes overwritten, 64
+  bytes of its metadata overwritten): the error says the file is damaged and names it (it said
+  that file had been moved or replaced by another run, or named the temporary copy and blamed
+  the deck).
 Usage (ctest does this): test_io_errors.py --exe multicor --work DIR --source REPO
 """
 import hashlib
@@ -98,6 +102,42 @@ def zero_file_size(exe, deck, work):
     check("the lock's own temporary files are gone", left == [], str(left))
 
 
+def damaged_results(exe, deck, work):
+    base = work / "damaged_base"
+    first = run(exe, deck, "--output", base, "--quiet", "--end", "0.3")
+    assert first.returncode == 0, first.stderr
+    size = (base / f"{deck.stem}.h5").stat().st_size
+    random_bytes = bytes((37 * k + 11) % 256 for k in range(64))
+
+    def truncate(f):
+        os.truncate(f, 400000)
+
+    def overwrite(offset):
+        def damage(f):
+            with open(f, "r+b") as h:
+                h.seek(offset)
+                h.write(random_bytes)
+        return damage
+
+    cases = [("truncated", truncate), ("first bytes overwritten", overwrite(0)),
+             ("metadata at byte 8000 overwritten", overwrite(8000))]
+    check("damaged results: the file is longer than its truncation", size > 400000, f"{size} bytes")
+    for name, damage in cases:
+        folder = work / ("damaged_" + name.split()[0])
+        shutil.rmtree(folder, ignore_errors=True)
+        shutil.copytree(base, folder)
+        result = folder / f"{deck.stem}.h5"
+        damage(result)
+        before = digests(folder)
+        proc = run(exe, deck, "--output", folder, "--quiet", "--restart", folder / "checkpoint.h5")
+        err = proc.stderr.strip()
+        check(f"damaged results ({name}): exit 1", proc.returncode == 1, f"exit {proc.returncode}")
+        check(f"damaged results ({name}): says the file is damaged, names it, and what to do",
+              f"the results file '{result}' of the checkpoint's run is damaged" in err and
+              ".partial" not in err and f"{deck.name}:" not in err and "without --restart" in err, err[-400:])
+        check(f"damaged results ({name}): the folder as it was", digests(folder) == before, "")
+
+
 def main():
     exe, work, src = arguments(fresh=True)
     deck = work / "cantilever.dat"
@@ -105,6 +145,7 @@ def main():
     os.environ.setdefault("OMP_NUM_THREADS", "1")
     xdmf_write_errors(exe, deck, work)
     zero_file_size(exe, deck, work)
+    damaged_results(exe, deck, work)
     sys.exit(summary())
 
 
