@@ -1,5 +1,5 @@
-/* File-system calls whose every failure is reported, for io_file_writer and io_lock
- * (src/io/file_writer.f90, src/io/lock.f90).
+/* File-system calls whose every failure is reported, for io_file_writer, io_lock and
+ * io_paths (src/io/file_writer.f90, src/io/lock.f90, src/io/paths.f90).
  *
  * libgfortran does not report some write errors of a formatted or stream unit: what it keeps
  * in its buffer and writes at a FLUSH or CLOSE fails without an error (writing to /dev/full,
@@ -80,6 +80,9 @@ int multicor_no_hard_links(int err)
 {
     return err == EPERM || err == ENOTSUP || err == EOPNOTSUPP || err == ENOSYS;
 }
+
+/* Create the folder `path` with mode 0755 (less the umask); 0 or errno. */
+int multicor_make_dir(const char *path) { return mkdir(path, 0755) == 0 ? 0 : errno; }
 
 /* The system's text for an errno ('No space left on device'), NUL-terminated in buf[n]. */
 void multicor_errno_text(int err, char *buf, long n)

@@ -3,7 +3,7 @@ module io_paths
     use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
     use, intrinsic :: iso_fortran_env, only: int64
     use core_error, only: error_t, make_error
-    use io_file_writer, only: file_writer_t
+    use io_file_writer, only: file_writer_t, system_error_text
     implicit none
     private
     public :: basename, dirname, stem, mkdir_p, remove_empty_folders, file_exists, remove_file, rename_file, copy_file
@@ -11,12 +11,11 @@ module io_paths
     public :: read_file_text
 
     interface
-        function c_mkdir(path, mode) bind(C, name='mkdir') result(rc)
+        function c_make_dir(path) bind(C, name='multicor_make_dir') result(err)
             import :: c_char, c_int
             character(kind=c_char), intent(in) :: path(*)
-            integer(c_int), value :: mode
-            integer(c_int) :: rc
-        end function c_mkdir
+            integer(c_int) :: err
+        end function c_make_dir
         function c_rmdir(path) bind(C, name='rmdir') result(rc)
             import :: c_char, c_int
             character(kind=c_char), intent(in) :: path(*)
@@ -84,23 +83,32 @@ contains
     subroutine mkdir_p(path, error, created)
         !> Folder to create.
         character(len=*), intent(in) :: path
-        !> Set if a folder could not be created.
+        !> Set if a folder could not be created, with the system's reason ('Permission
+        !> denied'), or the file in the way of a folder.
         type(error_t), allocatable, intent(out) :: error
         !> The outermost folder this call created ('' when `path` existed already), for
         !> `remove_empty_folders` to undo the call.
         character(len=:), allocatable, intent(out), optional :: created
         integer :: i
         integer(c_int) :: rc
+        character(len=:), allocatable :: parent
         if (present(created)) created = ''
         do i = 2, len_trim(path) + 1
             if (i <= len_trim(path)) then
                 if (path(i:i) /= '/') cycle
             end if
             if (file_exists(path(:i - 1))) cycle
-            rc = c_mkdir(path(:i - 1)//c_null_char, int(o'755', c_int))
+            rc = c_make_dir(path(:i - 1)//c_null_char)
             if (rc /= 0) then
                 if (file_exists(path(:i - 1))) cycle
-                call make_error(error, "cannot create folder '"//path(:i - 1)//"'")
+                parent = dirname(path(:i - 1))
+                if (file_exists(parent) .and. .not. file_exists(parent//'/.')) then
+                    ! ENOTDIR ('Not a directory') does not say which part of the path
+                    call make_error(error, "cannot create folder '"//path(:i - 1)//"': '"//parent// &
+                                    "' is a file, not a folder")
+                else
+                    call make_error(error, "cannot create folder '"//path(:i - 1)//"': "//system_error_text(int(rc)))
+                end if
                 return
             end if
             if (present(created)) then

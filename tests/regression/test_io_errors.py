@@ -15,6 +15,8 @@
   bytes of its metadata overwritten): the error says the file is damaged and names it (it said
   that file had been moved or replaced by another run, or named the temporary copy and blamed
   the deck).
+- A results folder that cannot be created (its parent read-only; a regular file in its
+  path): the error gives the reason.
 Usage (ctest does this): test_io_errors.py --exe multicor --work DIR --source REPO
 """
 import hashlib
@@ -138,6 +140,33 @@ def damaged_results(exe, deck, work):
         check(f"damaged results ({name}): the folder as it was", digests(folder) == before, "")
 
 
+def folder_errors(exe, deck, work):
+    # as user nobody when root (root may write a read-only folder)
+    user = 65534 if os.geteuid() == 0 else None
+    if user is not None and run(exe, "--version", user=user).returncode != 0:
+        print("skip   folder in a read-only folder: user nobody cannot run the program here")
+        user = -1
+    parent = work / "read_only"
+    parent.mkdir()
+    parent.chmod(0o555)
+    if user is not None:
+        work.chmod(0o755)
+    if user != -1:
+        proc = run(exe, deck, "--output", parent / "sub", "--quiet", "--end", "0.01", user=user)
+        err = proc.stderr.strip()
+        check("folder in a read-only folder: exit 1 with the reason", proc.returncode == 1 and
+              f"cannot create folder '{parent}/sub': Permission denied" in err,
+              f"exit {proc.returncode}: {err[-300:]}")
+    parent.chmod(0o755)
+    a_file = work / "a_file"
+    a_file.write_text("x\n")
+    proc = run(exe, deck, "--output", a_file / "sub" / "deeper", "--quiet", "--end", "0.01")
+    err = proc.stderr.strip()
+    check("folder under a regular file: exit 1 naming the file", proc.returncode == 1 and
+          f"cannot create folder '{a_file}/sub': '{a_file}' is a file, not a folder" in err,
+          f"exit {proc.returncode}: {err[-300:]}")
+
+
 def main():
     exe, work, src = arguments(fresh=True)
     deck = work / "cantilever.dat"
@@ -146,6 +175,7 @@ def main():
     xdmf_write_errors(exe, deck, work)
     zero_file_size(exe, deck, work)
     damaged_results(exe, deck, work)
+    folder_errors(exe, deck, work)
     sys.exit(summary())
 
 
