@@ -14,7 +14,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from .results import THETA, U, W, FigureFiles, Mesh, Results, ResultsError
+from .results import THETA, U, W, FigureFiles, Mesh, Results, ResultsError, max_over_records
 
 POINTS_PER_ELEMENT = 16
 
@@ -70,8 +70,8 @@ def default_node(res: Results) -> int:
     most; the last end node (else the last node) when nothing moves."""
     mesh = res.mesh
     if res.dynamic is not None:
-        motion = np.max(np.hypot(res.dynamic.displacement[..., U],
-                                 res.dynamic.displacement[..., W]), axis=0)
+        motion = max_over_records(res.dynamic.displacement,
+                                  lambda d: np.hypot(d[..., U], d[..., W]))
     elif res.static is not None:
         motion = np.hypot(res.static.displacement[:, U], res.static.displacement[:, W])
     else:
@@ -198,10 +198,11 @@ def plot_history(res: Results, node_id: Optional[int] = None) -> tuple[Figure, i
     ft, ut = _time_unit(dyn.time)
     fig = _new_figure(rows=2, height=3.0)
     ax_w, ax_u = fig.subplots(2, 1, sharex=True)
-    fw, uw = _length_unit(dyn.displacement[:, i, W])
-    fu, uu = _length_unit(dyn.displacement[:, i, U])
-    ax_w.plot(dyn.time * ft, dyn.displacement[:, i, W] * fw, color="C0")
-    ax_u.plot(dyn.time * ft, dyn.displacement[:, i, U] * fu, color="C1")
+    d = dyn.displacement[:, i]      # the node's history, read once
+    fw, uw = _length_unit(d[:, W])
+    fu, uu = _length_unit(d[:, U])
+    ax_w.plot(dyn.time * ft, d[:, W] * fw, color="C0")
+    ax_u.plot(dyn.time * ft, d[:, U] * fu, color="C1")
     ax_w.set_ylabel(f"w [{uw}]")
     ax_u.set_ylabel(f"u [{uu}]")
     ax_u.set_xlabel(f"time [{ut}]")

@@ -24,15 +24,17 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
 from .beam import _length_unit, _time_unit
-from .results import (FigureFiles, ResultsError, _open_results, complete_records,
-                      no_output_error, no_results_error, shape_error, unfinished_status)
+from .results import (FigureFiles, Records, ResultsError, _open_results, complete_records,
+                      complete_shape, max_over_records, no_output_error, no_results_error,
+                      shape_error, unfinished_status)
 
 
 @dataclass
 class ContinuumResults:
     """The /continuum group of one results file. ``u`` has one row per state: the static
     solution (time None), or the stored states of a dynamic run; ``stress`` likewise (None
-    for a modal run)."""
+    for a modal run). Those of a dynamic run, and the disks' positions of a coupled one, are
+    `Records`, read on demand (``res.u[k]`` reads state k); the rest are arrays."""
     path: str
     title: str
     analysis: str
@@ -40,11 +42,11 @@ class ContinuumResults:
     connectivity: np.ndarray   # (n_elements, 4), 1-based, 0 after a triangle's third node
     kind: np.ndarray           # (n_elements,) 1 = T3, 2 = Q4
     time: Optional[np.ndarray]
-    u: np.ndarray              # (n_states, n_nodes, 2) [m]
-    stress: Optional[np.ndarray]   # (n_states, n_elements, 3) [Pa]
+    u: np.ndarray              # (n_states, n_nodes, 2) [m] (dynamic: Records)
+    stress: Optional[np.ndarray]   # (n_states, n_elements, 3) [Pa] (dynamic: Records)
     energy: Optional[dict]
     frequency: Optional[np.ndarray] = None   # modal [Hz]
-    disk_position: Optional[np.ndarray] = None   # coupled: (n_out, n_disks, 3)
+    disk_position: Optional[Records] = None   # coupled: (n_out, n_disks, 3)
     disk_radius: Optional[np.ndarray] = None
     disk_time: Optional[np.ndarray] = None
     walls: Optional[np.ndarray] = None   # coupled: (n_out, n_walls, 4) x1, y1, x2, y2
@@ -113,7 +115,8 @@ def load_continuum(path) -> ContinuumResults:
             u = records(f, path, "continuum/displacement", time.size)
             stress = records(f, path, "continuum/stress", time.size)
             energy = {"time": need("continuum/energy/time")}
-            energy.update({name: records(f, path, f"continuum/energy/{name}", energy["time"].size)
+            energy.update({name: records(f, path, f"continuum/energy/{name}",
+                                         energy["time"].size, lazy=False)
                            for name in ENERGY_TERMS})
         res = ContinuumResults(path, title, analysis, x, connectivity, kind, time, u, stress,
                                energy, frequency)
@@ -124,21 +127,23 @@ def load_continuum(path) -> ContinuumResults:
                 raise no_output_error(f, path, "dem/time")
             res.disk_position = records(f, path, "dem/position", res.disk_time.size)
             if "dem/walls/position" in f:
-                res.walls = records(f, path, "dem/walls/position", res.disk_time.size)
+                res.walls = records(f, path, "dem/walls/position", res.disk_time.size, lazy=False)
     return res
 
 
-def records(f, path: str, name: str, n_out: int) -> np.ndarray:
+def records(f, path: str, name: str, n_out: int, lazy: bool = True):
     """The dataset ``name`` of the open results file ``path``, one record per stored output
-    (in a killed run's partial file, those of the outputs it wrote whole: `complete_records`):
-    ResultsError (`shape_error`) unless it holds ``n_out`` of them, or when it is missing."""
+    (in a killed run's partial file, those of the outputs it wrote whole: `complete_records`),
+    as `Records` read on demand (``lazy``: the fields), else as an array (the energy terms):
+    ResultsError (`shape_error`) unless it holds ``n_out`` of them, from the metadata, or when
+    it is missing."""
     if name not in f:
         raise ResultsError(f"{path}: missing dataset '/{name}' (not a MULTICOR continuum "
                            "results file, or one from another version)")
-    data = complete_records(f, name, f[name][...])
-    if data.ndim == 0 or data.shape[0] != n_out:
-        raise shape_error(f, path, name, data.shape, (n_out,) + data.shape[1:])
-    return data
+    shape = complete_shape(f, name)
+    if len(shape) == 0 or shape[0] != n_out:
+        raise shape_error(f, path, name, shape, (n_out,) + shape[1:])
+    return Records.of(f, path, name) if lazy else complete_records(f, name, f[name][...])
 
 
 def element_polygons(x, connectivity, kind, u=None, scale=1.0):
@@ -196,10 +201,11 @@ def plot_stress(res: ContinuumResults, time: Optional[float] = None,
         raise ResultsError(f"{res.path}: a {res.analysis} run stores no stress")
     k = res.nearest_index(time)
     u = res.u[k]
+    stress = res.stress[k]      # the state's, read once
     s = scale if scale is not None else auto_scale(res, u)
     deformed = element_polygons(res.x, res.connectivity, res.kind, u, s)
     outline = element_polygons(res.x, res.connectivity, res.kind)
-    fs, us = _stress_unit(res.stress[k])
+    fs, us = _stress_unit(stress)
     # one panel per component, as high as the body's shape asks (a slender one gets thin ones)
     corners = np.concatenate([res.x, res.x + s * u])
     extent = np.ptp(corners, axis=0)
@@ -208,9 +214,9 @@ def plot_stress(res: ContinuumResults, time: Optional[float] = None,
     axes = fig.subplots(3, 1, sharex=True)
     # a component below ROUNDOFF times the largest one is round-off (sigma_yy of a bar in
     # uniaxial tension): drawn white, not as a saturated pattern of noise
-    overall = float(np.max(np.abs(res.stress[k]))) * fs if res.stress[k].size else 0.0
+    overall = float(np.max(np.abs(stress))) * fs if stress.size else 0.0
     for c, (ax, name) in enumerate(zip(axes, ("σ_xx", "σ_yy", "σ_xy"))):
-        values = res.stress[k, :, c] * fs
+        values = stress[:, c] * fs
         # colour limits at the 99th percentile of |value|, so that a few elements at a corner
         # singularity (a clamped edge) do not wash out the field; the colour bar says so
         top = float(np.max(np.abs(values)))
@@ -245,8 +251,9 @@ def plot_stress(res: ContinuumResults, time: Optional[float] = None,
 
 
 def default_node(res: ContinuumResults) -> int:
-    """0-based index of the node with the largest displacement over the stored states."""
-    return int(np.argmax(np.max(np.hypot(res.u[..., 0], res.u[..., 1]), axis=0)))
+    """0-based index of the node with the largest displacement over the stored states (read
+    block by block: `max_over_records`)."""
+    return int(np.argmax(max_over_records(res.u, lambda u: np.hypot(u[..., 0], u[..., 1]))))
 
 
 def plot_history(res: ContinuumResults, node: Optional[int] = None) -> tuple[Figure, int]:
@@ -259,11 +266,12 @@ def plot_history(res: ContinuumResults, node: Optional[int] = None) -> tuple[Fig
         raise ResultsError(f"{res.path}: no node {node} (the mesh has {res.x.shape[0]} nodes)")
     ft, ut = _time_unit(res.time)
     # the unit of the beam plots (m, mm or µm by the largest value)
-    fl, ul = _length_unit(res.u[:, n])
+    u = res.u[:, n]     # the node's history, read once
+    fl, ul = _length_unit(u)
     fig = _figure(height=4.5)
     ax = fig.subplots()
-    ax.plot(res.time * ft, res.u[:, n, 0] * fl, label="u_x")
-    ax.plot(res.time * ft, res.u[:, n, 1] * fl, label="u_y")
+    ax.plot(res.time * ft, u[:, 0] * fl, label="u_x")
+    ax.plot(res.time * ft, u[:, 1] * fl, label="u_y")
     ax.set_xlabel(f"time [{ut}]")
     ax.set_ylabel(f"displacement [{ul}]")
     ax.grid(True, alpha=0.3)

@@ -24,7 +24,7 @@ from matplotlib.collections import EllipseCollection
 from matplotlib.figure import Figure
 
 from .beam import _time_unit
-from .results import (FigureFiles, ResultsError, _decode_attrs, _Getter, _open_results,
+from .results import (FigureFiles, Records, ResultsError, _decode_attrs, _Getter, _open_results,
                       no_output_error)
 
 #: Columns of the nodal and per-disk arrays: x (u), y (w), rotation.
@@ -140,7 +140,9 @@ def region_forces(path) -> tuple[np.ndarray, np.ndarray]:
 
 @dataclass
 class CoupledResults:
-    """The three parts of a coupled results file, at the stored outputs."""
+    """The three parts of a coupled results file, at the stored outputs. The fields of the
+    beam and of the disks are `Records`, read on demand (``res.position[k]`` reads output k);
+    the rest are arrays."""
 
     path: str
     attrs: dict                  # root attributes (title, ...)
@@ -148,11 +150,11 @@ class CoupledResults:
     node_y: np.ndarray           # (n_nodes,) [m]
     connectivity: np.ndarray     # (n_elements, 2), 0-based
     time: np.ndarray             # (n_out,) [s] (the same outputs for /fem, /dem, /coupling)
-    fe_displacement: np.ndarray  # (n_out, n_nodes, 3): u, w, theta
-    fe_velocity: np.ndarray      # (n_out, n_nodes, 3)
+    fe_displacement: Records     # (n_out, n_nodes, 3): u, w, theta
+    fe_velocity: Records         # (n_out, n_nodes, 3)
     radius: np.ndarray           # (n,) [m]
-    position: np.ndarray         # (n_out, n, 3): x, y, rot
-    velocity: np.ndarray         # (n_out, n, 3)
+    position: Records            # (n_out, n, 3): x, y, rot
+    velocity: Records            # (n_out, n, 3)
     overlap: np.ndarray          # (2,): s_fe, s_particle [m]
     coupled: np.ndarray          # (n_points,) 0-based disk indices
     alpha: np.ndarray            # (n_points,) weight at the coupled disks
@@ -222,10 +224,10 @@ def load_coupled(path) -> CoupledResults:
         return CoupledResults(
             path=path, attrs=_decode_attrs(f.attrs), node_x=xy[:, 0], node_y=xy[:, 1],
             connectivity=get("fem/mesh/connectivity", (None, 2)).astype(int) - 1, time=time,
-            fe_displacement=get("fem/displacement", (n_out, n_nodes, 3)),
-            fe_velocity=get("fem/velocity", (n_out, n_nodes, 3)), radius=radius,
-            position=get("dem/position", (n_out, n, 3)),
-            velocity=get("dem/velocity", (n_out, n, 3)),
+            fe_displacement=get.records("fem/displacement", (n_out, n_nodes, 3)),
+            fe_velocity=get.records("fem/velocity", (n_out, n_nodes, 3)), radius=radius,
+            position=get.records("dem/position", (n_out, n, 3)),
+            velocity=get.records("dem/velocity", (n_out, n, 3)),
             overlap=get("coupling/overlap", (2,)),
             coupled=get("coupling/particles", (None,)).astype(int) - 1,
             alpha=get("coupling/alpha", (None,)),

@@ -17,8 +17,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from .beam import _time_unit
-from .results import (FigureFiles, ResultsError, _decode_attrs, _Getter, _open_results,
-                      no_output_error)
+from .results import (FigureFiles, Records, ResultsError, _decode_attrs, _Getter, _open_results,
+                      abs_max, no_output_error)
 
 #: Columns of the per-disk arrays: x [m], y [m], rotation [rad].
 X, Y, ROT = 0, 1, 2
@@ -36,16 +36,17 @@ NOISE = 1e-6
 @dataclass
 class Contacts:
     """Contact network at the stored outputs, compressed rows: the contacts of output k are
-    entries ``offset[k]:offset[k + 1]`` of the other arrays."""
+    entries ``offset[k]:offset[k + 1]`` of the other arrays. The lists are `Records`, read on
+    demand (``c.rn[c.at(k)]`` reads output k's); the offsets are an array."""
 
     offset: np.ndarray    # (n_out + 1,) int
-    i: np.ndarray         # (n_c,) int, 1-based disk
-    j: np.ndarray         # (n_c,) int, 1-based disk (> 0) or wall (-j, < 0)
-    normal: np.ndarray    # (n_c, 2), unit, from j to i
-    rn: np.ndarray        # (n_c,) [N/m], > 0 compression, < 0 cohesive tension
-    rt: np.ndarray        # (n_c,) [N/m]
-    status: np.ndarray    # (n_c,) int, STATUS_NAMES
-    m: Optional[np.ndarray] = None  # (n_c,) [N.m/m] contact moment on i (files before it: None)
+    i: Records            # (n_c,) int, 1-based disk
+    j: Records            # (n_c,) int, 1-based disk (> 0) or wall (-j, < 0)
+    normal: Records       # (n_c, 2), unit, from j to i
+    rn: Records           # (n_c,) [N/m], > 0 compression, < 0 cohesive tension
+    rt: Records           # (n_c,) [N/m]
+    status: Records       # (n_c,) int, STATUS_NAMES
+    m: Optional[Records] = None  # (n_c,) [N.m/m] contact moment on i (files before it: None)
 
     def at(self, k: int) -> slice:
         """Entries of output ``k``."""
@@ -88,7 +89,8 @@ class Solver:
 
 @dataclass
 class DemResults:
-    """The /dem group of a results file."""
+    """The /dem group of a results file. The positions and velocities are `Records`, read on
+    demand (``res.position[k]`` reads output k); the other fields are arrays."""
 
     path: str
     attrs: dict                    # root attributes (title, analysis, ...)
@@ -96,8 +98,8 @@ class DemResults:
     mass: np.ndarray               # (n,) [kg/m]
     material: np.ndarray           # (n,) deck material ids
     time: np.ndarray               # (n_out,) [s]
-    position: np.ndarray           # (n_out, n, 3): x, y, rot
-    velocity: np.ndarray           # (n_out, n, 3)
+    position: Records              # (n_out, n, 3): x, y, rot
+    velocity: Records              # (n_out, n, 3)
     walls: Optional[np.ndarray]    # (n_out, n_walls, 4): x1, y1, x2, y2, or None
     energy: DemEnergy
     solver: Solver
@@ -159,8 +161,8 @@ def load_dem(path) -> DemResults:
         res = DemResults(path=path, attrs=_decode_attrs(f.attrs), radius=radius,
                          mass=get("dem/particles/mass", (n,)),
                          material=get("dem/particles/material", (n,)).astype(int),
-                         time=time, position=get("dem/position", (n_out, n, 3)),
-                         velocity=get("dem/velocity", (n_out, n, 3)), walls=walls,
+                         time=time, position=get.records("dem/position", (n_out, n, 3)),
+                         velocity=get.records("dem/velocity", (n_out, n, 3)), walls=walls,
                          energy=energy, solver=solver)
         if "dem/contacts" in f:
             offset = get("dem/contacts/offset", (n_out + 1,)).astype(int)
@@ -168,13 +170,14 @@ def load_dem(path) -> DemResults:
             if offset.size and (offset[0] != 0 or np.any(np.diff(offset) < 0)):
                 raise ResultsError(f"{path}: /dem/contacts/offset must start at 0 and not "
                                    "decrease")
-            res.contacts = Contacts(offset=offset, i=get("dem/contacts/i", (m,)).astype(int),
-                                    j=get("dem/contacts/j", (m,)).astype(int),
-                                    normal=get("dem/contacts/normal", (m, 2)),
-                                    rn=get("dem/contacts/rn", (m,)),
-                                    rt=get("dem/contacts/rt", (m,)),
-                                    status=get("dem/contacts/status", (m,)).astype(int),
-                                    m=get("dem/contacts/m", (m,)) if "dem/contacts/m" in f else None)
+            lists = get.records
+            res.contacts = Contacts(offset=offset, i=lists("dem/contacts/i", (m,)).astype(int),
+                                    j=lists("dem/contacts/j", (m,)).astype(int),
+                                    normal=lists("dem/contacts/normal", (m, 2)),
+                                    rn=lists("dem/contacts/rn", (m,)),
+                                    rt=lists("dem/contacts/rt", (m,)),
+                                    status=lists("dem/contacts/status", (m,)).astype(int),
+                                    m=lists("dem/contacts/m", (m,)) if "dem/contacts/m" in f else None)
     return res
 
 
@@ -209,10 +212,11 @@ def force_segments(res: DemResults, k: int):
 
 
 def force_scale(res: DemResults) -> float:
-    """Largest |r_n| of the run [N/m] (0 without contacts)."""
+    """Largest |r_n| of the run [N/m] (0 without contacts), the contact lists read block by
+    block (`abs_max`)."""
     if res.contacts is None or res.contacts.rn.size == 0:
         return 0.0
-    return float(np.max(np.abs(res.contacts.rn)))
+    return abs_max(res.contacts.rn)
 
 
 def force_widths(rn: np.ndarray, scale: Optional[float] = None) -> np.ndarray:
@@ -270,7 +274,7 @@ def plot_configuration(res: DemResults, k: Optional[int] = None) -> Figure:
         handles.append(Line2D([], [], color="0.4", marker="x", ls="", label="broken bonds"))
     if res.contacts is not None and res.contacts.m is not None:
         mom = np.abs(res.contacts.m[res.contacts.at(k)])
-        big = mom > NOISE * max(float(np.max(np.abs(res.contacts.m))), 0.0) if mom.size else mom > 0
+        big = mom > NOISE * abs_max(res.contacts.m) if mom.size else mom > 0
         if np.any(big):
             mid = segments[big].mean(axis=1)
             ax.scatter(mid[:, 0], mid[:, 1], s=80.0 * mom[big] / mom[big].max(), facecolors="none",
@@ -413,9 +417,11 @@ def plot_velocities(res: DemResults) -> Figure:
     fig = _new_figure(height=7.0)
     axes = fig.subplots(3, 1, sharex=True)
     labels = ["v_x [m/s]", "v_y [m/s]", "ω [rad/s]"]
+    for i in range(res.n):
+        v = res.velocity[:, i]      # the disk's history, read once
+        for d, ax in enumerate(axes):
+            ax.plot(t, v[:, d], lw=1.0, label=f"disk {i + 1}" if d == 0 else None)
     for d, ax in enumerate(axes):
-        for i in range(res.n):
-            ax.plot(t, res.velocity[:, i, d], lw=1.0, label=f"disk {i + 1}" if d == 0 else None)
         ax.set_ylabel(labels[d])
         ax.grid(True, alpha=0.3)
     axes[-1].set_xlabel(f"time [{ut}]")

@@ -1,12 +1,21 @@
-"""Load a MULTICOR results file (HDF5, layout in doc/output.md) into plain numpy arrays.
+"""Load a MULTICOR results file (HDF5, layout in doc/output.md).
 
 Every array is in h5py (C) order: nodal fields are ``(n_nodes, 3)`` with the columns
 ``u`` (x displacement), ``w`` (y displacement), ``theta`` (rotation about z); time series add
 a first axis, one entry per stored output.
+
+The loaders read the mesh, the times, the energy audits and the per-step series into numpy
+arrays. The series whose size grows with the outputs times the nodes, disks or contacts
+(the fields of a mesh, the disks' positions and velocities, the contact lists) are `Records`:
+they read the part asked for when indexed (``res.position[k]`` reads output k only), so that
+a plot of a few outputs of a cluster-sized run needs the memory of those outputs, not of the
+file. A `Records` opens the file for each read and closes it after; the loaders leave no file
+open.
 """
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import sys
@@ -248,9 +257,10 @@ class Dynamic:
     """Stored outputs of a dynamic run."""
 
     time: np.ndarray           # (n_out,) [s]
-    displacement: np.ndarray   # (n_out, n_nodes, 3) [m, m, rad]
-    velocity: np.ndarray       # (n_out, n_nodes, 3) [m/s, m/s, rad/s]
-    acceleration: np.ndarray   # (n_out, n_nodes, 3) [m/s^2, m/s^2, rad/s^2]
+    # the fields: Records, read on demand (module doc), or arrays of the same shape
+    displacement: Records      # (n_out, n_nodes, 3) [m, m, rad]
+    velocity: Records          # (n_out, n_nodes, 3) [m/s, m/s, rad/s]
+    acceleration: Records      # (n_out, n_nodes, 3) [m/s^2, m/s^2, rad/s^2]
 
     def nearest_index(self, t: float) -> int:
         """Index of the stored output whose time is nearest to ``t`` (first one on a tie)."""
@@ -343,9 +353,9 @@ def load_results(path) -> Results:
                 raise no_output_error(f, path, "fem/time")
             shape = (time.size, n, 3)
             res.dynamic = Dynamic(time=time,
-                                  displacement=reader.array("fem/displacement", shape=shape),
-                                  velocity=reader.array("fem/velocity", shape=shape),
-                                  acceleration=reader.array("fem/acceleration", shape=shape))
+                                  displacement=reader.records("fem/displacement", shape),
+                                  velocity=reader.records("fem/velocity", shape),
+                                  acceleration=reader.records("fem/acceleration", shape))
         if "energy" in f:
             time = reader.array("energy/time", ndim=1)
             parts = {name: reader.array(f"energy/{name}", shape=time.shape)
@@ -465,21 +475,281 @@ def complete_records(f, name: str, data: np.ndarray) -> np.ndarray:
     not finish, the series of stored outputs (extendible datasets, but the per-step and event
     series) are cut to that many records, and the contact lists of /dem/contacts to that
     output's offset. Other datasets, finished files and files without the count are returned
-    as they are."""
+    as they are (`complete_cut`)."""
+    if data.ndim == 0:
+        return data
+    cut = complete_cut(f, name)
+    return data if cut is None else data[:cut]
+
+
+def complete_cut(f, name: str) -> Optional[int]:
+    """The end ``e`` such that ``data[:e]`` are the records of dataset `name` of the open file
+    `f` that `complete_records` keeps, from the file's metadata (and one entry of
+    /dem/contacts/offset); None when it keeps them all."""
     summary = f.get("summary")
-    if summary is None or "outputs" not in summary.attrs or data.ndim == 0:
-        return data
+    if summary is None or "outputs" not in summary.attrs or f[name].ndim == 0:
+        return None
     if int(summary.attrs.get("finished", 1)) != 0:
-        return data
+        return None
     if f[name].maxshape[0] is not None or name.startswith(_NOT_OUTPUT_SERIES):
-        return data
+        return None
     n = int(summary.attrs["outputs"])
     if name == "dem/contacts/offset":
-        return data[:n + 1]
+        return n + 1
     if name.startswith("dem/contacts/"):
         offset = f["dem/contacts/offset"]
-        return data[:int(offset[min(n, len(offset) - 1)])] if len(offset) else data
-    return data[:n]
+        return int(offset[min(n, len(offset) - 1)]) if len(offset) else None
+    return n
+
+
+def complete_shape(f, name: str) -> tuple:
+    """The shape of the records of dataset `name` that `complete_records` keeps, from the
+    file's metadata: nothing is read but one entry of /dem/contacts/offset."""
+    shape = tuple(f[name].shape)
+    cut = complete_cut(f, name)
+    if cut is None or not shape:
+        return shape
+    return (len(range(shape[0])[:cut]),) + shape[1:]
+
+
+#: Largest block of a `Records` read at once by a reduction over all its records
+#: (`abs_max`, `max_over_records`) [bytes]: 16 MiB, small beside a plot's own memory (a
+#: configuration figure of 10^4 disks at 240 dpi takes about 100 MB) and large enough that a
+#: series is read in few calls (a contact list of 10^8 entries in 50 blocks).
+BLOCK_BYTES = 1 << 24
+
+
+class Records:
+    """A series of a results file read on demand: one of the datasets that grow with the
+    outputs times the nodes, disks or contacts (module doc). Indexing reads the records it
+    selects, as a numpy array of `dtype` (the values of numpy indexing): an integer or a slice
+    on the first axis, then integers, slices or one increasing index array go to HDF5 as a
+    selection; other index arrays and masks read the records the first index selects, then
+    index them in memory. ``np.asarray(records)`` reads them all. The file is opened for
+    each read and closed after it. `shape` is that of the records the loader kept (in a
+    killed run's partial file, those of the outputs written whole: `complete_records`)."""
+
+    def __init__(self, path: str, name: str, shape: tuple, dtype, source_dtype=None):
+        #: results file
+        self.path = path
+        #: dataset, without the leading '/'
+        self.name = name
+        #: shape of the records kept
+        self.shape = tuple(int(s) for s in shape)
+        #: type of the values returned
+        self.dtype = np.dtype(dtype)
+        self._source_dtype = np.dtype(dtype if source_dtype is None else source_dtype)
+        self._abs_max: Optional[float] = None
+
+    @classmethod
+    def of(cls, f, path: str, name: str, dtype=None) -> "Records":
+        """The records of dataset `name` of the open results file `f` (at `path`) that
+        `complete_records` keeps; values of the dataset's type unless `dtype` is given."""
+        source = f[name].dtype
+        return cls(path, name, complete_shape(f, name), source if dtype is None else dtype,
+                   source)
+
+    @property
+    def ndim(self) -> int:
+        return len(self.shape)
+
+    @property
+    def size(self) -> int:
+        return int(np.prod(self.shape, dtype=np.int64))
+
+    def __len__(self) -> int:
+        if not self.shape:
+            raise TypeError("len() of a 0-d series")
+        return self.shape[0]
+
+    def __repr__(self) -> str:
+        return f"Records('{self.path}', '/{self.name}', shape={self.shape}, dtype={self.dtype})"
+
+    def astype(self, dtype) -> "Records":
+        """The same records, read as values of `dtype` (nothing is read now)."""
+        return Records(self.path, self.name, self.shape, dtype, self._source_dtype)
+
+    def __array__(self, dtype=None, copy=None):
+        data = self[...]
+        return data if dtype is None else data.astype(dtype, copy=False)
+
+    def __iter__(self):
+        for k in range(len(self)):
+            yield self[k]
+
+    def __getitem__(self, key):
+        key = self._expand(key)
+        if not key:
+            key = (slice(None),)
+        first = _normalized_index(key[0], self.shape[0])
+        rest = tuple(_normalized_index(k, n, axis)
+                     for axis, (k, n) in enumerate(zip(key[1:], self.shape[1:]), start=1))
+        with self._dataset() as ds:
+            if _selection(first, rest):
+                data = ds[(first,) + rest]
+            else:
+                lo, hi, local = _covering(first, self.shape[0])
+                data = ds[lo:hi][(local,) + tuple(key[1:])]
+        return self._convert(data)
+
+    def abs_max(self) -> float:
+        """Largest |value| of all the records (0 for none), read block by block
+        (`BLOCK_BYTES`); kept for the next call."""
+        if self._abs_max is None:
+            top = 0.0
+            for block in self._blocks():
+                if block.size:
+                    top = max(top, float(np.max(np.abs(block))))
+            self._abs_max = top
+        return self._abs_max
+
+    def max_over_records(self, per_record) -> np.ndarray:
+        """``np.max(per_record(values), axis=0)`` over all the records, read block by block
+        (`BLOCK_BYTES`); `per_record` maps a block of records (first axis) to one value per
+        record and entry, e.g. the displacement's length at each node."""
+        top = None
+        for block in self._blocks():
+            if block.shape[0]:
+                part = np.max(per_record(block), axis=0)
+                top = part if top is None else np.maximum(top, part)
+        if top is None:
+            raise ValueError(f"/{self.name} holds no record")
+        return top
+
+    def _blocks(self):
+        """The records in consecutive blocks of at most BLOCK_BYTES (one record at least),
+        the file open while they are read."""
+        record = max(self.dtype.itemsize, self._source_dtype.itemsize) * int(
+            np.prod(self.shape[1:], dtype=np.int64))
+        step = max(1, BLOCK_BYTES // max(record, 1))
+        with self._dataset() as ds:
+            for lo in range(0, self.shape[0], step):
+                yield self._convert(ds[lo:min(lo + step, self.shape[0])])
+
+    def _expand(self, key) -> tuple:
+        """The key as a tuple of one index per axis at most (Ellipsis expanded)."""
+        key = key if isinstance(key, tuple) else (key,)
+        if any(k is None for k in key):
+            raise IndexError(f"/{self.name}: np.newaxis is not supported on a series read on "
+                             "demand (index np.asarray(...) or the records read)")
+        dots = [i for i, k in enumerate(key) if k is Ellipsis]
+        if len(dots) > 1:
+            raise IndexError("an index can only have a single ellipsis ('...')")
+        if dots:
+            i = dots[0]
+            key = key[:i] + (slice(None),) * (self.ndim - len(key) + 1) + key[i + 1:]
+        if len(key) > self.ndim:
+            raise IndexError(f"too many indices for /{self.name}: it has {self.ndim} "
+                             f"dimensions but {len(key)} were indexed")
+        return key
+
+    def _convert(self, data):
+        data = np.asarray(data)
+        if data.dtype != self.dtype:
+            data = data.astype(self.dtype)
+        return data[()] if data.ndim == 0 else data
+
+    @contextlib.contextmanager
+    def _dataset(self):
+        """The dataset, in the results file opened for one read: ResultsError when the file
+        cannot be opened again or no longer holds the records the loader found."""
+        try:
+            f = h5py.File(self.path, "r")
+        except OSError as exc:
+            raise ResultsError(f"'{self.path}' cannot be read again to get /{self.name} "
+                               f"({' '.join(str(exc).split())}): it was moved, removed or is "
+                               "being rewritten since it was loaded") from None
+        with f:
+            ds = f.get(self.name)
+            if (not isinstance(ds, h5py.Dataset) or tuple(ds.shape[1:]) != self.shape[1:]
+                    or (self.shape and ds.shape[0] < self.shape[0])):
+                got = "none" if not isinstance(ds, h5py.Dataset) else f"shape {tuple(ds.shape)}"
+                raise ResultsError(f"'{self.path}' changed since it was loaded: /{self.name} "
+                                   f"has {got}, {self.shape} when it was loaded (load it "
+                                   "again)")
+            yield ds
+
+
+def _normalized_index(key, n: int, axis: int = 0):
+    """The index of axis `axis` of a series, of length `n` (the first axis: the records
+    kept): an integer made non-negative and checked, a slice of positive step bounded to the
+    axis, an index array or a mask as a checked integer array."""
+    if isinstance(key, (int, np.integer)):
+        k = int(key)
+        if not -n <= k < n:
+            raise IndexError(f"index {k} is out of bounds for axis {axis} with size {n}")
+        return k + n if k < 0 else k
+    if isinstance(key, slice):
+        start, stop, step = key.indices(n)
+        if step > 0:
+            return slice(start, max(start, stop), step)
+        return key
+    return _index_array(key, n, axis)
+
+
+def _index_array(key, n: int, axis: int) -> np.ndarray:
+    """An index array or a boolean mask along an axis of length `n`, as checked
+    non-negative integers."""
+    a = np.asarray(key)
+    if a.dtype == bool:
+        if a.shape != (n,):
+            raise IndexError(f"boolean index of shape {a.shape} does not match axis {axis} "
+                             f"of size {n}")
+        return np.flatnonzero(a)
+    if a.dtype.kind not in "iu":
+        raise IndexError("only integers, slices, ellipsis and integer or boolean arrays are "
+                         "valid indices")
+    if a.size and (a.min() < -n or a.max() >= n):
+        raise IndexError(f"index out of bounds for axis {axis} with size {n}")
+    return np.where(a < 0, a + n, a)
+
+
+def _selection(first, rest) -> bool:
+    """Whether HDF5 selects (first, *rest) as numpy would index: integers, slices of
+    positive step, and at most one 1-D strictly increasing index array."""
+    arrays = 0
+    for k in (first,) + rest:
+        if isinstance(k, int) or (isinstance(k, slice) and (k.step or 1) > 0):
+            continue
+        if isinstance(k, np.ndarray) and k.ndim == 1 and k.size and np.all(np.diff(k) > 0):
+            arrays += 1
+            continue
+        return False
+    return arrays <= 1
+
+
+def _covering(first, n: int) -> tuple[int, int, object]:
+    """(lo, hi, local): the range of records lo:hi that holds those the first index selects,
+    and that index within the range."""
+    if isinstance(first, int):
+        return first, first + 1, 0
+    if isinstance(first, slice):
+        picked = range(n)[first]
+        if len(picked) == 0:
+            return 0, 0, slice(None)
+        lo, hi = min(picked[0], picked[-1]), max(picked[0], picked[-1]) + 1
+        stop = picked[-1] - lo - 1 if picked.step < 0 else picked[-1] - lo + 1
+        return lo, hi, slice(picked[0] - lo, None if stop < 0 else stop, picked.step)
+    if first.size == 0:
+        return 0, 0, first
+    lo, hi = int(first.min()), int(first.max()) + 1
+    return lo, hi, first - lo
+
+
+def abs_max(values) -> float:
+    """Largest |value| of an array or a `Records` (block by block), 0 for none."""
+    if isinstance(values, Records):
+        return values.abs_max()
+    values = np.asarray(values)
+    return float(np.max(np.abs(values))) if values.size else 0.0
+
+
+def max_over_records(values, per_record) -> np.ndarray:
+    """``np.max(per_record(values), axis=0)`` of an array or a `Records` (block by block:
+    `Records.max_over_records`)."""
+    if isinstance(values, Records):
+        return values.max_over_records(per_record)
+    return np.max(per_record(np.asarray(values)), axis=0)
 
 
 class _Reader:
@@ -490,26 +760,37 @@ class _Reader:
         self.path = path
 
     def array(self, name, ndim=None, shape=None):
+        self._check(name, ndim, shape)
+        data = np.asarray(self.f[name][()], dtype=float if self.f[name].dtype.kind == "f"
+                          else None)
+        return complete_records(self.f, name, data)
+
+    def records(self, name, shape):
+        """The dataset as `Records` (read on demand), its shape checked from the metadata."""
+        self._check(name, None, shape)
+        return Records.of(self.f, self.path, name,
+                          dtype=float if self.f[name].dtype.kind == "f" else None)
+
+    def _check(self, name, ndim, shape):
+        """ResultsError unless the records of dataset `name` that `complete_records` keeps
+        have `ndim` dimensions and the `shape` (None = any extent), from the metadata."""
         if name not in self.f or not isinstance(self.f[name], h5py.Dataset):
             raise ResultsError(f"{self.path}: missing dataset '/{name}' (not a MULTICOR "
                                "results file, or one from another version)")
-        data = np.asarray(self.f[name][()], dtype=float if self.f[name].dtype.kind == "f"
-                          else None)
-        data = complete_records(self.f, name, data)
+        got = complete_shape(self.f, name)
         if shape is not None:
             ndim = len(shape)
-        if ndim is not None and data.ndim != ndim:
-            raise ResultsError(f"{self.path}: dataset '/{name}' has {data.ndim} dimensions, "
+        if ndim is not None and len(got) != ndim:
+            raise ResultsError(f"{self.path}: dataset '/{name}' has {len(got)} dimensions, "
                                f"expected {ndim}")
-        if shape is not None and any(want is not None and got != want
-                                     for got, want in zip(data.shape, shape)):
-            raise shape_error(self.f, self.path, name, data.shape, shape)
-        return data
+        if shape is not None and any(want is not None and g != want
+                                     for g, want in zip(got, shape)):
+            raise shape_error(self.f, self.path, name, got, shape)
 
 
 class _Getter:
     """Reads a dataset and checks its shape (None = any extent); `kind` names the file in the
-    message for a missing dataset."""
+    message for a missing dataset. `records` gives a series read on demand instead."""
 
     def __init__(self, f, path, kind="results file"):
         self.f = f
@@ -517,14 +798,23 @@ class _Getter:
         self.kind = kind
 
     def __call__(self, name, shape):
+        self._check(name, shape)
+        return complete_records(self.f, name, np.asarray(self.f[name][()]))
+
+    def records(self, name, shape) -> Records:
+        """The dataset as `Records` (read on demand), its shape checked from the metadata."""
+        self._check(name, shape)
+        return Records.of(self.f, self.path, name)
+
+    def _check(self, name, shape):
+        """ResultsError unless dataset `name` exists and the records `complete_records` keeps
+        have the `shape`, from the metadata."""
         if name not in self.f or not isinstance(self.f[name], h5py.Dataset):
             raise ResultsError(f"{self.path}: missing dataset '/{name}' (not a MULTICOR "
                                f"{self.kind}, or one from another version)")
-        data = complete_records(self.f, name, np.asarray(self.f[name][()]))
-        if data.ndim != len(shape) or any(w is not None and g != w
-                                          for g, w in zip(data.shape, shape)):
-            raise shape_error(self.f, self.path, name, data.shape, shape)
-        return data
+        got = complete_shape(self.f, name)
+        if len(got) != len(shape) or any(w is not None and g != w for g, w in zip(got, shape)):
+            raise shape_error(self.f, self.path, name, got, shape)
 
 
 def _decode_attrs(attrs) -> dict:
