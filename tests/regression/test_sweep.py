@@ -188,6 +188,26 @@ def script_functions(src, work):
     state = sweep.point_state(folder, {"name": "p001"})
     check("point_state: exit_status -15 (Python's code of SIGTERM) with a checkpoint: 'checkpoint'",
           state == "checkpoint", state)
+    # scalar_value reads only the selected records through h5py; the selections h5py does not
+    # take (a negative step) are read whole and selected as numpy does: both give numpy's values
+    import h5py
+    import numpy as np
+    data = np.arange(60.0).reshape(5, 4, 3) - 17.0
+    with h5py.File(work / "scalars.h5", "w") as f:
+        f["s"] = data
+    with h5py.File(work / "scalars.h5", "r") as f:
+        cases = {"s[-1,1,0]": data[-1, 1, 0], "max(s[:,1,0])": data[:, 1, 0].max(),
+                 "sum(s[::-1,0,2])": data[::-1, 0, 2].sum(), "absmax(s[1:3,-1])": np.abs(data[1:3, -1]).max(),
+                 "mean(s)": data.mean()}
+        got = {spec: sweep.scalar_value(f, f"x={spec}") for spec in cases}
+        try:
+            sweep.scalar_value(f, "x=s[7,0,0]")
+            out_of_range = "no error"
+        except IndexError as e:
+            out_of_range = f"IndexError {e}"
+    check("scalar_value: selections read through h5py or whole give numpy's values; an index out "
+          "of range is numpy's IndexError", got == {k: float(v) for k, v in cases.items()}
+          and out_of_range.startswith("IndexError"), f"{got}, {out_of_range}")
 
 
 def same_record(src, exe, work):
