@@ -17,7 +17,10 @@
 !> finished = 0 and set to 1 by `close`;
 !> the run loops `flush` after every output, so the partial file of a killed run opens and
 !> holds every output up to the last one. A run stopped by a signal (`stop_at`) is closed by
-!> `close_unfinished`: it stays '.partial' with finished = 0 and the reason in /summary.
+!> `close_unfinished`: it stays '.partial' with finished = 0 and the reason in /summary. A run
+!> that ended but cannot complete its end after its final checkpoint (its XDMF file cannot be
+!> written: `close_partial`; the final rename fails: `close`) keeps its file whole as '.partial'
+!> (`kept_partial`), the state a kill there leaves, which a restart from that checkpoint finishes.
 !> Arrays per node are (3, n_nodes) in Fortran = (n_nodes, 3) in h5py, with the
 !> DOFs u (x), w (y), theta (rotation about z); time series add a last Fortran dimension
 !> (the first in h5py) per stored output.
@@ -76,6 +79,10 @@ module driver_results
         logical, allocatable :: own(:)
         !> Stored outputs flushed whole so far (/summary@outputs).
         integer :: outputs = 0
+        !> Whether the file of a run that ended was closed whole but keeps its partial name
+        !> (`close_partial`, or `close` whose rename failed); the earlier partial file set aside and
+        !> the files beside the results are then settled as for a stopped run.
+        logical :: kept_partial = .false.
     contains
         !> Create the results file (written as .partial until `close`).
         procedure :: open => writer_open
@@ -109,6 +116,9 @@ module driver_results
         procedure :: close => writer_close
         !> Close a stopped run: the file stays .partial with the reason in /summary.
         procedure :: close_unfinished => writer_close_unfinished
+        !> Close the file of a run that ended, with no more writes, as '.partial' (its end could
+        !> not be completed: the XDMF file cannot be written).
+        procedure :: close_partial => writer_close_partial
         !> Close and delete the partial file after an error.
         procedure :: abort => writer_abort
         !> True while the file is open.
@@ -672,8 +682,8 @@ contains
     end function writer_stopped
 
     !> Close the file and rename '<final_path>.partial' to `final_path` (replacing an earlier
-    !> file). If the rename fails, the results stay in the partial file (the error says so) and
-    !> the earlier file is left as it was.
+    !> file). If the rename fails, the results stay whole in the partial file (`kept_partial`),
+    !> settled as by `close_partial`, and the earlier file is left as it was.
     subroutine writer_close(self, error)
         !> An open writer; closed on return.
         class(results_writer_t), intent(inout) :: self
@@ -698,8 +708,8 @@ contains
         end if
         call rename_file(self%partial_path, self%final_path, error)
         if (allocated(error)) then
-            error%message = 'results: '//error%message//' (the results are '//"kept in '"// &
-                            self%partial_path//"')"
+            error%message = 'results: '//error%message
+            call keep_as_partial(self)
             return
         end if
         ! the earlier partial file set aside is settled by `settle_earlier`
@@ -734,6 +744,42 @@ contains
         self%set_aside = .false.
         call keep_companions(self, error)
     end subroutine writer_close_unfinished
+
+    !> Close the file of a run that ended, whose end after its final checkpoint cannot be
+    !> completed (its XDMF file cannot be written), with no more writes to it: it keeps the name
+    !> '<final_path>.partial' and /summary finished = 0, whole, as a run killed there leaves it
+    !> (`kept_partial`). As after `close_unfinished`, the earlier partial file set aside is left
+    !> to `settle_earlier` and the files beside the results get their final names. When the file
+    !> cannot be closed (HDF5 writes its last metadata then), it is not trusted: as `abort`.
+    subroutine writer_close_partial(self, error)
+        !> An open writer; closed on return.
+        class(results_writer_t), intent(inout) :: self
+        !> Set when the file cannot be closed (then deleted, but a resumed one).
+        type(error_t), allocatable, intent(out) :: error
+        call require_open(self, 'close_partial', error)
+        if (allocated(error)) return
+        call self%file%close(error)
+        if (allocated(error)) then
+            if (.not. self%resumed) call remove_file(self%partial_path)
+            call put_back_partial(self)
+            call drop_companions(self)
+            error%message = 'results: '//error%message
+            return
+        end if
+        call keep_as_partial(self)
+    end subroutine writer_close_partial
+
+    !> The file of a run that ended is closed whole as '<final_path>.partial': the earlier
+    !> partial file set aside is left to `settle_earlier`, the files beside the results get their
+    !> final names (one whose rename fails stays '.partial', which a restart takes over: `adopt`).
+    subroutine keep_as_partial(self)
+        !> The writer, closed.
+        class(results_writer_t), intent(inout) :: self
+        type(error_t), allocatable :: ignored
+        self%kept_partial = .true.
+        self%set_aside = .false.
+        call keep_companions(self, ignored)
+    end subroutine keep_as_partial
 
     !> Close and delete the partial file after a failed run (an earlier result is untouched)
     !> and put back the earlier partial file set aside for it. A resumed partial file is

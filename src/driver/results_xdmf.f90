@@ -72,7 +72,9 @@ module driver_results_xdmf
 contains
 
     !> Write the XDMF file `path` describing the open results file `file`.
-    subroutine write_results_xdmf(file, path, h5_name, error)
+    !>
+    !> The results file is read first, whole (`survey`); what follows writes the XDMF file alone.
+    subroutine write_results_xdmf(file, path, h5_name, error, results_read)
         !> The results file (open; every output written).
         type(h5_file_t), intent(in) :: file
         !> XDMF file to write.
@@ -81,11 +83,17 @@ contains
         character(len=*), intent(in) :: h5_name
         !> Set on a read failure, an inconsistent file, or when the XDMF file cannot be written.
         type(error_t), allocatable, intent(out) :: error
+        !> Whether the results file was read and found consistent: an error is then one of the
+        !> XDMF file itself (it cannot be created or written: a full disk, a quota, a file size
+        !> limit), which says nothing against the results file.
+        logical, intent(out) :: results_read
         type(survey_t) :: s
         type(xdmf_file_t) :: x
         integer :: k
+        results_read = .false.
         call survey(file, s, error)
         if (allocated(error)) return
+        results_read = .true.
         call x%open(path, h5_name, error)
         if (allocated(error)) return
         if (s%beam) call part(beam_grid, 'beam')

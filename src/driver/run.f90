@@ -16,7 +16,11 @@
 !> lock file (io_lock) is held while writing and removed on every way out.
 !>
 !> Every run that ends normally also gets `<name>.xdmf` (driver_results_xdmf), written beside
-!> the open results file and renamed into place once the HDF5 file has its final name.
+!> the open results file and renamed into place once the HDF5 file has its final name. A time
+!> loop whose XDMF file cannot be written (a full disk, a quota, a file size limit), or whose
+!> results file cannot be renamed, after its final checkpoint and with its results file whole,
+!> fails (exit 1) leaving the folder as a run killed there does: its results '<name>.h5.partial'
+!> and that checkpoint, which the command the error gives finishes with no step to do.
 !>
 !> Checkpoints (driver_checkpoint): the time loops of every kind of run (beam, particles,
 !> beam-particle coupled, continuum, continuum-particle coupled) write
@@ -315,7 +319,7 @@ contains
         if (run%out%stopped()) then
             call close_stopped(opts, report, run, error, kept, stopped_by)
         else
-            call close_finished(report, run, error, kept)
+            call close_finished(opts, report, run, error, kept)
         end if
     end subroutine run_and_close
 
@@ -362,18 +366,25 @@ contains
     !> The XDMF file is written beside the partial file and renamed once the results file has
     !> its final name: a failed run leaves an earlier result's XDMF file as it was, and a
     !> stopped run writes none (the earlier one still describes the earlier result, which is
-    !> left as it was).
-    subroutine close_finished(report, run, error, kept)
+    !> left as it was). A time loop that fails here after its final checkpoint with its results
+    !> whole (the XDMF file cannot be written, the results read whole; or the final rename
+    !> fails) keeps them, as '.partial', and that checkpoint: the state a kill there leaves,
+    !> which a restart finishes (`error` gives its command; `kept`).
+    subroutine close_finished(opts, report, run, error, kept)
+        !> What was run.
+        type(run_options_t), intent(in) :: opts
         !> Where warnings go.
         procedure(report_iface) :: report
         !> The run, ended.
         type(deck_run_t), intent(inout) :: run
         !> Set when the XDMF file cannot be written or the results file closed.
         type(error_t), allocatable, intent(out) :: error
-        !> Whether the results file got its final name: its files are the folder's now.
+        !> Whether the results file got its final name, or was kept whole as a run killed after its
+        !> final checkpoint leaves it: its files are the folder's now.
         logical, intent(out) :: kept
-        type(error_t), allocatable :: xdmf_error
+        type(error_t), allocatable :: xdmf_error, close_error
         character(len=:), allocatable :: xdmf
+        logical :: results_read
         kept = .false.
         xdmf = run%path(1:len(run%path) - 3)//'.xdmf'
         ! ParaView's XDMF 2 reader splits a reference 'file.h5:/dataset' at the first colon
@@ -381,22 +392,75 @@ contains
                                                             ' contains a colon, which ParaView''s XDMF reader '// &
                                                             'cannot open; rename the deck to view '// &
                                                             basename(xdmf)//' in ParaView')
-        call write_results_xdmf(run%out%file, xdmf//'.partial', basename(run%path), error)
+        ! the results written out first: a disk that the XDMF file fills leaves the close of a
+        ! whole results file nothing to write
+        call run%out%flush(error)
         if (allocated(error)) then
             call run%out%abort()
+            error%message = run%deck%file//': '//error%message
+            return
+        end if
+        call write_results_xdmf(run%out%file, xdmf//'.partial', basename(run%path), error, results_read)
+        if (allocated(error)) then
+            ! first: the space it took is free again for the close of the results file
             call remove_file(xdmf//'.partial')
             error%message = run%deck%file//': '//error%message
+            if (results_read .and. after_last_checkpoint(run)) then
+                ! no more writes to it but its close: whole, as a run killed here leaves it
+                call run%out%close_partial(close_error)
+                kept = .not. allocated(close_error)
+                if (kept) then
+                    call say_how_to_finish(opts, run, 'the XDMF file can be written (space freed)', error)
+                    return
+                end if
+                error%message = error%message//'; '//close_error%message
+            end if
+            call run%out%abort()
             return
         end if
         call run%out%close(error)
         kept = .not. allocated(error)
         if (.not. kept) then
             call remove_file(xdmf//'.partial')
+            if (.not. run%out%kept_partial) return
+            ! closed whole, its rename failed
+            if (after_last_checkpoint(run)) then
+                kept = .true.
+                error%message = run%deck%file//': '//error%message
+                call say_how_to_finish(opts, run, 'the results file can be renamed', error)
+            else
+                error%message = error%message//" (the results are kept in '"//run%out%partial_path//"')"
+            end if
             return
         end if
         call rename_file(xdmf//'.partial', xdmf, xdmf_error)
         if (allocated(xdmf_error)) call report('warning: '//xdmf_error%message)
     end subroutine close_finished
+
+    !> Whether the run has a time loop whose final checkpoint is written: what its end writes
+    !> after that checkpoint, a restart from it writes again (no step to do).
+    logical function after_last_checkpoint(run)
+        !> The run, ended.
+        type(deck_run_t), intent(in) :: run
+        after_last_checkpoint = run%sim%has_time_loop() .and. run%ck%last_step == run%sim%settings%n_steps
+    end function after_last_checkpoint
+
+    !> Add to the error of a run that ended and kept its results whole as '.partial' with its
+    !> final checkpoint what the folder holds and the command that finishes the run.
+    subroutine say_how_to_finish(opts, run, when, error)
+        !> What was run.
+        type(run_options_t), intent(in) :: opts
+        !> The run, its results file closed as '.partial'.
+        type(deck_run_t), intent(in) :: run
+        !> When the command can finish it ('the XDMF file can be written (space freed)').
+        character(len=*), intent(in) :: when
+        !> The error of the run's end, its message completed.
+        type(error_t), intent(inout) :: error
+        error%message = error%message//"; the results are whole, kept as '"//run%out%partial_path// &
+                        "' with the checkpoint of the last step '"//run%ck%path//"', as a run killed "// &
+                        'after its final checkpoint leaves them; once '//when//', this command finishes '// &
+                        'the run, with no step to do: '//continue_command(opts, run%ck, .true.)
+    end subroutine say_how_to_finish
 
     !> The command that continues this run from its checkpoint; with `same_end`, to the end
     !> time this run was given: `--end T` again when the run had one (in the fewest digits
@@ -498,8 +562,9 @@ contains
             ck%restart = .true.
             call report('restart from '//opts%restart//' at step '//to_str(ck%start%step))
             if (at_end) call report('note: the checkpoint is of the last step and the results file of its run '// &
-                                    'is still partial (the run was killed after its final checkpoint): no step '// &
-                                    'to do, the results are finished from the checkpoint')
+                                    'is still partial (the run was killed, or failed with its results whole, after '// &
+                                    'its final checkpoint): no step to do, the results are finished from the '// &
+                                    'checkpoint')
             if (len(ck%start%threads) > 0 .and. openmp_part(ck%start%threads) /= openmp_part(thread_setting())) &
                 call report('warning: the checkpoint was written with '//ck%start%threads//'; this run has '// &
                             thread_setting()//': the results go on correctly, bit for bit as both '// &

@@ -5,8 +5,19 @@
 - The XDMF file: libgfortran did not report its write errors (exit 0 with a truncated or
   empty `.xdmf`). Its path '.partial' a link to /dev/full (every write ENOSPC), and a file
   size limit (RLIMIT_FSIZE, as `ulimit -f`) between the sizes of the HDF5 and the XDMF file
-  of input/cantilever.dat: exit 1 with the system's reason, the folder's earlier result,
-  XDMF file and checkpoint untouched.
+  of input/cantilever.dat: exit 1 with the system's reason. A static analysis (no checkpoint)
+  leaves the folder as it found it. A time loop writes its XDMF file after its final
+  checkpoint, with its results whole: it deleted them and its checkpoint all the same (a long
+  run that hits its quota at the end lost everything). Now it leaves them as a run killed
+  there does, '<name>.h5.partial' and the checkpoint of the last step (the failed XDMF file
+  removed; an earlier finished result and its XDMF file untouched, an earlier partial file set
+  aside deleted, as for a stopped run), and the error gives the command that finishes the run:
+  run with the "disk" still full it fails again the same way, once it is freed it gives the
+  uninterrupted run's results and XDMF file bit for bit (a beam with an extra output after the
+  checkpoint, a bonded particle row, the beam under the file size limit). So too when the
+  rename of the results file is refused (ENOSPC injected by strace; before, the partial file
+  was left without its checkpoint, which the failed run deleted). A results file whose close
+  fails as well (its last write refused by strace) is not trusted: the run fails as any other.
 - A file size limit of 0 (`ulimit -f 0`): SIGXFSZ killed the run (exit -25) at the lock's
   first write and left an empty lock that refused every later run. Now exit 1 with the
   reason, no lock and no folder left, and the next run works. An empty lock (left so by an
@@ -21,12 +32,17 @@ Usage (ctest does this): test_io_errors.py --exe multicor --work DIR --source RE
 """
 import hashlib
 import os
+import pathlib
 import resource
+import shlex
 import shutil
 import subprocess
 import sys
 
+import h5py
+
 from checks import arguments, check, summary
+from test_restart import compare, compare_xdmf
 
 
 def run(exe, *args, limit=None, user=None):
@@ -47,20 +63,172 @@ def digests(folder):
             if p.is_file() and not p.is_symlink()}
 
 
-def xdmf_write_errors(exe, deck, work):
-    folder = work / "xdmf_full"
-    first = run(exe, deck, "--output", folder, "--quiet", "--end", "0.02")
+def files_in(folder):
+    """The names of the files in a folder (hidden ones too: the lock); none when it is gone."""
+    return sorted(p.name for p in folder.iterdir()) if folder.is_dir() else []
+
+
+def finish_command(err):
+    """The command the error of a run that kept its results after its final checkpoint gives
+    to finish it (split as the shell would), or None."""
+    head = "this command finishes the run, with no step to do: "
+    if head not in err:
+        return None
+    return shlex.split(err.split(head, 1)[1].splitlines()[0])
+
+
+def kept_after_last_checkpoint(exe, deck, folder, name, proc, reason, earlier=None):
+    """The run `proc` failed writing its XDMF file after its final checkpoint: exit 1 with the
+    reason; the folder holds its results '.partial' (finished = 0, this run's) and its final
+    checkpoint, and of the earlier files only a finished result and its XDMF file (`earlier`:
+    their digests), untouched. Returns the command the error gives to finish the run."""
+    err = proc.stderr.strip()
+    partial = folder / f"{deck.stem}.h5.partial"
+    check(f"{name}: exit 1", proc.returncode == 1, f"exit {proc.returncode}: {err[-300:]}")
+    check(f"{name}: the error names the XDMF file and the reason",
+          f"cannot write the XDMF file '{folder}/{deck.stem}.xdmf.partial': {reason}" in err, err[-400:])
+    check(f"{name}: the error says the results are whole, where, with which checkpoint",
+          f"the results are whole, kept as '{partial}' with the checkpoint of the last step "
+          f"'{folder}/checkpoint.h5'" in err, err[-400:])
+    command = finish_command(err)
+    check(f"{name}: the error gives the command that finishes the run",
+          command is not None and command[0] == "multicor" and "--restart" in command, err[-300:])
+    expected = sorted([partial.name, "checkpoint.h5"] + sorted(earlier or {}))
+    check(f"{name}: the results '.partial' and the checkpoint kept, the failed XDMF file removed, "
+          "nothing set aside left", files_in(folder) == expected, f"{files_in(folder)}")
+    check(f"{name}: /dev/full still there (only the link was removed)", pathlib.Path("/dev/full").is_char_device(), "")
+    if earlier:
+        check(f"{name}: the earlier finished result and its XDMF file untouched",
+              {k: v for k, v in digests(folder).items() if k in earlier} == earlier, "")
+    if partial.is_file() and (folder / "checkpoint.h5").is_file():
+        with h5py.File(partial, "r") as f:
+            finished, run_id = int(f["summary"].attrs["finished"]), f.attrs["run_id"]
+        with h5py.File(folder / "checkpoint.h5", "r") as f:
+            ck_run_id = f.attrs["run_id"]
+        check(f"{name}: the partial file is this run's, unfinished, and the checkpoint's results",
+              finished == 0 and run_id == ck_run_id, f"finished = {finished}, run ids {run_id} / {ck_run_id}")
+    return command
+
+
+def finished_by_command(exe, deck, folder, name, command, reference):
+    """The command the error gave, once the XDMF file can be written: the run finished with no
+    step, its results and XDMF file bitwise the uninterrupted run's, nothing else left."""
+    proc = run(exe, *command[1:])
+    check(f"{name}: the command given finishes the run once the space is free: exit 0, no step",
+          proc.returncode == 0 and "no step to do" in proc.stdout and "(0 in this run)" in proc.stdout,
+          (proc.stdout + proc.stderr).strip()[-300:])
+    if proc.returncode != 0:
+        return
+    compare(name, folder / f"{deck.stem}.h5", reference)
+    compare_xdmf(name, folder / f"{deck.stem}.xdmf", reference.with_suffix(".xdmf"))
+    check(f"{name}: the results, the XDMF file and the checkpoint are left",
+          files_in(folder) == sorted([f"{deck.stem}.h5", f"{deck.stem}.xdmf", "checkpoint.h5"]),
+          str(files_in(folder)))
+
+
+def xdmf_full_after_last_checkpoint(exe, deck, work, name, end=(), earlier=None, still_full=False):
+    """A dynamic run of `deck` (with `end`, options) whose XDMF file is on a full device (its
+    '.partial' a link to /dev/full), in a folder that holds an `earlier` run's files: a finished
+    result and its XDMF file ("finished"), or a partial file of the same deck ("interrupted")."""
+    ref = work / f"ref_{name}"
+    proc = run(exe, deck, "--output", ref, "--quiet", *end)
+    assert proc.returncode == 0, proc.stderr
+    folder = work / name
+    kept = None
+    if earlier is not None:
+        proc = run(exe, deck, "--output", folder, "--quiet", "--end", earlier[1])
+        assert proc.returncode == 0, proc.stderr
+        if earlier[0] == "finished":
+            kept = {k: v for k, v in digests(folder).items() if k != "checkpoint.h5"}
+        else:
+            # what a run killed at the rename of its results leaves (but the XDMF file)
+            (folder / f"{deck.stem}.h5").rename(folder / f"{deck.stem}.h5.partial")
+            (folder / f"{deck.stem}.xdmf").unlink()
+    folder.mkdir(exist_ok=True)
+    link = folder / f"{deck.stem}.xdmf.partial"
+    link.symlink_to("/dev/full")
+    proc = run(exe, deck, "--output", folder, "--quiet", *end)
+    command = kept_after_last_checkpoint(exe, deck, folder, name, proc, "No space left on device", kept)
+    if command is None:
+        return
+    if still_full:
+        link.symlink_to("/dev/full")
+        before = digests(folder)
+        again = run(exe, *command[1:])
+        check(f"{name}: the command given, the disk still full: exit 1, the same command again",
+              again.returncode == 1 and finish_command(again.stderr.strip()) == command, again.stderr.strip()[-300:])
+        check(f"{name}: the command given, the disk still full: the same files, the link removed",
+              sorted(before) == [n for n in files_in(folder)], f"{files_in(folder)}")
+    finished_by_command(exe, deck, folder, name, command, ref / f"{deck.stem}.h5")
+
+
+def xdmf_write_errors(exe, src, deck, work):
+    # a beam whose end (503 steps, outputs every 5) stores an extra output after the final
+    # checkpoint, in the folder of a finished earlier run
+    xdmf_full_after_last_checkpoint(exe, deck, work, "xdmf_full_beam", end=("--end", "0.1006"),
+                                    earlier=("finished", "0.02"), still_full=True)
+    # a bonded particle row (two ruptures) in the folder of an interrupted run of the deck
+    xdmf_full_after_last_checkpoint(exe, src / "input" / "cohesive_row.dat", work, "xdmf_full_particles",
+                                    earlier=("interrupted", "0.05"))
+
+    # the rename of the results file refused (ENOSPC: a folder that cannot grow), by strace
+    if shutil.which("strace") is None:
+        print("skip   the rename of the results file refused: no strace (Debian package strace)")
+    else:
+        folder = work / "rename_refused"
+        partial = folder / f"{deck.stem}.h5.partial"
+        renames = "rename,renameat,renameat2"
+        proc = subprocess.run(["strace", "-f", "-qq", "-o", os.devnull, "-P", str(partial), "-e", f"trace={renames}",
+                               "-e", f"inject={renames}:error=ENOSPC:when=1", str(exe), str(deck), "--output",
+                               str(folder), "--quiet", "--end", "0.1006"], capture_output=True, text=True, timeout=300)
+        err = proc.stderr.strip()
+        command = finish_command(err)
+        check("rename refused: exit 1, the error names the rename, says the results are whole, gives the command",
+              proc.returncode == 1 and f"results: cannot rename '{partial}' to '{folder}/{deck.stem}.h5'; the results "
+              f"are whole, kept as '{partial}' with the checkpoint of the last step '{folder}/checkpoint.h5'" in err
+              and command is not None, f"exit {proc.returncode}: {err[-400:]}")
+        check("rename refused: the results '.partial' and the checkpoint kept, nothing else",
+              files_in(folder) == sorted([partial.name, "checkpoint.h5"]), f"{files_in(folder)}")
+        if command is not None:
+            finished_by_command(exe, deck, folder, "rename refused", command,
+                                work / "ref_xdmf_full_beam" / f"{deck.stem}.h5")
+
+        # the XDMF file on a full device and the close of the results file refused too (its last
+        # pwrite, the superblock, ENOSPC): a file whose close failed is not trusted, the run fails
+        # as any other (the results and the checkpoint deleted)
+        def under_strace(folder, *options):
+            folder.mkdir()
+            (folder / f"{deck.stem}.xdmf.partial").symlink_to("/dev/full")
+            partial = folder / f"{deck.stem}.h5.partial"
+            return subprocess.run(["strace", "-f", "-qq", "-P", str(partial), "-e", "trace=pwrite64", *options,
+                                   str(exe), str(deck), "--output", str(folder), "--quiet", "--end", "0.1006"],
+                                  capture_output=True, text=True, timeout=300)
+        trace = work / "close_refused.trace"
+        under_strace(work / "close_counted", "-o", str(trace))
+        writes = sum("pwrite64(" in line for line in trace.read_text().splitlines())
+        folder = work / "close_refused"
+        proc = under_strace(folder, "-o", os.devnull, "-e", f"inject=pwrite64:error=ENOSPC:when={writes}")
+        err = proc.stderr.strip()
+        check(f"XDMF file and the close of the results file refused (pwrite {writes}): exit 1, both errors, no command",
+              proc.returncode == 1 and "cannot write the XDMF file" in err and "cannot close file" in err and
+              finish_command(err) is None, f"exit {proc.returncode}: {err[-300:]}")
+        check("XDMF file and the close of the results file refused: nothing left", files_in(folder) == [],
+              str(files_in(folder)))
+
+    # a static analysis writes no checkpoint: the folder as it found it
+    static = src / "tests" / "regression" / "decks" / "cantilever_static.dat"
+    folder = work / "xdmf_full_static"
+    first = run(exe, static, "--output", folder, "--quiet")
     assert first.returncode == 0, first.stderr
     before = digests(folder)
-    (folder / f"{deck.stem}.xdmf.partial").symlink_to("/dev/full")
-    proc = run(exe, deck, "--output", folder, "--quiet", "--end", "0.04")
+    (folder / f"{static.stem}.xdmf.partial").symlink_to("/dev/full")
+    proc = run(exe, static, "--output", folder, "--quiet")
     err = proc.stderr.strip()
-    check("XDMF file on a full device: exit 1", proc.returncode == 1, f"exit {proc.returncode}: {err[-300:]}")
-    check("XDMF file on a full device: the error names the file and the reason",
-          f"cannot write the XDMF file '{folder}/{deck.stem}.xdmf.partial': No space left on device" in err,
-          err[-300:])
-    check("XDMF file on a full device: the earlier result, XDMF file and checkpoint untouched",
-          digests(folder) == before, f"{sorted(before)} -> {sorted(digests(folder))}")
+    check("static, XDMF file on a full device: exit 1 with the reason", proc.returncode == 1 and
+          f"cannot write the XDMF file '{folder}/{static.stem}.xdmf.partial': No space left on device" in err
+          and finish_command(err) is None, f"exit {proc.returncode}: {err[-300:]}")
+    check("static, XDMF file on a full device: the earlier result and XDMF file untouched, nothing else",
+          digests(folder) == before and files_in(folder) == sorted(before), f"{files_in(folder)}")
 
     # the whole deck: its XDMF file (one grid per output) is larger than its HDF5 file
     folder = work / "xdmf_fsize"
@@ -71,13 +239,11 @@ def xdmf_write_errors(exe, deck, work):
     check("cantilever: the XDMF file is larger than the HDF5 file", xdmf > h5 + 65536, f"{xdmf} vs {h5} bytes")
     limit = (h5 + xdmf) // 2
     proc = run(exe, deck, "--output", folder, "--quiet", limit=limit)
-    err = proc.stderr.strip()
-    check(f"XDMF file beyond a file size limit of {limit} bytes: exit 1", proc.returncode == 1,
-          f"exit {proc.returncode}: {err[-300:]}")
-    check("XDMF file beyond the file size limit: the reason", "cannot write the XDMF file" in err and
-          "File too large" in err, err[-300:])
-    check("XDMF file beyond the file size limit: the folder it made removed", not folder.exists(),
-          str(sorted(p.name for p in folder.iterdir())) if folder.exists() else "")
+    command = kept_after_last_checkpoint(exe, deck, folder, f"XDMF file beyond a file size limit of {limit} bytes",
+                                         proc, "File too large")
+    if command is not None:
+        finished_by_command(exe, deck, folder, "XDMF file beyond the file size limit, then without it", command,
+                            work / "xdmf_ref" / f"{deck.stem}.h5")
 
 
 def zero_file_size(exe, deck, work):
@@ -172,7 +338,7 @@ def main():
     deck = work / "cantilever.dat"
     shutil.copy(src / "input" / "cantilever.dat", deck)
     os.environ.setdefault("OMP_NUM_THREADS", "1")
-    xdmf_write_errors(exe, deck, work)
+    xdmf_write_errors(exe, src, deck, work)
     zero_file_size(exe, deck, work)
     damaged_results(exe, deck, work)
     folder_errors(exe, deck, work)
