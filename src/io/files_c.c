@@ -84,6 +84,16 @@ int multicor_no_hard_links(int err)
 /* Create the folder `path` with mode 0755 (less the umask); 0 or errno. */
 int multicor_make_dir(const char *path) { return mkdir(path, 0755) == 0 ? 0 : errno; }
 
+/* Give the file `old` the name `new` (rename(2), which replaces `new`); 0 or errno. */
+int multicor_rename(const char *old, const char *new) { return rename(old, new) == 0 ? 0 : errno; }
+
+/* 1 when `path` names a folder (stat(2), which needs no permission on the folder itself), else 0. */
+int multicor_is_dir(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
 /* The system's text for an errno ('No space left on device'), NUL-terminated in buf[n]. */
 void multicor_errno_text(int err, char *buf, long n)
 {

@@ -13,7 +13,10 @@
 !> refused with a message saying how to remove it. A second run on the folder is refused
 !> with the owner's line. A lock left
 !> by a run that died without removing it (its pid no longer runs on this host) is stale: it is
-!> taken over, and the caller gets a warning to print. A lock from another host cannot be
+!> taken over, and the caller gets a warning to print. The takeover renames the stale lock
+!> to a name of its own before removing it, so that of two runs taking it over at once one
+!> only succeeds (before, both removed it by name, the later one the earlier one's new lock,
+!> and both ran in the folder). A lock from another host cannot be
 !> checked and is always respected. `lock_release` removes the file; the driver calls it on
 !> every way out of a run, errors included.
 module io_lock
@@ -21,7 +24,7 @@ module io_lock
     use, intrinsic :: iso_fortran_env, only: int64
     use core_error, only: error_t, make_error
     use core_strings, only: to_str, split_words, string_t, parse_int, shell_word
-    use io_paths, only: file_exists, remove_file
+    use io_paths, only: file_exists, remove_file, rename_file
     use io_file_writer, only: file_writer_t, system_error_text, errno_exists
     implicit none
     private
@@ -75,10 +78,10 @@ contains
         type(error_t), allocatable, intent(out) :: error
         character(len=:), allocatable :: owner
         integer :: attempt
-        logical :: created
+        logical :: created, taken
         warning = ''
         lock%path = dir//'/'//lock_name
-        do attempt = 1, 2
+        do attempt = 1, 3
             call try_create(lock%path, created, error)
             if (allocated(error)) return
             if (created) then
@@ -87,11 +90,11 @@ contains
             end if
             owner = read_owner(lock%path)
             if (len(owner) == 0 .and. .not. file_exists(lock%path)) cycle
-            if (attempt == 2) exit
+            if (attempt == 3) exit
             if (lock_owner_alive(owner, host_name())) exit
-            warning = "warning: taking over the stale lock '"//lock%path//"' of a run that no longer "// &
-                      'runs (host pid start: '//owner//')'
-            call remove_file(lock%path)
+            call set_aside_stale(lock%path, owner, taken)
+            if (taken) warning = "warning: taking over the stale lock '"//lock%path//"' of a run that no longer "// &
+                                 'runs (host pid start: '//owner//')'
         end do
         if (len(owner) == 0 .and. is_empty(lock%path)) then
             call make_error(error, "results folder '"//dir//"' is locked by an empty lock file '"//lock%path// &
@@ -200,6 +203,30 @@ contains
             error%message = system_error_text(code)
         end if
     end subroutine write_line_to
+
+    !> Remove the stale lock at `path` whose owner line is `owner`, in a way that two runs
+    !> taking it over at once cannot both do: rename(2) moves it to a name of this process's
+    !> own (of two renames of one file, one fails), and only a file that still names `owner`
+    !> there is removed. A lock that another run made after `owner`'s was read (that run took
+    !> the stale one over first) is linked back to its name. `taken`: the stale lock is gone.
+    subroutine set_aside_stale(path, owner, taken)
+        character(len=*), intent(in) :: path, owner
+        logical, intent(out) :: taken
+        character(len=:), allocatable :: aside
+        type(error_t), allocatable :: error
+        integer :: code
+        taken = .false.
+        aside = path//'.stale.'//host_name()//'.'//to_str(int(c_getpid()))
+        call rename_file(path, aside, error)
+        ! gone already: another run took it over (its own lock, if any, is judged next)
+        if (allocated(error)) return
+        if (read_owner(aside) == owner) then
+            taken = .true.
+        else
+            code = int(c_link_new(aside//c_null_char, path//c_null_char))
+        end if
+        call remove_file(aside)
+    end subroutine set_aside_stale
 
     !> Whether the file `path` exists and holds no byte.
     logical function is_empty(path)

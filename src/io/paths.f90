@@ -21,11 +21,16 @@ module io_paths
             character(kind=c_char), intent(in) :: path(*)
             integer(c_int) :: rc
         end function c_rmdir
-        function c_rename(old, new) bind(C, name='rename') result(rc)
+        function c_rename(old, new) bind(C, name='multicor_rename') result(err)
             import :: c_char, c_int
             character(kind=c_char), intent(in) :: old(*), new(*)
-            integer(c_int) :: rc
+            integer(c_int) :: err
         end function c_rename
+        function c_is_dir(path) bind(C, name='multicor_is_dir') result(yes)
+            import :: c_char, c_int
+            character(kind=c_char), intent(in) :: path(*)
+            integer(c_int) :: yes
+        end function c_is_dir
         function c_link(old, new) bind(C, name='link') result(rc)
             import :: c_char, c_int
             character(kind=c_char), intent(in) :: old(*), new(*)
@@ -102,7 +107,7 @@ contains
             if (rc /= 0) then
                 if (file_exists(path(:i - 1))) cycle
                 parent = dirname(path(:i - 1))
-                if (file_exists(parent) .and. .not. file_exists(parent//'/.')) then
+                if (file_exists(parent) .and. c_is_dir(parent//c_null_char) == 0) then
                     ! ENOTDIR ('Not a directory') does not say which part of the path
                     call make_error(error, "cannot create folder '"//path(:i - 1)//"': '"//parent// &
                                     "' is a file, not a folder")
@@ -115,9 +120,9 @@ contains
                 if (rc == 0 .and. len(created) == 0) created = path(:i - 1)
             end if
         end do
-        ! A file of that name is in the way (its '.' does not exist): the lock file or the
-        ! results inside it would fail with a less telling 'Not a directory'.
-        if (.not. file_exists(trim(path)//'/.')) &
+        ! A file of that name is in the way (not a folder): the lock file or the results
+        ! inside it would fail with a less telling 'Not a directory'.
+        if (c_is_dir(trim(path)//c_null_char) == 0) &
             call make_error(error, "cannot use '"//trim(path)//"' as the results folder: it exists and is not a "// &
                             'folder (give --output another name, or move that file)')
     end subroutine mkdir_p
@@ -164,9 +169,9 @@ contains
         character(len=*), intent(in) :: new
         !> Set if the rename failed.
         type(error_t), allocatable, intent(out) :: error
-        if (c_rename(old//c_null_char, new//c_null_char) /= 0) then
-            call make_error(error, "cannot rename '"//old//"' to '"//new//"'")
-        end if
+        integer(c_int) :: err
+        err = c_rename(old//c_null_char, new//c_null_char)
+        if (err /= 0) call make_error(error, "cannot rename '"//old//"' to '"//new//"': "//system_error_text(int(err)))
     end subroutine rename_file
     !> Copy a file byte for byte (the target is replaced; on failure it is removed).
     subroutine copy_file(old, new, error)

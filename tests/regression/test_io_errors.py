@@ -183,8 +183,9 @@ def xdmf_write_errors(exe, src, deck, work):
                                str(folder), "--quiet", "--end", "0.1006"], capture_output=True, text=True, timeout=300)
         err = proc.stderr.strip()
         command = finish_command(err)
-        check("rename refused: exit 1, the error names the rename, says the results are whole, gives the command",
-              proc.returncode == 1 and f"results: cannot rename '{partial}' to '{folder}/{deck.stem}.h5'; the results "
+        check("rename refused: exit 1, the error names the rename and the system's reason, says the results are "
+              "whole, gives the command",
+              proc.returncode == 1 and f"results: cannot rename '{partial}' to '{folder}/{deck.stem}.h5': No space left on device; the results "
               f"are whole, kept as '{partial}' with the checkpoint of the last step '{folder}/checkpoint.h5'" in err
               and command is not None, f"exit {proc.returncode}: {err[-400:]}")
         check("rename refused: the results '.partial' and the checkpoint kept, nothing else",
@@ -324,6 +325,18 @@ def folder_errors(exe, deck, work):
               f"cannot create folder '{parent}/sub': Permission denied" in err,
               f"exit {proc.returncode}: {err[-300:]}")
     parent.chmod(0o755)
+    # a folder that user nobody may not enter (mode 0744): its sub-folder is refused for that
+    # reason (before: "'nx' is a file, not a folder", from a failed access to 'nx/.')
+    if user is not None and user != -1:
+        locked = work / "no_entry"
+        locked.mkdir()
+        locked.chmod(0o744)
+        proc = run(exe, deck, "--output", locked / "sub", "--quiet", "--end", "0.01", user=user)
+        err = proc.stderr.strip()
+        check("folder in a folder one may not enter: exit 1, Permission denied", proc.returncode == 1 and
+              f"cannot create folder '{locked}/sub': Permission denied" in err and "is a file" not in err,
+              f"exit {proc.returncode}: {err[-300:]}")
+        locked.chmod(0o755)
     a_file = work / "a_file"
     a_file.write_text("x\n")
     proc = run(exe, deck, "--output", a_file / "sub" / "deeper", "--quiet", "--end", "0.01")
@@ -342,7 +355,41 @@ def main():
     zero_file_size(exe, deck, work)
     damaged_results(exe, deck, work)
     folder_errors(exe, deck, work)
+    stale_lock_race(exe, deck, work)
     sys.exit(summary())
+
+
+def stale_lock_race(exe, deck, work):
+    """Two runs take over one stale lock at once: one runs, the other is refused. Run B is held
+    (strace, 1.5 s) as it takes the stale lock out of the way (its first rename now; its
+    second unlink, after that of its own lock line's file, in the version before); run A
+    starts meanwhile, takes the stale lock over and holds the folder (its first write held
+    5 s). Before, B then removed A's new lock by name and
+    linked its own: both ran in the folder (a review's finding)."""
+    if shutil.which("strace") is None:
+        print("skip   stale_lock_race: no strace (Debian package strace)")
+        return
+    import socket
+    import time
+    folder = work / "stale_race"
+    folder.mkdir()
+    (folder / ".multicor.lock").write_text(f"{socket.gethostname()} 999999 2026-11-28T00:00:00\n")
+    args = [str(exe), str(deck), "--output", str(folder), "--quiet", "--end", "0.01"]
+    b = subprocess.Popen(["strace", "-f", "-qq", "-o", os.devnull, "-e", "trace=rename,renameat,renameat2,unlink,unlinkat",
+                          "-e", "inject=rename,renameat,renameat2:delay_enter=1500000:when=1",
+                          "-e", "inject=unlink,unlinkat:delay_enter=1500000:when=2"] + args,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(0.5)
+    a = subprocess.Popen(["strace", "-f", "-qq", "-o", os.devnull, "-e", "trace=pwrite64",
+                          "-e", "inject=pwrite64:delay_enter=5000000:when=1"] + args,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    out_b, err_b = b.communicate(timeout=120)
+    out_a, err_a = a.communicate(timeout=120)
+    codes = sorted([a.returncode, b.returncode])
+    refused = [e for e in (err_a, err_b) if f"results folder '{folder}' is in use by another run" in e]
+    check("two runs taking over one stale lock: one runs (exit 0), the other is refused (exit 1)",
+          codes == [0, 1] and len(refused) == 1, f"exits A {a.returncode}, B {b.returncode}: "
+          f"{err_a.strip()[-200:]} | {err_b.strip()[-200:]}")
 
 
 if __name__ == "__main__":
