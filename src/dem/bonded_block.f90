@@ -115,10 +115,12 @@
 !> judgement of dem_contacts (contacts_finish) then breaks it exactly as after the NLGS.
 !> Stall: a pass whose problem has no solution with the bonds held (a wall of imposed velocity
 !> pushing a stack that its bonds hold on the floor) never converges, its reactions growing by
-!> a fixed step per iteration; dem_nlgs stops it (`nlgs_stats_t%stalled`, when a bond lies
-!> outside its cone, `must_yield`) and it is judged as a converged pass, the step solved again
-!> from the reactions at its start (before: every step at the cap, no bond released, the wall
-!> through the disks; doc/theory.md 7.10, "Stall").
+!> a fixed step per iteration along a self-stress that moves no body; dem_nlgs stops it
+!> (`nlgs_stats_t%stalled`, when a bond lies outside its cone, `must_yield`, and the growth
+!> moves nothing: a slow convergence, whose growth moves bodies, is not stopped) and it is
+!> judged as a converged pass, the step solved again from the reactions at its start, the
+!> grown ones carrying a self-stress of arbitrary size (before: every step at the cap, no bond
+!> released, the wall through the disks; doc/theory.md 7.10, "Stall").
 !> A pass is converged by the error of the problem it solves, the bonds of B held: the norm of
 !> the sweeps with the block's share |u_B|^2, or with criterion = siconos the Siconos error
 !> with the members measured by their equalities (nlgs criterion `begin`, `held`). Measured
@@ -479,7 +481,7 @@ contains
                     end if
                 end if
                 ! a stalled pass has no solution with its bonds held: its reactions grow without
-                ! bound along a direction that loads some bond outside its cone (module header,
+                ! bound along a self-stress that loads some bond outside its cone (module header,
                 ! "Stall"), and no number of iterations converges it; it is judged as a converged one
                 if (.not. (pass%converged .or. pass%stalled)) exit
                 ! release only the bond farthest outside its cone: the others may come back inside
@@ -531,7 +533,9 @@ contains
                 block%resolving = .true.
                 ! back to the velocities without the contact impulses (nlgs_solve applies the
                 ! current reactions again: the warm start of the next pass; after a stall those
-                ! at the start of the pass, the stalled ones having grown by its iterations)
+                ! at the start of the pass, the stalled ones carrying a self-stress grown with
+                ! its iterations, of no meaning: a pass whose growth moved bodies, however
+                ! slowly, is not stalled and keeps its reactions)
                 cs%r(:, 1:cs%n) = -cs%r(:, 1:cs%n)
                 call nlgs_apply_reactions(cs, im, vel)
                 if (pass%stalled) then

@@ -82,11 +82,26 @@
 !> the held block forbids). The block Gauss-Seidel then adds the same impulses at every
 !> iteration: the reactions grow by a fixed step, the velocities and the norm's numerator stay
 !> put, and the relative error falls only as the reactions grow (as 1/sweeps: 20 000 sweeps
-!> left it at 1.9e-5 on that stack). At sweeps 2 stall_first, 4 stall_first, ... the solve
-!> compares the norm with its state at half as many: a numerator not halved and a denominator
-!> sum |W r|^2 grown by stall_growth (4 for a linear growth), while `must_yield` finds a member
-!> outside what it can hold, stop the solve, unconverged, with `stalled` set: the strategy
-!> releases a member and solves again (dem_bonded_block).
+!> left it at 1.9e-5 on that stack). A slow convergence has the same signature for as long as
+!> it lasts (a bonded row hit by a disk 1.9e5 times heavier: the reactions grow linearly for
+!> about a thousand sweeps, at a rate of the mass ratio), so the growth alone tells nothing;
+!> what tells them apart is whether it moves anything. Without a solution the growth is a
+!> self-stress, impulses in equilibrium (Farkas: a combination of the swept contacts' pushes
+!> that, with the members held, moves no body), while a slow convergence moves the bodies
+!> (the heavy disk slows down). At sweeps 2 stall_first, 4 stall_first, ... the solve compares
+!> its state with that at half as many: a numerator not halved and a denominator sum |W r|^2
+!> grown by stall_growth (4 for a linear growth), the growth d of the reactions moving the
+!> bodies by at most stall_mobility = roundoff^2 of what its impulses would alone
+!> (growth_mobility, |v - v_half|_M^2 / sum d_k^T W_kk d_k: 4e-33 on the wall-push stack,
+!> 4.6e-7 on the row), and `must_yield` finding a member outside what it can hold: the solve
+!> stops, unconverged, with `stalled` set, and the strategy releases a member and solves again
+!> (dem_bonded_block). Any other pass runs to its tolerance or its cap; before the growth's
+!> mobility was tested the row's first step stalled at 64 sweeps, its root bond released and
+!> the step at the cap of 20 000 (999 sweeps without the test). A problem without solution
+!> whose growth keeps moving bodies is not detected and its step ends at the cap, unconverged:
+!> the 6 x 4 stack of doc/theory.md 7.10 from its fifth step, the wall's two contacts carrying
+!> friction near its bound, the growth's mobility falling as 1/sweeps^2 (1.2e-8 at 1 024
+!> sweeps, 4.6e-11 at 16 384) but never to a self-stress's.
 !>
 !> Correction (`correction`, an extension of `nlgs_correction_t`; none by default): before
 !> the first sweep and after every `correction%every` sweeps it changes the reactions of the
@@ -136,6 +151,12 @@ module dem_nlgs
     !> Relative resolution of the shifted reactions of bonds (see the module header): 64
     !> machine epsilons.
     real(wp), parameter :: roundoff = 64.0_wp*epsilon(1.0_wp)
+    !> Stall (stall_first): ... and the growth since the last test moves no body, its mobility
+    !> (growth_mobility: 0 for a self-stress, 1 for one contact's impulse alone) at most
+    !> roundoff^2, 2.0e-28 (the velocities are known to roundoff). A slow convergence moves
+    !> bodies: a clamped bonded row of 5 disks hit by a disk 1.9e5 times heavier, 4.6e-7 (it
+    !> scales as the mass ratio: the threshold at a ratio of 4e26); the wall-push stack 4e-33.
+    real(wp), parameter :: stall_mobility = roundoff**2
 
     !> A correction of the swept contacts' reactions between sweeps (module header). It must
     !> change nothing at a solution of the sweeps.
@@ -739,6 +760,9 @@ contains
         ! denominator at the one before
         integer :: stall_at
         real(wp) :: num_at, den_at
+        ! ... and the reactions and velocities there, whose growth since is judged
+        ! (growth_mobility)
+        real(wp), allocatable :: r_at(:, :), v_at(:, :)
         stats%n_contacts = cs%n
         call skip_blocked(cs, stats%n_blocked)
         stats%n_active = count(cs%active(1:cs%n))
@@ -868,19 +892,24 @@ contains
                     stats%converged = .true.
                     exit
                 end if
-                if (s == stall_at) then
+                if (s == stall_at .and. stats%n_block > 0) then
                     ! with the block's members held the problem has no solution: the reactions
                     ! grow by a fixed step per sweep and the error falls only by their growth (the
-                    ! first test at 2 stall_first sweeps, against the state at stall_first)
-                    if (s > stall_first .and. stats%n_block > 0 .and. num >= stall_residual*num_at .and. &
-                        den >= stall_growth*den_at) then
+                    ! first test at 2 stall_first sweeps, against the state at stall_first), and
+                    ! that growth moves no body (a self-stress; growing reactions that move bodies,
+                    ! however slowly, are a slow convergence: module header, "Stall")
+                    if (s > stall_first .and. num >= stall_residual*num_at .and. den >= stall_growth*den_at) then
                         if (block%must_yield(cs)) then
-                            stats%stalled = .true.
-                            exit
+                            if (growth_mobility(cs, im, vel, r_at, v_at) <= stall_mobility) then
+                                stats%stalled = .true.
+                                exit
+                            end if
                         end if
                     end if
                     num_at = num
                     den_at = den
+                    r_at = cs%r(:, 1:cs%n)
+                    v_at = vel
                     stall_at = 2*s
                 end if
                 mix_now = accelerate .and. s > config%anderson_after
@@ -1103,6 +1132,32 @@ contains
         class(nlgs_criterion_t), intent(in) :: self
         yes = .false.
     end function criterion_not_siconos
+
+    !> How much the growth of the reactions since r_at moves the bodies (module header,
+    !> "Stall"): d^T W d / sum_k d_k^T W_kk d_k for d = r - r_at over the active contacts, W_kk
+    !> each contact's own Delassus block, with d^T W d = |vel - v_at|_M^2 (the velocities are
+    !> those of the reactions: vel - v_at = M^-1 H d, the bilateral constraints' share
+    !> included). 0 for a self-stress (impulses in equilibrium, which move nothing), 1 for the
+    !> impulse of one contact alone; the velocities being known to roundoff, a quotient below
+    !> roundoff^2 is a self-stress.
+    pure real(wp) function growth_mobility(cs, im, vel, r_at, v_at) result(q)
+        type(contact_set_t), intent(in) :: cs
+        real(wp), intent(in) :: im(:, :), vel(:, :), r_at(:, :), v_at(:, :)
+        real(wp) :: moved, alone, d(3)
+        integer :: k
+        moved = sum((vel - v_at)**2/max(im, tiny(1.0_wp)), mask=im > 0.0_wp)
+        alone = 0.0_wp
+        do k = 1, cs%n
+            if (.not. cs%active(k)) cycle
+            d = cs%r(:, k) - r_at(:, k)
+            alone = alone + dot_product(d, wmul(cs%w(:, k), d))
+        end do
+        if (alone > 0.0_wp) then
+            q = moved/alone
+        else
+            q = merge(huge(1.0_wp), 0.0_wp, moved > 0.0_wp)
+        end if
+    end function growth_mobility
 
     !> Round-off floor of the convergence norm's denominator for contact k (module header).
     pure real(wp) function roundoff_floor(cs, k, vel) result(f)
