@@ -585,7 +585,7 @@ class Records:
         rest = tuple(_normalized_index(k, n, axis)
                      for axis, (k, n) in enumerate(zip(key[1:], self.shape[1:]), start=1))
         with self._dataset() as ds:
-            if _selection(first, rest):
+            if _selection(first, rest, self.shape):
                 data = ds[(first,) + rest]
             else:
                 lo, hi, local = _covering(first, self.shape[0])
@@ -704,16 +704,27 @@ def _index_array(key, n: int, axis: int) -> np.ndarray:
     return np.where(a < 0, a + n, a)
 
 
-def _selection(first, rest) -> bool:
+def _selection(first, rest, shape) -> bool:
     """Whether HDF5 selects (first, *rest) as numpy would index: integers, slices of
-    positive step, and at most one 1-D strictly increasing index array."""
-    arrays = 0
-    for k in (first,) + rest:
-        if isinstance(k, int) or (isinstance(k, slice) and (k.step or 1) > 0):
+    positive step, and at most one 1-D strictly increasing index array; none of them empty
+    (HDF5 refuses an empty selection beside an index array), and the integers next to the
+    array (numpy moves the array's axis to the front when a slice parts them; HDF5 keeps
+    it in place)."""
+    arrays, advanced = 0, []
+    for axis, (k, n) in enumerate(zip((first,) + rest, shape)):
+        if isinstance(k, int):
+            advanced.append(axis)
+            continue
+        if isinstance(k, slice) and (k.step or 1) > 0:
+            if len(range(n)[k]) == 0:
+                return False
             continue
         if isinstance(k, np.ndarray) and k.ndim == 1 and k.size and np.all(np.diff(k) > 0):
             arrays += 1
+            advanced.append(axis)
             continue
+        return False
+    if arrays == 1 and advanced[-1] - advanced[0] + 1 != len(advanced):
         return False
     return arrays <= 1
 
