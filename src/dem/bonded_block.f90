@@ -148,6 +148,18 @@
 !> of their own. Not with bilateral constraints (their multipliers work on the disks too),
 !> and only in a step whose block held bonds: without intact bonds the step is method =
 !> nlgs's, bit for bit, its unconverged steps included.
+!> The block is given up the same way when a pass ends at the cap unconverged, not stalled,
+!> after one of its stall tests saw the reactions grow as without a solution (nlgs_stats_t%
+!> growth_seen: the signature, the growth moving bodies), with a bond of B outside its cone
+!> at its end (must_yield): a problem without solution whose growth moves bodies, which the
+!> stall test cannot tell from a slow convergence (the audit's 6 x 4 stack pushed by a wall,
+!> turning about its last floor bond: every step from the fifth at the cap, no bond broken,
+!> the wall 1.9e-4 m into the disks; now 24 ruptures, 20 with method = nlgs, the wall out
+!> of the disks but for the (1 - theta) h v of a contact made within a step). A pass that
+!> met the cap converging (the thrown lattice at max_sweeps = 100 with anderson = 0 or
+!> criterion = siconos), or with the few iterations that releases left it (the same lattice:
+!> the step, not the pass, is out of iterations), keeps the block. stats%block_given_up
+!> tells the two reasons apart.
 !>
 !> Released bonds that hold a part alone (`condense`): a released bond whose two bodies are
 !> not connected through B carries the part beyond it by itself, a rigid body or a structure
@@ -170,7 +182,7 @@ module dem_bonded_block
     use dem_bipotential, only: case_stick, case_slip, case_roll, case_slip_roll, rolling_local_solve, &
                                bipotential_local_solve
     use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_apply_reactions, nlgs_block_t, &
-                        nlgs_bilateral_t
+                        nlgs_bilateral_t, block_kept, block_given_up_energy, block_given_up_unconverged
     use dem_solve_method, only: solve_method_t
     implicit none
     private
@@ -244,7 +256,8 @@ module dem_bonded_block
         integer(i8) :: deletions = 0
         !> Set-ups whose factorisation failed (the bonds were then swept as by the NLGS).
         integer(i8) :: failures = 0
-        !> Steps whose block solve was given up (energy guard) and solved by the plain sweeps.
+        !> Steps whose block solve was given up (energy guard, or unconverged at the cap) and
+        !> solved by the plain sweeps.
         integer(i8) :: give_ups = 0
     end type bonded_block_counts_t
 
@@ -414,8 +427,11 @@ contains
     !> (created_energy above created_fraction of the kinetic energy) is given up: the step is
     !> solved again from its free velocities and zero reactions by the plain sweeps (as method
     !> = nlgs), with a cap of its own (module header, "Cap and energy guard"), and
-    !> stats%block_given_up is set. A step without intact bonds (none in the deck, or all
-    !> broken) is the sweeps of method = nlgs, bit for bit, converged or not.
+    !> stats%block_given_up is block_given_up_energy; so is a step whose last pass met the cap
+    !> unconverged after its reactions grew as without a solution (nlgs_stats_t%growth_seen),
+    !> with a bond outside its cone, with block_given_up_unconverged. A step without intact
+    !> bonds (none in the deck, or all broken) is the sweeps of method = nlgs, bit for bit,
+    !> converged or not.
     subroutine bonded_block_solve(self, config, cs, im, vel, stats, bilateral)
         !> The strategy and its block (kept between steps).
         class(bonded_block_method_t), intent(inout) :: self
@@ -433,11 +449,11 @@ contains
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         type(nlgs_stats_t) :: pass
         type(nlgs_config_t) :: left
-        integer :: k, released, n_blocked, sweeps, worst
+        integer :: k, released, n_blocked, sweeps, worst, given_up
         real(wp) :: excess
         integer(i8) :: updates, local
         real(wp), allocatable :: vfree(:, :), r_start(:, :)
-        logical :: give_up_block, held
+        logical :: held, cap_growing
         associate (block => self%block)
             if (allocated(block%excluded)) then
                 if (size(block%excluded) < cs%n) deallocate (block%excluded)
@@ -453,8 +469,9 @@ contains
             updates = 0_i8
             local = 0_i8
             n_blocked = -1
-            give_up_block = .false.
+            given_up = block_kept
             held = .false.
+            cap_growing = .false.
             block%resolving = .false.
             do
                 left%max_sweeps = config%max_sweeps - sweeps
@@ -476,13 +493,14 @@ contains
                 ! pulled apart at step 1 was given up there, its bonds never released)
                 if (held .and. .not. present(bilateral) .and. block%consistent) then
                     if (bonded_block_creates_energy(cs, im, vel, vfree)) then
-                        give_up_block = .true.
+                        given_up = block_given_up_energy
                         exit
                     end if
                 end if
                 ! a stalled pass has no solution with its bonds held: its reactions grow without
                 ! bound along a self-stress that loads some bond outside its cone (module header,
                 ! "Stall"), and no number of iterations converges it; it is judged as a converged one
+                cap_growing = .not. (pass%converged .or. pass%stalled) .and. pass%growth_seen
                 if (.not. (pass%converged .or. pass%stalled)) exit
                 ! release only the bond farthest outside its cone: the others may come back inside
                 ! once it yields, and bonds released together are swept against the rigid rest of
@@ -545,7 +563,15 @@ contains
                 end if
             end do
             block%resolving = .false.
-            if (give_up_block) then
+            ! a pass that ran to the cap after its reactions grew as without a solution (the
+            ! signature of a stall, the growth moving bodies), a bond outside its cone, has no
+            ! solution with its bonds held for all the stall test can tell; the plain sweeps judge
+            ! each bond by its own law (module header, "Cap and energy guard"). A pass that met
+            ! the cap converging, or with the few iterations that releases left it, keeps the block
+            if (given_up == block_kept .and. cap_growing .and. .not. present(bilateral)) then
+                if (block%must_yield(cs)) given_up = block_given_up_unconverged
+            end if
+            if (given_up /= block_kept) then
                 ! the plain sweeps from the free velocities (the bonds swept with their cones),
                 ! from zero reactions: the block's carry self-stresses (the kernel of W_BB) that
                 ! the sweeps, clipping them to the cones, turn into kinetic energy (the lattice of
@@ -561,7 +587,7 @@ contains
                 local = local + pass%local_iterations
             end if
             stats = pass
-            stats%block_given_up = give_up_block
+            stats%block_given_up = given_up
             stats%n_blocked = n_blocked
             stats%sweeps = sweeps
             stats%updates = updates

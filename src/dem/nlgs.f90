@@ -98,10 +98,12 @@
 !> (dem_bonded_block). Any other pass runs to its tolerance or its cap; before the growth's
 !> mobility was tested the row's first step stalled at 64 sweeps, its root bond released and
 !> the step at the cap of 20 000 (999 sweeps without the test). A problem without solution
-!> whose growth keeps moving bodies is not detected and its step ends at the cap, unconverged:
+!> whose growth keeps moving bodies is not detected and the solve runs to its cap, unconverged:
 !> the 6 x 4 stack of doc/theory.md 7.10 from its fifth step, the wall's two contacts carrying
 !> friction near its bound, the growth's mobility falling as 1/sweeps^2 (1.2e-8 at 1 024
-!> sweeps, 4.6e-11 at 16 384) but never to a self-stress's.
+!> sweeps, 4.6e-11 at 16 384) but never to a self-stress's. `growth_seen` says that a test
+!> found the signature whatever the growth moved, so that the strategy can give its block up
+!> for such a pass when it meets its cap (dem_bonded_block).
 !>
 !> Correction (`correction`, an extension of `nlgs_correction_t`; none by default): before
 !> the first sweep and after every `correction%every` sweeps it changes the reactions of the
@@ -136,6 +138,17 @@ module dem_nlgs
     public :: nlgs_siconos_error
     public :: nlgs_split_t, nlgs_split_build
     public :: nlgs_criterion_t, lmgc90_criterion_t, siconos_criterion_t, nlgs_criterion_name, nlgs_start_name
+    public :: block_kept, block_given_up_energy, block_given_up_unconverged
+
+    !> Values of nlgs_stats_t%block_given_up (and of /dem/solver/block_given_up): the bonded
+    !> block solved the step, or the method has none, ...
+    integer, parameter :: block_kept = 0
+    !> ... it was given up by its energy guard (a pass created energy: dem_bonded_block), ...
+    integer, parameter :: block_given_up_energy = 1
+    !> ... or because a pass whose reactions grew as without a solution (growth_seen) ended
+    !> unconverged at max_sweeps with a bond of the block outside its cone
+    !> (nlgs_block_t%must_yield). The step was then solved again by the plain sweeps.
+    integer, parameter :: block_given_up_unconverged = 2
 
     !> Stall of a solve with a block (module header, "Stall"): the test runs at sweeps
     !> 2 stall_first, 4 stall_first, ..., against the state at half as many sweeps.
@@ -294,13 +307,20 @@ module dem_nlgs
         integer :: n_block = 0
         !> Corrections done (config%correction).
         integer :: corrections = 0
-        !> The bonded block was given up for the step (its energy guard, dem_bonded_block) and
-        !> the step solved again by the plain sweeps; never set by the other methods.
-        logical :: block_given_up = .false.
+        !> Why the bonded block was given up for the step and the step solved again by the
+        !> plain sweeps (dem_bonded_block): block_given_up_energy (its energy guard) or
+        !> block_given_up_unconverged (unconverged at its cap, a bond outside its cone);
+        !> block_kept when it was not, and always with the other methods.
+        integer :: block_given_up = block_kept
         !> The solve stopped before its cap because its problem, the block's members held, has
         !> no solution (module header, "Stall"): the reactions grew by a fixed step per
         !> sweep, the error unchanged, and a member must yield (nlgs_block_t%must_yield).
         logical :: stalled = .false.
+        !> At one of the solve's stall tests (module header, "Stall") its reactions grew as in a
+        !> problem without solution, the numerator not halved and the denominator grown by
+        !> stall_growth, while a member must yield: the signature of a stall, whether or not
+        !> the growth moved bodies (a stall is the case where it moved none).
+        logical :: growth_seen = .false.
     end type nlgs_stats_t
 
     !> History of the Anderson acceleration: differences of the sweep map's outputs g and
@@ -900,6 +920,9 @@ contains
                     ! however slowly, are a slow convergence: module header, "Stall")
                     if (s > stall_first .and. num >= stall_residual*num_at .and. den >= stall_growth*den_at) then
                         if (block%must_yield(cs)) then
+                            ! (the signature, whatever the growth moves: a strategy whose pass meets
+                            ! its cap after it may give its block up, dem_bonded_block)
+                            stats%growth_seen = .true.
                             if (growth_mobility(cs, im, vel, r_at, v_at) <= stall_mobility) then
                                 stats%stalled = .true.
                                 exit

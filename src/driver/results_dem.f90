@@ -16,7 +16,7 @@ module driver_results_dem
     use core_strings, only: to_str
     use core_version, only: multicor_name, multicor_version
     use io_hdf5_file, only: h5_file_t
-    use dem_nlgs, only: nlgs_stats_t, nlgs_criterion_name, nlgs_start_name
+    use dem_nlgs, only: nlgs_stats_t, nlgs_criterion_name, nlgs_start_name, block_kept, block_given_up_unconverged
     use dem_moreau_jean, only: dem_system_t, energies_balance
     use dem_local_problem, only: local_problem_t, local_problem_siconos_error
     implicit none
@@ -44,10 +44,15 @@ module driver_results_dem
         integer :: n_buffered = 0, n_steps = 0
         !> Bond ruptures written so far.
         integer :: n_ruptures = 0
-        !> Steps recorded so far whose bonded block was given up (nlgs_stats_t%block_given_up).
+        !> Steps recorded so far whose bonded block was given up (nlgs_stats_t%block_given_up),
+        !> for either reason, ...
         integer :: n_block_given_up = 0
+        !> ... and those of them given up unconverged at the cap with a bond outside its cone
+        !> (block_given_up_unconverged; the others by the energy guard).
+        integer :: n_block_given_up_unconverged = 0
         !> Buffered statistics per step: sweeps, contacts in the list, active contacts,
-        !> converged (1) or not (0), bonded block given up (1) or not (0).
+        !> converged (1) or not (0), why the bonded block was given up (nlgs_stats_t%block_given_up,
+        !> 0 when it was not).
         integer, allocatable :: sweeps(:), contacts(:), active(:), blocked(:), converged(:), given_up(:)
         !> Buffered convergence norms and Signorini-Coulomb residuals per step.
         real(wp), allocatable :: norm(:), residual(:)
@@ -96,6 +101,7 @@ contains
         self%n_steps = 0
         self%n_ruptures = 0
         self%n_block_given_up = 0
+        self%n_block_given_up_unconverged = 0
         allocate (self%sweeps(stats_buffer), self%contacts(stats_buffer), &
                   self%active(stats_buffer), self%blocked(stats_buffer), self%converged(stats_buffer), &
                   self%given_up(stats_buffer), self%norm(stats_buffer), &
@@ -168,6 +174,8 @@ contains
             call file%write_attribute('/dem/solver', 'unconverged_steps', 0, error)
             if (allocated(error)) return
             call file%write_attribute('/dem/solver', 'block_given_up_steps', 0, error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem/solver', 'block_given_up_unconverged_steps', 0, error)
             if (allocated(error)) return
             call file%write_attribute('/dem/solver', 'detection_seconds', 0.0_wp, error)
             if (allocated(error)) return
@@ -388,8 +396,10 @@ contains
         self%active(k) = stats%n_active
         self%blocked(k) = stats%n_blocked
         self%converged(k) = merge(1, 0, stats%converged)
-        self%given_up(k) = merge(1, 0, stats%block_given_up)
-        if (stats%block_given_up) self%n_block_given_up = self%n_block_given_up + 1
+        self%given_up(k) = stats%block_given_up
+        if (stats%block_given_up /= block_kept) self%n_block_given_up = self%n_block_given_up + 1
+        if (stats%block_given_up == block_given_up_unconverged) &
+            self%n_block_given_up_unconverged = self%n_block_given_up_unconverged + 1
         self%norm(k) = stats%error
         self%residual(k) = stats%residual
         self%siconos(k) = stats%siconos_error
@@ -427,6 +437,7 @@ contains
         self%n_steps = 0
         self%n_ruptures = 0
         self%n_block_given_up = 0
+        self%n_block_given_up_unconverged = 0
         if (allocated(self%sweeps)) deallocate (self%sweeps, self%contacts, self%active, self%blocked, &
                                                 self%converged, self%norm, self%residual)
         if (allocated(self%siconos)) deallocate (self%siconos)
@@ -468,8 +479,8 @@ contains
     end subroutine flush_stats
 
     !> Write the buffered statistics and the closing attributes of /dem/solver (steps,
-    !> unconverged steps, steps whose bonded block was given up, time spent in detection and
-    !> in the solver).
+    !> unconverged steps, steps whose bonded block was given up, for either reason and
+    !> unconverged at its cap, time spent in detection and in the solver).
     subroutine writer_finish(self, file, sys, unconverged, error)
         !> The writer.
         class(dem_writer_t), intent(inout) :: self
@@ -488,6 +499,9 @@ contains
         call file%write_attribute('/dem/solver', 'unconverged_steps', unconverged, error)
         if (allocated(error)) return
         call file%write_attribute('/dem/solver', 'block_given_up_steps', self%n_block_given_up, error)
+        if (allocated(error)) return
+        call file%write_attribute('/dem/solver', 'block_given_up_unconverged_steps', self%n_block_given_up_unconverged, &
+                                  error)
         if (allocated(error)) return
         call file%write_attribute('/dem/solver', 'detection_seconds', sys%time_detection, error)
         if (allocated(error)) return

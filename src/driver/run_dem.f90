@@ -6,7 +6,8 @@
 !> which a disk moved farther than the alert distance (contacts may then be found late), and
 !> once, then counted in the summary, a converged step whose contacts created energy
 !> (driver_guards::creation_allowance; Newton's restitution, doc/theory.md 2.4), and once,
-!> then counted in the summary, a step whose bonded block was given up by its energy guard
+!> then counted in the summary, a step whose bonded block was given up, by its energy guard
+!> or unconverged at its cap with a bond outside its cone, each reason on its own
 !> (dem_bonded_block; doc/theory.md 7.10).
 !> After every step the state is checked (driver_guards): a non-finite value, a disk beyond
 !> the representable box, or a disk that passed through a wall or another disk stops the run
@@ -21,6 +22,7 @@ module driver_run_dem
     use dem_moreau_jean, only: dem_system_t, mj_init, mj_step, energies_balance, mj_free_velocities, mj_detect, &
                                mj_solve, mj_end_step, mj_bonds_made
     use dem_local_problem, only: local_problem_t, local_problem_build
+    use dem_nlgs, only: block_given_up_energy, block_given_up_unconverged
     use driver_config, only: run_config_t
     use driver_config_dem, only: dem_config_t
     use driver_results, only: results_writer_t
@@ -136,9 +138,16 @@ contains
             call writer%record_step(out%file, cfg%system%stats, error)
             if (allocated(error)) return
             if (.not. cfg%system%stats%converged) call warn_unconverged()
-            ! the first step whose bonded block was given up (the writer's count survives a restart)
-            if (cfg%system%stats%block_given_up .and. writer%n_block_given_up == 1) &
-                call report(block_given_up_warning(k, cfg%system%time))
+            ! the first step whose bonded block was given up for each reason (the writer's counts
+            ! survive a restart)
+            select case (cfg%system%stats%block_given_up)
+            case (block_given_up_energy)
+                if (writer%n_block_given_up - writer%n_block_given_up_unconverged == 1) &
+                    call report(block_given_up_warning(k, cfg%system%time, block_given_up_energy))
+            case (block_given_up_unconverged)
+                if (writer%n_block_given_up_unconverged == 1) &
+                    call report(block_given_up_warning(k, cfg%system%time, block_given_up_unconverged))
+            end select
             call check_created_energy()
             if (cfg%system%stats%n_blocked > 0 .and. .not. blocked_warned) then
                 call report('warning: contacts between bodies that cannot move (fixed or imposed '// &
@@ -312,7 +321,12 @@ contains
                     sys%energies%contact_dissipation, ' J/m)'
                 call report(trim(buf))
                 if (creating > 0) call report(energy_creation_summary(creating, n_steps))
-                if (writer%n_block_given_up > 0) call report(block_given_up_summary(writer%n_block_given_up, n_steps))
+                if (writer%n_block_given_up > writer%n_block_given_up_unconverged) &
+                    call report(block_given_up_summary(writer%n_block_given_up - writer%n_block_given_up_unconverged, &
+                                                       n_steps, block_given_up_energy))
+                if (writer%n_block_given_up_unconverged > 0) &
+                    call report(block_given_up_summary(writer%n_block_given_up_unconverged, n_steps, &
+                                                       block_given_up_unconverged))
             end associate
             call report(progress%summary_line(n_steps, cfg%system%time, out%stopped()))
         end subroutine summary
@@ -370,36 +384,56 @@ contains
                '(lost); a larger alert distance or a shorter step keeps them'
     end function lost_bonds_warning
 
-    !> Warning for the first step whose bonded block ([solver] method = block) was given up by
-    !> its energy guard (dem_bonded_block, doc/theory.md 7.10): what happened, why, and what
-    !> the settings measured on the lattice of theory.md 7.10 did.
-    function block_given_up_warning(k, t) result(line)
+    !> Warning for the first step whose bonded block ([solver] method = block) was given up for
+    !> a reason (dem_bonded_block, doc/theory.md 7.10): what happened, why, and what the
+    !> settings measured on the decks of theory.md 7.10 did.
+    function block_given_up_warning(k, t, reason) result(line)
         !> Step.
         integer(i8), intent(in) :: k
         !> Time at its end [s].
         real(wp), intent(in) :: t
+        !> Why (nlgs_stats_t%block_given_up): block_given_up_energy or block_given_up_unconverged.
+        integer, intent(in) :: reason
         character(len=:), allocatable :: line
         character(len=16) :: tbuf
         write (tbuf, '(es11.4e2)') t
         line = 'warning: step '//to_str(k)//' (t = '//trim(adjustl(tbuf))//' s): the bonded block ([solver] '// &
-               'method = block) was given up: a pass created more than 0.1 of the kinetic energy, its reactions '// &
-               'carrying self-stresses of the loops of the bonded lattice, which the convergence norm does not '// &
-               'bound and which released bonds set free (doc/theory.md 7.10); the step was solved again by '// &
-               'plain sweeps from zero reactions. Further such steps are only counted (total in the summary, '// &
-               'per step in /dem/solver/block_given_up). A [solver] max_sweeps large enough for every step to '// &
-               'converge avoids it (100000 on the lattice of theory.md 7.10, where 1000 did not); criterion = '// &
-               'siconos, anderson = 0 or tolerance = 1e-5 kept the block there but left its steps unconverged'
+               'method = block) was given up '
+        if (reason == block_given_up_unconverged) then
+            line = line//'unconverged at its cap: the step ran out of its max_sweeps block iterations with a bond '// &
+                   'of the block outside its cone, which the block cannot hold and which no pass released (a body '// &
+                   'pushed into bonded disks held by their bonds: with the bonds held the step may have no '// &
+                   'solution, doc/theory.md 7.10); the step was solved again by plain sweeps from zero reactions, '// &
+                   'whose bonds break by their own law. Further such steps are only counted (total in the summary, '// &
+                   'per step in /dem/solver/block_given_up as 2). Each costs max_sweeps block iterations before the '// &
+                   'sweeps: [solver] method = nlgs spares them'
+        else
+            line = line//'by its energy guard: a pass created more than 0.1 of the kinetic energy, its reactions '// &
+                   'carrying self-stresses of the loops of the bonded lattice, which the convergence norm does not '// &
+                   'bound and which released bonds set free (doc/theory.md 7.10); the step was solved again by '// &
+                   'plain sweeps from zero reactions. Further such steps are only counted (total in the summary, '// &
+                   'per step in /dem/solver/block_given_up as 1). A [solver] max_sweeps large enough for every step '// &
+                   'to converge avoids it (100000 on the lattice of theory.md 7.10, where 1000 did not); criterion '// &
+                   '= siconos, anderson = 0 or tolerance = 1e-5 kept the block there but left its steps unconverged'
+        end if
     end function block_given_up_warning
 
-    !> Summary line of the steps whose bonded block was given up (its energy guard).
-    function block_given_up_summary(n, n_steps) result(line)
-        !> Steps given up.
+    !> Summary line of the steps whose bonded block was given up for a reason.
+    function block_given_up_summary(n, n_steps, reason) result(line)
+        !> Steps given up for that reason.
         integer, intent(in) :: n
         !> Steps of the run.
         integer(i8), intent(in) :: n_steps
+        !> Why (nlgs_stats_t%block_given_up): block_given_up_energy or block_given_up_unconverged.
+        integer, intent(in) :: reason
         character(len=:), allocatable :: line
-        line = 'bonded block given up (energy guard, solved by plain sweeps): '//to_str(n)//' of '// &
-               to_str(n_steps)//' steps (/dem/solver/block_given_up)'
+        if (reason == block_given_up_unconverged) then
+            line = 'bonded block given up (unconverged at max_sweeps, a bond outside its cone; solved by plain '// &
+                   'sweeps): '//to_str(n)//' of '//to_str(n_steps)//' steps (/dem/solver/block_given_up = 2)'
+        else
+            line = 'bonded block given up (energy guard, solved by plain sweeps): '//to_str(n)//' of '// &
+                   to_str(n_steps)//' steps (/dem/solver/block_given_up = 1)'
+        end if
     end function block_given_up_summary
 
     !> Text added to an unconverged step's warning when the tolerance is more than ten times
