@@ -158,8 +158,13 @@
 !> of the disks but for the (1 - theta) h v of a contact made within a step). A pass that
 !> met the cap converging (the thrown lattice at max_sweeps = 100 with anderson = 0 or
 !> criterion = siconos), or with the few iterations that releases left it (the same lattice:
-!> the step, not the pass, is out of iterations), keeps the block. stats%block_given_up
-!> tells the two reasons apart.
+!> the step, not the pass, is out of iterations), keeps the block. A slow convergence with
+!> a solution can meet the cap with the same signature (a clamped bonded row hit by heavy
+!> disks, which needs 999 iterations, at max_sweeps = 200: plain sweeps at 5.4e-3 where
+!> the block reached 3.3e-4): the block's state at the cap is kept, and when the plain
+!> sweeps end unconverged with a larger error the give-up is taken back, the step ending on
+!> the block's answer as if it had been kept (block_given_up_reverted). stats%block_given_up
+!> tells the cases apart.
 !>
 !> Released bonds that hold a part alone (`condense`): a released bond whose two bodies are
 !> not connected through B carries the part beyond it by itself, a rigid body or a structure
@@ -182,7 +187,8 @@ module dem_bonded_block
     use dem_bipotential, only: case_stick, case_slip, case_roll, case_slip_roll, rolling_local_solve, &
                                bipotential_local_solve
     use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_apply_reactions, nlgs_block_t, &
-                        nlgs_bilateral_t, block_kept, block_given_up_energy, block_given_up_unconverged
+                        nlgs_bilateral_t, block_kept, block_given_up_energy, block_given_up_unconverged, &
+                        block_given_up_reverted
     use dem_solve_method, only: solve_method_t
     implicit none
     private
@@ -429,7 +435,9 @@ contains
     !> = nlgs), with a cap of its own (module header, "Cap and energy guard"), and
     !> stats%block_given_up is block_given_up_energy; so is a step whose last pass met the cap
     !> unconverged after its reactions grew as without a solution (nlgs_stats_t%growth_seen),
-    !> with a bond outside its cone, with block_given_up_unconverged. A step without intact
+    !> with a bond outside its cone, with block_given_up_unconverged, unless the plain sweeps
+    !> end unconverged with a larger error than the block's at its cap: the step then ends on
+    !> the block's answer (block_given_up_reverted). A step without intact
     !> bonds (none in the deck, or all broken) is the sweeps of method = nlgs, bit for bit,
     !> converged or not.
     subroutine bonded_block_solve(self, config, cs, im, vel, stats, bilateral)
@@ -447,12 +455,14 @@ contains
         type(nlgs_stats_t), intent(out) :: stats
         !> Bilateral constraints kept satisfied (default: none).
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
-        type(nlgs_stats_t) :: pass
+        type(nlgs_stats_t) :: pass, at_cap
         type(nlgs_config_t) :: left
         integer :: k, released, n_blocked, sweeps, worst, given_up
         real(wp) :: excess
         integer(i8) :: updates, local
-        real(wp), allocatable :: vfree(:, :), r_start(:, :)
+        real(wp), allocatable :: vfree(:, :), r_start(:, :), r_cap(:, :), v_cap(:, :)
+        integer, allocatable :: pcase_cap(:)
+        logical, allocatable :: member_cap(:)
         logical :: held, cap_growing
         associate (block => self%block)
             if (allocated(block%excluded)) then
@@ -571,12 +581,22 @@ contains
             if (given_up == block_kept .and. cap_growing .and. .not. present(bilateral)) then
                 if (block%must_yield(cs)) given_up = block_given_up_unconverged
             end if
+            if (given_up == block_given_up_unconverged) then
+                ! the block's answer at its cap (reactions, velocities, the cases of the last
+                ! local solves, its members), kept if the plain sweeps end worse: a slow
+                ! convergence with a solution meets the cap with the same signature (module
+                ! header, "Cap and energy guard")
+                at_cap = pass
+                r_cap = cs%r(:, 1:cs%n)
+                v_cap = vel
+                pcase_cap = cs%pcase(1:cs%n)
+                member_cap = block%member
+            end if
             if (given_up /= block_kept) then
                 ! the plain sweeps from the free velocities (the bonds swept with their cones),
                 ! from zero reactions: the block's carry self-stresses (the kernel of W_BB) that
                 ! the sweeps, clipping them to the cones, turn into kinetic energy (the lattice of
                 ! the module header: 1.0 J/m created from a warm start, 0.14 J/m free)
-                block%counts%give_ups = block%counts%give_ups + 1
                 block%member = .false.
                 vel = vfree
                 cs%r(:, 1:cs%n) = 0.0_wp
@@ -585,6 +605,20 @@ contains
                 sweeps = sweeps + pass%sweeps
                 updates = updates + pass%updates
                 local = local + pass%local_iterations
+                if (given_up == block_given_up_unconverged .and. .not. pass%converged) then
+                    ! unconverged too, and farther from a solution by the step's own norm: the
+                    ! block's answer is the better one, and the step ends on it as without the
+                    ! give-up (unconverged, its bonds held), its count keeping both solves
+                    if (pass%error > at_cap%error) then
+                        given_up = block_given_up_reverted
+                        cs%r(:, 1:cs%n) = r_cap
+                        vel = v_cap
+                        cs%pcase(1:cs%n) = pcase_cap
+                        block%member = member_cap
+                        pass = at_cap
+                    end if
+                end if
+                if (given_up /= block_given_up_reverted) block%counts%give_ups = block%counts%give_ups + 1
             end if
             stats = pass
             stats%block_given_up = given_up

@@ -138,7 +138,7 @@ module dem_nlgs
     public :: nlgs_siconos_error
     public :: nlgs_split_t, nlgs_split_build
     public :: nlgs_criterion_t, lmgc90_criterion_t, siconos_criterion_t, nlgs_criterion_name, nlgs_start_name
-    public :: block_kept, block_given_up_energy, block_given_up_unconverged
+    public :: block_kept, block_given_up_energy, block_given_up_unconverged, block_given_up_reverted
 
     !> Values of nlgs_stats_t%block_given_up (and of /dem/solver/block_given_up): the bonded
     !> block solved the step, or the method has none, ...
@@ -149,6 +149,10 @@ module dem_nlgs
     !> unconverged at max_sweeps with a bond of the block outside its cone
     !> (nlgs_block_t%must_yield). The step was then solved again by the plain sweeps.
     integer, parameter :: block_given_up_unconverged = 2
+    !> ... or it was given up so, but the plain sweeps ended unconverged too with a larger error
+    !> (the step's norm) than the block's at its cap: the step ends on the block's answer,
+    !> unconverged, as if it had been kept (its sweeps counting both solves).
+    integer, parameter :: block_given_up_reverted = 3
 
     !> Stall of a solve with a block (module header, "Stall"): the test runs at sweeps
     !> 2 stall_first, 4 stall_first, ..., against the state at half as many sweeps.
@@ -310,7 +314,9 @@ module dem_nlgs
         !> Why the bonded block was given up for the step and the step solved again by the
         !> plain sweeps (dem_bonded_block): block_given_up_energy (its energy guard) or
         !> block_given_up_unconverged (unconverged at its cap, a bond outside its cone);
-        !> block_kept when it was not, and always with the other methods.
+        !> block_given_up_reverted when so given up but the plain sweeps ended worse, the
+        !> step ending on the block's answer; block_kept when it was not, and always with
+        !> the other methods.
         integer :: block_given_up = block_kept
         !> The solve stopped before its cap because its problem, the block's members held, has
         !> no solution (module header, "Stall"): the reactions grew by a fixed step per

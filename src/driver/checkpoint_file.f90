@@ -26,10 +26,11 @@ module driver_checkpoint_file
     character(len=*), parameter :: checkpoint_name = 'checkpoint.h5'
     !> Format tag written in every checkpoint: its layout number goes up when the layout
     !> changes within a code version (2: the particle writer's count of steps whose bonded
-    !> block was given up; 3: and of those given up unconverged at its cap), so that a
-    !> checkpoint of an earlier build is refused by name.
+    !> block was given up; 3: and of those given up unconverged at its cap; 4: and of the
+    !> steps whose give-up at the cap was taken back), so that a checkpoint of an earlier
+    !> build is refused by name.
     character(len=*), parameter :: format_stem = 'MULTICOR checkpoint '
-    character(len=*), parameter :: format_tag = format_stem//'3'
+    character(len=*), parameter :: format_tag = format_stem//'4'
     !> States of `checkpoint_run_t%found`.
     integer, parameter :: found_unknown = 0, found_kept = 1, found_none = 2
     !> Checkpoints of one run: where and when to write them, and the checkpoint a restart

@@ -210,7 +210,8 @@ contains
         call file%write_attribute('/writers', 'dem', real([writer%n_out, writer%n_contacts_stored, &
                                                            writer%n_steps, writer%n_buffered, writer%n_ruptures, &
                                                            writer%n_block_given_up, &
-                                                           writer%n_block_given_up_unconverged], wp), error)
+                                                           writer%n_block_given_up_unconverged, &
+                                                           writer%n_block_given_up_reverted], wp), error)
     end subroutine save_dem_writer
 
     !> Read the counters of the particle writer (begun again: its buffers exist).
@@ -224,7 +225,7 @@ contains
         integer, allocatable :: c(:)
         call read_int_attr_1d(file, '/writers', 'dem', c, error)
         if (allocated(error)) return
-        if (size(c) /= 7) then
+        if (size(c) /= 8) then
             call make_error(error, 'checkpoint: /writers: wrong number of particle writer counters')
             return
         end if
@@ -235,6 +236,9 @@ contains
         if (allocated(error)) return
         call require_range(c(7:7), 0, c(6), '/writers@dem value 7 (steps whose bonded block was given up unconverged '// &
                            'at its cap, at most those given up)', error)
+        if (allocated(error)) return
+        call require_range(c(8:8), 0, c(3) - c(6), '/writers@dem value 8 (steps whose give-up at the cap was taken '// &
+                           'back, at most the steps recorded not given up)', error)
         if (allocated(error)) return
         if (c(4) /= 0) then
             call make_error(error, 'checkpoint: the particle writer had unwritten statistics')
@@ -247,6 +251,7 @@ contains
         writer%n_ruptures = c(5)
         writer%n_block_given_up = c(6)
         writer%n_block_given_up_unconverged = c(7)
+        writer%n_block_given_up_reverted = c(8)
     end subroutine load_dem_writer
 
     !> Write the counters and running maxima of the coupling writer (nothing buffered).

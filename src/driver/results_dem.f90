@@ -16,7 +16,8 @@ module driver_results_dem
     use core_strings, only: to_str
     use core_version, only: multicor_name, multicor_version
     use io_hdf5_file, only: h5_file_t
-    use dem_nlgs, only: nlgs_stats_t, nlgs_criterion_name, nlgs_start_name, block_kept, block_given_up_unconverged
+    use dem_nlgs, only: nlgs_stats_t, nlgs_criterion_name, nlgs_start_name, block_kept, block_given_up_unconverged, &
+                        block_given_up_reverted
     use dem_moreau_jean, only: dem_system_t, energies_balance
     use dem_local_problem, only: local_problem_t, local_problem_siconos_error
     implicit none
@@ -50,6 +51,9 @@ module driver_results_dem
         !> ... and those of them given up unconverged at the cap with a bond outside its cone
         !> (block_given_up_unconverged; the others by the energy guard).
         integer :: n_block_given_up_unconverged = 0
+        !> Steps recorded so far whose block was given up unconverged at the cap and taken back,
+        !> the plain sweeps ending worse (block_given_up_reverted; not in n_block_given_up).
+        integer :: n_block_given_up_reverted = 0
         !> Buffered statistics per step: sweeps, contacts in the list, active contacts,
         !> converged (1) or not (0), why the bonded block was given up (nlgs_stats_t%block_given_up,
         !> 0 when it was not).
@@ -102,6 +106,7 @@ contains
         self%n_ruptures = 0
         self%n_block_given_up = 0
         self%n_block_given_up_unconverged = 0
+        self%n_block_given_up_reverted = 0
         allocate (self%sweeps(stats_buffer), self%contacts(stats_buffer), &
                   self%active(stats_buffer), self%blocked(stats_buffer), self%converged(stats_buffer), &
                   self%given_up(stats_buffer), self%norm(stats_buffer), &
@@ -176,6 +181,8 @@ contains
             call file%write_attribute('/dem/solver', 'block_given_up_steps', 0, error)
             if (allocated(error)) return
             call file%write_attribute('/dem/solver', 'block_given_up_unconverged_steps', 0, error)
+            if (allocated(error)) return
+            call file%write_attribute('/dem/solver', 'block_given_up_reverted_steps', 0, error)
             if (allocated(error)) return
             call file%write_attribute('/dem/solver', 'detection_seconds', 0.0_wp, error)
             if (allocated(error)) return
@@ -397,7 +404,10 @@ contains
         self%blocked(k) = stats%n_blocked
         self%converged(k) = merge(1, 0, stats%converged)
         self%given_up(k) = stats%block_given_up
-        if (stats%block_given_up /= block_kept) self%n_block_given_up = self%n_block_given_up + 1
+        if (stats%block_given_up /= block_kept .and. stats%block_given_up /= block_given_up_reverted) &
+            self%n_block_given_up = self%n_block_given_up + 1
+        if (stats%block_given_up == block_given_up_reverted) &
+            self%n_block_given_up_reverted = self%n_block_given_up_reverted + 1
         if (stats%block_given_up == block_given_up_unconverged) &
             self%n_block_given_up_unconverged = self%n_block_given_up_unconverged + 1
         self%norm(k) = stats%error
@@ -438,6 +448,7 @@ contains
         self%n_ruptures = 0
         self%n_block_given_up = 0
         self%n_block_given_up_unconverged = 0
+        self%n_block_given_up_reverted = 0
         if (allocated(self%sweeps)) deallocate (self%sweeps, self%contacts, self%active, self%blocked, &
                                                 self%converged, self%norm, self%residual)
         if (allocated(self%siconos)) deallocate (self%siconos)
@@ -502,6 +513,8 @@ contains
         if (allocated(error)) return
         call file%write_attribute('/dem/solver', 'block_given_up_unconverged_steps', self%n_block_given_up_unconverged, &
                                   error)
+        if (allocated(error)) return
+        call file%write_attribute('/dem/solver', 'block_given_up_reverted_steps', self%n_block_given_up_reverted, error)
         if (allocated(error)) return
         call file%write_attribute('/dem/solver', 'detection_seconds', sys%time_detection, error)
         if (allocated(error)) return

@@ -22,7 +22,7 @@ module driver_run_dem
     use dem_moreau_jean, only: dem_system_t, mj_init, mj_step, energies_balance, mj_free_velocities, mj_detect, &
                                mj_solve, mj_end_step, mj_bonds_made
     use dem_local_problem, only: local_problem_t, local_problem_build
-    use dem_nlgs, only: block_given_up_energy, block_given_up_unconverged
+    use dem_nlgs, only: block_given_up_energy, block_given_up_unconverged, block_given_up_reverted
     use driver_config, only: run_config_t
     use driver_config_dem, only: dem_config_t
     use driver_results, only: results_writer_t
@@ -147,6 +147,9 @@ contains
             case (block_given_up_unconverged)
                 if (writer%n_block_given_up_unconverged == 1) &
                     call report(block_given_up_warning(k, cfg%system%time, block_given_up_unconverged))
+            case (block_given_up_reverted)
+                if (writer%n_block_given_up_reverted == 1) &
+                    call report(block_given_up_warning(k, cfg%system%time, block_given_up_reverted))
             end select
             call check_created_energy()
             if (cfg%system%stats%n_blocked > 0 .and. .not. blocked_warned) then
@@ -327,6 +330,9 @@ contains
                 if (writer%n_block_given_up_unconverged > 0) &
                     call report(block_given_up_summary(writer%n_block_given_up_unconverged, n_steps, &
                                                        block_given_up_unconverged))
+                if (writer%n_block_given_up_reverted > 0) &
+                    call report(block_given_up_summary(writer%n_block_given_up_reverted, n_steps, &
+                                                       block_given_up_reverted))
             end associate
             call report(progress%summary_line(n_steps, cfg%system%time, out%stopped()))
         end subroutine summary
@@ -392,14 +398,22 @@ contains
         integer(i8), intent(in) :: k
         !> Time at its end [s].
         real(wp), intent(in) :: t
-        !> Why (nlgs_stats_t%block_given_up): block_given_up_energy or block_given_up_unconverged.
+        !> Why (nlgs_stats_t%block_given_up): block_given_up_energy, block_given_up_unconverged or
+        !> block_given_up_reverted.
         integer, intent(in) :: reason
         character(len=:), allocatable :: line
         character(len=16) :: tbuf
         write (tbuf, '(es11.4e2)') t
         line = 'warning: step '//to_str(k)//' (t = '//trim(adjustl(tbuf))//' s): the bonded block ([solver] '// &
                'method = block) was given up '
-        if (reason == block_given_up_unconverged) then
+        if (reason == block_given_up_reverted) then
+            line = line//'unconverged at its cap, a bond of the block outside its cone, but the plain sweeps that '// &
+                   'solved the step again ended unconverged too with a larger error: the step ends on the block''s '// &
+                   'answer, unconverged, its bonds held (a slow convergence, not a step without solution, doc/'// &
+                   'theory.md 7.10). Further such steps are only counted (total in the summary, per step in '// &
+                   '/dem/solver/block_given_up as 3). A [solver] max_sweeps large enough for the block to converge '// &
+                   'avoids it'
+        else if (reason == block_given_up_unconverged) then
             line = line//'unconverged at its cap: the step ran out of its max_sweeps block iterations with a bond '// &
                    'of the block outside its cone, which the block cannot hold and which no pass released (a body '// &
                    'pushed into bonded disks held by their bonds: with the bonds held the step may have no '// &
@@ -424,10 +438,15 @@ contains
         integer, intent(in) :: n
         !> Steps of the run.
         integer(i8), intent(in) :: n_steps
-        !> Why (nlgs_stats_t%block_given_up): block_given_up_energy or block_given_up_unconverged.
+        !> Why (nlgs_stats_t%block_given_up): block_given_up_energy, block_given_up_unconverged or
+        !> block_given_up_reverted.
         integer, intent(in) :: reason
         character(len=:), allocatable :: line
-        if (reason == block_given_up_unconverged) then
+        if (reason == block_given_up_reverted) then
+            line = 'bonded block given up at max_sweeps and taken back (the plain sweeps ended with a larger error; '// &
+                   'the block''s answer kept, unconverged): '//to_str(n)//' of '//to_str(n_steps)// &
+                   ' steps (/dem/solver/block_given_up = 3)'
+        else if (reason == block_given_up_unconverged) then
             line = 'bonded block given up (unconverged at max_sweeps, a bond outside its cone; solved by plain '// &
                    'sweeps): '//to_str(n)//' of '//to_str(n_steps)//' steps (/dem/solver/block_given_up = 2)'
         else

@@ -25,6 +25,13 @@ Checks:
   - variant with M2 = 36 000 kg/m (C = 3.6e7): the capacity 1.8005e5 is below the root's
     2.1e5, so the root breaks at step 1 in moment (mode 3), and only it (with the root
     yielding at its bound the next bond carries 1.29e5 < its 1.8005e5).
+  - variant with max_sweeps = 200 (the block needs 999 iterations): step 1's pass meets the
+    cap with the growth signature and a bond outside its cone, so the block is given up
+    (doc/theory.md 7.10, "Given up at the cap"); the plain sweeps that solve the step again
+    end unconverged too, farther from the solution (error 5.4e-3, that of method = nlgs's
+    step 1 at the same cap, against the block's 3.3e-4): the give-up is taken back, the step
+    ends on the block's answer and /dem/solver/block_given_up records 3 (before: 2 at both
+    steps, each at the sweeps' 5.4e-3).
 Usage (ctest does this): test_block_heavy_impact.py --exe multicor --work DIR --source REPO
 """
 import math
@@ -56,6 +63,24 @@ def variant(src, work, name, m2):
     deck = work / f"{name}.dat"
     deck.write_text(text)
     return deck
+
+
+def capped(src, work, name, method):
+    """The deck with [solver] max_sweeps = 200 and the given method."""
+    text = (src / "tests" / "regression" / "decks" / DECK).read_text()
+    old = "max_sweeps = 20000\n"
+    assert old in text, old
+    text = text.replace(old, f"max_sweeps = 200\nmethod = {method}\n", 1)
+    deck = work / f"{name}.dat"
+    deck.write_text(text)
+    return deck
+
+
+def solver(path):
+    with h5py.File(path, "r") as f:
+        s = f["dem/solver"]
+        return dict(error=s["error"][...], given_up=s["block_given_up"][...], sweeps=s["sweeps"][...],
+                    converged=s["converged"][...].astype(bool), attrs=dict(s.attrs))
 
 
 def results(path):
@@ -109,6 +134,30 @@ def main():
           s * R * (2 * N - 3) > cap2 and broken["bonds"] == [(2, 1, MOMENT, 1)],
           f"root moment {s * R * (2 * N - 3):.4e} > capacity {cap2:.4e}; ruptures (i, j, mode, step) "
           f"{broken['bonds']}, iterations {broken['sweeps'].tolist()}")
+    # the cap of 200 iterations: the block's give-up at the cap taken back
+    h5, proc = multicor(exe, capped(src, work, "cap200", "block"), work)
+    blk = solver(h5)
+    nlgs = solver(multicor(exe, capped(src, work, "cap200_nlgs", "nlgs"), work)[0])
+    # method = nlgs's step 1 (200 sweeps from the free velocities and zero reactions) is the
+    # give-up's plain sweeps; the block's answer at the cap is 16 times closer (3.3e-4 and
+    # 1.6e-4 measured at steps 1 and 2, where the sweeps end at 5.4e-3): 1e-3 lies a factor
+    # 3 from either
+    check("cap 200: both steps unconverged, step 1 no worse than method = nlgs's, both below 1e-3",
+          not blk["converged"].any() and blk["error"][0] <= nlgs["error"][0] and (blk["error"] <= 1e-3).all(),
+          f"errors {blk['error'].tolist()} (method = nlgs {nlgs['error'].tolist()}), converged "
+          f"{blk['converged'].tolist()}")
+    a = blk["attrs"]
+    check("cap 200: step 1's give-up taken back (block_given_up 3, step 2 kept), counted as such",
+          blk["given_up"].tolist() == [3, 0] and a.get("block_given_up_steps") == 0
+          and a.get("block_given_up_reverted_steps") == 1,
+          f"block_given_up {blk['given_up'].tolist()}, attributes "
+          f"{ {k: int(v) for k, v in a.items() if k.startswith('block_given_up')} }")
+    check("cap 200: step 1 counts the block's and the sweeps' iterations (200 + 200)",
+          blk["sweeps"].tolist()[0] == 400, f"iterations {blk['sweeps'].tolist()}")
+    out = proc.stdout + proc.stderr
+    check("cap 200: a warning and a summary line tell of it",
+          "given up unconverged at its cap, a bond of the block outside its cone, but the plain sweeps" in out
+          and "(/dem/solver/block_given_up = 3)" in out, out[-600:])
     return summary()
 
 
