@@ -608,8 +608,9 @@ contains
                 if (given_up == block_given_up_unconverged .and. .not. pass%converged) then
                     ! unconverged too, and farther from a solution by the step's own norm: the
                     ! block's answer is the better one, and the step ends on it as without the
-                    ! give-up (unconverged, its bonds held), its count keeping both solves
-                    if (pass%error > at_cap%error) then
+                    ! give-up (unconverged, its bonds held), its count keeping both solves (and
+                    ! when the sweeps' error is not a number)
+                    if (.not. (pass%error <= at_cap%error)) then
                         given_up = block_given_up_reverted
                         cs%r(:, 1:cs%n) = r_cap
                         vel = v_cap
