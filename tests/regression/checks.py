@@ -89,6 +89,15 @@ def plots(src, h5, out, names):
           f"exit {proc.returncode}, stderr {proc.stderr.strip()[-300:]!r}, printed {printed}")
 
 
+def with_solver_lines(deck, dst, lines):
+    """Write to `dst` the deck `deck` with `lines` added at the top of its [solver] section
+    (which it must have); returns `dst`."""
+    text = deck.read_text()
+    assert "[solver]\n" in text, deck
+    dst.write_text(text.replace("[solver]\n", "[solver]\n" + "".join(f"{ln}\n" for ln in lines), 1))
+    return dst
+
+
 def datasets(path, group="/"):
     """Every dataset below `group` of the HDF5 file `path`, by its name relative to the group:
     name -> array."""

@@ -26,7 +26,7 @@ import sys
 import h5py
 import numpy as np
 
-from checks import arguments, check, multicor, summary
+from checks import arguments, check, multicor, summary, with_solver_lines
 from test_fclib_export import proj_coulomb, proj_rolling, siconos_error
 
 STEP = 187
@@ -35,11 +35,8 @@ TOL = 1.0e-10
 
 def variant(src, work, name, extra):
     """The deck with extra [solver] lines."""
-    text = (src / "tests" / "regression" / "decks" / "dem_bonded_row_impact.dat").read_text()
-    text = text.replace("[solver]\n", "[solver]\n" + "".join(f"{ln}\n" for ln in extra), 1)
-    deck = work / f"{name}.dat"
-    deck.write_text(text)
-    return deck
+    return with_solver_lines(src / "tests" / "regression" / "decks" / "dem_bonded_row_impact.dat",
+                             work / f"{name}.dat", extra)
 
 
 def results(path):

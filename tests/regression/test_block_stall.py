@@ -33,7 +33,7 @@ import sys
 import h5py
 import numpy as np
 
-from checks import arguments, check, multicor, summary
+from checks import arguments, check, multicor, summary, with_solver_lines
 
 DECK = "dem_bonded_wall_push.dat"
 THETA = 0.5  # [time] theta, the default
@@ -44,11 +44,8 @@ CONTACT_STEP = 4  # the wall, 0.17 mm away at 0.05 mm per step, reaches the stac
 
 def variant(src, work, name, extra, cap=20000):
     """The deck with extra [solver] lines and max_sweeps = cap."""
-    text = (src / "tests" / "regression" / "decks" / DECK).read_text()
-    text = text.replace("[solver]\n", "[solver]\n" + "".join(f"{ln}\n" for ln in extra), 1)
-    text = text.replace("max_sweeps = 20000\n", f"max_sweeps = {cap}\n", 1)
-    deck = work / f"{name}.dat"
-    deck.write_text(text)
+    deck = with_solver_lines(src / "tests" / "regression" / "decks" / DECK, work / f"{name}.dat", extra)
+    deck.write_text(deck.read_text().replace("max_sweeps = 20000\n", f"max_sweeps = {cap}\n", 1))
     return deck
 
 
