@@ -139,6 +139,7 @@ def on_slurm(src, exe, work):
               and (single / "incline.h5").stat().st_mtime_ns > first, log[-400:])
         resubmission(src, exe, work, cluster)
         duplicate(src, exe, work, cluster)
+        empty_lock(src, exe, work, cluster)
         collect_partition(src, exe, work, cluster)
     finally:
         cluster.stop()
@@ -277,6 +278,32 @@ def locally(src, exe, work):
     check("a second local run has nothing to do", "4 points finished before, 0 to run"
           in again.stdout, again.stdout.strip().splitlines()[0])
     return rows
+
+
+def empty_lock(src, exe, work, cluster):
+    """A point whose folder holds an empty lock (left by an earlier multicor killed as it
+    created it): multicor refuses it with the command to remove it (exit 1), and the job
+    script records the failure (exit_status 1, 'exit 1' in job.log, status failed). Before,
+    the script took any lock left after exit 1 for another run's: 'refused', exit_status left
+    'running' for ever."""
+    folder = work / "empty_lock"
+    sweep_tool(src, ["create", src / "input" / "incline.dat", "--exe", exe, "--set", "time.end=0.1",
+                     "--time", "5", "--dir", folder])
+    out = folder / "runs" / "p001"
+    out.mkdir(parents=True)
+    (out / ".multicor.lock").write_text("")
+    sweep_tool(src, ["submit", "--no-collect", folder], env=cluster.env)
+    status_file = out / "exit_status"
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < 30 and (not status_file.exists() or status_file.read_text().strip() == "running"):
+        time.sleep(0.2)
+    wait_idle(cluster, 30)
+    text = (out / "job.log").read_text() if (out / "job.log").exists() else ""
+    status = status_file.read_text().strip() if status_file.exists() else ""
+    state = sweep_tool(src, ["status", folder], env=cluster.env).stdout
+    check("an empty lock in the point's folder: exit_status 1, 'exit 1' logged, status failed",
+          status == "1" and "p001 exit 1" in text and " refused " not in text and "p001 failed" in state,
+          f"{status!r}\n{text}\n{state}")
 
 
 def main():
