@@ -179,8 +179,8 @@ contains
                 if (progress%due()) call report(progress%line(k, integ%t))
             end if
         end do
-        write (buf, '(a,i0,a,es13.5e3,a,es11.3e3)') 'dynamic run: ', n_steps, ' steps to t = ', &
-            integ%t, ' s; energy balance residual ', integ%energy_balance()
+        write (buf, '(a,i0,a,es13.5e3,a,es11.3e3,a)') 'dynamic run: ', n_steps, ' steps to t = ', &
+            integ%t, ' s; energy balance residual ', integ%energy_balance(), ' J'
         call report(trim(buf)//run%balance_note())
         warning = large_displacement_warning(u_max, model_extent(model%x, model%y), &
                                              '[beam] section, load, distributed, gravity, line, node, [initial]')
