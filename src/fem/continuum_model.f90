@@ -95,6 +95,9 @@ module fem_continuum_model
         procedure :: has_timed_prescribed => model_has_timed_prescribed
         !> Stress (xx, yy, xy) at every element centre.
         procedure :: centre_stresses => model_centre_stresses
+        !> Out-of-plane stress sigma_zz and von Mises stress of every element from its in-plane
+        !> stress (xx, yy, xy), by the element's material.
+        procedure :: stress_measures => model_stress_measures
         !> Whether the prescribed dofs stop the three rigid motions of the plane of every body.
         procedure :: stops_rigid_motions => model_stops_rigid_motions
         !> First body of the mesh whose rigid motions the prescribed dofs do not stop (0: none).
@@ -646,6 +649,28 @@ contains
             end associate
         end do
     end subroutine model_centre_stresses
+
+    !> sigma_zz and von Mises stress of every element (fem_elastic2d: sigma_zz = nu (sigma_xx +
+    !> sigma_yy) in plane strain, 0 in plane stress) from its stress (xx, yy, xy), such as the
+    !> centre stresses of `centre_stresses`.
+    pure subroutine model_stress_measures(self, stress, sigma_zz, von_mises)
+        !> The model (its materials assigned: `check`).
+        class(continuum_model_t), intent(in) :: self
+        !> Stresses (3, number of elements) [Pa].
+        real(wp), intent(in) :: stress(:, :)
+        !> sigma_zz of each element [Pa].
+        real(wp), allocatable, intent(out) :: sigma_zz(:)
+        !> Von Mises stress of each element [Pa].
+        real(wp), allocatable, intent(out) :: von_mises(:)
+        integer :: e
+        allocate (sigma_zz(size(stress, 2)), von_mises(size(stress, 2)))
+        do e = 1, size(stress, 2)
+            associate (mat => self%materials(self%element_material(e)))
+                sigma_zz(e) = mat%sigma_zz(stress(:, e))
+                von_mises(e) = mat%von_mises(stress(:, e))
+            end associate
+        end do
+    end subroutine model_stress_measures
 
     !> Whether the prescribed dofs stop the rigid motions of every body (unheld_body is 0).
     pure logical function model_stops_rigid_motions(self) result(stops)

@@ -4,6 +4,11 @@
 !> sigma = D eps and the strain energy density is eps^T D eps / 2. Plane stress:
 !> D = E/(1 - nu^2) [1 nu 0; nu 1 0; 0 0 (1 - nu)/2]. Plane strain:
 !> D = E/((1 + nu)(1 - 2 nu)) [1-nu nu 0; nu 1-nu 0; 0 0 (1 - 2 nu)/2].
+!>
+!> The out-of-plane stress follows from the hypothesis: sigma_zz = 0 in plane stress,
+!> sigma_zz = nu (sigma_xx + sigma_yy) in plane strain (eps_zz = 0); the von Mises stress of
+!> the full state (xx, yy, zz, xy; xz = yz = 0) is
+!> sqrt(((sxx - syy)^2 + (syy - szz)^2 + (szz - sxx)^2)/2 + 3 sxy^2).
 module fem_elastic2d
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
@@ -39,6 +44,10 @@ module fem_elastic2d
     contains
         !> Elasticity matrix D (3 x 3, Voigt order xx, yy, xy).
         procedure :: d_matrix => elastic2d_d_matrix
+        !> Out-of-plane stress sigma_zz of an in-plane stress (xx, yy, xy).
+        procedure :: sigma_zz => elastic2d_sigma_zz
+        !> Von Mises (equivalent) stress of an in-plane stress (xx, yy, xy) with its sigma_zz.
+        procedure :: von_mises => elastic2d_von_mises
     end type elastic2d_t
 
 contains
@@ -107,4 +116,31 @@ contains
         end if
         d(2, 1) = d(1, 2)
     end function elastic2d_d_matrix
+
+    !> Out-of-plane stress: nu (sigma_xx + sigma_yy) in plane strain, 0 in plane stress.
+    pure function elastic2d_sigma_zz(self, sigma) result(szz)
+        !> The material.
+        class(elastic2d_t), intent(in) :: self
+        !> In-plane stress (xx, yy, xy) [Pa].
+        real(wp), intent(in) :: sigma(3)
+        !> sigma_zz [Pa].
+        real(wp) :: szz
+        szz = 0.0_wp
+        if (self%plane_strain) szz = self%poisson*(sigma(1) + sigma(2))
+    end function elastic2d_sigma_zz
+
+    !> Von Mises stress sqrt(((sxx - syy)^2 + (syy - szz)^2 + (szz - sxx)^2)/2 + 3 sxy^2),
+    !> with szz the material's sigma_zz (`sigma_zz`).
+    pure function elastic2d_von_mises(self, sigma) result(vm)
+        !> The material.
+        class(elastic2d_t), intent(in) :: self
+        !> In-plane stress (xx, yy, xy) [Pa].
+        real(wp), intent(in) :: sigma(3)
+        !> Von Mises stress [Pa] (>= 0).
+        real(wp) :: vm
+        real(wp) :: szz
+        szz = self%sigma_zz(sigma)
+        vm = sqrt(0.5_wp*((sigma(1) - sigma(2))**2 + (sigma(2) - szz)**2 + (szz - sigma(1))**2) + &
+                  3.0_wp*sigma(3)**2)
+    end function elastic2d_von_mises
 end module fem_elastic2d
