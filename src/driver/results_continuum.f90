@@ -10,10 +10,11 @@
 !> stress); /continuum/sets/{nodes,elements}/<name> (1-based indices) and
 !> /continuum/sets/edges/<name> (2, n_edges). A static run writes
 !> /continuum/static/{displacement (2, n_nodes), stress (3, n_elements: xx, yy, xy at element
-!> centres), reactions (2, n_nodes: K u - f on the prescribed dofs, N; 0 on the free ones),
-!> strain_energy}; a modal run
+!> centres), stress_zz and von_mises (n_elements: sigma_zz and the von Mises stress of those
+!> centre stresses, fem_elastic2d), reactions (2, n_nodes: K u - f on the prescribed dofs, N;
+!> 0 on the free ones), strain_energy}; a modal run
 !> /continuum/modal/{omega, frequency, shapes (2, n_nodes, n_modes)}; a dynamic run the
-!> series /continuum/{time, displacement, velocity, stress} and /continuum/energy/{time,
+!> series /continuum/{time, displacement, velocity, stress, stress_zz, von_mises} and /continuum/energy/{time,
 !> kinetic, strain, external_work, damping, balance, reaction_work} (h5py: one row per stored
 !> state) with /continuum/energy/reaction (2: the x and y resultants of the reactions on the
 !> prescribed dofs, N) per record.
@@ -44,6 +45,10 @@ module driver_results_continuum
         character(len=:), allocatable :: topology
         !> Number of values of the topology dataset.
         integer :: topology_size = 0
+        !> Whether the dynamic run's file has the series stress_zz and von_mises: false for the
+        !> file of an earlier build continued by a restart, to which they are not appended
+        !> (driver_results_xdmf then leaves them out).
+        logical :: stress_measures = .true.
     contains
         !> Write the mesh and the sets; create the series of the analysis.
         procedure :: begin => writer_begin
@@ -79,6 +84,7 @@ contains
         self%n_elements = model%mesh%element_count()
         self%analysis = analysis
         self%n_out = 0
+        self%stress_measures = .true.
         call file%create_group('/continuum', error)
         if (allocated(error)) return
         call file%create_group('/continuum/mesh', error)
@@ -124,6 +130,8 @@ contains
         if (.not. allocated(error)) call series('/continuum/displacement', [2, self%n_nodes], 'm', error)
         if (.not. allocated(error)) call series('/continuum/velocity', [2, self%n_nodes], 'm/s', error)
         if (.not. allocated(error)) call series('/continuum/stress', [3, self%n_elements], 'Pa', error)
+        if (.not. allocated(error)) call series('/continuum/stress_zz', [self%n_elements], 'Pa', error)
+        if (.not. allocated(error)) call series('/continuum/von_mises', [self%n_elements], 'Pa', error)
         if (.not. allocated(error)) call file%create_group('/continuum/energy', error)
         if (.not. allocated(error)) call series('/continuum/energy/time', [integer ::], 's', error)
         if (.not. allocated(error)) call series('/continuum/energy/kinetic', [integer ::], 'J', error)
@@ -213,7 +221,7 @@ contains
 
     !> Take up the results file of a dynamic run at a restart, its series already cut to the
     !> checkpoint (driver_checkpoint::load_results): the count of stored states is that of
-    !> /continuum/time.
+    !> /continuum/time. The series stress_zz and von_mises are appended to when the file has them.
     subroutine writer_resume(self, file, mesh, error)
         !> The writer.
         class(continuum_writer_t), intent(inout) :: self
@@ -231,11 +239,12 @@ contains
         call file%dataset_shape('/continuum/time', dims, error)
         if (allocated(error)) return
         self%n_out = dims(1)
+        self%stress_measures = file%exists('/continuum/stress_zz') .and. file%exists('/continuum/von_mises')
     end subroutine writer_resume
 
-    !> Static displacements (2, n_nodes), centre stresses (3, n_elements), reactions (2, n_nodes)
-    !> and strain energy.
-    subroutine writer_write_static(self, file, d, stress, reactions, strain_energy, error)
+    !> Static displacements (2, n_nodes), centre stresses (3, n_elements), their sigma_zz and
+    !> von Mises stress (n_elements), reactions (2, n_nodes) and strain energy.
+    subroutine writer_write_static(self, file, d, stress, sigma_zz, von_mises, reactions, strain_energy, error)
         !> The writer.
         class(continuum_writer_t), intent(inout) :: self
         !> The open results file.
@@ -244,13 +253,17 @@ contains
         real(wp), intent(in) :: d(:, :)
         !> Stresses [Pa].
         real(wp), intent(in) :: stress(:, :)
+        !> sigma_zz of the stresses [Pa] (continuum_model_t%stress_measures).
+        real(wp), intent(in) :: sigma_zz(:)
+        !> Von Mises stress of the stresses [Pa].
+        real(wp), intent(in) :: von_mises(:)
         !> Reactions of the supports on the prescribed dofs, 0 on the free ones [N].
         real(wp), intent(in) :: reactions(:, :)
         !> Strain energy [J].
         real(wp), intent(in) :: strain_energy
         !> Set on a write failure.
         type(error_t), allocatable, intent(out) :: error
-        call check_shapes(self, d, stress, error)
+        call check_shapes(self, d, stress, sigma_zz, von_mises, error)
         if (allocated(error)) return
         if (any(shape(reactions) /= shape(d))) then
             call make_error(error, 'results: continuum reactions do not match the mesh')
@@ -261,6 +274,10 @@ contains
         if (.not. allocated(error)) call file%write_attribute('/continuum/static/displacement', 'units', 'm', error)
         if (.not. allocated(error)) call file%write_dataset('/continuum/static/stress', stress, error)
         if (.not. allocated(error)) call file%write_attribute('/continuum/static/stress', 'units', 'Pa', error)
+        if (.not. allocated(error)) call file%write_dataset('/continuum/static/stress_zz', sigma_zz, error)
+        if (.not. allocated(error)) call file%write_attribute('/continuum/static/stress_zz', 'units', 'Pa', error)
+        if (.not. allocated(error)) call file%write_dataset('/continuum/static/von_mises', von_mises, error)
+        if (.not. allocated(error)) call file%write_attribute('/continuum/static/von_mises', 'units', 'Pa', error)
         if (.not. allocated(error)) call file%write_dataset('/continuum/static/reactions', reactions, error)
         if (.not. allocated(error)) call file%write_attribute('/continuum/static/reactions', 'units', 'N', error)
         if (.not. allocated(error)) call file%write_attribute('/continuum/static', 'strain_energy', strain_energy, error)
@@ -288,8 +305,9 @@ contains
                                                               'kg^-1/2 (mass-normalised)', error)
     end subroutine writer_write_modal
 
-    !> Append one state: time, displacements, velocities (2, n_nodes), stresses (3, n_elements).
-    subroutine writer_store(self, file, t, d, v, stress, error)
+    !> Append one state: time, displacements, velocities (2, n_nodes), stresses (3, n_elements),
+    !> their sigma_zz and von Mises stress (n_elements).
+    subroutine writer_store(self, file, t, d, v, stress, sigma_zz, von_mises, error)
         !> The writer.
         class(continuum_writer_t), intent(inout) :: self
         !> The open results file.
@@ -298,16 +316,24 @@ contains
         real(wp), intent(in) :: t
         !> Displacements and velocities.
         real(wp), intent(in) :: d(:, :), v(:, :)
-        !> Stresses.
+        !> Stresses [Pa].
         real(wp), intent(in) :: stress(:, :)
+        !> sigma_zz of the stresses [Pa] (continuum_model_t%stress_measures).
+        real(wp), intent(in) :: sigma_zz(:)
+        !> Von Mises stress of the stresses [Pa].
+        real(wp), intent(in) :: von_mises(:)
         !> Set on a size mismatch or a write failure.
         type(error_t), allocatable, intent(out) :: error
-        call check_shapes(self, d, stress, error)
+        call check_shapes(self, d, stress, sigma_zz, von_mises, error)
         if (allocated(error)) return
         call file%append('/continuum/time', t, error)
         if (.not. allocated(error)) call file%append('/continuum/displacement', d, error)
         if (.not. allocated(error)) call file%append('/continuum/velocity', v, error)
         if (.not. allocated(error)) call file%append('/continuum/stress', stress, error)
+        if (self%stress_measures) then
+            if (.not. allocated(error)) call file%append('/continuum/stress_zz', sigma_zz, error)
+            if (.not. allocated(error)) call file%append('/continuum/von_mises', von_mises, error)
+        end if
         if (allocated(error)) return
         self%n_out = self%n_out + 1
     end subroutine writer_store
@@ -349,13 +375,14 @@ contains
         if (.not. allocated(error)) call file%append('/continuum/energy/reaction', r, error)
     end subroutine writer_store_energy
 
-    !> Error unless d is (2, n_nodes) and stress (3, n_elements).
-    subroutine check_shapes(self, d, stress, error)
+    !> Error unless d is (2, n_nodes), stress (3, n_elements), sigma_zz and von_mises (n_elements).
+    subroutine check_shapes(self, d, stress, sigma_zz, von_mises, error)
         type(continuum_writer_t), intent(in) :: self
-        real(wp), intent(in) :: d(:, :), stress(:, :)
+        real(wp), intent(in) :: d(:, :), stress(:, :), sigma_zz(:), von_mises(:)
         type(error_t), allocatable, intent(out) :: error
         if (size(d, 1) /= 2 .or. size(d, 2) /= self%n_nodes .or. size(stress, 1) /= 3 .or. &
-            size(stress, 2) /= self%n_elements) &
+            size(stress, 2) /= self%n_elements .or. size(sigma_zz) /= self%n_elements .or. &
+            size(von_mises) /= self%n_elements) &
             call make_error(error, 'results: continuum fields do not match the mesh (begin first)')
     end subroutine check_shapes
 end module driver_results_continuum

@@ -8,8 +8,9 @@
 !>   displacement (x, y; ParaView adds z = 0, so that Warp By Vector applies), the rotation,
 !>   and the velocity and acceleration when stored; the node ids;
 !> - a 2D continuum (/continuum/mesh): its mesh "continuum" with displacement, velocity, the
-!>   static reactions, the centre stresses as the scalars sigma_xx, sigma_yy, sigma_xy and
-!>   each element's material;
+!>   static reactions, the centre stresses as the scalars sigma_xx, sigma_yy, sigma_xy, their
+!>   sigma_zz and von Mises stress (von_mises; when stored: a file of an earlier build, continued
+!>   by a restart, lacks them) and each element's material;
 !> - disks (/dem/position): a point grid "disks" (the centres) with radius, material, velocity,
 !>   rotation and angular velocity; walls (/dem/walls/position): segments "walls";
 !> - static: one grid; modal: a temporal collection per part with one grid per mode, at the
@@ -46,6 +47,10 @@ module driver_results_xdmf
         !> The continuum's /continuum/mesh/material and /continuum/static/reactions are stored
         !> (a file of an earlier build, continued by a restart, may lack them).
         logical :: mesh_material = .false., static_reactions = .false.
+        !> The continuum's sigma_zz and von Mises stress are stored (static: stress_zz and von_mises
+        !> of /continuum/static; dynamic: the series /continuum/stress_zz and von_mises, which a
+        !> file of an earlier build, continued by a restart, lacks).
+        logical :: stress_measures = .false.
         !> Disks and walls.
         integer :: n_disks = 0, n_walls = 0
         !> Stored states (dynamic) or modes (modal).
@@ -151,6 +156,12 @@ contains
             s%mesh_elements = d(1)
             s%mesh_material = file%exists('/continuum/mesh/material')
             s%static_reactions = file%exists('/continuum/static/reactions')
+            if (s%analysis == 'static') then
+                s%stress_measures = file%exists('/continuum/static/stress_zz') .and. &
+                                    file%exists('/continuum/static/von_mises')
+            else
+                s%stress_measures = file%exists('/continuum/stress_zz') .and. file%exists('/continuum/von_mises')
+            end if
             call shape_of(file, '/continuum/mesh/topology', s%topology_dims, error)
             if (allocated(error)) return
             if (size(s%topology_dims) == 1) then
@@ -199,6 +210,10 @@ contains
             if (s%beam) call check_records(file, '/fem/displacement', s%n_states, error)
             if (s%continuum .and. .not. allocated(error)) &
                 call check_records(file, '/continuum/displacement', s%n_states, error)
+            if (s%stress_measures .and. .not. allocated(error)) &
+                call check_records(file, '/continuum/stress_zz', s%n_states, error)
+            if (s%stress_measures .and. .not. allocated(error)) &
+                call check_records(file, '/continuum/von_mises', s%n_states, error)
             if (s%disks .and. .not. allocated(error)) call check_records(file, '/dem/position', s%n_states, error)
             if (s%walls .and. .not. allocated(error)) call check_records(file, '/dem/walls/position', s%n_states, error)
         end select
@@ -272,6 +287,10 @@ contains
                 call x%attribute(stress_names(c), 'Scalar', 'Cell', &
                                  xdmf_slab('/continuum/static/stress', [e, 3], [0, c - 1], [e, 1]))
             end do
+            if (s%stress_measures) then
+                call x%attribute('sigma_zz', 'Scalar', 'Cell', xdmf_whole('/continuum/static/stress_zz', [e]))
+                call x%attribute('von_mises', 'Scalar', 'Cell', xdmf_whole('/continuum/static/von_mises', [e]))
+            end if
         case ('modal')
             call x%attribute('mode_shape', 'Vector', 'Node', &
                              xdmf_slab('/continuum/modal/shapes', [s%n_states, n, 2], [k - 1, 0, 0], [1, n, 2]))
@@ -284,6 +303,12 @@ contains
                 call x%attribute(stress_names(c), 'Scalar', 'Cell', &
                                  xdmf_slab('/continuum/stress', [s%n_states, e, 3], [k - 1, 0, c - 1], [1, e, 1]))
             end do
+            if (s%stress_measures) then
+                call x%attribute('sigma_zz', 'Scalar', 'Cell', &
+                                 xdmf_slab('/continuum/stress_zz', [s%n_states, e], [k - 1, 0], [1, e]))
+                call x%attribute('von_mises', 'Scalar', 'Cell', &
+                                 xdmf_slab('/continuum/von_mises', [s%n_states, e], [k - 1, 0], [1, e]))
+            end if
         end select
         call x%end_grid()
     end subroutine continuum_grid

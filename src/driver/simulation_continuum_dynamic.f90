@@ -259,7 +259,7 @@ contains
         !> Store the current state and energies.
         subroutine store(error)
             type(error_t), allocatable, intent(out) :: error
-            real(wp), allocatable :: u(:), v(:), stress(:, :)
+            real(wp), allocatable :: u(:), v(:), stress(:, :), szz(:), vm(:)
             real(wp) :: energies(5)
             character(len=200) :: buf
             integer :: n
@@ -268,15 +268,18 @@ contains
             n = self%model%mesh%node_count()
             call self%model%centre_stresses(u, stress, error)
             if (allocated(error)) return
+            call self%model%stress_measures(stress, szz, vm)
             associate (g => self%integ, au => self%audit)
                 energies = [au%kinetic, au%strain, au%load_work, au%damping, au%balance()]
-                if (.not. (all(ieee_is_finite(stress)) .and. all(ieee_is_finite(energies)))) then
+                ! (von Mises squares the stresses: it is not finite beyond 1e154 Pa)
+                if (.not. (all(ieee_is_finite(stress)) .and. all(ieee_is_finite(vm)) .and. &
+                           all(ieee_is_finite(energies)))) then
                     write (buf, '(a,es13.5e3,a)') 'continuum: a stress or an energy is not finite at t = ', g%t, &
                         ' s; likely cause: loads or moduli far too large or too small'
                     call make_error(error, trim(buf))
                     return
                 end if
-                call writer%store(out%file, g%t, reshape(u, [2, n]), reshape(v, [2, n]), stress, error)
+                call writer%store(out%file, g%t, reshape(u, [2, n]), reshape(v, [2, n]), stress, szz, vm, error)
                 if (allocated(error)) return
                 ! a free body's translation strains nothing: only the rest counts
                 associate (un => reshape(u, [2, n]))

@@ -202,14 +202,16 @@ contains
         !> Stresses, reactions and energy of the solution, written.
         subroutine run_static(error)
             type(error_t), allocatable, intent(out) :: error
-            real(wp), allocatable :: u(:), stress(:, :), r(:), rest(:)
+            real(wp), allocatable :: u(:), stress(:, :), szz(:), vm(:), r(:), rest(:)
             character(len=160) :: buf
             character(len=:), allocatable :: warning
             real(wp) :: energy, u_max
             u = self%model%expand(self%uf)
             call self%model%centre_stresses(u, stress, error)
             if (allocated(error)) return
-            if (.not. (all(ieee_is_finite(u)) .and. all(ieee_is_finite(stress)))) then
+            call self%model%stress_measures(stress, szz, vm)
+            ! (von Mises squares the stresses: it is not finite beyond 1e154 Pa)
+            if (.not. (all(ieee_is_finite(u)) .and. all(ieee_is_finite(stress)) .and. all(ieee_is_finite(vm)))) then
                 call make_error(error, 'static solution of the continuum: a displacement or a stress is not '// &
                                 'finite; likely cause: loads or moduli far too large or too small')
                 return
@@ -227,8 +229,8 @@ contains
                                 'cause: loads or moduli far too large or too small')
                 return
             end if
-            call writer%write_static(out%file, reshape(u, [2, size(u)/2]), stress, reshape(r, [2, size(r)/2]), &
-                                     energy, error)
+            call writer%write_static(out%file, reshape(u, [2, size(u)/2]), stress, szz, vm, &
+                                     reshape(r, [2, size(r)/2]), energy, error)
             if (allocated(error)) return
             ! The largest nodal displacement sqrt(ux^2 + uy^2), the measure the warning below uses.
             u_max = largest_displacement(reshape(u, [2, size(u)/2]))
