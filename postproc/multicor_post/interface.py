@@ -55,6 +55,9 @@ class InterfaceRun:
             self.kind = read("continuum/mesh/kind")
             self.u = read("continuum/displacement")
             self.stress = read("continuum/stress")
+            # the von Mises stress the run stored with the stresses (doc/output.md); None for a
+            # file of a build before it, whose von Mises `plot_stress` computes (`von_mises`)
+            self.stored_von_mises = read("continuum/von_mises") if "continuum/von_mises" in f else None
             self.sets = {k: f["continuum/sets/nodes"][k][...] - 1 for k in f["continuum/sets/nodes"]}
             self.balance = read("coupling/energy/balance")
             self.fe_balance = read("continuum/energy/balance")
@@ -123,7 +126,8 @@ def peak_and_residual(s, mu_app, last=1.0e-3):
 
 def von_mises(stress, plane_strain_nu=None):
     """Von Mises stress of (xx, yy, xy) [Pa]: sigma_zz = nu (xx + yy) in plane strain, with nu
-    given per element (0 for an element in plane stress), or 0 when nu is None."""
+    given per element (0 for an element in plane stress), or 0 when nu is None. For the files
+    of builds before /continuum/von_mises, which store the stresses alone."""
     sxx, syy, sxy = stress[..., 0], stress[..., 1], stress[..., 2]
     szz = 0 if plane_strain_nu is None else plane_strain_nu * (sxx + syy)
     return np.sqrt(0.5 * ((sxx - syy) ** 2 + (syy - szz) ** 2 + (szz - sxx) ** 2) + 3 * sxy ** 2)
@@ -201,9 +205,16 @@ def plot_configuration(run, k, window=None):
 
 def plot_stress(run, k, component="xy"):
     """Stress field in the blocks at output k: sigma_xy, or von Mises ('vm'), per element
-    (centre values) on the deformed mesh [MPa]."""
+    (centre values) on the deformed mesh [MPa]. The von Mises stress is the stored one
+    (/continuum/von_mises), computed from the stresses and the materials for a file of an
+    earlier build that lacks it."""
     s = run.stress[k]
-    values = s[:, 2] if component == "xy" else von_mises(s, run.plane_strain_nu)
+    if component == "xy":
+        values = s[:, 2]
+    elif run.stored_von_mises is not None:
+        values = run.stored_von_mises[k]
+    else:
+        values = von_mises(s, run.plane_strain_nu)
     fig, ax = _figure((7, 5))
     pc = PolyCollection(_element_polygons(run, k), array=values / 1e6, cmap="RdBu_r" if component == "xy"
                         else "viridis", edgecolor="none")
@@ -214,7 +225,8 @@ def plot_stress(run, k, component="xy"):
     ax.autoscale_view()
     ax.set_aspect("equal")
     label = "sigma_xy" if component == "xy" else \
-        "von Mises" if run.plane_strain_nu is not None else "von Mises (sigma_zz taken as 0)"
+        "von Mises" if run.stored_von_mises is not None or run.plane_strain_nu is not None else \
+        "von Mises (sigma_zz taken as 0)"
     fig.colorbar(pc, ax=ax, label=label + " [MPa]")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")

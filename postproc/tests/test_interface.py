@@ -140,6 +140,30 @@ def test_von_mises_of_the_stress_plot_takes_sigma_zz_in_plane_strain(interface_f
     assert fig.axes[1].get_ylabel() == "von Mises [MPa]"
 
 
+def test_stress_plot_takes_the_stored_von_mises(interface_file):
+    """A file that stores /continuum/von_mises (the builds since it, doc/output.md): the plot
+    shows those values, not the ones it would compute from the stresses (here 1 MPa with
+    sigma_zz taken as 0: the file has no materials); a partial file's complete outputs alone."""
+    stored = np.array([[2.5e6, 4.0e6]] * N_OUT) * np.arange(1, N_OUT + 1)[:, None]
+    with h5py.File(interface_file, "r+") as f:
+        stress = np.zeros((N_OUT, 2, 3))
+        stress[:, :, 0] = 1e6
+        f["continuum/stress"][...] = stress
+        # extendible, as multicor creates its series
+        f.create_dataset("continuum/von_mises", data=stored, maxshape=(None, 2))
+    run = interface.InterfaceRun(interface_file)
+    assert np.array_equal(run.stored_von_mises, stored)
+    fig = interface.plot_stress(run, N_OUT - 1, "vm")
+    # the stored doubles divided by 1e6 for MPa, as the plot does: equal
+    assert np.array_equal(fig.axes[0].collections[0].get_array(), stored[-1] / 1e6)
+    assert fig.axes[1].get_ylabel() == "von Mises [MPa]"
+    with h5py.File(interface_file, "r+") as f:
+        f.create_group("summary")
+        f["summary"].attrs["finished"] = np.int32(0)
+        f["summary"].attrs["outputs"] = np.int32(N_OUT - 2)
+    assert interface.InterfaceRun(interface_file).stored_von_mises.shape == (N_OUT - 2, 2)
+
+
 def test_von_mises_counts_the_shear_three_times():
     """Von Mises of a pure shear tau is sqrt(3) tau; with normal stresses and shear in plane
     strain, the same value as from the deviator of the full 3-D stress tensor, sqrt(3/2 s:s),
