@@ -103,7 +103,9 @@ contains
     !> From the opening of the results file on, SIGTERM, SIGINT, SIGUSR1 and SIGHUP stop a time loop
     !> after the step under way: that step is stored, the file is closed as
     !> '<name>.h5.partial' with /summary finished = 0, and `error` says what was saved
-    !> (`stopped_by` is then the signal number).
+    !> (`stopped_by` is then the signal number). Caught after the model's build and before the
+    !> results file is opened, they stop any run before it writes anything, its folder's lock
+    !> removed (`stop_before_writing`).
     subroutine run_deck(opts, report, error, stopped_by)
         !> What to run and where to write.
         type(run_options_t), intent(in) :: opts
@@ -127,6 +129,11 @@ contains
         end if
 
         call results_folder(opts, run%dir, error)
+        if (allocated(error)) return
+        ! From here a stop signal is only recorded: the run must not die holding the folder's
+        ! lock (stop_before_writing, write_into_folder). Until here (the deck read, the model
+        ! built) its default action stops the program at once, with nothing written.
+        call install_signal_handlers(error)
         if (allocated(error)) return
         call mkdir_p(run%dir, error, run%created)
         if (allocated(error)) return
@@ -209,16 +216,49 @@ contains
         if (allocated(error)) return
         if (len(warning) > 0) call report(warning)
         call start_checkpoints(opts, report, run, error)
-        ! Until here a signal kills the program at once (nothing is written yet).
-        if (.not. allocated(error)) call install_signal_handlers(error)
+        if (.not. allocated(error)) call stop_before_writing(opts, report, run, error, stopped_by)
         if (.not. allocated(error)) call write_results(opts, report, run, error, stopped_by)
         call lock_release(run%lock)
         if (allocated(error)) return
         call report('results written to '//run%path)
         if (run%ck%last_step >= 0) call report('checkpoint: '//to_str(run%ck%last_step)//' steps, t = '// &
                                                num(run%ck%last_time)//' s, in '//run%ck%path//' (to go on to a later '// &
-                                               'end time: '//continue_command(opts, run%ck, .false.)//' --end T)')
+                                               'end time: '//continue_command(opts, run%ck%path, .false.)//' --end T)')
     end subroutine write_into_folder
+
+    !> A stop signal (SIGTERM, SIGINT, SIGUSR1, SIGHUP) caught from the handlers' installation
+    !> (before the results folder is made) to the opening of the results file ends the run
+    !> there, before it writes anything: the checkpoint a restart read is closed as it was, and
+    !> `error` says the run stopped (`stopped_by` is the signal; the caller releases the lock
+    !> and removes a folder the run made). Before, the handlers were installed only after the
+    !> checkpoint was read, and a signal after the lock was taken (a restart reads its
+    !> checkpoint meanwhile: 5 ms for a 2 500-disk deposit) killed the program and left the
+    !> lock, which refused every later start on another host.
+    subroutine stop_before_writing(opts, report, run, error, stopped_by)
+        !> What to run.
+        type(run_options_t), intent(in) :: opts
+        !> Where the lines go.
+        procedure(report_iface) :: report
+        !> The run, its folder locked and its checkpoints started.
+        type(deck_run_t), intent(inout) :: run
+        !> Set when a stop signal was caught.
+        type(error_t), allocatable, intent(out) :: error
+        !> Signal that stopped the run (unchanged when none).
+        integer, intent(inout), optional :: stopped_by
+        type(error_t), allocatable :: ignored
+        if (caught_signal() == 0) return
+        if (run%ck%restart) call run%ck%source%close(ignored)
+        if (present(stopped_by)) stopped_by = caught_signal()
+        call report('stopped: '//signal_name(caught_signal())//' before the run wrote anything (the folder is '// &
+                    'as it was)')
+        if (allocated(opts%restart)) then
+            call report('to continue: '//continue_command(opts, opts%restart, .true.))
+        else
+            call report('to continue: run the deck again (nothing was written)')
+        end if
+        call make_error(error, run%deck%file//': run stopped by '//signal_name(caught_signal())// &
+                        ' before it wrote anything')
+    end subroutine stop_before_writing
 
     !> The run's checkpoints: where and when they are written; with `--restart`, the
     !> checkpoint the run continues from, else, for a run that writes checkpoints (a time
@@ -352,7 +392,7 @@ contains
         if (run%ck%last_step >= 0) then
             call report('checkpoint: '//to_str(run%ck%last_step)//' steps, t = '//num(run%ck%last_time)// &
                         ' s, in '//run%ck%path)
-            call report('to continue: '//continue_command(opts, run%ck, .true.))
+            call report('to continue: '//continue_command(opts, run%ck%path, .true.))
         else
             call report('to continue: run the deck again (no checkpoint was written)')
         end if
@@ -459,17 +499,17 @@ contains
         error%message = error%message//"; the results are whole, kept as '"//run%out%partial_path// &
                         "' with the checkpoint of the last step '"//run%ck%path//"', as a run killed "// &
                         'after its final checkpoint leaves them; once '//when//', this command finishes '// &
-                        'the run, with no step to do: '//continue_command(opts, run%ck, .true.)
+                        'the run, with no step to do: '//continue_command(opts, run%ck%path, .true.)
     end subroutine say_how_to_finish
 
     !> The command that continues this run from its checkpoint; with `same_end`, to the end
     !> time this run was given: `--end T` again when the run had one (in the fewest digits
     !> that read back as the same double, hence the same step count), else the deck's end.
-    function continue_command(opts, ck, same_end) result(command)
+    function continue_command(opts, checkpoint, same_end) result(command)
         !> The run's options.
         type(run_options_t), intent(in) :: opts
-        !> The run's checkpoints.
-        type(checkpoint_run_t), intent(in) :: ck
+        !> Path of the checkpoint to continue from.
+        character(len=*), intent(in) :: checkpoint
         !> Whether to repeat this run's `--end` (else the caller appends its own).
         logical, intent(in) :: same_end
         character(len=:), allocatable :: command
@@ -478,7 +518,7 @@ contains
         integer :: ios
         command = 'multicor '//shell_word(opts%deck_path)
         if (allocated(opts%output_dir)) command = command//' --output '//shell_word(opts%output_dir)
-        command = command//' --restart '//shell_word(ck%path)
+        command = command//' --restart '//shell_word(checkpoint)
         if (same_end .and. opts%end_time >= 0.0_wp) then
             ! as the user wrote it when its shortest form reads back as the same double
             ! (0.4, not 4.00000000000000022E-001), else all 17 digits

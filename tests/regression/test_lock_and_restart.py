@@ -1,0 +1,120 @@
+#!/usr/bin/env python3
+"""The results folder's lock around a run's start and a restart (doc/output.md, the lock,
+"Interrupted runs", "Checkpoints and restart"; doc/cluster.md).
+
+- A stop signal between the lock's creation and the opening of the results file: the
+  handlers were installed only after the checkpoint was read, and the signal killed the
+  program holding the lock (exit -15), which then refused every later start on another host
+  (a Slurm job requeued after a time limit). strace sends the signal as the lock is linked
+  into place (every kind: beam static and modal, continuum static, beam and particle time
+  loops, fresh and restarted), and as a restart opens its checkpoint (the audit's repro).
+  Now the run stops there: exit 128 + the signal (SIGTERM 143, SIGINT 130, SIGUSR1 138,
+  SIGHUP 129), no lock, the folder as it was (a folder the run made removed), and the same
+  command then runs.
+Usage (ctest does this): test_lock_and_restart.py --exe multicor --work DIR --source REPO
+"""
+import hashlib
+import os
+import shutil
+import signal
+import subprocess
+import sys
+
+from checks import arguments, check, summary
+
+EXIT = {"SIGTERM": 143, "SIGINT": 130, "SIGUSR1": 138, "SIGHUP": 129}
+
+
+def run(exe, *args):
+    """multicor with `args`."""
+    return subprocess.run([str(exe)] + [str(a) for a in args], capture_output=True, text=True, timeout=300)
+
+
+def under_strace(exe, path, calls, sig, *args):
+    """multicor with `args`, sent `sig` by strace as it first enters one of `calls` on `path`
+    (the call is done)."""
+    trace = ",".join(calls)
+    return subprocess.run(["strace", "-f", "-qq", "-o", os.devnull, "-P", str(path), "-e", f"trace={trace}",
+                           "-e", f"inject={trace}:signal={sig}:when=1", str(exe)] + [str(a) for a in args],
+                          capture_output=True, text=True, timeout=300)
+
+
+def digests(folder):
+    """Name -> SHA-256 of every file in `folder` (hidden ones too: the lock); {} when it does
+    not exist."""
+    if not folder.is_dir():
+        return {}
+    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(folder.iterdir())}
+
+
+def stopped_before_writing(exe, name, folder, proc, sig, before):
+    """The checks of a run stopped by `sig` before it opened its results file."""
+    err = proc.stderr.strip()
+    check(f"{name}: stopped by {sig}, exit {EXIT[sig]}", proc.returncode == EXIT[sig],
+          f"exit {proc.returncode}: {err[-200:]}")
+    check(f"{name}: the message says it stopped before writing anything",
+          f"run stopped by {sig} before it wrote anything" in err, err[-200:])
+    after = digests(folder)
+    check(f"{name}: no lock left, the folder as it was", after == before,
+          f"before {sorted(before)}, after {sorted(after)}")
+
+
+def signal_at_start(exe, src, work):
+    """A stop signal as the lock is made, for every kind of run; and at a restart's reading of
+    its checkpoint."""
+    if shutil.which("strace") is None:
+        print("skip   signals at the lock's creation: no strace (Debian package strace)")
+        return
+    decks = src / "tests" / "regression" / "decks"
+    lock = ".multicor.lock"
+    cases = [("beam_static", decks / "cantilever_static.dat", ()),
+             ("beam_modal", decks / "cantilever_modal.dat", ()),
+             ("continuum_static", src / "input" / "continuum_cantilever.dat", ()),
+             ("beam_dynamic", src / "input" / "cantilever.dat", ("--end", "0.05")),
+             ("particles_dynamic", src / "input" / "cohesive_row.dat", ("--end", "0.01"))]
+    for name, deck, end in cases:
+        # into a folder it makes (removed again), and into one with an earlier result (kept)
+        folder = work / f"start_{name}"
+        proc = under_strace(exe, folder / lock, ["link", "linkat"], "SIGTERM", deck, "--output", folder,
+                            "--quiet", *end)
+        stopped_before_writing(exe, f"{name}, fresh folder", folder, proc, "SIGTERM", {})
+        proc = run(exe, deck, "--output", folder, "--quiet", *end)
+        check(f"{name}: the same command then runs: exit 0", proc.returncode == 0, proc.stderr.strip()[-200:])
+        before = digests(folder)
+        proc = under_strace(exe, folder / lock, ["link", "linkat"], "SIGTERM", deck, "--output", folder,
+                            "--quiet", *end)
+        stopped_before_writing(exe, f"{name}, folder with a result", folder, proc, "SIGTERM", before)
+
+    # restarts: each stop signal as the lock is made, SIGTERM as the checkpoint is opened
+    deck = src / "input" / "cantilever.dat"
+    folder = work / "restart"
+    proc = run(exe, deck, "--output", folder, "--quiet", "--end", "0.05")
+    check("restart: the first run to t = 0.05 s: exit 0", proc.returncode == 0, proc.stderr.strip()[-200:])
+    before = digests(folder)
+    restart = ["--output", folder, "--quiet", "--restart", folder / "checkpoint.h5", "--end", "0.1"]
+    for sig in EXIT:
+        proc = under_strace(exe, folder / lock, ["link", "linkat"], sig, deck, *restart)
+        stopped_before_writing(exe, f"restart, {sig} as the lock is made", folder, proc, sig, before)
+    proc = under_strace(exe, folder / "checkpoint.h5", ["open", "openat"], "SIGTERM", deck, *restart)
+    stopped_before_writing(exe, "restart, SIGTERM as the checkpoint is opened", folder, proc, "SIGTERM", before)
+    check("restart stopped: the message gives the command that continues",
+          f"to continue: multicor {deck} --output {folder} --restart {folder}/checkpoint.h5 --end 0.1" in proc.stdout,
+          proc.stdout.strip()[-300:])
+    proc = run(exe, deck, *restart)
+    check("restart: the same command then continues the run: exit 0",
+          proc.returncode == 0 and (folder / "cantilever.h5").is_file() and not (folder / lock).exists(),
+          proc.stderr.strip()[-200:])
+
+
+def main():
+    exe, work, src = arguments(fresh=True)
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    # the stop signals' default actions in the runs (a test started under nohup ignores SIGHUP)
+    for sig in (signal.SIGHUP, signal.SIGINT):
+        signal.signal(sig, signal.SIG_DFL)
+    signal_at_start(exe, src, work)
+    sys.exit(summary())
+
+
+if __name__ == "__main__":
+    main()
