@@ -213,7 +213,12 @@ contains
         character(len=:), allocatable :: warning
         run%path = run%dir//'/'//stem(opts%deck_path)//'.h5'
         call lock_acquire(run%lock, run%dir, warning, error)
-        if (allocated(error)) return
+        if (allocated(error)) then
+            ! a restart continues the results in the checkpoint's folder: no other folder can take it
+            if (.not. allocated(opts%restart)) error%message = error%message//'; or give this run another '// &
+                                                               '--output folder'
+            return
+        end if
         if (len(warning) > 0) call report(warning)
         call start_checkpoints(opts, report, run, error)
         if (.not. allocated(error)) call stop_before_writing(opts, report, run, error, stopped_by)

@@ -1,5 +1,6 @@
 /* File-system calls whose every failure is reported, for io_file_writer, io_lock and
- * io_paths (src/io/file_writer.f90, src/io/lock.f90, src/io/paths.f90).
+ * io_paths (src/io/file_writer.f90, src/io/lock.f90, src/io/paths.f90), and the listing of a
+ * folder (Fortran has none).
  *
  * libgfortran does not report some write errors of a formatted or stream unit: what it keeps
  * in its buffer and writes at a FLUSH or CLOSE fails without an error (writing to /dev/full,
@@ -10,6 +11,7 @@
  * Functions return 0 or a positive errno; a created file descriptor is returned as is, or as
  * minus the errno. */
 #define _POSIX_C_SOURCE 200809L
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
@@ -92,6 +94,28 @@ int multicor_is_dir(const char *path)
 {
     struct stat st;
     return stat(path, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+/* The names of the entries of folder `path` that begin with `prefix` ("." and ".." never),
+ * each followed by a NUL, written to buf[n] as far as they fit. Returns the bytes all of them
+ * take (larger than n: call again with a buffer that size), or -errno when the folder cannot
+ * be read. */
+long multicor_folder_names(const char *path, const char *prefix, char *buf, long n)
+{
+    DIR *dir = opendir(path);
+    struct dirent *entry;
+    size_t lp = strlen(prefix);
+    long used = 0;
+    if (dir == NULL) return -(long)errno;
+    while ((entry = readdir(dir)) != NULL) {
+        long len = (long)strlen(entry->d_name);
+        if (strncmp(entry->d_name, prefix, lp) != 0) continue;
+        if (strcmp(entry->d_name, ".") == 0 || strcmp(entry->d_name, "..") == 0) continue;
+        if (used + len + 1 <= n) memcpy(buf + used, entry->d_name, (size_t)len + 1);
+        used += len + 1;
+    }
+    closedir(dir);
+    return used;
 }
 
 /* The system's text for an errno ('No space left on device'), NUL-terminated in buf[n]. */

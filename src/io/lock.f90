@@ -17,14 +17,21 @@
 !> to a name of its own before removing it, so that of two runs taking it over at once one
 !> only succeeds (before, both removed it by name, the later one the earlier one's new lock,
 !> and both ran in the folder). A lock from another host cannot be
-!> checked and is always respected. `lock_release` removes the file; the driver calls it on
-!> every way out of a run, errors included.
+!> checked and is always respected; its refusal says how to remove it once that run is gone.
+!> `lock_release` removes the file; the driver calls it on every way out of a run, errors
+!> included.
+!>
+!> A run killed between the creation of its file `.multicor.lock.<host>.<pid>` and that
+!> file's removal (or between the rename of a stale lock to `.multicor.lock.stale.<host>.<pid>`
+!> and its removal) leaves it: the run that takes the lock next removes those of its own host
+!> whose process no longer runs (never another host's, which it cannot judge, nor a live
+!> process's).
 module io_lock
     use, intrinsic :: iso_c_binding, only: c_char, c_int, c_size_t, c_null_char
     use, intrinsic :: iso_fortran_env, only: int64
     use core_error, only: error_t, make_error
     use core_strings, only: to_str, split_words, string_t, parse_int, shell_word
-    use io_paths, only: file_exists, remove_file, rename_file
+    use io_paths, only: file_exists, remove_file, rename_file, folder_names, basename, dirname
     use io_file_writer, only: file_writer_t, system_error_text, errno_exists
     implicit none
     private
@@ -86,6 +93,7 @@ contains
             if (allocated(error)) return
             if (created) then
                 lock%held = .true.
+                call remove_dead_files(lock%path)
                 return
             end if
             owner = read_owner(lock%path)
@@ -105,9 +113,61 @@ contains
         end if
         if (len(owner) == 0) owner = 'unknown'
         call make_error(error, "results folder '"//dir//"' is in use by another run (host pid start: "//owner// &
-                        "; lock file '"//lock%path//"'): choose another --output folder, or wait; "// &
-                        'remove the lock file only if that run is gone')
+                        "; lock file '"//lock%path//"'): wait for it to end; if that run is gone ("// &
+                        owner_check(owner)//'), remove the lock (rm '//shell_word(lock%path)//') and start again')
     end subroutine lock_acquire
+
+    !> How to check that the run of the owner line `owner` is gone: a job killed with its
+    !> node (Slurm requeues it on another) leaves its lock, which no later run can judge.
+    function owner_check(owner) result(text)
+        character(len=*), intent(in) :: owner
+        character(len=:), allocatable :: text
+        type(string_t), allocatable :: words(:)
+        text = 'its job ended or was killed, or its node failed'
+        call split_words(owner, words)
+        if (size(words) < 2) return
+        text = text//'; on host '//words(1)%s//', ps -p '//words(2)%s//' -o args shows no multicor'
+    end function owner_check
+
+    !> Remove the files that runs of this host killed while taking a lock of this folder left
+    !> (`<lock>.<host>.<pid>`, `<lock>.stale.<host>.<pid>`), whose process no longer runs.
+    !> Files of another host, or of a process that runs (perhaps another run taking the lock
+    !> now), are left; so is everything where /proc does not show this process.
+    subroutine remove_dead_files(path)
+        !> Path of the lock (held).
+        character(len=*), intent(in) :: path
+        type(string_t), allocatable :: names(:)
+        character(len=:), allocatable :: prefix, rest, host, own
+        integer :: k
+        host = host_name()
+        own = to_str(int(c_getpid()))
+        if (.not. file_exists('/proc/'//own)) return
+        prefix = basename(path)//'.'
+        call folder_names(dirname(path), prefix, names)
+        do k = 1, size(names)
+            rest = names(k)%s(len(prefix) + 1:)
+            if (len(rest) > 6) then
+                if (rest(1:6) == 'stale.' .and. .not. dead_process(rest)) rest = rest(7:)
+            end if
+            if (dead_process(rest)) call remove_file(dirname(path)//'/'//names(k)%s)
+        end do
+    contains
+        !> Whether `name` is '<host>.<pid>' of this host and a process that no longer runs.
+        logical function dead_process(name)
+            character(len=*), intent(in) :: name
+            character(len=:), allocatable :: digits
+            integer :: pid
+            logical :: ok
+            dead_process = .false.
+            if (len(name) <= len(host) + 1) return
+            if (name(:len(host) + 1) /= host//'.') return
+            digits = name(len(host) + 2:)
+            if (verify(digits, '0123456789') /= 0 .or. digits == own) return
+            call parse_int(digits, pid, ok)
+            if (.not. ok .or. pid <= 0) return
+            dead_process = .not. file_exists('/proc/'//to_str(pid))
+        end function dead_process
+    end subroutine remove_dead_files
 
     !> Remove the lock file if this process holds it.
     subroutine lock_release(lock)

@@ -1,14 +1,16 @@
-!> File-system helpers: file name parts, directory creation, file existence, copy and removal.
+!> File-system helpers: file name parts, directory creation and listing, file existence, copy
+!> and removal.
 module io_paths
-    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_null_char
+    use, intrinsic :: iso_c_binding, only: c_char, c_int, c_long, c_null_char
     use, intrinsic :: iso_fortran_env, only: int64
     use core_error, only: error_t, make_error
+    use core_strings, only: string_t
     use io_file_writer, only: file_writer_t, system_error_text
     implicit none
     private
     public :: basename, dirname, stem, mkdir_p, remove_empty_folders, file_exists, remove_file, rename_file, copy_file
     public :: link_or_copy_file
-    public :: read_file_text
+    public :: read_file_text, folder_names
 
     interface
         function c_make_dir(path) bind(C, name='multicor_make_dir') result(err)
@@ -31,6 +33,13 @@ module io_paths
             character(kind=c_char), intent(in) :: path(*)
             integer(c_int) :: yes
         end function c_is_dir
+        function c_folder_names(path, prefix, buf, n) bind(C, name='multicor_folder_names') result(used)
+            import :: c_char, c_long
+            character(kind=c_char), intent(in) :: path(*), prefix(*)
+            character(kind=c_char), intent(out) :: buf(*)
+            integer(c_long), value :: n
+            integer(c_long) :: used
+        end function c_folder_names
         function c_link(old, new) bind(C, name='link') result(rc)
             import :: c_char, c_int
             character(kind=c_char), intent(in) :: old(*), new(*)
@@ -150,6 +159,37 @@ contains
             folder = folder(:i - 1)
         end do
     end subroutine remove_empty_folders
+
+    !> The names of the entries of folder `path` that begin with `prefix` (any order; none
+    !> when the folder cannot be read).
+    subroutine folder_names(path, prefix, names)
+        !> The folder.
+        character(len=*), intent(in) :: path
+        !> Beginning of the names wanted ('' for all but '.' and '..').
+        character(len=*), intent(in) :: prefix
+        !> The names.
+        type(string_t), allocatable, intent(out) :: names(:)
+        character(kind=c_char, len=:), allocatable :: buf
+        integer(c_long) :: used
+        integer :: first, last, attempt
+        names = [string_t ::]
+        used = 256
+        ! a folder that grows between two calls needs a third
+        do attempt = 1, 5
+            if (allocated(buf)) deallocate (buf)
+            allocate (character(kind=c_char, len=max(int(used), 1)) :: buf)
+            used = c_folder_names(path//c_null_char, prefix//c_null_char, buf, int(len(buf), c_long))
+            if (used < 0) return
+            if (used <= len(buf)) exit
+        end do
+        if (used > len(buf)) return
+        first = 1
+        do while (first <= used)
+            last = first + index(buf(first:used), c_null_char) - 2
+            names = [names, string_t(buf(first:last))]
+            first = last + 2
+        end do
+    end subroutine folder_names
 
     !> Delete a file if it exists.
     subroutine remove_file(path)

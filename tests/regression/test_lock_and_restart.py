@@ -11,12 +11,17 @@
   Now the run stops there: exit 128 + the signal (SIGTERM 143, SIGINT 130, SIGUSR1 138,
   SIGHUP 129), no lock, the folder as it was (a folder the run made removed), and the same
   command then runs.
+- A run killed (SIGKILL) between the creation of `.multicor.lock.<host>.<pid>` and its
+  removal left it for ever: the next run that takes the lock removes it.
+- Another host's lock refuses a restart with the rm command of the lock (not 'choose
+  another --output folder', which a restart cannot).
 Usage (ctest does this): test_lock_and_restart.py --exe multicor --work DIR --source REPO
 """
 import hashlib
 import os
 import shutil
 import signal
+import socket
 import subprocess
 import sys
 
@@ -106,6 +111,50 @@ def signal_at_start(exe, src, work):
           proc.stderr.strip()[-200:])
 
 
+def killed_at_link(exe, src, work):
+    """SIGKILL between the creation of the lock's line file and its removal."""
+    if shutil.which("strace") is None:
+        print("skip   a kill at the lock's link: no strace (Debian package strace)")
+        return
+    deck = src / "input" / "cantilever.dat"
+    folder = work / "killed_at_link"
+    folder.mkdir()
+    proc = subprocess.run(["strace", "-f", "-qq", "-o", os.devnull, "-P", str(folder / ".multicor.lock"),
+                           "-e", "trace=link,linkat", "-e", "inject=link,linkat:signal=SIGKILL:when=1",
+                           str(exe), str(deck), "--output", str(folder), "--quiet", "--end", "0.01"],
+                          capture_output=True, text=True, timeout=300)
+    left = sorted(p.name for p in folder.iterdir() if p.name.startswith(".multicor.lock."))
+    check("killed at the lock's link: its line's file is left", proc.returncode in (-9, 137) and len(left) == 1,
+          f"exit {proc.returncode}, {left}")
+    # a live process's file and another host's stay
+    alive = folder / f".multicor.lock.{socket.gethostname()}.1"
+    other = folder / ".multicor.lock.nodeB01.4194305"
+    alive.write_text("")
+    other.write_text("")
+    proc = run(exe, deck, "--output", folder, "--quiet", "--end", "0.01")
+    names = sorted(p.name for p in folder.iterdir() if p.name.startswith(".multicor.lock"))
+    check("the next run removes the dead run's file, keeps a live process's and another host's",
+          proc.returncode == 0 and names == sorted([alive.name, other.name]), f"exit {proc.returncode}, {names}")
+
+
+def another_hosts_lock(exe, src, work):
+    """A lock left by a job killed with its node, found by the requeued job on another host."""
+    deck = src / "input" / "cantilever.dat"
+    folder = work / "other_host"
+    proc = run(exe, deck, "--output", folder, "--quiet", "--end", "0.05")
+    check("other host's lock: the first run: exit 0", proc.returncode == 0, proc.stderr.strip()[-200:])
+    (folder / ".multicor.lock").write_text("nodeB01 22344 2026-11-28T05:50:58\n")
+    proc = run(exe, deck, "--output", folder, "--quiet", "--restart", folder / "checkpoint.h5", "--end", "0.1")
+    err = proc.stderr.strip()
+    check("restart refused by another host's lock: the rm command, no other --output",
+          proc.returncode == 1 and f"remove the lock (rm {folder}/.multicor.lock)" in err and
+          "ps -p 22344" in err and "--output folder" not in err, err[-400:])
+    proc = run(exe, deck, "--output", folder, "--quiet", "--end", "0.05")
+    check("fresh run refused by it: the rm command, or another --output folder",
+          proc.returncode == 1 and f"(rm {folder}/.multicor.lock)" in proc.stderr and
+          "another --output folder" in proc.stderr, proc.stderr.strip()[-400:])
+
+
 def main():
     exe, work, src = arguments(fresh=True)
     os.environ.setdefault("OMP_NUM_THREADS", "1")
@@ -113,6 +162,8 @@ def main():
     for sig in (signal.SIGHUP, signal.SIGINT):
         signal.signal(sig, signal.SIG_DFL)
     signal_at_start(exe, src, work)
+    killed_at_link(exe, src, work)
+    another_hosts_lock(exe, src, work)
     sys.exit(summary())
 
 
