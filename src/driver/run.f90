@@ -594,6 +594,11 @@ contains
                                  run%run_id, error)
             if (allocated(error)) return
             run%mark%run_id = run%run_id
+            call check_results_place(opts, run, error)
+            if (allocated(error)) then
+                call ck%source%close(ignored)
+                return
+            end if
             at_end = ck%start%step == sim%settings%n_steps
             if (at_end) at_end = interrupted()
             if (ck%start%step >= sim%settings%n_steps .and. .not. at_end) then
@@ -629,4 +634,60 @@ contains
             if (.not. interrupted) interrupted = run%mark%held_by(run%path//'.partial.prev')
         end function interrupted
     end subroutine open_checkpoint
+
+    !> With `--restart`: the run continues the results file `<results folder>/<deck name>.h5`
+    !> (or its '.partial'). When no file of the checkpoint's run is there, but the file the
+    !> checkpoint records (its root attribute `results`) is in the checkpoint's folder, the deck
+    !> has another name than the checkpoint's run's (a copy of it), or `--output` names another
+    !> folder: refused, naming that file and what to change. Before, the restart said that
+    !> neither file there was the run's: 'it was moved, deleted or replaced by another run'.
+    subroutine check_results_place(opts, run, error)
+        !> The run's options.
+        type(run_options_t), intent(in) :: opts
+        !> The run: its results path and the checkpoint's run id set.
+        type(deck_run_t), intent(in) :: run
+        !> Set when the checkpoint's results lie elsewhere than this run would continue them.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: hash, results, run_id, folder, held, advice, renamed
+        type(results_mark_t) :: same_run
+        logical :: found
+        call checkpoint_owner(opts%restart, found, hash, results, run_id)
+        if (.not. found .or. len(results) == 0) return
+        same_run%run_id = run%run_id
+        if (len(run_file(run%path)) > 0) return
+        folder = dirname(opts%restart)
+        held = run_file(folder//'/'//results)
+        if (len(held) == 0) return
+        advice = ''
+        if (results /= basename(run%path)) then
+            ! the deck's name with the stem of the checkpoint's results ('.dat' kept)
+            renamed = basename(opts%deck_path)
+            renamed = dirname(opts%deck_path)//'/'//stem(results)//renamed(len(stem(opts%deck_path)) + 1:)
+            advice = "the results file's name follows the deck's file name ("//opts%deck_path//' writes '// &
+                     basename(run%path)//'): run the deck as '//shell_word(renamed)//", the name the "// &
+                     "checkpoint's run had (copy it to that name)"
+        end if
+        if (run%dir /= folder) then
+            if (len(advice) > 0) advice = advice//', and '
+            advice = advice//"the results folder is the checkpoint's ("//folder//') unless --output gives '// &
+                     'another: leave out --output, or give --output '//shell_word(folder)
+        end if
+        call make_error(error, "--restart: this run would continue '"//run%path//"', but the results of the "// &
+                        "checkpoint's run are '"//held//"' (the file its attribute 'results' records, beside "// &
+                        'it): '//advice)
+    contains
+        !> The file of the checkpoint's run among '<path>.partial', '<path>.partial.prev' and
+        !> `path` ('' when none is).
+        function run_file(path) result(name)
+            character(len=*), intent(in) :: path
+            character(len=:), allocatable :: name
+            name = path//'.partial'
+            if (same_run%held_by(name)) return
+            name = path//'.partial.prev'
+            if (same_run%held_by(name)) return
+            name = path
+            if (same_run%held_by(name)) return
+            name = ''
+        end function run_file
+    end subroutine check_results_place
 end module driver_run

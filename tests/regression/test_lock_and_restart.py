@@ -13,6 +13,9 @@
   command then runs.
 - A run killed (SIGKILL) between the creation of `.multicor.lock.<host>.<pid>` and its
   removal left it for ever: the next run that takes the lock removes it.
+- A restart whose deck has another name (a copy of the same text), or whose --output is
+  another folder, said the checkpoint's results were 'moved, deleted or replaced by another
+  run' while they lay next to the checkpoint: the message names them and what to change.
 - Another host's lock refuses a restart with the rm command of the lock (not 'choose
   another --output folder', which a restart cannot).
 Usage (ctest does this): test_lock_and_restart.py --exe multicor --work DIR --source REPO
@@ -137,6 +140,37 @@ def killed_at_link(exe, src, work):
           proc.returncode == 0 and names == sorted([alive.name, other.name]), f"exit {proc.returncode}, {names}")
 
 
+def results_elsewhere(exe, src, work):
+    """A restart of a renamed copy of the deck, or into another --output folder."""
+    folder = work / "renamed"
+    folder.mkdir()
+    shutil.copy(src / "input" / "cantilever.dat", folder / "cant.dat")
+    shutil.copy(src / "input" / "cantilever.dat", folder / "cant_v2.dat")
+    out = folder / "out"
+    proc = run(exe, folder / "cant.dat", "--output", out, "--quiet", "--end", "0.05")
+    check("renamed deck: the first run: exit 0", proc.returncode == 0, proc.stderr.strip()[-200:])
+    before = digests(out)
+    proc = run(exe, folder / "cant_v2.dat", "--quiet", "--restart", out / "checkpoint.h5", "--end", "0.1")
+    err = proc.stderr.strip()
+    check("renamed deck: refused, naming the checkpoint's results and the deck name to use",
+          proc.returncode == 1 and f"the results of the checkpoint's run are '{out}/cant.h5'" in err and
+          "the results file's name follows the deck's file name" in err and f"run the deck as {folder}/cant.dat" in err
+          and "moved, deleted or replaced" not in err, err[-400:])
+    proc = run(exe, folder / "cant.dat", "--quiet", "--restart", out / "checkpoint.h5", "--output",
+               folder / "elsewhere", "--end", "0.1")
+    err = proc.stderr.strip()
+    check("other --output: refused, naming the checkpoint's results and its folder",
+          proc.returncode == 1 and f"the results of the checkpoint's run are '{out}/cant.h5'" in err and
+          f"the results folder is the checkpoint's ({out})" in err and "moved, deleted or replaced" not in err
+          and not (folder / "elsewhere").exists(), err[-400:])
+    check("both refusals leave the checkpoint's folder as it was", digests(out) == before, "")
+    # the results really gone: the message stays the one of a moved file
+    shutil.move(out / "cant.h5", folder / "moved.h5")
+    proc = run(exe, folder / "cant.dat", "--quiet", "--restart", out / "checkpoint.h5", "--end", "0.1")
+    check("results moved away: still 'moved, deleted or replaced'",
+          proc.returncode == 1 and "moved, deleted or replaced" in proc.stderr, proc.stderr.strip()[-300:])
+
+
 def another_hosts_lock(exe, src, work):
     """A lock left by a job killed with its node, found by the requeued job on another host."""
     deck = src / "input" / "cantilever.dat"
@@ -163,6 +197,7 @@ def main():
         signal.signal(sig, signal.SIG_DFL)
     signal_at_start(exe, src, work)
     killed_at_link(exe, src, work)
+    results_elsewhere(exe, src, work)
     another_hosts_lock(exe, src, work)
     sys.exit(summary())
 
