@@ -14,6 +14,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -127,3 +128,13 @@ void multicor_errno_text(int err, char *buf, long n)
 
 /* Errno values the callers test. */
 int multicor_eexist(void) { return EEXIST; }
+
+/* Whether process pid may still run on this host: kill(pid, 0) succeeds or is refused for
+   permission (another user's process). Only ESRCH (no such process) says it is gone; any
+   other failure is taken as alive, the safe side for a lock. */
+int multicor_process_alive(int pid)
+{
+    if (pid <= 0) return 1;
+    if (kill((pid_t)pid, 0) == 0) return 1;
+    return errno == ESRCH ? 0 : 1;
+}

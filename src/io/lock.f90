@@ -63,6 +63,11 @@ module io_lock
             integer(c_int), value :: err
             integer(c_int) :: yes
         end function c_no_hard_links
+        function c_process_alive(pid) bind(C, name='multicor_process_alive') result(alive)
+            import :: c_int
+            integer(c_int), value :: pid
+            integer(c_int) :: alive
+        end function c_process_alive
         function c_gethostname(name, length) bind(C, name='gethostname') result(rc)
             import :: c_char, c_int, c_size_t
             character(kind=c_char), intent(out) :: name(*)
@@ -132,7 +137,7 @@ contains
     !> Remove the files that runs of this host killed while taking a lock of this folder left
     !> (`<lock>.<host>.<pid>`, `<lock>.stale.<host>.<pid>`), whose process no longer runs.
     !> Files of another host, or of a process that runs (perhaps another run taking the lock
-    !> now), are left; so is everything where /proc does not show this process.
+    !> now), are left.
     subroutine remove_dead_files(path)
         !> Path of the lock (held).
         character(len=*), intent(in) :: path
@@ -141,7 +146,6 @@ contains
         integer :: k
         host = host_name()
         own = to_str(int(c_getpid()))
-        if (.not. file_exists('/proc/'//own)) return
         prefix = basename(path)//'.'
         call folder_names(dirname(path), prefix, names)
         do k = 1, size(names)
@@ -165,7 +169,7 @@ contains
             if (verify(digits, '0123456789') /= 0 .or. digits == own) return
             call parse_int(digits, pid, ok)
             if (.not. ok .or. pid <= 0) return
-            dead_process = .not. file_exists('/proc/'//to_str(pid))
+            dead_process = c_process_alive(int(pid, c_int)) == 0
         end function dead_process
     end subroutine remove_dead_files
 
@@ -179,8 +183,8 @@ contains
     end subroutine lock_release
 
     !> Whether the owner line `host pid ...` names a process that may still run: always true
-    !> for another host (it cannot be checked) or an unreadable line; on this host, true when
-    !> /proc/<pid> exists.
+    !> for another host (it cannot be checked) or an unreadable line; on this host, false only
+    !> when kill(pid, 0) says there is no such process.
     logical function lock_owner_alive(owner, this_host) result(alive)
         !> The lock file's line.
         character(len=*), intent(in) :: owner
@@ -195,7 +199,7 @@ contains
         if (words(1)%s /= this_host) return
         call parse_int(words(2)%s, pid, ok)
         if (.not. ok .or. pid <= 0) return
-        alive = file_exists('/proc/'//to_str(pid))
+        alive = c_process_alive(int(pid, c_int)) /= 0
     end function lock_owner_alive
 
     !> Create the lock file with its owner line; `created` is false when it exists already.
