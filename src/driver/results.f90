@@ -171,7 +171,9 @@ contains
         self%own = [logical ::]
         call set_aside_partial(self, keep, error)
         if (allocated(error)) return
-        call self%file%create(self%partial_path, error)
+        ! every dataset holding values with a checksum of its data, which HDF5 checks at every
+        ! read (doc/output.md)
+        call self%file%create(self%partial_path, error, checksums=.true.)
         if (allocated(error)) return
         call root_attributes(error)
         if (.not. allocated(error)) call self%file%create_group('/summary', error)
