@@ -17,7 +17,9 @@
 !> the steps (the CPU time is the figure to trust on a loaded machine), and the block's counts
 !> (analyses, factorisations, kept factors, refinements, releases).
 !> Run: cmake --build <build> --target bench_bonded && OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
-!>      <build>/bench/bench_bonded [deck [nlgs_steps]]
+!>      <build>/bench/bench_bonded [deck [nlgs_steps]]   (--help or -h: the usage, nothing run)
+!> A deck that does not exist, or that does not read, stops the program with a message and exit
+!> code 1 before anything is timed; a malformed command line with the usage and exit code 2.
 program bench_bonded
     use, intrinsic :: iso_fortran_env, only: output_unit, error_unit, compiler_version
     use core_kinds, only: wp, i8
@@ -40,22 +42,31 @@ program bench_bonded
     character(len=512) :: arg
     character(len=:), allocatable :: deck_path
     integer :: nlgs_steps, ios
-    write (output_unit, '(a)') '# bonded block against NLGS (1 core); compiler: '//compiler_version()
+    logical :: exists
     deck_path = 'input/bending_stack.dat'
     if (command_argument_count() >= 1) then
         call get_command_argument(1, arg)
+        select case (trim(arg))
+        case ('--help', '-h')
+            call print_usage(output_unit)
+            stop
+        end select
+        if (arg(1:1) == '-') call usage_error('unknown option '''//trim(arg)//'''')
         deck_path = trim(arg)
     end if
+    if (command_argument_count() > 2) call usage_error('at most two arguments, a deck and nlgs_steps')
     nlgs_steps = 5
     if (command_argument_count() >= 2) then
         call get_command_argument(2, arg)
         read (arg, *, iostat=ios) nlgs_steps
-        if (ios /= 0 .or. nlgs_steps < 0) then
-            write (error_unit, '(a)') 'bench_bonded: usage: bench_bonded [deck [nlgs_steps >= 0]] (got '// &
-                trim(arg)//')'
-            stop 2, quiet = .true.
-        end if
+        if (ios /= 0 .or. nlgs_steps < 0) call usage_error('nlgs_steps must be an integer >= 0 (got '''// &
+                                                           trim(arg)//''')')
     end if
+    inquire (file=deck_path, exist=exists)
+    if (.not. exists) call fail('cannot open the deck '''//deck_path//''': no such file (give the path of '// &
+                                'the reference stack''s deck as the first argument; without one, '// &
+                                'input/bending_stack.dat is read from the current folder)')
+    write (output_unit, '(a)') '# bonded block against NLGS (1 core); compiler: '//compiler_version()
     write (output_unit, '(a)') '# clamped bonded row, 50 disks, tip load, one step from rest, tol 1e-10'
     write (output_unit, '(a)') '# method  iterations  converged  time[s]  err_rn/Ph  err_rt/Ph  err_M/(PR(2N-1)h)'
     call clamped_row(bonded_block_method_t())
@@ -93,7 +104,7 @@ contains
         end do
         call particles_add_load(sys%particles, n, dof_y, p, error)
         call mj_init(sys, error)
-        if (allocated(error)) error stop 'bench_bonded: row set-up failed'
+        if (allocated(error)) call fail('the clamped row''s set-up failed: '//error%message)
         call system_clock(c0, rate)
         call mj_step(sys)
         call system_clock(c1)
@@ -129,20 +140,14 @@ contains
         if (.not. allocated(error)) call build_config(deck, run, beam, error)
         if (.not. allocated(error)) call build_dem_config(deck, run, beam%functions, dem, error)
         if (.not. allocated(error)) call build_coupling_config(deck, run, beam, dem, setup, error)
-        if (allocated(error)) then
-            write (output_unit, '(a)') 'bench_bonded: '//error%message
-            error stop 1
-        end if
+        if (allocated(error)) call fail(error%message)
         dem%system%solver%tol = 1.0e-10_wp
         dem%system%solver%max_sweeps = 100000
         deallocate (dem%system%method)
         allocate (dem%system%method, source=method)
         allocate (sys)
         call build_coupled(run, beam, dem, setup, sys, report_line, error)
-        if (allocated(error)) then
-            write (output_unit, '(a)') 'bench_bonded: '//error%message
-            error stop 1
-        end if
+        if (allocated(error)) call fail(error%message)
         it_sum = 0.0_wp
         it_max = 0
         n_conv = 0
@@ -151,7 +156,7 @@ contains
         call system_clock(c0, rate)
         do k = 1, steps
             call arlequin_step(sys, error)
-            if (allocated(error)) error stop 'bench_bonded: step failed'
+            if (allocated(error)) call fail('step failed: '//error%message)
             it_sum = it_sum + sys%dem%stats%sweeps
             it_max = max(it_max, sys%dem%stats%sweeps)
             if (sys%dem%stats%converged) n_conv = n_conv + 1
@@ -173,6 +178,40 @@ contains
                 t_total, cpu1 - cpu0
         end select
     end subroutine reference_stack
+
+    !> The usage, on `unit`.
+    subroutine print_usage(unit)
+        !> Where it is written.
+        integer, intent(in) :: unit
+        write (unit, '(a)') 'usage: bench_bonded [deck [nlgs_steps]]', &
+            '       bench_bonded --help', &
+            'The bonded block ([solver] method = block) against plain NLGS, at the tolerance 1e-10:', &
+            'a clamped bonded row of 50 disks (one step from rest, against the closed form), then the', &
+            'reference stack deck: 1 000 steps with the block and the first nlgs_steps with NLGS.', &
+            '  deck        the reference stack''s deck (default: input/bending_stack.dat, from the', &
+            '              current folder)', &
+            '  nlgs_steps  steps of the deck with NLGS (default 5); 0 skips NLGS in both cases', &
+            'For the one-core figures of doc/performance.md ("Bonded block"), run with', &
+            'OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1.'
+    end subroutine print_usage
+
+    !> A malformed command line: the message and the usage on standard error, exit code 2.
+    subroutine usage_error(message)
+        !> What is wrong.
+        character(len=*), intent(in) :: message
+        write (error_unit, '(a)') 'bench_bonded: '//message
+        call print_usage(error_unit)
+        stop 2, quiet = .true.
+    end subroutine usage_error
+
+    !> An error of the run (a deck missing or that does not read, a failed step): the message
+    !> on standard error, exit code 1, no backtrace.
+    subroutine fail(message)
+        !> What went wrong.
+        character(len=*), intent(in) :: message
+        write (error_unit, '(a)') 'bench_bonded: '//message
+        stop 1, quiet = .true.
+    end subroutine fail
 
     !> Lines the set-up announces (a long one), printed as they come.
     subroutine report_line(line)
