@@ -182,6 +182,7 @@
 module dem_bonded_block
     use core_kinds, only: wp, i8
     use core_error, only: error_t
+    use core_state, only: state_sink_t, state_source_t
     use core_sparse, only: sparse_matrix_t, sparse_solver_t, sparse_ldlt, sparse_stats_t
     use dem_contacts, only: contact_set_t, status_cohesive, bond_on_bound, contacts_directions
     use dem_bipotential, only: case_stick, case_slip, case_roll, case_slip_roll, rolling_local_solve, &
@@ -381,6 +382,10 @@ module dem_bonded_block
         procedure :: solve => bonded_block_solve
         !> 'block'.
         procedure :: name => bonded_block_name
+        !> The factor in use: its bond graph and values (`bonded_block_save_state`).
+        procedure :: save_state => bonded_block_save_state
+        !> See `save_state`.
+        procedure :: load_state => bonded_block_load_state
     end type bonded_block_method_t
 
 contains
@@ -424,6 +429,91 @@ contains
         block%analysed = .false.
         block%factored = .false.
     end subroutine bonded_block_restore
+
+    !> Put the factor in use, if any: the bond graph (key_i1, key_i2, key_rows) and the values
+    !> factored with their scaling (values, scale), and the slots whose bonds left the block
+    !> (dead, as 0 or 1, when any: identity rows, some deleted from the factor after its
+    !> factorisation: deleted, in order, replayed at the restart). A restart factors these
+    !> values again (`bonded_block_load_state`).
+    subroutine bonded_block_save_state(self, sink, error)
+        !> The strategy.
+        class(bonded_block_method_t), intent(in) :: self
+        !> Where the state goes.
+        class(state_sink_t), intent(inout) :: sink
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        associate (b => self%block)
+            if (.not. (b%factored .and. allocated(b%values_factored))) return
+            if (size(b%key_i1) == 0) return
+            call sink%put_integers('key_i1', b%key_i1, error)
+            if (.not. allocated(error)) call sink%put_integers('key_i2', b%key_i2, error)
+            if (.not. allocated(error)) call sink%put_integers('key_rows', b%key_rows, error)
+            if (.not. allocated(error)) call sink%put_reals('values', b%values_factored, error)
+            if (.not. allocated(error)) call sink%put_reals('scale', b%scale_factored, error)
+            if (.not. any(b%dead)) return
+            if (.not. allocated(error)) call sink%put_integers('dead', merge(1, 0, b%dead), error)
+            if (.not. allocated(error) .and. b%n_deleted > 0) &
+                call sink%put_integers('deleted', b%deleted(1:b%n_deleted), error)
+        end associate
+    end subroutine bonded_block_save_state
+
+    !> Take back the factor put by `bonded_block_save_state` and restore it
+    !> (`bonded_block_restore`); nothing when none is stored, or one of an earlier build without
+    !> its scaling: its values are those of W_BB + eps I, not of S W_BB S + eps I, and the
+    !> restart then factors the current values (the run goes on within the solver's tolerance,
+    !> not bitwise).
+    subroutine bonded_block_load_state(self, source, n_disks, n_walls, error)
+        !> The strategy (built from the deck).
+        class(bonded_block_method_t), intent(inout) :: self
+        !> Where the state comes from.
+        class(state_source_t), intent(in) :: source
+        !> Numbers of disks and walls of the system (the range of the bond graph's bodies).
+        integer, intent(in) :: n_disks, n_walls
+        !> Set on a read failure or a damaged value.
+        type(error_t), allocatable, intent(out) :: error
+        integer, allocatable :: k1(:), k2(:), kr(:), dead(:), deleted(:)
+        real(wp), allocatable :: v(:), scale(:)
+        if (.not. source%has('values')) return
+        if (.not. source%has('scale')) return
+        call source%get_reals('scale', scale, error)
+        if (allocated(error)) return
+        call source%get_integers('key_i1', k1, error)
+        if (.not. allocated(error)) call source%get_integers('key_i2', k2, error)
+        if (.not. allocated(error)) call source%get_integers('key_rows', kr, error)
+        if (.not. allocated(error)) call source%get_reals('values', v, error)
+        if (allocated(error)) return
+        if (size(k2) /= size(k1) .or. size(kr) /= size(k1)) then
+            call source%damaged('key_i1, key_i2 and key_rows differ in size', error)
+            return
+        end if
+        allocate (dead(size(k1)), deleted(0))
+        dead = 0
+        if (source%has('dead')) call source%get_integers('dead', dead, error)
+        if (allocated(error)) return
+        if (source%has('deleted')) call source%get_integers('deleted', deleted, error)
+        if (allocated(error)) return
+        if (size(dead) /= size(k1)) then
+            call source%damaged('dead and key_i1 differ in size', error)
+            return
+        end if
+        call source%require_range('dead', dead, 0, 1, error)
+        if (.not. allocated(error)) call source%require_range('deleted', deleted, 1, size(k1), error)
+        if (allocated(error)) return
+        if (size(deleted) > 0) then
+            if (any(dead(deleted) == 0)) then
+                call source%damaged('a slot of deleted is not dead', error)
+                return
+            end if
+        end if
+        call source%require_range('key_i1', k1, -n_walls, n_disks, error)
+        if (.not. allocated(error)) call source%require_range('key_i2', k2, 1, n_disks, error)
+        if (allocated(error)) return
+        if (size(scale) /= sum(popcnt(kr))) then
+            call source%damaged('scale has not one value per unknown of key_rows', error)
+            return
+        end if
+        call bonded_block_restore(self%block, k1, k2, kr, v, scale, dead == 1, deleted)
+    end subroutine bonded_block_load_state
 
     !> Solve the contact problem of one step with the intact bonds as a direct block and
     !> the NLGS sweeps over the other contacts (block Gauss-Seidel), then the outer check of

@@ -9,6 +9,8 @@
 !> settings.
 module dem_solve_method
     use core_kinds, only: wp
+    use core_error, only: error_t
+    use core_state, only: state_sink_t, state_source_t
     use dem_contacts, only: contact_set_t
     use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_bilateral_t, nlgs_solve
     implicit none
@@ -22,6 +24,10 @@ module dem_solve_method
         procedure(method_solve), deferred :: solve
         !> Name, with the settings (the value of `[solver] method`).
         procedure(method_name), deferred :: name
+        !> Put the state kept between steps into a checkpoint.
+        procedure(method_save_state), deferred :: save_state
+        !> Take it back from a checkpoint (the strategy built from the deck).
+        procedure(method_load_state), deferred :: load_state
     end type solve_method_t
 
     abstract interface
@@ -54,6 +60,30 @@ module dem_solve_method
             !> Bilateral constraints kept satisfied (default: none).
             class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         end subroutine method_solve
+
+        !> Put the state kept between steps (nothing for a strategy without one).
+        subroutine method_save_state(self, sink, error)
+            import :: solve_method_t, state_sink_t, error_t
+            !> The strategy.
+            class(solve_method_t), intent(in) :: self
+            !> Where the state goes.
+            class(state_sink_t), intent(inout) :: sink
+            !> Set on a write failure.
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine method_save_state
+
+        !> Take back the state put by `save_state`, checking it against the system's bodies.
+        subroutine method_load_state(self, source, n_disks, n_walls, error)
+            import :: solve_method_t, state_source_t, error_t
+            !> The strategy (built from the deck).
+            class(solve_method_t), intent(inout) :: self
+            !> Where the state comes from.
+            class(state_source_t), intent(in) :: source
+            !> Numbers of disks and walls of the system.
+            integer, intent(in) :: n_disks, n_walls
+            !> Set on a read failure, a damaged value, or a state of another strategy.
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine method_load_state
     end interface
 
     !> NLGS sweeps over every contact (`method = nlgs`; `coarse` with the settings'
@@ -64,6 +94,10 @@ module dem_solve_method
         procedure :: solve => sweeps_solve
         !> 'nlgs', or 'coarse' with the settings' correction.
         procedure :: name => sweeps_name
+        !> Nothing to put.
+        procedure :: save_state => sweeps_save_state
+        !> Nothing to take back: a stored state is another strategy's.
+        procedure :: load_state => sweeps_load_state
     end type sweeps_method_t
 
 contains
@@ -100,4 +134,28 @@ contains
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         call nlgs_solve(config, cs, im, vel, stats, bilateral)
     end subroutine sweeps_solve
+
+    !> Nothing to put: the sweeps keep no state between steps.
+    subroutine sweeps_save_state(self, sink, error)
+        !> The strategy.
+        class(sweeps_method_t), intent(in) :: self
+        !> Where the state goes.
+        class(state_sink_t), intent(inout) :: sink
+        !> Never set.
+        type(error_t), allocatable, intent(out) :: error
+    end subroutine sweeps_save_state
+
+    !> Nothing to take back; a stored state (that of the bonded block) is an error: the deck,
+    !> whose hash the checkpoint matches, chose the strategy.
+    subroutine sweeps_load_state(self, source, n_disks, n_walls, error)
+        !> The strategy.
+        class(sweeps_method_t), intent(inout) :: self
+        !> Where the state comes from.
+        class(state_source_t), intent(in) :: source
+        !> Numbers of disks and walls of the system.
+        integer, intent(in) :: n_disks, n_walls
+        !> Set when a state is stored.
+        type(error_t), allocatable, intent(out) :: error
+        if (.not. source%is_empty()) call source%damaged('the deck solves no bonded block ([solver] method)', error)
+    end subroutine sweeps_load_state
 end module dem_solve_method

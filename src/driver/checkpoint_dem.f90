@@ -1,18 +1,18 @@
 !> The particles' state in a checkpoint (driver_checkpoint): the Moreau-Jean state of the
 !> disks and walls, the contact list with its reactions and statuses for the warm start, the
-!> bond ruptures so far and the factor of the bonded block in use, under a group such as
-!> '/dem'.
+!> bond ruptures so far, under a group such as '/dem', and the state of the solve method (the
+!> factor of the bonded block in use), which the method puts and takes back itself under
+!> '/dem/block' (driver_checkpoint_state).
 module driver_checkpoint_dem
     use core_kinds, only: wp, i8
-    use core_error, only: error_t, make_error, make_internal_error
+    use core_error, only: error_t, make_error
     use core_strings, only: to_str
     use io_hdf5_file, only: h5_file_t
     use dem_contacts, only: contacts_list_problem, status_open, status_broken
     use dem_bipotential, only: case_slip_roll
     use dem_bonds, only: break_none, break_tension, break_lost
     use dem_moreau_jean, only: dem_system_t
-    use dem_solve_method, only: sweeps_method_t
-    use dem_bonded_block, only: bonded_block_method_t, bonded_block_restore
+    use driver_checkpoint_state, only: h5_state_sink_t, h5_state_source_t
     use driver_checkpoint_values, only: put_part, read_int_attr_1d, read_finite_attribute, require_finite, &
                                         require_range, damaged, real_text
     implicit none
@@ -110,42 +110,23 @@ contains
         end associate
     end subroutine save_bodies
 
-    !> The factor of the bonded block in use (solver method = block): its bond graph and
-    !> values, factored again at the restart (dem_bonded_block::bonded_block_restore).
+    !> The state of the solve method kept between steps, which it puts itself
+    !> (solve_method_t%save_state) under group/block (the factor of the bonded block in use,
+    !> solver method = block: its bond graph and values, factored again at the restart).
     subroutine save_block(file, group, sys, error)
         !> Checkpoint being written.
-        type(h5_file_t), intent(inout) :: file
+        type(h5_file_t), intent(inout), target :: file
         !> Group of the particle system, e.g. '/dem'.
         character(len=*), intent(in) :: group
         !> The system.
         type(dem_system_t), intent(in) :: sys
         !> Set on a write failure.
         type(error_t), allocatable, intent(out) :: error
-        character(len=:), allocatable :: g
+        type(h5_state_sink_t) :: sink
         if (.not. allocated(sys%method)) return
-        select type (m => sys%method)
-        type is (bonded_block_method_t)
-            associate (b => m%block)
-                if (.not. (b%factored .and. allocated(b%values_factored))) return
-                if (size(b%key_i1) == 0) return
-                g = group//'/block'
-                call file%write_dataset(g//'/key_i1', b%key_i1, error)
-                if (.not. allocated(error)) call file%write_dataset(g//'/key_i2', b%key_i2, error)
-                if (.not. allocated(error)) call file%write_dataset(g//'/key_rows', b%key_rows, error)
-                if (.not. allocated(error)) call file%write_dataset(g//'/values', b%values_factored, error)
-                if (.not. allocated(error)) call file%write_dataset(g//'/scale', b%scale_factored, error)
-                ! slots whose bonds left the block: identity rows, some deleted from the factor
-                ! after its factorisation (replayed in order at the restart)
-                if (.not. any(b%dead)) return
-                if (.not. allocated(error)) call file%write_dataset(g//'/dead', merge(1, 0, b%dead), error)
-                if (.not. allocated(error) .and. b%n_deleted > 0) &
-                    call file%write_dataset(g//'/deleted', b%deleted(1:b%n_deleted), error)
-            end associate
-        type is (sweeps_method_t)
-            ! no state between steps
-        class default
-            call make_internal_error(error, 'save_dem', 'no checkpoint for the state of this solve method')
-        end select
+        sink%file => file
+        sink%group = group//'/block'
+        call sys%method%save_state(sink, error)
     end subroutine save_block
 
     !> Write the contact list with its reactions and statuses (the warm start of the next step).
@@ -340,78 +321,26 @@ contains
         end associate
     end subroutine load_bodies
 
-    !> Read the factor of the bonded block (save_block) and restore it in the deck's solve
-    !> method, which must be the bonded block; nothing when the checkpoint has none.
+    !> Give the deck's solve method its state of group/block (save_block), which it checks
+    !> against the system's disks and walls and takes back (solve_method_t%load_state).
     subroutine load_block(file, group, sys, error)
         !> Checkpoint being read.
-        type(h5_file_t), intent(inout) :: file
+        type(h5_file_t), intent(inout), target :: file
         !> Group of the particle system, e.g. '/dem'.
         character(len=*), intent(in) :: group
-        !> The system (built from the deck, its solve method the bonded block when there is a
-        !> factor to restore).
+        !> The system (built from the deck).
         type(dem_system_t), intent(inout) :: sys
-        !> Set on a read failure, a damaged value, or when the deck solves no bonded block.
+        !> Set on a read failure, a damaged value, or a state of another method than the deck's.
         type(error_t), allocatable, intent(out) :: error
-        character(len=:), allocatable :: g
-        integer, allocatable :: k1(:), k2(:), kr(:), dead(:), deleted(:)
-        real(wp), allocatable :: v(:), scale(:)
-        g = group//'/block'
-        if (.not. file%exists(g//'/values')) return
-        ! a checkpoint of the block before its scaling (no 'scale'): its values are those of
-        ! W_BB + eps I, not of S W_BB S + eps I; the restart then factors the current values
-        ! (the run goes on within the solver's tolerance, not bitwise)
-        if (.not. file%exists(g//'/scale')) return
-        call file%read_dataset(g//'/scale', scale, error)
-        if (allocated(error)) return
-        call file%read_dataset(g//'/key_i1', k1, error)
-        if (.not. allocated(error)) call file%read_dataset(g//'/key_i2', k2, error)
-        if (.not. allocated(error)) call file%read_dataset(g//'/key_rows', kr, error)
-        if (.not. allocated(error)) call file%read_dataset(g//'/values', v, error)
-        if (allocated(error)) return
-        if (size(k2) /= size(k1) .or. size(kr) /= size(k1)) then
-            call damaged(error, g//': key_i1, key_i2 and key_rows differ in size')
-            return
-        end if
-        allocate (dead(size(k1)), deleted(0))
-        dead = 0
-        if (file%exists(g//'/dead')) call file%read_dataset(g//'/dead', dead, error)
-        if (allocated(error)) return
-        if (file%exists(g//'/deleted')) call file%read_dataset(g//'/deleted', deleted, error)
-        if (allocated(error)) return
-        if (size(dead) /= size(k1)) then
-            call damaged(error, g//': dead and key_i1 differ in size')
-            return
-        end if
-        call require_range(dead, 0, 1, g//'/dead', error)
-        if (.not. allocated(error)) call require_range(deleted, 1, size(k1), g//'/deleted', error)
-        if (allocated(error)) return
-        if (size(deleted) > 0) then
-            if (any(dead(deleted) == 0)) then
-                call damaged(error, g//': a slot of deleted is not dead')
-                return
-            end if
-        end if
-        call require_range(k1, -sys%walls%n, sys%particles%n, g//'/key_i1', error)
-        if (.not. allocated(error)) call require_range(k2, 1, sys%particles%n, g//'/key_i2', error)
-        if (.not. allocated(error)) call require_finite(v, g//'/values', error)
-        if (.not. allocated(error)) call require_finite(scale, g//'/scale', error)
-        if (allocated(error)) return
-        if (size(scale) /= sum(popcnt(kr))) then
-            call damaged(error, g//': scale has not one value per unknown of key_rows')
-            return
-        end if
-        ! the deck (whose hash the checkpoint matches) chose the strategy: only the
-        ! bonded block has a factor to restore
+        type(h5_state_source_t) :: source
+        source%file => file
+        source%group = group//'/block'
         if (.not. allocated(sys%method)) then
-            call damaged(error, g//': the deck solves no bonded block ([solver] method)')
+            ! the deck (whose hash the checkpoint matches) chose the strategy
+            if (.not. source%is_empty()) call source%damaged('the deck solves no bonded block ([solver] method)', error)
             return
         end if
-        select type (m => sys%method)
-        type is (bonded_block_method_t)
-            call bonded_block_restore(m%block, k1, k2, kr, v, scale, dead == 1, deleted)
-        class default
-            call damaged(error, g//': the deck solves no bonded block ([solver] method)')
-        end select
+        call sys%method%load_state(source, sys%particles%n, sys%walls%n, error)
     end subroutine load_block
 
     !> Read the first n values of a per-body array (the array keeps its size).

@@ -1,11 +1,14 @@
-!> The time integrator's state in a checkpoint (driver_checkpoint): the Newmark or central
-!> difference state of a beam or a 2D continuum, under a group such as '/fe'.
+!> The time integrator's state in a checkpoint (driver_checkpoint): the state common to every
+!> scheme of a beam or a 2D continuum, under a group such as '/fe', and what the scheme keeps
+!> beyond it, which it puts and takes back itself (time_integrator_t%save_state, load_state)
+!> as attributes and datasets of the same group (driver_checkpoint_state).
 module driver_checkpoint_fem
     use core_kinds, only: wp, i8
-    use core_error, only: error_t, make_internal_error
+    use core_error, only: error_t
     use core_strings, only: to_str
     use io_hdf5_file, only: h5_file_t
-    use fem_newmark, only: time_integrator_t, newmark_t, central_difference_t
+    use fem_newmark, only: time_integrator_t
+    use driver_checkpoint_state, only: h5_state_sink_t, h5_state_source_t
     use driver_checkpoint_values, only: put_r1, get_r1, read_finite_attribute, require_range, damaged, real_text
     implicit none
     private
@@ -22,13 +25,14 @@ contains
     !> Write the state of a time integrator under `group`.
     subroutine save_integrator(file, group, integ, error)
         !> Checkpoint being written.
-        type(h5_file_t), intent(inout) :: file
+        type(h5_file_t), intent(inout), target :: file
         !> Group, e.g. '/fe'.
         character(len=*), intent(in) :: group
         !> The integrator.
         class(time_integrator_t), intent(in) :: integ
         !> Set on a write failure.
         type(error_t), allocatable, intent(out) :: error
+        type(h5_state_sink_t) :: sink
         call file%create_group(group, error)
         if (allocated(error)) return
         call file%write_attribute(group, 'scalars', [integ%t, integ%h, integ%t0, integ%kinetic, &
@@ -51,22 +55,15 @@ contains
         if (allocated(error)) return
         call put_r1(file, group//'/f_new', integ%f_new, error)
         if (allocated(error)) return
-        select type (integ)
-        type is (newmark_t)
-            call file%write_attribute(group, 'predicted', merge(1, 0, integ%predicted), error)
-            if (allocated(error)) return
-            call put_r1(file, group//'/fc_old', integ%fc_old, error)
-        type is (central_difference_t)
-            ! no state beyond the common one (init builds the rest from the deck)
-        class default
-            call make_internal_error(error, 'save_integrator', 'no checkpoint for the state of this time integrator')
-        end select
+        sink%file => file
+        sink%group = group
+        call integ%save_state(sink, error)
     end subroutine save_integrator
 
     !> Read the state of a time integrator (built from the deck) from `group`.
     subroutine load_integrator(file, group, integ, step, error)
         !> Checkpoint being read.
-        type(h5_file_t), intent(inout) :: file
+        type(h5_file_t), intent(inout), target :: file
         !> Group, e.g. '/fe'.
         character(len=*), intent(in) :: group
         !> The integrator (init done).
@@ -77,6 +74,7 @@ contains
         type(error_t), allocatable, intent(out) :: error
         real(wp), allocatable :: s(:)
         integer :: k
+        type(h5_state_source_t) :: source
         call read_finite_attribute(file, group, 'scalars', s, 9, error, names=integrator_scalars)
         if (allocated(error)) return
         call file%read_attribute(group, 'step_count', k, error)
@@ -114,18 +112,8 @@ contains
         if (allocated(error)) return
         call get_r1(file, group//'/f_new', integ%f_new, error)
         if (allocated(error)) return
-        select type (integ)
-        type is (newmark_t)
-            call file%read_attribute(group, 'predicted', k, error)
-            if (allocated(error)) return
-            call require_range([k], 0, 1, group//'@predicted', error)
-            if (allocated(error)) return
-            integ%predicted = k /= 0
-            call get_r1(file, group//'/fc_old', integ%fc_old, error)
-        type is (central_difference_t)
-            ! no state beyond the common one (init builds the rest from the deck)
-        class default
-            call make_internal_error(error, 'load_integrator', 'no checkpoint for the state of this time integrator')
-        end select
+        source%file => file
+        source%group = group
+        call integ%load_state(source, error)
     end subroutine load_integrator
 end module driver_checkpoint_fem

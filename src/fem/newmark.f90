@@ -23,6 +23,7 @@
 module fem_newmark
     use core_kinds, only: wp
     use core_error, only: error_t, make_error, make_internal_error
+    use core_state, only: state_sink_t, state_source_t
     use fem_dynamic_operator, only: dynamic_operator_t, spd_factor_t
     implicit none
     private
@@ -68,6 +69,11 @@ module fem_newmark
         procedure, non_overridable :: initial_residual
         !> Energy accounts, time and step count after a step.
         procedure, non_overridable :: finish_step
+        !> Put the state of the scheme beyond the common one (the components above) into a
+        !> checkpoint; a scheme that does not override it is an internal error there.
+        procedure :: save_state => unknown_save_state
+        !> Take it back from a checkpoint (after `init` from the deck).
+        procedure :: load_state => unknown_load_state
     end type time_integrator_t
 
     abstract interface
@@ -136,6 +142,10 @@ module fem_newmark
         !> x = S^-1 b with S = M + gamma h C + beta h^2 K (one or several right-hand sides).
         generic :: solve_effective => solve_effective_vec, solve_effective_mat
         procedure, private :: free_solve
+        !> `predicted` and the coupling force `fc_old`.
+        procedure :: save_state => newmark_save_state
+        !> See `save_state`.
+        procedure :: load_state => newmark_load_state
     end type newmark_t
 
     !> Explicit central-difference scheme (Newmark beta = 0, gamma = 1/2), lumped mass.
@@ -152,6 +162,10 @@ module fem_newmark
         procedure :: init => central_difference_init
         !> See `time_integrator_t%step`.
         procedure :: step => central_difference_step
+        !> Nothing beyond the common state (`init` builds the rest from the deck).
+        procedure :: save_state => central_difference_save_state
+        !> See `save_state`.
+        procedure :: load_state => central_difference_load_state
     end type central_difference_t
 
 contains
@@ -431,6 +445,76 @@ contains
         self%predicted = .false.
         call self%finish_step(model)
     end subroutine newmark_correct
+
+    !> A scheme whose state beyond the common one no checkpoint knows: an internal error.
+    subroutine unknown_save_state(self, sink, error)
+        !> The integrator.
+        class(time_integrator_t), intent(in) :: self
+        !> Where the state goes.
+        class(state_sink_t), intent(inout) :: sink
+        !> Always set.
+        type(error_t), allocatable, intent(out) :: error
+        call make_internal_error(error, 'save_integrator', 'no checkpoint for the state of this time integrator')
+    end subroutine unknown_save_state
+
+    !> See `unknown_save_state`.
+    subroutine unknown_load_state(self, source, error)
+        !> The integrator.
+        class(time_integrator_t), intent(inout) :: self
+        !> Where the state comes from.
+        class(state_source_t), intent(in) :: source
+        !> Always set.
+        type(error_t), allocatable, intent(out) :: error
+        call make_internal_error(error, 'load_integrator', 'no checkpoint for the state of this time integrator')
+    end subroutine unknown_load_state
+
+    !> Put `predicted` (0 or 1) and the coupling force of the previous step `fc_old`.
+    subroutine newmark_save_state(self, sink, error)
+        !> The integrator.
+        class(newmark_t), intent(in) :: self
+        !> Where the state goes.
+        class(state_sink_t), intent(inout) :: sink
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
+        call sink%put_integer('predicted', merge(1, 0, self%predicted), error)
+        if (allocated(error) .or. .not. allocated(self%fc_old)) return
+        call sink%put_reals('fc_old', self%fc_old, error)
+    end subroutine newmark_save_state
+
+    !> Take back `predicted` and `fc_old` (see `newmark_save_state`).
+    subroutine newmark_load_state(self, source, error)
+        !> The integrator (init done).
+        class(newmark_t), intent(inout) :: self
+        !> Where the state comes from.
+        class(state_source_t), intent(in) :: source
+        !> Set on a read failure or a damaged value.
+        type(error_t), allocatable, intent(out) :: error
+        integer :: k
+        call source%get_integer('predicted', 0, 1, k, error)
+        if (allocated(error)) return
+        self%predicted = k /= 0
+        call source%get_reals('fc_old', self%fc_old, error)
+    end subroutine newmark_load_state
+
+    !> Nothing to put.
+    subroutine central_difference_save_state(self, sink, error)
+        !> The integrator.
+        class(central_difference_t), intent(in) :: self
+        !> Where the state goes.
+        class(state_sink_t), intent(inout) :: sink
+        !> Never set.
+        type(error_t), allocatable, intent(out) :: error
+    end subroutine central_difference_save_state
+
+    !> Nothing to take back.
+    subroutine central_difference_load_state(self, source, error)
+        !> The integrator (init done).
+        class(central_difference_t), intent(inout) :: self
+        !> Where the state comes from.
+        class(state_source_t), intent(in) :: source
+        !> Never set.
+        type(error_t), allocatable, intent(out) :: error
+    end subroutine central_difference_load_state
 
     !> x = S^-1 b, S = M + gamma h C + beta h^2 K (factored at `init`). The FE velocity
     !> responds to a force f at t_{n+1} by gamma h S^-1 f, the displacement by beta h^2 S^-1 f.
