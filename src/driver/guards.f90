@@ -17,14 +17,11 @@
 !>   `energy_creation_warning`): a step whose contacts gave the bodies energy beyond what the
 !>   scheme makes near rest and the solver's tolerance (Newton's restitution, doc/theory.md
 !>   2.4) is reported by the time loops, once, then counted.
-!> - `model_size_t`, `model_memory_bytes`, `check_memory`: the memory a model will need, from
-!>   the numbers of disks, beam nodes and elements and continuum elements, against the memory
-!>   available.
 module driver_guards
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite, ieee_is_nan
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
-    use core_strings, only: to_str, gib, num => sci_text
+    use core_strings, only: to_str, num => sci_text
     use dem_particles, only: particles_t
     use dem_walls, only: walls_t
     use dem_contacts, only: contact_set_t
@@ -37,31 +34,6 @@ module driver_guards
     public :: step_start_t, take_step_start, check_tunnelling
     public :: step_created_energy, creation_allowance, step_creates_energy, energy_creation_warning, &
               energy_creation_summary
-    public :: model_size_t, model_memory_bytes, check_memory
-    public :: bytes_per_disk, bytes_per_node, bytes_per_element, bytes_per_q4, bytes_per_t3
-
-    !> Peak memory per disk of a run [bytes]: state, properties and work arrays, detection
-    !> grid, contact candidates, the Anderson history, output buffers. Measured: 0.79 kB per
-    !> disk on a 90,000-disk lattice at rest (maximum resident size, minus that of a 900-disk
-    !> run), but 2.6 kB per disk on a settling deposit of 100 000 disks with the default
-    !> solver (Anderson 5) once 2.5 contacts per disk are active (280 MB against a 22 MB base
-    !> at step 500; an audit found the earlier figure of 1 kB a third of the peak).
-    integer(i8), parameter :: bytes_per_disk = 3000
-    !> Peak memory per beam node [bytes]: 3 DOFs, band matrices (stiffness, mass, effective
-    !> matrix) and state vectors. Measured: 1.28 kB per node and element of a 100,000-element
-    !> beam run (same difference as for the disks).
-    integer(i8), parameter :: bytes_per_node = 1200
-    !> Peak memory per element [bytes] (connectivity, section, element matrices).
-    integer(i8), parameter :: bytes_per_element = 200
-    !> Peak memory per Q4 element of the continuum [bytes]: element triplets, sparse stiffness
-    !> and mass, CHOLMOD factor, state vectors. Measured: 10.1 to 10.2 kB per element (maximum
-    !> resident size of static and dynamic runs on rectangle meshes of 100 x 100, 200 x 200 and
-    !> 300 x 300 Q4, differences between them); the factor's fill grows like log(n), hence the
-    !> margin.
-    integer(i8), parameter :: bytes_per_q4 = 11000
-    !> Peak memory per T3 element of the continuum [bytes]. Measured: 6.3 kB per element (the
-    !> same runs with 2 T3 per cell: 12.7 kB per cell, against 10.2 kB for one Q4).
-    integer(i8), parameter :: bytes_per_t3 = 7000
 
     !> Energy a step may create, relative to the disks' kinetic energy, before it is reported
     !> (creation_allowance): the error of a solve stopped at the sweeps' tolerance (1.7e-4 on
@@ -71,20 +43,6 @@ module driver_guards
     !> Round-off of the end velocities relative to the sizes of their terms (step_creates_energy;
     !> the bonded block's guard uses the same 64 eps, dem_bonded_block).
     real(wp), parameter :: velocity_roundoff = 64.0_wp*epsilon(1.0_wp)
-
-    !> Numbers of things a model holds, for its memory estimate.
-    type :: model_size_t
-        !> Disks.
-        integer(i8) :: disks = 0
-        !> Beam nodes.
-        integer(i8) :: beam_nodes = 0
-        !> Beam elements.
-        integer(i8) :: beam_elements = 0
-        !> Q4 elements of the continuum.
-        integer(i8) :: q4 = 0
-        !> T3 elements of the continuum.
-        integer(i8) :: t3 = 0
-    end type model_size_t
 
     !> Where the disks and walls were at the start of a step.
     type :: step_start_t
@@ -617,54 +575,6 @@ contains
         line = 'steps whose contacts created energy: '//to_str(n)//' of '//to_str(n_steps)// &
                ' (doc/theory.md 2.4 and 2.5)'
     end function energy_creation_summary
-
-    !> Memory a model will need at its peak [bytes] (see bytes_per_disk, bytes_per_node,
-    !> bytes_per_element, bytes_per_q4, bytes_per_t3); huge(0_i8) when that exceeds 2^62 bytes
-    !> (the counts may each approach 2^63: summed in real(wp), which cannot overflow).
-    pure integer(i8) function model_memory_bytes(counts) result(bytes)
-        !> Numbers of disks, nodes and elements.
-        type(model_size_t), intent(in) :: counts
-        real(wp) :: total
-        total = real(bytes_per_disk, wp)*real(counts%disks, wp) + &
-                real(bytes_per_node, wp)*real(counts%beam_nodes, wp) + &
-                real(bytes_per_element, wp)*real(counts%beam_elements, wp) + &
-                real(bytes_per_q4, wp)*real(counts%q4, wp) + real(bytes_per_t3, wp)*real(counts%t3, wp)
-        if (total < 2.0_wp**62) then
-            bytes = int(total, i8)
-        else
-            bytes = huge(0_i8)
-        end if
-    end function model_memory_bytes
-
-    !> Error when the model's estimated memory exceeds what is available (nothing is checked
-    !> when the available memory is unknown, `available` < 0).
-    subroutine check_memory(counts, available, error)
-        !> Numbers of disks, nodes and elements.
-        type(model_size_t), intent(in) :: counts
-        !> Available memory [bytes] (-1: unknown).
-        integer(i8), intent(in) :: available
-        !> Set when the model does not fit.
-        type(error_t), allocatable, intent(out) :: error
-        integer(i8) :: need
-        if (available < 0) return
-        need = model_memory_bytes(counts)
-        if (need <= available) return
-        call make_error(error, 'the model needs about '//gib(need)//' of memory ('// &
-                        to_str(counts%disks)//' disks, '//to_str(counts%beam_nodes)//' beam nodes, '// &
-                        to_str(counts%beam_elements)//' beam elements, '//continuum()//') and only '// &
-                        gib(available)//' are available (MemAvailable in /proc/meminfo): make the model '// &
-                        'smaller, or run it on a machine with more memory')
-    contains
-        !> 'n continuum elements', or 'n Q4 and m T3 continuum elements' when both kinds are there.
-        function continuum() result(text)
-            character(len=:), allocatable :: text
-            if (counts%q4 > 0 .and. counts%t3 > 0) then
-                text = to_str(counts%q4)//' Q4 and '//to_str(counts%t3)//' T3 continuum elements'
-            else
-                text = to_str(counts%q4 + counts%t3)//' continuum elements'
-            end if
-        end function continuum
-    end subroutine check_memory
 
     !> 'step k (t = ... s): '
     function when(step, t) result(text)

@@ -156,7 +156,7 @@ contains
         if (allocated(error)) return
         call select_simulation(run%deck, run%sim, error)
         if (allocated(error)) return
-        call check_model_size(run%deck, error)
+        call check_model_size(run%deck, run%sim, error)
         if (allocated(error)) return
         call run%clock%start(0_i8, 0.0_wp, 0.0_wp)
         call run%sim%init(run%deck, report, error)

@@ -4,13 +4,11 @@
 !> that are zero over the whole run, and an end time that is not a whole number of steps.
 module driver_run_checks
     use core_kinds, only: wp, i8
-    use core_error, only: error_t, make_error, make_input_error, make_internal_error
+    use core_error, only: error_t, make_error
     use core_strings, only: string_t, to_str, num => sci_text
     use io_memory, only: available_memory
     use io_deck, only: deck_t, deck_entry_t
-    use driver_guards, only: model_size_t, model_memory_bytes, check_memory
-    use fem_mesh_generator, only: rectangle_size, check_rectangle_size
-    use fem_element_registry, only: element_slot_t, new_element, kind_of_name
+    use driver_model_size, only: size_estimate_t, check_size_estimate
     use driver_simulation, only: simulation_t, report_iface
     use driver_config, only: steps_to_end, max_steps, build_time_functions
     use core_timefunc, only: time_function_t
@@ -222,97 +220,21 @@ contains
     end subroutine apply_end_time
 
     !> Refuse a model whose memory estimate exceeds the available memory, from the numbers of
-    !> disks, nodes and elements the deck asks for (before allocating them), and a rectangle
-    !> mesh with more nodes or elements than a mesh can number. The memory error names the
-    !> generator record (lattice, row, deposit, beam line, continuum mesh) that asks for the
-    !> most memory; the counts are summed without overflow (saturating at huge(0_i8), where
-    !> the estimate is refused anyway).
-    subroutine check_model_size(deck, error)
+    !> disks, nodes and elements the deck asks for (before allocating them: each kind of run
+    !> adds its parts, `simulation_t%size_estimate`), and a model with more disks or a
+    !> rectangle mesh with more nodes or elements than a run can number. The memory error
+    !> names the generator record (lattice, row, deposit, beam line, continuum mesh) that asks
+    !> for the most memory (driver_model_size).
+    subroutine check_model_size(deck, sim, error)
         !> The deck.
         type(deck_t), intent(in) :: deck
+        !> Its simulation (not yet initialised).
+        class(simulation_t), intent(in) :: sim
         !> Set when the model is too large.
         type(error_t), allocatable, intent(out) :: error
-        type(model_size_t) :: total, part
-        type(element_slot_t) :: element
-        integer(i8) :: n_nodes, n_elements, largest
-        integer :: k, line
-        character(len=:), allocatable :: keyword, message
-        largest = -1
-        line = 0
-        keyword = ''
-        total%disks = deck%count('particles', 'disk')
-        total%beam_nodes = deck%count('beam', 'node')
-        total%beam_elements = deck%count('beam', 'element')
-        do k = 1, size(deck%entries)
-            associate (e => deck%entries(k))
-                part = model_size_t()
-                select case (e%section//' '//e%keyword)
-                case ('particles row', 'particles deposit')
-                    part%disks = e%int('n')
-                case ('particles square_lattice', 'particles hex_lattice')
-                    part%disks = int(e%int('nx'), i8)*int(e%int('ny'), i8)
-                case ('beam line', 'beam polar_line')
-                    part%beam_nodes = int(e%int('elements'), i8) + 1
-                    part%beam_elements = e%int('elements')
-                case ('continuum mesh')
-                    if (e%word('kind') /= 'rectangle') cycle
-                    ! The schema admits only the names of registered element kinds.
-                    call new_element(kind_of_name(e%word('element')), element)
-                    call check_rectangle_size(e%int('nx'), e%int('ny'), element%element, error)
-                    if (allocated(error)) then
-                        message = error%message
-                        call make_input_error(error, deck%file, e%line, e%keyword, message)
-                        return
-                    end if
-                    call rectangle_size(e%int('nx'), e%int('ny'), element%element, n_nodes, n_elements)
-                    ! the memory model has a figure per kind (driver_guards): a kind without
-                    ! one is an internal error, not Q4's figure
-                    select case (element%element%name())
-                    case ('t3')
-                        part%t3 = n_elements
-                    case ('q4')
-                        part%q4 = n_elements
-                    case default
-                        call make_internal_error(error, 'check_model_size', 'no memory figure for the element kind '// &
-                                                 element%element%name()//' (driver_guards)')
-                        return
-                    end select
-                case default
-                    cycle
-                end select
-                total%disks = add(total%disks, part%disks)
-                total%beam_nodes = add(total%beam_nodes, part%beam_nodes)
-                total%beam_elements = add(total%beam_elements, part%beam_elements)
-                total%q4 = add(total%q4, part%q4)
-                total%t3 = add(total%t3, part%t3)
-                if (model_memory_bytes(part) > largest) then
-                    largest = model_memory_bytes(part)
-                    line = e%line
-                    keyword = e%keyword
-                end if
-            end associate
-        end do
-        if (total%disks > huge(0)) then
-            call make_error(error, deck%file//': the deck asks for '//to_str(total%disks)// &
-                            ' disks, more than a run can number ('//to_str(huge(0))//')')
-            return
-        end if
-        call check_memory(total, available_memory(), error)
-        if (allocated(error)) then
-            message = error%message
-            call make_input_error(error, deck%file, line, keyword, message)
-        end if
-
-    contains
-
-        !> a + b for counts >= 0, huge(0_i8) when that overflows.
-        pure integer(i8) function add(a, b)
-            integer(i8), intent(in) :: a, b
-            if (a > huge(0_i8) - b) then
-                add = huge(0_i8)
-            else
-                add = a + b
-            end if
-        end function add
+        type(size_estimate_t) :: estimate
+        call sim%size_estimate(deck, estimate, error)
+        if (allocated(error)) return
+        call check_size_estimate(deck, estimate, available_memory(), error)
     end subroutine check_model_size
 end module driver_run_checks

@@ -19,6 +19,7 @@ module driver_simulation
     use driver_results, only: results_writer_t
     use driver_config, only: run_config_t
     use driver_checkpoint, only: checkpoint_run_t
+    use driver_model_size, only: size_estimate_t
     implicit none
     private
     public :: simulation_t, report_iface, report_to_stdout
@@ -55,6 +56,9 @@ module driver_simulation
         procedure(simulation_check_deck), deferred :: check_deck
         !> Warnings for settings that this kind of run accepts and does not use.
         procedure(simulation_deck_warnings), deferred :: deck_warnings
+        !> Add the parts of the model the deck asks for to the estimate of its memory (from
+        !> the deck alone: called after `check_deck`, before `init` allocates anything).
+        procedure(simulation_size_estimate), deferred :: size_estimate
         !> Text that stands for the files besides the deck the model was read from (the hash of
         !> a Gmsh mesh); hashed into checkpoints with the deck, so that a restart refuses a
         !> changed mesh. Default: none.
@@ -138,6 +142,20 @@ module driver_simulation
             !> The warnings (none: size 0).
             type(string_t), allocatable :: warnings(:)
         end function simulation_deck_warnings
+
+        !> Counts of the model's parts (disks, nodes, elements) as the deck asks for them.
+        subroutine simulation_size_estimate(self, deck, estimate, error)
+            import :: simulation_t, deck_t, size_estimate_t, error_t
+            !> The simulation (not yet initialised).
+            class(simulation_t), intent(in) :: self
+            !> The validated deck.
+            type(deck_t), intent(in) :: deck
+            !> The estimate, this kind's parts added.
+            type(size_estimate_t), intent(inout) :: estimate
+            !> Set when a part is larger than its kind can number (naming file, line and
+            !> keyword).
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine simulation_size_estimate
     end interface
 
 contains

@@ -4,7 +4,7 @@
 !> _dynamic); `driver_simulations` picks it from `[run] analysis`.
 module driver_simulation_beam
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-    use core_kinds, only: wp
+    use core_kinds, only: wp, i8
     use core_error, only: error_t, make_input_error
     use core_strings, only: string_t, to_str
     use io_deck, only: deck_t
@@ -14,9 +14,10 @@ module driver_simulation_beam
     use driver_results, only: results_writer_t
     use driver_simulation, only: simulation_t
     use driver_run_kind, only: check_particle_keywords_unused
+    use driver_model_size, only: size_estimate_t, model_size_t
     implicit none
     private
-    public :: beam_simulation_t, beam_setup, check_initial_energy
+    public :: beam_simulation_t, beam_setup, check_initial_energy, add_beam_size
 
     !> A planar frame run; its analysis is the extension.
     type, abstract, extends(simulation_t) :: beam_simulation_t
@@ -35,6 +36,8 @@ module driver_simulation_beam
         procedure :: check_deck => beam_check_deck
         !> See `simulation_t%deck_warnings`: none.
         procedure :: deck_warnings => beam_deck_warnings
+        !> See `simulation_t%size_estimate`: the frame's nodes and elements (`add_beam_size`).
+        procedure :: size_estimate => beam_size_estimate
         !> Write the nodes and the elements into the results file.
         procedure :: write_mesh => beam_write_mesh
     end type beam_simulation_t
@@ -102,6 +105,39 @@ contains
         type(string_t), allocatable :: warnings(:)
         allocate (warnings(0))
     end function beam_deck_warnings
+
+    !> See `add_beam_size`.
+    subroutine beam_size_estimate(self, deck, estimate, error)
+        !> The simulation (not yet initialised).
+        class(beam_simulation_t), intent(in) :: self
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        !> The estimate, the frame added.
+        type(size_estimate_t), intent(inout) :: estimate
+        !> Never set (a frame's counts are numbered as they are read).
+        type(error_t), allocatable, intent(out) :: error
+        call add_beam_size(deck, estimate)
+    end subroutine beam_size_estimate
+
+    !> The frame's part of a memory estimate (a beam run's, a coupled run's): its nodes and
+    !> elements, those given one by one and those of each `line` and `polar_line` record.
+    subroutine add_beam_size(deck, estimate)
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        !> The estimate, the frame added.
+        type(size_estimate_t), intent(inout) :: estimate
+        integer :: k
+        call estimate%add_count(model_size_t(beam_nodes=int(deck%count('beam', 'node'), i8), &
+                                             beam_elements=int(deck%count('beam', 'element'), i8)))
+        do k = 1, size(deck%entries)
+            associate (e => deck%entries(k))
+                if (e%section /= 'beam') cycle
+                if (e%keyword /= 'line' .and. e%keyword /= 'polar_line') cycle
+                call estimate%add_record(model_size_t(beam_nodes=int(e%int('elements'), i8) + 1, &
+                                                      beam_elements=int(e%int('elements'), i8)), k, e)
+            end associate
+        end do
+    end subroutine add_beam_size
 
     !> The frame's nodes and elements into the results file.
     subroutine beam_write_mesh(self, out, error)

@@ -11,12 +11,12 @@
 !> and restart as the beam's (driver_checkpoint: the integrator's state and the results file's
 !> record counts).
 module driver_simulation_continuum
-    use core_kinds, only: wp
-    use core_error, only: error_t, make_input_error
+    use core_kinds, only: wp, i8
+    use core_error, only: error_t, make_input_error, make_internal_error
     use core_strings, only: string_t, to_str, quoted_name, same_name
     use io_deck, only: deck_t, deck_entry_t
     use fem_mesh2d, only: mesh2d_t
-    use fem_mesh_generator, only: rectangle_mesh
+    use fem_mesh_generator, only: rectangle_mesh, rectangle_size, check_rectangle_size
     use fem_element_registry, only: element_slot_t, new_element, kind_of_name
     use fem_gmsh_reader, only: read_gmsh
     use io_paths, only: read_file_text
@@ -28,6 +28,7 @@ module driver_simulation_continuum
     use driver_checkpoint, only: deck_hash
     use driver_simulation, only: simulation_t
     use driver_run_kind, only: check_particle_keywords_unused, check_initial_unused
+    use driver_model_size, only: size_estimate_t, model_size_t
     implicit none
     private
     public :: continuum_simulation_t, continuum_setup, check_density
@@ -53,6 +54,8 @@ module driver_simulation_continuum
         procedure :: check_deck => continuum_check_deck
         !> See `simulation_t%deck_warnings`: none.
         procedure :: deck_warnings => continuum_deck_warnings
+        !> See `simulation_t%size_estimate`: the elements of a rectangle mesh.
+        procedure :: size_estimate => continuum_size_estimate
         !> See `simulation_t%inputs_text`: the Gmsh mesh file.
         procedure :: inputs_text => continuum_inputs_text
     end type continuum_simulation_t
@@ -451,6 +454,55 @@ contains
         type(string_t), allocatable :: warnings(:)
         allocate (warnings(0))
     end function continuum_deck_warnings
+
+    !> The continuum's part of a memory estimate (a continuum run's, a coupled one's): the
+    !> elements of each rectangle mesh, each kind with its own figure (a Gmsh file's are not
+    !> known before it is read). A rectangle with more nodes or elements than a mesh can number
+    !> is an input error.
+    subroutine continuum_size_estimate(self, deck, estimate, error)
+        !> The simulation (not yet initialised).
+        class(continuum_simulation_t), intent(in) :: self
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        !> The estimate, the elements added.
+        type(size_estimate_t), intent(inout) :: estimate
+        !> Set on a rectangle too large to number, naming file, line and keyword.
+        type(error_t), allocatable, intent(out) :: error
+        type(element_slot_t) :: element
+        type(model_size_t) :: part
+        integer(i8) :: n_nodes, n_elements
+        character(len=:), allocatable :: message
+        integer :: k
+        do k = 1, size(deck%entries)
+            associate (e => deck%entries(k))
+                if (e%section /= 'continuum' .or. e%keyword /= 'mesh') cycle
+                if (e%word('kind') /= 'rectangle') cycle
+                ! The schema admits only the names of registered element kinds.
+                call new_element(kind_of_name(e%word('element')), element)
+                call check_rectangle_size(e%int('nx'), e%int('ny'), element%element, error)
+                if (allocated(error)) then
+                    message = error%message
+                    call make_input_error(error, deck%file, e%line, e%keyword, message)
+                    return
+                end if
+                call rectangle_size(e%int('nx'), e%int('ny'), element%element, n_nodes, n_elements)
+                ! the memory model has a figure per kind (driver_model_size): a kind without
+                ! one is an internal error, not Q4's figure
+                part = model_size_t()
+                select case (element%element%name())
+                case ('t3')
+                    part%t3 = n_elements
+                case ('q4')
+                    part%q4 = n_elements
+                case default
+                    call make_internal_error(error, 'check_model_size', 'no memory figure for the element kind '// &
+                                             element%element%name()//' (driver_model_size)')
+                    return
+                end select
+                call estimate%add_record(part, k, e)
+            end associate
+        end do
+    end subroutine continuum_size_estimate
 
     !> See `simulation_t%inputs_text`: the hash of the Gmsh mesh file ('' for a generated mesh).
     function continuum_inputs_text(self) result(text)

@@ -21,7 +21,9 @@ module driver_simulation_coupled
     use driver_results_coupled, only: write_beam_overlap
     use driver_guards, only: check_beam_state
     use driver_simulation, only: report_iface
-    use driver_simulation_beam, only: check_initial_energy
+    use driver_simulation_beam, only: check_initial_energy, add_beam_size
+    use driver_simulation_dem, only: add_particles_size
+    use driver_model_size, only: size_estimate_t
     use driver_coupled_loop, only: arlequin_simulation_t
     use driver_coupled_rolling, only: free_rolling_warning
     use driver_displacement_scale, only: largest_displacement, model_extent, large_displacement_warning
@@ -48,6 +50,8 @@ module driver_simulation_coupled
         procedure :: init => coupled_init
         !> See `simulation_t%describe`.
         procedure :: describe => coupled_describe
+        !> See `simulation_t%size_estimate`: the beam's and the particles' parts.
+        procedure :: size_estimate => coupled_size_estimate
         !> See `simulation_t%checkpoint_kind`.
         procedure :: checkpoint_kind => coupled_checkpoint_kind
         !> See `arlequin_simulation_t%particle_output`.
@@ -65,6 +69,21 @@ module driver_simulation_coupled
     end type coupled_simulation_t
 
 contains
+
+    !> The beam's part and the particles' (driver_simulation_beam::add_beam_size,
+    !> driver_simulation_dem::add_particles_size).
+    subroutine coupled_size_estimate(self, deck, estimate, error)
+        !> The simulation (not yet initialised).
+        class(coupled_simulation_t), intent(in) :: self
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        !> The estimate, both parts added.
+        type(size_estimate_t), intent(inout) :: estimate
+        !> Never set (neither part can fail).
+        type(error_t), allocatable, intent(out) :: error
+        call add_beam_size(deck, estimate)
+        call add_particles_size(deck, estimate)
+    end subroutine coupled_size_estimate
 
     !> Both models and the coupled system; everything that can fail because of the input
     !> (library errors are attached to the [coupling] overlap line).

@@ -36,6 +36,7 @@ module driver_simulation_coupled2d
     use driver_coupled_rolling, only: free_rolling_warning
     use driver_checkpoint, only: read_finite_attribute
     use driver_displacement_scale, only: largest_displacement, model_extent, large_displacement_warning
+    use driver_model_size, only: size_estimate_t
     implicit none
     private
     public :: coupled2d_simulation_t
@@ -58,6 +59,8 @@ module driver_simulation_coupled2d
         procedure :: init => coupled2d_init
         !> See `simulation_t%describe`.
         procedure :: describe => coupled2d_describe
+        !> See `simulation_t%size_estimate`: the continuum's part and the particles'.
+        procedure :: size_estimate => coupled2d_size_estimate
         !> See `simulation_t%checkpoint_kind`.
         procedure :: checkpoint_kind => coupled2d_checkpoint_kind
         !> See `arlequin_simulation_t%particle_output`.
@@ -85,6 +88,21 @@ module driver_simulation_coupled2d
     end type coupled2d_simulation_t
 
 contains
+
+    !> The continuum's part and the particles', as their own runs estimate them.
+    subroutine coupled2d_size_estimate(self, deck, estimate, error)
+        !> The simulation (not yet initialised).
+        class(coupled2d_simulation_t), intent(in) :: self
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        !> The estimate, both parts added.
+        type(size_estimate_t), intent(inout) :: estimate
+        !> Set on a continuum mesh too large to number.
+        type(error_t), allocatable, intent(out) :: error
+        call self%continuum%size_estimate(deck, estimate, error)
+        if (allocated(error)) return
+        call self%particles%size_estimate(deck, estimate, error)
+    end subroutine coupled2d_size_estimate
 
     !> Both models and the coupled system (library errors are attached to the first region line).
     subroutine coupled2d_init(self, deck, report, error)

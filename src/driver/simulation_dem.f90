@@ -1,5 +1,6 @@
 !> Particle (Contact Dynamics) runs: a [particles] deck without [beam].
 module driver_simulation_dem
+    use core_kinds, only: i8
     use core_error, only: error_t
     use core_strings, only: string_t, counted
     use core_timefunc, only: time_function_t
@@ -12,9 +13,10 @@ module driver_simulation_dem
     use driver_simulation, only: simulation_t, report_iface
     use driver_run_kind, only: check_beam_keywords_unused
     use driver_swept_bonds, only: swept_bonds_warning
+    use driver_model_size, only: size_estimate_t, model_size_t
     implicit none
     private
-    public :: dem_simulation_t
+    public :: dem_simulation_t, add_particles_size
 
     !> A run of rigid disks and walls.
     type, extends(simulation_t) :: dem_simulation_t
@@ -37,9 +39,48 @@ module driver_simulation_dem
         procedure :: check_deck => dem_check_deck
         !> See `simulation_t%deck_warnings`: bonds swept one contact at a time.
         procedure :: deck_warnings => dem_deck_warnings
+        !> See `simulation_t%size_estimate`: the disks (`add_particles_size`).
+        procedure :: size_estimate => dem_size_estimate
     end type dem_simulation_t
 
 contains
+
+    !> See `add_particles_size`.
+    subroutine dem_size_estimate(self, deck, estimate, error)
+        !> The simulation (not yet initialised).
+        class(dem_simulation_t), intent(in) :: self
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        !> The estimate, the disks added.
+        type(size_estimate_t), intent(inout) :: estimate
+        !> Never set (too many disks to number is refused on the whole estimate,
+        !> driver_model_size::check_size_estimate).
+        type(error_t), allocatable, intent(out) :: error
+        call add_particles_size(deck, estimate)
+    end subroutine dem_size_estimate
+
+    !> The particles' part of a memory estimate (a particle run's, a coupled run's): the disks
+    !> given one by one and those of each `row`, `deposit`, `square_lattice` and `hex_lattice`
+    !> record.
+    subroutine add_particles_size(deck, estimate)
+        !> The validated deck.
+        type(deck_t), intent(in) :: deck
+        !> The estimate, the disks added.
+        type(size_estimate_t), intent(inout) :: estimate
+        integer :: k
+        call estimate%add_count(model_size_t(disks=int(deck%count('particles', 'disk'), i8)))
+        do k = 1, size(deck%entries)
+            associate (e => deck%entries(k))
+                if (e%section /= 'particles') cycle
+                select case (e%keyword)
+                case ('row', 'deposit')
+                    call estimate%add_record(model_size_t(disks=int(e%int('n'), i8)), k, e)
+                case ('square_lattice', 'hex_lattice')
+                    call estimate%add_record(model_size_t(disks=int(e%int('nx'), i8)*int(e%int('ny'), i8)), k, e)
+                end select
+            end associate
+        end do
+    end subroutine add_particles_size
 
     !> Configuration of the particles and walls; everything that can fail because of the input.
     subroutine dem_init(self, deck, report, error)
