@@ -39,8 +39,6 @@ module driver_results_continuum
         integer :: n_nodes = 0, n_elements = 0
         !> Number of stored states (dynamic) so far.
         integer :: n_out = 0
-        !> Analysis ('static', 'modal', 'dynamic').
-        character(len=:), allocatable :: analysis
         !> XDMF topology of /continuum/mesh/topology: 'Triangle', 'Quadrilateral' or 'Mixed'.
         character(len=:), allocatable :: topology
         !> Number of values of the topology dataset.
@@ -50,8 +48,10 @@ module driver_results_continuum
         !> (driver_results_xdmf then leaves them out).
         logical :: stress_measures = .true.
     contains
-        !> Write the mesh and the sets; create the series of the analysis.
+        !> Write the mesh, the materials and the sets (every analysis).
         procedure :: begin => writer_begin
+        !> Create the series of a run with a time loop (after `begin`).
+        procedure :: begin_series => writer_begin_series
         !> Take up a dynamic run's results file again at a restart (nothing written).
         procedure :: resume => writer_resume
         !> Static solution.
@@ -66,23 +66,20 @@ module driver_results_continuum
 
 contains
 
-    !> Mesh, materials, sets and the series of a dynamic run.
-    subroutine writer_begin(self, file, model, analysis, error)
+    !> Mesh, materials and sets.
+    subroutine writer_begin(self, file, model, error)
         !> The writer.
         class(continuum_writer_t), intent(inout) :: self
         !> The open results file.
         type(h5_file_t), intent(inout) :: file
         !> The continuum (its mesh and materials).
         type(continuum_model_t), intent(in) :: model
-        !> 'static', 'modal' or 'dynamic'.
-        character(len=*), intent(in) :: analysis
         !> Set on a write failure.
         type(error_t), allocatable, intent(out) :: error
         integer, allocatable :: topo(:)
         integer :: k, n
         self%n_nodes = model%mesh%node_count()
         self%n_elements = model%mesh%element_count()
-        self%analysis = analysis
         self%n_out = 0
         self%stress_measures = .true.
         call file%create_group('/continuum', error)
@@ -125,7 +122,16 @@ contains
             call file%write_dataset('/continuum/sets/edges/'//model%mesh%edge_sets(k)%name, model%mesh%edge_sets(k)%nodes, error)
             if (allocated(error)) return
         end do
-        if (analysis /= 'dynamic') return
+    end subroutine writer_begin
+
+    !> The series of a run with a time loop: time, displacement, velocity, stresses, energies.
+    subroutine writer_begin_series(self, file, error)
+        !> The writer (after `begin`).
+        class(continuum_writer_t), intent(inout) :: self
+        !> The open results file.
+        type(h5_file_t), intent(inout) :: file
+        !> Set on a write failure.
+        type(error_t), allocatable, intent(out) :: error
         call series('/continuum/time', [integer ::], 's', error)
         if (.not. allocated(error)) call series('/continuum/displacement', [2, self%n_nodes], 'm', error)
         if (.not. allocated(error)) call series('/continuum/velocity', [2, self%n_nodes], 'm/s', error)
@@ -150,7 +156,7 @@ contains
             if (allocated(error)) return
             call file%write_attribute(path, 'units', units, error)
         end subroutine series
-    end subroutine writer_begin
+    end subroutine writer_begin_series
 
     !> /continuum/mesh/material (each element's material) and /continuum/materials (the
     !> properties of each material, in the order of the deck's `material` records).
@@ -234,7 +240,6 @@ contains
         integer, allocatable :: topo(:), dims(:)
         self%n_nodes = mesh%node_count()
         self%n_elements = mesh%element_count()
-        self%analysis = 'dynamic'
         call set_topology(self, mesh, topo)
         call file%dataset_shape('/continuum/time', dims, error)
         if (allocated(error)) return

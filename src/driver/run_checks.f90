@@ -52,7 +52,7 @@ contains
         !> Where the warning goes.
         procedure(report_iface) :: report
         integer :: step
-        if (sim%settings%analysis /= 'dynamic' .or. .not. deck%has('solver', 'fclib_step')) return
+        if (.not. sim%has_time_loop() .or. .not. deck%has('solver', 'fclib_step')) return
         step = deck%get_int('solver', 'fclib_step')
         if (step > sim%settings%n_steps) call report(fclib_after_end_warning(step, sim%settings%n_steps))
     end subroutine warn_fclib_after_end
@@ -87,7 +87,7 @@ contains
         type(deck_entry_t), allocatable :: list(:)
         real(wp) :: nyquist
         integer :: i
-        if (sim%settings%analysis /= 'dynamic' .or. .not. sim%settings%h > 0.0_wp) return
+        if (.not. sim%has_time_loop() .or. .not. sim%settings%h > 0.0_wp) return
         nyquist = 0.5_wp/sim%settings%h
         allocate (list, source=deck%records('functions', 'function'))
         do i = 1, size(list)
@@ -121,7 +121,7 @@ contains
         character(len=:), allocatable :: users
         real(wp) :: t_last
         integer :: i, k, n_users
-        if (sim%settings%analysis /= 'dynamic' .or. .not. sim%settings%h > 0.0_wp) return
+        if (.not. sim%has_time_loop() .or. .not. sim%settings%h > 0.0_wp) return
         ! the model's build has read the same functions without error
         call build_time_functions(deck, functions, ids, error)
         if (allocated(error)) return
@@ -165,7 +165,7 @@ contains
         procedure(report_iface) :: report
         real(wp) :: t_last
         character(len=24) :: buf
-        if (sim%settings%analysis /= 'dynamic' .or. .not. sim%settings%h > 0.0_wp) return
+        if (.not. sim%has_time_loop() .or. .not. sim%settings%h > 0.0_wp) return
         associate (run => sim%settings)
             t_last = real(run%n_steps, wp)*run%h
             ! a whole number of steps up to the rounding of end / step (steps_to_end)

@@ -138,18 +138,21 @@ contains
         real(wp) :: u_max
         u_max = 0.0_wp
         ! At a restart the file has the mesh and the series already (restore).
-        if (.not. ck%restart) call writer%begin(out%file, self%model, self%settings%analysis, error)
+        if (.not. ck%restart) then
+            call writer%begin(out%file, self%model, error)
+            if (.not. allocated(error)) call writer%begin_series(out%file, error)
+        end if
         if (allocated(error)) return
         call run_dynamic(error)
 
     contains
 
         !> What makes a step's state blow up: the stability limit only for a conditionally
-        !> stable scheme (central differences, or Newmark with 2 beta < gamma).
+        !> stable scheme (central differences, or Newmark with 2 beta < gamma; the integrator
+        !> says, `time_integrator_t%conditionally_stable`).
         function likely_cause() result(cause)
             character(len=:), allocatable :: cause
-            if (self%settings%scheme == 'central_difference' .or. &
-                2*self%settings%beta < self%settings%gamma) then
+            if (self%integ%conditionally_stable()) then
                 cause = 'a time step above the stability limit of the scheme, or loads far too large'
             else
                 cause = 'loads, moduli or densities far out of range (this Newmark scheme is '// &

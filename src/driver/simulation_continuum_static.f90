@@ -193,7 +193,7 @@ contains
         !> Set on a run or write failure.
         type(error_t), allocatable, intent(out) :: error
         type(continuum_writer_t) :: writer
-        call writer%begin(out%file, self%model, self%settings%analysis, error)
+        call writer%begin(out%file, self%model, error)
         if (allocated(error)) return
         call run_static(error)
 

@@ -222,7 +222,8 @@ contains
         type(error_t), allocatable, intent(out) :: error
         integer, allocatable :: region(:)
         integer :: r
-        call self%fe_out%begin(out%file, self%continuum%model, 'dynamic', error)
+        call self%fe_out%begin(out%file, self%continuum%model, error)
+        if (.not. allocated(error)) call self%fe_out%begin_series(out%file, error)
         if (allocated(error)) return
         ! the region of each multiplier row (that of its disk's centre at t = 0), so that a
         ! region's resultant is the sum of its rows of /coupling/lambda

@@ -63,6 +63,9 @@ module fem_newmark
         procedure(integrator_step), deferred :: step
         !> kinetic + strain + dissipation - external work - initial energy [J].
         procedure :: energy_balance
+        !> Whether the scheme is stable only below a critical time step (what a state that
+        !> blows up is blamed on). Default: yes (a scheme that says nothing may have a limit).
+        procedure :: conditionally_stable => integrator_conditionally_stable
         !> Common part of `init` for the schemes (state, work arrays, energies).
         procedure, non_overridable :: start_state
         !> a = F(t) - K u - C v with the current state.
@@ -138,6 +141,8 @@ module fem_newmark
         procedure :: predict => newmark_predict
         !> Add the response to a coupling force and finish the step.
         procedure :: correct => newmark_correct
+        !> See `time_integrator_t%conditionally_stable`: when 2 beta < gamma.
+        procedure :: conditionally_stable => newmark_conditionally_stable
         procedure, private :: solve_effective_vec, solve_effective_mat
         !> x = S^-1 b with S = M + gamma h C + beta h^2 K (one or several right-hand sides).
         generic :: solve_effective => solve_effective_vec, solve_effective_mat
@@ -166,6 +171,8 @@ module fem_newmark
         procedure :: save_state => central_difference_save_state
         !> See `save_state`.
         procedure :: load_state => central_difference_load_state
+        !> See `time_integrator_t%conditionally_stable`: yes.
+        procedure :: conditionally_stable => central_difference_conditionally_stable
     end type central_difference_t
 
 contains
@@ -205,6 +212,28 @@ contains
         energy_balance = self%kinetic + self%strain + self%damping_dissipation &
                          - self%external_work - self%coupling_work - self%initial_energy
     end function energy_balance
+
+    !> See `time_integrator_t%conditionally_stable`: yes.
+    pure logical function integrator_conditionally_stable(self)
+        !> The integrator.
+        class(time_integrator_t), intent(in) :: self
+        integrator_conditionally_stable = .true.
+    end function integrator_conditionally_stable
+
+    !> Newmark is stable whatever the step for 2 beta >= gamma (gamma >= 1/2, undamped
+    !> limit), only below h_crit otherwise.
+    pure logical function newmark_conditionally_stable(self)
+        !> The integrator.
+        class(newmark_t), intent(in) :: self
+        newmark_conditionally_stable = 2*self%beta < self%gamma
+    end function newmark_conditionally_stable
+
+    !> Central differences are stable only below 2/omega_max (less with stiffness damping).
+    pure logical function central_difference_conditionally_stable(self)
+        !> The integrator.
+        class(central_difference_t), intent(in) :: self
+        central_difference_conditionally_stable = .true.
+    end function central_difference_conditionally_stable
 
     !> Common part of `init`: checks, state, work arrays, energies; leaves
     !> F(t0) - K u0 - C v0 in `a` (to be multiplied by M^-1 by the scheme).
