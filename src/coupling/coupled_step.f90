@@ -59,9 +59,10 @@
 !>
 !> Energy audit (`coupled_energies`): FE kinetic + strain (weighted), DEM kinetic + potential
 !> (weighted, times t), external works of both, Rayleigh, contact and numerical dissipation,
-!> coupling works of both sides. The FE terms are those of the whole FE body when its driver
-!> sets `whole` (a 2D continuum: its audit over all dofs, with the reactions' work on the
-!> prescribed dofs), else the integrator's (free dofs; a beam, whose supports are fixed).
+!> coupling works of both sides. The FE terms are those of `accounts` (coupling_fe_accounts):
+!> the whole FE body's when its driver sets them (a 2D continuum: its audit over all dofs,
+!> with the reactions' work on the prescribed dofs), else the integrator's (free dofs; a
+!> beam, whose supports are fixed).
 !> `balance` = total energy + dissipation - works - initial, which
 !> equals the net coupling work (zero up to the drift term and round-off with the schemes
 !> above; a first-step impulse that removes inconsistent initial velocities dissipates energy
@@ -81,9 +82,10 @@ module coupling_coupled_step
     use coupling_lambda, only: coupling_system_t, fe_coupling_force
     use coupling_bilateral, only: coupling_rows_t
     use coupling_multiplier_space, only: multiplier_space_t, disk_space_t
+    use coupling_fe_accounts, only: fe_accounts_t, fe_energies_t, integrator_accounts_t
     implicit none
     private
-    public :: coupled_system_t, coupled_stats_t, coupled_energies_t, fe_whole_t
+    public :: coupled_system_t, coupled_stats_t, coupled_energies_t
     public :: notice_iface
     public :: complete_coupled_system, disk_space, arlequin_step, coupled_energies, coordinate_residual
     public :: multipliers_particles, multipliers_nodes
@@ -164,23 +166,6 @@ module coupling_coupled_step
         real(wp) :: balance = 0.0_wp
     end type coupled_energies_t
 
-    !> The FE side's accounts over all its dofs, prescribed ones included [J]: a 2D continuum's
-    !> audit of the whole body (fem_continuum_dynamics `continuum_audit_t`, weighted), set by
-    !> its driver after every step. The integrator's own terms cover the free dofs only: with
-    !> a displacement prescribed in time they miss the energy stored through the prescribed
-    !> dofs and the supports' work. (A beam's supports are fixed, u = v = 0 there, and its
-    !> integrator's terms are already those of the whole beam.)
-    type :: fe_whole_t
-        !> The accounts below are set (otherwise the integrator's are used).
-        logical :: set = .false.
-        !> Kinetic 1/2 v.M v and strain 1/2 u.K u over all dofs.
-        real(wp) :: kinetic = 0.0_wp, strain = 0.0_wp
-        !> Work of the loads, Rayleigh dissipation, work of the reactions on the prescribed dofs.
-        real(wp) :: external_work = 0.0_wp, damping = 0.0_wp, reaction_work = 0.0_wp
-        !> Kinetic + strain energy at the start.
-        real(wp) :: initial = 0.0_wp
-    end type fe_whole_t
-
     !> A coupled simulation: both domains, the coupling and its state.
     type :: coupled_system_t
         !> Weighted FE model (the beam's band matrices, the continuum's sparse ones).
@@ -240,8 +225,9 @@ module coupling_coupled_step
         !> sum of (lambda_n + lambda_n+1)/2 . (C_p u_p(t_n+1) - C_p u_p(t_n)) [J]: the FE side's
         !> coupling work on those dofs is its negative.
         real(wp) :: prescribed_coupling_work = 0.0_wp
-        !> The FE side's accounts over all its dofs, when its driver sets them (see fe_whole_t).
-        type(fe_whole_t) :: whole
+        !> The FE side's energy accounts: the integrator's (`complete_coupled_system`), or those
+        !> its driver sets after every step (a 2D continuum's whole body, coupling_fe_accounts).
+        class(fe_accounts_t), allocatable :: accounts
     end type coupled_system_t
 
     abstract interface
@@ -287,6 +273,9 @@ contains
         real(wp) :: h
         integer :: n, r
         n = sys%dem%particles%n
+        ! The integrator's energy accounts until the FE side's driver sets others.
+        if (allocated(sys%accounts)) deallocate (sys%accounts)
+        allocate (integrator_accounts_t :: sys%accounts)
         call scale_disks(sys)
         call mj_init(sys%dem, error)
         if (allocated(error)) return
@@ -614,29 +603,18 @@ contains
         type(coupled_system_t), intent(in) :: sys
         type(coupled_energies_t) :: e
         real(wp) :: t
-        real(wp) :: fe_balance
+        type(fe_energies_t) :: fe
         t = sys%thickness
         ! On the free dofs (the integrator's), and on the prescribed ones (FE dofs prescribed in time).
         e%fe_coupling_work = sys%fe%coupling_work - sys%prescribed_coupling_work
-        if (sys%whole%set) then
-            ! The whole FE body (its audit closes with the coupling work on all its dofs).
-            e%fe_kinetic = sys%whole%kinetic
-            e%fe_strain = sys%whole%strain
-            e%fe_external_work = sys%whole%external_work
-            e%fe_damping = sys%whole%damping
-            e%fe_reaction_work = sys%whole%reaction_work
-            fe_balance = e%fe_kinetic + e%fe_strain + e%fe_damping - e%fe_external_work - e%fe_reaction_work - &
-                         e%fe_coupling_work - sys%whole%initial
-        else
-            e%fe_kinetic = sys%fe%kinetic
-            e%fe_strain = sys%fe%strain
-            e%fe_external_work = sys%fe%external_work
-            e%fe_damping = sys%fe%damping_dissipation
-            e%fe_reaction_work = 0.0_wp
-            ! (the integrator's balance, with its coupling work on the free dofs; nothing
-            ! prescribed in time then)
-            fe_balance = sys%fe%energy_balance()
-        end if
+        ! The whole FE body's (its audit closes with the coupling work on all its dofs), or the
+        ! integrator's (free dofs), as the FE side set them.
+        fe = sys%accounts%energies(sys%fe, e%fe_coupling_work)
+        e%fe_kinetic = fe%kinetic
+        e%fe_strain = fe%strain
+        e%fe_external_work = fe%external_work
+        e%fe_damping = fe%damping
+        e%fe_reaction_work = fe%reaction_work
         associate (d => sys%dem%energies)
             e%dem_kinetic = t*d%kinetic
             e%dem_potential = t*d%potential
@@ -645,15 +623,11 @@ contains
             e%dem_contact_dissipation = t*d%contact_dissipation
             e%dem_numerical_dissipation = t*d%numerical_dissipation
             e%dem_coupling_work = t*d%coupling_work
-            if (sys%whole%set) then
-                e%initial = sys%whole%initial + t*d%initial
-            else
-                e%initial = sys%fe%initial_energy + t*d%initial
-            end if
+            e%initial = fe%initial + t*d%initial
             e%coupling_work = e%fe_coupling_work + e%dem_coupling_work
             ! Each side's own audit (its coupling work included) closes to round-off; their
             ! sum without the coupling works is the balance of the coupled system.
-            e%balance = fe_balance + t*energies_balance(d) + e%coupling_work
+            e%balance = fe%balance + t*energies_balance(d) + e%coupling_work
         end associate
     end function coupled_energies
 end module coupling_coupled_step

@@ -10,6 +10,7 @@ set(MULTICOR_COUPLING_SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/operator2d.f90
     ${CMAKE_CURRENT_LIST_DIR}/weighted2d.f90
     ${CMAKE_CURRENT_LIST_DIR}/bilateral.f90
+    ${CMAKE_CURRENT_LIST_DIR}/fe_accounts.f90
     ${CMAKE_CURRENT_LIST_DIR}/coupled_step.f90
     ${CMAKE_CURRENT_LIST_DIR}/arlequin.f90
     ${CMAKE_CURRENT_LIST_DIR}/arlequin2d.f90)

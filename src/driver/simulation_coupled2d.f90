@@ -23,7 +23,8 @@ module driver_simulation_coupled2d
     use io_deck, only: deck_t
     use io_hdf5_file, only: h5_file_t
     use fem_continuum_dynamics, only: continuum_dynamics_t
-    use coupling_coupled_step, only: coupled_energies_t, coupled_energies, fe_whole_t
+    use coupling_coupled_step, only: coupled_energies_t, coupled_energies
+    use coupling_fe_accounts, only: fe_whole_t
     use coupling_operator2d, only: continuum_operator_t
     use coupling_arlequin2d, only: build_coupled2d
     use driver_config_coupling2d, only: coupled2d_setup_t, build_coupling2d_config, check_coupled2d_scheme
@@ -288,9 +289,11 @@ contains
                                          'continuum''s')
                 return
             end select
-            self%sys%whole = fe_whole_t(set=.true., kinetic=au%kinetic, strain=au%strain, &
-                                        external_work=au%load_work, damping=au%damping, &
-                                        reaction_work=au%reaction_work, initial=au%initial)
+            ! the FE side's accounts in the coupled audit are the whole body's
+            deallocate (self%sys%accounts)
+            allocate (self%sys%accounts, source=fe_whole_t(kinetic=au%kinetic, strain=au%strain, &
+                                                           external_work=au%load_work, damping=au%damping, &
+                                                           reaction_work=au%reaction_work, initial=au%initial))
         end associate
     end subroutine audit_step
 
