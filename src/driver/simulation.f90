@@ -8,8 +8,12 @@
 !> `--check` run), and `run` (static solve, modes or time steps, writing every output into the
 !> open results file). A run with a time loop (`has_time_loop`) can be extended (`--end`) and
 !> restarted; its checkpoints (driver_checkpoint) name its kind of run with `checkpoint_kind`,
-!> which a restart checks. Adding a kind of model adds an extension in its own file and one
-!> line in `driver_simulations`.
+!> which a restart checks. Before `init`, `size_estimate` adds the parts of the model the deck
+!> asks for to the memory estimate (driver_model_size). Adding a kind of model adds an
+!> extension in its own file (every deferred binding above; a coupled kind may combine the
+!> bindings of the kinds it couples), listed in src/CMakeLists.txt, its keywords in the schema
+!> (io), and its case in `driver_simulations`, which picks it from the deck's sections. A kind
+!> that writes a results group of its own also teaches driver_results_xdmf to index it.
 module driver_simulation
     use, intrinsic :: iso_fortran_env, only: output_unit
     use core_error, only: error_t

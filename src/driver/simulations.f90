@@ -10,8 +10,9 @@
 !> `select_simulation` refuses the sections that make no kind of run ([coupling] without both
 !> models, [continuum] with [beam], or with only one of [particles] and [coupling]), then
 !> the keywords that the kind of run would ignore (the extension's `check_deck`), each error
-!> naming file, line and keyword. Adding a kind of run adds its extension's file and its
-!> line here.
+!> naming file, line and keyword. Adding a kind of run adds its extension's file (see
+!> driver_simulation: its bindings, its entry in src/CMakeLists.txt, its keywords in the
+!> schema) and here its case in `select_simulation` and the sections that make it.
 module driver_simulations
     use core_error, only: error_t, make_input_error, make_internal_error
     use io_deck, only: deck_t
