@@ -13,7 +13,8 @@
 !> extension in its own file (every deferred binding above; a coupled kind may combine the
 !> bindings of the kinds it couples), listed in src/CMakeLists.txt, its keywords in the schema
 !> (io), and its case in `driver_simulations`, which picks it from the deck's sections. A kind
-!> that writes a results group of its own also teaches driver_results_xdmf to index it.
+!> that writes a results group of its own also adds its XDMF part type (driver_xdmf_part) in
+!> its own file and one line in `registered_parts` of driver_results_xdmf.
 module driver_simulation
     use, intrinsic :: iso_fortran_env, only: output_unit
     use core_error, only: error_t
