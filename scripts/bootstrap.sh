@@ -8,9 +8,11 @@ MULTICOR_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 # user who is not root and lacks only these gets a note, not an error. python3-siconos and
 # python3-h5py (Siconos 4.4 for the system python3) are required: the FCLIB cross-check
 # (tests/regression/test_fclib_siconos.py) fails without them on Debian; python3-siconos also
-# runs bench/siconos_deposit.py and its comparison test.
+# runs bench/siconos_deposit.py and its comparison test. strace is required too: the tests of
+# kills and signals at chosen system calls (restart, lock, I/O errors) inject them with it, and
+# fail without it.
 MULTICOR_APT_OPTIONAL="slurm-wlm munge paraview python3-paraview"
-MULTICOR_APT_PACKAGES="gfortran cmake ninja-build libhdf5-dev hdf5-tools libopenblas-dev liblapack-dev libsuitesparse-dev gmsh python3 python3-venv python3-pip slurm-wlm munge paraview python3-paraview python3-siconos python3-h5py"
+MULTICOR_APT_PACKAGES="gfortran cmake ninja-build libhdf5-dev hdf5-tools libopenblas-dev liblapack-dev libsuitesparse-dev gmsh python3 python3-venv python3-pip slurm-wlm munge paraview python3-paraview python3-siconos python3-h5py strace"
 
 say() { printf '[multicor] %s\n' "$*"; }
 die() { printf '[multicor] error: %s\n' "$*" >&2; exit 1; }

@@ -19,6 +19,16 @@ def check(name, ok, detail=""):
     return ok
 
 
+def have_strace(what):
+    """Whether strace is here for the fault-injection checks of `what`. strace is a required
+    package (./test.sh installs it, scripts/bootstrap.sh): without it those checks would not
+    run, so its absence is a failed check, not a skip."""
+    found = shutil.which("strace") is not None
+    if not found:
+        check(f"strace for {what}", False, "strace not found (Debian package strace; ./test.sh installs it)")
+    return found
+
+
 def summary():
     """Print the failed checks and the closing line; the script's exit code."""
     if FAILED:

@@ -42,7 +42,7 @@ import sys
 
 import h5py
 
-from checks import arguments, check, summary
+from checks import arguments, check, have_strace, summary
 from test_restart import compare, compare_xdmf
 
 
@@ -173,9 +173,7 @@ def xdmf_write_errors(exe, src, deck, work):
                                     earlier=("interrupted", "0.05"))
 
     # the rename of the results file refused (ENOSPC: a folder that cannot grow), by strace
-    if shutil.which("strace") is None:
-        print("skip   the rename of the results file refused: no strace (Debian package strace)")
-    else:
+    if have_strace("the rename of the results file refused"):
         folder = work / "rename_refused"
         partial = folder / f"{deck.stem}.h5.partial"
         renames = "rename,renameat,renameat2"
@@ -430,8 +428,7 @@ def stale_lock_race(exe, deck, work):
     starts meanwhile, takes the stale lock over and holds the folder (its first write held
     5 s). Before, B then removed A's new lock by name and
     linked its own: both ran in the folder (a review's finding)."""
-    if shutil.which("strace") is None:
-        print("skip   stale_lock_race: no strace (Debian package strace)")
+    if not have_strace("stale_lock_race"):
         return
     import socket
     import time

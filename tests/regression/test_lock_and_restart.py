@@ -28,7 +28,7 @@ import socket
 import subprocess
 import sys
 
-from checks import arguments, check, summary
+from checks import arguments, check, have_strace, summary
 
 EXIT = {"SIGTERM": 143, "SIGINT": 130, "SIGUSR1": 138, "SIGHUP": 129}
 
@@ -70,8 +70,7 @@ def stopped_before_writing(exe, name, folder, proc, sig, before):
 def signal_at_start(exe, src, work):
     """A stop signal as the lock is made, for every kind of run; and at a restart's reading of
     its checkpoint."""
-    if shutil.which("strace") is None:
-        print("skip   signals at the lock's creation: no strace (Debian package strace)")
+    if not have_strace("signals at the lock's creation"):
         return
     decks = src / "tests" / "regression" / "decks"
     lock = ".multicor.lock"
@@ -116,8 +115,7 @@ def signal_at_start(exe, src, work):
 
 def killed_at_link(exe, src, work):
     """SIGKILL between the creation of the lock's line file and its removal."""
-    if shutil.which("strace") is None:
-        print("skip   a kill at the lock's link: no strace (Debian package strace)")
+    if not have_strace("a kill at the lock's link"):
         return
     deck = src / "input" / "cantilever.dat"
     folder = work / "killed_at_link"

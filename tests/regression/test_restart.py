@@ -61,7 +61,7 @@ import sys
 import h5py
 import numpy as np
 
-from checks import check, summary
+from checks import check, have_strace, summary
 
 # Attributes that measure wall-clock time or dates: they differ between any two runs; and the
 # count of runs that made the file (/summary@runs: 2 for a restarted run, 1 for the
@@ -820,10 +820,7 @@ def killed_after_last_checkpoint(exe, src, work):
     proc = run(exe, beam, "--output", ref_folder, "--quiet", "--end", end)
     assert proc.returncode == 0, proc.stderr
     ref = ref_folder / "beam_last.h5"
-    if shutil.which("strace") is None:
-        print("skip   the kills at the renames and at the XDMF file of a run's end: no strace (Debian package "
-              "strace); the same state made by renaming files is tested below")
-    else:
+    if have_strace("the kills at the renames and at the XDMF file of a run's end"):
         # (a) killed where the results file was to be renamed (the state the audit found: lock,
         # partial file, XDMF file '.partial', end checkpoint)
         folder = work / "last_rename"
@@ -1400,9 +1397,7 @@ def created_energy_counts(exe, work):
     if check("kane_two_end: first part exit 0", first.returncode == 0, first.stderr.strip()[-300:]):
         restarted("kane_two_end", folder, first.stdout)
     # killed (SIGKILL) at the commit of the checkpoint of step 10: the restart is from step 5
-    if shutil.which("strace") is None:
-        print("skip   kane_two_kill9: no strace (Debian package strace)")
-    else:
+    if have_strace("kane_two_kill9"):
         kdeck = edit_deck(deck, work / "kane_two_kill.dat", extra_output=["checkpoint_interval = 5"])
         folder = work / "kane_two_kill9"
         trace = "rename,renameat,renameat2"
@@ -1451,8 +1446,7 @@ def killed_in_metadata_writes(exe, src, work):
     writes (pwrite 23-28 of the restart, the last 3 of a run) left '/' unlistable and the
     checkpoint useless for good. Every kill here must leave the same command able to finish the
     run, bitwise as the uninterrupted one (doc/output.md, restart)."""
-    if shutil.which("strace") is None:
-        print("skip   killed_in_metadata_writes: no strace (Debian package strace)")
+    if not have_strace("killed_in_metadata_writes"):
         return
     deck = src / "input" / "cantilever.dat"
     env = dict(os.environ, OMP_NUM_THREADS="1")
