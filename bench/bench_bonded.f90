@@ -43,6 +43,8 @@ program bench_bonded
     character(len=:), allocatable :: deck_path
     integer :: nlgs_steps, ios
     logical :: exists
+    type(deck_t) :: checked
+    type(error_t), allocatable :: deck_error
     deck_path = 'input/bending_stack.dat'
     if (command_argument_count() >= 1) then
         call get_command_argument(1, arg)
@@ -66,6 +68,9 @@ program bench_bonded
     if (.not. exists) call fail('cannot open the deck '''//deck_path//''': no such file (give the path of '// &
                                 'the reference stack''s deck as the first argument; without one, '// &
                                 'input/bending_stack.dat is read from the current folder)')
+    ! a deck that does not read stops here, before the clamped row is timed
+    call read_deck(deck_path, multicor_schema(), checked, deck_error)
+    if (allocated(deck_error)) call fail(deck_error%message)
     write (output_unit, '(a)') '# bonded block against NLGS (1 core); compiler: '//compiler_version()
     write (output_unit, '(a)') '# clamped bonded row, 50 disks, tip load, one step from rest, tol 1e-10'
     write (output_unit, '(a)') '# method  iterations  converged  time[s]  err_rn/Ph  err_rt/Ph  err_M/(PR(2N-1)h)'

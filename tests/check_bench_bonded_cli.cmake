@@ -1,6 +1,6 @@
 # bench_bonded's command line: --help (and -h) prints the usage and runs nothing, exit 0; a deck
-# that does not exist is a clean error before anything runs: a message naming it on standard
-# error, exit code 1, no "ERROR STOP" and no backtrace; an unknown option is a usage error,
+# that does not exist, or does not read, is a clean error before anything runs: a message naming
+# it on standard error, exit code 1, no "ERROR STOP" and no backtrace; an unknown option is a usage error,
 # exit code 2. Inputs: EXE (bench_bonded), WORK (scratch folder).
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
@@ -36,6 +36,19 @@ if(NOT err MATCHES "cannot open the deck 'no_such_deck.dat': no such file")
     message(FATAL_ERROR "missing deck: the message on standard error does not name the deck")
 endif()
 expect_clean("missing deck" "${out}" "${err}")
+
+# a deck that exists but does not read: its error (file, line) before the clamped row is timed
+file(WRITE ${WORK}/bad_section.dat "[foo]\n")
+execute_process(COMMAND ${EXE} bad_section.dat 0 WORKING_DIRECTORY ${WORK} TIMEOUT 60
+    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message(STATUS "bench_bonded bad_section.dat 0 -> exit ${rc}\n${out}${err}")
+if(NOT rc EQUAL 1)
+    message(FATAL_ERROR "deck that does not read: expected exit code 1, got '${rc}'")
+endif()
+if(NOT err MATCHES "bad_section.dat:1: unknown section \\[foo\\]")
+    message(FATAL_ERROR "deck that does not read: the message on standard error does not name file and line")
+endif()
+expect_clean("deck that does not read" "${out}" "${err}")
 
 execute_process(COMMAND ${EXE} --frobnicate WORKING_DIRECTORY ${WORK} TIMEOUT 60
     RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
