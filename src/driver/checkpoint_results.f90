@@ -37,10 +37,10 @@ contains
         if (allocated(error)) return
         call file%create_group('/results', error)
         if (allocated(error)) return
-        call file%write_attribute('/results', 'writer', real([out%n_nodes, merge(1, 0, out%have_state), &
-                                                              merge(1, 0, out%have_energy)], wp), error)
+        call file%write_attribute('/results', 'writer', real([out%beam%n_nodes, merge(1, 0, out%beam%have_state), &
+                                                              merge(1, 0, out%beam%have_energy)], wp), error)
         if (allocated(error)) return
-        call file%write_attribute('/results', 'energy0', out%energy0, error)
+        call file%write_attribute('/results', 'energy0', out%beam%energy0, error)
         if (allocated(error)) return
         joined = ''
         do k = 1, size(paths)
@@ -80,10 +80,10 @@ contains
         if (.not. allocated(error)) call file%read_attribute('/results', 'energy0', energy0, error)
         if (.not. allocated(error)) call require_finite([energy0], '/results@energy0', error)
         if (allocated(error)) return
-        out%n_nodes = w(1)
-        out%have_state = w(2) /= 0
-        out%have_energy = w(3) /= 0
-        out%energy0 = energy0
+        out%beam%n_nodes = w(1)
+        out%beam%have_state = w(2) /= 0
+        out%beam%have_energy = w(3) /= 0
+        out%beam%energy0 = energy0
         call file%read_attribute('/results', 'datasets', joined, error)
         if (allocated(error)) return
         ! the results' own dataset paths, one per line: other bytes are damage (not quoted)

@@ -147,7 +147,7 @@ contains
         type(results_writer_t), intent(inout) :: out
         !> Set on a write failure.
         type(error_t), allocatable, intent(out) :: error
-        call out%write_mesh(self%beam%node_id, self%beam%x, self%beam%y, self%beam%conn, error)
+        call out%beam%write_mesh(out%file, self%beam%node_id, self%beam%x, self%beam%y, self%beam%conn, error)
     end subroutine beam_write_mesh
 
     !> The kinetic energy 1/2 v.M v of the [initial] velocities and the strain energy

@@ -230,12 +230,12 @@ contains
             call model%expand(integ%u, d)
             call model%expand(integ%v, v)
             call model%expand(integ%a, a)
-            call out%append_state(integ%t, d, v, a, error)
+            call out%beam%append_state(out%file, integ%t, d, v, a, error)
             if (allocated(error)) return
             ! a free body's translation strains nothing: only the rest counts
             u_max = max(u_max, largest_displacement(d(1:2, :) - spread(sum(d(1:2, :), dim=2)/size(d, 2), 2, size(d, 2))))
-            call out%append_energy(integ%t, integ%kinetic, integ%strain, integ%external_work, &
-                                   integ%damping_dissipation, error)
+            call out%beam%append_energy(out%file, integ%t, integ%kinetic, integ%strain, integ%external_work, &
+                                        integ%damping_dissipation, error)
             if (allocated(error)) return
             call out%flush_output(error)
         end subroutine store

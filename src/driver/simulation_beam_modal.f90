@@ -102,8 +102,8 @@ contains
             end if
             call report(trim(buf))
         end do
-        call out%write_modal(omega, full, error)
+        call out%beam%write_modal(out%file, omega, full, error)
         if (allocated(error)) return
-        call out%write_modal_kinds(fraction, adjustl(kinds), dominant_fraction, error)
+        call out%beam%write_modal_kinds(out%file, fraction, adjustl(kinds), dominant_fraction, error)
     end subroutine run_modal
 end module driver_simulation_beam_modal

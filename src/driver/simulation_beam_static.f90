@@ -122,7 +122,7 @@ contains
                             'magnitudes in [beam])')
             return
         end if
-        call out%write_static(d, r, error)
+        call out%beam%write_static(out%file, d, r, error)
         if (allocated(error)) return
         ! The largest nodal displacement sqrt(u^2 + w^2), the measure the warning below uses.
         u_max = largest_displacement(d(1:2, :))

@@ -201,7 +201,7 @@ contains
         type(results_writer_t), intent(inout) :: out
         !> Set on a write failure.
         type(error_t), allocatable, intent(out) :: error
-        call out%write_mesh(self%beam%node_id, self%beam%x, self%beam%y, self%beam%conn, error)
+        call out%beam%write_mesh(out%file, self%beam%node_id, self%beam%x, self%beam%y, self%beam%conn, error)
         if (allocated(error)) return
         call write_beam_overlap(out%file, self%sys, error)
     end subroutine coupled_begin
@@ -233,7 +233,7 @@ contains
         real(wp), allocatable :: d(:, :), v(:, :), a(:, :)
         call nodal_state(self, d, v, a)
         self%u_max = max(self%u_max, largest_displacement(d(1:2, :) - spread(sum(d(1:2, :), dim=2)/size(d, 2), 2, size(d, 2))))
-        call out%append_state(self%sys%fe%t, d, v, a, error)
+        call out%beam%append_state(out%file, self%sys%fe%t, d, v, a, error)
     end subroutine coupled_store_part
 
     !> Displacements, velocities and accelerations (3, n_nodes) of the beam.
