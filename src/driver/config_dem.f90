@@ -38,7 +38,8 @@ module driver_config_dem
     use dem_bonded_block, only: bonded_block_method_t
     use dem_coarse, only: coarse_correction_t
     use dem_cold_start, only: hydrostatic_start_t
-    use driver_config, only: run_config_t, repeated_dof
+    use driver_config, only: run_config_t
+    use driver_config_beam, only: repeated_dof
     implicit none
     private
     public :: dem_config_t, build_dem_config

@@ -10,7 +10,8 @@ module driver_run_checks
     use io_deck, only: deck_t, deck_entry_t
     use driver_model_size, only: size_estimate_t, check_size_estimate
     use driver_simulation, only: simulation_t, report_iface
-    use driver_config, only: steps_to_end, max_steps, build_time_functions
+    use driver_config, only: steps_to_end, max_steps
+    use driver_config_timefunc, only: build_time_functions
     use core_timefunc, only: time_function_t
     use driver_run_dem, only: fclib_after_end_warning
     implicit none

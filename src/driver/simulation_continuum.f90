@@ -24,7 +24,8 @@ module driver_simulation_continuum
     use fem_continuum_model, only: continuum_model_t
     use fem_continuum_dynamics, only: continuum_dynamics_t
     use fem_mass_scheme, only: mass_scheme_t, make_mass_scheme
-    use driver_config, only: build_run_settings, build_time_functions
+    use driver_config, only: build_run_settings
+    use driver_config_timefunc, only: build_time_functions
     use driver_checkpoint, only: deck_hash
     use driver_simulation, only: simulation_t
     use driver_run_kind, only: check_particle_keywords_unused, check_initial_unused
