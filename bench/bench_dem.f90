@@ -63,7 +63,8 @@ program bench_dem
     use dem_detection, only: detect_contacts
     use dem_moreau_jean, only: dem_system_t, mj_init, mj_step, dem_system_bytes
     use dem_activation, only: activation_siconos_t, activation_predicted_t
-    use dem_nlgs, only: nlgs_config_t, lmgc90_criterion_t, siconos_criterion_t
+    use dem_nlgs, only: nlgs_config_t
+    use dem_nlgs_criterion, only: lmgc90_criterion_t, siconos_criterion_t
     use dem_solve_method, only: sweeps_method_t
     use dem_bonded_block, only: bonded_block_method_t
     use dem_coarse, only: coarse_correction_t

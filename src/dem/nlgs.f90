@@ -36,12 +36,13 @@
 !> 4.7).
 !> The Siconos error (nlgs_siconos_error, doc/theory.md 4.5) of the final state is always
 !> computed, from u = H^T (v_free + M^-1 H r) + shift in full; `criterion` (an extension of
-!> `nlgs_criterion_t`: lmgc90_criterion_t, the default, or siconos_criterion_t) chooses which
-!> error stops the sweeps. As a stopping test the Siconos error is evaluated from the
-!> velocities the sweeps keep up to date (the same up to round-off, and one pass over the
-!> contacts instead of three), only after the sweeps where it may be near the tolerance
-!> (siconos_period, siconos_margin); once that is below the tolerance it is computed again in
-!> full, and only that value stops the sweeps (Siconos' "light, full final" evaluation).
+!> `nlgs_criterion_t`, dem_nlgs_criterion: lmgc90_criterion_t, or siconos_criterion_t; when none
+!> is set, the convergence norm of the sweeps as lmgc90_criterion_t) chooses which error stops
+!> the sweeps. As a stopping test the Siconos error is evaluated from the velocities the sweeps
+!> keep up to date (the same up to round-off, and one pass over the contacts instead of three),
+!> only after the sweeps where it may be near the tolerance (dem_nlgs_criterion); once that is
+!> below the tolerance it is computed again in full, and only that value stops the sweeps
+!> (Siconos' "light, full final" evaluation).
 !> With a block, its members are measured by the natural map of their equalities (u_hat on
 !> their locked components: the problem the solve solves, in which their reactions may leave
 !> their cones), and the final Siconos error is that of the contact problem, in full.
@@ -118,7 +119,8 @@
 !>
 !> Files: this one holds the solve, the sweeps and their domain split; the submodules
 !> dem_nlgs_anderson (nlgs_anderson.f90) and dem_nlgs_siconos (nlgs_siconos.f90) the
-!> Anderson step and the Siconos error.
+!> Anderson step and the Siconos error; the module dem_nlgs_criterion (nlgs_criterion.f90) the
+!> stopping tests, as dem_coarse and dem_cold_start hold a correction and a start.
 module dem_nlgs
     use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
     use core_kinds, only: wp, i8
@@ -135,9 +137,9 @@ module dem_nlgs
     public :: nlgs_config_t, nlgs_stats_t, nlgs_solve, nlgs_apply_reactions, nlgs_residual
     public :: nlgs_bilateral_t, nlgs_block_t
     public :: nlgs_correction_t, nlgs_start_t
-    public :: nlgs_siconos_error
+    public :: nlgs_siconos_error, siconos_error, siconos_ratio
     public :: nlgs_split_t, nlgs_split_build
-    public :: nlgs_criterion_t, lmgc90_criterion_t, siconos_criterion_t, nlgs_criterion_name, nlgs_start_name
+    public :: nlgs_criterion_t, nlgs_criterion_name, nlgs_start_name
     public :: block_kept, block_given_up_energy, block_given_up_unconverged, block_given_up_reverted
 
     !> Values of nlgs_stats_t%block_given_up (and of /dem/solver/block_given_up): the bonded
@@ -261,7 +263,8 @@ module dem_nlgs
         !> with the one check_every sweeps earlier, and omega falls back to 1 for the rest of
         !> the solve when it rose.
         integer :: check_every = 10
-        !> Stopping criterion (module header); lmgc90_criterion_t when not allocated.
+        !> Stopping criterion (module header; dem_nlgs_criterion); when not allocated, the
+        !> convergence norm of the sweeps (as lmgc90_criterion_t).
         class(nlgs_criterion_t), allocatable :: criterion
         !> Anderson acceleration of the sweeps (module header): depth (number of previous
         !> sweeps mixed); 0: none. Not used when intact bonds are swept without a block
@@ -371,20 +374,6 @@ module dem_nlgs
 
     !> Contacts per chunk of the deterministic parallel sums of the Anderson step.
     integer, parameter :: dot_chunk = 1024
-    !> Siconos criterion: the error is evaluated at least every siconos_period sweeps, and at
-    !> every sweep once the norm of the sweeps times their last measured ratio is below
-    !> siconos_margin times the tolerance and the norm is below its value at the last
-    !> evaluation (which found the error above the tolerance: while the norm has not fallen
-    !> since, the estimate has not either). Without that second condition a step where the
-    !> error hangs just above the tolerance for hundreds of sweeps (the impacts of the
-    !> 200-disk deposit) evaluated it at every one of them: 45 % of the sweeps on seed 8,
-    !> 25 % with it, and 0.83 against 0.87 ms per step over 24 layouts (doc/performance.md,
-    !> "Fewer evaluations of the Siconos error"). A margin of 2 rather than 4: on the 200-disk deposit
-    !> over 24 layouts 0.789 against 0.813 ms per step, on the 2 000-disk one over 6 layouts
-    !> 18.7 against 20.6 ms, with the same sweeps on average (doc/performance.md,
-    !> "Explicit-shape kernels"); the deposits are chaotic, so one layout does not decide.
-    integer, parameter :: siconos_period = 8
-    real(wp), parameter :: siconos_margin = 2.0_wp
     !> Tikhonov term of the Anderson least-squares system, relative to its trace: far above
     !> the rounding of the Gram matrix (1e-16), far below its genuine eigenvalues.
     real(wp), parameter :: anderson_regularisation = 1.0e-12_wp
@@ -482,42 +471,6 @@ module dem_nlgs
             logical, intent(out) :: evaluated
         end subroutine criterion_measure
     end interface
-
-    !> The LMGC90-like convergence norm of the sweeps (module header), the default.
-    type, extends(nlgs_criterion_t) :: lmgc90_criterion_t
-    contains
-        !> 'lmgc90'.
-        procedure :: name => lmgc90_name
-        !> Nothing to set up.
-        procedure :: begin => lmgc90_begin
-        !> The norm itself, always exact.
-        procedure :: measure => lmgc90_measure
-    end type lmgc90_criterion_t
-
-    !> The Siconos error (nlgs_siconos_error), evaluated only where it may be near the
-    !> tolerance (module header; siconos_period, siconos_margin).
-    type, extends(nlgs_criterion_t) :: siconos_criterion_t
-        !> The active contacts of the solve, in increasing order.
-        integer, allocatable, private :: act(:)
-        !> Contacts held as bilateral constraints in the solve (the members of a block),
-        !> measured by the equality u = 0 on their locked components (siconos_ratio);
-        !> size 0 when none.
-        logical, allocatable, private :: held(:)
-        !> Ratio of the Siconos error to the norm of the sweeps at its last evaluation, that
-        !> norm, and that sweep.
-        real(wp), private :: per_norm = 0.0_wp, norm_evaluated = huge(1.0_wp)
-        !> See `per_norm`.
-        integer, private :: last_evaluation = 0
-    contains
-        !> 'siconos'.
-        procedure :: name => siconos_name
-        !> The active contacts, no evaluation yet.
-        procedure :: begin => siconos_begin
-        !> The error where it may be near the tolerance, an estimate elsewhere.
-        procedure :: measure => siconos_measure
-        !> True.
-        procedure :: is_siconos_error => siconos_is_siconos_error
-    end type siconos_criterion_t
 
     !> Linear velocity constraints kept satisfied during the sweeps (see the module header).
     type, abstract :: nlgs_bilateral_t
@@ -693,12 +646,17 @@ module dem_nlgs
         end subroutine anderson_mix
 
         !> Siconos error of the current reactions, u computed in full (submodule
-        !> dem_nlgs_siconos).
+        !> dem_nlgs_siconos; the criterion siconos_criterion_t evaluates it).
         real(wp) module function siconos_error(cs, im, vfree, vel, vwork, bilateral, nq, held) result(err)
+            !> Contacts (reactions r).
             type(contact_set_t), intent(in) :: cs
+            !> Inverse mass, free velocities and velocities (3, n_disks); |q| (siconos_free_norm).
             real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :), nq
+            !> Work array (3, n_disks).
             real(wp), intent(inout) :: vwork(:, :)
+            !> Bilateral constraints changed the velocities (their impulses are not contacts).
             logical, intent(in) :: bilateral
+            !> Contacts held as bilateral constraints (size >= cs%n; none when absent).
             logical, intent(in), optional :: held(:)
         end function siconos_error
 
@@ -732,11 +690,16 @@ module dem_nlgs
         end function siconos_free_norm
 
         !> Siconos error of the contacts act from the velocities vel, |q| = nq, the contacts
-        !> with held(k) measured as bilateral constraints (dem_nlgs_siconos).
+        !> with held(k) measured as bilateral constraints (dem_nlgs_siconos; the criterion
+        !> siconos_criterion_t evaluates it).
         pure real(wp) module function siconos_ratio(cs, act, vel, nq, held) result(err)
+            !> Contacts (reactions r).
             type(contact_set_t), intent(in) :: cs
+            !> The active contacts measured, in increasing order.
             integer, intent(in) :: act(:)
+            !> Velocities (3, n_disks); |q| (siconos_free_norm).
             real(wp), intent(in) :: vel(:, :), nq
+            !> Contacts held as bilateral constraints (size >= cs%n; none when absent).
             logical, intent(in), optional :: held(:)
         end function siconos_ratio
     end interface
@@ -770,10 +733,11 @@ contains
         real(wp), allocatable :: vfree(:, :), vwork(:, :)
         ! |q| of the Siconos error (constant over the solve)
         real(wp) :: nq
-        ! the stopping test of this solve (a copy of the settings' criterion) and whether its
-        ! error after the sweep is exact
+        ! the stopping test of this solve (a copy of the settings' criterion; none: the norm of
+        ! the sweeps, exact after every sweep), whether its error after the sweep is exact, and
+        ! whether that error is the Siconos error of the final state
         class(nlgs_criterion_t), allocatable :: criterion
-        logical :: evaluated, needed
+        logical :: evaluated, needed, siconos_stops
         real(wp) :: floor, omega, checked
         type(anderson_t) :: aa
         type(nlgs_split_t) :: split
@@ -803,15 +767,15 @@ contains
         allocate (vwork, mold=vel)
         ! |q| of the Siconos error, for the criterion and the final error
         nq = siconos_free_norm(cs, im, vfree, bilateral)
+        siconos_stops = .false.
         if (allocated(config%criterion)) then
             allocate (criterion, source=config%criterion)
-        else
-            allocate (lmgc90_criterion_t :: criterion)
-        end if
-        if (stats%n_block > 0) then
-            call criterion%begin(cs, block%member)
-        else
-            call criterion%begin(cs)
+            if (stats%n_block > 0) then
+                call criterion%begin(cs, block%member)
+            else
+                call criterion%begin(cs)
+            end if
+            siconos_stops = criterion%is_siconos_error()
         end if
         s = 0
         floor = 0.0_wp
@@ -912,8 +876,10 @@ contains
                 ! and by the correction's
                 needed = s == config%max_sweeps .or. (omega /= 1.0_wp .and. mod(s, config%check_every) == 0) &
                          .or. (correcting .and. mod(s, every) == 0)
-                call criterion%measure(s, needed, config%tol, cs, im, vfree, vel, vwork, present(bilateral), nq, &
-                                       stats%error, evaluated)
+                evaluated = .true.
+                if (allocated(criterion)) &
+                    call criterion%measure(s, needed, config%tol, cs, im, vfree, vel, vwork, present(bilateral), nq, &
+                                           stats%error, evaluated)
                 if (evaluated .and. stats%error <= config%tol) then
                     stats%converged = .true.
                     exit
@@ -981,7 +947,7 @@ contains
         stats%relaxation = omega
         stats%updates = int(n_swept, i8)*stats%sweeps
         stats%residual = nlgs_residual(cs, vel)
-        if (criterion%is_siconos_error() .and. stats%converged .and. stats%n_block == 0) then
+        if (siconos_stops .and. stats%converged .and. stats%n_block == 0) then
             ! the last error of the sweeps, computed in full (with a block, that of the
             ! problem with its members held: below, the error of the contact problem)
             stats%siconos_error = stats%error
@@ -989,7 +955,7 @@ contains
             stats%siconos_error = siconos_error(cs, im, vfree, vel, vwork, present(bilateral), nq)
         end if
         stats%siconos_floor = 0.0_wp
-        if (criterion%is_siconos_error() .and. .not. stats%converged) &
+        if (siconos_stops .and. .not. stats%converged) &
             stats%siconos_floor = siconos_floor(cs, im, vfree, vel, nq)
     end subroutine nlgs_solve
 
@@ -1017,143 +983,6 @@ contains
             name = 'zero'
         end if
     end function nlgs_start_name
-
-    !> 'lmgc90'.
-    pure function lmgc90_name(self) result(name)
-        !> The criterion.
-        class(lmgc90_criterion_t), intent(in) :: self
-        character(len=:), allocatable :: name
-        name = 'lmgc90'
-    end function lmgc90_name
-
-    !> Nothing to set up.
-    subroutine lmgc90_begin(self, cs, held)
-        !> The criterion.
-        class(lmgc90_criterion_t), intent(inout) :: self
-        !> Contacts.
-        type(contact_set_t), intent(in) :: cs
-        !> Contacts held (not used: the norm of the sweeps measures the block by its own share).
-        logical, intent(in), optional :: held(:)
-    end subroutine lmgc90_begin
-
-    !> The convergence norm of the sweeps is the error, exact.
-    subroutine lmgc90_measure(self, s, needed, tol, cs, im, vfree, vel, vwork, bilateral, nq, error, evaluated)
-        !> The criterion.
-        class(lmgc90_criterion_t), intent(inout) :: self
-        !> Sweeps done.
-        integer, intent(in) :: s
-        !> The exact error is needed.
-        logical, intent(in) :: needed
-        !> Tolerance.
-        real(wp), intent(in) :: tol
-        !> Contacts.
-        type(contact_set_t), intent(in) :: cs
-        !> Inverse mass, free velocities and velocities (3, n_disks).
-        real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :)
-        !> Work array (3, n_disks).
-        real(wp), intent(inout) :: vwork(:, :)
-        !> Bilateral constraints changed the velocities.
-        logical, intent(in) :: bilateral
-        !> |q| of the Siconos error.
-        real(wp), intent(in) :: nq
-        !> The convergence norm, kept.
-        real(wp), intent(inout) :: error
-        !> True.
-        logical, intent(out) :: evaluated
-        evaluated = .true.
-    end subroutine lmgc90_measure
-
-    !> 'siconos'.
-    pure function siconos_name(self) result(name)
-        !> The criterion.
-        class(siconos_criterion_t), intent(in) :: self
-        character(len=:), allocatable :: name
-        name = 'siconos'
-    end function siconos_name
-
-    !> The active contacts, in increasing order (the running error runs over them), and those
-    !> held; no evaluation yet.
-    subroutine siconos_begin(self, cs, held)
-        !> The criterion (the copy of a solve).
-        class(siconos_criterion_t), intent(inout) :: self
-        !> Contacts (activity set).
-        type(contact_set_t), intent(in) :: cs
-        !> Contacts held as bilateral constraints (a block's members; none when absent).
-        logical, intent(in), optional :: held(:)
-        integer :: k
-        self%act = pack([(k, k=1, cs%n)], cs%active(1:cs%n))
-        if (present(held)) then
-            self%held = held(1:cs%n)
-        else
-            if (allocated(self%held)) deallocate (self%held)
-            allocate (self%held(0))
-        end if
-        self%per_norm = 0.0_wp
-        self%norm_evaluated = huge(1.0_wp)
-        self%last_evaluation = 0
-    end subroutine siconos_begin
-
-    !> The Siconos error after sweep s, evaluated when it may be near the tolerance (the norm
-    !> of the sweeps times their last measured ratio), every siconos_period sweeps, and where
-    !> the solve needs it (the cap, a safeguard); from the velocities the sweeps keep up to
-    !> date, and below the tolerance again from u = W r + q in full, which alone stops the
-    !> sweeps. Elsewhere an estimate (the norm times the last ratio), which does not stop
-    !> them.
-    subroutine siconos_measure(self, s, needed, tol, cs, im, vfree, vel, vwork, bilateral, nq, error, evaluated)
-        !> The criterion (the copy of a solve).
-        class(siconos_criterion_t), intent(inout) :: self
-        !> Sweeps done.
-        integer, intent(in) :: s
-        !> The solve needs the exact error (the cap, a safeguard).
-        logical, intent(in) :: needed
-        !> Tolerance.
-        real(wp), intent(in) :: tol
-        !> Contacts (reactions).
-        type(contact_set_t), intent(in) :: cs
-        !> Inverse mass, free velocities and velocities (3, n_disks).
-        real(wp), intent(in) :: im(:, :), vfree(:, :), vel(:, :)
-        !> Work array (3, n_disks).
-        real(wp), intent(inout) :: vwork(:, :)
-        !> Bilateral constraints changed the velocities.
-        logical, intent(in) :: bilateral
-        !> |q| of the Siconos error.
-        real(wp), intent(in) :: nq
-        !> The norm of the sweeps in, the Siconos error (or its estimate) out.
-        real(wp), intent(inout) :: error
-        !> The error is exact.
-        logical, intent(out) :: evaluated
-        real(wp) :: norm
-        evaluated = s - self%last_evaluation >= siconos_period .or. needed &
-                    .or. (error*self%per_norm <= siconos_margin*tol .and. error < self%norm_evaluated)
-        if (evaluated) then
-            norm = error
-            self%norm_evaluated = norm
-            if (size(self%held) > 0) then
-                error = siconos_ratio(cs, self%act, vel, nq, self%held)
-            else
-                error = siconos_ratio(cs, self%act, vel, nq)
-            end if
-            self%per_norm = 0.0_wp
-            if (norm > 0.0_wp) self%per_norm = error/norm
-            self%last_evaluation = s
-            if (error <= tol) then
-                if (size(self%held) > 0) then
-                    error = siconos_error(cs, im, vfree, vel, vwork, bilateral, nq, self%held)
-                else
-                    error = siconos_error(cs, im, vfree, vel, vwork, bilateral, nq)
-                end if
-            end if
-        else
-            error = error*self%per_norm
-        end if
-    end subroutine siconos_measure
-
-    !> True: the error that stops the sweeps is the Siconos error of the final state.
-    pure logical function siconos_is_siconos_error(self) result(yes)
-        !> The criterion.
-        class(siconos_criterion_t), intent(in) :: self
-        yes = .true.
-    end function siconos_is_siconos_error
 
     !> No: the error that stops the sweeps is not the Siconos error.
     pure logical function criterion_not_siconos(self) result(yes)

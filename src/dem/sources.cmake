@@ -13,6 +13,7 @@ set(MULTICOR_DEM_SOURCES
     ${CMAKE_CURRENT_LIST_DIR}/nlgs.f90
     ${CMAKE_CURRENT_LIST_DIR}/nlgs_anderson.f90
     ${CMAKE_CURRENT_LIST_DIR}/nlgs_siconos.f90
+    ${CMAKE_CURRENT_LIST_DIR}/nlgs_criterion.f90
     ${CMAKE_CURRENT_LIST_DIR}/cold_start.f90
     ${CMAKE_CURRENT_LIST_DIR}/coarse.f90
     ${CMAKE_CURRENT_LIST_DIR}/solve_method.f90

@@ -33,7 +33,7 @@ module driver_config_dem
     use dem_contacts, only: contact_set_t
     use dem_detection, only: detector_t, detect_contacts, coordinate_limit
     use dem_moreau_jean, only: dem_system_t, mj_bonds_at_start
-    use dem_nlgs, only: lmgc90_criterion_t, siconos_criterion_t
+    use dem_nlgs_criterion, only: lmgc90_criterion_t, siconos_criterion_t
     use dem_solve_method, only: sweeps_method_t
     use dem_bonded_block, only: bonded_block_method_t
     use dem_coarse, only: coarse_correction_t
