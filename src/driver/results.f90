@@ -272,10 +272,6 @@ contains
         if (copy) source = final_path
         call refuse_damaged(source, error)
         if (allocated(error)) return
-        ! and every record up to the checkpoint, whose checksums HDF5 checks (a file of an
-        ! earlier build has none: read, unchecked)
-        call refuse(source, mark%records_damage(source), error)
-        if (allocated(error)) return
         if (copy) then
             ! a copy: the finished file keeps the outputs, a failure removes the copy (and puts
             ! back the partial file of another run it set aside)
@@ -300,20 +296,15 @@ contains
         subroutine refuse_damaged(path, error)
             character(len=*), intent(in) :: path
             type(error_t), allocatable, intent(out) :: error
+            character(len=:), allocatable :: reason
             if (.not. file_exists(path)) return
-            call refuse(path, results_file_damage(path), error)
-        end subroutine refuse_damaged
-
-        !> An error naming the damaged file `path` and HDF5's `reason` (none when it is '').
-        subroutine refuse(path, reason, error)
-            character(len=*), intent(in) :: path, reason
-            type(error_t), allocatable, intent(out) :: error
+            reason = results_file_damage(path)
             if (len(reason) == 0) return
             call make_error(error, "results: the results file '"//path//"' of the checkpoint's run is "// &
                             'damaged, truncated or overwritten in part ('//reason//'): a restart cannot '// &
                             'continue it; put back a good copy of it, or run the deck again without '// &
                             '--restart (h5dump -H '//shell_word(path)//' shows what can still be read)')
-        end subroutine refuse
+        end subroutine refuse_damaged
 
         !> Give '<partial_path>.prev' its name back, deleting the partial file found under it.
         subroutine take_back_set_aside(error)

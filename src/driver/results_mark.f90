@@ -7,8 +7,7 @@
 !>
 !> `results_file_damage` tells a damaged file (truncated, overwritten in part: HDF5 cannot
 !> open it, read its run id or list its datasets) from one of another run, so that a restart
-!> says which it is; `records_damage` reads the records the checkpoint counts, whose
-!> checksums HDF5 checks.
+!> says which it is.
 module driver_results_mark
     use core_error, only: error_t
     use core_strings, only: string_t
@@ -29,8 +28,6 @@ module driver_results_mark
     contains
         !> Whether a file holds the checkpoint's results (its run id, at least its records).
         procedure :: held_by => mark_held_by
-        !> Why the records of the checkpoint in a file are damaged ('' when they all read).
-        procedure :: records_damage => mark_records_damage
     end type results_mark_t
 
 contains
@@ -71,39 +68,6 @@ contains
         end if
         call f%close(e)
     end function mark_held_by
-
-    !> Why the records of the checkpoint in the HDF5 file `path` are damaged (HDF5's message,
-    !> naming the dataset), or '' when every record up to the checkpoint's count of every dataset
-    !> of the mark reads: HDF5 checks their checksums as it reads them. A file of an earlier
-    !> build has no checksums: its records read, unchecked. A dataset missing from the file is
-    !> not read (the reading of the checkpoint refuses the file for it).
-    function mark_records_damage(self, path) result(reason)
-        !> The checkpoint's results.
-        class(results_mark_t), intent(in) :: self
-        !> Path of the file (it opens: `results_file_damage`).
-        character(len=*), intent(in) :: path
-        !> HDF5's message, or ''.
-        character(len=:), allocatable :: reason
-        type(h5_file_t) :: f
-        type(error_t), allocatable :: e, ignored
-        integer :: k
-        reason = ''
-        if (.not. allocated(self%paths)) return
-        call f%open(path, e)
-        if (allocated(e)) then
-            reason = e%message
-            return
-        end if
-        do k = 1, size(self%paths)
-            if (.not. f%exists(self%paths(k)%s)) cycle
-            call f%verify_records(self%paths(k)%s, self%counts(k), e)
-            if (allocated(e)) then
-                reason = e%message
-                exit
-            end if
-        end do
-        call f%close(ignored)
-    end function mark_records_damage
 
     !> Why the existing HDF5 file `path` is damaged (HDF5's message), or '' when it opens and
     !> every dataset's shape reads (a file without run id is not called damaged: it may be

@@ -25,8 +25,7 @@
 - A damaged results file continued by --restart (truncated, its first bytes overwritten, 64
   bytes of its metadata overwritten): the error says the file is damaged and names it (it said
   that file had been moved or replaced by another run, or named the temporary copy and blamed
-  the deck). Two bytes flipped inside a data record: refused the same way, naming the dataset
-  (it was continued, exit 0); a file without checksums (an earlier build's) is continued.
+  the deck).
 - A results folder that cannot be created (its parent read-only; a regular file in its
   path): the error gives the reason.
 Usage (ctest does this): test_io_errors.py --exe multicor --work DIR --source REPO
@@ -324,49 +323,6 @@ def damaged_results(exe, deck, work):
               f"the results file '{result}' of the checkpoint's run is damaged" in err and
               ".partial" not in err and f"{deck.name}:" not in err and "without --restart" in err, err[-400:])
         check(f"damaged results ({name}): the folder as it was", digests(folder) == before, "")
-    damaged_records(exe, deck, work, base)
-
-
-def damaged_records(exe, deck, work, base):
-    """Two bytes flipped inside a data record of the results file (its metadata intact): the
-    restart reads every record up to the checkpoint before it continues, the record's checksum
-    fails, and the restart is refused naming the file and the dataset, exit 1, the folder as it
-    was. Before, the restart did not read the records (and they had no checksums): it continued
-    the file with exit 0. A file without checksums (an earlier build's, here the same file
-    repacked without filters by h5repack) cannot be checked: it is continued, exit 0."""
-    folder = work / "damaged_records"
-    shutil.rmtree(folder, ignore_errors=True)
-    shutil.copytree(base, folder)
-    result = folder / f"{deck.stem}.h5"
-    with h5py.File(result, "r") as f:
-        d = f["fem/displacement"]
-        offset = d.id.get_chunk_info(0).byte_offset if d.chunks else d.id.get_offset()
-    with open(result, "r+b") as fh:
-        fh.seek(offset + 40)
-        two = fh.read(2)
-        fh.seek(offset + 40)
-        fh.write(bytes([two[0] ^ 0xFF, two[1] ^ 0x13]))
-    before = digests(folder)
-    proc = run(exe, deck, "--output", folder, "--quiet", "--restart", folder / "checkpoint.h5", "--end", "0.4")
-    err = proc.stderr.strip()
-    check("damaged records: restart refused, exit 1", proc.returncode == 1, f"exit {proc.returncode}")
-    check("damaged records: says the file is damaged, names it and the dataset",
-          f"the results file '{result}' of the checkpoint's run is damaged" in err and
-          "'/fem/displacement'" in err and "without --restart" in err, err[-400:])
-    check("damaged records: the folder as it was", digests(folder) == before, "")
-    repack = shutil.which("h5repack")
-    if repack is None:
-        print("skip   results file without checksums: no h5repack")
-        return
-    folder = work / "unchecked_records"
-    shutil.rmtree(folder, ignore_errors=True)
-    shutil.copytree(base, folder)
-    result = folder / f"{deck.stem}.h5"
-    subprocess.run([repack, "-f", "NONE", str(base / result.name), str(result)], check=True)
-    check("results file repacked without checksums: its datasets have none", unchecked_datasets(result) != [], "")
-    proc = run(exe, deck, "--output", folder, "--quiet", "--restart", folder / "checkpoint.h5", "--end", "0.4")
-    check("results file without checksums (an earlier build's): continued, exit 0", proc.returncode == 0,
-          f"exit {proc.returncode}: {proc.stderr.strip()[-300:]}")
 
 
 def folder_errors(exe, deck, work):
