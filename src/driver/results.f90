@@ -150,9 +150,7 @@ contains
         self%own = [logical ::]
         call set_aside_partial(self, keep, error)
         if (allocated(error)) return
-        ! every dataset holding values with a checksum of its data, which HDF5 checks at every
-        ! read (doc/output.md)
-        call self%file%create(self%partial_path, error, checksums=.true.)
+        call self%file%create(self%partial_path, error)
         if (allocated(error)) return
         call root_attributes(error)
         if (.not. allocated(error)) call self%file%create_group('/summary', error)
