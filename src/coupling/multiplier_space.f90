@@ -220,9 +220,13 @@ contains
             am%a = matmul(pi, matmul(a%a, transpose(pi)))
             call symmetrize(am%a)
             call am%factor(error)
+            ! Which of the two tests below sees a nearly singular A_m first depends on round-off
+            ! (the BLAS kernels of the machine): on one machine the factor of the H1 pairing's
+            ! A_m at h1_length = 1e3 m succeeds with rcond ~1e-20, on another it fails. Both say
+            ! the same thing to the user.
             if (allocated(error)) then
-                error%message = 'coupling: multipliers = nodes: A_m = Pi A Pi^T is singular; '// &
-                                error%message
+                error%message = 'coupling: multipliers = nodes: A_m = Pi A Pi^T is singular to working '// &
+                                'precision ('//error%message//')'
                 return
             end if
             ! A factor of a nearly singular A_m can succeed on round-off (the H1 pairing with a
