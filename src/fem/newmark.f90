@@ -73,10 +73,10 @@ module fem_newmark
         !> Energy accounts, time and step count after a step.
         procedure, non_overridable :: finish_step
         !> Put the state of the scheme beyond the common one (the components above) into a
-        !> checkpoint; a scheme that does not override it is an internal error there.
-        procedure :: save_state => unknown_save_state
+        !> checkpoint (deferred: a new scheme cannot be built without saying what it keeps).
+        procedure(integrator_save_state), deferred :: save_state
         !> Take it back from a checkpoint (after `init` from the deck).
-        procedure :: load_state => unknown_load_state
+        procedure(integrator_load_state), deferred :: load_state
     end type time_integrator_t
 
     abstract interface
@@ -108,6 +108,28 @@ module fem_newmark
             !> Set on failure of the linear solve.
             type(error_t), allocatable, intent(out) :: error
         end subroutine integrator_step
+
+        !> Put the state of the scheme beyond the common one into a checkpoint.
+        subroutine integrator_save_state(self, sink, error)
+            import :: time_integrator_t, state_sink_t, error_t
+            !> The integrator.
+            class(time_integrator_t), intent(in) :: self
+            !> Where the state goes.
+            class(state_sink_t), intent(inout) :: sink
+            !> Set when the state cannot be written.
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine integrator_save_state
+
+        !> Take the state of the scheme beyond the common one back from a checkpoint.
+        subroutine integrator_load_state(self, source, error)
+            import :: time_integrator_t, state_source_t, error_t
+            !> The integrator.
+            class(time_integrator_t), intent(inout) :: self
+            !> Where the state comes from.
+            class(state_source_t), intent(in) :: source
+            !> Set when the state cannot be read or does not fit.
+            type(error_t), allocatable, intent(out) :: error
+        end subroutine integrator_load_state
     end interface
 
     !> Start of the message of a model whose highest natural frequency no time step resolves
@@ -474,28 +496,6 @@ contains
         self%predicted = .false.
         call self%finish_step(model)
     end subroutine newmark_correct
-
-    !> A scheme whose state beyond the common one no checkpoint knows: an internal error.
-    subroutine unknown_save_state(self, sink, error)
-        !> The integrator.
-        class(time_integrator_t), intent(in) :: self
-        !> Where the state goes.
-        class(state_sink_t), intent(inout) :: sink
-        !> Always set.
-        type(error_t), allocatable, intent(out) :: error
-        call make_internal_error(error, 'save_integrator', 'no checkpoint for the state of this time integrator')
-    end subroutine unknown_save_state
-
-    !> See `unknown_save_state`.
-    subroutine unknown_load_state(self, source, error)
-        !> The integrator.
-        class(time_integrator_t), intent(inout) :: self
-        !> Where the state comes from.
-        class(state_source_t), intent(in) :: source
-        !> Always set.
-        type(error_t), allocatable, intent(out) :: error
-        call make_internal_error(error, 'load_integrator', 'no checkpoint for the state of this time integrator')
-    end subroutine unknown_load_state
 
     !> Put `predicted` (0 or 1) and the coupling force of the previous step `fc_old`.
     subroutine newmark_save_state(self, sink, error)
