@@ -29,7 +29,7 @@ module coupling_operator2d
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
     use core_linalg, only: dense_spd_t
-    use core_timefunc, only: time_function_t
+    use core_timefunc, only: time_function_slot_t
     use fem_continuum_model, only: continuum_model_t
     use coupling_map, only: coupling_map_t
     use coupling_locate2d, only: element_grid_t
@@ -64,7 +64,7 @@ module coupling_operator2d
         !> Time function of each entry on a dof prescribed in time (width, n_rows); 0 elsewhere.
         integer, allocatable :: timed_function(:, :)
         !> The model's time functions.
-        type(time_function_t), allocatable :: functions(:)
+        type(time_function_slot_t), allocatable :: functions(:)
     contains
         !> y = C u (u over the free dofs).
         procedure :: apply => op2d_apply
@@ -251,7 +251,7 @@ contains
         do r = 1, self%n_rows
             do k = 1, width
                 if (self%timed_function(k, r) == 0) cycle
-                associate (fn => self%functions(self%timed_function(k, r)))
+                associate (fn => self%functions(self%timed_function(k, r))%fn)
                     if (derivative == 0) y(r) = y(r) + self%timed(k, r)*fn%value(t)
                     if (derivative /= 0) y(r) = y(r) + self%timed(k, r)*fn%rate(t)
                 end associate

@@ -9,7 +9,7 @@ module dem_particles
     use core_kinds, only: wp, i8
     use core_constants, only: pi
     use core_error, only: error_t, make_error, make_internal_error
-    use core_timefunc, only: time_function_t
+    use core_timefunc, only: time_function_slot_t
     implicit none
     private
     public :: particles_t, dof_condition_t, particle_load_t
@@ -87,7 +87,7 @@ module dem_particles
         !> Loads (first n_loads used).
         type(particle_load_t), allocatable :: loads(:)
         !> Time functions referenced by conditions and loads.
-        type(time_function_t), allocatable :: functions(:)
+        type(time_function_slot_t), allocatable :: functions(:)
     end type particles_t
 
 contains
@@ -266,7 +266,7 @@ contains
         if (func == 0) then
             f = 1.0_wp
         else
-            f = p%functions(func)%value(t)
+            f = p%functions(func)%fn%value(t)
         end if
     end function particles_time_function
 

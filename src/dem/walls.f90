@@ -6,7 +6,7 @@
 module dem_walls
     use core_kinds, only: wp
     use core_error, only: error_t, make_error
-    use core_timefunc, only: time_function_t
+    use core_timefunc, only: time_function_slot_t
     implicit none
     private
     public :: walls_t, walls_add, walls_velocity, walls_advance, segment_closest_point
@@ -26,7 +26,7 @@ module dem_walls
         !> Material index.
         integer, allocatable :: mat(:)
         !> Time functions referenced by `func`.
-        type(time_function_t), allocatable :: functions(:)
+        type(time_function_slot_t), allocatable :: functions(:)
     end type walls_t
 
 contains
@@ -91,7 +91,7 @@ contains
         real(wp) :: v(2)
         real(wp) :: f
         f = 1.0_wp
-        if (w%func(k) > 0) f = w%functions(w%func(k))%value(t)
+        if (w%func(k) > 0) f = w%functions(w%func(k))%fn%value(t)
         v = [w%vx(k), w%vy(k)]*f
     end function walls_velocity
 

@@ -8,7 +8,7 @@ module driver_config
     use core_constants, only: relative_roundoff
     use core_error, only: error_t, make_input_error
     use core_strings, only: to_str
-    use core_timefunc, only: time_function_t
+    use core_timefunc, only: time_function_slot_t
     use fem_beam_config, only: beam_config_t
     use fem_mass_scheme, only: mass_scheme_t, consistent_mass_t
     use io_deck, only: deck_t
@@ -105,7 +105,7 @@ contains
         !> Run configuration.
         type(run_config_t), intent(out) :: run
         !> The deck's time functions.
-        type(time_function_t), allocatable, intent(out) :: functions(:)
+        type(time_function_slot_t), allocatable, intent(out) :: functions(:)
         !> Error, if any.
         type(error_t), allocatable, intent(out) :: error
         type(beam_config_t) :: frame

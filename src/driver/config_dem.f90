@@ -18,7 +18,7 @@ module driver_config_dem
     use core_constants, only: deg_to_rad, pi
     use core_error, only: error_t, make_input_error, make_internal_error
     use core_strings, only: string_t, to_str, sci_to_str, num => sci_text
-    use core_timefunc, only: time_function_t
+    use core_timefunc, only: time_function_slot_t
     use io_deck, only: deck_t, deck_entry_t
     use io_deck_schema, only: parse_selection
     use io_memory, only: available_memory
@@ -88,7 +88,7 @@ contains
         type(run_config_t), intent(in) :: run
         !> Time functions of the deck, in the order of the `function` records (as built by
         !> driver_config::build_config).
-        type(time_function_t), intent(in) :: functions(:)
+        type(time_function_slot_t), intent(in) :: functions(:)
         !> The model.
         type(dem_config_t), intent(out) :: cfg
         !> Error naming file, line and keyword, if any.

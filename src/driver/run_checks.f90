@@ -12,7 +12,7 @@ module driver_run_checks
     use driver_simulation, only: simulation_t, report_iface
     use driver_config, only: steps_to_end, max_steps
     use driver_config_timefunc, only: build_time_functions
-    use core_timefunc, only: time_function_t
+    use core_timefunc, only: time_function_slot_t
     use driver_run_dem, only: fclib_after_end_warning
     implicit none
     private
@@ -115,7 +115,7 @@ contains
         procedure(report_iface) :: report
         !> Records named in full in a warning; the others are counted.
         integer, parameter :: listed = 3
-        type(time_function_t), allocatable :: functions(:)
+        type(time_function_slot_t), allocatable :: functions(:)
         type(deck_entry_t), allocatable :: list(:)
         type(error_t), allocatable :: error
         integer, allocatable :: ids(:)
@@ -130,7 +130,7 @@ contains
         ! the last step's loads are those at n h, at or just past the end asked for
         t_last = max(sim%settings%t_end, real(sim%settings%n_steps, wp)*sim%settings%h)
         do i = 1, size(functions)
-            if (.not. functions(i)%zero_on(0.0_wp, t_last)) cycle
+            if (.not. functions(i)%fn%zero_on(0.0_wp, t_last)) cycle
             users = ''
             n_users = 0
             do k = 1, size(deck%entries)

@@ -3,7 +3,7 @@ module driver_simulation_dem
     use core_kinds, only: i8
     use core_error, only: error_t
     use core_strings, only: string_t, counted
-    use core_timefunc, only: time_function_t
+    use core_timefunc, only: time_function_slot_t
     use io_deck, only: deck_t
     use driver_config, only: build_particles_config
     use driver_config_dem, only: dem_config_t, build_dem_config
@@ -21,7 +21,7 @@ module driver_simulation_dem
     !> A run of rigid disks and walls.
     type, extends(simulation_t) :: dem_simulation_t
         !> The deck's time functions.
-        type(time_function_t), allocatable :: functions(:)
+        type(time_function_slot_t), allocatable :: functions(:)
         !> Particles, walls, contact laws and solver settings.
         type(dem_config_t) :: dem
     contains

@@ -5,7 +5,7 @@
 !> DOFs per node: 1 = u (axial/x), 2 = w (transverse/y), 3 = theta (rotation about z).
 module fem_beam_config
     use core_kinds, only: wp
-    use core_timefunc, only: time_function_t
+    use core_timefunc, only: time_function_slot_t
     use fem_mass_scheme, only: mass_scheme_t
     implicit none
     private
@@ -84,7 +84,7 @@ module fem_beam_config
         !> Nodal loads.
         type(beam_load_t), allocatable :: loads(:)
         !> Time functions referenced by loads.
-        type(time_function_t), allocatable :: functions(:)
+        type(time_function_slot_t), allocatable :: functions(:)
         !> Distributed loads on elements (consistent nodal forces and moments).
         type(beam_element_load_t), allocatable :: element_loads(:)
         !> Gravity acceleration (gx, gy) [m/s^2]: self-weight rho A g on every element.

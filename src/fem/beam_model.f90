@@ -18,7 +18,7 @@ module fem_beam_model
     use core_error, only: error_t, make_error, make_internal_error
     use core_linalg, only: band_spd_t, largest_generalized_eigenvalue
     use core_sort, only: sort_in_place
-    use core_timefunc, only: time_function_t
+    use core_timefunc, only: time_function_slot_t
     use core_weight, only: weight_function_t
     use fem_dynamic_operator, only: dynamic_operator_t, spd_factor_t
     use fem_mass_scheme, only: consistent_mass_t
@@ -70,7 +70,7 @@ module fem_beam_model
         !> Nodal loads (value times function).
         type(beam_load_t), allocatable :: loads(:)
         !> Time functions referenced by the loads.
-        type(time_function_t), allocatable :: functions(:)
+        type(time_function_slot_t), allocatable :: functions(:)
         !> Distributed loads, self-weight included: element of each (size n_element_loads).
         integer, allocatable :: eload_element(:)
         !> Time function of each distributed load (0 = constant 1).
@@ -697,12 +697,12 @@ contains
             ieq = self%eq(self%loads(i)%dof, self%loads(i)%node)
             if (ieq == 0) cycle
             scale = 1.0_wp
-            if (self%loads(i)%func > 0) scale = self%functions(self%loads(i)%func)%value(t)
+            if (self%loads(i)%func > 0) scale = self%functions(self%loads(i)%func)%fn%value(t)
             f(ieq) = f(ieq) + self%loads(i)%value*scale
         end do
         do i = 1, size(self%eload_element)
             scale = 1.0_wp
-            if (self%eload_func(i) > 0) scale = self%functions(self%eload_func(i))%value(t)
+            if (self%eload_func(i) > 0) scale = self%functions(self%eload_func(i))%fn%value(t)
             dofs = element_dofs(self, self%eload_element(i))
             do k = 1, 6
                 if (dofs(k) > 0) f(dofs(k)) = f(dofs(k)) + self%eload_vector(k, i)*scale
@@ -902,14 +902,14 @@ contains
         do i = 1, size(self%loads)
             associate (ld => self%loads(i))
                 scale = 1.0_wp
-                if (ld%func > 0) scale = self%functions(ld%func)%value(t)
+                if (ld%func > 0) scale = self%functions(ld%func)%fn%value(t)
                 r(ld%dof, ld%node) = r(ld%dof, ld%node) - ld%value*scale
             end associate
         end do
         ! Distributed loads: their consistent forces on fixed DOFs go to the supports.
         do i = 1, size(self%eload_element)
             scale = 1.0_wp
-            if (self%eload_func(i) > 0) scale = self%functions(self%eload_func(i))%value(t)
+            if (self%eload_func(i) > 0) scale = self%functions(self%eload_func(i))%fn%value(t)
             n1 = self%conn(1, self%eload_element(i))
             n2 = self%conn(2, self%eload_element(i))
             r(:, n1) = r(:, n1) - self%eload_vector(1:3, i)*scale

@@ -36,7 +36,7 @@ module fem_continuum_dynamics
     use core_sparse, only: sparse_matrix_t, sparse_solver_t
     use core_linalg, only: band_spd_t, band_generalized_eigen
     use fem_dynamic_operator, only: dynamic_operator_t, spd_factor_t
-    use core_timefunc, only: time_function_t
+    use core_timefunc, only: time_function_slot_t
     use fem_continuum_model, only: continuum_model_t
     use fem_triplets, only: fem_triplets_t
     use fem_newmark, only: time_integrator_t
@@ -60,7 +60,7 @@ module fem_continuum_dynamics
         !> Loads on the free dofs times a time function: column k times functions(k)(t) [N].
         real(wp), allocatable :: timed_load(:, :)
         !> The model's time functions (one per column of `timed_load`).
-        type(time_function_t), allocatable :: functions(:)
+        type(time_function_slot_t), allocatable :: functions(:)
         !> Stiffness over all dofs (for the strain energy of the whole body).
         type(fem_triplets_t) :: k_all
         !> Mass over all dofs (for the prescribed motion's inertia and the audit).
@@ -280,7 +280,7 @@ contains
         integer :: k, i
         f = self%load
         do k = 1, size(self%functions)
-            f = f + self%functions(k)%value(t)*self%timed_load(:, k)
+            f = f + self%functions(k)%fn%value(t)*self%timed_load(:, k)
         end do
         if (.not. any(self%timed_function > 0 .and. self%equation == 0)) return
         up = self%timed_motion(t, 0)
@@ -309,7 +309,7 @@ contains
         integer :: k, i
         f = self%load
         do k = 1, size(self%functions)
-            f = f + self%functions(k)%value(t)*self%timed_load(:, k)
+            f = f + self%functions(k)%fn%value(t)*self%timed_load(:, k)
         end do
         allocate (w(size(self%equation)))
         call self%k_all%matvec(self%timed_motion(t, 0), w)
@@ -329,7 +329,7 @@ contains
         integer :: k
         f = self%load_all
         do k = 1, size(self%functions)
-            f = f + self%functions(k)%value(t)*self%timed_all(:, k)
+            f = f + self%functions(k)%fn%value(t)*self%timed_all(:, k)
         end do
     end function dynamics_loads_at
 
@@ -348,7 +348,7 @@ contains
         allocate (x(size(self%timed_value)), source=0.0_wp)
         do i = 1, size(x)
             if (self%timed_function(i) == 0 .or. self%equation(i) /= 0) cycle
-            associate (fn => self%functions(self%timed_function(i)))
+            associate (fn => self%functions(self%timed_function(i))%fn)
                 select case (derivative)
                 case (0)
                     x(i) = self%timed_value(i)*fn%value(t)

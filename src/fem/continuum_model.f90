@@ -16,7 +16,7 @@ module fem_continuum_model
     use core_constants, only: singular_ratio
     use core_error, only: error_t, make_error
     use core_strings, only: to_str
-    use core_timefunc, only: time_function_t
+    use core_timefunc, only: time_function_slot_t
     use fem_elastic2d, only: elastic2d_t
     use fem_element_registry, only: element_slot_t, element_family, kind_node_count
     use fem_edge_load, only: edge_traction_linear, edge_traction_normal_tangential, &
@@ -47,7 +47,7 @@ module fem_continuum_model
         !> External nodal forces (N), size 2 * number of nodes (constant in time).
         real(wp), allocatable :: load(:)
         !> Time functions multiplying the columns of `timed_load` (none: every load constant).
-        type(time_function_t), allocatable :: functions(:)
+        type(time_function_slot_t), allocatable :: functions(:)
         !> Nodal forces (N) times a time function: column k (size 2 * number of nodes) is
         !> multiplied by functions(k)(t); size (dof_count, size(functions)).
         real(wp), allocatable :: timed_load(:, :)
@@ -609,11 +609,11 @@ contains
         do k = 1, size(self%functions)
             select case (derivative)
             case (0)
-                f(k) = self%functions(k)%value(t)
+                f(k) = self%functions(k)%fn%value(t)
             case (1)
-                f(k) = self%functions(k)%rate(t)
+                f(k) = self%functions(k)%fn%rate(t)
             case default
-                f(k) = self%functions(k)%acceleration(t)
+                f(k) = self%functions(k)%fn%acceleration(t)
             end select
         end do
         allocate (up(self%dof_count()), source=0.0_wp)
