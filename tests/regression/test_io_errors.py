@@ -359,11 +359,14 @@ def main():
 
 def stale_lock_race(exe, deck, work):
     """Two runs take over one stale lock at once: one runs, the other is refused. Run B is held
-    (strace, 1.5 s) as it takes the stale lock out of the way (its first rename now; its
-    second unlink, after that of its own lock line's file, in the version before); run A
-    starts meanwhile, takes the stale lock over and holds the folder (its first write held
-    5 s). Before, B then removed A's new lock by name and
-    linked its own: both ran in the folder (a review's finding)."""
+    (strace, 1.5 s) as it takes the stale lock out of the way: now at its second unlink, that
+    of its `.break` lock line's file, holding `.break` (run A, started meanwhile, is refused:
+    B takes the stale lock over, and then runs); in the versions before at its first rename
+    (setting the stale lock aside) or its second unlink (of the stale lock, by name), and run A
+    took the stale lock over meanwhile and held the folder (its first write held 5 s). In the
+    first version B then removed A's new lock by name and linked its own: both ran in the
+    folder (a review's finding). A third run defeated the renaming version:
+    test_lock_takeover.py."""
     if not have_strace("stale_lock_race"):
         return
     import socket
