@@ -33,10 +33,16 @@ from checks import arguments, check, summary
 
 SRUN = """#!/bin/bash
 # stand-in for srun: drop its options, run the command; FAKE_SIGNAL_AFTER=s sends FAKE_SIGNAL
-# (default KILL) to it after s seconds
+# (default KILL) to it after s seconds, counted from the moment the file FAKE_SIGNAL_WAIT_FOR
+# exists when that is set (the run's results file: a signal before it opens stops the run
+# without a checkpoint, and a fixed delay from the start reached a run still in its set-up on
+# a loaded machine)
 while [[ "$1" == --* ]]; do shift; done
 if [ -n "${FAKE_SIGNAL_AFTER:-}" ]; then
     "$@" & pid=$!
+    if [ -n "${FAKE_SIGNAL_WAIT_FOR:-}" ]; then
+        while [ ! -e "$FAKE_SIGNAL_WAIT_FOR" ] && kill -0 "$pid" 2>/dev/null; do sleep 0.01; done
+    fi
     sleep "$FAKE_SIGNAL_AFTER"
     kill -"${FAKE_SIGNAL:-KILL}" "$pid" 2>/dev/null
     wait "$pid"
@@ -104,7 +110,8 @@ def main():
           and not (out / "incline.h5.partial").exists(), f"exit {rc}")
 
     stopped = work / "stopped"
-    log, rc = job(src, exe, work, deck, stopped, FAKE_SIGNAL_AFTER=0.3, FAKE_SIGNAL="USR1")
+    log, rc = job(src, exe, work, deck, stopped, FAKE_SIGNAL_AFTER=0.05, FAKE_SIGNAL="USR1",
+                  FAKE_SIGNAL_WAIT_FOR=str(stopped / "incline.h5.partial"))
     check("4. SIGUSR1: exit of the scontrol requeue path (0), checkpoint written",
           rc == 0 and (stopped / "checkpoint.h5").exists() and "requeued" in log, f"exit {rc}")
     log, rc = job(src, exe, work, deck, stopped, SLURM_RESTART_COUNT=1)
@@ -129,8 +136,8 @@ def other_names(src, exe, work, text, reference):
     deck = work / "incline.v2.txt"
     deck.write_text(text)
     out = scratch / "multicor" / "incline.v2"
-    log, rc = job(src, exe, work, deck, None, SCRATCH=scratch, FAKE_SIGNAL_AFTER=0.3,
-                  FAKE_SIGNAL="USR1")
+    log, rc = job(src, exe, work, deck, None, SCRATCH=scratch, FAKE_SIGNAL_AFTER=0.05,
+                  FAKE_SIGNAL="USR1", FAKE_SIGNAL_WAIT_FOR=str(out / "incline.v2.h5.partial"))
     check("5. incline.v2.txt stopped by SIGUSR1: requeued, default folder multicor/incline.v2",
           rc == 0 and (out / "checkpoint.h5").exists() and (out / "incline.v2.h5.partial").exists()
           and "requeued" in log, f"exit {rc}; {sorted(p.name for p in scratch.rglob('*'))}")
