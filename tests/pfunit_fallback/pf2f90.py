@@ -7,31 +7,43 @@ generation time what real pFUnit would refuse, at generation or at compile time:
 
 * directives are matched with pFUnit's own patterns: ``@test`` (no options), ``@before``
   and ``@after`` alone on their line; ``@assert<Variant>(...)`` alone on its line, ending
-  with ``)``: no trailing comment and no ``&`` continuation (pFUnit would copy such a line
-  unchanged and the compiler would reject the ``@``); at least as many comma-separated
-  arguments as pFUnit requires for the variant;
+  with ``)``: no trailing comment and no ``&`` continuation (pFUnit 4.12 copies such a line
+  unchanged and the compiler rejects the ``@``; joining the continuation lines of a
+  directive came after 4.14, pFUnit issue #537); at least as many comma-separated arguments
+  as pFUnit requires for the variant;
 * the line after ``@before``/``@after`` (comments aside) must be the ``subroutine``
   statement, as pFUnit reads it;
-* test procedure names <= 63 characters (Fortran), module name = file name, spelled
-  exactly (pFUnit's registry calls ``<file name>_suite``) and <= 57 characters (pFUnit
-  generates ``<module>_suite`` and ``Wrap<module>``);
-* no code past column 132 in what pFUnit generates (gfortran's default free-form limit,
-  counted in bytes as gfortran does: ``add_pfunit_ctest`` adds no line-length flag): a copied
-  line may run past it only with a comment (gfortran 12's scanner.c: a '!' outside character
-  literals before column 133, or as the first non-blank past it); for an assert, the line
-  ``  call assert<Variant>(<arguments>, &`` that pFUnit writes.
+* test procedure names <= 63 characters (Fortran), module name = file name, case aside
+  (pFUnitParser.py compares them with ``.lower()``: "do not match (ignoring case)"; its
+  registry calls ``<file name>_suite``, and Fortran ignores case) and <= 57 characters (pFUnit
+  generates ``<module>_suite`` and ``Wrap<module>``).
+
+No line-length rule: tests/CMakeLists.txt compiles every suite with ``-ffree-line-length-none``,
+with pFUnit as with the fallback, so a long line compiles under both.
 
 Supported asserts: ``@assertEqual``, ``@assertTrue``, ``@assertFalse``, ``@assertLessThan``,
 ``@assertGreaterThan``, ``@assertRelativelyEqual`` (tolerance required, as in pFUnit),
 ``@assertIsFinite`` (scalar). The generated code calls the same procedures with the same
 ``location=SourceLocation(file, line)`` argument as pFUnit; the fallback's ``funit`` module
 (funit.fypp) exports pFUnit's public names, so a helper named like one of them (``run``...)
-fails to compile as under pFUnit. After the module, a ``<module>_suite`` subroutine uses the
-test module and ``funit`` unrestricted, declares ``suite`` and ``t`` and names ``TestMethod``,
-as pFUnit's generated suite function does, so the same name clashes fail, and no other: the
-harness is used inside a ``block``. Each test runs as pFUnit's ``TestCase%runBare`` runs it
-(``fallback_run_test``): the ``@before`` procedure, then, only if it raised nothing, the test
+fails to compile as under pFUnit. After the module come the statements pFUnit writes: the
+module ``Wrap<module>`` (it uses ``funit`` and the test module and exports nothing) and the
+function ``<module>_suite``, which uses ``funit``, the test module and the wrapper
+unrestricted, declares ``suite`` and ``t``, builds each test with the generic
+``TestMethod(name, procedure, setUp=, tearDown=)`` and adds it with ``suite%addTest``; so a
+name clashes (or, as a module's own ``TestMethod`` type with gfortran 12, does not) exactly as
+under pFUnit. The driver runs each suite as pFUnit's ``TestCase%runBare`` runs a test
+(``fallback_run_suite``): the ``@before`` procedure, then, only if it raised nothing, the test
 and the ``@after`` procedure (also after a failed test, never after a failed set-up).
+
+Checked against pFUnit (README.md, "Unit tests and pFUnit", has the details): an audit of
+commit 17faccf ran pFUnit's own preprocessor (``pFUnitParser.py`` at pFUnit's commit 05504b8,
+after 4.14, and a "4.12-approx" copy without its two later changes: the joining of continued
+directives and a special case for ``@assertExceptionRaised``) on the 65 ``.pf`` files: the
+same 587 tests as this script, same names, same order, from 3 265 assertion directives; its
+output compiled against a stand-in FUnit written from pFUnit's sources (1 133 specific
+assertions) and every suite passed; of 29 241 assertion call forms, both modules accepted the
+same 1 134; and test_strictness.py's cases, each alone, behave through it as the test says.
 
 Line numbers are preserved (annotations become blank lines, asserts stay on their line),
 so compiler messages and failure reports point into the ``.pf`` file.
@@ -68,7 +80,6 @@ COMMENT = re.compile(r'\s*(!.*|)$')
 
 MAX_NAME = 63          # Fortran 2008 name length
 MAX_MODULE = MAX_NAME - len('_suite')
-MAX_LINE = 132         # gfortran default free-form line length
 
 
 class PfError(Exception):
@@ -77,40 +88,6 @@ class PfError(Exception):
 
 def fortran_string(text):
     return "'" + text.replace("'", "''") + "'"
-
-
-def columns(line):
-    """Line length as gfortran counts it: bytes (a UTF-8 'e' with an accent counts 2)."""
-    return len(line.encode('utf-8'))
-
-
-def truncated(line):
-    """Whether gfortran, free form at its default 132 columns, reports 'Line truncated' (an
-    error by default) for `line`: gfortran 12's scanner.c load_line. It reads the first 132
-    bytes ('\\r' and NUL not counted), noting a '!' outside a character literal as a comment;
-    past column 132 it skips blanks and stops at the first other byte: the line is truncated
-    unless a comment started before, or that byte is a '!'."""
-    data = line.encode('utf-8')
-    kept, quote, comment, rest = 0, None, False, b''
-    for i, b in enumerate(data):
-        c = chr(b)
-        if c in '\r\0':
-            continue
-        if quote is None:
-            if c in "'\"":
-                quote = c
-        elif c == quote:
-            quote = None
-        if c == '!' and quote is None:
-            comment = True
-        kept += 1
-        if kept >= MAX_LINE:
-            rest = data[i + 1:]
-            break
-    if comment:
-        return False
-    rest = rest.lstrip(b' \r')
-    return bool(rest) and not rest.startswith(b'!')
 
 
 def code_outside_literals(line, quote=None):
@@ -198,11 +175,6 @@ def parse(path):
                 if variant.lower() not in SUPPORTED:
                     raise PfError(f"{where}: @assert{variant} is not supported by the fallback")
                 check_arguments(args, where)
-                generated = f"  call assert{variant}({args}, &"
-                if columns(generated) > MAX_LINE:
-                    raise PfError(f"{where}: pFUnit would generate a {columns(generated)}-character "
-                                  f"line ('  call assert{variant}(..., &'), more than gfortran's "
-                                  f"default {MAX_LINE}: shorten the assert")
                 indent = line[:len(line) - len(line.lstrip())]
                 out.append(f"{indent}call assert{variant}({args}, location=SourceLocation("
                            f"{fortran_string(base)}, {number})); if (anyExceptions()) return")
@@ -224,10 +196,6 @@ def parse(path):
         if '@assert' in code.lower():
             # pFUnit copies the line unchanged; the compiler would reject the '@'
             raise PfError(f"{where}: an @assert must stand alone on its line")
-        if truncated(line):
-            raise PfError(f"{where}: code past column {MAX_LINE} ({columns(line)} characters), "
-                          f"more than gfortran's default {MAX_LINE} (pFUnit copies the line "
-                          "unchanged; only a comment may run past it)")
         m = MODULE.match(line)
         if m and m.group(1).lower() != 'procedure':
             module = m.group(1)   # as pFUnit: the last 'module <name>' line wins
@@ -243,11 +211,11 @@ def parse(path):
         raise PfError(f"{base}: @test not followed by a subroutine statement")
     if module is None:
         raise PfError(f"{base}: no module found")
-    if module != stem:
-        # exact spelling: pFUnit (>= 4.7) refuses a module not named like its file, and the
-        # case rule of that check could not be read in 4.12's source (see the report)
-        raise PfError(f"{base}: module '{module}' must be named exactly like the file "
-                      f"('{stem}'): pFUnit's registry calls {stem}_suite")
+    if module.lower() != stem.lower():
+        # pFUnit >= 4.7 (pFUnitParser.py): "module name (...) and file name (...) do not match
+        # (ignoring case)"; its registry calls <file name>_suite, and Fortran ignores case
+        raise PfError(f"{base}: module '{module}' must be named like the file ('{stem}', case "
+                      f"aside): pFUnit's registry calls {stem}_suite")
     if len(module) > MAX_MODULE:
         raise PfError(f"{base}: module name longer than {MAX_MODULE} characters (pFUnit "
                       f"generates '{module}_suite')")
@@ -262,34 +230,26 @@ def parse(path):
 
 
 def suite_lines(module, tests, befores, afters):
-    """`<module>_suite`: runs every test, with pFUnit's suite-function scope.
-
-    It declares `suite` and `t` and names `TestMethod`, as pFUnit's generated suite function
-    does, and nothing else: its other names (a TestMethod variable, the harness reached through
-    a USE) are local to BLOCKs, which hide the host's names, so they clash with nothing."""
-    text = [f"subroutine {module}_suite()",
-            "    use funit",
-            f"    use {module}",
-            "    implicit none",
-            "    ! as in pFUnit's generated suite function (name clashes fail the same way)",
-            "    type(TestSuite) :: suite",
+    """What pFUnit 4.12's preprocessor appends to a test module without a test case type: the
+    empty wrapper module `Wrap<module>` and the suite function `<module>_suite`, statement for
+    statement (pFUnitParser.py, printHeader and printMakeSuite), so that the names they use
+    resolve, or clash with the test module's, as under pFUnit."""
+    text = ["", f"module Wrap{module}", "    use funit", f"    use {module}", "    implicit none",
+            "    private", "contains", f"end module Wrap{module}", "",
+            f"function {module}_suite() result(suite)", "    use funit", f"    use {module}",
+            f"    use Wrap{module}", "    implicit none", "    type(TestSuite) :: suite",
             "    class(Test), allocatable :: t",
-            "    ! pFUnit builds each test with the TestMethod constructor (block-local: no clash)",
-            "    block",
-            "        type(TestMethod) :: method",
-            "        allocate (t, source=method)",
-            "    end block"]
+            f"    suite = TestSuite('{module}_suite')"]
     extra = ''
     if befores:
-        extra += f", set_up={befores[0]}"
+        extra += f", setUp={befores[0]}"
     if afters:
-        extra += f", tear_down={afters[0]}"
+        extra += f", tearDown={afters[0]}"
     for name in tests:
-        text += ["    block",
-                 "        use funit_fallback_runner, only: fallback_run_test",
-                 f"        call fallback_run_test('{module}', '{name}', {name}{extra})",
-                 "    end block"]
-    text.append(f"end subroutine {module}_suite")
+        text += ["    if (allocated(t)) deallocate (t)",
+                 f"    allocate (t, source=TestMethod('{name}', {name}{extra}))",
+                 "    call suite%addTest(t)"]
+    text.append(f"end function {module}_suite")
     return text
 
 
@@ -302,12 +262,13 @@ def write_module(src, dst):
 def write_driver(dst, sources):
     modules = [parse(src)[0] for src in sources]
     text = ["! Generated by pf2f90.py (pFUnit fallback). Do not edit.", "program funit_driver",
-            "    use funit_fallback_runner, only: fallback_finish", "    implicit none",
-            "    interface"]
+            "    use funit_fallback_runner, only: TestSuite, fallback_run_suite, fallback_finish",
+            "    implicit none", "    interface"]
     for m in modules:
-        text += [f"        subroutine {m}_suite()", f"        end subroutine {m}_suite"]
+        text += [f"        function {m}_suite() result(suite)", "            import :: TestSuite",
+                 "            type(TestSuite) :: suite", f"        end function {m}_suite"]
     text.append("    end interface")
-    text += [f"    call {m}_suite()" for m in modules]
+    text += [f"    call fallback_run_suite({m}_suite())" for m in modules]
     text += ["    call fallback_finish()", "end program funit_driver"]
     with open(dst, 'w', encoding='utf-8') as f:
         f.write('\n'.join(text) + '\n')
