@@ -7,7 +7,10 @@
 !> - `dense_spd_t`: dense symmetric positive-definite matrix, Cholesky (dpotrf/dpotrs).
 !> - `band_generalized_eigen`: selected eigenpairs of A x = lambda B x for band A, B (dsbgvx),
 !>   eigenvectors B-normalised; `largest_generalized_eigenvalue` for the critical time step.
+!> - `dense_generalized_eigen`: all eigenpairs of a small dense A x = lambda B x (dsygv), e.g.
+!>   the Rayleigh-Ritz problem of a subspace iteration.
 !>
+!> - `even_exponent`: the power of 2 that scales a matrix to entries of order 1, exactly.
 !> - `symmetrize`: A = factor (A + A^T)/2 in place (no n^2 temporary).
 !> - `dot`: the dot product of two contiguous vectors (ddot; vectorised, where a Fortran
 !>   loop must add in order).
@@ -19,7 +22,8 @@ module core_linalg
     use core_error, only: error_t, make_error, make_internal_error
     implicit none
     private
-    public :: band_spd_t, dense_spd_t, band_generalized_eigen, largest_generalized_eigenvalue, dot, symmetrize
+    public :: band_spd_t, dense_spd_t, band_generalized_eigen, largest_generalized_eigenvalue, dense_generalized_eigen
+    public :: dot, symmetrize, even_exponent
 
     !> Symmetric positive-definite band matrix (upper band storage) and its Cholesky factor.
     type :: band_spd_t
@@ -166,6 +170,14 @@ module core_linalg
             real(wp), intent(in) :: vl, vu, abstol
             integer, intent(out) :: m, iwork(*), ifail(*), info
         end subroutine dsbgvx
+        subroutine dsygv(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
+            import :: wp
+            character(len=1), intent(in) :: jobz, uplo
+            integer, intent(in) :: itype, n, lda, ldb, lwork
+            real(wp), intent(inout) :: a(lda, *), b(ldb, *)
+            real(wp), intent(out) :: w(*), work(*)
+            integer, intent(out) :: info
+        end subroutine dsygv
     end interface
 
 contains
@@ -580,18 +592,61 @@ contains
         lambda = scale(w(1:m), ea - eb)
         ! z^T (B 2^-eb) z = 1: the B-normalised vectors are z 2^(-eb/2).
         if (present(vectors)) vectors = scale(z(:, 1:m), -eb/2)
-    contains
-        !> Even exponent e such that the largest |entry| times 2^-e lies in [1/2, 2) (0 for a
-        !> zero or non-finite matrix).
-        pure integer function even_exponent(x) result(e)
-            real(wp), intent(in) :: x(:, :)
-            real(wp) :: big
-            e = 0
-            big = maxval(abs(x))
-            if (.not. (big > 0.0_wp .and. big <= huge(big))) return
-            e = 2*floor(0.5_wp*real(exponent(big), wp))
-        end function even_exponent
     end subroutine band_generalized_eigen
+
+    !> Even exponent e such that the largest |entry| of x times 2^-e lies in [1/2, 2) (0 for a
+    !> zero or non-finite matrix): scaling by 2^-e is exact, and so is the square root of it.
+    pure integer function even_exponent(x) result(e)
+        !> The entries (e.g. a band matrix's storage).
+        real(wp), intent(in) :: x(:, :)
+        real(wp) :: big
+        e = 0
+        big = maxval(abs(x))
+        if (.not. (big > 0.0_wp .and. big <= huge(big))) return
+        e = 2*floor(0.5_wp*real(exponent(big), wp))
+    end function even_exponent
+
+    !> All eigenpairs of A x = lambda B x, A symmetric and B symmetric positive definite, both
+    !> dense and small (dsygv: Cholesky of B, then the standard problem; n^3 flops). Only the
+    !> upper triangles are read. Eigenvalues ascending, eigenvectors with X^T B X = I.
+    subroutine dense_generalized_eigen(a, b, lambda, vectors, error)
+        !> Matrix A (n, n).
+        real(wp), intent(in) :: a(:, :)
+        !> Matrix B (n, n), positive definite.
+        real(wp), intent(in) :: b(:, :)
+        !> The n eigenvalues, ascending.
+        real(wp), allocatable, intent(out) :: lambda(:)
+        !> The eigenvectors (n, n), B-normalised, in the order of lambda.
+        real(wp), allocatable, intent(out) :: vectors(:, :)
+        !> Set on invalid sizes or LAPACK failure.
+        type(error_t), allocatable, intent(out) :: error
+        real(wp), allocatable :: bb(:, :), work(:)
+        real(wp) :: query(1)
+        integer :: n, info
+        character(len=160) :: buf
+        n = size(a, 1)
+        if (size(a, 2) /= n .or. any(shape(b) /= [n, n]) .or. n < 1) then
+            call make_internal_error(error, 'dense generalized eigenproblem', 'matrices of different or invalid sizes')
+            return
+        end if
+        vectors = a
+        bb = b
+        allocate (lambda(n))
+        call dsygv(1, 'V', 'U', n, vectors, n, bb, n, lambda, query, -1, info)
+        allocate (work(max(1, int(query(1)))))
+        call dsygv(1, 'V', 'U', n, vectors, n, bb, n, lambda, work, size(work), info)
+        if (info == 0) return
+        if (info < 0) then
+            write (buf, '(a,i0,a)') 'dense generalized eigenproblem (dsygv): argument ', -info, ' is invalid'
+        else if (info <= n) then
+            write (buf, '(a,i0,a)') 'dense generalized eigenproblem (dsygv): ', info, &
+                ' off-diagonal elements did not converge to zero'
+        else
+            write (buf, '(a,i0,a)') 'dense generalized eigenproblem (dsygv): the second matrix is not '// &
+                'positive definite (leading minor of order ', info - n, ')'
+        end if
+        call make_error(error, trim(buf))
+    end subroutine dense_generalized_eigen
 
     !> Largest eigenvalue of A x = lambda B x (A symmetric, B symmetric positive definite,
     !> both band), e.g. omega_max^2 of K x = omega^2 M x for the critical time step.

@@ -7,7 +7,7 @@ module driver_simulation_beam_modal
     use core_error, only: error_t, make_error, make_input_error
     use io_deck, only: deck_t
     use fem_beam_model, only: beam_model_t
-    use fem_modal, only: solve_modal, mode_axial_fraction, mode_kind, dominant_fraction
+    use fem_modal, only: solve_modal, axial_fractions, mode_kind, dominant_fraction
     use driver_config, only: run_config_t
     use driver_results, only: results_writer_t
     use driver_checkpoint, only: checkpoint_run_t
@@ -88,11 +88,12 @@ contains
         character(len=:), allocatable :: kinds
         character(len=5) :: share
         integer :: k
-        allocate (full(3, model%n_nodes, run%n_modes), fraction(run%n_modes))
+        allocate (full(3, model%n_nodes, run%n_modes))
+        call axial_fractions(model, shapes, fraction, error)
+        if (allocated(error)) return
         kinds = ''
         do k = 1, run%n_modes
             call model%expand(shapes(:, k), full(:, :, k))
-            fraction(k) = mode_axial_fraction(model, shapes(:, k))
             kinds = trim(kinds//' '//mode_kind(fraction(k)))
             write (buf, '(a,i3,a,es15.7e3,a,es15.7e3,a)') 'mode ', k, ': omega = ', omega(k), &
                 ' rad/s, f = ', omega(k)/two_pi, ' Hz, '//mode_kind(fraction(k))

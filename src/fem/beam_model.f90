@@ -16,7 +16,7 @@ module fem_beam_model
     use core_kinds, only: wp
     use core_constants, only: relative_roundoff, singular_ratio
     use core_error, only: error_t, make_error, make_internal_error
-    use core_linalg, only: band_spd_t, largest_generalized_eigenvalue
+    use core_linalg, only: band_spd_t, largest_generalized_eigenvalue, dense_generalized_eigen
     use core_sort, only: sort_in_place
     use core_timefunc, only: time_function_slot_t
     use core_weight, only: weight_function_t
@@ -113,6 +113,10 @@ module fem_beam_model
         procedure :: equation_label
         !> Error when a connected part of the frame can move as a rigid body.
         procedure :: check_supports
+        !> Connected part of each node (its smallest node index).
+        procedure :: part_roots
+        !> Rigid-body motions of one part that its supports leave free.
+        procedure :: part_rigid_motions
         !> Curvilinear abscissa at reduced coordinate xi of an element.
         procedure :: abscissa_at
         !> Band Cholesky factor of c_m M + c_k K.
@@ -999,6 +1003,76 @@ contains
             end do
         end function coincident_hint
     end subroutine check_supports
+
+    !> Connected part of each node: the smallest node index of its part (elements join nodes).
+    pure function part_roots(self) result(comp)
+        !> The model.
+        class(beam_model_t), intent(in) :: self
+        integer :: comp(self%n_nodes)
+        call component_roots(self, comp)
+    end function part_roots
+
+    !> The rigid-body motions of the part whose smallest node index is `root` that its supports
+    !> allow: the combinations of the part's x and y translations and its rotation about its
+    !> centre that move none of its fixed DOFs. They are the part's motions without strain
+    !> energy (K's null space there: an Euler-Bernoulli element strains under any other
+    !> motion). Columns on the free DOFs, zero outside the part; none for a part that its
+    !> supports hold. The combinations are the null space of the Gram matrix of the fixed DOFs'
+    !> rows of the three motions, the rotation scaled by the part's radius so that the three
+    !> columns are comparable: the eigenvectors of eigenvalues at most singular_ratio times its
+    !> trace (exact dependence rounds to ~1e-16 of it; all three for a part without supports).
+    function part_rigid_motions(self, comp, root, error) result(motions)
+        !> The model.
+        class(beam_model_t), intent(in) :: self
+        !> The parts, from `part_roots`.
+        integer, intent(in) :: comp(:)
+        !> The part (its smallest node index).
+        integer, intent(in) :: root
+        !> Set on LAPACK failure.
+        type(error_t), allocatable, intent(out) :: error
+        !> The free rigid-body motions (n_free, 0 to 3).
+        real(wp), allocatable :: motions(:, :)
+        real(wp) :: centre(2), radius, gram(3, 3), row(3), identity(3, 3)
+        real(wp), allocatable :: w(:), v(:, :)
+        integer, allocatable :: nodes(:)
+        integer :: i, d, k, n_null
+        nodes = pack([(i, i=1, self%n_nodes)], comp == root)
+        centre = [sum(self%x(nodes)), sum(self%y(nodes))]/size(nodes)
+        radius = maxval(hypot(self%x(nodes) - centre(1), self%y(nodes) - centre(2)))
+        if (.not. radius > 0) radius = 1.0_wp
+        gram = 0.0_wp
+        do k = 1, size(nodes)
+            i = nodes(k)
+            do d = 1, 3
+                if (self%eq(d, i) /= 0) cycle
+                row = scaled_row(i, d)
+                gram = gram + spread(row, 2, 3)*spread(row, 1, 3)
+            end do
+        end do
+        identity = 0.0_wp
+        do d = 1, 3
+            identity(d, d) = 1.0_wp
+        end do
+        call dense_generalized_eigen(gram, identity, w, v, error)
+        if (allocated(error)) return
+        n_null = count(w <= singular_ratio*(gram(1, 1) + gram(2, 2) + gram(3, 3)))
+        allocate (motions(self%n_free, n_null), source=0.0_wp)
+        do k = 1, size(nodes)
+            i = nodes(k)
+            do d = 1, 3
+                if (self%eq(d, i) == 0) cycle
+                motions(self%eq(d, i), :) = matmul(scaled_row(i, d), v(:, 1:n_null))
+            end do
+        end do
+    contains
+        !> DOF d of node i in the three motions (x, y translation, rotation of 1/radius).
+        pure function scaled_row(i, d) result(r)
+            integer, intent(in) :: i, d
+            real(wp) :: r(3)
+            r = rigid_row(d, self%x(i) - centre(1), self%y(i) - centre(2))
+            r(3) = r(3)/radius
+        end function scaled_row
+    end function part_rigid_motions
 
     !> Smallest node index of the connected part of each node (union-find over elements).
     pure subroutine component_roots(self, comp)
