@@ -6,7 +6,10 @@
 !>     free motion closes its gap, g + theta h u_n(free) <= 0 (up to a round-off allowance),
 !>     or when it carried a compressive reaction at the previous step; Newton restitution
 !>     when it closes, otherwise a gap term that lets it close its gap during the step but
-!>     not overlap;
+!>     not overlap. A contact the free motion leaves open can still be shut by the impulses
+!>     of the others: after the solve, the rule re-checks the contacts it left out on the
+!>     end-of-step velocities, g + theta h u_n(end) < -allowance, lets those in with the gap
+!>     term, and the step is solved again (`recheck`; dem_moreau_jean::mj_solve);
 !>   - `activation_siconos_t` (`contact_scheme = siconos`): the step of Siconos 4.4's
 !>     TimeStepping with MoreauJeanOSI and one Newton iteration, so that MULTICOR and Siconos
 !>     integrate the same discrete problem. Siconos evaluates the contact geometry once per
@@ -14,9 +17,10 @@
 !>     the output it computed there at the previous step: y + h/2 y' <= 0, with y the gap and
 !>     y' the normal velocity at the start of the previous step, both in the previous step's
 !>     geometry. An active contact takes u_n >= -e y' (Newton restitution on that velocity);
-!>     there is no gap term. Measured against Siconos 4.4 (doc/performance.md, "The same
-!>     scheme as Siconos"): the trajectories agree to the solver's tolerance until its NSGS
-!>     stops at its iteration cap.
+!>     there is no gap term, and no re-check: a contact left out stays out for the step, as
+!>     in Siconos. Measured against Siconos 4.4 (doc/performance.md, "The same scheme as
+!>     Siconos"): the trajectories agree to the solver's tolerance until its NSGS stops at its
+!>     iteration cap.
 !> Intact bonds are always active with Newton restitution, whatever the rule
 !> (dem_contacts::contacts_set_laws).
 module dem_activation
@@ -36,6 +40,10 @@ module dem_activation
         procedure(offset_iface), deferred, nopass :: offset
         !> Whether a contact without a bond is active, and its normal target u_n >= target.
         procedure(decide_iface), deferred, nopass :: decide
+        !> After the solve: whether a contact the rule left out (no bond, inactive) must be let
+        !> in, from its end-of-step normal velocity, and its normal target then; the step is
+        !> then solved again (dem_moreau_jean::mj_solve).
+        procedure(recheck_iface), deferred, nopass :: recheck
         !> The deck word of the rule (`[time] contact_scheme`).
         procedure(name_iface), deferred, nopass :: name
     end type activation_t
@@ -70,6 +78,22 @@ module dem_activation
             real(wp), intent(out) :: target
         end subroutine decide_iface
 
+        pure subroutine recheck_iface(h, theta, allowance, gap, un_end, active, target)
+            import :: wp
+            !> Time step [s] and theta.
+            real(wp), intent(in) :: h, theta
+            !> Round-off allowance of the gap [m].
+            real(wp), intent(in) :: allowance
+            !> Gap at the detection configuration [m].
+            real(wp), intent(in) :: gap
+            !> Normal relative velocity at the end of the step, from the solve [m/s].
+            real(wp), intent(in) :: un_end
+            !> The contact must take part in the solve.
+            logical, intent(out) :: active
+            !> Normal target u_n >= target of the step [m/s] (when active).
+            real(wp), intent(out) :: target
+        end subroutine recheck_iface
+
         pure function name_iface() result(word)
             character(len=:), allocatable :: word
         end function name_iface
@@ -80,6 +104,7 @@ module dem_activation
     contains
         procedure, nopass :: offset => predicted_offset
         procedure, nopass :: decide => predicted_decide
+        procedure, nopass :: recheck => predicted_recheck
         procedure, nopass :: name => predicted_name
     end type activation_predicted_t
 
@@ -88,6 +113,7 @@ module dem_activation
     contains
         procedure, nopass :: offset => siconos_offset
         procedure, nopass :: decide => siconos_decide
+        procedure, nopass :: recheck => siconos_recheck
         procedure, nopass :: name => siconos_name
     end type activation_siconos_t
 
@@ -116,6 +142,20 @@ contains
         end if
         active = gp <= allowance .or. rn > 0.0_wp
     end subroutine predicted_decide
+
+    !> A contact left out whose end-of-step gap g + theta h u_n(end) is below -allowance (the
+    !> predicted gap of predicted_decide on the solved velocities instead of the free ones):
+    !> the other contacts' impulses shut it. It is let in with the gap term -max(g, 0)/(theta
+    !> h), as an open contact of predicted_decide: it may close its gap but not overlap. The
+    !> allowance on the other side (-allowance, where predicted_decide lets in at +allowance)
+    !> leaves out contacts that end touching to the rounding of the coordinates.
+    pure subroutine predicted_recheck(h, theta, allowance, gap, un_end, active, target)
+        real(wp), intent(in) :: h, theta, allowance, gap, un_end
+        logical, intent(out) :: active
+        real(wp), intent(out) :: target
+        active = gap + theta*h*un_end < -allowance
+        target = -max(gap, 0.0_wp)/(theta*h)
+    end subroutine predicted_recheck
 
     !> The deck's word for the predicted-gap rule ('multicor').
     pure function predicted_name() result(word)
@@ -147,6 +187,16 @@ contains
         active = y(1) + 0.5_wp*h*y(2) <= 0.0_wp
         target = -e*y(2)
     end subroutine siconos_decide
+
+    !> No re-check (active is false): Siconos decides the active set once per step, before the
+    !> solve (its contacts left out may overlap within the step, doc/theory.md 2.6).
+    pure subroutine siconos_recheck(h, theta, allowance, gap, un_end, active, target)
+        real(wp), intent(in) :: h, theta, allowance, gap, un_end
+        logical, intent(out) :: active
+        real(wp), intent(out) :: target
+        active = .false.
+        target = 0.0_wp
+    end subroutine siconos_recheck
 
     !> The deck's word for Siconos' rule ('siconos').
     pure function siconos_name() result(word)

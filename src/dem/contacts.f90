@@ -15,7 +15,7 @@
 !> contacts are appended (warm start).
 module dem_contacts
     use core_kinds, only: wp, i8
-    use core_constants, only: relative_roundoff
+    use core_constants, only: relative_roundoff, diagonal_floor
     use dem_materials, only: materials_t, bond_e_default
     use dem_bipotential, only: case_separation, case_slip, case_roll, case_slip_roll
     use dem_bonds, only: break_none, break_tension, break_shear, break_moment, break_shear_moment
@@ -26,7 +26,7 @@ module dem_contacts
     public :: status_open, status_stick, status_slip, status_cohesive, status_broken
     public :: contacts_begin_detection, contacts_append, contacts_append_owner
     public :: contacts_extend, contacts_fill
-    public :: contacts_set_frames, contacts_set_laws, contacts_finish, contacts_impulses
+    public :: contacts_set_frames, contacts_set_laws, contacts_recheck, contacts_finish, contacts_impulses
     public :: contacts_local_velocity, contacts_count_status, contacts_bytes, contacts_moments_active
     public :: contacts_apply_impulse, contacts_solver_velocity, contacts_directions
     public :: contacts_list_problem, contacts_make_bonds, contacts_lost_bonds
@@ -641,11 +641,14 @@ contains
     !> loaded contact stays in the solve even when the rounding or the solver tolerance left it
     !> slightly open), Newton restitution when g_p <= 0 and otherwise the gap term
     !> -max(g, 0)/(theta h): the contact may close its gap during the step but not overlap, so
-    !> activating it changes the work of the solver, not the solution.
-    !> There is no position correction (standard Moreau-Jean): with theta = 1 an active
-    !> contact never closes past its gap at the start of the step; with theta < 1 an impact
-    !> may overlap by up to (1 - theta) h |u_n|, and the overlap is kept. (A full push-out
-    !> -g/(theta h) of overlaps was tried and makes dense packings unstable.)
+    !> activating it changes the work of the solver, not the solution. A contact left out that
+    !> the others' impulses shut within the step is let in after the solve by the rule's
+    !> re-check (contacts_recheck), and the step solved again.
+    !> There is no position correction (standard Moreau-Jean): with theta = 1 no contact
+    !> overlaps beyond the allowance; with theta < 1 a step takes a contact at most
+    !> (1 - theta) h |u_n| farther in, u_n its normal velocity at the start of the step
+    !> (doc/theory.md 2.4), and the overlap is kept. (A full push-out -g/(theta h) of overlaps
+    !> was tried and makes dense packings unstable.)
     !> The pair's output y = (g, u_n(begin)) is stored for the next step's rule.
     subroutine contacts_set_laws(cs, law, rule, radius, mat, wall_mat, materials, vel_begin, vel_free, &
                                  wall_vel_begin, wall_vel_end)
@@ -707,6 +710,52 @@ contains
         end do
         !$omp end parallel do
     end subroutine contacts_set_laws
+
+    !> After a solve: the rule's re-check (activation_t%recheck) of the contacts left out of
+    !> it, neither active nor intact bonds, on the end-of-step velocities. With `activate`
+    !> those it lets in become active, with r = 0 and the normal target it gives (the solver
+    !> shift as contacts_set_laws sets it); without, they are only counted. A contact that
+    !> cannot move along its normal (W_nn at the floor of dem_nlgs's blocked contacts: both
+    !> bodies fixed or imposed) is not re-checked: no impulse can shut it, and the solve would
+    !> leave it out again. Contacts are independent: the loop runs over the OpenMP threads
+    !> (same result).
+    subroutine contacts_recheck(cs, law, rule, vel, wall_vel, activate, added)
+        !> Contacts, after the solve (frames, laws, activity set).
+        type(contact_set_t), intent(inout) :: cs
+        !> Step parameters.
+        type(contact_law_t), intent(in) :: law
+        !> Rule of activation of the contacts without a bond.
+        class(activation_t), intent(in) :: rule
+        !> End-of-step disk velocities (3, n_disks).
+        real(wp), intent(in) :: vel(:, :)
+        !> Wall velocities at the end of the step (2, n_walls).
+        real(wp), intent(in) :: wall_vel(:, :)
+        !> Let the contacts in (else count them only).
+        logical, intent(in) :: activate
+        !> Contacts the re-check lets in.
+        integer, intent(out) :: added
+        integer :: k
+        real(wp) :: u(3), uw(2), target
+        logical :: active
+        added = 0
+        !$omp parallel do schedule(static) private(k, u, uw, target, active) reduction(+:added) &
+        !$omp if (cs%n >= parallel_min)
+        do k = 1, cs%n
+            if (cs%active(k) .or. cs%status(k) == status_cohesive) cycle
+            if (cs%w(1, k) <= diagonal_floor*(cs%w(1, k) + cs%w(3, k))) cycle
+            u = contacts_local_velocity(cs, k, vel, wall_vel)
+            call rule%recheck(law%h, law%theta, law%gap_allowance*cs%amoy(k), cs%gap(k), u(1), active, target)
+            if (.not. active) cycle
+            added = added + 1
+            if (.not. activate) cycle
+            uw = 0.0_wp
+            if (cs%i1(k) < 0) uw = -wall_term(cs%nrm(:, k), wall_vel(:, -cs%i1(k)))
+            cs%shift(1, k) = uw(1) - target
+            cs%r(:, k) = 0.0_wp
+            cs%active(k) = .true.
+        end do
+        !$omp end parallel do
+    end subroutine contacts_recheck
 
     !> Local components (n.v, t.v) of a wall velocity v.
     pure function wall_term(nrm, v) result(u)

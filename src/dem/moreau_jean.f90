@@ -11,7 +11,9 @@
 !>   3. contact laws (by default activation on the predicted gap with a round-off allowance,
 !>      or on the previous reaction; Newton restitution or gap term; cohesion), frames;
 !>   4. NLGS with the bi-potential local solver: v+ and the impulses (blocked contacts, whose
-!>      bodies are both immobile along the normal, are left out and counted in `stats`);
+!>      bodies are both immobile along the normal, are left out and counted in `stats`); the
+!>      rule of activation re-checks the contacts it left out on v+, and the step is solved
+!>      again with those the impulses shut (mj_solve);
 !>   5. q+ = q + h [(1 - theta) v + theta v+]; bonds pulled beyond their cohesion break;
 !>      energies.
 !> Energy audit (per unit thickness), exact for the discrete scheme up to round-off:
@@ -40,9 +42,9 @@ module dem_moreau_jean
     use dem_materials, only: materials_t
     use dem_contacts, only: contact_set_t, contact_law_t, contacts_set_frames, contacts_make_bonds, contacts_lost_bonds, &
                             status_cohesive, contacts_set_laws, contacts_finish, contacts_impulses, contacts_local_velocity, &
-                            contacts_bytes
+                            contacts_bytes, contacts_recheck
     use dem_detection, only: detector_t, detect_contacts, detector_bytes
-    use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_bilateral_t
+    use dem_nlgs, only: nlgs_config_t, nlgs_stats_t, nlgs_bilateral_t, nlgs_apply_reactions, block_kept
     use dem_solve_method, only: solve_method_t, sweeps_method_t
     use dem_bonds, only: rupture_log_t, break_none, break_lost
     use dem_activation, only: activation_t, activation_predicted_t
@@ -52,12 +54,20 @@ module dem_moreau_jean
     public :: mj_free_velocities, mj_detect, mj_solve, mj_end_step, mj_load_energy, mj_velocity_error_energy, &
               mj_bonds_at_start, mj_bonds_made
 
+    !> Most contact solves of a step (mj_solve): the first, and one after each re-check of the
+    !> rule of activation that let in contacts the solve before had shut. Each round lets in
+    !> the contacts the last one's impulses shut, one more link of a chain of contacts pushed
+    !> shut in turn (a column falling on its support); at the cap the step is reported
+    !> unconverged.
+    integer, parameter, public :: mj_max_solves = 10
+
     !> Time-stepping settings.
     type :: mj_config_t
         !> Time step [s].
         real(wp) :: h = 1.0e-4_wp
         !> Theta in [1/2, 1]. theta = 1/2 conserves energy in free flight and at e = 1 impacts;
-        !> theta = 1 never lets a contact overlap.
+        !> theta = 1 never lets a contact overlap (with MULTICOR's rule of activation, which
+        !> re-checks the contacts it left out: mj_solve).
         real(wp) :: theta = 0.5_wp
         !> Alert distance of the detection [m].
         real(wp) :: alert = 0.0_wp
@@ -255,17 +265,69 @@ contains
     !> Part 3 of a step: the contact solve by the system's strategy (`method`: the NLGS
     !> sweeps, or the intact bonds as a direct block with sweeps over the others) from the
     !> velocities in `vel`; end-of-step velocities in `vel`.
+    !> Then the rule of activation re-checks the contacts it left out on the end-of-step
+    !> velocities (activation_t%recheck, contacts_recheck): a contact the free motion left open
+    !> may have been shut by the other contacts' impulses. Those it lets in join the solve, which
+    !> is done again warm-started from the reactions found, until a re-check lets in none, for
+    !> at most mj_max_solves solves (stats%solves); at the cap, contacts still shut are counted
+    !> (stats%recheck_left) and the step is not converged. The velocities the solve starts from
+    !> again are the end-of-step ones without the contact impulses (the strategy applies the
+    !> reactions again), so that the multipliers of bilateral constraints stay those of the
+    !> velocities. With MULTICOR's rule no contact then ends shut beyond the round-off allowance
+    !> (doc/theory.md 2.4); Siconos' rule never lets one in, and its step is one solve.
     subroutine mj_solve(sys, bilateral)
         !> System, after `mj_detect`.
         type(dem_system_t), intent(inout) :: sys
         !> Bilateral velocity constraints kept satisfied by the solver (default: none).
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         integer(i8) :: c0, c1, rate
+        type(nlgs_stats_t) :: first, round
+        integer :: added
         call system_clock(c0, rate)
         call sys%method%solve(sys%solver, sys%contacts, sys%im, sys%vel, sys%stats, bilateral)
+        first = sys%stats
+        do
+            call contacts_recheck(sys%contacts, step_law(sys), sys%scheme%activation, sys%vel, sys%wall_v1, &
+                                  sys%stats%solves < mj_max_solves, added)
+            if (added == 0) exit
+            if (sys%stats%solves == mj_max_solves) then
+                sys%stats%recheck_left = added
+                sys%stats%converged = .false.
+                exit
+            end if
+            ! back to the velocities without the contact impulses (the strategy applies them again)
+            sys%contacts%r(:, 1:sys%contacts%n) = -sys%contacts%r(:, 1:sys%contacts%n)
+            call nlgs_apply_reactions(sys%contacts, sys%im, sys%vel)
+            sys%contacts%r(:, 1:sys%contacts%n) = -sys%contacts%r(:, 1:sys%contacts%n)
+            call sys%method%solve(sys%solver, sys%contacts, sys%im, sys%vel, round, bilateral)
+            call add_round(sys%stats, round, added)
+        end do
+        ! the blocked contacts were taken out of the list's active set by the first solve
+        sys%stats%n_blocked = first%n_blocked
         call system_clock(c1)
         sys%time_solver = sys%time_solver + real(c1 - c0, wp)/real(rate, wp)
     end subroutine mj_solve
+
+    !> The statistics of the step after one more solve `round` (mj_solve), which `added`
+    !> contacts joined: its state (error, convergence, active set) with the work of both.
+    pure subroutine add_round(stats, round, added)
+        !> Statistics of the step so far; on exit, of the step with the round.
+        type(nlgs_stats_t), intent(inout) :: stats
+        !> Statistics of the solve just done.
+        type(nlgs_stats_t), intent(in) :: round
+        !> Contacts the re-check before it let in.
+        integer, intent(in) :: added
+        type(nlgs_stats_t) :: total
+        total = round
+        total%sweeps = stats%sweeps + round%sweeps
+        total%local_iterations = stats%local_iterations + round%local_iterations
+        total%updates = stats%updates + round%updates
+        total%corrections = stats%corrections + round%corrections
+        if (round%block_given_up == block_kept) total%block_given_up = stats%block_given_up
+        total%solves = stats%solves + 1
+        total%rechecked = stats%rechecked + added
+        stats = total
+    end subroutine add_round
 
     !> Part 4 of a step: statuses and broken bonds (logged in `ruptures`; bonds are judged
     !> at converged steps only), energy audit (coupling_impulse included), new configuration

@@ -330,6 +330,15 @@ module dem_nlgs
         !> stall_growth, while a member must yield: the signature of a stall, whether or not
         !> the growth moved bodies (a stall is the case where it moved none).
         logical :: growth_seen = .false.
+        !> Solves of the step (set by the time step, dem_moreau_jean::mj_solve; the counts above
+        !> are summed over them, the rest is the last one's): 1, plus one for each re-check of
+        !> the rule of activation that let in contacts the solve before had shut.
+        integer :: solves = 1
+        !> Contacts the re-checks let in.
+        integer :: rechecked = 0
+        !> Contacts the re-check after the last solve allowed still found shut, left out (0 when
+        !> the solves ended before their cap): the step is then not converged.
+        integer :: recheck_left = 0
     end type nlgs_stats_t
 
     !> History of the Anderson acceleration: differences of the sweep map's outputs g and

@@ -34,7 +34,8 @@ module driver_coupled_loop
     use driver_results_dem, only: dem_writer_t
     use driver_results_coupled, only: coupled_writer_t
     use driver_run_dem, only: max_warnings, speed_warning, last_unconverged_warning, fclib_path, tolerance_floor_hint, &
-                              fclib_moment_note, fclib_after_end_warning, fclib_no_contacts_warning, lost_bonds_warning, bonds_line
+                              fclib_moment_note, fclib_after_end_warning, fclib_no_contacts_warning, lost_bonds_warning, &
+                              bonds_line, recheck_capped_text
     use driver_results_dem, only: write_fclib_local
     use dem_local_problem, only: local_problem_t
     use dem_contacts, only: status_cohesive
@@ -516,10 +517,16 @@ contains
         character(len=512) :: buf
         lp%unconverged = lp%unconverged + 1
         if (lp%unconverged > max_warnings) return
-        write (buf, '(a,i0,a,es12.4e3,a,i0,a)') 'warning: step ', lp%k, ' (t = ', self%sys%fe%t, &
-            ' s): the joint contact/multiplier solve did not converge in ', self%sys%stats%sweeps, ' sweeps'
-        call report(trim(buf)//self%unconverged_detail()// &
-                    tolerance_floor_hint(self%sys%dem%stats%siconos_floor, self%sys%dem%solver%tol))
+        if (self%sys%dem%stats%recheck_left > 0) then
+            write (buf, '(a,i0,a,es12.4e3,a)') 'warning: step ', lp%k, ' (t = ', self%sys%fe%t, ' s): '
+            call report(trim(buf)//' '// &
+                        recheck_capped_text(self%sys%dem%stats%recheck_left, self%sys%dem%stats%solves))
+        else
+            write (buf, '(a,i0,a,es12.4e3,a,i0,a)') 'warning: step ', lp%k, ' (t = ', self%sys%fe%t, &
+                ' s): the joint contact/multiplier solve did not converge in ', self%sys%stats%sweeps, ' sweeps'
+            call report(trim(buf)//self%unconverged_detail()// &
+                        tolerance_floor_hint(self%sys%dem%stats%siconos_floor, self%sys%dem%solver%tol))
+        end if
         if (lp%unconverged == max_warnings) call report(last_unconverged_warning())
     end subroutine warn_unconverged
 

@@ -56,8 +56,8 @@ module driver_results_dem
         integer :: n_block_given_up_reverted = 0
         !> Buffered statistics per step: sweeps, contacts in the list, active contacts,
         !> converged (1) or not (0), why the bonded block was given up (nlgs_stats_t%block_given_up,
-        !> 0 when it was not).
-        integer, allocatable :: sweeps(:), contacts(:), active(:), blocked(:), converged(:), given_up(:)
+        !> 0 when it was not), contact solves (nlgs_stats_t%solves).
+        integer, allocatable :: sweeps(:), contacts(:), active(:), blocked(:), converged(:), given_up(:), solves(:)
         !> Buffered convergence norms and Signorini-Coulomb residuals per step.
         real(wp), allocatable :: norm(:), residual(:)
         !> Buffered Siconos errors per step (dem_nlgs, nlgs_siconos_error).
@@ -109,7 +109,7 @@ contains
         self%n_block_given_up_reverted = 0
         allocate (self%sweeps(stats_buffer), self%contacts(stats_buffer), &
                   self%active(stats_buffer), self%blocked(stats_buffer), self%converged(stats_buffer), &
-                  self%given_up(stats_buffer), self%norm(stats_buffer), &
+                  self%given_up(stats_buffer), self%solves(stats_buffer), self%norm(stats_buffer), &
                   self%residual(stats_buffer), self%siconos(stats_buffer))
         call properties(error)
         if (allocated(error)) return
@@ -196,8 +196,8 @@ contains
             !&<
             character(len=*), parameter :: energies(7) = [character(len=13) :: 'kinetic', &
                 'potential', 'external_work', 'drive_work', 'dissipated', 'numerical', 'balance']
-            character(len=*), parameter :: stats_int(6) = [character(len=14) :: 'sweeps', &
-                'contacts', 'active', 'blocked', 'converged', 'block_given_up']
+            character(len=*), parameter :: stats_int(7) = [character(len=14) :: 'sweeps', &
+                'contacts', 'active', 'blocked', 'converged', 'block_given_up', 'solves']
             character(len=*), parameter :: bond_ints(4) = [character(len=4) :: 'i', 'j', 'step', 'mode']
             !&>
             integer :: k
@@ -404,6 +404,7 @@ contains
         self%blocked(k) = stats%n_blocked
         self%converged(k) = merge(1, 0, stats%converged)
         self%given_up(k) = stats%block_given_up
+        self%solves(k) = stats%solves
         if (stats%block_given_up /= block_kept .and. stats%block_given_up /= block_given_up_reverted) &
             self%n_block_given_up = self%n_block_given_up + 1
         if (stats%block_given_up == block_given_up_reverted) &
@@ -453,9 +454,11 @@ contains
                                                 self%converged, self%norm, self%residual)
         if (allocated(self%siconos)) deallocate (self%siconos)
         if (allocated(self%given_up)) deallocate (self%given_up)
+        if (allocated(self%solves)) deallocate (self%solves)
         allocate (self%sweeps(stats_buffer), self%contacts(stats_buffer), &
                   self%active(stats_buffer), self%blocked(stats_buffer), self%converged(stats_buffer), &
-                  self%given_up(stats_buffer), self%norm(stats_buffer), self%residual(stats_buffer), &
+                  self%given_up(stats_buffer), self%solves(stats_buffer), self%norm(stats_buffer), &
+                  self%residual(stats_buffer), &
                   self%siconos(stats_buffer))
     end subroutine writer_resume
 
@@ -477,6 +480,8 @@ contains
         call file%append_chunk('/dem/solver/converged', self%converged(:k), error)
         if (allocated(error)) return
         call file%append_chunk('/dem/solver/block_given_up', self%given_up(:k), error)
+        if (allocated(error)) return
+        call file%append_chunk('/dem/solver/solves', self%solves(:k), error)
         if (allocated(error)) return
         call file%append_chunk('/dem/solver/error', self%norm(:k), error)
         if (allocated(error)) return

@@ -36,7 +36,7 @@ module driver_run_dem
     implicit none
     private
     public :: run_dem, max_warnings, report_line_iface, speed_warning, last_unconverged_warning
-    public :: tolerance_floor_hint
+    public :: tolerance_floor_hint, recheck_capped_text
     public :: fclib_path, fclib_after_end_warning, fclib_no_contacts_warning, fclib_moment_note, lost_bonds_warning
     public :: bonds_line
     public :: block_given_up_warning, block_given_up_summary
@@ -273,12 +273,17 @@ contains
         subroutine warn_unconverged()
             unconverged = unconverged + 1
             if (unconverged > max_warnings) return
-            write (buf, '(a,i0,a,es12.4e3,a,i0,a,es10.2e3,a,es10.2e3,a)') 'warning: step ', k, &
-                ' (t = ', cfg%system%time, ' s): the contact solver did not converge in ', &
-                cfg%system%stats%sweeps, ' sweeps (error ', cfg%system%stats%error, &
-                ' > tolerance ', cfg%system%solver%tol, ')'
-            call report(trim(buf)//tolerance_floor_hint(cfg%system%stats%siconos_floor, cfg%system%solver%tol)// &
-                        stall_hint(cfg%system%stats%stalled))
+            if (cfg%system%stats%recheck_left > 0) then
+                write (buf, '(a,i0,a,es12.4e3,a)') 'warning: step ', k, ' (t = ', cfg%system%time, ' s): '
+                call report(trim(buf)//' '//recheck_capped_text(cfg%system%stats%recheck_left, cfg%system%stats%solves))
+            else
+                write (buf, '(a,i0,a,es12.4e3,a,i0,a,es10.2e3,a,es10.2e3,a)') 'warning: step ', k, &
+                    ' (t = ', cfg%system%time, ' s): the contact solver did not converge in ', &
+                    cfg%system%stats%sweeps, ' sweeps (error ', cfg%system%stats%error, &
+                    ' > tolerance ', cfg%system%solver%tol, ')'
+                call report(trim(buf)//tolerance_floor_hint(cfg%system%stats%siconos_floor, cfg%system%solver%tol)// &
+                            stall_hint(cfg%system%stats%stalled))
+            end if
             if (unconverged == max_warnings) call report(last_unconverged_warning())
         end subroutine warn_unconverged
 
@@ -487,6 +492,19 @@ contains
         text = '; with its intact bonds held the step had no solution (a bond must yield, doc/theory.md 7.10) '// &
                'and no iteration was left to solve it again with the bond released: raise [solver] max_sweeps'
     end function stall_hint
+
+    !> Why a step whose solves met their cap (dem_moreau_jean::mj_max_solves) is not converged:
+    !> the impulses of its last solve still shut contacts left out of it.
+    pure function recheck_capped_text(left, solves) result(text)
+        !> Contacts still shut, left out (nlgs_stats_t%recheck_left).
+        integer, intent(in) :: left
+        !> Solves of the step (nlgs_stats_t%solves).
+        integer, intent(in) :: solves
+        character(len=:), allocatable :: text
+        text = 'the contact solve did not converge: after '//counted(solves, 'solve')//' the contact impulses '// &
+               'still shut '//counted(left, 'contact')//' left out of the solve (each solve lets in those the one '// &
+               'before shut, doc/theory.md 2.4), which may overlap; lower [time] step'
+    end function recheck_capped_text
 
     !> Line closing the series of per-step warnings about unconverged steps.
     pure function last_unconverged_warning() result(line)

@@ -69,12 +69,14 @@ contains
         call s%add_keyword('time', 'theta', [real_field('theta', '', lower=0.5_wp, upper=1.0_wp)], &
                            'Moreau-Jean theta of the particles: positions advance with (1 - theta) v(t) + '// &
                            'theta v(t + h); 1/2 conserves energy in free flight and elastic impacts, '// &
-                           '1 is fully implicit (dissipative, never overlaps).', default='0.5', &
+                           '1 is fully implicit (dissipative; with contact_scheme = multicor no contact overlaps, '// &
+                           'below 1 a step takes one at most (1 - theta) h |u_n| in, doc/theory.md 2.4).', default='0.5', &
                            allowed_when=when('run', 'analysis', 'dynamic'))
         call s%add_keyword('time', 'contact_scheme', [word_field('contact_scheme', 'multicor siconos')], &
                            'How the contacts of the particles enter a step. multicor: detected on the '// &
                            'mid configuration q + (1 - theta) h v, active when the free motion closes '// &
-                           'them or when they carried a load, a gap term for those still open '// &
+                           'them or when they carried a load, a gap term for those still open; after the '// &
+                           'solve, those left out that the others shut join it and the step is solved again '// &
                            '(doc/theory.md 2.3-2.4). siconos: the step of Siconos 4.4 (TimeStepping, '// &
                            'MoreauJeanOSI, one Newton iteration), to compare with it on the same discrete '// &
                            'problem: geometry at q + h v, active when the previous step''s gap plus h/2 '// &

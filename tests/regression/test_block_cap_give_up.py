@@ -19,7 +19,8 @@ projected onto its cone by its own law):
   - the wall does not go through the disks: its overlap is at most the (1 - theta) h v_wall a
     contact made within a step leaves, with both methods;
   - energy: the balance closes, the wall's work is of the order of nlgs's and at most 2 M v^2;
-  - every step converged or ended near the tolerance, as nlgs's steps do;
+  - every step converged or ended near the tolerance, as nlgs's steps do (but two of nlgs's,
+    whose alternating sweeps cycle at 6e-8);
   - reporting: /dem/solver/block_given_up marks step 5 (and any other step given up) with 2,
     the value of this reason, never 1 (the energy guard's); its attributes
     block_given_up_steps and block_given_up_unconverged_steps count them; one warning, at
@@ -104,9 +105,14 @@ def physics(blk, ngs):
     # nlgs itself leaves a step of this stack unconverged at 1.1e-12 (4.8e-11 on the audit's
     # 6 x 4 stack); the block's step 6, its bonds inside their cones, ends at its cap at 4e-12
     # (1.7e-12 in the Debug build): 100 times the tolerance tells steps that end as nlgs's do
-    # from the 1e-5 of a block held through the wall
-    for name, res in (("block", blk), ("nlgs", ngs)):
-        check(f"{name}: every step converged or ended near the tolerance", res["error"].max() <= 100 * TOLERANCE,
+    # from the 1e-5 of a block held through the wall. nlgs's alternating sweeps have cycled at
+    # 6.2e-8 and 8.1e-9 at steps 6 and 7 (the same with 400 000 sweeps; forward sweeps converge
+    # every step) since the broken bond (9, 4), which the wall's push shut within step 5, is let
+    # in by the re-check of the rule of activation (doc/theory.md 2.4): before, it stayed out of
+    # step 5 and the two disks overlapped by 1.75e-6 m for good. 1e-6 for nlgs, 16 times that
+    # cycle and 10 times below the 1e-5 of a block held through the wall.
+    for name, res, bound in (("block", blk, 100 * TOLERANCE), ("nlgs", ngs, 1e-6)):
+        check(f"{name}: every step converged or ended near the tolerance", res["error"].max() <= bound,
               f"unconverged steps {(np.flatnonzero(~res['converged']) + 1).tolist()}, errors "
               f"{np.array2string(res['error'], precision=2)}, iterations {res['sweeps'].tolist()}")
 
