@@ -19,7 +19,9 @@
 !>   solver contact updates per second = active contacts x sweeps / solver time of a step
 !>   (median and best over the timed steps); bytes per particle = every array of the system (disks,
 !>   walls, contacts, previous contact list, detection grid, work arrays) at its allocated size,
-!>   divided by N; and the detection scaling ratio t(1e5)/t(1e4).
+!>   divided by N; and the detection scaling ratio t(1e5)/t(1e4). The line closing each N
+!>   also counts the timed steps solved more than once (the re-check of the rule of
+!>   activation, doc/theory.md 2.4), as a comment line after the Siconos deposit's figures does.
 !> With the argument `--convergence`, prints instead the sweeps one step needs to reach the
 !> tolerance from a cold start (no warm start, cap 50000) on packings of 250 to 16000 disks:
 !> what limits the solver on tall static packings.
@@ -364,7 +366,7 @@ contains
         integer, intent(in) :: n
         type(case_t), intent(out) :: c
         real(wp), allocatable :: t_det(:), t_sol(:), rate(:)
-        integer :: s, n_steps, sweeps, n_conv, corrections
+        integer :: s, n_steps, sweeps, n_conv, corrections, resolved, solves_max
         real(wp) :: before_det, before_sol, sic
         ! at least 8 steps, and ~2e5 disk-steps for the small cases (unless --steps)
         n_steps = max(8, 200000/n)
@@ -387,6 +389,8 @@ contains
         sweeps = 0
         n_conv = 0
         corrections = 0
+        resolved = 0
+        solves_max = 1
         sic = 0.0_wp
         do s = 1, n_steps
             before_det = sys%time_detection
@@ -403,6 +407,8 @@ contains
                 sys%stats%sweeps, sys%stats%converged, sys%stats%siconos_error, 1.0e3_wp*t_sol(s), &
                 sys%stats%corrections
             corrections = corrections + sys%stats%corrections
+            if (sys%stats%solves > 1) resolved = resolved + 1
+            solves_max = max(solves_max, sys%stats%solves)
             c%sic_max = max(c%sic_max, sys%stats%siconos_error)
         end do
         c%sic_mean = sic/n_steps
@@ -421,9 +427,10 @@ contains
             c%v_mean = sum(sqrt(p%vx(1:p%n)**2 + p%vy(1:p%n)**2))/p%n/(gravity*step)
             c%v_max = maxval(sqrt(p%vx(1:p%n)**2 + p%vy(1:p%n)**2))/(gravity*step)
         end associate
-        write (output_unit, '(a, i0, a, f0.1, a, f0.2, a, f0.2, a, f0.3)') '# N = ', c%n, ' done (', &
+        write (output_unit, '(a, i0, a, f0.1, a, f0.2, a, f0.2, a, f0.3, 3(a, i0))') '# N = ', c%n, ' done (', &
             sum(t_det) + sum(t_sol), ' s timed); sweeps/step ', c%sweeps, ', coarse corrections/step ', &
-            real(corrections, wp)/n_steps, ', converged ', c%converged
+            real(corrections, wp)/n_steps, ', converged ', c%converged, '; solved more than once ', resolved, &
+            ' of ', n_steps, ' steps, at most ', solves_max
         flush (output_unit)
     end subroutine run_case
 
@@ -505,7 +512,7 @@ contains
         real(wp), allocatable :: x(:), y(:), radius(:), t_step(:), t_sol(:)
         real(wp) :: width, top, sic, sic_max, before_sol
         integer(i8) :: c0, c1, rate
-        integer :: n_row, n_rows, n_steps, s, sweeps, sweeps_max, n_conv
+        integer :: n_row, n_rows, n_steps, s, sweeps, sweeps_max, n_conv, resolved, solves_max
         select case (n)
         case (200)
             n_row = 10
@@ -553,6 +560,8 @@ contains
         allocate (t_step(n_steps), t_sol(n_steps))
         sweeps = 0
         sweeps_max = 0
+        resolved = 0
+        solves_max = 1
         n_conv = 0
         sic = 0.0_wp
         sic_max = 0.0_wp
@@ -572,6 +581,8 @@ contains
             t_sol(s) = sys%time_solver - before_sol
             sweeps = sweeps + sys%stats%sweeps
             sweeps_max = max(sweeps_max, sys%stats%sweeps)
+            if (sys%stats%solves > 1) resolved = resolved + 1
+            solves_max = max(solves_max, sys%stats%solves)
             if (sys%stats%converged) n_conv = n_conv + 1
             sic = sic + sys%stats%siconos_error
             sic_max = max(sic_max, sys%stats%siconos_error)
@@ -588,6 +599,8 @@ contains
                 sic/n_steps, sic_max, maxval(p%y(1:n) + p%radius(1:n)), sum(p%mass(1:n)*p%y(1:n))/sum(p%mass(1:n)), &
                 sum(sqrt(p%vx(1:n)**2 + p%vy(1:n)**2))/n
         end associate
+        write (output_unit, '(3(a, i0))') '# solved more than once (the rule''s re-check, doc/theory.md 2.4): ', &
+            resolved, ' of ', n_steps, ' steps, at most ', solves_max
     end subroutine siconos_deposit
 
     !> The layout as CSV: a header of comment lines (box, material), then x, y, radius,
