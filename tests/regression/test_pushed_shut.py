@@ -13,6 +13,9 @@ in the solve and the disks overlapped for good.
 - columns of 8 and 12 disks 1e-5 m apart, hit from above at 1 m/s: each solve lets in one
   more contact down the column; 8 disks need 8 solves, 12 meet the cap of 10 (the step is
   reported unconverged with a warning);
+- three disks 3e-4 m apart, e = 1, the first at 1 m/s: sequential collisions at h = 0.1 ms;
+  at h = 1 ms both impacts fall in step 1 and are solved together, a closed form; momentum
+  kept, energy never created;
 - tests/regression/decks/dem_column_drop.dat (three disks dropped at h = 2 ms): no overlap at
   theta = 1, the per-step bound at theta = 1/2, and a run stopped and restarted gives the
   same record, bit for bit (the re-check keeps no state of its own).
@@ -149,6 +152,58 @@ def columns(exe, work):
           "\n".join(warnings) or proc.stdout[-400:])
 
 
+def cradle_deck(work, h, theta):
+    """Three disks in a row along x, 3e-4 m apart, no gravity, e = 1, mu = 0; disk 1 at 1 m/s
+    towards the others; 20 ms at step h."""
+    xs = [k * (2 * R + 3e-4) for k in range(3)]
+    disks = "".join(f"disk = {x!r} 0.2 {R} 1\n" for x in xs)
+    out = work / f"cradle_{h:g}_{theta}.dat"
+    out.write_text("[run]\nanalysis = dynamic\n[particles]\nmaterial = 1 2500\n" + disks +
+                   "initial_velocity = 1 x 1.0\n[contacts]\nlaw = 1 1 0.0 1 0\n[time]\n"
+                   f"step = {h!r}\nend = 0.02\ntheta = {theta}\n[solver]\ntolerance = 1e-12\n"
+                   "[output]\ninterval = 1\n")
+    return out
+
+
+def cradle(exe, work):
+    """Elastic impacts that one step chains (doc/theory.md 2.4). Two disks struck in turn, 3e-4 m
+    apart, at 1 m/s: the impacts are 0.3 ms apart. At h = 0.1 ms each has its own steps and the
+    row ends as the sequential collisions leave it, (0, 0, 1) m/s. At h = 1 ms both fall in the
+    first step: the first contact closes by its free motion (Newton, u_n >= e 1 m/s), the second
+    is shut by the first's impulse and let in by the re-check with the gap term
+    u_n >= -g/(theta h); the solve of both gives, with a = -(1 + t)/3 and t = -g/(theta h),
+    v = (a, a + 1, a + 1 + t) after step 1, and disks 2 and 3 then swap their velocities in an
+    impact of their own: (a, a + 1 + t, a + 1) at the end. Momentum is kept, energy is lost,
+    never created. (Before the re-check the second pair overlapped by 4e-4 m and bounced at
+    the next step.)"""
+    g = 3e-4
+    for theta in (0.5, 1.0):
+        for h in (1e-4, 1e-3):
+            rec = record(multicor(exe, cradle_deck(work, h, theta), work)[0])
+            vx = rec["velocity"][:, :, 0]
+            if h == 1e-4:
+                expect = {"end": np.array([0.0, 0.0, 1.0])}
+                solves = "every step solved once"
+                ok_solves = (rec["solves"] == 1).all()
+            else:
+                t = -g / (theta * h)
+                a = -(1 + t) / 3
+                expect = {"step 1": np.array([a, a + 1, a + 1 + t]), "end": np.array([a, a + 1 + t, a + 1])}
+                solves = "step 1 solved twice (the re-check), the others once"
+                ok_solves = rec["solves"][0] == 2 and (rec["solves"][1:] == 1).all()
+            got = {"step 1": vx[1], "end": vx[-1]}
+            # velocities of 1 m/s solved to 1e-12: 1e-12 m/s
+            err = max(float(np.abs(got[k] - v).max()) for k, v in expect.items())
+            check(f"cradle, h = {h:g}, theta {theta:g}: velocities {', '.join(expect)} the closed form",
+                  err < 1e-12 and rec["converged"].all(), f"error {err:.3g} m/s, end {vx[-1]}")
+            check(f"cradle, h = {h:g}, theta {theta:g}: {solves}", ok_solves, f"{rec['solves'][:5].tolist()}")
+            # momentum 1 (unit masses, 1 m/s) and kinetic energy at most 1/2, to round-off
+            momentum = np.abs(vx.sum(axis=1) - 1).max()
+            energy = (vx**2).sum(axis=1).max() - 1
+            check(f"cradle, h = {h:g}, theta {theta:g}: momentum kept, energy never created",
+                  momentum < 1e-12 and energy < 1e-12, f"momentum error {momentum:.3g}, energy excess {energy:.3g}")
+
+
 def column_drop(exe, decks, work):
     deck = decks / "dem_column_drop.dat"
     h = 2e-3
@@ -180,6 +235,7 @@ def main():
     decks = src / "tests" / "regression" / "decks"
     pushed_pair(exe, decks, work)
     columns(exe, work)
+    cradle(exe, work)
     column_drop(exe, decks, work)
     return summary()
 
