@@ -52,8 +52,9 @@ contains
         class(coupling_system_t), intent(inout) :: self
         !> The coupling operator.
         class(coupling_map_t), intent(in) :: op
-        !> The FE time integrator, initialised (its factored S, h and gamma are used).
-        type(newmark_t), intent(in) :: integ
+        !> The FE time integrator, initialised (its factored S, h and gamma are used; the solves
+        !> with S update a sparse factor's workspace).
+        type(newmark_t), intent(inout) :: integ
         !> Set on inconsistent sizes, a negative inverse mass or a singular A.
         type(error_t), allocatable, intent(out) :: error
         !> Particle side, independent DOFs: 1/((1 - alpha) m) per row (translations) or

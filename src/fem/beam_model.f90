@@ -804,7 +804,7 @@ contains
 
     !> x <- A^-1 x.
     subroutine band_factor_solve_vec(self, x, error)
-        class(band_factor_t), intent(in) :: self
+        class(band_factor_t), intent(inout) :: self
         real(wp), contiguous, intent(inout) :: x(:)
         type(error_t), allocatable, intent(out) :: error
         call self%a%solve(x, error)
@@ -812,7 +812,7 @@ contains
 
     !> X <- A^-1 X.
     subroutine band_factor_solve_mat(self, x, error)
-        class(band_factor_t), intent(in) :: self
+        class(band_factor_t), intent(inout) :: self
         real(wp), contiguous, intent(inout) :: x(:, :)
         type(error_t), allocatable, intent(out) :: error
         call self%a%solve(x, error)

@@ -139,11 +139,10 @@ module fem_continuum_dynamics
         procedure :: resume => audit_resume
     end type continuum_audit_t
 
-    !> A CHOLMOD factor as a `spd_factor_t` (the solver is reached through a pointer because
-    !> CHOLMOD's solve updates its workspace).
+    !> A CHOLMOD factor as a `spd_factor_t` (freed with it: sparse_solver_t's finaliser).
     type, extends(spd_factor_t) :: sparse_factor_t
         !> The factored solver.
-        type(sparse_solver_t), pointer :: solver => null()
+        type(sparse_solver_t), allocatable :: solver
     contains
         procedure :: solve_vec => sparse_factor_solve_vec
         procedure :: solve_mat => sparse_factor_solve_mat
@@ -578,7 +577,7 @@ contains
 
     !> x <- A^-1 x.
     subroutine sparse_factor_solve_vec(self, x, error)
-        class(sparse_factor_t), intent(in) :: self
+        class(sparse_factor_t), intent(inout) :: self
         real(wp), contiguous, intent(inout) :: x(:)
         type(error_t), allocatable, intent(out) :: error
         real(wp) :: b(size(x))
@@ -588,7 +587,7 @@ contains
 
     !> X <- A^-1 X.
     subroutine sparse_factor_solve_mat(self, x, error)
-        class(sparse_factor_t), intent(in) :: self
+        class(sparse_factor_t), intent(inout) :: self
         real(wp), contiguous, intent(inout) :: x(:, :)
         type(error_t), allocatable, intent(out) :: error
         real(wp), allocatable :: b(:, :)

@@ -66,8 +66,8 @@ module fem_dynamic_operator
         !> x <- A^-1 x.
         subroutine factor_solve_vec(self, x, error)
             import :: spd_factor_t, wp, error_t
-            !> The factor.
-            class(spd_factor_t), intent(in) :: self
+            !> The factor (a sparse solver updates its workspace).
+            class(spd_factor_t), intent(inout) :: self
             !> Right-hand side on entry, solution on exit.
             real(wp), contiguous, intent(inout) :: x(:)
             !> Set on a size mismatch or a failed solve.
@@ -77,8 +77,8 @@ module fem_dynamic_operator
         !> X <- A^-1 X.
         subroutine factor_solve_mat(self, x, error)
             import :: spd_factor_t, wp, error_t
-            !> The factor.
-            class(spd_factor_t), intent(in) :: self
+            !> The factor (a sparse solver updates its workspace).
+            class(spd_factor_t), intent(inout) :: self
             !> Right-hand sides on entry (n, k), solutions on exit.
             real(wp), contiguous, intent(inout) :: x(:, :)
             !> Set on a size mismatch or a failed solve.

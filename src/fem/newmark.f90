@@ -549,7 +549,7 @@ contains
     !> responds to a force f at t_{n+1} by gamma h S^-1 f, the displacement by beta h^2 S^-1 f.
     subroutine solve_effective_vec(self, b, x, error)
         !> The integrator (initialised).
-        class(newmark_t), intent(in) :: self
+        class(newmark_t), intent(inout) :: self
         !> Right-hand side (n_free).
         real(wp), intent(in) :: b(:)
         !> Solution (n_free).
@@ -567,7 +567,7 @@ contains
     !> X = S^-1 B for several right-hand sides (columns).
     subroutine solve_effective_mat(self, b, x, error)
         !> The integrator (initialised).
-        class(newmark_t), intent(in) :: self
+        class(newmark_t), intent(inout) :: self
         !> Right-hand sides (n_free, k).
         real(wp), intent(in) :: b(:, :)
         !> Solutions (n_free, k).
