@@ -57,7 +57,11 @@ def auto_scale(mesh: Mesh, d: np.ndarray, fraction: float = 0.1) -> float:
     dmax = float(np.max(np.hypot(d[:, U], d[:, W]))) if d.size else 0.0
     if dmax == 0.0 or size == 0.0:
         return 1.0
-    raw = fraction * size / dmax
+    return round_scale(fraction * size / dmax)
+
+
+def round_scale(raw: float) -> float:
+    """The largest round factor (1, 2 or 5 times a power of ten) not above ``raw`` > 0."""
     exponent = np.floor(np.log10(raw))
     mantissa = raw / 10**exponent
     step = 1.0 if mantissa < 2 else 2.0 if mantissa < 5 else 5.0

@@ -23,7 +23,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import EllipseCollection
 from matplotlib.figure import Figure
 
-from .beam import _time_unit
+from .beam import _time_unit, round_scale
 from .results import (FigureFiles, Records, ResultsError, _decode_attrs, _Getter, _open_results,
                       no_output_error)
 
@@ -168,6 +168,15 @@ class CoupledResults:
     @property
     def n_disks(self) -> int:
         return int(self.radius.size)
+
+    @property
+    def size(self) -> float:
+        """Larger side of the model's box at t = 0 (beam nodes and disks) [m]."""
+        xy, r = self.position[0][:, :2], self.radius[:, None]
+        nodes = np.column_stack([self.node_x, self.node_y])
+        lo = np.vstack([nodes, xy - r]).min(axis=0)
+        hi = np.vstack([nodes, xy + r]).max(axis=0)
+        return float(np.max(hi - lo))
 
     @property
     def length(self) -> float:
@@ -343,16 +352,85 @@ def plot_profiles(res: CoupledResults, time: Optional[float] = None,
     return fig
 
 
-def auto_scale(res: CoupledResults, k: int, fraction: float = 0.08) -> float:
-    """Displacement scale factor of a configuration plot: the largest displacement is drawn
-    as ``fraction`` of the model's length, unless it is already larger, or larger than a
-    quarter of the smallest disk radius (then the true geometry is drawn: magnifying would
-    draw the disks overlapping): scale 1."""
+#: Largest displacement of a configuration plot magnified automatically, as a fraction of the
+#: model's size (the larger side of its box at t = 0): the deformation scale of Abaqus' and
+#: of the beam plots (beam.auto_scale).
+SCALE_FRACTION = 0.1
+#: Largest change of the distance between the centres of two neighbouring disks that an
+#: automatic magnification may draw, as a fraction of the smaller radius: magnified further,
+#: the drawing would show disks overlapping or parted that are not (a quarter of a radius is
+#: a visible part of a disk). Neighbours: disks whose gap is at most that much at t = 0 or at
+#: the output drawn.
+GAP_CHANGE = 0.25
+
+
+def near_pairs(xy: np.ndarray, radius: np.ndarray, gap: float) -> tuple[np.ndarray, np.ndarray]:
+    """(i, j), i < j: the pairs of disks (centres ``xy`` (n, 2), radii ``radius``) whose gap
+    (distance of the centres minus the radii) is at most ``gap`` times the smaller radius;
+    found in a grid of cells the size of the largest such distance, each disk against the
+    disks of its cell and of the 8 around it (O(n) for disks of similar sizes)."""
+    n = radius.size
+    if n < 2:
+        return np.zeros(0, int), np.zeros(0, int)
+    reach = (2.0 + gap) * float(radius.max())
+    cell = np.floor((xy - xy.min(axis=0)) / reach).astype(np.int64)
+    # cell (cx, cy) -> cx rows + cy: the rows leave room for cy - 1 and cy + 1 of every cell
+    rows = int(cell[:, 1].max()) + 3
+    key = cell[:, 0] * rows + cell[:, 1]
+    order = np.argsort(key, kind="stable")
+    ordered = key[order]
+    first, second = [], []
+    # half of the 9 neighbouring cells: each pair of cells is looked at once
+    for dx, dy in ((0, 0), (1, -1), (1, 0), (1, 1), (0, 1)):
+        lo = np.searchsorted(ordered, key + dx * rows + dy, side="left")
+        hi = np.searchsorted(ordered, key + dx * rows + dy, side="right")
+        count = hi - lo
+        within = np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
+        first.append(np.repeat(np.arange(n), count))
+        second.append(order[np.repeat(lo, count) + within])
+    i, j = np.concatenate(first), np.concatenate(second)
+    i, j = np.minimum(i, j)[i != j], np.maximum(i, j)[i != j]
+    pair = np.unique(i * n + j)
+    i, j = pair // n, pair % n
+    distance = np.hypot(*(xy[j] - xy[i]).T)
+    keep = distance <= radius[i] + radius[j] + gap * np.minimum(radius[i], radius[j])
+    return i[keep], j[keep]
+
+
+def scale_limits(res: CoupledResults, k: int,
+                 fraction: float = SCALE_FRACTION) -> tuple[float, float]:
+    """(wanted, allowed) magnifications of the displacements at output ``k``: ``wanted``
+    draws the largest displacement (beam nodes and disks) as ``fraction`` of the model's size
+    (inf when nothing moves); ``allowed`` is the largest that draws no change of the distance
+    between the centres of two neighbouring disks (`GAP_CHANGE`) above GAP_CHANGE times the
+    smaller radius (inf when no neighbours' distance changes). A row or a stack of disks that
+    bends as a body keeps its distances: it is magnified like the beam; disks that move
+    against each other by a visible part of a radius are drawn at true scale."""
     p = profile(res, k)
-    dmax = max(float(np.abs(p.node_d).max(initial=0.0)), float(np.abs(p.disk_d).max(initial=0.0)))
-    if dmax == 0.0 or dmax >= 0.25 * float(res.radius.min()):
-        return 1.0
-    return max(1.0, fraction * res.length / dmax)
+    dmax = max(float(np.hypot(*p.node_d.T).max(initial=0.0)),
+               float(np.hypot(*p.disk_d.T).max(initial=0.0)))
+    wanted = fraction * res.size / dmax if dmax > 0.0 else np.inf
+    start, now = res.position[0][:, :2], res.position[k][:, :2]
+    pairs = [near_pairs(xy, res.radius, GAP_CHANGE) for xy in (start, now)]
+    i, j = (np.concatenate(side) for side in zip(*pairs))
+    change = np.abs(np.hypot(*(now[j] - now[i]).T) - np.hypot(*(start[j] - start[i]).T))
+    moved = change > 0.0
+    allowed = float(np.min(GAP_CHANGE * np.minimum(res.radius[i], res.radius[j])[moved]
+                           / change[moved])) if moved.any() else np.inf
+    return wanted, allowed
+
+
+def auto_scale(res: CoupledResults, k: int, fraction: float = SCALE_FRACTION) -> float:
+    """Displacement scale factor of a configuration plot (`scale_limits`): the wanted
+    magnification, at most the allowed one, rounded down to 1, 2 or 5 times a power of ten;
+    1 (true scale) when either is below 2 or nothing moves."""
+    return _chosen_scale(*scale_limits(res, k, fraction))
+
+
+def _chosen_scale(wanted: float, allowed: float) -> float:
+    """The factor `auto_scale` chooses from the magnifications `scale_limits` gives."""
+    raw = min(wanted, allowed)
+    return round_scale(raw) if 2.0 <= raw < np.inf else 1.0
 
 
 def plot_configuration(res: CoupledResults, time: Optional[float] = None,
@@ -360,10 +438,14 @@ def plot_configuration(res: CoupledResults, time: Optional[float] = None,
     """The deformed configuration at the stored output nearest to ``time``: the beam through
     its displaced nodes, the disks as circles at their displaced centres (coupled disks in
     green), the initial beam dashed, the overlap shaded; displacements times ``scale``
-    (default: auto_scale)."""
+    (default: auto_scale), the factor in the title and the legend (and, when the disks'
+    relative motion keeps it below the wanted one, why: `scale_limits`)."""
     k = res.nearest_index(time)
+    limited = False
     if scale is None:
-        scale = auto_scale(res, k)
+        wanted, allowed = scale_limits(res, k)
+        scale = _chosen_scale(wanted, allowed)
+        limited = scale != _chosen_scale(wanted, np.inf)
     d = res.fe_displacement[k]
     p0 = res.position[0]
     centres = p0[:, :2] + scale * (res.position[k, :, :2] - p0[:, :2])
@@ -390,15 +472,19 @@ def plot_configuration(res: CoupledResults, time: Optional[float] = None,
                                         lw=1.2, zorder=2))
     ax.set_xlim(xs.min() - pad, xs.max() + pad)
     ax.set_ylim(ys.min() - pad, ys.max() + pad)
-    ax.plot([], [], "-", color=FE_COLOUR, lw=2.5, label="beam (deformed)")
+    magnified = "true scale" if scale == 1.0 else f"displacements × {scale:g}"
+    ax.plot([], [], "--", color="0.6", lw=1, label="beam at t = 0")
+    ax.plot([], [], "-", color=FE_COLOUR, lw=2.5, label=f"beam (deformed, {magnified})")
     ax.plot([], [], "o", mfc="none", color=DEM_COLOUR, label="disks")
     ax.plot([], [], "o", mfc="none", color=COUPLED_COLOUR, label="coupled disks")
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    ax.legend(loc="lower left", fontsize="small")
-    ax.set_title(f"{res.title}\nt = {_time_text(res.time[k], res.time)}, "
-                 f"displacements x {scale:.3g}")
+    fig.legend(loc="outside lower center", ncol=5, fontsize="small", frameon=False)
+    more = "magnifying" if scale == 1.0 else "magnifying more"
+    why = (f" ({more} would draw gaps between disks changed by over {GAP_CHANGE:g} R)"
+           if limited else "")
+    ax.set_title(f"{res.title}\nt = {_time_text(res.time[k], res.time)}, {magnified}{why}")
     return fig
 
 

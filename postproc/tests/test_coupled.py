@@ -13,7 +13,7 @@ from multicor_post.results import ResultsError
 from synthetic import cantilever_layout, write_results
 from synthetic_coupled import (COUPLED, DISK_X, NODE_X, OVERLAP, V, beam_w, disk_dy,
                                write_coupled)
-from synthetic_dem import H, N_OUT, STEPS_PER_OUT
+from synthetic_dem import H, N_OUT, R, STEPS_PER_OUT
 
 # Values written as float64 and read back: exact; derived ones (differences of positions
 # of O(0.1 m)): a few ulps of 0.2.
@@ -102,14 +102,68 @@ def test_write_all_writes_the_coupled_plots(tmp_path, coupled_file):
     assert all(os.path.getsize(p) > 10000 for p in paths)
 
 
-def test_auto_scale_magnifies_small_displacements_only(coupled_file):
+def test_auto_scale_magnifies_a_row_that_bends_as_a_body(coupled_file):
+    # The disks follow the beam (a parabola, then its tangent): their displacement at the
+    # last output, 5 mm, exceeds R/4 = 2.5 mm, which drew them at true scale (x 1): a
+    # deflection invisible beside the model. It is now drawn as 10 % of the model's size,
+    # the factor rounded down to 1, 2 or 5 times a power of ten (exact).
     res = coupled.load_coupled(coupled_file)
-    # Output 1: largest displacement 1.7 mm < R/4 = 2.5 mm, drawn as 8 % of the length.
-    dmax = abs(disk_dy(DISK_X[-1], 1))
-    assert coupled.auto_scale(res, 1) == pytest.approx(0.08 * res.length / dmax, rel=1e-12)
-    # Output 3: 5 mm > R/4: true geometry; output 0: no displacement.
-    assert coupled.auto_scale(res, N_OUT - 1) == 1.0
+    size = DISK_X[-1] + R                     # box 0 .. 0.17 m along x, 0.02 m high
+    assert res.size == pytest.approx(size, rel=1e-15)
+    dmax = abs(disk_dy(DISK_X[-1], N_OUT - 1))
+    assert dmax > R / 4
+    assert coupled.scale_limits(res, N_OUT - 1)[0] == pytest.approx(0.1 * size / dmax, rel=1e-12)
+    assert coupled.auto_scale(res, N_OUT - 1) == 2.0            # 3.4 rounded down
+    assert coupled.auto_scale(res, 1) == 10.0                   # 10.2 rounded down
+    # output 0: nothing moves
     assert coupled.auto_scale(res, 0) == 1.0
+    fig = coupled.plot_configuration(res)
+    assert fig.axes[0].get_title().endswith(", displacements × 2")
+    assert "beam (deformed, displacements × 2)" in [t.get_text() for t in fig.legends[0].texts]
+
+
+def with_disk_moved(res, disk, dx):
+    """The results with disk `disk` (0-based) moved by dx along x at every output after the
+    first (towards its neighbour at dx > 0): the positions as an array in memory."""
+    position = np.asarray(res.position).copy()
+    position[1:, disk, 0] += dx
+    res.position = position
+    return res
+
+
+def test_auto_scale_keeps_the_gaps_between_disks_as_they_are(coupled_file):
+    # Disk 4 moves 1 mm towards disk 5 (pitch 2 R): x 10 would draw the gap closed by 1 cm,
+    # the disks overlapping; the magnification stops where a gap drawn changes by R/4:
+    # 0.25 R / (the largest change of a neighbours' distance, 1 mm and the bending's 3e-6 m)
+    # = 2.49, rounded down to 2.
+    res = with_disk_moved(coupled.load_coupled(coupled_file), 3, 1e-3)
+    wanted, allowed = coupled.scale_limits(res, 1)
+    row = [np.hypot(*np.diff(res.position[k][:, :2], axis=0).T) for k in (0, 1)]
+    # the same differences of positions as scale_limits takes: round-off of 0.02 m, 1e-12
+    assert allowed == pytest.approx(0.25 * R / np.abs(row[1] - row[0]).max(), rel=1e-12)
+    assert allowed == pytest.approx(2.5, rel=1e-2)     # the bending's share, 0.3 %
+    assert wanted > 10.0
+    assert coupled.auto_scale(res, 1) == 2.0
+    title = coupled.plot_configuration(res, time=float(res.time[1])).axes[0].get_title()
+    assert title.endswith(", displacements × 2 (magnifying more would draw gaps between "
+                          "disks changed by over 0.25 R)")
+    # 2 mm, over R/8: magnifying at all would change the gap by over R/4: true scale
+    res = with_disk_moved(coupled.load_coupled(coupled_file), 3, 2e-3)
+    assert coupled.auto_scale(res, 1) == 1.0
+    assert "true scale (magnifying would" in coupled.plot_configuration(
+        res, time=float(res.time[1])).axes[0].get_title()
+
+
+def test_near_pairs_are_those_a_search_of_every_pair_finds():
+    rng = np.random.default_rng(7)
+    radius = rng.uniform(0.5, 1.0, 400)
+    xy = rng.uniform(0.0, 30.0, (400, 2))
+    i, j = coupled.near_pairs(xy, radius, 0.25)
+    a, b = np.triu_indices(400, 1)
+    gap = np.hypot(*(xy[b] - xy[a]).T) - radius[a] - radius[b]
+    near = gap <= 0.25 * np.minimum(radius[a], radius[b])
+    assert near.sum() > 100                    # the test has pairs to find
+    assert sorted(zip(i.tolist(), j.tolist())) == sorted(zip(a[near].tolist(), b[near].tolist()))
 
 
 def test_plot_results_handles_a_coupled_file(tmp_path, coupled_file, capsys):
@@ -168,7 +222,7 @@ def test_titles_give_the_time_in_the_unit_of_the_run(coupled_file):
     title = coupled.plot_profiles(res).axes[0].get_title()
     assert title.endswith("\nt = 1.62346 s")
     config = coupled.plot_configuration(res, time=0.0).axes[0].get_title()
-    assert "\nt = 0.123457 s, displacements x " in config
+    assert config.endswith("\nt = 0.123457 s, true scale")     # nothing moves at t = 0
     compare = coupled.plot_compare_profiles([res], ["a"]).axes[0].get_title()
     assert compare == "t = 1.62346 s"
     # a run of a few ms keeps its ms (the synthetic outputs: 0 .. 15 ms)
