@@ -11,10 +11,14 @@ from dataclasses import dataclass
 from typing import Optional
 
 import numpy as np
+from matplotlib import colormaps
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.cm import ScalarMappable
 from matplotlib.collections import EllipseCollection, LineCollection
+from matplotlib.colors import BoundaryNorm
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from matplotlib.ticker import MaxNLocator
 
 from .beam import _time_unit
 from .results import (FigureFiles, Records, ResultsError, _decode_attrs, _Getter, _open_results,
@@ -31,6 +35,12 @@ MAX_FORCE_WIDTH = 4.0
 SMALL_SYSTEM = 50
 #: Contact forces below this fraction of the largest of the run are not drawn.
 NOISE = 1e-6
+#: Velocity histories of up to this many disks get a legend, one colour of matplotlib's
+#: default cycle (10 colours) each; more are coloured by number (VELOCITY_MAP).
+LEGEND_DISKS = 10
+#: Colour map of the disks' numbers in the velocity histories of more than LEGEND_DISKS:
+#: sequential and perceptually uniform, its ends (dark blue, yellow) both visible on white.
+VELOCITY_MAP = colormaps["viridis"]
 
 
 @dataclass
@@ -411,21 +421,36 @@ def plot_solver(res: DemResults) -> Figure:
 
 
 def plot_velocities(res: DemResults) -> Figure:
-    """Velocity history (vx, vy, omega) of every disk of a small system."""
+    """Velocity history (vx, vy, omega) of every disk of a small system. Up to
+    LEGEND_DISKS disks, each has a colour of matplotlib's default cycle and a legend entry;
+    more (the cycle would repeat its 10 colours: 17 disks drew 7 pairs of one colour) are
+    coloured by their number along a sequential colour map, numbered by a colour bar."""
     ft, ut = _time_unit(res.time)
     t = res.time * ft
     fig = _new_figure(height=7.0)
     axes = fig.subplots(3, 1, sharex=True)
     labels = ["v_x [m/s]", "v_y [m/s]", "ω [rad/s]"]
+    numbered = res.n > LEGEND_DISKS
+    if numbered:
+        # one colour per disk number, 1 .. n, in bands of a discrete colour bar
+        norm = BoundaryNorm(np.arange(res.n + 1) + 0.5, VELOCITY_MAP.N)
+        colour = [VELOCITY_MAP(norm(i + 1)) for i in range(res.n)]
+    else:
+        colour = [f"C{i}" for i in range(res.n)]
     for i in range(res.n):
         v = res.velocity[:, i]      # the disk's history, read once
         for d, ax in enumerate(axes):
-            ax.plot(t, v[:, d], lw=1.0, label=f"disk {i + 1}" if d == 0 else None)
+            ax.plot(t, v[:, d], lw=1.0, color=colour[i], label=f"disk {i + 1}" if d == 0 else None)
     for d, ax in enumerate(axes):
         ax.set_ylabel(labels[d])
         ax.grid(True, alpha=0.3)
     axes[-1].set_xlabel(f"time [{ut}]")
-    if res.n <= 10:
+    if numbered:
+        bar = fig.colorbar(ScalarMappable(norm=norm, cmap=VELOCITY_MAP), ax=axes, aspect=40,
+                           label="disk")
+        bar.locator = MaxNLocator(nbins=min(res.n, 20), integer=True)
+        bar.update_ticks()
+    elif res.n > 0:
         axes[0].legend(loc="best", fontsize="small", ncol=2)
     axes[0].set_title(f"{res.title}\nvelocities of the disks")
     return fig

@@ -5,10 +5,13 @@ import numpy as np
 import pytest
 from synthetic import cantilever_layout, write_results
 from synthetic_dem import G, MASS, N_DISKS, N_OUT, R, column_state, write_dem
+from synthetic_large import write_large_dem
 
 import plot_results
+from matplotlib.collections import QuadMesh
+from matplotlib.colors import to_rgba
 from multicor_post.particles import (MAX_FORCE_WIDTH, force_segments, force_widths, load_dem,
-                                     plot_configuration, plot_solver)
+                                     plot_configuration, plot_solver, plot_velocities)
 from multicor_post.results import ResultsError
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -229,3 +232,36 @@ def test_cli_reports_missing_files_and_datasets(tmp_path, capsys):
     assert "missing dataset '/dem/contacts/rn'" in capsys.readouterr().err
     with pytest.raises(ResultsError, match="no /dem group"):
         load_dem(write_results(tmp_path / "b.h5", *cantilever_layout(), parts=("static",)))
+
+
+@pytest.mark.parametrize("n_disks", [17, 50])
+def test_velocities_of_many_disks_are_told_apart_by_a_numbered_colour_bar(tmp_path, n_disks):
+    # 17 disks (the row of input/bending_case1.dat) had no legend and the default cycle's
+    # 10 colours, 7 of them drawn twice: now one colour per disk along the colour map, and a
+    # colour bar from disk 1 to disk n giving each its colour
+    res = load_dem(write_large_dem(tmp_path / "many.h5", n_disks, n_out=4, per_output=2))
+    fig = plot_velocities(res)
+    velocity_axes = fig.axes[:3]
+    for ax in velocity_axes:
+        colours = [tuple(to_rgba(line.get_color())) for line in ax.get_lines()]
+        assert len(colours) == n_disks
+        assert len(set(colours)) == n_disks
+    bar, = [ax for ax in fig.axes if ax not in velocity_axes]
+    assert bar.get_ylabel() == "disk"
+    assert bar.get_ylim() == (0.5, n_disks + 0.5)   # one band per disk, centred on its number
+    fig.canvas.draw()                                # the bar's colours are set when drawn
+    mesh, = [c for c in bar.collections if isinstance(c, QuadMesh)]
+    bands = mesh.get_facecolors()
+    assert len(bands) == n_disks
+    for band, line in zip(bands, velocity_axes[0].get_lines()):
+        # the band of disk i on the bar has the colour of its curve (the same rgba numbers)
+        assert tuple(band) == to_rgba(line.get_color())
+    assert velocity_axes[0].get_legend() is None
+
+
+def test_velocities_of_a_few_disks_keep_their_legend(tmp_path):
+    res = load_dem(write_dem(tmp_path / "col.h5"))
+    fig = plot_velocities(res)
+    assert len(fig.axes) == 3                       # no colour bar
+    legend = fig.axes[0].get_legend()
+    assert [t.get_text() for t in legend.get_texts()] == [f"disk {i}" for i in range(1, 6)]
