@@ -6,7 +6,8 @@ Figures (``write_all``):
   the deformed mesh at one state (static: the solution; dynamic: the stored state nearest to
   the time asked, default the last), the undeformed outline in grey and, in a coupled run, the
   disks (their displacements from the first output magnified like the mesh's). Small
-  displacements are magnified (the factor is in the title).
+  displacements are magnified (the factor is in the title). A component zero to round-off
+  (below ROUNDOFF of the largest, or `roundoff_stress`: a rigid motion's) is drawn white.
 - <name>_continuum_energy.png (dynamic): the energy audit of /continuum/energy.
 - <name>_history.png (dynamic): the displacement of one node against time (default: the node
   with the largest displacement over the stored states).
@@ -50,6 +51,7 @@ class ContinuumResults:
     disk_radius: Optional[np.ndarray] = None
     disk_time: Optional[np.ndarray] = None
     walls: Optional[np.ndarray] = None   # coupled: (n_out, n_walls, 4) x1, y1, x2, y2
+    young: Optional[np.ndarray] = None   # (n_elements,) [Pa]; None: a file without materials
 
     def nearest_index(self, t: Optional[float]) -> int:
         """The stored state nearest to time t (the last one for None or a static run)."""
@@ -64,6 +66,13 @@ TITLE_CHARACTERS = 80
 
 #: Relative level below which a stress component is round-off of the largest one.
 ROUNDOFF = 1e-9
+#: Multiple of eps E |u|max / h (`roundoff_stress`) below which a state's stresses are zero to
+#: round-off. The stresses of a rigid motion are D B u of nodal displacements that agree to
+#: their rounding: 1 to 3.3 times eps E |u|max / h measured in input/coupled2d_block.dat over
+#: its 100 steps (the displacements' rounding adds up step after step); 1e3 leaves room for
+#: 10^5 times as many steps adding up at random, and stays at a strain of 2e-13 |u|max / h,
+#: below what a solve in double precision resolves.
+ROUNDOFF_STRAIN = 1e3
 
 ENERGY_TERMS = ("kinetic", "strain", "external_work", "damping", "reaction_work", "balance")
 
@@ -120,6 +129,12 @@ def load_continuum(path) -> ContinuumResults:
                            for name in ENERGY_TERMS})
         res = ContinuumResults(path, title, analysis, x, connectivity, kind, time, u, stress,
                                energy, frequency)
+        if "continuum/materials/young" in f and "continuum/mesh/material" in f:
+            material = need("continuum/mesh/material")
+            young = need("continuum/materials/young")
+            if material.shape == (connectivity.shape[0],) and material.size and \
+                    1 <= material.min() and material.max() <= young.size:
+                res.young = young[material - 1]
         if "dem/position" in f:
             res.disk_radius = need("dem/particles/radius")
             res.disk_time = need("dem/time")
@@ -160,6 +175,29 @@ def auto_scale(res: ContinuumResults, u: np.ndarray, fraction: float = 0.1) -> f
     if umax == 0.0 or umax >= fraction * size:
         return 1.0
     return fraction * size / umax
+
+
+def shortest_side(res: ContinuumResults) -> float:
+    """Length of the shortest side of the elements in the reference mesh [m]."""
+    shortest = np.inf
+    for corners in element_polygons(res.x, res.connectivity, res.kind):
+        sides = np.hypot(*(np.roll(corners, -1, axis=0) - corners).T)
+        shortest = min(shortest, float(sides.min()))
+    return shortest
+
+
+def roundoff_stress(res: ContinuumResults, u: np.ndarray) -> float:
+    """Stress [Pa] below which a component of the state of displacements ``u`` is zero to
+    round-off: ROUNDOFF_STRAIN eps E |u|max / h (E the largest Young modulus, h the shortest
+    element side), D B u of nodal displacements known to their rounding eps |u|. 0 for a
+    file without the materials (of a build before /continuum/materials) or a state at rest."""
+    if res.young is None or not res.young.size or not u.size:
+        return 0.0
+    umax = float(np.max(np.hypot(u[:, 0], u[:, 1])))
+    h = shortest_side(res)
+    if umax == 0.0 or not 0.0 < h < np.inf:
+        return 0.0
+    return ROUNDOFF_STRAIN * np.finfo(float).eps * float(np.max(res.young)) * umax / h
 
 
 def _figure(width=8.0, height=6.0):
@@ -212,9 +250,13 @@ def plot_stress(res: ContinuumResults, time: Optional[float] = None,
     panel = float(np.clip(6.5 * extent[1] / max(extent[0], 1e-300) + 0.9, 1.6, 3.5))
     fig = _figure(height=1.0 + 3 * panel)
     axes = fig.subplots(3, 1, sharex=True)
-    # a component below ROUNDOFF times the largest one is round-off (sigma_yy of a bar in
-    # uniaxial tension): drawn white, not as a saturated pattern of noise
+    # a component below ROUNDOFF times the largest one (sigma_yy of a bar in uniaxial
+    # tension), or below the rounding of a stress computed from these displacements (every
+    # component of a rigid motion: `roundoff_stress`), is zero to round-off: drawn white over
+    # a colour range of that level, not as a saturated pattern of noise
     overall = float(np.max(np.abs(stress))) * fs if stress.size else 0.0
+    floor = max(ROUNDOFF * overall, roundoff_stress(res, u) * fs)
+    zero = []
     for c, (ax, name) in enumerate(zip(axes, ("σ_xx", "σ_yy", "σ_xy"))):
         values = stress[:, c] * fs
         # colour limits at the 99th percentile of |value|, so that a few elements at a corner
@@ -222,9 +264,10 @@ def plot_stress(res: ContinuumResults, time: Optional[float] = None,
         top = float(np.max(np.abs(values)))
         lim = float(np.percentile(np.abs(values), 99)) if values.size else 0.0
         lim = lim if lim > 0 else (top or 1.0)
-        noise = 0.0 < top < ROUNDOFF * overall
+        noise = top <= floor and floor > 0.0
         if noise:
-            lim = ROUNDOFF * overall
+            lim = floor
+            zero.append(top)
         ax.add_collection(PolyCollection(outline, facecolor="none", edgecolor="0.8", lw=0.3))
         pc = PolyCollection(deformed, array=values, cmap="RdBu_r", edgecolor="face", lw=0.2)
         pc.set_clim(-lim, lim)
@@ -235,7 +278,8 @@ def plot_stress(res: ContinuumResults, time: Optional[float] = None,
         ax.set_ylabel("y [m]")
         label = f"{name} [{us}]" + (f" (largest {top:.3g})" if top > lim * (1 + 1e-12) else "")
         if noise:
-            label = f"{name} [{us}] (round-off: at most {top:.1g})"
+            label = (f"{name} [{us}] (zero to round-off: at most {top:.1g})" if top > 0.0
+                     else f"{name} [{us}] (zero)")
         fig.colorbar(pc, ax=ax, label=label, extend="both" if top > lim * (1 + 1e-12) else "neither")
     axes[-1].set_xlabel("x [m]")
     when = ""
@@ -246,6 +290,8 @@ def plot_stress(res: ContinuumResults, time: Optional[float] = None,
     # over the figure, not over the panels: those of a tall body are narrower than its title
     # (which the figure clipped); a title line longer than the figure is wide is wrapped
     title = f"{res.title}\nstress per element on the deformed mesh{when} ({magnified})"
+    if len(zero) == 3:
+        title += f"\nevery component zero to round-off (|σ| at most {max(zero) / fs:.1g} Pa)"
     fig.suptitle("\n".join(textwrap.fill(line, TITLE_CHARACTERS) for line in title.split("\n")))
     return fig
 

@@ -220,3 +220,50 @@ def test_round_off_components_are_drawn_white(tmp_path):
     # the real component keeps its own limits
     assert fig.axes[0].collections[1].get_clim()[1] == pytest.approx(1.0, rel=1e-12)
     assert "round-off" not in fig.axes[3].get_ylabel()
+
+
+def with_materials(path, young=210e9):
+    """The results file with /continuum/materials/young and /continuum/mesh/material (every
+    element of material 1), as a build since /continuum/materials writes them."""
+    with h5py.File(path, "r+") as f:
+        f["continuum/materials/young"] = np.array([young])
+        f["continuum/mesh/material"] = np.ones(len(CONN), np.int32)
+    return path
+
+
+def test_the_stress_of_a_rigid_motion_is_drawn_as_zero_to_round_off(tmp_path):
+    # input/coupled2d_block.dat: a steel block in a rigid motion, |u| 0.94 mm, elements of
+    # 0.25 m; its stresses of 1e-7 Pa are D B u of displacements equal to their rounding,
+    # which every component drew in a full colour range, as a pattern of stress. Here: a
+    # translation of 1 mm (|u| = sqrt(5) mm) with stresses of +-5e-7 Pa
+    path = with_materials(write(tmp_path / "s.h5", "static"))
+    noise = 5e-7 * np.array([[1.0, -0.4, 0.2], [-0.6, 0.9, -1.0], [0.3, 0.7, -0.5]])
+    with h5py.File(path, "r+") as f:
+        f["continuum/static/displacement"][...] = np.tile([1e-3, -2e-3], (len(X), 1))
+        f["continuum/static/stress"][...] = noise
+    res = continuum.load_continuum(path)
+    # shortest side 1 m (the Q4s'; the T3's are 1.12 m and 1 m): 1e3 eps E |u| / h
+    level = 1e3 * np.finfo(float).eps * 210e9 * np.sqrt(5) * 1e-3 / 1.0
+    assert continuum.roundoff_stress(res, res.u[0]) == pytest.approx(level, rel=1e-12)
+    fig = continuum.plot_stress(res)
+    for c in range(3):
+        # the colour range is +-that level (about 1e-4 Pa): the noise is drawn near white
+        lo, hi = fig.axes[c].collections[1].get_clim()
+        assert hi == pytest.approx(level, rel=1e-12) and lo == -hi
+        assert "zero to round-off" in fig.axes[3 + c].get_ylabel()
+    assert fig.get_suptitle().endswith(
+        "\nevery component zero to round-off (|σ| at most 5e-07 Pa)")
+
+
+def test_a_small_real_stress_keeps_its_colour_range(tmp_path):
+    # the synthetic kPa stresses of displacements of 0.9 mm in steel: 1e11 times the rounding
+    # of a stress computed from them, drawn in their own range
+    res = continuum.load_continuum(with_materials(write(tmp_path / "s.h5", "static")))
+    assert continuum.roundoff_stress(res, res.u[0]) < 1e-4
+    fig = continuum.plot_stress(res)
+    for c in range(3):
+        assert "round-off" not in fig.axes[3 + c].get_ylabel()
+        # kPa, the 99th percentile of the element values 1, 2, 3 (times c + 1)
+        top = np.percentile(stress(1)[:, c], 99) / 1e3
+        assert fig.axes[c].collections[1].get_clim()[1] == pytest.approx(top, rel=1e-12)
+    assert "zero to round-off" not in fig.get_suptitle()
