@@ -1,12 +1,15 @@
 """results.png of `scripts/multicor-sweep collect` (its plot function on rows as collect builds
-them from results.csv): a word-valued swept key and a sweep without any value yet; the grid
-file of `create --grid`."""
+them from results.csv): a word-valued swept key and a sweep without any value yet, the units
+on its axes (of the keys from the deck reference, of the scalars from the results'
+datasets); the grid file of `create --grid`."""
 import importlib.machinery
 import importlib.util
 import math
 import pathlib
+import subprocess
 
 import matplotlib.figure
+import numpy as np
 import pytest
 
 SCRIPT = pathlib.Path(__file__).resolve().parents[2] / "scripts" / "multicor-sweep"
@@ -115,3 +118,82 @@ def test_a_grid_file_gives_its_keys_and_values(sweep_tool, tmp_path):
     path.write_text("# comment\ntime.step = 1e-4, 2e-4\n\nsolver.method = block  # end\n")
     assert sweep_tool.read_grid_file(path) == [("time.step", ["1e-4", "2e-4"]),
                                                ("solver.method", ["block"])]
+
+
+def test_the_axes_give_the_units_of_the_key_and_of_the_scalar(sweep_tool, saved, tmp_path):
+    # 'vx' against 'time.step', without units: now those of the deck reference (the
+    # manifest's) and of the results' dataset (collect's)
+    manifest = manifest_of("time.step", ["1e-4", "2e-4"])
+    manifest["units"] = {"time.step": "s"}
+    rows = [{"point": p["name"], **p["params"], "vx": "1.0", "n": "2"}
+            for p in manifest["points"]]
+    sweep_tool.plot(tmp_path, manifest, rows, ["vx", "n"], None, {"vx": "m/s", "n": ""})
+    (fig, _), = saved
+    assert [ax.get_xlabel() for ax in fig.axes] == ["time.step [s]"] * 2
+    # a count or a ratio has no unit: its name alone
+    assert [ax.get_ylabel() for ax in fig.axes] == ["vx [m/s]", "n"]
+
+
+def test_a_manifest_without_units_keeps_the_names(sweep_tool, saved, tmp_path):
+    # a sweep created before the units were recorded
+    manifest = manifest_of("time.step", ["1e-4", "2e-4"])
+    rows = [{"point": p["name"], **p["params"], "vx": "1.0"} for p in manifest["points"]]
+    sweep_tool.plot(tmp_path, manifest, rows, ["vx"], None)
+    (fig, _), = saved
+    assert (fig.axes[0].get_xlabel(), fig.axes[0].get_ylabel()) == ("time.step", "vx")
+
+
+def test_a_scalar_has_the_unit_of_the_columns_it_selects(sweep_tool, tmp_path):
+    h5py = pytest.importorskip("h5py")
+    with h5py.File(tmp_path / "r.h5", "w") as f:
+        f["dem/velocity"] = np.zeros((4, 2, 3))
+        f["dem/velocity"].attrs["units"] = "m/s, m/s, rad/s"
+        f["dem/energy/balance"] = np.zeros(4)
+        f["dem/energy/balance"].attrs["units"] = "J/m"
+        f["coupling/lambda"] = np.zeros((4, 14))
+        f["coupling/lambda"].attrs["units"] = "N, N.m"
+        f["dem/solver/sweeps"] = np.ones(4, np.int32)
+    with h5py.File(tmp_path / "r.h5", "r") as f:
+        units = {spec: sweep_tool.scalar_unit(f, "s=" + spec) for spec in (
+            "dem/velocity[-1,1,0]", "dem/velocity[-1,1,2]", "max(dem/velocity[:,1,0:2])",
+            "absmax(dem/velocity)", "dem/energy/balance[-1]", "coupling/lambda[-1,3]",
+            "dem/solver/sweeps[0]", "dem/missing[0]")}
+    assert units == {"dem/velocity[-1,1,0]": "m/s", "dem/velocity[-1,1,2]": "rad/s",
+                     "max(dem/velocity[:,1,0:2])": "m/s",
+                     "absmax(dem/velocity)": "m/s, rad/s",       # columns of both units
+                     "dem/energy/balance[-1]": "J/m",
+                     "coupling/lambda[-1,3]": "N, N.m",          # rows, not one per column
+                     "dem/solver/sweeps[0]": "", "dem/missing[0]": ""}
+
+
+def test_the_deck_reference_gives_the_units_of_the_values(sweep_tool, monkeypatch):
+    reference = "\n".join([
+        "### [time]", "",
+        "| keyword | values | unit | default | allowed | description |",
+        "|---|---|---|---|---|---|",
+        "| `step` | `step` (real) | s | required | > 0 | Time step h. |",
+        "| `scheme` | `scheme` (word) | | `newmark` | newmark, central | Scheme. |",
+        "### [particles]", "",
+        "| `gravity` | `gx` (real) | m/s^2 | 0 0 | | Gravity. |",
+        "| | `gy` (real) | m/s^2 | | | |", ""])
+    monkeypatch.setattr(sweep_tool.subprocess, "run", lambda *a, **k: subprocess.CompletedProcess(
+        a, 0, stdout=reference, stderr=""))
+    schema = sweep_tool.read_schema("multicor")
+    assert schema["time"]["step"]["units"] == {"step": "s"}
+    assert schema["time"]["scheme"]["units"] == {"scheme": ""}
+    assert schema["particles"]["gravity"]["units"] == {"gx": "m/s^2", "gy": "m/s^2"}
+    assert [f[0] for f in schema["particles"]["gravity"]["fields"]] == ["gx", "gy"]
+
+
+def test_the_legend_gives_the_units_of_the_other_keys(sweep_tool, saved, tmp_path):
+    manifest = {"keys": ["contacts.law[2].mu", "particles.gravity.gy"],
+                "units": {"contacts.law[2].mu": "", "particles.gravity.gy": "m/s^2"},
+                "points": [{"name": f"p{i}", "params": {"contacts.law[2].mu": mu,
+                                                         "particles.gravity.gy": g}}
+                           for i, (mu, g) in enumerate([("0.1", "-9.81"), ("0.2", "-9.81")])]}
+    rows = [{"point": p["name"], **p["params"], "vx": "1.0"} for p in manifest["points"]]
+    sweep_tool.plot(tmp_path, manifest, rows, ["vx"], None, {"vx": "m/s"})
+    (fig, _), = saved
+    assert fig.axes[0].get_xlabel() == "contacts.law[2].mu"      # a ratio: no unit
+    assert [t.get_text() for t in fig.axes[0].get_legend().get_texts()] == [
+        "particles.gravity.gy=-9.81 m/s^2"]

@@ -137,6 +137,10 @@ def generated_decks(src, exe, work):
         check(f"{name}: only the swept token changed", len(body) == len(original)
               and len(changed) == (0 if mu == "0.1" else 1)
               and all(b == expected_line for _, b in changed), str(changed))
+    # the keys' units, from the deck reference, for the axes of results.png: mu has none
+    units = json.loads((folder / "sweep.json").read_text()).get("units")
+    check("sweep.json: the units of the swept values", units == {
+        "contacts.law[material1=2 material2=3].mu": "", "particles.disk[2].3": "m"}, str(units))
     return folder
 
 
@@ -256,6 +260,16 @@ def sequential_run(src, folder):
         check(f"{r['point']}: absmax of a negative series is -min", float(r["vy"]) == -vy.min()
               and vy.max() <= 0 < -vy.min(), f"vy={r['vy']} -min={float(-vy.min())!r}")
     check("results.png drawn", (folder / "results.png").exists(), "")
+    # the scalars' units for its axes: from the datasets' units attributes (a column of
+    # /dem/velocity's 'm/s, m/s, rad/s', /dem/energy's J/m)
+    import h5py
+    tool = sweep_module(src)
+    with h5py.File(folder / rows[0]["file"], "r") as f:
+        units = {spec.split("=")[0]: tool.scalar_unit(f, spec) for spec in
+                 ("v2x=dem/velocity[-1,1,0]", "balance=absmax(dem/energy/balance)",
+                  "w=dem/velocity[-1,1,2]", "v=absmax(dem/velocity)")}
+    check("units of the scalars", units == {"v2x": "m/s", "balance": "J/m", "w": "rad/s",
+                                             "v": "m/s, rad/s"}, str(units))
     killed_point(src, folder)
 
 
