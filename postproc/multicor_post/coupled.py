@@ -295,9 +295,15 @@ def rigid_fit(x: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, float]:
 # --------------------------------------------------------------------------------------------
 
 def _new_figure(width=8.0, height=6.0, rows=1):
+    """A figure of ``rows`` axes one above the other, sharing their x axis (the same abscissa
+    or time in every figure of several rows): its numbers, and its label with the unit, are
+    those of the bottom axes alone."""
     fig = Figure(figsize=(width, height), layout="constrained")
     FigureCanvasAgg(fig)
-    axes = [fig.add_subplot(rows, 1, i + 1) for i in range(rows)]
+    axes = [fig.add_subplot(rows, 1, 1)]
+    axes += [fig.add_subplot(rows, 1, i + 1, sharex=axes[0]) for i in range(1, rows)]
+    for ax in axes[:-1]:
+        ax.tick_params(labelbottom=False)
     return fig, axes
 
 
@@ -632,7 +638,9 @@ def plot_coupling(diag: CouplingDiagnostics) -> Figure:
     else:
         _note_absent(ax_r, [name for name, _ in residuals + [("sweeps", "")]
                             if name not in steps])
-    ax_r.set_ylabel("residual")
+    # the units of the residuals drawn (each in its legend label): m, m/s, rad
+    units = [label.rsplit("[", 1)[1].rstrip("]") for name, label in residuals if name in steps]
+    ax_r.set_ylabel(f"residual [{', '.join(dict.fromkeys(units))}]" if units else "residual")
     _legend(ax_r)
     if "sweeps" in steps:
         ax_s = ax_r.twinx()
@@ -649,10 +657,8 @@ def plot_coupling(diag: CouplingDiagnostics) -> Figure:
         ax_l.plot(t, steps["lambda_norm"], "k", lw=1.2,
                   label="‖λ_m‖ of every step (mediator multipliers on the FE nodes)"
                   if diag.mediator else "‖λ‖ of every step")
-    if diag.no_step_yet:
-        # the empty per-step panel spans the outputs' times, as the multipliers' panel
-        ax_r.set_xlim(ax_l.get_xlim())
-    else:
+    # without a step, the empty per-step panel spans the outputs' times (the shared x axis)
+    if not diag.no_step_yet:
         _note_absent(ax_l, [] if "lambda_norm" in steps else ["lambda_norm"])
     ax_l.set_ylabel("multipliers λ [N, N·m]" if diag.attrs.get("rotation", 0) == 1
                     else "multipliers λ [N]")

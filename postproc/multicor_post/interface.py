@@ -149,7 +149,7 @@ def plot_friction(curves, title, mu_theory=(), radius=None):
     if mu_theory:
         ax.plot([], [], "k--", lw=0.8, label="tan(atan mu - asin(s/2R))")
     ax.set_xlabel("slip [mm]")
-    ax.set_ylabel("apparent friction T / N (top band)")
+    ax.set_ylabel("apparent friction T / N (top band) [-]")
     ax.set_title(title)
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small")

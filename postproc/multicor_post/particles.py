@@ -406,7 +406,7 @@ def plot_solver(res: DemResults) -> Figure:
     if np.isfinite(s.tolerance):
         ax_e.axhline(s.tolerance, color="0.5", ls="--", lw=0.8,
                      label=f"tolerance {s.tolerance:.4g}")
-    ax_e.set_ylabel("relative error")
+    ax_e.set_ylabel("relative error [-]")
     ax_e.legend(loc="best", fontsize="small")
     ax_c.plot(t, s.contacts, lw=0.8, label="contacts in the list")
     ax_c.plot(t, s.active, lw=0.8, label="active contacts")

@@ -228,3 +228,18 @@ def test_titles_give_the_time_in_the_unit_of_the_run(coupled_file):
     # a run of a few ms keeps its ms (the synthetic outputs: 0 .. 15 ms)
     short = coupled.load_coupled(coupled_file)
     assert coupled.plot_profiles(short).axes[0].get_title().endswith("\nt = 15 ms")
+
+
+@pytest.mark.parametrize("draw", [
+    lambda res: coupled.plot_profiles(res),
+    lambda res: coupled.plot_histories([res], 4, ["a"]),
+    lambda res: coupled.plot_compare_profiles([res], ["a"])])
+def test_panels_one_above_the_other_share_the_labelled_x_axis(coupled_file, draw):
+    # the upper panel (the displacements) had an x axis of its own, numbered without a label
+    fig = draw(coupled.load_coupled(coupled_file))
+    top, bottom = fig.axes
+    assert top.get_shared_x_axes().joined(top, bottom)
+    assert bottom.get_xlabel() in ("x at t = 0 [m]", "t [ms]")
+    fig.canvas.draw()                                   # tick labels are set when drawn
+    assert any(t.get_visible() and t.get_text() for t in bottom.get_xticklabels())
+    assert not any(t.get_visible() and t.get_text() for t in top.get_xticklabels())

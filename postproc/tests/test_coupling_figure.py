@@ -223,3 +223,23 @@ def test_region_forces_sum_the_rows_of_each_region(tmp_path):
     np.testing.assert_allclose(forces[:, 0, 1], 0.1 * k * (3 + 5), rtol=1e-15)
     np.testing.assert_allclose(forces[:, 1, 0], 0.1 * k * 0, rtol=1e-15)
     np.testing.assert_allclose(forces[:, 1, 1], 0.1 * k * 1, rtol=1e-15)
+
+
+def test_every_axis_of_the_figure_gives_its_unit(tmp_path):
+    # the residual axis said 'residual' over curves in m and m/s, and the two upper panels
+    # had time axes of their own, numbered but without a label (nor its unit): the panels
+    # now share the bottom one's, 't [ms]'
+    path = write_coupled(tmp_path / "b.h5")
+    fig = figure(path, "beam")
+    ax_r, ax_l, ax_e, ax_s = fig.axes
+    assert ax_r.get_ylabel() == "residual [m, m/s]"
+    assert ax_e.get_xlabel() == "t [ms]"
+    fig.canvas.draw()                                   # tick labels are set when drawn
+    assert any(t.get_visible() and t.get_text() for t in ax_e.get_xticklabels())
+    for ax in (ax_r, ax_l):
+        assert ax.get_shared_x_axes().joined(ax, ax_e)
+        assert ax.get_xlabel() == ""
+        assert not any(t.get_visible() and t.get_text() for t in ax.get_xticklabels())
+    with h5py.File(path, "r+") as f:
+        f["coupling"].attrs["rotation"] = np.int32(1)
+    assert figure(path, "beam").axes[0].get_ylabel() == "residual [m, m/s, rad]"

@@ -90,6 +90,8 @@ def test_figures_are_drawn(interface_file):
     run = interface.InterfaceRun(interface_file)
     fig = interface.plot_friction([("synthetic", run)], "t", (0.3,), 0.1)
     assert len(fig.axes[0].lines) == 3                # the run, the theory and its legend entry
+    # a ratio: '[-]', as every axis gives its unit
+    assert fig.axes[0].get_ylabel() == "apparent friction T / N (top band) [-]"
     assert interface.plot_configuration(run, N_OUT - 1) is not None
     assert interface.plot_stress(run, N_OUT - 1, "vm") is not None
 

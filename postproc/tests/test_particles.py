@@ -116,6 +116,8 @@ def test_solver_plot_marks_the_unconverged_step(tmp_path):
     assert len(marked) == 1 and len(marked[0].get_xdata()) == 1
     # step 8 (index 7) ends at t = 8 ms
     assert marked[0].get_xdata()[0] == pytest.approx(8.0)
+    # the error and residual relative to their scales: '[-]', as every axis gives its unit
+    assert plot_solver(res).axes[1].get_ylabel() == "relative error [-]"
 
 
 def test_solver_plot_of_exact_steps_draws_without_warning(tmp_path):
