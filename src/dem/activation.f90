@@ -78,7 +78,7 @@ module dem_activation
             real(wp), intent(out) :: target
         end subroutine decide_iface
 
-        pure subroutine recheck_iface(h, theta, allowance, gap, un_end, active, target)
+        pure subroutine recheck_iface(h, theta, allowance, gap, un_end, reach, active, target)
             import :: wp
             !> Time step [s] and theta.
             real(wp), intent(in) :: h, theta
@@ -88,6 +88,9 @@ module dem_activation
             real(wp), intent(in) :: gap
             !> Normal relative velocity at the end of the step, from the solve [m/s].
             real(wp), intent(in) :: un_end
+            !> Gap [m] below which the contact is let in whether shut or not: within reach of
+            !> the step's motion (0: only if shut).
+            real(wp), intent(in) :: reach
             !> The contact must take part in the solve.
             logical, intent(out) :: active
             !> Normal target u_n >= target of the step [m/s] (when active).
@@ -145,15 +148,15 @@ contains
 
     !> A contact left out whose end-of-step gap g + theta h u_n(end) is below -allowance (the
     !> predicted gap of predicted_decide on the solved velocities instead of the free ones):
-    !> the other contacts' impulses shut it. It is let in with the gap term -max(g, 0)/(theta
+    !> the other contacts' impulses shut it; or whose gap is below `reach`. It is let in with the gap term -max(g, 0)/(theta
     !> h), as an open contact of predicted_decide: it may close its gap but not overlap. The
     !> allowance on the other side (-allowance, where predicted_decide lets in at +allowance)
     !> leaves out contacts that end touching to the rounding of the coordinates.
-    pure subroutine predicted_recheck(h, theta, allowance, gap, un_end, active, target)
-        real(wp), intent(in) :: h, theta, allowance, gap, un_end
+    pure subroutine predicted_recheck(h, theta, allowance, gap, un_end, reach, active, target)
+        real(wp), intent(in) :: h, theta, allowance, gap, un_end, reach
         logical, intent(out) :: active
         real(wp), intent(out) :: target
-        active = gap + theta*h*un_end < -allowance
+        active = gap + theta*h*un_end < -allowance .or. gap < reach
         target = -max(gap, 0.0_wp)/(theta*h)
     end subroutine predicted_recheck
 
@@ -190,8 +193,8 @@ contains
 
     !> No re-check (active is false): Siconos decides the active set once per step, before the
     !> solve (its contacts left out may overlap within the step, doc/theory.md 2.6).
-    pure subroutine siconos_recheck(h, theta, allowance, gap, un_end, active, target)
-        real(wp), intent(in) :: h, theta, allowance, gap, un_end
+    pure subroutine siconos_recheck(h, theta, allowance, gap, un_end, reach, active, target)
+        real(wp), intent(in) :: h, theta, allowance, gap, un_end, reach
         logical, intent(out) :: active
         real(wp), intent(out) :: target
         active = .false.

@@ -712,14 +712,15 @@ contains
     end subroutine contacts_set_laws
 
     !> After a solve: the rule's re-check (activation_t%recheck) of the contacts left out of
-    !> it, neither active nor intact bonds, on the end-of-step velocities. With `activate`
+    !> it, neither active nor intact bonds, on the end-of-step velocities, and within `reach`.
+    !> With `activate`
     !> those it lets in become active, with r = 0 and the normal target it gives (the solver
     !> shift as contacts_set_laws sets it); without, they are only counted. A contact that
     !> cannot move along its normal (W_nn at the floor of dem_nlgs's blocked contacts: both
     !> bodies fixed or imposed) is not re-checked: no impulse can shut it, and the solve would
     !> leave it out again. Contacts are independent: the loop runs over the OpenMP threads
     !> (same result).
-    subroutine contacts_recheck(cs, law, rule, vel, wall_vel, activate, added)
+    subroutine contacts_recheck(cs, law, rule, vel, wall_vel, reach, activate, added)
         !> Contacts, after the solve (frames, laws, activity set).
         type(contact_set_t), intent(inout) :: cs
         !> Step parameters.
@@ -730,6 +731,8 @@ contains
         real(wp), intent(in) :: vel(:, :)
         !> Wall velocities at the end of the step (2, n_walls).
         real(wp), intent(in) :: wall_vel(:, :)
+        !> Gap [m] below which a contact left out is let in, shut or not (0: only those shut).
+        real(wp), intent(in) :: reach
         !> Let the contacts in (else count them only).
         logical, intent(in) :: activate
         !> Contacts the re-check lets in.
@@ -744,7 +747,7 @@ contains
             if (cs%active(k) .or. cs%status(k) == status_cohesive) cycle
             if (cs%w(1, k) <= diagonal_floor*(cs%w(1, k) + cs%w(3, k))) cycle
             u = contacts_local_velocity(cs, k, vel, wall_vel)
-            call rule%recheck(law%h, law%theta, law%gap_allowance*cs%amoy(k), cs%gap(k), u(1), active, target)
+            call rule%recheck(law%h, law%theta, law%gap_allowance*cs%amoy(k), cs%gap(k), u(1), reach, active, target)
             if (.not. active) cycle
             added = added + 1
             if (.not. activate) cycle

@@ -55,10 +55,9 @@ module dem_moreau_jean
               mj_bonds_at_start, mj_bonds_made
 
     !> Most contact solves of a step (mj_solve): the first, and one after each re-check of the
-    !> rule of activation that let in contacts the solve before had shut. Each round lets in
-    !> the contacts the last one's impulses shut, one more link of a chain of contacts pushed
-    !> shut in turn (a column falling on its support); at the cap the step is reported
-    !> unconverged.
+    !> rule of activation that let in contacts the solve before had shut (with those within
+    !> reach of the step, so that a chain of contacts pushed shut in turn joins at once); at
+    !> the cap the step is reported unconverged.
     integer, parameter, public :: mj_max_solves = 10
 
     !> Time-stepping settings.
@@ -267,14 +266,20 @@ contains
     !> velocities in `vel`; end-of-step velocities in `vel`.
     !> Then the rule of activation re-checks the contacts it left out on the end-of-step
     !> velocities (activation_t%recheck, contacts_recheck): a contact the free motion left open
-    !> may have been shut by the other contacts' impulses. Those it lets in join the solve, which
-    !> is done again warm-started from the reactions found, until a re-check lets in none, for
-    !> at most mj_max_solves solves (stats%solves); at the cap, contacts still shut are counted
-    !> (stats%recheck_left) and the step is not converged. The velocities the solve starts from
-    !> again are the end-of-step ones without the contact impulses (the strategy applies the
-    !> reactions again), so that the multipliers of bilateral constraints stay those of the
-    !> velocities. With MULTICOR's rule no contact then ends shut beyond the round-off allowance
-    !> (doc/theory.md 2.4); Siconos' rule never lets one in, and its step is one solve.
+    !> may have been shut by the other contacts' impulses. When a re-check finds such contacts,
+    !> it lets them in and, with them, every contact left out within reach of the step, whose
+    !> gap the fastest motion of the step could close (below 2 theta h v_max, v_max the largest
+    !> speed of a disk's rim or of a wall at the end of the solve): in a chain of contacts
+    !> pushed shut in turn (a column falling on its support) the next links join at once
+    !> instead of one per solve, and a contact let in that stays open carries no reaction. The
+    !> step is then solved again warm-started from the reactions found, until a re-check finds
+    !> none, for at most mj_max_solves solves (stats%solves) and [solver] max_sweeps sweeps over
+    !> all of them; at either cap, contacts still shut are counted (stats%recheck_left) and the
+    !> step is not converged. The velocities the solve starts from again are the end-of-step
+    !> ones without the contact impulses (the strategy applies the reactions again), so that
+    !> the multipliers of bilateral constraints stay those of the velocities. With MULTICOR's
+    !> rule no contact then ends shut beyond the round-off allowance (doc/theory.md 2.4);
+    !> Siconos' rule never lets one in, and its step is one solve.
     subroutine mj_solve(sys, bilateral)
         !> System, after `mj_detect`.
         type(dem_system_t), intent(inout) :: sys
@@ -282,31 +287,54 @@ contains
         class(nlgs_bilateral_t), intent(inout), optional :: bilateral
         integer(i8) :: c0, c1, rate
         type(nlgs_stats_t) :: first, round
-        integer :: added
+        type(nlgs_config_t) :: rest
+        integer :: added, within
         call system_clock(c0, rate)
         call sys%method%solve(sys%solver, sys%contacts, sys%im, sys%vel, sys%stats, bilateral)
         first = sys%stats
+        rest = sys%solver
         do
-            call contacts_recheck(sys%contacts, step_law(sys), sys%scheme%activation, sys%vel, sys%wall_v1, &
-                                  sys%stats%solves < mj_max_solves, added)
+            rest%max_sweeps = sys%solver%max_sweeps - sys%stats%sweeps
+            call contacts_recheck(sys%contacts, step_law(sys), sys%scheme%activation, sys%vel, sys%wall_v1, 0.0_wp, &
+                                  sys%stats%solves < mj_max_solves .and. rest%max_sweeps > 0, added)
             if (added == 0) exit
-            if (sys%stats%solves == mj_max_solves) then
+            if (sys%stats%solves == mj_max_solves .or. rest%max_sweeps <= 0) then
                 sys%stats%recheck_left = added
                 sys%stats%converged = .false.
                 exit
             end if
+            call contacts_recheck(sys%contacts, step_law(sys), sys%scheme%activation, sys%vel, sys%wall_v1, &
+                                  reach(sys), .true., within)
             ! back to the velocities without the contact impulses (the strategy applies them again)
             sys%contacts%r(:, 1:sys%contacts%n) = -sys%contacts%r(:, 1:sys%contacts%n)
             call nlgs_apply_reactions(sys%contacts, sys%im, sys%vel)
             sys%contacts%r(:, 1:sys%contacts%n) = -sys%contacts%r(:, 1:sys%contacts%n)
-            call sys%method%solve(sys%solver, sys%contacts, sys%im, sys%vel, round, bilateral)
-            call add_round(sys%stats, round, added)
+            call sys%method%solve(rest, sys%contacts, sys%im, sys%vel, round, bilateral)
+            call add_round(sys%stats, round, added + within)
         end do
         ! the blocked contacts were taken out of the list's active set by the first solve
         sys%stats%n_blocked = first%n_blocked
         call system_clock(c1)
         sys%time_solver = sys%time_solver + real(c1 - c0, wp)/real(rate, wp)
     end subroutine mj_solve
+
+    !> Gap [m] within which a contact left out could be shut in the step (mj_solve): 2 theta h
+    !> v_max, v_max the largest speed of a point of a disk's rim, |v| + R |omega|, or of a wall,
+    !> at the end of the solve (two such points closing on each other).
+    pure function reach(sys) result(gap)
+        !> System, after a solve.
+        type(dem_system_t), intent(in) :: sys
+        real(wp) :: gap, v_max
+        integer :: i
+        v_max = 0.0_wp
+        do i = 1, sys%particles%n
+            v_max = max(v_max, sqrt(sys%vel(1, i)**2 + sys%vel(2, i)**2) + sys%particles%radius(i)*abs(sys%vel(3, i)))
+        end do
+        do i = 1, size(sys%wall_v1, 2)
+            v_max = max(v_max, sqrt(sys%wall_v1(1, i)**2 + sys%wall_v1(2, i)**2))
+        end do
+        gap = 2.0_wp*sys%scheme%theta*sys%scheme%h*v_max
+    end function reach
 
     !> The statistics of the step after one more solve `round` (mj_solve), which `added`
     !> contacts joined: its state (error, convergence, active set) with the work of both.

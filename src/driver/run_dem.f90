@@ -503,7 +503,7 @@ contains
         character(len=:), allocatable :: text
         text = 'the contact solve did not converge: after '//counted(solves, 'solve')//' the contact impulses '// &
                'still shut '//counted(left, 'contact')//' left out of the solve (each solve lets in those the one '// &
-               'before shut, doc/theory.md 2.4), which may overlap; lower [time] step'
+               'before shut, doc/theory.md 2.4), which may overlap; lower [time] step or raise [solver] max_sweeps'
     end function recheck_capped_text
 
     !> Line closing the series of per-step warnings about unconverged steps.

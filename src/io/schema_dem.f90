@@ -207,9 +207,9 @@ contains
                            'step whose block of intact bonds created energy is solved again by plain sweeps from zero '// &
                            'reactions, which take up to max_sweeps more, counted too: doc/theory.md 7.10); a '// &
                            'step that reaches it without converging is reported (warning) and counted. The cap '// &
-                           'is per solve: a step solved again because the rule of activation let in contacts '// &
-                           'that the solve shut ([time] contact_scheme = multicor, doc/theory.md 2.4) has it for '// &
-                           'each solve.', default='1000')
+                           'is over all the solves of the step: a step solved again because the rule of '// &
+                           'activation let in contacts that the solve shut ([time] contact_scheme = multicor, '// &
+                           'doc/theory.md 2.4) has the sweeps the solves before left.', default='1000')
         call s%add_keyword('solver', 'local_tolerance', [real_field('local_tolerance', '', lower=0.0_wp, &
                                                                     upper=1.0_wp, lower_strict=.true., &
                                                                     upper_strict=.true.)], &
