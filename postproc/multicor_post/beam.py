@@ -51,13 +51,22 @@ def element_fields(mesh: Mesh, d: np.ndarray, points: int = POINTS_PER_ELEMENT):
 
 
 def auto_scale(mesh: Mesh, d: np.ndarray, fraction: float = 0.1) -> float:
-    """Round scale factor (1, 2 or 5 times a power of ten) making the largest displacement
-    about ``fraction`` of the structure's size; 1 when nothing moves."""
+    """Magnification (`magnification`) making the largest displacement about ``fraction`` of
+    the structure's size; 1 (true scale) when nothing moves or the displacements are already
+    that large."""
     size = max(np.ptp(mesh.x), np.ptp(mesh.y))
     dmax = float(np.max(np.hypot(d[:, U], d[:, W]))) if d.size else 0.0
     if dmax == 0.0 or size == 0.0:
         return 1.0
-    return round_scale(fraction * size / dmax)
+    return magnification(fraction * size / dmax)
+
+
+def magnification(raw: float) -> float:
+    """Displacement factor of a drawing for the wanted magnification ``raw``: rounded down to
+    1, 2 or 5 times a power of ten (`round_scale`), so that the title gives a round factor;
+    1 (true scale) when ``raw`` is below 2 (never a factor that shrinks the displacements, nor
+    one too close to 1 to tell from the true scale) or not finite."""
+    return round_scale(raw) if 2.0 <= raw < np.inf else 1.0
 
 
 def round_scale(raw: float) -> float:

@@ -24,7 +24,7 @@ from matplotlib.collections import LineCollection, PatchCollection, PolyCollecti
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle
 
-from .beam import _length_unit, _time_unit
+from .beam import _length_unit, _time_unit, magnification
 from .results import (FigureFiles, Records, ResultsError, _open_results, complete_records,
                       complete_shape, max_over_records, no_output_error, no_results_error,
                       shape_error, unfinished_status)
@@ -168,13 +168,19 @@ def element_polygons(x, connectivity, kind, u=None, scale=1.0):
 
 
 def auto_scale(res: ContinuumResults, u: np.ndarray, fraction: float = 0.1) -> float:
-    """Magnification of the displacements u: the largest drawn as `fraction` of the mesh's
-    larger side when it is smaller than that, else 1 (true scale)."""
+    """Magnification of the displacements u (`beam.magnification`): the largest drawn as about
+    `fraction` of the mesh's larger side, the factor rounded down to 1, 2 or 5 times a power
+    of ten; 1 (true scale) when nothing moves or the displacements are already that large."""
+    raw = mode_scale(res, u, fraction)
+    return magnification(raw) if raw > 0.0 else 1.0
+
+
+def mode_scale(res: ContinuumResults, u: np.ndarray, fraction: float = 0.1) -> float:
+    """Factor drawing the largest of the displacements u as `fraction` of the mesh's larger
+    side, larger or smaller than 1 (a mode shape has no true scale); 0 when nothing moves."""
     size = float(np.max(np.ptp(res.x, axis=0)))
     umax = float(np.max(np.hypot(u[:, 0], u[:, 1]))) if u.size else 0.0
-    if umax == 0.0 or umax >= fraction * size:
-        return 1.0
-    return fraction * size / umax
+    return fraction * size / umax if umax > 0.0 else 0.0
 
 
 def shortest_side(res: ContinuumResults) -> float:
@@ -362,7 +368,7 @@ def plot_modes(res: ContinuumResults, max_modes: int = 6,
     axes = np.atleast_1d(fig.subplots(n, 1, sharex=True))
     outline = element_polygons(res.x, res.connectivity, res.kind)
     for m, ax in enumerate(axes):
-        s = scale if scale is not None else auto_scale(res, res.u[m])
+        s = scale if scale is not None else (mode_scale(res, res.u[m]) or 1.0)
         ax.add_collection(PolyCollection(outline, facecolor="none", edgecolor="0.8", lw=0.3))
         ax.add_collection(PolyCollection(element_polygons(res.x, res.connectivity, res.kind, res.u[m], s),
                                          facecolor="#c6dbef", edgecolor="0.2", lw=0.3))

@@ -23,7 +23,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import EllipseCollection
 from matplotlib.figure import Figure
 
-from .beam import _time_unit, round_scale
+from .beam import _time_unit, magnification
 from .results import (FigureFiles, Records, ResultsError, _decode_attrs, _Getter, _open_results,
                       no_output_error)
 
@@ -436,7 +436,7 @@ def auto_scale(res: CoupledResults, k: int, fraction: float = SCALE_FRACTION) ->
 def _chosen_scale(wanted: float, allowed: float) -> float:
     """The factor `auto_scale` chooses from the magnifications `scale_limits` gives."""
     raw = min(wanted, allowed)
-    return round_scale(raw) if 2.0 <= raw < np.inf else 1.0
+    return magnification(raw)
 
 
 def plot_configuration(res: CoupledResults, time: Optional[float] = None,

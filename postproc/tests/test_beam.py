@@ -79,6 +79,11 @@ def test_auto_scale_is_round_and_makes_the_largest_displacement_visible():
     # Target 10 % of the size; rounding down to 1-2-5 keeps it within a factor 2.5.
     shown = scale * np.max(np.abs(d[:, 1])) / L
     assert 0.04 <= shown <= 0.1 + 1e-12
+    # displacements already a tenth of the beam or more are drawn at true scale: a factor
+    # rounded down from below 2 would shrink them (0.5 for a deflection of a fifth) or be
+    # too close to 1 to tell from it
+    assert auto_scale(mesh, d * (0.2 * L / np.max(np.abs(d[:, 1])))) == 1.0
+    assert auto_scale(mesh, d * (0.1 / 1.5 * L / np.max(np.abs(d[:, 1])))) == 1.0
 
 
 def test_deflection_title_states_the_nearest_stored_time(cantilever_file):

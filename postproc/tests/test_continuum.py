@@ -88,10 +88,32 @@ def test_small_displacements_are_magnified_to_a_tenth_of_the_mesh(tmp_path):
     res = continuum.load_continuum(write(tmp_path / "s.h5", "static"))
     u = res.u[0]
     s = continuum.auto_scale(res, u)
-    # the mesh's larger side is 3 m: the largest displacement is drawn as 0.3 m
-    assert s * np.max(np.hypot(u[:, 0], u[:, 1])) == pytest.approx(0.3, rel=1e-12)
-    # displacements already larger than that are drawn at true scale
+    # the mesh's larger side is 3 m: the largest displacement is drawn as 0.3 m, the factor
+    # rounded down to 1, 2 or 5 times a power of ten (the title says "× 200", not "× 212"):
+    # the drawn displacement is within a factor 2.5 below 0.3 m (the widest step, 2 -> 5)
+    mantissa = s / 10 ** np.floor(np.log10(s))
+    assert min(abs(mantissa - m) for m in (1.0, 2.0, 5.0)) < 1e-12
+    shown = s * np.max(np.hypot(u[:, 0], u[:, 1]))
+    assert 0.3 / 2.5 <= shown <= 0.3
+    # displacements already larger than that are drawn at true scale, and so are those that
+    # a factor below 2 would magnify (never a factor that shrinks them)
     assert continuum.auto_scale(res, 1e4 * u) == 1.0
+    assert continuum.auto_scale(res, 0.3 / 1.5 / np.max(np.hypot(u[:, 0], u[:, 1])) * u) == 1.0
+
+
+def test_mode_shapes_are_drawn_as_a_tenth_of_the_mesh_whatever_their_norm(tmp_path):
+    path = write(tmp_path / "m.h5", "modal")
+    with h5py.File(path, "r+") as f:
+        # mass-normalised shapes of a light body are large: the second one 1.8e2 m here
+        f["continuum/modal/shapes"][1] = 1e5 * f["continuum/modal/shapes"][1]
+    fig = continuum.plot_modes(continuum.load_continuum(path))
+    for ax in fig.axes[:2]:
+        outline = np.concatenate([p.vertices for p in ax.collections[0].get_paths()])
+        drawn = np.concatenate([p.vertices for p in ax.collections[1].get_paths()])
+        # a mode shape has no true scale: its largest nodal displacement is drawn as a tenth
+        # of the mesh's larger side (3 m), above or below its stored norm; exact but for the
+        # rounding of the coordinates (1e-12 m on 3 m)
+        assert np.max(np.hypot(*(drawn - outline).T)) == pytest.approx(0.3, abs=1e-12)
 
 
 def test_stress_plot_colours_each_element_on_the_deformed_mesh(tmp_path):
