@@ -4,7 +4,9 @@ in decks, where the syntax allows it: tests/data has decks with tabs on purpose)
 BEL in a Markdown formula is the trace of a backslash eaten by an escape (\\t of \\text, \\a
 of \\alpha), and a stray byte in a deck or a source is invisible in an editor. Fortran lines
 (.f90, .fypp, .pf; fypp directives aside) hold at most 132 characters, gfortran's default and
-the project's hard limit: fprettify's format test leaves comment lines alone.
+the project's hard limit: fprettify's format test leaves comment lines alone. pFUnit tests
+(.pf) are ASCII: pFUnit's preprocessor (bin/funit/pFUnitParser.py) opens them in the locale's
+encoding, which a Python before 3.7 under the C locale takes as ASCII.
 Usage (ctest does this): check_text_files.py ROOT. Exit 1 with file:line:column of each."""
 import pathlib
 import re
@@ -42,7 +44,12 @@ def main():
             if path.suffix in FORTRAN and len(line) > MAX_FORTRAN and not line.lstrip().startswith("#:"):
                 bad += 1
                 print(f"{path.relative_to(root)}:{number}: {len(line)} characters, more than {MAX_FORTRAN}")
-    print(f"{checked} files checked, {bad} control characters or long Fortran lines")
+            if path.suffix == ".pf" and not line.isascii():
+                bad += 1
+                column = next(i for i, c in enumerate(line) if not c.isascii()) + 1
+                print(f"{path.relative_to(root)}:{number}:{column}: not ASCII (pFUnit's preprocessor reads "
+                      "a .pf file in the locale's encoding)")
+    print(f"{checked} files checked, {bad} control characters, long Fortran lines or non-ASCII .pf lines")
     return 1 if bad or not checked else 0
 
 
