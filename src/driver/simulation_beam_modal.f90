@@ -79,7 +79,8 @@ contains
     subroutine run_modal(run, model, omega, shapes, out, report, error)
         type(run_config_t), intent(in) :: run
         type(beam_model_t), intent(in) :: model
-        real(wp), intent(in) :: omega(:), shapes(:, :)
+        real(wp), intent(in) :: omega(:)
+        real(wp), contiguous, intent(in) :: shapes(:, :)
         type(results_writer_t), intent(inout) :: out
         procedure(report_iface) :: report
         type(error_t), allocatable, intent(out) :: error
