@@ -33,7 +33,7 @@ ensure_venv
 configure_and_build build Release
 
 if [ $experiments -eq 1 ]; then
-    out=results/experiments
+    out="$MULTICOR_ROOT/results/experiments"
     for name in bending_case1 bending_case2 bending_stack; do
         say "running input/$name.dat"
         build/src/multicor "input/$name.dat" --output "$out/$name"
@@ -42,15 +42,17 @@ if [ $experiments -eq 1 ]; then
     .venv/bin/python postproc/run_interface_experiment.py --exe build/src/multicor --out "$out/interface"
     say "plotting the experiments"
     .venv/bin/python postproc/plot_experiments.py --results "$out"
-    say "figures in $MULTICOR_ROOT/$out"
+    say "figures in $out"
     exit 0
 fi
 
 name=$(basename "$deck")
 name=${name%.*}
-out="results/$name"
+# absolute, so that the commands the run prints (continue with --restart, --end) work from
+# any folder, not only from the repository's root where this script runs the deck
+out="$MULTICOR_ROOT/results/$name"
 say "running $deck"
 build/src/multicor "$deck" --output "$out"
 say "plotting"
 .venv/bin/python postproc/plot_results.py "$out/$name.h5" --out "$out" "${plot_time[@]}"
-say "results in $MULTICOR_ROOT/$out"
+say "results in $out"
