@@ -241,6 +241,7 @@ contains
             if (act%store_last .and. .not. allocated(error)) call store_output(self, out, error)
             if (allocated(error)) return
         end if
+        call out%begin_loop()
         do k = lp%k0 + 1, lp%n_steps
             lp%k = k
             call take_step(self, lp, out, report, error)
@@ -365,11 +366,13 @@ contains
         else
             call arlequin_step(self%sys, error)
         end if
-        if (allocated(error)) return
-        call self%after_step(error)
-        if (allocated(error)) return
-        call check_step(self, lp, error)
-        if (allocated(error)) return
+        if (.not. allocated(error)) call self%after_step(error)
+        if (.not. allocated(error)) call check_step(self, lp, error)
+        if (allocated(error)) then
+            ! the results file is as its last output left it: kept (driver_run)
+            call out%fail_at(lp%k, real(lp%k, wp)*self%settings%h)
+            return
+        end if
         call self%dem_out%record_step(out%file, self%sys%dem%stats, error)
         if (allocated(error)) return
         call self%cpl_out%record_step(out%file, self%sys, error)

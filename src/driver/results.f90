@@ -77,6 +77,13 @@ module driver_results
         !> (`close_partial`, or `close` whose rename failed); the earlier partial file set aside and
         !> the files beside the results are then settled as for a stopped run.
         logical :: kept_partial = .false.
+        !> Outputs counted when the time loop began its first step (`begin_loop`): those of the
+        !> checkpoint at a restart, the initial state's in a fresh run.
+        integer :: loop_outputs = huge(0)
+        !> Step in which the time loop failed, its results file sound (`fail_at`; 0: none).
+        integer(int64) :: failed_step = 0
+        !> Time that step reaches [s].
+        real(wp) :: failed_time = 0.0_wp
     contains
         !> Create the results file (written as .partial until `close`).
         procedure :: open => writer_open
@@ -103,6 +110,14 @@ module driver_results
         procedure :: close_partial => writer_close_partial
         !> Close and delete the partial file after an error.
         procedure :: abort => writer_abort
+        !> Count the outputs stored before the time loop's first step.
+        procedure :: begin_loop => writer_begin_loop
+        !> Record that the time loop failed in a step (the step or a guard, not a write).
+        procedure :: fail_at => writer_fail_at
+        !> Whether a failed run keeps its records (`close_failed`).
+        procedure :: keeps_failure => writer_keeps_failure
+        !> Close the file of a failed time loop and keep it as '<final_path>.failed'.
+        procedure :: close_failed => writer_close_failed
         !> True while the file is open.
         procedure :: is_open => writer_is_open
         !> Path to write a file beside the results under, which follows the results file.
@@ -559,6 +574,92 @@ contains
         call put_back_partial(self)
         call drop_companions(self)
     end subroutine writer_abort
+
+    !> Count the outputs stored before the time loop's first step (the initial state's in a
+    !> fresh run, the checkpoint's at a restart): a failure keeps the records of a run that
+    !> stored outputs after them (`keeps_failure`).
+    subroutine writer_begin_loop(self)
+        !> The open writer.
+        class(results_writer_t), intent(inout) :: self
+        self%loop_outputs = self%outputs
+    end subroutine writer_begin_loop
+
+    !> Record that the time loop failed in step `step` (a failure of the step, such as its
+    !> solver, or of a guard after it; an internal error there too), the results file
+    !> untouched since its last output: not for a failed write, after which the file may be
+    !> unsound.
+    subroutine writer_fail_at(self, step, t)
+        !> The open writer.
+        class(results_writer_t), intent(inout) :: self
+        !> The step that failed.
+        integer(int64), intent(in) :: step
+        !> The time that step reaches [s].
+        real(wp), intent(in) :: t
+        self%failed_step = step
+        self%failed_time = t
+    end subroutine writer_fail_at
+
+    !> Whether the run, which failed, keeps its records as '<final_path>.failed'
+    !> (`close_failed`): its time loop failed in a step (`fail_at`) after it stored outputs
+    !> beyond those it began with (a run that fails at its first step, or before its first
+    !> output, has nothing to show but its deck: it leaves nothing).
+    logical function writer_keeps_failure(self)
+        !> The writer.
+        class(results_writer_t), intent(in) :: self
+        writer_keeps_failure = self%is_open() .and. self%failed_step > 0 .and. self%outputs > self%loop_outputs
+    end function writer_keeps_failure
+
+    !> Close the file of a time loop that failed (`keeps_failure`) and keep what it holds as
+    !> '<final_path>.failed' (replacing an earlier one), with /summary finished = 0, status
+    !> 'failed at step N, t = T s: <the first line of `reason`>', steps N - 1 and the outputs it
+    !> stored whole, as a stopped run's. The folder's other files are left as a failed run
+    !> leaves them (`abort`): the earlier partial file set aside is put back, the files beside
+    !> the results are deleted; a partial file continued in place (a restart) is kept as it is
+    !> (the next restart cuts what came after its checkpoint) and copied to the '.failed' name.
+    !> When the file cannot be written, closed, or given that name, nothing is kept: `error`
+    !> says why and the file is settled as by `abort`.
+    subroutine writer_close_failed(self, reason, error)
+        !> An open writer; closed on return.
+        class(results_writer_t), intent(inout) :: self
+        !> The error of the run (its first line goes into /summary status).
+        character(len=*), intent(in) :: reason
+        !> Set when the records cannot be kept.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=40) :: sbuf, tbuf
+        character(len=:), allocatable :: failed
+        integer :: eol
+        call require_open(self, 'close_failed', error)
+        if (allocated(error)) return
+        failed = self%final_path//'.failed'
+        write (sbuf, '(i0)') self%failed_step
+        write (tbuf, '(es16.8e3)') self%failed_time
+        eol = index(reason, new_line('a'))
+        if (eol == 0) eol = len(reason) + 1
+        call self%file%write_attribute('/summary', 'status', 'failed at step '//trim(sbuf)//', t = '// &
+                                       trim(adjustl(tbuf))//' s: '//reason(:eol - 1), error)
+        if (.not. allocated(error)) call self%file%write_attribute('/summary', 'steps', &
+                                                                   int(self%failed_step - 1), error)
+        if (.not. allocated(error)) call self%file%write_attribute('/summary', 'ended', iso_date_time(), error)
+        if (allocated(error)) then
+            call self%abort()
+            error%message = 'results: '//error%message
+            return
+        end if
+        call self%file%close(error)
+        if (.not. allocated(error)) then
+            if (self%resumed) then
+                call copy_file(self%partial_path, failed, error)
+            else
+                call rename_file(self%partial_path, failed, error)
+            end if
+        end if
+        if (allocated(error)) then
+            if (.not. self%resumed) call remove_file(self%partial_path)
+            error%message = 'results: '//error%message
+        end if
+        call put_back_partial(self)
+        call drop_companions(self)
+    end subroutine writer_close_failed
 
     !> Before this run creates '<partial_path>': rename the partial file of an earlier run,
     !> if any, to '<partial_path>.prev' (`abort` puts it back). When '<partial_path>.prev'

@@ -31,7 +31,7 @@
 module driver_run
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
-    use core_strings, only: to_str, num => sci_text, shell_word
+    use core_strings, only: to_str, counted, num => sci_text, shell_word
     use io_lock, only: lock_t, lock_acquire, lock_release
     use io_progress, only: progress_t
     use core_signals, only: caught_signal, signal_name, install_signal_handlers
@@ -357,8 +357,12 @@ contains
         ! and its wall time is that of `clock`.
         if (.not. allocated(error) .and. .not. run%sim%has_time_loop()) call run%out%write_summary(0, run%clock, error)
         if (allocated(error)) then
-            call run%out%abort()
-            error%message = run%deck%file//': '//error%message
+            if (run%out%keeps_failure()) then
+                call keep_failed(run, error)
+            else
+                call run%out%abort()
+                error%message = run%deck%file//': '//error%message
+            end if
             return
         end if
         if (run%out%stopped()) then
@@ -367,6 +371,29 @@ contains
             call close_finished(opts, report, run, error, kept)
         end if
     end subroutine run_and_close
+
+    !> A time loop that failed in a step after it stored outputs (driver_results,
+    !> `keeps_failure`: a guard, the step's solver, an internal error there; not a failed write)
+    !> keeps its records as '<path>.failed', with its /summary status naming the failure, so
+    !> that what led to it can be read; the message ends with where they are. The folder is
+    !> otherwise left as any failed run leaves it (`write_results`): its checkpoints are
+    !> dropped and the earlier ones put back, for a restart from one of its checkpoints with the
+    !> same deck would fail again, and one with the deck changed is refused (its hash differs).
+    subroutine keep_failed(run, error)
+        !> The run, its results file open.
+        type(deck_run_t), intent(inout) :: run
+        !> The run's error, its message completed.
+        type(error_t), intent(inout) :: error
+        type(error_t), allocatable :: keep_error
+        call run%out%close_failed(error%message, keep_error)
+        error%message = run%deck%file//': '//error%message
+        if (allocated(keep_error)) then
+            error%message = error%message//' (its records could not be kept: '//keep_error%message//')'
+        else
+            error%message = error%message//'; the records up to the failure ('//counted(run%out%outputs, 'output')// &
+                            ") are kept in '"//run%out%final_path//".failed' (/summary status: what failed)"
+        end if
+    end subroutine keep_failed
 
     !> Close the results file of a run a signal stopped as '<path>.partial' and say what was
     !> saved and how to continue; `error` says the run stopped.

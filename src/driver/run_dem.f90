@@ -125,16 +125,20 @@ contains
             if (act%store_last .and. .not. allocated(error)) call store(error)
             if (allocated(error)) return
         end if
+        call out%begin_loop()
         do k = k0 + 1, n_steps
             call take_step_start(start, cfg%system%particles, cfg%system%walls, cfg%system%energies)
             if (k == cfg%fclib_step) then
                 call step_with_export(error)
-                if (allocated(error)) return
             else
                 call mj_step(cfg%system)
             end if
-            call check_step(error)
-            if (allocated(error)) return
+            if (.not. allocated(error)) call check_step(error)
+            if (allocated(error)) then
+                ! the results file is as its last output left it: kept (driver_run)
+                call out%fail_at(k, real(k, wp)*run%h)
+                return
+            end if
             call writer%record_step(out%file, cfg%system%stats, error)
             if (allocated(error)) return
             if (.not. cfg%system%stats%converged) call warn_unconverged()

@@ -159,11 +159,15 @@ contains
             if (act%store_last .and. .not. allocated(error)) call store(error)
             if (allocated(error)) return
         end if
+        call out%begin_loop()
         do k = k0 + 1, n_steps
             call integ%step(model, error)
-            if (allocated(error)) return
-            call check(k, error)
-            if (allocated(error)) return
+            if (.not. allocated(error)) call check(k, error)
+            if (allocated(error)) then
+                ! the results file is as its last output left it: kept (driver_run)
+                call out%fail_at(k, real(k, wp)*run%h)
+                return
+            end if
             act = end_of_step(k, n_steps, run%output_interval, ck%schedule)
             if (act%store_first) call store(error)
             if (act%checkpoint .and. .not. allocated(error)) call checkpoint(error)

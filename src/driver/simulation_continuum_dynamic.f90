@@ -188,9 +188,14 @@ contains
                 if (act%store_last .and. .not. allocated(error)) call store(error)
                 if (allocated(error)) return
             end if
+            call out%begin_loop()
             do k = k0 + 1, n_steps
                 call self%integ%step(self%ops, error)
-                if (allocated(error)) return
+                if (allocated(error)) then
+                    ! the results file is as its last output left it: kept (driver_run)
+                    call out%fail_at(k, real(k, wp)*self%settings%h)
+                    return
+                end if
                 call self%audit%advance(self%ops, self%model, self%integ)
                 ! State and energy accounts (a checkpoint may follow: it must hold finite values).
                 if (.not. (all(ieee_is_finite(self%integ%u)) .and. all(ieee_is_finite(self%integ%v)) .and. &
@@ -199,6 +204,7 @@ contains
                     write (buf, '(a,i0,a,es13.5e3,a)') 'continuum: the state is not finite after step ', k, &
                         ' (t = ', self%integ%t, ' s); likely cause:'
                     call make_error(error, trim(buf)//' '//likely_cause())
+                    call out%fail_at(k, real(k, wp)*self%settings%h)
                     return
                 end if
                 act = end_of_step(k, n_steps, self%settings%output_interval, ck%schedule)
@@ -280,6 +286,8 @@ contains
                     write (buf, '(a,es13.5e3,a)') 'continuum: a stress or an energy is not finite at t = ', g%t, &
                         ' s; likely cause: loads or moduli far too large or too small'
                     call make_error(error, trim(buf))
+                    ! a guard: nothing of this output is written yet (kept by driver_run when in the loop)
+                    call out%fail_at(k, g%t)
                     return
                 end if
                 call writer%store(out%file, g%t, reshape(u, [2, n]), reshape(v, [2, n]), stress, szz, vm, error)

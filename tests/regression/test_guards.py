@@ -14,6 +14,7 @@ import hashlib
 import os
 import pathlib
 import re
+import shutil
 import socket
 import subprocess
 import sys
@@ -577,6 +578,126 @@ progress = 0
                 text.format(v="1"))
 
 
+#: A disk driven by a force of 1e300 N switched on at t = 0.041 s (the audit's late.dat): it
+#: runs 40 steps, storing an output every 2 (21 with the initial state) and a checkpoint
+#: every 10, then step 41 puts it beyond the box.
+LATE_DECK = """[run]
+analysis = dynamic
+[particles]
+material = 1   7800
+disk     = 0.03  0.04   0.05    1
+force = 1 x 1e300 1
+[functions]
+function = 1 table 0 0 0.04 0 0.041 1
+[time]
+step     = 1.0e-3
+end      = 0.05
+[output]
+interval = 2
+checkpoint_interval = 10
+progress = 0
+"""
+LATE_STATUS = r"failed at step 41, t = 4\.10000000E-002 s: step 41 \(t = 4\.10000E-002 s\): disk 1 is at "
+
+
+def failed_records(exe, work):
+    """A time loop that failed after some outputs deleted them all, its checkpoints and the
+    folder it created: nothing was left to see what led to the blow-up (a kill -9 kept more).
+    Its records are now kept as '<name>.h5.failed' (/summary status naming the failure, the
+    outputs whole), beside the folder's earlier files left byte for byte; its checkpoints are
+    dropped. A later fresh run and a restart of the earlier checkpoint go on as if it were
+    not there, and a restart that fails replaces it, its own results file left to the next
+    restart."""
+    for old in ("failed_new", "failed_kept"):
+        shutil.rmtree(work / old, ignore_errors=True)
+    new = work / "failed_new" / "sub"
+    deck = work / "late.dat"
+    deck.write_text(LATE_DECK)
+    proc = multicor(exe, deck, "--output", new, "--quiet")
+    failed = new / "late.h5.failed"
+    check("failed run: exit 1", proc.returncode == 1, f"exit {proc.returncode}")
+    check("failed run: the message ends with where the records are",
+          proc.stderr.strip().endswith(f"the records up to the failure (21 outputs) are kept in '{failed}' "
+                                       "(/summary status: what failed)"), proc.stderr.strip()[-300:])
+    check("failed run into a new folder: the folder kept with the records alone",
+          new.is_dir() and sorted(p.name for p in new.iterdir()) == ["late.h5.failed"],
+          str(sorted(new.iterdir())) if new.is_dir() else "no folder")
+    if failed.exists():
+        failed_file(failed)
+    failed_beside_results(exe, work, deck)
+
+
+def failed_file(failed):
+    """The checks of the records of the late deck's failed run."""
+    with h5py.File(failed, "r") as f:
+        attrs = dict(f["summary"].attrs)
+        time = f["dem/time"][()]
+        position = f["dem/position"][()]
+    check("failed records: /summary finished = 0, outputs 21, steps 40",
+          (attrs["finished"], attrs["outputs"], attrs["steps"]) == (0, 21, 40), str(attrs))
+    check("failed records: status names the step and the failure",
+          re.match(LATE_STATUS, attrs["status"]) is not None, attrs["status"][:200])
+    # the stored times are k * 1e-3 computed in binary: 1e-12 is far above their round-off
+    check("failed records: the 21 outputs up to t = 0.04 s, finite",
+          time.shape == (21,) and np.allclose(time, 2e-3 * np.arange(21), rtol=0, atol=1e-12)
+          and position.shape[0] == 21 and np.isfinite(position).all(), f"{time.shape} {position.shape}")
+
+
+def failed_beside_results(exe, work, deck):
+    """The late deck failing in a folder holding a finished run to 0.03 s (the same deck,
+    --end) and its checkpoint, then restarted."""
+    folder = work / "failed_kept"
+    first = multicor(exe, deck, "--output", folder, "--quiet", "--end", "0.03")
+    check("failed run beside a result: the earlier run", first.returncode == 0, first.stderr[-300:])
+    earlier = {p.name: digest(p) for p in folder.iterdir()}
+    proc = multicor(exe, deck, "--output", folder, "--quiet")
+    check("failed run beside a result: exit 1", proc.returncode == 1, proc.stderr.strip()[:300])
+    after = {p.name: digest(p) for p in folder.iterdir() if p.name != "late.h5.failed"}
+    check("failed run beside a result: its records kept, the earlier files byte for byte",
+          (folder / "late.h5.failed").exists() and after == earlier, f"{sorted(after)} {sorted(earlier)}")
+    if not (folder / "late.h5.failed").exists():
+        return
+    kept = digest(folder / "late.h5.failed")
+    # a restart of the earlier checkpoint (step 30) to 0.036 s, then a fresh run to 0.03 s
+    proc = multicor(exe, deck, "--restart", folder / "checkpoint.h5", "--quiet", "--end", "0.036")
+    with h5py.File(folder / "late.h5", "r") as f:
+        outputs = f["dem/time"].shape[0]
+    check("restart beside the records of a failed run: extends the earlier result",
+          proc.returncode == 0 and outputs == 19, f"exit {proc.returncode}, {outputs} outputs; {proc.stderr[-300:]}")
+    check("restart beside the records of a failed run: they are left as they were",
+          digest(folder / "late.h5.failed") == kept, "")
+    # a restart that fails (from step 36, at step 41): the copy of the finished file it
+    # continued becomes the records, replacing the earlier ones; the finished file stays
+    finished = digest(folder / "late.h5")
+    checkpoint = digest(folder / "checkpoint.h5")
+    proc = multicor(exe, deck, "--restart", folder / "checkpoint.h5", "--quiet")
+    with h5py.File(folder / "late.h5.failed", "r") as f:
+        attrs = dict(f["summary"].attrs)
+        outputs = f["dem/time"].shape[0]
+    check("failed restart: exit 1, the records replaced by its own (21 outputs)",
+          proc.returncode == 1 and digest(folder / "late.h5.failed") != kept and outputs == 21
+          and attrs["outputs"] == 21 and re.match(LATE_STATUS, attrs["status"]) is not None,
+          f"exit {proc.returncode}, {outputs} outputs, {attrs['status'][:100]}")
+    check("failed restart: the finished result and its checkpoint as they were, nothing else",
+          digest(folder / "late.h5") == finished and digest(folder / "checkpoint.h5") == checkpoint
+          and sorted(p.name for p in folder.iterdir()) == ["checkpoint.h5", "late.h5", "late.h5.failed", "late.xdmf"],
+          str(sorted(p.name for p in folder.iterdir())))
+    # a restart that continues a partial file in place (the checkpoint's results, as a
+    # stopped run leaves them) keeps it for the next restart and copies it as the records
+    (folder / "late.h5").rename(folder / "late.h5.partial")
+    proc = multicor(exe, deck, "--restart", folder / "checkpoint.h5", "--quiet")
+    check("failed restart of a partial file: exit 1, the partial file kept, its copy the records",
+          proc.returncode == 1 and (folder / "late.h5.partial").exists()
+          and digest(folder / "late.h5.partial") == digest(folder / "late.h5.failed"), proc.stderr.strip()[-200:])
+    proc = multicor(exe, deck, "--restart", folder / "checkpoint.h5", "--quiet", "--end", "0.04")
+    check("failed restart of a partial file: the next restart continues it",
+          proc.returncode == 0 and (folder / "late.h5").exists() and not (folder / "late.h5.partial").exists(),
+          proc.stderr.strip()[-300:])
+    proc = multicor(exe, deck, "--output", folder, "--quiet", "--end", "0.03")
+    check("fresh run beside the records of a failed run: exit 0, the records left",
+          proc.returncode == 0 and (folder / "late.h5.failed").exists(), proc.stderr.strip()[-300:])
+
+
 def main():
     exe, work, src = arguments()
     non_finite(exe, work)
@@ -590,6 +711,7 @@ def main():
     output_empty(exe, work)
     end_option(exe, work)
     no_empty_folder(exe, work)
+    failed_records(exe, work)
     exponents(exe, work)
     speed_warning(exe, work)
     wall_end_beyond_box(exe, work)
