@@ -32,7 +32,7 @@ from multicor_post import beam, continuum, coupled, particles  # noqa: E402
 from multicor_post.results import (READ_ERRORS, ResultsError, file_contents, finite_float,  # noqa: E402
                                    report_read_error,
                                    load_results, outside_time_note, scale_factor,
-                                   unused_scale_note, unused_time_note)
+                                   unfinished_note, unused_scale_note, unused_time_note)
 
 
 def contents(path):
@@ -66,10 +66,8 @@ def main(argv=None):
             raise ResultsError(f"{args.results}: neither /fem/mesh, /continuum nor /dem: not a "
                                "MULTICOR results file")
         paths = []
-        if args.results.endswith(".partial"):
-            # printed with the figures (a file with nothing to plot gets its error alone)
-            notes.append(f"'{args.results}' is the partial file of a run that did not finish: "
-                         "the figures show the outputs stored so far")
+        # printed with the figures (a file with nothing to plot gets its error alone)
+        notes.append(unfinished_note(args.results))
         # a deformed shape that --scale magnifies: a continuum's, a beam-coupled run's
         # configuration, a frame's (beam.uses_scale)
         scaled = has_continuum or (is_coupled and has_beam)

@@ -214,11 +214,32 @@ def outside_time_note(requested: Optional[float], times: Optional[np.ndarray]) -
 
 def figure_stem(path) -> str:
     """The name the figures of a results file start with: the deck name, also for the
-    partial file of an unfinished run (``deck.h5.partial`` gives ``deck``)."""
+    partial file of an unfinished run (``deck.h5.partial`` gives ``deck``) and the records of
+    a failed run (``deck.h5.failed``)."""
     name = os.path.basename(os.fspath(path))
-    if name.endswith(".partial"):
-        name = name[:-len(".partial")]
+    for suffix in UNFINISHED_SUFFIXES:
+        if name.endswith(suffix):
+            name = name[:-len(suffix)]
     return os.path.splitext(name)[0]
+
+
+#: What multicor appends to `<deck>.h5` for the file of a run that did not finish: a partial
+#: file (running, stopped, killed) and the records of a run that failed in its time loop
+#: (doc/output.md, Interrupted runs).
+UNFINISHED_SUFFIXES = (".partial", ".failed")
+
+
+def unfinished_note(path) -> Optional[str]:
+    """What the plotting scripts print with the figures of a run that did not finish, from
+    its file's name: a partial file or a failed run's records; None for a results file."""
+    path = os.fspath(path)
+    if path.endswith(".partial"):
+        return (f"'{path}' is the partial file of a run that did not finish: the figures show "
+                "the outputs stored so far")
+    if path.endswith(".failed"):
+        return (f"'{path}' holds the records of a run that failed (its /summary status says "
+                "why): the figures show the outputs stored before the failure")
+    return None
 
 
 @dataclass
@@ -394,7 +415,7 @@ def _mode_kinds(f, n_modes: int) -> Optional[list]:
 
 def _open_results(path: str) -> h5py.File:
     """Open a results file for reading. Raises ResultsError, in one line, when it is missing
-    (saying so when the run left a '.partial' file), a folder, not a readable HDF5 file, or one
+    (saying so when the run left a '.partial' or '.failed' file), a folder, not a readable HDF5 file, or one
     of the other HDF5 files multicor writes: a checkpoint or an FCLIB export (saying what it
     is and where the results are)."""
     path = os.fspath(path)
@@ -402,6 +423,8 @@ def _open_results(path: str) -> h5py.File:
         hint = ""
         if os.path.exists(path + ".partial"):
             hint = f" ('{path}.partial' exists: the run did not finish)"
+        elif os.path.exists(path + ".failed"):
+            hint = f" ('{path}.failed' exists: the run failed, and those are its records)"
         raise ResultsError(f"results file '{path}' does not exist{hint}")
     if os.path.isdir(path):
         raise ResultsError(f"'{path}' is a folder, not a results file: give the <deck name>.h5 "

@@ -554,3 +554,50 @@ def test_an_error_not_from_h5py_is_not_called_damage(tmp_path):
         with pytest.raises(KeyError) as info:
             f["dem/position"]
     assert damaged_file_error(info.value, path) is None
+
+
+# --------------------------------------------------------------------------------------------
+# The records of a run that failed in its time loop: '<deck>.h5.failed'
+# --------------------------------------------------------------------------------------------
+
+FAILED_STATUS = ("failed at step 41, t = 4.10000000E-002 s: step 41 (t = 4.10000E-002 s): disk 1 "
+                 "is at (4.081E+291, 4.000E-002) m, beyond the box the run can represent")
+
+
+def test_a_failed_runs_records_are_plotted_as_a_partial_file(tmp_path, capsys):
+    # multicor keeps the outputs a time loop stored before a guard stopped it as
+    # '<deck>.h5.failed' (finished = 0, its whole outputs counted, status naming the failure):
+    # read as a partial file, up to that count, the figures named after the deck, with a note
+    path = write_dem(tmp_path / "column.h5.failed")
+    extendible(path, dem_series(path) + [f"dem/contacts/{n}" for n in CONTACT_LISTS + ("offset",)])
+    with h5py.File(path, "r") as f:
+        position = f["dem/position"][()]
+    mark_killed(path)
+    with h5py.File(path, "a") as f:
+        f["summary"].attrs["status"] = FAILED_STATUS
+        f["summary"].attrs["outputs"] = np.int32(N_OUT - 1)
+    res = particles.load_dem(path)
+    assert res.time.size == N_OUT - 1 and np.array_equal(res.position, position[:N_OUT - 1])
+    out = tmp_path / "png"
+    assert plot_results.main([str(path), "--out", str(out)]) == 0
+    printed = capsys.readouterr()
+    names = [p.rsplit("/", 1)[-1] for p in printed.out.split()]
+    assert names and all(n.startswith("column_") and n.endswith(".png") for n in names), names
+    assert f"'{path}' holds the records of a run that failed" in printed.err
+    assert "error" not in printed.err
+
+
+def test_a_failed_file_with_nothing_stored_names_its_status(tmp_path, capsys):
+    # its status is what the scripts quote when it has nothing to plot, as for a partial file
+    path = mark_killed(tmp_path / "big.h5.failed")
+    with h5py.File(path, "a") as f:
+        f["summary"].attrs["status"] = FAILED_STATUS
+    assert plot_results.main([str(path), "--out", str(tmp_path / "png")]) == 1
+    assert_one_line_error(capsys.readouterr().err, "plot_results.py: error: ", str(path), STOPPED,
+                          "failed at step 41")
+
+
+def test_a_missing_results_file_points_to_the_failed_runs_records(tmp_path):
+    (tmp_path / "run.h5.failed").write_bytes(b"")
+    with pytest.raises(ResultsError, match=r"'.*run\.h5\.failed' exists: the run failed"):
+        load_results(tmp_path / "run.h5")
