@@ -21,6 +21,10 @@
 !> that ended but cannot complete its end after its final checkpoint (its XDMF file cannot be
 !> written: `close_partial`; the final rename fails: `close`) keeps its file whole as '.partial'
 !> (`kept_partial`), the state a kill there leaves, which a restart from that checkpoint finishes.
+!> A time loop that fails in a step (`fail_at`: a guard, the step's solver, not a write) after
+!> storing outputs beyond those it began with (`begin_loop`) is closed by `close_failed`: its
+!> records are kept as '<final_path>.failed' with the failure in /summary status, the folder's
+!> other files settled as by `abort`.
 !> The beam's datasets are written by the writer's part `beam` (driver_results_beam), those of
 !> the other models by their own writers (driver_results_continuum, driver_results_dem,
 !> driver_results_coupled) into `file`.

@@ -7,7 +7,9 @@
 !> Everything that can fail because of the input is checked before the results folder is
 !> touched; the HDF5 file is written as '<name>.h5.partial' and renamed only on success, so
 !> earlier results stay intact when a run fails, and a results folder the failed run created
-!> is removed again when it is left empty.
+!> is removed again when it is left empty. A time loop that fails in a step (a guard, the
+!> step's solver) after it stored outputs keeps them as '<name>.h5.failed' (`keep_failed`), a
+!> name no run reads, replacing only an earlier failed run's.
 !>
 !> Guards (driver_guards): before anything is built, the model's memory estimate is checked
 !> against the available memory; disks and walls must lie in the box the detection can
