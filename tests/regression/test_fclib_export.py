@@ -319,7 +319,8 @@ def killed_run_export(exe, decks, work):
 def failed_run_keeps_export(exe, work):
     """A run that fails after its export leaves the folder as it found it (doc/output.md,
     "What a run replaces"): an earlier run's export unchanged, none of its own; into a new
-    folder, no folder at all. The failure: a force of 1e30 N switched on at 5 ms throws a disk
+    folder, none of its export either. Its records alone are kept, as 'export.h5.failed' (its
+    time loop failed in a step after storing outputs: "A time loop that fails in a step"). The failure: a force of 1e30 N switched on at 5 ms throws a disk
     out of the box, which the run's guard stops (exit 1); a second disk moving at the start
     makes its step-1 problem differ from the earlier run's."""
     text = """[run]
@@ -349,17 +350,21 @@ fclib_step = 1
     (good / "export.dat").write_text(text.format(force=""))
     (bad / "export.dat").write_text(text.format(force="initial_velocity = 2 x 0.2\nforce = 6 y -1e30 1"))
     out = work / "export_folder"
+    fresh = work / "export_fresh"
+    for folder in (out, fresh):
+        shutil.rmtree(folder, ignore_errors=True)
     first = subprocess.run([str(exe), "-q", "-o", str(out), str(good / "export.dat")], capture_output=True, text=True)
     before = {p.name: p.read_bytes() for p in out.iterdir()} if out.is_dir() else {}
     second = subprocess.run([str(exe), "-q", "-o", str(out), str(bad / "export.dat")], capture_output=True, text=True)
-    after = {p.name: p.read_bytes() for p in out.iterdir()}
-    check("a failed run leaves the earlier export as it was", first.returncode == 0 and second.returncode == 1
-          and "export_fclib_1.h5" in before and after == before,
+    after = {p.name: p.read_bytes() for p in out.iterdir() if p.name != "export.h5.failed"}
+    check("a failed run leaves the earlier export as it was, its records apart",
+          first.returncode == 0 and second.returncode == 1 and "export_fclib_1.h5" in before and after == before
+          and (out / "export.h5.failed").exists(),
           f"exits {first.returncode}, {second.returncode}; files before {sorted(before)}, after {sorted(after)}")
-    fresh = work / "export_fresh"
     third = subprocess.run([str(exe), "-q", "-o", str(fresh), str(bad / "export.dat")], capture_output=True, text=True)
-    check("a failed run into a new folder leaves no folder", third.returncode == 1 and not fresh.exists(),
-          f"exit {third.returncode}, left {sorted(p.name for p in fresh.iterdir()) if fresh.exists() else []}")
+    left = sorted(p.name for p in fresh.iterdir()) if fresh.exists() else []
+    check("a failed run into a new folder leaves its records alone, no export", third.returncode == 1
+          and left == ["export.h5.failed"], f"exit {third.returncode}, left {left}")
 
 
 if __name__ == "__main__":
