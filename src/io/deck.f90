@@ -425,13 +425,13 @@ contains
             end if
             if (len(current) == 0) then
                 call make_input_error(error, file, line_no, key, &
-                                      'appears before any [section] header'//home_of(schema, key))
+                                      'appears before any [section] header'//home_of(schema, key, header_sections(schema, text)))
                 return
             end if
             k = schema%find_keyword(current, key)
             if (k == 0) then
                 call make_input_error(error, file, line_no, key, &
-                                      unknown_keyword(schema, current, key))
+                                      unknown_keyword(schema, current, key, header_sections(schema, text)))
                 return
             end if
             if (.not. schema%keywords(k)%repeatable .and. first_line(k) > 0) then
@@ -690,60 +690,155 @@ contains
     end function tolerance
 
     !> Message for a keyword unknown in `section`: closest name in the section, or in another
-    !> section when that fits better, and the list of the section's keywords.
-    function unknown_keyword(schema, section, key) result(message)
+    !> section when that fits better (the section of the deck's model when the keyword is in
+    !> several: `gravity` under [time] of a deck of disks goes to [particles]), and the list of
+    !> the section's keywords.
+    function unknown_keyword(schema, section, key, present) result(message)
         !> The schema.
         type(schema_t), intent(in) :: schema
         !> Current section.
         character(len=*), intent(in) :: section
         !> The unknown keyword.
         character(len=*), intent(in) :: key
-        character(len=:), allocatable :: message, hint
+        !> The sections whose headers the deck holds (header_sections).
+        type(string_t), intent(in) :: present(:)
+        character(len=:), allocatable :: message, hint, home
         type(string_t), allocatable :: local(:), everywhere(:)
+        type(string_t) :: item
         integer :: k, best_local, d_local, best_all, d_all
-        allocate (local(0), everywhere(size(schema%keywords)))
+        allocate (local(0), everywhere(0))
         do k = 1, size(schema%keywords)
-            everywhere(k)%s = schema%keywords(k)%name
-            if (schema%keywords(k)%section == section) local = [local, everywhere(k)]
+            item%s = schema%keywords(k)%name
+            if (schema%keywords(k)%section == section) local = [local, item]
+            ! A keyword of a model's section that the deck does not have is no likely
+            ! misspelling: `damping` in a continuum deck is not [coupling] `pairing`.
+            if (fits_model(schema%keywords(k)%section)) everywhere = [everywhere, item]
         end do
         call closest_match(key, local, best_local, d_local)
         call closest_match(key, everywhere, best_all, d_all)
         message = 'unknown keyword in section ['//section//']'
         hint = schema%hint(section, key)
+        home = home_sections(schema, key, present)
         if (len(hint) > 0) then
             message = message//'; '//hint
+        else if (len(home) > 0) then
+            ! The keyword itself, in another section.
+            message = message//"; keyword '"//key//"' belongs to "//home
+            if (index(home, 'sections ') == 1) then
+                message = message//': move it to the section (or sections) it is meant for'
+            else
+                message = message//': move it there'
+            end if
         else if (best_all > 0 .and. d_all < d_local .and. d_all <= tolerance(key)) then
             ! A better match in another section.
-            if (everywhere(best_all)%s == key) then
-                message = message//"; keyword '"//key//"' belongs to section ["// &
-                          schema%keywords(best_all)%section//']: move it there'
-            else
-                message = message//"; did you mean '"//everywhere(best_all)%s//"'? keyword '"// &
-                          everywhere(best_all)%s//"' belongs to section ["// &
-                          schema%keywords(best_all)%section//']'
-            end if
+            message = message//"; did you mean '"//everywhere(best_all)%s//"'? keyword '"// &
+                      everywhere(best_all)%s//"' belongs to "//home_sections(schema, everywhere(best_all)%s, present)
         else if (best_local > 0 .and. d_local <= tolerance(key)) then
             message = message//"; did you mean '"//local(best_local)%s//"'?"
         end if
         message = message//' (keywords of ['//section//']: '//join_words(local, ', ')//')'
+    contains
+        !> Whether `name` is no section of a model ([particles], [continuum], [beam], [coupling])
+        !> or one the deck has (or the deck has none of them yet).
+        logical function fits_model(name)
+            character(len=*), intent(in) :: name
+            integer :: i
+            fits_model = .true.
+            if (.not. is_model_section(name)) return
+            if (.not. any([(is_model_section(present(i)%s), i=1, size(present))])) return
+            fits_model = any([(present(i)%s == name, i=1, size(present))])
+        end function fits_model
     end function unknown_keyword
 
-    !> " (it belongs to section [x])" for a keyword known in some section, '' otherwise.
-    function home_of(schema, key) result(text)
+    !> Whether `name` is the section of a model: [particles], [continuum], [beam] or [coupling].
+    pure logical function is_model_section(name)
+        !> Section name.
+        character(len=*), intent(in) :: name
+        is_model_section = name == 'particles' .or. name == 'continuum' .or. name == 'beam' .or. name == 'coupling'
+    end function is_model_section
+
+    !> "section [x]" for the section that keyword `key` belongs to: the only one that has it,
+    !> or the only one of those that the deck has (`present`); "sections [a], [b] and [c]"
+    !> when several of the deck's sections have it, or none of them and several others
+    !> (`gravity` in a deck without [beam], [particles] or [continuum]); '' when no section has it.
+    function home_sections(schema, key, present) result(text)
         !> The schema.
         type(schema_t), intent(in) :: schema
         !> Keyword.
         character(len=*), intent(in) :: key
+        !> The sections whose headers the deck holds.
+        type(string_t), intent(in) :: present(:)
         character(len=:), allocatable :: text
-        integer :: k
-        text = ''
+        type(string_t), allocatable :: homes(:), inside(:)
+        type(string_t) :: item
+        integer :: k, i
+        allocate (homes(0), inside(0))
         do k = 1, size(schema%keywords)
-            if (schema%keywords(k)%name == key) then
-                text = '; it belongs to section ['//schema%keywords(k)%section//']'
-                return
-            end if
+            if (schema%keywords(k)%name /= key) cycle
+            item%s = '['//schema%keywords(k)%section//']'
+            homes = [homes, item]
+            if (any([(present(i)%s == schema%keywords(k)%section, i=1, size(present))])) &
+                inside = [inside, homes(size(homes))]
         end do
+        if (size(inside) > 0 .and. size(homes) > 1) homes = inside
+        select case (size(homes))
+        case (0)
+            text = ''
+        case (1)
+            text = 'section '//homes(1)%s
+        case default
+            text = 'sections '//join_words(homes(:size(homes) - 1), ', ')//' and '//homes(size(homes))%s
+        end select
+    end function home_sections
+
+    !> "; it belongs to section [x]" for a keyword known in some section (home_sections), ''
+    !> otherwise.
+    function home_of(schema, key, present) result(text)
+        !> The schema.
+        type(schema_t), intent(in) :: schema
+        !> Keyword.
+        character(len=*), intent(in) :: key
+        !> The sections whose headers the deck holds.
+        type(string_t), intent(in) :: present(:)
+        character(len=:), allocatable :: text
+        text = home_sections(schema, key, present)
+        if (len(text) > 0) text = '; it belongs to '//text
     end function home_of
+
+    !> The known sections whose headers `text` holds, each once, in the order of the deck (the
+    !> model a hint is for: what the deck has, before and after the line being read).
+    function header_sections(schema, text) result(names)
+        !> The schema.
+        type(schema_t), intent(in) :: schema
+        !> The deck's text.
+        character(len=*), intent(in) :: text
+        type(string_t), allocatable :: names(:)
+        type(string_t) :: item
+        character(len=:), allocatable :: line
+        integer :: start, lf, hash, i
+        allocate (names(0))
+        start = 1
+        do while (start <= len(text))
+            lf = index(text(start:), new_line('a'))
+            if (lf == 0) then
+                lf = len(text) + 1
+            else
+                lf = start + lf - 1
+            end if
+            line = text(start:lf - 1)
+            start = lf + 1
+            hash = index(line, '#')
+            if (hash > 0) line = line(:hash - 1)
+            line = strip(line)
+            if (len(line) < 3) cycle
+            if (line(1:1) /= '[' .or. line(len(line):) /= ']') cycle
+            line = strip(line(2:len(line) - 1))
+            if (schema%find_section(line) == 0) cycle
+            if (any([(names(i)%s == line, i=1, size(names))])) cycle
+            item%s = line
+            names = [names, item]
+        end do
+    end function header_sections
 
     !> "[run] analysis, ..." : the unconditionally required keywords.
     function required_list(schema) result(text)

@@ -76,6 +76,7 @@ contains
         call s%add_keyword('continuum', 'gravity', [real_field('gx', 'm/s^2'), real_field('gy', 'm/s^2')], &
                            'Acceleration of gravity (body force rho g).', default='0 0', &
                            effective_when=unless('run', 'analysis', 'modal'))
+        call s%add_hint('continuum', 'damping', "damping is Rayleigh's: 'rayleigh = <a0> <a1>' (C = a0 M + a1 K)")
         call s%add_keyword('continuum', 'rayleigh', &
                            [real_field('a0', '1/s', lower=0.0_wp), real_field('a1', 's', lower=0.0_wp)], &
                            'Rayleigh damping C = a0 M + a1 K.', default='0 0', allowed_when=when('run', 'analysis', 'dynamic'))

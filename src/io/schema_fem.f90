@@ -79,6 +79,7 @@ contains
                            'Gravity acceleration: self-weight density area (gx, gy) per unit length on every '// &
                            'element (the default is none; write gravity = 0 -9.81 for the usual one).', &
                            default='0 0', effective_when=unless('run', 'analysis', 'modal'))
+        call s%add_hint('beam', 'damping', "damping is Rayleigh's: 'rayleigh = <a0> <a1>' (C = a0 M + a1 K)")
         call s%add_keyword('beam', 'rayleigh', &
                            [real_field('a0', '1/s', lower=0.0_wp), real_field('a1', 's', lower=0.0_wp)], &
                            'Rayleigh damping C = a0 M + a1 K.', default='0 0', allowed_when=when('run', 'analysis', 'dynamic'))
