@@ -1,13 +1,17 @@
 !> Stop requests from the operating system: SIGTERM (Slurm at the time limit, `kill`),
-!> SIGINT (Ctrl-C), SIGUSR1 (`sbatch --signal=USR1@120`, sent before the time limit) and
-!> SIGHUP (the terminal of an interactive run closed, an ssh session lost).
+!> SIGINT (Ctrl-C), SIGUSR1 (`sbatch --signal=USR1@120`, sent before the time limit), SIGUSR2
+!> (LSF's warning before its time limit, `bsub -wa USR2 -wt 2`), SIGHUP (the terminal of an
+!> interactive run closed, an ssh session lost) and SIGXCPU (a CPU time limit's warning before
+!> SIGKILL: the soft limit of `ulimit -S -t`, SGE's `s_cpu`). SIGQUIT (Ctrl-\) keeps its
+!> default action: a user's "quit now".
 !>
 !> `install_signal_handlers` installs a handler (src/core/signals_c.c) that only records the
 !> first signal caught; the time loops poll `caught_signal()` once per step, finish the step,
 !> write a checkpoint, store the step and close the results (doc/output.md, "Interrupted
 !> runs"). A second Ctrl-C (SIGINT) stops the program at once (its default action again after
-!> the first delivery); a second SIGTERM, SIGUSR1 or SIGHUP is the same request again (Slurm
-!> sends SIGTERM twice at a time limit). SIGXFSZ is ignored from the program's start
+!> the first delivery); a second SIGTERM, SIGUSR1, SIGUSR2, SIGHUP or SIGXCPU is the same
+!> request again (Slurm sends SIGTERM twice at a time limit, the kernel SIGXCPU every second past
+!> the soft limit). SIGXFSZ is ignored from the program's start
 !> (`ignore_file_size_signal`), so that a file size limit (`ulimit -f`) gives a write error
 !> instead of killing the program. The flag lives in the C file (a signal handler can
 !> only set a `volatile sig_atomic_t`); this module keeps no state.
@@ -74,16 +78,24 @@ module core_signals
         integer(c_int) function c_sighup() bind(c, name='multicor_sighup')
             import :: c_int
         end function c_sighup
+        !> SIGUSR2 of this platform.
+        integer(c_int) function c_sigusr2() bind(c, name='multicor_sigusr2')
+            import :: c_int
+        end function c_sigusr2
+        !> SIGXCPU of this platform.
+        integer(c_int) function c_sigxcpu() bind(c, name='multicor_sigxcpu')
+            import :: c_int
+        end function c_sigxcpu
     end interface
 
 contains
 
-    !> Catch SIGTERM, SIGINT, SIGUSR1 and SIGHUP from now on.
+    !> Catch SIGTERM, SIGINT, SIGUSR1, SIGUSR2, SIGHUP and SIGXCPU from now on.
     subroutine install_signal_handlers(error)
         !> Set when the operating system refuses a handler.
         type(error_t), allocatable, intent(out) :: error
         if (c_install() /= 0) call make_error(error, 'cannot install the signal handlers '// &
-                                              '(SIGTERM, SIGINT, SIGUSR1, SIGHUP)')
+                                              '(SIGTERM, SIGINT, SIGUSR1, SIGUSR2, SIGHUP, SIGXCPU)')
     end subroutine install_signal_handlers
 
     !> Ignore SIGXFSZ from now on: a write beyond the file size limit (`ulimit -f`) fails
@@ -127,7 +139,8 @@ contains
         call c_clear()
     end subroutine clear_caught_signal
 
-    !> Name of a signal number: 'SIGTERM', 'SIGINT', 'SIGUSR1', 'SIGHUP', or 'signal <n>'.
+    !> Name of a signal number: 'SIGTERM', 'SIGINT', 'SIGUSR1', 'SIGUSR2', 'SIGHUP', 'SIGXCPU',
+    !> or 'signal <n>'.
     function signal_name(sig) result(name)
         !> Signal number.
         integer, intent(in) :: sig
@@ -142,21 +155,28 @@ contains
             name = 'SIGUSR1'
         else if (sig == int(c_sighup())) then
             name = 'SIGHUP'
+        else if (sig == int(c_sigusr2())) then
+            name = 'SIGUSR2'
+        else if (sig == int(c_sigxcpu())) then
+            name = 'SIGXCPU'
         else
             write (buf, '(a,i0)') 'signal ', sig
             name = trim(buf)
         end if
     end function signal_name
 
-    !> Numbers of the stop signals of this platform: SIGTERM, SIGINT, SIGUSR1, SIGHUP.
+    !> Numbers of the stop signals of this platform: SIGTERM, SIGINT, SIGUSR1, SIGHUP, SIGUSR2,
+    !> SIGXCPU.
     function stop_signals() result(sigs)
-        !> The four numbers, in that order.
-        integer :: sigs(4)
-        sigs = [int(c_sigterm()), int(c_sigint()), int(c_sigusr1()), int(c_sighup())]
+        !> The six numbers, in that order.
+        integer :: sigs(6)
+        sigs = [int(c_sigterm()), int(c_sigint()), int(c_sigusr1()), int(c_sighup()), int(c_sigusr2()), &
+                int(c_sigxcpu())]
     end function stop_signals
 
     !> Exit code of a run stopped by a signal: 128 + the signal number, the shell's
-    !> convention (SIGTERM 143, SIGINT 130, SIGUSR1 138, SIGHUP 129 on Linux).
+    !> convention (SIGTERM 143, SIGINT 130, SIGUSR1 138, SIGUSR2 140, SIGHUP 129, SIGXCPU 152
+    !> on Linux).
     pure integer function signal_exit_code(sig)
         !> Signal number.
         integer, intent(in) :: sig

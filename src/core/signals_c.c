@@ -1,15 +1,21 @@
 /* Signal handling for core_signals (src/core/signals.f90).
  *
- * SIGTERM, SIGINT, SIGUSR1 and SIGHUP set a flag and nothing else (the only thing a handler may
- * safely do); the time loops poll it once per step and stop cleanly. SIGINT alone has
- * SA_RESETHAND, its default action back after the first delivery: a second Ctrl-C kills the
- * program at once. A repeated SIGTERM, SIGUSR1 or SIGHUP is only the same request again:
+ * SIGTERM, SIGINT, SIGUSR1, SIGUSR2, SIGHUP and SIGXCPU set a flag and nothing else (the only
+ * thing a handler may safely do); the time loops poll it once per step and stop cleanly. SIGINT
+ * alone has SA_RESETHAND, its default action back after the first delivery: a second Ctrl-C
+ * kills the program at once. A repeated SIGTERM, SIGUSR1, SIGUSR2, SIGHUP or SIGXCPU is only
+ * the same request again:
  * Slurm at a job's time limit sends a step's processes SIGTERM twice within milliseconds
  * (slurmstepd and srun), which killed the run before its checkpoint; SIGKILL is the way to
  * stop at once (Slurm sends it after KillWait). SIGHUP (the terminal of an interactive run
  * closed, an ssh session lost) stops the run as SIGTERM does, with its checkpoint, instead of killing it;
  * under `nohup` (SIGHUP ignored when the program starts) it stays ignored, and so does a
  * SIGINT ignored at the start (the results file stays readable up to its last flush).
+ * SIGUSR2 is the warning signal of LSF (`bsub -wa USR2 -wt ...`) and SIGXCPU that of a CPU time
+ * limit (the soft limit of `ulimit -S -t`, SGE's `s_cpu`), sent before SIGKILL; the kernel
+ * repeats SIGXCPU every second of CPU time past the soft limit, each one the same request. Their
+ * default actions killed the run (SIGXCPU with a core dump, and gfortran's backtrace, whose
+ * handler this one replaces). SIGQUIT (Ctrl-\, "quit now") keeps its default action.
  * SIGXFSZ (file size limit, `ulimit -f`) is ignored from the program's start, so that
  * exceeding the limit makes the write fail with EFBIG and is reported like a full disk instead
  * of killing the process (ignored only once the handlers were installed, it killed a run under
@@ -39,7 +45,7 @@ static void multicor_on_sigpipe(int sig)
 /* Install the handlers; 0 on success, -1 when sigaction fails. */
 int multicor_signals_install(void)
 {
-    static const int handled[] = {SIGTERM, SIGINT, SIGUSR1, SIGHUP};
+    static const int handled[] = {SIGTERM, SIGINT, SIGUSR1, SIGUSR2, SIGHUP, SIGXCPU};
     struct sigaction sa;
     size_t k;
     memset(&sa, 0, sizeof sa);
@@ -102,3 +108,5 @@ int multicor_sigterm(void) { return SIGTERM; }
 int multicor_sigint(void) { return SIGINT; }
 int multicor_sigusr1(void) { return SIGUSR1; }
 int multicor_sighup(void) { return SIGHUP; }
+int multicor_sigusr2(void) { return SIGUSR2; }
+int multicor_sigxcpu(void) { return SIGXCPU; }

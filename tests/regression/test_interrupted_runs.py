@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Interrupted runs: results readable after `kill -9`, clean stop on SIGTERM / SIGINT /
-SIGUSR1, write errors reported at the write (doc/output.md, "Interrupted runs").
+SIGUSR1 / SIGUSR2 / SIGXCPU, write errors reported at the write (doc/output.md, "Interrupted
+runs").
 
 Long versions of example decks (input/cantilever.dat, input/incline.dat,
 input/bending_case2.dat with a far end time) are started, left to write a few outputs, then
@@ -12,7 +13,11 @@ full 512 KiB tmpfs: the run must stop with a clear error at the write and exit c
 crash. An --output that names a file: exit 1 saying so, the file untouched. A particle run
 (input/incline.dat), a coupled run (input/bending_case2.dat), a continuum run
 (input/continuum_cantilever_dynamic.dat) and a continuum-disk run (input/coupled2d_block.dat)
-killed with -9: the same for their partial files.
+killed with -9: the same for their partial files. SIGUSR2 (LSF's warning signal) and
+SIGXCPU, sent by the kernel at a soft CPU time limit (RLIMIT_CPU 1 s, as `ulimit -S -t 1`,
+unprivileged), stop a beam run as SIGUSR1 does: exit 140 and 152, no lock left, no
+backtrace (before: killed, exit -12 and -24, SIGXCPU with gfortran's backtrace, the lock
+and a partial file "running (or killed)" left).
 Usage (ctest does this): test_interrupted_runs.py --exe multicor --work DIR --source REPO
 """
 import argparse
@@ -269,15 +274,22 @@ def readable_while_running(name, partial):
     check(f"{name}: the partial file opens in h5py while the run goes on", False, errors[-1][:300])
 
 
-def stop_by_signal(exe, src, work, deck_name, sig, name, repeat=1, min_step=100):
+def stop_by_signal(exe, src, work, deck_name, sig, name, repeat=1, min_step=100, cpu_limit=None):
     """Send `sig` to a long run (`repeat` times, 1 ms apart: Slurm sends SIGTERM twice at a
     time limit): exit 128 + sig, message, partial closed with finished = 0 and every output up
-    to the step of the stop, equal to an uninterrupted run."""
+    to the step of the stop, equal to an uninterrupted run. With `cpu_limit` (seconds), the
+    run gets that soft CPU time limit (the hard one a minute above) and the kernel sends
+    SIGXCPU, `sig`, once it is used up."""
     deck_src = src / "input" / deck_name
     folder = work / name
     deck = deck_with_end(deck_src, work / f"{name}.dat", 1000.0, progress=0.02)
     partial = folder / f"{name}.h5.partial"
-    proc = start(exe, deck, folder)
+    if cpu_limit is None:
+        proc = start(exe, deck, folder)
+    else:
+        def limit_cpu():
+            resource.setrlimit(resource.RLIMIT_CPU, (cpu_limit, cpu_limit + 60))
+        proc = start(exe, deck, folder, preexec_fn=limit_cpu)
     lines = []
     # Past min_step: at least 10 outputs (an output every 5 or 10 steps, 3 in the deposit).
     if not wait_for_step(proc, min_step, lines):
@@ -285,10 +297,11 @@ def stop_by_signal(exe, src, work, deck_name, sig, name, repeat=1, min_step=100)
         return
     readable_while_running(name, partial)
     t0 = time.monotonic()
-    proc.send_signal(sig)
-    for _ in range(repeat - 1):
-        time.sleep(0.001)
+    if cpu_limit is None:
         proc.send_signal(sig)
+        for _ in range(repeat - 1):
+            time.sleep(0.001)
+            proc.send_signal(sig)
     out, err = proc.communicate()
     out = "".join(lines) + out
     delay = time.monotonic() - t0
@@ -305,6 +318,8 @@ def stop_by_signal(exe, src, work, deck_name, sig, name, repeat=1, min_step=100)
           str(partial) in out, "")
     check(f"{name}: error line names the signal", f"run stopped by {signame}" in err,
           err.strip()[-200:])
+    check(f"{name}: no lock left, no backtrace", not (folder / ".multicor.lock").exists() and
+          "Backtrace" not in err, err.strip()[-300:])
     n_out, summary = readable(name, partial)
     if not m or n_out == 0:
         return
@@ -420,6 +435,9 @@ def main():
                               count=1, flags=re.M))
     stop_by_signal(exe, src, work, deposit, signal.SIGTERM, "term_twice_dem", repeat=2, min_step=30)
     stop_by_signal(exe, src, work, "incline.dat", signal.SIGUSR1, "usr1_dem")
+    # LSF's warning signal, and a soft CPU time limit of 1 s: the beam deck, the cheapest
+    stop_by_signal(exe, src, work, "cantilever.dat", signal.SIGUSR2, "usr2_beam")
+    stop_by_signal(exe, src, work, "cantilever.dat", signal.SIGXCPU, "xcpu_beam", cpu_limit=1)
     stop_by_signal(exe, src, work, "bending_case2.dat", signal.SIGINT, "int_coupled")
     write_error(exe, src, work)
     full_disk(exe, src, work)

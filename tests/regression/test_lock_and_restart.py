@@ -9,7 +9,8 @@
   into place (every kind: beam static and modal, continuum static, beam and particle time
   loops, fresh and restarted), and as a restart opens its checkpoint (the audit's repro).
   Now the run stops there: exit 128 + the signal (SIGTERM 143, SIGINT 130, SIGUSR1 138,
-  SIGHUP 129), no lock, the folder as it was (a folder the run made removed), and the same
+  SIGHUP 129, SIGUSR2 140, SIGXCPU 152: LSF's warning and a CPU time limit's, which killed
+  the run and left the lock before they were handled), no lock, the folder as it was (a folder the run made removed), and the same
   command then runs.
 - A run killed (SIGKILL) between the creation of `.multicor.lock.<host>.<pid>` and its
   removal left it for ever: the next run that takes the lock removes it.
@@ -30,7 +31,7 @@ import sys
 
 from checks import arguments, check, have_strace, summary
 
-EXIT = {"SIGTERM": 143, "SIGINT": 130, "SIGUSR1": 138, "SIGHUP": 129}
+EXIT = {"SIGTERM": 143, "SIGINT": 130, "SIGUSR1": 138, "SIGHUP": 129, "SIGUSR2": 140, "SIGXCPU": 152}
 
 
 def run(exe, *args):
