@@ -9,8 +9,13 @@
 !> failed internal consistency check (a bug: sizes that the code itself computed disagree, a
 !> routine called out of order), built by `make_internal_error` and worded so that nobody
 !> looks for the cause in the deck.
+!>
+!> A message shows every control character and every byte that is not UTF-8 as its value
+!> (`<0x00>`, core_utf8::printable): a junk file echoed in a message (a mesh's line) prints
+!> as text instead of sending raw bytes to the terminal.
 module core_error
     use core_strings, only: shorten
+    use core_utf8, only: printable
     implicit none
     private
     public :: error_t, make_error, make_input_error, make_internal_error
@@ -44,7 +49,7 @@ contains
         !> What went wrong and what to do about it.
         character(len=*), intent(in) :: message
         allocate (error)
-        error%message = message
+        error%message = printable(message)
         error%file = ''
         error%keyword = ''
     end subroutine make_error
@@ -60,8 +65,8 @@ contains
         character(len=*), intent(in) :: message
         allocate (error)
         error%kind = error_internal
-        error%message = 'internal error in '//where//': '//message//' (a bug in MULTICOR, '// &
-                        'not a problem of the input: please report it with the deck)'
+        error%message = printable('internal error in '//where//': '//message//' (a bug in MULTICOR, '// &
+                                  'not a problem of the input: please report it with the deck)')
         error%file = ''
         error%keyword = ''
     end subroutine make_internal_error
@@ -91,6 +96,6 @@ contains
             error%message = file//': '
         end if
         if (len(keyword) > 0) error%message = error%message//"keyword '"//shorten(keyword)//"': "
-        error%message = error%message//message
+        error%message = printable(error%message//message)
     end subroutine make_input_error
 end module core_error

@@ -6,7 +6,7 @@
 module core_utf8
     implicit none
     private
-    public :: invalid_utf8_column, find_invisible_space, byte_hex, replace_invalid_utf8
+    public :: invalid_utf8_column, find_invisible_space, byte_hex, replace_invalid_utf8, printable
 
     !> An invisible Unicode space: its code point and its Unicode name.
     type :: invisible_t
@@ -126,6 +126,54 @@ contains
         end do
         utf8 = utf8(:k)
     end function replace_invalid_utf8
+
+    !> `text` as a message may show it on a terminal: each control character (a byte below 32,
+    !> or 127: a NUL, an escape sequence) and each byte that does not begin or continue a
+    !> well-formed UTF-8 sequence written as its value between angle brackets (`<0x00>`, `<0xFF>`,
+    !> as the deck reader names such bytes); `text` itself when it has none. A file of junk
+    !> echoed in a message (`found "<0x00><0x01>junk<0xFF>"`) then prints as text.
+    pure function printable(text) result(shown)
+        !> The text.
+        character(len=*), intent(in) :: text
+        character(len=:), allocatable :: shown
+        integer :: i, n, k
+        i = 1
+        do while (i <= len(text))
+            n = shown_length(i)
+            if (n == 0) exit
+            i = i + n
+        end do
+        if (i > len(text)) then
+            shown = text
+            return
+        end if
+        ! at most six bytes for each byte of the text
+        allocate (character(len=6*len(text)) :: shown)
+        shown(:i - 1) = text(:i - 1)
+        k = i - 1
+        do while (i <= len(text))
+            n = shown_length(i)
+            if (n == 0) then
+                shown(k + 1:k + 6) = '<'//byte_hex(text(i:i))//'>'
+                k = k + 6
+                i = i + 1
+            else
+                shown(k + 1:k + n) = text(i:i + n - 1)
+                k = k + n
+                i = i + n
+            end if
+        end do
+        shown = shown(:k)
+    contains
+        !> Length of the UTF-8 sequence at byte j that is shown as it is; 0 for a byte to escape.
+        pure integer function shown_length(j) result(m)
+            integer, intent(in) :: j
+            integer :: c
+            m = sequence_length(text, j)
+            c = ichar(text(j:j))
+            if (m == 1 .and. (c < 32 .or. c == 127)) m = 0
+        end function shown_length
+    end function printable
 
     !> A byte as `0xE9`.
     pure function byte_hex(c) result(text)

@@ -19,6 +19,7 @@ program multicor
     use core_version, only: multicor_version
     use core_signals, only: signal_exit_code, catch_broken_pipe, ignore_file_size_signal
     use core_strings, only: parse_real, is_real_syntax, to_lower
+    use core_utf8, only: printable
     use io_deck_schema, only: multicor_schema, schema_markdown
     use io_unit_words, only: unit_hint
     use driver_run, only: run_options_t, run_deck
@@ -40,7 +41,7 @@ program multicor
     ! instead of killing the program before its first file is whole (an empty folder lock).
     if (.not. allocated(error)) call ignore_file_size_signal(error)
     if (allocated(error)) then
-        write (error_unit, '(a)') 'multicor: error: '//error%message
+        write (error_unit, '(a)') 'multicor: error: '//printable(error%message)
         stop 1, quiet = .true.
     end if
     n = command_argument_count()
@@ -125,16 +126,16 @@ program multicor
     ! modes of the start, or the end of the program would signal them again.
     call ieee_set_status(fp_status)
     if (allocated(error) .and. stopped_by /= 0) then
-        write (error_unit, '(a)') 'multicor: stopped: '//error%message
+        write (error_unit, '(a)') 'multicor: stopped: '//printable(error%message)
         flush (error_unit)
         stop signal_exit_code(stopped_by), quiet = .true.
     else if (allocated(error)) then
         if (error%kind == error_internal) then
-            write (error_unit, '(a)') 'multicor: '//error%message
+            write (error_unit, '(a)') 'multicor: '//printable(error%message)
             flush (error_unit)
             stop 3, quiet = .true.
         end if
-        write (error_unit, '(a)') 'multicor: error: '//error%message
+        write (error_unit, '(a)') 'multicor: error: '//printable(error%message)
         flush (error_unit)
         stop 1, quiet = .true.
     end if
@@ -163,7 +164,7 @@ contains
 
     subroutine usage_error(message)
         character(len=*), intent(in) :: message
-        write (error_unit, '(a)') 'multicor: error: '//message
+        write (error_unit, '(a)') 'multicor: error: '//printable(message)
         ! every option of --help (print_help), in its order
         write (error_unit, '(a)') 'usage: multicor [-o DIR] [-q] [--check] [--restart FILE] [--end T] deck.dat', &
             '       multicor --schema-markdown | -V | -h', &

@@ -284,17 +284,11 @@ contains
         !> would not show it in the message, and it means a binary or damaged file.
         subroutine check_control(s)
             character(len=*), intent(in) :: s
-            integer :: i, c
-            do i = 1, len(s)
-                c = iachar(s(i:i))
-                if (c == 13 .and. i == len(s)) cycle  ! the CR of a CR LF line end
-                if ((c < 32 .and. c /= 9) .or. c == 127) then
-                    call make_input_error(error, file, line_no, '', 'control character '//byte_hex(s(i:i))// &
-                                          ' at column '//to_str(i)//': a deck is plain text '// &
-                                          '(a binary or damaged file?)')
-                    return
-                end if
-            end do
+            integer :: i
+            i = control_column(s)
+            if (i > 0) call make_input_error(error, file, line_no, '', 'control character '//byte_hex(s(i:i))// &
+                                             ' at column '//to_str(i)//': a deck is plain text '// &
+                                             '(a binary or damaged file?)')
         end subroutine check_control
 
         !> An invisible Unicode space (no-break, thin, zero width, ...) in a line up to its
@@ -338,7 +332,7 @@ contains
             character(len=:), allocatable :: s, key, value, message
             type(string_t), allocatable :: tokens(:)
             logical, allocatable :: quoted(:)
-            integer :: hash, eq, k, raw_eq, last, glued
+            integer :: hash, eq, k, raw_eq, last, glued, control
             hash = index(raw, '#')
             ! The values of a keyword line may hold double-quoted names, where '#' is no
             ! comment; those of a text keyword (title) are the rest of the line up to the first
@@ -386,6 +380,12 @@ contains
                 k = invalid_utf8_column(raw(:hash - 1))
             else
                 k = invalid_utf8_column(raw)
+            end if
+            ! The first offending byte is named: a control character before it (a binary file)
+            ! is reported by check_control below.
+            if (k > 0) then
+                control = control_column(raw(:merge(hash - 1, len(raw), hash > 0)))
+                if (control > 0 .and. control < k) k = 0
             end if
             if (k > 0) then
                 call make_input_error(error, file, line_no, '', 'byte '//byte_hex(raw(k:k))//' at column '// &
@@ -511,6 +511,23 @@ contains
             open_name = name
         end subroutine parse_header
     end subroutine read_deck_text
+
+    !> Column of the first control character of a line of a deck outside its comment (0: none):
+    !> any byte below 32 or 127, but a tab and the CR of a CR LF line end.
+    pure integer function control_column(s) result(column)
+        !> The line up to its comment.
+        character(len=*), intent(in) :: s
+        integer :: i, c
+        do i = 1, len(s)
+            c = iachar(s(i:i))
+            if (c == 13 .and. i == len(s)) cycle  ! the CR of a CR LF line end
+            if ((c < 32 .and. c /= 9) .or. c == 127) then
+                column = i
+                return
+            end if
+        end do
+        column = 0
+    end function control_column
 
     !> Deck text without a leading UTF-8 byte-order mark, and with lone CRs (lines ending in
     !> CR only) turned into LFs; CR LF pairs are left for `strip`, which drops the CR.
