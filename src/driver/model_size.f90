@@ -5,9 +5,10 @@
 !> `simulation_t%size_estimate`: the beam its nodes and elements, the particles their disks, the
 !> continuum its elements; a coupled run both of its parts'): counts of explicit records with
 !> `add_count`, generator records (lattice, row, deposit, beam line, continuum mesh) with
-!> `add_record`, which also keeps the record that asks for the most memory, for the message.
-!> `check_size_estimate` then refuses a model whose estimate exceeds the available memory, or
-!> with more disks than a run can number.
+!> `add_record`, which also keeps the records that ask for the most memory, the most disks and
+!> the most beam nodes, for the messages. `check_size_estimate` then refuses a model with more
+!> disks or beam nodes than a run can number, or whose estimate exceeds the available memory,
+!> each error at the line of its record.
 module driver_model_size
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error, make_input_error
@@ -56,8 +57,18 @@ module driver_model_size
         integer(i8) :: t3 = 0
     end type model_size_t
 
+    !> The generator record that asks for the most of one kind of part (disks, beam nodes).
+    type :: record_count_t
+        !> How many it asks for (0: no record yet).
+        integer(i8) :: count = 0
+        !> Its line (0: none).
+        integer :: line = 0
+        !> Its keyword ('': none).
+        character(len=:), allocatable :: keyword
+    end type record_count_t
+
     !> The counts of a deck's model, summed over its parts without overflow (saturating at
-    !> huge(0_i8), where the estimate is refused anyway), and its largest generator record.
+    !> huge(0_i8), where the estimate is refused anyway), and its largest generator records.
     type :: size_estimate_t
         !> Counts of the whole model.
         type(model_size_t) :: total
@@ -69,6 +80,10 @@ module driver_model_size
         integer :: line = 0
         !> Its keyword ('': none).
         character(len=:), allocatable :: keyword
+        !> The generator record with the most disks.
+        type(record_count_t) :: most_disks
+        !> The generator record with the most beam nodes.
+        type(record_count_t) :: most_beam_nodes
     contains
         !> Add counts that no generator record stands for (disks, nodes, elements given one by one).
         procedure :: add_count => estimate_add_count
@@ -108,6 +123,18 @@ contains
             self%line = e%line
             self%keyword = e%keyword
         end if
+        call keep_largest(self%most_disks, part%disks)
+        call keep_largest(self%most_beam_nodes, part%beam_nodes)
+    contains
+        !> Make the record `most` when it asks for more than `most`.
+        subroutine keep_largest(most, count)
+            type(record_count_t), intent(inout) :: most
+            integer(i8), intent(in) :: count
+            if (count <= most%count) return
+            most%count = count
+            most%line = e%line
+            most%keyword = e%keyword
+        end subroutine keep_largest
     end subroutine estimate_add_record
 
     !> a + b count by count, each huge(0_i8) when it overflows (counts >= 0).
@@ -129,8 +156,9 @@ contains
         end function add
     end function add_sizes
 
-    !> Error when the deck's model has more disks than a run can number, or does not fit in
-    !> the available memory (naming the generator record that asks for the most).
+    !> Error when the deck's model has more disks or beam nodes than a run can number (naming
+    !> the generator record that asks for the most of them), or does not fit in the available
+    !> memory (naming the generator record that asks for the most memory).
     subroutine check_size_estimate(deck, estimate, available, error)
         !> The deck.
         type(deck_t), intent(in) :: deck
@@ -141,11 +169,10 @@ contains
         !> Set when the model is too large.
         type(error_t), allocatable, intent(out) :: error
         character(len=:), allocatable :: message, keyword
-        if (estimate%total%disks > huge(0)) then
-            call make_error(error, deck%file//': the deck asks for '//to_str(estimate%total%disks)// &
-                            ' disks, more than a run can number ('//to_str(huge(0))//')')
-            return
-        end if
+        call check_count(estimate%total%disks, estimate%most_disks, 'disks')
+        if (allocated(error)) return
+        call check_count(estimate%total%beam_nodes, estimate%most_beam_nodes, 'beam nodes')
+        if (allocated(error)) return
         call check_memory(estimate%total, available, error)
         if (allocated(error)) then
             message = error%message
@@ -153,6 +180,21 @@ contains
             if (allocated(estimate%keyword)) keyword = estimate%keyword
             call make_input_error(error, deck%file, estimate%line, keyword, message)
         end if
+    contains
+        !> Error when `total` things exceed huge(0), at the line of the record `most`.
+        subroutine check_count(total, most, things)
+            integer(i8), intent(in) :: total
+            type(record_count_t), intent(in) :: most
+            character(len=*), intent(in) :: things
+            character(len=:), allocatable :: text, key
+            if (total <= huge(0)) return
+            text = 'the deck asks for '//to_str(total)//' '//things
+            if (most%count > 0 .and. most%count < total) text = text//' ('//to_str(most%count)//' of them from this line)'
+            key = ''
+            if (allocated(most%keyword)) key = most%keyword
+            call make_input_error(error, deck%file, most%line, key, text//', more than a run can number ('// &
+                                  to_str(huge(0))//')')
+        end subroutine check_count
     end subroutine check_size_estimate
 
     !> Memory a model will need at its peak [bytes] (see bytes_per_disk, bytes_per_node,

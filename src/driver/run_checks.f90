@@ -222,7 +222,7 @@ contains
 
     !> Refuse a model whose memory estimate exceeds the available memory, from the numbers of
     !> disks, nodes and elements the deck asks for (before allocating them: each kind of run
-    !> adds its parts, `simulation_t%size_estimate`), and a model with more disks or a
+    !> adds its parts, `simulation_t%size_estimate`), and a model with more disks or beam nodes, or a
     !> rectangle mesh with more nodes or elements than a run can number. The memory error
     !> names the generator record (lattice, row, deposit, beam line, continuum mesh) that asks
     !> for the most memory (driver_model_size).
