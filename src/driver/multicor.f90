@@ -190,7 +190,7 @@ contains
             '', &
             'Results: DIR/<deck name>.h5 (HDF5, layout in doc/output.md) and DIR/<deck name>.xdmf', &
             '(the same results for ParaView''s XDMF Reader); plots: postproc/plot_results.py.', &
-            'Exit codes: 0 success, 1 error in the deck or the run, 2 bad command line,', &
+            'Exit codes: 0 success, 1 error in the deck or the run, 2 bad command line, 3 internal error,', &
             '128 + signal number when SIGTERM (143), SIGINT (130), SIGUSR1 (138), SIGUSR2 (140),', &
             'SIGHUP (129) or SIGXCPU (152, a CPU time limit) stopped the', &
             'run: the results so far are then in DIR/<deck name>.h5.partial, and the state in the', &
