@@ -192,9 +192,10 @@ contains
     end subroutine checkpoint_run_finish
 
     !> Whose checkpoint lies at `path`: the hash of its deck, the name of its results file
-    !> ('' when the checkpoint does not record it) and the run id of its results; `found` is
-    !> false when there is no checkpoint there or it cannot be read (a restart from it says why).
-    subroutine checkpoint_owner(path, found, hash, results, run_id)
+    !> ('' when the checkpoint does not record it), the run id of its results, and the step
+    !> and time it holds; `found` is false when there is no checkpoint there or it cannot be
+    !> read (a restart from it says why).
+    subroutine checkpoint_owner(path, found, hash, results, run_id, step, time)
         !> Path of the checkpoint.
         character(len=*), intent(in) :: path
         !> A checkpoint could be read there.
@@ -203,12 +204,18 @@ contains
         character(len=:), allocatable, intent(out) :: hash, results
         !> Its 'run_id' root attribute, that of its results file ('' when not found).
         character(len=:), allocatable, intent(out) :: run_id
+        !> Its step (/loop@step; -1 when it cannot be read).
+        integer, intent(out), optional :: step
+        !> Its time (root attribute 'time') [s] (0 when it cannot be read).
+        real(wp), intent(out), optional :: time
         type(h5_file_t) :: file
         type(error_t), allocatable :: error, ignored
         found = .false.
         hash = ''
         results = ''
         run_id = ''
+        if (present(step)) step = -1
+        if (present(time)) time = 0.0_wp
         if (.not. file_exists(path)) return
         call file%open(path, error)
         if (allocated(error)) return
@@ -219,6 +226,14 @@ contains
         if (allocated(ignored)) results = ''
         if (found) call file%read_attribute('/', 'run_id', run_id, ignored)
         if (allocated(ignored)) run_id = ''
+        if (found .and. present(step)) then
+            call file%read_attribute('/loop', 'step', step, ignored)
+            if (allocated(ignored)) step = -1
+        end if
+        if (found .and. present(time)) then
+            call file%read_attribute('/', 'time', time, ignored)
+            if (allocated(ignored)) time = 0.0_wp
+        end if
         call file%close(ignored)
     end subroutine checkpoint_owner
 

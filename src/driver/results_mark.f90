@@ -15,7 +15,7 @@ module driver_results_mark
     use io_paths, only: file_exists
     implicit none
     private
-    public :: results_mark_t, results_file_damage
+    public :: results_mark_t, results_file_damage, results_deck_file
 
     !> The results of a checkpoint: run id, datasets and their record counts.
     type :: results_mark_t
@@ -91,4 +91,22 @@ contains
         if (allocated(e)) reason = e%message
         call f%close(ignored)
     end function results_file_damage
+
+    !> The deck path a results file records (root attribute 'deck_file', as given on the
+    !> command line of its run), or '' when the file or the attribute cannot be read.
+    function results_deck_file(path) result(deck_file)
+        !> Path of the results file.
+        character(len=*), intent(in) :: path
+        !> The deck's path, or ''.
+        character(len=:), allocatable :: deck_file
+        type(h5_file_t) :: f
+        type(error_t), allocatable :: e, ignored
+        deck_file = ''
+        if (.not. file_exists(path)) return
+        call f%open(path, e)
+        if (allocated(e)) return
+        call f%read_attribute('/', 'deck_file', deck_file, e)
+        if (allocated(e)) deck_file = ''
+        call f%close(ignored)
+    end function results_deck_file
 end module driver_results_mark

@@ -42,7 +42,7 @@ module driver_run
     use io_deck, only: deck_t, read_deck
     use io_paths, only: stem, basename, dirname, mkdir_p, remove_empty_folders, file_exists, remove_file, rename_file
     use driver_results, only: results_writer_t
-    use driver_results_mark, only: results_mark_t
+    use driver_results_mark, only: results_mark_t, results_deck_file
     use driver_results_xdmf, only: write_results_xdmf
     use driver_simulation, only: simulation_t, report_iface
     use driver_simulations, only: select_simulation
@@ -290,7 +290,7 @@ contains
         if (allocated(opts%restart)) then
             call open_checkpoint(opts, report, run, error)
         else if (run%sim%has_time_loop()) then
-            call guard_other_run(report, run, error)
+            call guard_other_run(opts, report, run, error)
         end if
     end subroutine start_checkpoints
 
@@ -563,36 +563,115 @@ contains
         end if
     end function continue_command
 
-    !> A fresh run with a time loop replaces the folder's checkpoint (at its first commit). When that
-    !> checkpoint is another deck's and its run is interrupted (its results file still
-    !> '.partial'), the interrupted run could no longer be continued by the command it
-    !> printed: refused. Another deck's finished run only loses the checkpoint that would
-    !> extend it (`--restart --end`): a warning.
-    subroutine guard_other_run(report, run, error)
+    !> A fresh run with a time loop replaces the folder's checkpoint (at its first commit), and
+    !> at its end the results file '<deck name>.h5'.
+    !>
+    !> - When the checkpoint's run can still be continued (its results, which the checkpoint
+    !>   records by run id and record counts, are still '.partial', or '.partial.prev' where a
+    !>   fresh run set them aside and was killed: a run stopped by a signal, killed after a
+    !>   checkpoint), the run is refused, whatever the deck: that run's deck, this deck again,
+    !>   another of the same file name. The message gives the step and time of the checkpoint,
+    !>   the command that continues it, and what to do to start afresh (remove the checkpoint,
+    !>   or another `--output`). Before, only another deck of another file name was refused;
+    !>   a fresh run of the same deck, or of another deck of the same file name (`c1/deck.dat`,
+    !>   `c2/deck.dat`), replaced the stopped run silently.
+    !> - Another deck's finished run only loses the checkpoint that would extend it (`--restart
+    !>   --end`), and, when its deck has the same file name, its results: a warning.
+    !> - The same deck over its own finished results: nothing to say (a run reproduces it).
+    subroutine guard_other_run(opts, report, run, error)
+        !> The run's options (for the command that continues the stopped run).
+        type(run_options_t), intent(in) :: opts
         !> Where the warning goes.
         procedure(report_iface) :: report
         !> The run, its checkpoint path and deck text set.
         type(deck_run_t), intent(in) :: run
-        !> Set when the folder holds the checkpoint of another deck's interrupted run.
+        !> Set when the folder holds the checkpoint of a run that can still be continued.
         type(error_t), allocatable, intent(out) :: error
-        character(len=:), allocatable :: hash, results, run_id
-        logical :: found
-        call checkpoint_owner(run%ck%path, found, hash, results, run_id)
+        character(len=:), allocatable :: hash, results, run_id, held, deck_file
+        type(results_mark_t) :: mark
+        logical :: found, same_deck, same_name
+        integer :: step
+        real(wp) :: time
+        call checkpoint_owner(run%ck%path, found, hash, results, run_id, step, time)
         if (.not. found) return
-        if (hash == deck_hash(run%ck%deck_text) .or. results == basename(run%path)) return
+        same_deck = hash == deck_hash(run%ck%deck_text)
         if (len(results) > 0) then
-            if (file_exists(run%dir//'/'//results//'.partial')) then
-                call make_error(error, run%deck%file//': the folder '//run%dir//' holds the checkpoint of an '// &
-                                'interrupted run of another deck (its results '//run%dir//'/'//results// &
-                                '.partial): this run would replace it, and that run could no longer be '// &
-                                'continued; continue it first, or give this run another --output')
+            mark = checkpoint_results_mark(run%ck%path)
+            held = run%dir//'/'//results//'.partial'
+            if (.not. mark%held_by(held)) held = held//'.prev'
+            if (mark%held_by(held)) then
+                call refuse_over_interrupted_run(opts, run, same_deck, results, held, step, time, error)
                 return
             end if
+        end if
+        if (same_deck) return
+        same_name = results == basename(run%path)
+        if (same_name) same_name = mark%held_by(run%path)
+        if (same_name) then
+            deck_file = results_deck_file(run%path)
+            if (len(deck_file) > 0) deck_file = ' ('//deck_file//')'
+            call report('warning: the folder '//run%dir//' holds the finished results of another deck of the same '// &
+                        'file name'//deck_file//': this run replaces its checkpoint '//run%ck%path// &
+                        ' and, when it ends, its results '//run%path//' (to keep them, stop this run and give it '// &
+                        'another --output)')
+            return
         end if
         if (len(results) > 0) results = ' ('//results//')'
         call report('warning: this run replaces '//run%ck%path//', the checkpoint of another deck''s run'// &
                     results//', which can then no longer be extended with --restart --end')
     end subroutine guard_other_run
+
+    !> The refusal of a fresh run into the folder of a run that can still be continued (its
+    !> checkpoint `run%ck%path`, its results `held`, still partial): what that run is, the
+    !> command that continues it, and how to start afresh.
+    subroutine refuse_over_interrupted_run(opts, run, same_deck, results, held, step, time, error)
+        !> The run's options.
+        type(run_options_t), intent(in) :: opts
+        !> The fresh run.
+        type(deck_run_t), intent(in) :: run
+        !> Whether the checkpoint is this deck's (same hash).
+        logical, intent(in) :: same_deck
+        !> Name of the checkpoint's results file in the folder ('deck.h5').
+        character(len=*), intent(in) :: results
+        !> The checkpoint's results: '<results>.partial' or '<results>.partial.prev'.
+        character(len=*), intent(in) :: held
+        !> Step of the checkpoint (-1: unknown).
+        integer, intent(in) :: step
+        !> Time of the checkpoint [s].
+        real(wp), intent(in) :: time
+        !> The refusal.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: who, at, command, replaced, afresh
+        if (same_deck) then
+            who = 'this deck'
+            command = continue_command(opts, run%ck%path, .true.)
+            replaced = 'this run would replace them'
+            afresh = 'to start afresh instead'
+        else
+            who = results_deck_file(held)
+            if (len(who) > 0) then
+                command = 'multicor '//shell_word(who)//' --restart '//shell_word(run%ck%path)//' (its deck as it was)'
+                who = 'another deck ('//who//')'
+            else
+                command = 'multicor DECK --restart '//shell_word(run%ck%path)//' (DECK: that run''s deck as it was)'
+                who = 'another deck'
+            end if
+            if (results == basename(run%path)) then
+                who = who//' of the same file name'
+                replaced = 'this run would replace them, and that run could no longer be continued'
+            else
+                replaced = 'this run would replace that checkpoint, and that run could no longer be continued'
+            end if
+            afresh = 'to run this deck here all the same'
+        end if
+        at = ''
+        if (step >= 0) at = ' at step '//to_str(step)//', t = '//num(time)//' s'
+        call make_error(error, run%deck%file//': the folder '//run%dir//' holds an interrupted run of '//who// &
+                        ', which can still be continued from its checkpoint'//at//' ('//run%ck%path// &
+                        '; its results '//held//'): '//replaced//'. To continue it: '//command//'; '//afresh// &
+                        ', remove that checkpoint (rm '//shell_word(run%ck%path)//') or give this run '// &
+                        'another --output')
+    end subroutine refuse_over_interrupted_run
 
     !> Option `--restart`: open the checkpoint and check it belongs to this deck, this code and this
     !> kind of run, and that it leaves steps to do, or that it is the checkpoint of the last step

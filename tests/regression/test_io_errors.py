@@ -129,7 +129,8 @@ def finished_by_command(exe, deck, folder, name, command, reference):
 def xdmf_full_after_last_checkpoint(exe, deck, work, name, end=(), earlier=None, still_full=False):
     """A dynamic run of `deck` (with `end`, options) whose XDMF file is on a full device (its
     '.partial' a link to /dev/full), in a folder that holds an `earlier` run's files: a finished
-    result and its XDMF file ("finished"), or a partial file of the same deck ("interrupted")."""
+    result and its XDMF file ("finished"), or a partial file of the same deck ("interrupted", its
+    checkpoint removed)."""
     ref = work / f"ref_{name}"
     proc = run(exe, deck, "--output", ref, "--quiet", *end)
     assert proc.returncode == 0, proc.stderr
@@ -141,9 +142,12 @@ def xdmf_full_after_last_checkpoint(exe, deck, work, name, end=(), earlier=None,
         if earlier[0] == "finished":
             kept = {k: v for k, v in digests(folder).items() if k != "checkpoint.h5"}
         else:
-            # what a run killed at the rename of its results leaves (but the XDMF file)
+            # what a run killed at the rename of its results leaves (but the XDMF file), its
+            # checkpoint removed: a fresh run over a run that can be continued is refused
+            # (test_shared_folder.py); without it, the partial file is set aside and replaced
             (folder / f"{deck.stem}.h5").rename(folder / f"{deck.stem}.h5.partial")
             (folder / f"{deck.stem}.xdmf").unlink()
+            (folder / "checkpoint.h5").unlink()
     folder.mkdir(exist_ok=True)
     link = folder / f"{deck.stem}.xdmf.partial"
     link.symlink_to("/dev/full")

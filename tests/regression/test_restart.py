@@ -919,7 +919,8 @@ def stale_prev_of_the_same_run(exe, src, work):
 def set_aside_partial_files(exe, src, work):
     """'<name>.h5.partial.prev': a run started afresh sets the partial file of an interrupted run
     aside under that name and puts it back if it fails; killed, it cannot. Two fresh runs killed
-    after periodic checkpoints, then the second continued: the run that ends deletes the
+    after periodic checkpoints (the first one's checkpoint removed before the second starts),
+    then the second continued: the run that ends deletes the
     partial file the second run set aside (it stayed, though doc/output.md says a run that ends
     deletes the .prev files). When the set-aside file holds the results of the folder's
     checkpoint (the second run killed before its first checkpoint), a restart says which file
@@ -935,6 +936,10 @@ def set_aside_partial_files(exe, src, work):
     ref = reference(exe, deck, work, "aside")
     folder = work / "aside"
     for attempt in ("first", "second"):
+        if attempt == "second":
+            # a fresh run over a run that can be continued is refused (test_shared_folder.py):
+            # the first run's checkpoint removed, as the refusal says, to start afresh
+            (folder / "checkpoint.h5").unlink()
         proc = start(exe, deck, folder)
         # the progress line of step k comes after that step's checkpoint
         if not wait_for_step(proc, 200, []):

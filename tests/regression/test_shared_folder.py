@@ -12,6 +12,8 @@ another deck's run (dyn_disks.h5), which can then no longer be extended", which 
 Usage (ctest does this): test_shared_folder.py --exe multicor --work DIR --source REPO
 """
 import hashlib
+import pathlib
+import re
 import signal
 import subprocess
 import sys
@@ -138,10 +140,112 @@ def after_interrupted_run(exe, work):
           f"exit {run.returncode}, steps {steps}, {run.stderr.strip()[-300:]!r}")
 
 
+def stop_by_sigterm(exe, deck, folder, cwd):
+    """Run `deck` (relative to `cwd`) into `folder` without --output, the default
+    results/<deck name>, and stop it by SIGTERM once its partial file exists; returns
+    (exit code, standard output)."""
+    partial = cwd / folder / f"{deck.stem}.h5.partial"
+    proc = subprocess.Popen([str(exe), str(deck)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            cwd=cwd)
+    deadline = time.monotonic() + 60
+    while not partial.exists() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.01)
+    proc.send_signal(signal.SIGTERM)
+    out, _ = proc.communicate(timeout=300)
+    return proc.returncode, out
+
+
+def folder_digests(folder):
+    return {p.name: digest(p) for p in folder.iterdir() if p.is_file()}
+
+
+def same_file_name(exe, work):
+    """Decks of the same file name share their default results folder, results/<deck name>
+    (doc/output.md, "What a run replaces"). A fresh run into the folder of a run that can
+    still be continued (stopped by SIGTERM; killed by kill -9 after a periodic checkpoint) is
+    refused, whatever the deck: the same deck again, or another deck of the same file name
+    (c2/deck.dat beside c1/deck.dat, another friction); the folder stays byte for byte, and the
+    command the refusal gives continues the run. Removing the checkpoint, as it says, lets a
+    fresh run start. Over the finished results of another deck of the same file name: a
+    warning; over its own: no word. Before, every one of these runs went on silently and
+    replaced the stopped run (its printed command then failed)."""
+    base = work / "same_name"
+    for case, mu in (("c1", "0.5"), ("c2", "0.4")):
+        (base / case).mkdir(parents=True)
+        (base / case / "deck.dat").write_text(PARTICLES.replace("end = 0.01", "end = 2.0")
+                                              .replace("1 1 0.5 0 0", f"1 1 {mu} 0 0"))
+    folder = pathlib.Path("results") / "deck"
+    code, out = stop_by_sigterm(exe, pathlib.Path("c1") / "deck.dat", folder, base)
+    c = re.search(r"^to continue: (multicor .*)$", out, flags=re.M)
+    if not check("same name: c1/deck.dat stopped by SIGTERM with the command to continue",
+                 code == 143 and c is not None, f"exit {code}"):
+        return
+    before = folder_digests(base / folder)
+    ckpt = folder / "checkpoint.h5"
+    with h5py.File(base / ckpt, "r") as f:
+        step = int(f["loop"].attrs["step"])
+    for case, who in (("c1", "this deck"), ("c2", "another deck (c1/deck.dat) of the same file name")):
+        proc = subprocess.run([str(exe), f"{case}/deck.dat", "--quiet"], capture_output=True, text=True, cwd=base,
+                              timeout=300)
+        check(f"same name: {case}/deck.dat afresh into the stopped run's folder refused, with the step and "
+              "the command that continues it", proc.returncode == 1
+              and f"holds an interrupted run of {who}, which can still be continued from its checkpoint at "
+              f"step {step}," in proc.stderr and f"To continue it: multicor c1/deck.dat --restart {ckpt}" in proc.stderr
+              and f"remove that checkpoint (rm {ckpt})" in proc.stderr, proc.stderr.strip()[-600:])
+        check(f"same name: the refusal of {case}/deck.dat leaves the folder byte for byte",
+              folder_digests(base / folder) == before, str(sorted(folder_digests(base / folder))))
+    proc = subprocess.run([str(exe), *c.group(1).split()[1:], "--quiet"], capture_output=True, text=True,
+                          cwd=base, timeout=300)
+    check("same name: the stopped run's command continues it", proc.returncode == 0 and
+          (base / folder / "deck.h5").exists(), proc.stderr.strip()[-300:])
+    # over the finished results of another deck of the same file name: a warning, the run goes on
+    proc = subprocess.run([str(exe), "c2/deck.dat", "--end", "0.01"], capture_output=True, text=True, cwd=base,
+                          timeout=300)
+    check("same name: c2/deck.dat over c1's finished results: exit 0 with a warning",
+          proc.returncode == 0 and "warning: the folder results/deck holds the finished results of another deck "
+          "of the same file name (c1/deck.dat)" in proc.stdout, (proc.stdout + proc.stderr).strip()[-400:])
+    # the same deck over its own finished results: nothing to say
+    proc = subprocess.run([str(exe), "c2/deck.dat", "--end", "0.01"], capture_output=True, text=True, cwd=base,
+                          timeout=300)
+    check("same name: c2/deck.dat again over its own finished results: exit 0, no warning",
+          proc.returncode == 0 and "warning" not in proc.stdout + proc.stderr,
+          (proc.stdout + proc.stderr).strip()[-400:])
+
+    # kill -9 after a periodic checkpoint: the run can be continued, so refused the same way
+    deck = work / "killed.dat"
+    deck.write_text(PARTICLES.replace("end = 0.01", "end = 2.0") + "[output]\ncheckpoint_interval = 20\n")
+    folder = work / "killed"
+    proc = subprocess.Popen([str(exe), str(deck), "--output", str(folder), "--quiet"], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 60
+    while not (folder / "checkpoint.h5").exists() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.005)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    if not check("kill -9: killed after a periodic checkpoint, its partial file left",
+                 proc.returncode == -signal.SIGKILL and (folder / "checkpoint.h5").exists()
+                 and (folder / "killed.h5.partial").exists(), f"exit {proc.returncode}, {sorted(folder.iterdir())}"):
+        return
+    before = folder_digests(folder)
+    proc = multicor(exe, deck, "--output", folder, "--quiet")
+    check("kill -9: a fresh run of the same deck refused, the folder byte for byte",
+          proc.returncode == 1 and "holds an interrupted run of this deck" in proc.stderr
+          and folder_digests(folder) == {k: v for k, v in before.items() if k != ".multicor.lock"},
+          proc.stderr.strip()[-300:])
+    # as the refusal says: the checkpoint removed, the run starts afresh (no run can continue
+    # the partial file then: it is replaced)
+    (folder / "checkpoint.h5").unlink()
+    proc = multicor(exe, deck, "--output", folder, "--quiet", "--end", "0.01")
+    check("kill -9: the checkpoint removed, a fresh run goes on: exit 0, no warning",
+          proc.returncode == 0 and "warning" not in proc.stdout and finished(folder / "killed.h5"),
+          (proc.stdout + proc.stderr).strip()[-300:])
+
+
 def main():
     exe, work, _ = arguments(fresh=True)
     after_finished_run(exe, work)
     after_interrupted_run(exe, work)
+    same_file_name(exe, work)
     return summary()
 
 
