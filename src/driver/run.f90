@@ -33,7 +33,7 @@
 module driver_run
     use core_kinds, only: wp, i8
     use core_error, only: error_t, make_error
-    use core_strings, only: to_str, counted, num => sci_text, shell_word
+    use core_strings, only: to_str, counted, num => sci_text, shell_word, to_lower
     use io_lock, only: lock_t, lock_acquire, lock_release
     use io_progress, only: progress_t
     use core_signals, only: caught_signal, signal_name, install_signal_handlers
@@ -122,6 +122,8 @@ contains
         if (present(stopped_by)) stopped_by = 0
         ! Before any factorisation: results that do not depend on the threads OpenBLAS is given
         call single_thread_blas()
+        call check_deck_name(opts%deck_path, error)
+        if (allocated(error)) return
         call build_run(opts, report, run, error)
         if (allocated(error)) return
         if (opts%check_only) then
@@ -562,6 +564,33 @@ contains
             command = command//' --end '//trim(adjustl(end_text))
         end if
     end function continue_command
+
+    !> A deck whose results file would be the folder's checkpoint: its name without extension is
+    !> 'checkpoint' (`checkpoint.dat` writes '<folder>/checkpoint.h5'), in any case of letters
+    !> (`Checkpoint.dat` writes the same file where the file system does not tell case apart:
+    !> macOS, Windows shares). Refused before anything is read or written. Before, its results
+    !> replaced the checkpoint and the checkpoint them, and the printed `--restart` command
+    !> failed ('is not a MULTICOR checkpoint'). No other name of a run's files can be another's:
+    !> the results' ('<name>.h5', '.h5.partial', '.h5.partial.prev', '<name>.xdmf',
+    !> '.xdmf.partial', '<name>_fclib_<step>.h5', '.h5.partial') end in '.h5', '.xdmf', '.partial'
+    !> or '.prev'; the checkpoint's are 'checkpoint.h5', '.h5.tmp' and '.h5.prev'; the lock's
+    !> ('.multicor.lock', '.multicor.lock.<host>.<pid>', '.multicor.lock.break', ...) end in
+    !> neither, and the lock's clean-up removes only names ending in a process id.
+    subroutine check_deck_name(deck_path, error)
+        !> Path of the deck.
+        character(len=*), intent(in) :: deck_path
+        !> Set when the deck's name is refused.
+        type(error_t), allocatable, intent(out) :: error
+        character(len=:), allocatable :: results, case_note
+        if (to_lower(stem(deck_path))//'.h5' /= checkpoint_name) return
+        results = stem(deck_path)//'.h5'
+        case_note = ''
+        if (results /= checkpoint_name) case_note = ' where the file system does not tell case apart'
+        call make_error(error, deck_path//": a deck named '"//basename(deck_path)//"' writes its results as '"// &
+                        results//"', the name of the results folder's checkpoint ('"//checkpoint_name//"'"// &
+                        case_note//"): they would overwrite each other; rename the deck (its name without "// &
+                        "extension other than '"//stem(checkpoint_name)//"', in any case of letters)")
+    end subroutine check_deck_name
 
     !> A fresh run with a time loop replaces the folder's checkpoint (at its first commit), and
     !> at its end the results file '<deck name>.h5'.

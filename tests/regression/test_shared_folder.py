@@ -241,11 +241,31 @@ def same_file_name(exe, work):
           (proc.stdout + proc.stderr).strip()[-300:])
 
 
+def checkpoint_named_deck(exe, work):
+    """A deck named checkpoint.dat would write its results as <folder>/checkpoint.h5, the
+    folder's checkpoint: refused before anything is written (also Checkpoint.dat, the same file
+    where the file system does not tell case apart). Before, its results overwrote the
+    checkpoint and the printed --restart command failed ('is not a MULTICOR checkpoint')."""
+    for name in ("checkpoint", "Checkpoint"):
+        deck = work / "named" / f"{name}.dat"
+        deck.parent.mkdir(exist_ok=True)
+        deck.write_text(PARTICLES)
+        proc = multicor(exe, deck, "--output", work / "named" / name)
+        check(f"{name}.dat refused by name, nothing written", proc.returncode == 1
+              and f"writes its results as '{name}.h5', the name of the results folder's checkpoint" in proc.stderr
+              and "rename the deck" in proc.stderr and not (work / "named" / name).exists(),
+              proc.stderr.strip()[-300:])
+    proc = multicor(exe, work / "named" / "checkpoint.dat", "--check")
+    check("checkpoint.dat refused by --check too", proc.returncode == 1 and "rename the deck" in proc.stderr,
+          proc.stderr.strip()[-300:])
+
+
 def main():
     exe, work, _ = arguments(fresh=True)
     after_finished_run(exe, work)
     after_interrupted_run(exe, work)
     same_file_name(exe, work)
+    checkpoint_named_deck(exe, work)
     return summary()
 
 
