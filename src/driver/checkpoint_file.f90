@@ -195,7 +195,7 @@ contains
     !> ('' when the checkpoint does not record it), the run id of its results, and the step
     !> and time it holds; `found` is false when there is no checkpoint there or it cannot be
     !> read (a restart from it says why).
-    subroutine checkpoint_owner(path, found, hash, results, run_id, step, time)
+    subroutine checkpoint_owner(path, found, hash, results, run_id, step, time, this_build)
         !> Path of the checkpoint.
         character(len=*), intent(in) :: path
         !> A checkpoint could be read there.
@@ -208,6 +208,10 @@ contains
         integer, intent(out), optional :: step
         !> Its time (root attribute 'time') [s] (0 when it cannot be read).
         real(wp), intent(out), optional :: time
+        !> Whether this build can continue it: its layout ('format') and code version are this
+        !> build's (a restart refuses another's).
+        logical, intent(out), optional :: this_build
+        character(len=:), allocatable :: text
         type(h5_file_t) :: file
         type(error_t), allocatable :: error, ignored
         found = .false.
@@ -216,6 +220,7 @@ contains
         run_id = ''
         if (present(step)) step = -1
         if (present(time)) time = 0.0_wp
+        if (present(this_build)) this_build = .false.
         if (.not. file_exists(path)) return
         call file%open(path, error)
         if (allocated(error)) return
@@ -233,6 +238,14 @@ contains
         if (found .and. present(time)) then
             call file%read_attribute('/', 'time', time, ignored)
             if (allocated(ignored)) time = 0.0_wp
+        end if
+        if (found .and. present(this_build)) then
+            call file%read_attribute('/', 'format', text, ignored)
+            this_build = .not. allocated(ignored)
+            if (this_build) this_build = text == format_tag
+            if (this_build) call file%read_attribute('/', 'code_version', text, ignored)
+            if (this_build) this_build = .not. allocated(ignored)
+            if (this_build) this_build = text == multicor_version
         end if
         call file%close(ignored)
     end subroutine checkpoint_owner

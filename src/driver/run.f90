@@ -618,10 +618,10 @@ contains
         type(error_t), allocatable, intent(out) :: error
         character(len=:), allocatable :: hash, results, run_id, held, deck_file
         type(results_mark_t) :: mark
-        logical :: found, same_deck, same_name
+        logical :: found, same_deck, same_name, this_build
         integer :: step
         real(wp) :: time
-        call checkpoint_owner(run%ck%path, found, hash, results, run_id, step, time)
+        call checkpoint_owner(run%ck%path, found, hash, results, run_id, step, time, this_build)
         if (.not. found) return
         same_deck = hash == deck_hash(run%ck%deck_text)
         if (len(results) > 0) then
@@ -629,7 +629,8 @@ contains
             held = run%dir//'/'//results//'.partial'
             if (.not. mark%held_by(held)) held = held//'.prev'
             if (mark%held_by(held)) then
-                call refuse_over_interrupted_run(opts, run, same_deck, results, held, step, time, error)
+                call refuse_over_interrupted_run(opts, run, same_deck, results, held, step, time, this_build, &
+                                                 error)
                 return
             end if
         end if
@@ -653,7 +654,7 @@ contains
     !> The refusal of a fresh run into the folder of a run that can still be continued (its
     !> checkpoint `run%ck%path`, its results `held`, still partial): what that run is, the
     !> command that continues it, and how to start afresh.
-    subroutine refuse_over_interrupted_run(opts, run, same_deck, results, held, step, time, error)
+    subroutine refuse_over_interrupted_run(opts, run, same_deck, results, held, step, time, this_build, error)
         !> The run's options.
         type(run_options_t), intent(in) :: opts
         !> The fresh run.
@@ -668,6 +669,8 @@ contains
         integer, intent(in) :: step
         !> Time of the checkpoint [s].
         real(wp), intent(in) :: time
+        !> Whether this build can continue the checkpoint (else the build that wrote it can).
+        logical, intent(in) :: this_build
         !> The refusal.
         type(error_t), allocatable, intent(out) :: error
         character(len=:), allocatable :: who, at, command, replaced, afresh
@@ -695,6 +698,8 @@ contains
         end if
         at = ''
         if (step >= 0) at = ' at step '//to_str(step)//', t = '//num(time)//' s'
+        if (.not. this_build) command = 'with the MULTICOR build that wrote it (another code version or layout '// &
+                                        'than this build, which cannot), '//command
         call make_error(error, run%deck%file//': the folder '//run%dir//' holds an interrupted run of '//who// &
                         ', which can still be continued from its checkpoint'//at//' ('//run%ck%path// &
                         '; its results '//held//'): '//replaced//'. To continue it: '//command//'; '//afresh// &

@@ -232,6 +232,14 @@ def same_file_name(exe, work):
           proc.returncode == 1 and "holds an interrupted run of this deck" in proc.stderr
           and folder_digests(folder) == {k: v for k, v in before.items() if k != ".multicor.lock"},
           proc.stderr.strip()[-300:])
+    # a checkpoint of another code version: this build cannot continue it, the one that wrote
+    # it can (a restart here is refused by version): refused too, the message says which build
+    with h5py.File(folder / "checkpoint.h5", "r+") as f:
+        f.attrs["code_version"] = "0.0.1-other"
+    proc = multicor(exe, deck, "--output", folder, "--quiet")
+    check("kill -9: a checkpoint of another code version: the fresh run refused, continued by the build that "
+          "wrote it", proc.returncode == 1 and "To continue it: with the MULTICOR build that wrote it" in proc.stderr,
+          proc.stderr.strip()[-300:])
     # as the refusal says: the checkpoint removed, the run starts afresh (no run can continue
     # the partial file then: it is replaced)
     (folder / "checkpoint.h5").unlink()
