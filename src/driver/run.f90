@@ -102,7 +102,7 @@ contains
 
     !> Read, check and run a deck; write results unless only checking.
     !>
-    !> From the opening of the results file on, SIGTERM, SIGINT, SIGUSR1 and SIGHUP stop a time loop
+    !> From the opening of the results file on, SIGTERM, SIGINT, SIGUSR1, SIGUSR2, SIGHUP and SIGXCPU stop a time loop
     !> after the step under way: that step is stored, the file is closed as
     !> '<name>.h5.partial' with /summary finished = 0, and `error` says what was saved
     !> (`stopped_by` is then the signal number). Caught after the model's build and before the
@@ -235,7 +235,7 @@ contains
                                                'end time: '//continue_command(opts, run%ck%path, .false.)//' --end T)')
     end subroutine write_into_folder
 
-    !> A stop signal (SIGTERM, SIGINT, SIGUSR1, SIGHUP) caught from the handlers' installation
+    !> A stop signal (SIGTERM, SIGINT, SIGUSR1, SIGUSR2, SIGHUP, SIGXCPU) caught from the handlers' installation
     !> (before the results folder is made) to the opening of the results file ends the run
     !> there, before it writes anything: the checkpoint a restart read is closed as it was, and
     !> `error` says the run stopped (`stopped_by` is the signal; the caller releases the lock
