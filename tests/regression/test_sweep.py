@@ -271,6 +271,33 @@ def sequential_run(src, folder):
     check("units of the scalars", units == {"v2x": "m/s", "balance": "J/m", "w": "rad/s",
                                              "v": "m/s, rad/s"}, str(units))
     killed_point(src, folder)
+    failed_records(src, folder)
+
+
+def failed_records(src, folder):
+    """A point whose time loop failed after storing outputs keeps them as pNNN.h5.failed
+    (doc/output.md): collect reads its /summary, so that the table says what failed, and
+    leaves its scalars empty, for its last values are no results (before: an empty row)."""
+    import shutil
+    import h5py
+    import numpy as np
+    copy = folder.parent / (folder.name + "_failed")
+    shutil.rmtree(copy, ignore_errors=True)
+    shutil.copytree(folder, copy)
+    out = copy / "runs" / "p001"
+    status = "failed at step 41, t = 4.10000000E-002 s: step 41: disk 2 is at 4e291 m"
+    with h5py.File(out / "p001.h5", "a") as f:
+        f["summary"].attrs["finished"] = np.int32(0)
+        f["summary"].attrs["status"] = status
+    (out / "p001.h5").rename(out / "p001.h5.failed")
+    (out / "exit_status").write_text("1\n")
+    sweep_tool(src, ["collect", "--no-plot", copy], expect=None)
+    rows = {r["point"]: r for r in read_table(copy / "results.csv")}
+    check("collect: a failed point's /summary read from its .failed file, its scalars empty",
+          rows["p001"]["summary.status"] == status and rows["p001"]["file"].endswith("p001.h5.failed")
+          and all(rows["p001"][k] == "" for k in ("v2x", "vmax", "balance", "vy"))
+          and rows["p002"]["v2x"] != "",
+          str({k: v for k, v in rows["p001"].items() if k.startswith("summary") or k in ("v2x", "file")}))
 
 
 def killed_point(src, folder):
