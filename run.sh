@@ -3,7 +3,8 @@
 #   ./run.sh [deck.dat]       default: reference experiment 1 (input/bending_case1.dat)
 #   ./run.sh --experiments    all reference experiments and their figures (doc/experiments.md)
 # Installs what is missing, builds a Release build in build/, runs the deck, writes
-# results/<deck name>/<deck name>.h5 and its plots, and prints where they are. With
+# results/<deck name>/<deck name>.h5 and its plots, and prints where they are (a run of the
+# deck stopped by a signal, Ctrl-C, is continued from its checkpoint). With
 # --experiments: input/bending_case1.dat, bending_case2.dat and bending_stack.dat into
 # results/experiments/<case>/, the interface experiment (input/interface_shear.dat and its
 # variants of friction, cohesion and band width, postproc/run_interface_experiment.py) into
@@ -51,8 +52,25 @@ name=${name%.*}
 # absolute, so that the commands the run prints (continue with --restart, --end) work from
 # any folder, not only from the repository's root where this script runs the deck
 out="$MULTICOR_ROOT/results/$name"
-say "running $deck"
-build/src/multicor "$deck" --output "$out"
+# A run of this deck stopped by a signal (Ctrl-C: its partial file and checkpoint in $out) is
+# continued; when it cannot be (the deck changed since, its own message says why), the deck
+# runs afresh, which multicor refuses while that stopped run could still be continued.
+continued=0
+if [ -f "$out/checkpoint.h5" ] && [ -f "$out/$name.h5.partial" ]; then
+    say "continuing the run stopped in $out (to run $deck afresh, remove that folder first)"
+    rc=0
+    build/src/multicor "$deck" --output "$out" --restart "$out/checkpoint.h5" || rc=$?
+    [ $rc -eq 0 ] || [ $rc -eq 1 ] || exit $rc
+    if [ $rc -eq 0 ]; then
+        continued=1
+    else
+        say "the stopped run cannot be continued (above): running $deck afresh"
+    fi
+fi
+if [ $continued -eq 0 ]; then
+    say "running $deck"
+    build/src/multicor "$deck" --output "$out"
+fi
 say "plotting"
 .venv/bin/python postproc/plot_results.py "$out/$name.h5" --out "$out" "${plot_time[@]}"
 say "results in $out"
