@@ -33,11 +33,30 @@ ensure_system_deps
 ensure_venv
 configure_and_build build Release
 
+# run_deck <deck> <folder>: runs the deck into the folder. A run of it stopped there by a
+# signal (Ctrl-C: its partial file and checkpoint) is continued; when it cannot be (the deck
+# changed since: multicor says why), the deck runs afresh, which multicor refuses while that
+# stopped run could still be continued (its message says what to do).
+run_deck() {
+    local deck="$1" out="$2" name rc=0
+    name=$(basename "$deck")
+    name=${name%.*}
+    if [ -f "$out/checkpoint.h5" ] && [ -f "$out/$name.h5.partial" ]; then
+        say "continuing the run stopped in $out (to run $deck afresh, remove that folder first)"
+        build/src/multicor "$deck" --output "$out" --restart "$out/checkpoint.h5" || rc=$?
+        [ $rc -eq 0 ] && return 0
+        [ $rc -eq 1 ] || exit $rc
+        say "the stopped run cannot be continued (above): running $deck afresh"
+    else
+        say "running $deck"
+    fi
+    build/src/multicor "$deck" --output "$out"
+}
+
 if [ $experiments -eq 1 ]; then
     out="$MULTICOR_ROOT/results/experiments"
     for name in bending_case1 bending_case2 bending_stack; do
-        say "running input/$name.dat"
-        build/src/multicor "input/$name.dat" --output "$out/$name"
+        run_deck "$MULTICOR_ROOT/input/$name.dat" "$out/$name"
     done
     say "running the interface experiment (input/interface_shear.dat and its variants)"
     .venv/bin/python postproc/run_interface_experiment.py --exe build/src/multicor --out "$out/interface"
@@ -52,25 +71,7 @@ name=${name%.*}
 # absolute, so that the commands the run prints (continue with --restart, --end) work from
 # any folder, not only from the repository's root where this script runs the deck
 out="$MULTICOR_ROOT/results/$name"
-# A run of this deck stopped by a signal (Ctrl-C: its partial file and checkpoint in $out) is
-# continued; when it cannot be (the deck changed since, its own message says why), the deck
-# runs afresh, which multicor refuses while that stopped run could still be continued.
-continued=0
-if [ -f "$out/checkpoint.h5" ] && [ -f "$out/$name.h5.partial" ]; then
-    say "continuing the run stopped in $out (to run $deck afresh, remove that folder first)"
-    rc=0
-    build/src/multicor "$deck" --output "$out" --restart "$out/checkpoint.h5" || rc=$?
-    [ $rc -eq 0 ] || [ $rc -eq 1 ] || exit $rc
-    if [ $rc -eq 0 ]; then
-        continued=1
-    else
-        say "the stopped run cannot be continued (above): running $deck afresh"
-    fi
-fi
-if [ $continued -eq 0 ]; then
-    say "running $deck"
-    build/src/multicor "$deck" --output "$out"
-fi
+run_deck "$deck" "$out"
 say "plotting"
 .venv/bin/python postproc/plot_results.py "$out/$name.h5" --out "$out" "${plot_time[@]}"
 say "results in $out"
