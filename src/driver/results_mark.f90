@@ -15,7 +15,7 @@ module driver_results_mark
     use io_paths, only: file_exists
     implicit none
     private
-    public :: results_mark_t, results_file_damage, results_deck_file
+    public :: results_mark_t, results_file_damage, results_deck_file, results_root_text
 
     !> The results of a checkpoint: run id, datasets and their record counts.
     type :: results_mark_t
@@ -99,14 +99,26 @@ contains
         character(len=*), intent(in) :: path
         !> The deck's path, or ''.
         character(len=:), allocatable :: deck_file
+        deck_file = results_root_text(path, 'deck_file')
+    end function results_deck_file
+
+    !> A text root attribute of a results file ('deck_file', 'deck_text', ...), or '' when the
+    !> file or the attribute cannot be read.
+    function results_root_text(path, name) result(text)
+        !> Path of the results file.
+        character(len=*), intent(in) :: path
+        !> Name of the attribute.
+        character(len=*), intent(in) :: name
+        !> Its value, or ''.
+        character(len=:), allocatable :: text
         type(h5_file_t) :: f
         type(error_t), allocatable :: e, ignored
-        deck_file = ''
+        text = ''
         if (.not. file_exists(path)) return
         call f%open(path, e)
         if (allocated(e)) return
-        call f%read_attribute('/', 'deck_file', deck_file, e)
-        if (allocated(e)) deck_file = ''
+        call f%read_attribute('/', name, text, e)
+        if (allocated(e)) text = ''
         call f%close(ignored)
-    end function results_deck_file
+    end function results_root_text
 end module driver_results_mark

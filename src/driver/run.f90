@@ -42,7 +42,7 @@ module driver_run
     use io_deck, only: deck_t, read_deck
     use io_paths, only: stem, basename, dirname, mkdir_p, remove_empty_folders, file_exists, remove_file, rename_file
     use driver_results, only: results_writer_t
-    use driver_results_mark, only: results_mark_t, results_deck_file
+    use driver_results_mark, only: results_mark_t, results_deck_file, results_root_text
     use driver_results_xdmf, only: write_results_xdmf
     use driver_simulation, only: simulation_t, report_iface
     use driver_simulations, only: select_simulation
@@ -293,8 +293,30 @@ contains
             call open_checkpoint(opts, report, run, error)
         else if (run%sim%has_time_loop()) then
             call guard_other_run(opts, report, run, error)
+        else
+            call guard_other_results(report, run)
         end if
     end subroutine start_checkpoints
+
+    !> A static or modal run replaces the folder's results '<deck name>.h5' when it ends. When
+    !> they are another deck's of the same file name (the deck they record differs:
+    !> `case1/beam.dat` and `case2/beam.dat` into the default folder), a warning says so, as for
+    !> a run with a time loop (`guard_other_run`, whose checkpoint identifies the deck); the
+    !> same deck again reproduces them silently.
+    subroutine guard_other_results(report, run)
+        !> Where the warning goes.
+        procedure(report_iface) :: report
+        !> The run, its results path set.
+        type(deck_run_t), intent(in) :: run
+        character(len=:), allocatable :: deck_file
+        if (.not. file_exists(run%path)) return
+        if (results_root_text(run%path, 'deck_text') == run%deck%text) return
+        deck_file = results_deck_file(run%path)
+        if (len(deck_file) > 0) deck_file = ' ('//deck_file//')'
+        call report('warning: the folder '//run%dir//' holds the results of another deck of the same file name'// &
+                    deck_file//': this run replaces them, '//run%path//', when it ends (to keep both, give each deck '// &
+                    'its own --output)')
+    end subroutine guard_other_results
 
     !> Run the analysis into '<path>.partial', renamed to `path` on success (the caller
     !> holds the folder's lock). A failed run leaves the folder's results, partial file and

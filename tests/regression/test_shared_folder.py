@@ -249,6 +249,28 @@ def same_file_name(exe, work):
           (proc.stdout + proc.stderr).strip()[-300:])
 
 
+def same_name_without_time_loop(exe, work):
+    """Static and modal runs of decks of the same file name share their default results
+    folder, results/<deck name>, and have no checkpoint to tell them apart: another deck's
+    results replaced are warned (from the deck the results record), the same deck again is
+    silent. Before, both were silent."""
+    for kind in ("static_beam", "modal_continuum"):
+        base = work / f"same_name_{kind}"
+        for case, extra in (("c1", ""), ("c2", "# another deck\n")):
+            (base / case).mkdir(parents=True)
+            (base / case / f"{kind}.dat").write_text(NO_TIME_LOOP[kind] + extra)
+        results = base / "results" / kind / f"{kind}.h5"
+        for case, warned in (("c1", False), ("c1", False), ("c2", True), ("c2", False)):
+            proc = subprocess.run([str(exe), f"{case}/{kind}.dat", "--quiet"], capture_output=True, text=True,
+                                  cwd=base, timeout=300)
+            text = proc.stdout + proc.stderr
+            expected = (f"warning: the folder results/{kind} holds the results of another deck of the same file "
+                        f"name (c1/{kind}.dat): this run replaces them")
+            check(f"same name, {kind}: {case}/{kind}.dat {'warned' if warned else 'silent'}, exit 0",
+                  proc.returncode == 0 and finished(results)
+                  and ((expected in proc.stdout) if warned else "warning" not in text), text.strip()[-400:])
+
+
 def checkpoint_named_deck(exe, work):
     """A deck named checkpoint.dat would write its results as <folder>/checkpoint.h5, the
     folder's checkpoint: refused before anything is written (also Checkpoint.dat, the same file
@@ -273,6 +295,7 @@ def main():
     after_finished_run(exe, work)
     after_interrupted_run(exe, work)
     same_file_name(exe, work)
+    same_name_without_time_loop(exe, work)
     checkpoint_named_deck(exe, work)
     return summary()
 
