@@ -2,6 +2,8 @@
 meaningful figure, a folder that cannot be written and a file of the wrong kind end with a
 one-line message (usage errors exit 2, file errors exit 1), never a traceback and never a
 figure saved with exit 0."""
+import os
+
 import h5py
 import pytest
 from synthetic_coupled import write_coupled
@@ -49,10 +51,14 @@ def test_a_time_or_scale_without_a_meaning_is_a_usage_error(script, option, valu
     assert not out.exists()
 
 
-def test_a_finite_scale_and_time_are_accepted(cantilever_file, tmp_path):
+def test_a_finite_scale_and_time_are_accepted(cantilever_file, tmp_path, drawing_only):
     out = tmp_path / "png"
-    assert plot_results.main([str(cantilever_file()), "--scale", "1e-3", "--time", "-1",
-                              "--out", str(out)]) == 0
+    # of a straight beam, the deflection at the first output (--time -1) is the figure these
+    # values shape; the others are those test_beam.py's
+    # test_cli_writes_every_plot_of_a_straight_cantilever draws
+    with drawing_only("cantilever_deflection.png"):
+        assert plot_results.main([str(cantilever_file()), "--scale", "1e-3", "--time", "-1",
+                                  "--out", str(out)]) == 0
     assert any(out.iterdir())
 
 
@@ -79,15 +85,20 @@ def test_plot_beam_says_what_a_checkpoint_is(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("disk", ["0", "-2", "10000"])
-def test_plot_experiments_refuses_a_tracked_disk_the_runs_do_not_have(disk, tmp_path, capsys):
+def test_plot_experiments_refuses_a_tracked_disk_the_runs_do_not_have(disk, tmp_path, capsys,
+                                                                     drawing_only):
     # --track 0 drew the last disk (index -1) under the title 'disk 0', with exit 0
     for case in plot_experiments.CASES:
         (tmp_path / case).mkdir()
         write_coupled(tmp_path / case / f"{case}.h5", title=case)
-    assert plot_experiments.main(["--results", str(tmp_path), "--track", disk]) == 1
+    # the profiles and configurations saved before the tracked disks are read: those
+    # test_coupled.py's test_plot_experiments_writes_png_pdf_and_summary draws of these files
+    with drawing_only() as skipped:
+        assert plot_experiments.main(["--results", str(tmp_path), "--track", disk]) == 1
     err = capsys.readouterr().err
     assert f"no disk {disk} (the run has disks 1.." in err
     assert not list(tmp_path.glob("history_*"))
+    assert not [p for p in skipped if os.path.basename(p).startswith("history_")]
 
 
 def test_plot_experiments_creates_no_folder_for_results_it_cannot_load(tmp_path, capsys):
@@ -160,44 +171,65 @@ def test_run_interface_experiment_empties_an_earlier_experiment(fake_exe, tmp_pa
     assert "mesh = file " in (out / "interface_shear.dat").read_text()
 
 
-def test_a_node_without_a_history_to_plot_is_said_to_be_unused(cantilever_file, tmp_path, capsys):
+def test_a_node_without_a_history_to_plot_is_said_to_be_unused(cantilever_file, tmp_path, capsys,
+                                                               drawing_only):
     # --node was silently ignored where no node history is drawn (static, modal, particles)
     static = cantilever_file("static.h5", parts=("static",))
-    assert plot_results.main([str(static), "--node", "3", "--out", str(tmp_path / "a")]) == 0
-    err = capsys.readouterr().err
-    assert "--node 3 is not used" in err and "static.h5" in err
-    dem = write_dem(tmp_path / "dem.h5")
-    assert plot_results.main([str(dem), "--node", "3", "--out", str(tmp_path / "b")]) == 0
-    assert "--node 3 is not used" in capsys.readouterr().err
-    # where the history is drawn, no note
+    # figures drawn by test_beam.py's test_cli_writes_every_plot_of_a_straight_cantilever and
+    # test_particles.py's test_cli_writes_the_particle_plots (--node changes none of them)
+    with drawing_only():
+        assert plot_results.main([str(static), "--node", "3", "--out", str(tmp_path / "a")]) == 0
+        err = capsys.readouterr().err
+        assert "--node 3 is not used" in err and "static.h5" in err
+        dem = write_dem(tmp_path / "dem.h5")
+        assert plot_results.main([str(dem), "--node", "3", "--out", str(tmp_path / "b")]) == 0
+        assert "--node 3 is not used" in capsys.readouterr().err
+    # where the history is drawn, no note (the energy, static and modal figures: those of
+    # test_cli_writes_every_plot_of_a_straight_cantilever)
     dynamic = cantilever_file("dynamic.h5")
-    assert plot_results.main([str(dynamic), "--node", "50", "--out", str(tmp_path / "c")]) == 0
+    with drawing_only("dynamic_deflection.png", "dynamic_history_node50.png"):
+        assert plot_results.main([str(dynamic), "--node", "50", "--out", str(tmp_path / "c")]) == 0
     assert "not used" not in capsys.readouterr().err
 
 
 def test_a_scale_without_a_deformed_shape_to_magnify_is_said_to_be_unused(cantilever_file,
-                                                                          tmp_path, capsys):
+                                                                          tmp_path, capsys,
+                                                                          drawing_only):
     # --scale was silently ignored where no figure magnifies displacements: a straight beam
     # (its deflection drawn in length units), its mode shapes, particles only
     from test_continuum import write as write_continuum
     straight = cantilever_file("straight.h5")
-    for script in (plot_results, plot_beam):
-        assert script.main([str(straight), "--scale", "100", "--out", str(tmp_path / "a")]) == 0
-        err = capsys.readouterr().err
-        assert err == (f"{script.__name__}.py: note: --scale 100 is not used: '{straight}' has "
-                       "no deformed shape to magnify (frames, 2D continua and beam-coupled runs "
-                       "have one; a straight beam's deflection is drawn in length units)\n")
-    dem = write_dem(tmp_path / "dem.h5")
-    assert plot_results.main([str(dem), "--scale", "5", "--out", str(tmp_path / "b")]) == 0
-    assert "--scale 5 is not used" in capsys.readouterr().err
-    # where a deformed shape is drawn (a frame, a continuum, a beam-coupled run), no note
+    # --scale changes none of these figures: the straight beam's are drawn by
+    # test_a_node_without_a_history_to_plot_is_said_to_be_unused (the deflection at the last
+    # output) and test_beam.py's test_cli_writes_every_plot_of_a_straight_cantilever, the
+    # particles' by test_particles.py's test_cli_writes_the_particle_plots
+    with drawing_only():
+        for script in (plot_results, plot_beam):
+            assert script.main([str(straight), "--scale", "100", "--out", str(tmp_path / "a")]) == 0
+            err = capsys.readouterr().err
+            assert err == (f"{script.__name__}.py: note: --scale 100 is not used: '{straight}' "
+                           "has no deformed shape to magnify (frames, 2D continua and "
+                           "beam-coupled runs have one; a straight beam's deflection is drawn "
+                           "in length units)\n")
+        dem = write_dem(tmp_path / "dem.h5")
+        assert plot_results.main([str(dem), "--scale", "5", "--out", str(tmp_path / "b")]) == 0
+        assert "--scale 5 is not used" in capsys.readouterr().err
+    # where a deformed shape is drawn (a frame, a continuum, a beam-coupled run), no note; the
+    # figures --scale shapes are drawn, the others are those of the tests named above and of
+    # test_continuum.py's test_cli_writes_the_figures_of_each_kind and test_coupled.py's
+    # test_plot_results_handles_a_coupled_file
     frame = cantilever_file("frame.h5", angle=0.5)
     plate = write_continuum(tmp_path / "plate.h5")
     glued = write_coupled(tmp_path / "glued.h5")
-    for path in (frame, plate, glued):
-        assert plot_results.main([str(path), "--scale", "100", "--out", str(tmp_path / "c")]) == 0
+    for path, drawn in ((frame, ("deflection", "history_node90", "static", "modes")),
+                        (plate, ("stress",)), (glued, ("configuration",))):
+        with drawing_only(*(f"{path.stem}_{name}.png" for name in drawn)):
+            assert plot_results.main([str(path), "--scale", "100", "--out",
+                                      str(tmp_path / "c")]) == 0
         assert "not used" not in capsys.readouterr().err
-    assert plot_beam.main([str(frame), "--scale", "100", "--out", str(tmp_path / "c")]) == 0
+    # the figures plot_results.py has just drawn of the frame
+    with drawing_only():
+        assert plot_beam.main([str(frame), "--scale", "100", "--out", str(tmp_path / "c")]) == 0
     assert "not used" not in capsys.readouterr().err
 
 
