@@ -160,7 +160,7 @@ def test_a_continuum_without_a_stored_output(tmp_path, capsys):
 # A figure skipped because its series is empty
 # --------------------------------------------------------------------------------------------
 
-def test_a_solver_figure_without_steps_is_skipped_with_a_note(tmp_path, capsys):
+def test_a_solver_figure_without_steps_is_skipped_with_a_note(tmp_path, capsys, drawing_only):
     # a run killed before its 4096th step: the outputs are there, /dem/solver holds no step;
     # the solver figure was skipped without a word
     path = write_dem(tmp_path / "column.h5")
@@ -174,8 +174,10 @@ def test_a_solver_figure_without_steps_is_skipped_with_a_note(tmp_path, capsys):
     assert not (out / "column_solver.png").exists()
     assert ("plot_results.py: note: column_solver.png is not written: /dem/solver holds no step"
             in printed.err)
-    # with the steps, no note
-    assert plot_results.main([str(write_dem(tmp_path / "full.h5")), "--out", str(out)]) == 0
+    # with the steps, no note (the other figures: those test_particles.py's
+    # test_cli_writes_the_particle_plots draws)
+    with drawing_only("full_solver.png"):
+        assert plot_results.main([str(write_dem(tmp_path / "full.h5")), "--out", str(out)]) == 0
     printed = capsys.readouterr()
     assert (out / "full_solver.png").exists() and "note" not in printed.err
 
@@ -186,10 +188,13 @@ def test_a_solver_figure_without_steps_is_skipped_with_a_note(tmp_path, capsys):
 
 @pytest.mark.parametrize("time, used", [("99", "the last one, t = 0.015 s"),
                                         ("-5", "the first one, t = 0 s")])
-def test_a_time_outside_the_outputs_gets_a_note(time, used, tmp_path, capsys):
+def test_a_time_outside_the_outputs_gets_a_note(time, used, tmp_path, capsys, drawing_only):
     # --time 99 on a run that ends at 15 ms drew the last output without a word
     path = write_dem(tmp_path / "column.h5")
-    assert plot_results.main([str(path), "--time", time, "--out", str(tmp_path / "png")]) == 0
+    # the configuration at the last or the first output and the series: figures that
+    # test_particles.py's test_cli_writes_the_particle_plots draws
+    with drawing_only():
+        assert plot_results.main([str(path), "--time", time, "--out", str(tmp_path / "png")]) == 0
     err = capsys.readouterr().err
     assert err == (f"plot_results.py: note: --time {time} s is outside the stored outputs "
                    f"[0, 0.015] s: the snapshot figures show {used}\n")
@@ -210,11 +215,15 @@ def test_a_time_just_outside_the_outputs_gets_a_note(time):
 
 
 @pytest.mark.parametrize("script", [plot_results, plot_beam])
-def test_a_beam_time_outside_the_outputs_gets_a_note(script, cantilever_file, tmp_path, capsys):
+def test_a_beam_time_outside_the_outputs_gets_a_note(script, cantilever_file, tmp_path, capsys,
+                                                    drawing_only):
     path = cantilever_file(parts=("dynamic", "energy"))
     with h5py.File(path, "r") as f:
         t_last = float(f["fem/time"][-1])
-    assert script.main([str(path), "--time", "1e3", "--out", str(tmp_path / "png")]) == 0
+    # the history and the energy do not depend on --time: test_beam.py's
+    # test_cli_writes_every_plot_of_a_straight_cantilever draws them
+    with drawing_only("cantilever_deflection.png"):
+        assert script.main([str(path), "--time", "1e3", "--out", str(tmp_path / "png")]) == 0
     err = capsys.readouterr().err
     assert f"{script.__name__}.py: note: --time 1000 s is outside the stored outputs" in err
     assert f"the last one, t = {t_last:.6g} s" in err and err.count("\n") == 1
@@ -296,27 +305,32 @@ def test_a_dynamic_continuum_killed_before_its_series_were_created(tmp_path, cap
 @pytest.mark.parametrize("analysis", ["static", "modal"])
 @pytest.mark.parametrize("script", [plot_results, plot_beam])
 def test_a_time_for_a_static_beam_gets_a_note(script, analysis, cantilever_file, tmp_path,
-                                              capsys):
+                                              capsys, drawing_only):
     # --time 0.5 on a static run was ignored without a word
     path = cantilever_file(parts=(analysis,))
-    assert script.main([str(path), "--time", "0.5", "--out", str(tmp_path / "png")]) == 0
-    err = capsys.readouterr().err
-    assert err == (f"{script.__name__}.py: note: --time 0.5 s is ignored: it applies to dynamic "
-                   f"runs only, and this is a {analysis} run ("
-                   + ("one solution" if analysis == "static" else "mode shapes")
-                   + ", no stored outputs in time)\n")
-    # without --time, or for a dynamic run, no note
-    assert script.main([str(path), "--out", str(tmp_path / "png")]) == 0
-    assert capsys.readouterr().err == ""
-    dynamic = cantilever_file("dynamic.h5", parts=("dynamic", "energy"))
-    assert script.main([str(dynamic), "--time", "0.005", "--out", str(tmp_path / "png")]) == 0
-    assert capsys.readouterr().err == ""
+    # every figure here is one test_beam.py's test_cli_writes_every_plot_of_a_straight_cantilever
+    # draws (the same cantilever, the deflection at --time 0.005)
+    with drawing_only():
+        assert script.main([str(path), "--time", "0.5", "--out", str(tmp_path / "png")]) == 0
+        err = capsys.readouterr().err
+        assert err == (f"{script.__name__}.py: note: --time 0.5 s is ignored: it applies to "
+                       f"dynamic runs only, and this is a {analysis} run ("
+                       + ("one solution" if analysis == "static" else "mode shapes")
+                       + ", no stored outputs in time)\n")
+        # without --time, or for a dynamic run, no note
+        assert script.main([str(path), "--out", str(tmp_path / "png")]) == 0
+        assert capsys.readouterr().err == ""
+        dynamic = cantilever_file("dynamic.h5", parts=("dynamic", "energy"))
+        assert script.main([str(dynamic), "--time", "0.005", "--out", str(tmp_path / "png")]) == 0
+        assert capsys.readouterr().err == ""
 
 
 @pytest.mark.parametrize("analysis", ["static", "modal"])
-def test_a_time_for_a_static_continuum_gets_a_note(analysis, tmp_path, capsys):
+def test_a_time_for_a_static_continuum_gets_a_note(analysis, tmp_path, capsys, drawing_only):
     path = write_continuum(tmp_path / "plate.h5", analysis)
-    assert plot_results.main([str(path), "--time", "2", "--out", str(tmp_path / "png")]) == 0
+    # the figure test_continuum.py's test_cli_writes_the_figures_of_each_kind draws
+    with drawing_only():
+        assert plot_results.main([str(path), "--time", "2", "--out", str(tmp_path / "png")]) == 0
     err = capsys.readouterr().err
     assert err.startswith("plot_results.py: note: --time 2 s is ignored: it applies to "
                           f"dynamic runs only, and this is a {analysis} run")
