@@ -3,9 +3,9 @@ of a cluster-sized results file needs the memory of the outputs it draws, not of
 (multicor_post.results.Records, doc/output.md "Plots").
 
 A child process limits its address space (RLIMIT_AS) to what it has mapped after its imports
-plus HEADROOM, then runs plot_results.py and the particle loader on a synthetic file whose
-series read whole need several times HEADROOM; the figures' values are checked against a
-direct h5py read of the slices they draw."""
+plus HEADROOM, then runs plot_results.py on a synthetic file whose series read whole need
+several times HEADROOM; the values of the configuration figures it saves are checked against
+a direct h5py read of the slices they draw."""
 import json
 import os
 import re
@@ -41,8 +41,9 @@ OUTPUTS = (0, 1, N_OUT // 2, N_OUT - 1)
 #: matplotlib's own: a configuration figure of 4000 disks at 240 dpi is 1920 x 1440 RGBA
 #: (11 MB) with its renderer's buffers. Measured (VmPeak beyond the imports, the child's
 #: report): plot_results.py on this file 88 MB, on a file of the same disks with 4 outputs
-#: 70 MB; the whole child, five configuration figures, about 140 MB, a third of the limit:
-#: the test does not depend on the details of a matplotlib or numpy version.
+#: 70 MB; the whole child, three configuration figures, about 140 MB (144 MB with matplotlib
+#: 3.11.2, numpy 2.4.6), a third of the limit: the test does not depend on the details of a
+#: matplotlib or numpy version.
 HEADROOM = 400 * 2**20
 
 CHILD = r"""
@@ -51,7 +52,7 @@ sys.path.insert(0, sys.argv[1])
 import numpy as np
 from matplotlib.collections import EllipseCollection, LineCollection
 import plot_results
-from multicor_post import particles
+from multicor_post import results
 
 
 def vm(key):
@@ -62,22 +63,36 @@ def vm(key):
 
 
 path, out, headroom = sys.argv[2], sys.argv[3], int(sys.argv[4])
+# the values the configuration figures saved draw: at t = 0 (start), the last output (last)
+# and the --time of output 1 (t1)
+plotted = {}
+draw = results.save_figure
+CONFIGURATIONS = {"large_particles_start.png": "start", "large_particles.png": "last",
+                  os.path.join("t1", "large_particles.png"): "t1"}
+
+
+def save_figure(fig, name, dpi):
+    key = CONFIGURATIONS.get(os.path.relpath(name, out))
+    if key is None and os.path.dirname(name) == os.path.join(out, "t1"):
+        return      # the series of the run with --time: drawn by the first run byte for byte
+    draw(fig, name, dpi)
+    if key is not None:
+        ax = fig.axes[0]
+        disks = next(c for c in ax.collections if isinstance(c, EllipseCollection))
+        forces = next(c for c in ax.collections
+                      if isinstance(c, LineCollection) and c.get_capstyle() == "round")
+        plotted[f"offsets_{key}"] = disks.get_offsets()
+        plotted[f"segments_{key}"] = np.array(forces.get_segments())
+        plotted[f"widths_{key}"] = np.asarray(forces.get_linewidths())
+        plotted[f"title_{key}"] = np.array(ax.get_title())
+
+
+results.save_figure = save_figure
 base = vm("VmSize")
 resource.setrlimit(resource.RLIMIT_AS, (base + headroom, base + headroom))
 try:
     rc = plot_results.main([path, "--out", out])
     rc_time = plot_results.main([path, "--out", os.path.join(out, "t1"), "--time", sys.argv[5]])
-    res = particles.load_dem(path)
-    plotted = {}
-    for k in (0, 1, res.time.size - 1):
-        ax = particles.plot_configuration(res, k).axes[0]
-        disks = next(c for c in ax.collections if isinstance(c, EllipseCollection))
-        forces = next(c for c in ax.collections
-                      if isinstance(c, LineCollection) and c.get_capstyle() == "round")
-        plotted[f"offsets{k}"] = disks.get_offsets()
-        plotted[f"segments{k}"] = np.array(forces.get_segments())
-        plotted[f"widths{k}"] = np.asarray(forces.get_linewidths())
-        plotted[f"title{k}"] = np.array(ax.get_title())
     np.savez(os.path.join(out, "plotted.npz"), **plotted)
 except MemoryError:
     print(json.dumps({"error": "MemoryError"}))
@@ -104,27 +119,30 @@ def test_plots_of_a_large_file_stay_within_a_memory_limit(tmp_path):
         assert (out / f"large_{name}.png").stat().st_size > 0
     assert (out / "t1" / "large_particles.png").stat().st_size > 0
     plotted = np.load(out / "plotted.npz")
-    # the values drawn, from the slices the figures need, read directly
+    assert sorted(plotted.files) == sorted(f"{name}_{key}" for key in ("start", "t1", "last")
+                                           for name in ("offsets", "segments", "widths", "title"))
+    # the values drawn in the configurations saved, from the slices the figures need, read
+    # directly
     with h5py.File(path, "r") as f:
         offset = f["dem/contacts/offset"][...]
         run_max = float(np.max(np.abs(f["dem/contacts/rn"][...])))
-        for k in (0, 1, N_OUT - 1):
+        for k, key in ((0, "start"), (1, "t1"), (N_OUT - 1, "last")):
             pos = f["dem/position"][k]
             s = slice(int(offset[k]), int(offset[k + 1]))
             i, j, rn = f["dem/contacts/i"][s], f["dem/contacts/j"][s], f["dem/contacts/rn"][s]
-            assert np.array_equal(plotted[f"offsets{k}"], pos[:, :2])
+            assert np.array_equal(plotted[f"offsets_{key}"], pos[:, :2])
             carrying = np.abs(rn) > NOISE * run_max
             # the round-off cut depends on the force at output N_OUT // 2: some drawn, some not
             assert 0 < np.count_nonzero(carrying) < rn.size
             segments = np.stack([pos[i[carrying] - 1, :2], pos[j[carrying] - 1, :2]], axis=1)
-            assert np.array_equal(plotted[f"segments{k}"], segments)
+            assert np.array_equal(plotted[f"segments_{key}"], segments)
             # widths proportional to |r_n|: ratios of stored values, to round-off (1e-12)
-            widths = plotted[f"widths{k}"]
+            widths = plotted[f"widths_{key}"]
             np.testing.assert_allclose(widths / widths.max(),
                                        np.abs(rn[carrying]) / np.abs(rn[carrying]).max(),
                                        rtol=1e-12)
             assert (f"{rn.size} contacts ({np.count_nonzero(carrying)} carrying a force)"
-                    in str(plotted[f"title{k}"]))
+                    in str(plotted[f"title_{key}"]))
 
 
 def _series_file(path, finished=True):
