@@ -37,13 +37,14 @@ T_LAST = H * STEPS_PER_OUT * (N_OUT - 1)
 
 def mark_killed(path, analysis="dynamic"):
     """Give a results file the root attributes and /summary of a killed run's partial file
-    (as written by multicor at the file's creation)."""
+    (as written by multicor at the file's creation; the deck's title, kept when the file has
+    one, so that the figures of data another test plots are the same)."""
     with h5py.File(path, "a") as f:
         f.attrs["code_name"] = "MULTICOR"
         f.attrs["code_version"] = "0.1.0"
         f.attrs["analysis"] = analysis
         f.attrs["run_id"] = "2026-01-01T00:00:00+00:00 1"
-        f.attrs["title"] = ""
+        f.attrs["title"] = f.attrs.get("title", "")
         summary = f.require_group("summary")
         summary.attrs["finished"] = np.int32(0)
         summary.attrs["status"] = "running (or killed)"
