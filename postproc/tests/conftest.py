@@ -25,8 +25,9 @@ def cantilever_file(tmp_path):
 def drawing_only(monkeypatch):
     """Context manager for a test of what a plotting script says or returns: inside
     ``with drawing_only(*names) as skipped:``, the scripts draw and write only the figure
-    files named (none without a name); each other figure is built as without it but not
-    drawn, and the path it would have been written to is appended to ``skipped``.
+    files named (none without a name), inside ``with drawing_only(all_but=names)`` every
+    figure file but those named; each other figure is built as without it but not drawn, and
+    the path it would have been written to is appended to ``skipped``.
 
     Drawing a figure (constrained layout, then rendering and PNG encoding) costs about 0.3
     CPU-s: most of this suite's time. A test uses it only for figures that another test
@@ -38,12 +39,14 @@ def drawing_only(monkeypatch):
     from multicor_post import results
 
     @contextlib.contextmanager
-    def drawing(*names):
+    def drawing(*names, all_but=None):
+        assert not (names and all_but is not None)
         skipped = []
         draw = results.save_figure
 
         def save_figure(fig, path, dpi):
-            if os.path.basename(os.fspath(path)) in names:
+            name = os.path.basename(os.fspath(path))
+            if (name not in all_but) if all_but is not None else (name in names):
                 draw(fig, path, dpi)
             else:
                 skipped.append(os.fspath(path))

@@ -169,7 +169,10 @@ def test_a_solver_figure_without_steps_is_skipped_with_a_note(tmp_path, capsys, 
         names = [f"dem/solver/{n}" for n in f["dem/solver"]]
     mark_killed(empty_series(path, names))
     out = tmp_path / "png"
-    assert plot_results.main([str(path), "--out", str(out)]) == 0
+    # the other figures: those test_particles.py's test_cli_writes_the_particle_plots draws
+    # (the solver figure is drawn if saved, for the check below)
+    with drawing_only("column_solver.png"):
+        assert plot_results.main([str(path), "--out", str(out)]) == 0
     printed = capsys.readouterr()
     assert str(out / "column_particles.png") in printed.out.split()
     assert not (out / "column_solver.png").exists()
@@ -347,7 +350,7 @@ COUPLED_KINDS = {"beam": (write_coupled, lambda path: coupled.load_coupled(path)
 
 
 @pytest.mark.parametrize("kind", sorted(COUPLED_KINDS))
-def test_the_coupling_figure_without_steps_says_so(kind, tmp_path, capsys):
+def test_the_coupling_figure_without_steps_says_so(kind, tmp_path, capsys, drawing_only):
     # the per-step panels were drawn empty (curves of no point in the legend, axes around 0)
     # with nothing saying why
     write, load = COUPLED_KINDS[kind]
@@ -368,7 +371,11 @@ def test_the_coupling_figure_without_steps_says_so(kind, tmp_path, capsys):
     lo, hi = ax_r.get_xlim()
     assert (lo, hi) == ax_l.get_xlim() and lo <= 0.0 and hi >= T_LAST * 1e3
     out = tmp_path / "png"
-    assert plot_results.main([str(path), "--out", str(out)]) == 0
+    # the other figures of the same data: those test_coupled.py's
+    # test_plot_results_handles_a_coupled_file and test_coupling_figure.py's
+    # test_plot_results_writes_the_coupling_figure_of_a_continuum_run draw
+    with drawing_only("glued_coupling.png"):
+        assert plot_results.main([str(path), "--out", str(out)]) == 0
     printed = capsys.readouterr()
     assert str(out / "glued_coupling.png") in printed.out.split()
     assert ("plot_results.py: note: glued_coupling.png has no per-step curves: /coupling holds "
@@ -421,7 +428,7 @@ def extendible(path, names):
     return path
 
 
-def test_a_killed_file_is_read_up_to_its_count_of_whole_outputs(tmp_path, capsys):
+def test_a_killed_file_is_read_up_to_its_count_of_whole_outputs(tmp_path, capsys, drawing_only):
     # /summary@outputs counts the outputs a run flushed whole: a kill inside the flush of
     # the next one left /dem/position one record short (out of step) and the last record of
     # /dem/velocity zero (in step, but not written): both are left out, the figures drawn
@@ -440,7 +447,10 @@ def test_a_killed_file_is_read_up_to_its_count_of_whole_outputs(tmp_path, capsys
     res = particles.load_dem(path)
     assert res.time.size == N_OUT - 1 and res.position.shape[0] == N_OUT - 1
     assert np.array_equal(res.velocity, velocity[:N_OUT - 1])
-    assert plot_results.main([str(path), "--out", str(tmp_path / "png")]) == 0
+    # the first output and the solver statistics, which the cut leaves as they are:
+    # test_particles.py's test_cli_writes_the_particle_plots draws them
+    with drawing_only(all_but=("column_particles_start.png", "column_solver.png")):
+        assert plot_results.main([str(path), "--out", str(tmp_path / "png")]) == 0
     assert "error" not in capsys.readouterr().err
     # a finished file is read whole: the count does not cut it
     with h5py.File(path, "a") as f:
@@ -474,7 +484,8 @@ def killed_after(path, whole):
 
 
 @pytest.mark.parametrize("kind", ["continuum", "coupled continuum"])
-def test_a_killed_continuum_is_read_up_to_its_count_of_whole_outputs(kind, tmp_path, capsys):
+def test_a_killed_continuum_is_read_up_to_its_count_of_whole_outputs(kind, tmp_path, capsys,
+                                                                  drawing_only):
     # the continuum loader cut /continuum/time to /summary@outputs but not the series read
     # against it (displacement, stress, energy terms, /dem/position, /dem/walls/position):
     # "records of its last output are incomplete ... nothing to plot" for the partial file of
@@ -499,7 +510,11 @@ def test_a_killed_continuum_is_read_up_to_its_count_of_whole_outputs(kind, tmp_p
         diag = coupled.load_continuum_coupling(path)
         assert diag.time.size == n_out - 1 and diag.lam.shape[0] == n_out - 1
     out = tmp_path / "png"
-    assert plot_results.main([str(path), "--out", str(out)]) == 0
+    # the disks at t = 0 and the solver statistics of the coupled run, which the cut leaves as
+    # they are: test_coupling_figure.py's
+    # test_plot_results_writes_the_coupling_figure_of_a_continuum_run draws them
+    with drawing_only(all_but=("block_particles_start.png", "block_solver.png")):
+        assert plot_results.main([str(path), "--out", str(out)]) == 0
     printed = capsys.readouterr()
     assert "error" not in printed.err and str(out / "block_stress.png") in printed.out.split()
     assert str(out / "block_history.png") in printed.out.split()
@@ -579,7 +594,7 @@ FAILED_STATUS = ("failed at step 41, t = 4.10000000E-002 s: step 41 (t = 4.10000
                  "is at (4.081E+291, 4.000E-002) m, beyond the box the run can represent")
 
 
-def test_a_failed_runs_records_are_plotted_as_a_partial_file(tmp_path, capsys):
+def test_a_failed_runs_records_are_plotted_as_a_partial_file(tmp_path, capsys, drawing_only):
     # multicor keeps the outputs a time loop stored before a guard stopped it as
     # '<deck>.h5.failed' (finished = 0, its whole outputs counted, status naming the failure):
     # read as a partial file, up to that count, the figures named after the deck, with a note
@@ -594,7 +609,10 @@ def test_a_failed_runs_records_are_plotted_as_a_partial_file(tmp_path, capsys):
     res = particles.load_dem(path)
     assert res.time.size == N_OUT - 1 and np.array_equal(res.position, position[:N_OUT - 1])
     out = tmp_path / "png"
-    assert plot_results.main([str(path), "--out", str(out)]) == 0
+    # the figures of the same outputs that test_particles.py's test_cli_writes_the_particle_plots
+    # and test_a_killed_file_is_read_up_to_its_count_of_whole_outputs draw
+    with drawing_only():
+        assert plot_results.main([str(path), "--out", str(out)]) == 0
     printed = capsys.readouterr()
     names = [p.rsplit("/", 1)[-1] for p in printed.out.split()]
     assert names and all(n.startswith("column_") and n.endswith(".png") for n in names), names
