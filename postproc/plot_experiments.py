@@ -155,6 +155,12 @@ def main(argv=None):
         for name in CASES:
             path = os.path.join(args.results, name, f"{name}.h5")
             runs[name] = coupled.load_coupled(path)
+        # the tracked disks before any figure: a mistyped --track replaced the profiles and
+        # configurations of the folder before it was refused
+        for disk in args.track:
+            for r in (runs["bending_case1"], runs["bending_case2"]):
+                if not 1 <= disk <= r.n_disks:
+                    raise ResultsError(f"{r.path}: no disk {disk} (the run has disks 1..{r.n_disks})")
         make_out_dir(out)  # once the runs load: a mistyped --results creates no folder
         for name, r in runs.items():
             save(coupled.plot_profiles(r, args.time), out, f"{name}_profiles", written)

@@ -85,20 +85,21 @@ def test_plot_beam_says_what_a_checkpoint_is(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("disk", ["0", "-2", "10000"])
-def test_plot_experiments_refuses_a_tracked_disk_the_runs_do_not_have(disk, tmp_path, capsys,
-                                                                     drawing_only):
-    # --track 0 drew the last disk (index -1) under the title 'disk 0', with exit 0
+def test_plot_experiments_refuses_a_tracked_disk_the_runs_do_not_have(disk, tmp_path, capsys):
+    # --track 0 drew the last disk (index -1) under the title 'disk 0', with exit 0; then the
+    # refusal came after the profiles and configurations of the folder had been replaced
     for case in plot_experiments.CASES:
         (tmp_path / case).mkdir()
         write_coupled(tmp_path / case / f"{case}.h5", title=case)
-    # the profiles and configurations saved before the tracked disks are read: those
-    # test_coupled.py's test_plot_experiments_writes_png_pdf_and_summary draws of these files
-    with drawing_only() as skipped:
-        assert plot_experiments.main(["--results", str(tmp_path), "--track", disk]) == 1
+    earlier = tmp_path / "bending_case1_profiles.png"
+    earlier.write_bytes(b"figure of an earlier run")
+    before = sorted(tmp_path.rglob("*"))
+    assert plot_experiments.main(["--results", str(tmp_path), "--track", disk]) == 1
     err = capsys.readouterr().err
     assert f"no disk {disk} (the run has disks 1.." in err
-    assert not list(tmp_path.glob("history_*"))
-    assert not [p for p in skipped if os.path.basename(p).startswith("history_")]
+    # refused before any figure: nothing written, the earlier figure as it was
+    assert sorted(tmp_path.rglob("*")) == before
+    assert earlier.read_bytes() == b"figure of an earlier run"
 
 
 def test_plot_experiments_creates_no_folder_for_results_it_cannot_load(tmp_path, capsys):
@@ -115,7 +116,8 @@ def test_plot_experiments_output_folder_that_is_a_file(tmp_path, capsys):
     for case in plot_experiments.CASES:
         (tmp_path / case).mkdir()
         write_coupled(tmp_path / case / f"{case}.h5", title=case)
-    assert plot_experiments.main(["--results", str(tmp_path), "--out", str(blocker)]) == 1
+    # disks the synthetic runs have (5; the default 7 11 17 is refused before the folder)
+    assert plot_experiments.main(["--results", str(tmp_path), "--out", str(blocker), "--track", "2", "5"]) == 1
     assert f"the folder of the figures '{blocker}' is a file" in capsys.readouterr().err
 
 
