@@ -250,9 +250,22 @@ def compare_xdmf(name, continued, reference):
           continued.read_bytes() == reference.read_bytes(), str(continued))
 
 
-def start(exe, deck, folder):
-    return subprocess.Popen([str(exe), str(deck), "--output", str(folder)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+# [output] progress of the runs stopped by a signal or a kill once they report a step: a line at
+# every step (the value is the wall time between lines, below that of any step). Their output
+# is read through a pipe of 4 KiB (`start`): a run whose line of step k has been read cannot
+# get more than about 130 steps past k (4 KiB in the pipe and 8 KiB read ahead by Python hold
+# that many lines of about 95 bytes) before it waits for the pipe, which is read again only
+# after the signal is sent. So those runs are stopped before their end however late the
+# signal comes, with decks of only a few hundred steps more than the step awaited (at least
+# 240 here; they had thousands, 14 000 for the beam, for the signal to come in time).
+EVERY_STEP = 1e-9
+
+
+def start(exe, deck, folder, *args):
+    """Start a run whose progress lines are read with `wait_for_step` (through a 4 KiB pipe:
+    see EVERY_STEP)."""
+    return subprocess.Popen([str(exe), str(deck), "--output", str(folder), *map(str, args)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, pipesize=4096)
 
 
 def wait_for_step(proc, min_step, lines):
@@ -279,7 +292,7 @@ def stopped_after(exe, deck, folder, min_step, name):
 
 def by_signal(exe, deck_src, work, name, sig, end, min_step):
     """A signal stops the run after step min_step; the command printed continues it."""
-    deck = edit_deck(deck_src, work / f"{name}.dat", end=end, progress=0.02)
+    deck = edit_deck(deck_src, work / f"{name}.dat", end=end, progress=EVERY_STEP)
     ref = reference(exe, deck, work, name)
     folder = work / name
     proc = start(exe, deck, folder)
@@ -321,7 +334,7 @@ def by_kill_9(exe, deck_src, work, name, end, every, min_step, seconds=None):
     """kill -9 after periodic checkpoints (every `every` steps, or every `seconds` of wall
     time); restart from the last one."""
     extra = [f"checkpoint_seconds = {seconds!r}"] if seconds else [f"checkpoint_interval = {every}"]
-    deck = edit_deck(deck_src, work / f"{name}.dat", end=end, progress=0.02, extra_output=extra)
+    deck = edit_deck(deck_src, work / f"{name}.dat", end=end, progress=EVERY_STEP, extra_output=extra)
     ref = reference(exe, deck, work, name)
     folder = work / name
     proc = start(exe, deck, folder)
@@ -417,7 +430,7 @@ def two_decks_one_folder(exe, src, work):
     finished run of another deck: a warning (that run only loses the checkpoint that would
     extend it)."""
     folder = work / "two_decks"
-    beam = edit_deck(src / "input" / "cantilever.dat", work / "two_beam.dat", end=3.0, progress=0.02)
+    beam = edit_deck(src / "input" / "cantilever.dat", work / "two_beam.dat", end=0.3, progress=EVERY_STEP)
     other = src / "input" / "continuum_cantilever_dynamic.dat"
     stopped = stopped_after(exe, beam, folder, 1000, "two decks")
     if stopped is None:
@@ -745,7 +758,7 @@ def failed_runs_keep_state(exe, src, work):
     # (c) a long run stopped by SIGTERM, then a failing run of another deck of the same name (refused)
     # (fails at step 8), then a restart from a damaged copy of the checkpoint
     folder = work / "keep_partial"
-    long = small_beam(work / "keep_long" / "beam.dat", end=20, extra="progress = 0.02")
+    long = small_beam(work / "keep_long" / "beam.dat", end=20, extra=f"progress = {EVERY_STEP!r}")
     stopped = stopped_after(exe, long, folder, 200, "keep_partial")
     if stopped is None:
         return
@@ -774,7 +787,7 @@ def failed_runs_keep_state(exe, src, work):
     check("damaged checkpoint of a stopped run: refused, the partial file not written to",
           proc.returncode == 1 and "the checkpoint is damaged" in proc.stderr and state(folder) == before,
           proc.stderr.strip()[-300:])
-    proc = run(exe, *command.group(1).split(), "--end", 2.0)
+    proc = run(exe, *command.group(1).split(), "--end", 0.2)
     check("failing run after a stopped one: the printed command continues the run", proc.returncode == 0,
           proc.stderr.strip()[-300:])
     check("keep_partial: nothing set aside is left", not list(folder.glob("*.prev")), str(sorted(folder.iterdir())))
@@ -934,7 +947,7 @@ def set_aside_partial_files(exe, src, work):
     A static run killed after setting that file aside and writing its own partial file: the next
     run set its partial file aside over the '.prev' file and the checkpoint's results were gone;
     now the killed run's partial file is deleted and the printed command continues the run."""
-    deck = edit_deck(src / "input" / "cantilever.dat", work / "aside.dat", end=3.0, progress=0.02,
+    deck = edit_deck(src / "input" / "cantilever.dat", work / "aside.dat", end=0.2, progress=EVERY_STEP,
                      extra_output=["checkpoint_interval = 100"])
     ref = reference(exe, deck, work, "aside")
     folder = work / "aside"
@@ -1092,7 +1105,7 @@ def continuation_set_aside(exe, src, work):
     (the static run again) set it aside over the '.prev' file, and the checkpoint's results were
     gone. Now a file of the run with fewer records than the checkpoint does not count as its
     results: it is deleted, the '.prev' file gets its name back, the restart continues it."""
-    deck = edit_deck(src / "input" / "cantilever.dat", work / "cont.dat", end=3.0, progress=0.02,
+    deck = edit_deck(src / "input" / "cantilever.dat", work / "cont.dat", end=0.3, progress=EVERY_STEP,
                      extra_output=["checkpoint_interval = 100"])
     ref = reference(exe, deck, work, "cont")
     static = work / "cont_static" / "cont.dat"
@@ -1102,8 +1115,7 @@ def continuation_set_aside(exe, src, work):
     folder = work / "cont"
     proc = run(exe, deck, "--output", folder, "--quiet", "--end", 0.1)
     assert proc.returncode == 0, proc.stderr
-    proc = subprocess.Popen([str(exe), deck, "--output", folder, "--restart", folder / "checkpoint.h5"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = start(exe, deck, folder, "--restart", folder / "checkpoint.h5")
     # the progress line of step k comes after that step's checkpoint
     if not wait_for_step(proc, 900, []):
         check("cont: the continuation reached step 900", False, proc.communicate()[1][-300:])
@@ -1204,14 +1216,13 @@ def signal_with_end(exe, deck_src, work, name, end, t_stop, min_step):
     """A run given `--end t_stop` (before the deck's end), stopped by SIGTERM after min_step:
     the command printed repeats `--end` and continues to t_stop, not to the deck's end; the
     continued file equals the uninterrupted run to t_stop."""
-    deck = edit_deck(deck_src, work / f"{name}.dat", end=end, progress=0.02)
+    deck = edit_deck(deck_src, work / f"{name}.dat", end=end, progress=EVERY_STEP)
     folder = work / name
     ref_folder = work / f"ref_{name}"
     proc = run(exe, deck, "--output", ref_folder, "--quiet", "--end", t_stop)
     if proc.returncode != 0:
         raise SystemExit(f"reference run of {deck} failed: {proc.stdout}{proc.stderr}")
-    proc = subprocess.Popen([str(exe), str(deck), "--output", str(folder), "--end", str(t_stop)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = start(exe, deck, folder, "--end", t_stop)
     lines = []
     if not wait_for_step(proc, min_step, lines):
         check(f"{name}: run reached step {min_step}", False, proc.communicate()[1][-300:])
@@ -1326,7 +1337,7 @@ def earlier_results(exe, src, work):
             del c["results/records"]
             c["results/records"] = records[keep]
 
-    deck = edit_deck(src / "input" / "coupled2d_block.dat", work / "earlier.dat", end=0.01, progress=0.02,
+    deck = edit_deck(src / "input" / "coupled2d_block.dat", work / "earlier.dat", end=0.01, progress=EVERY_STEP,
                      extra_output=["checkpoint_interval = 20"])
     for kind in ("finished", "interrupted"):
         folder = work / f"earlier_{kind}"
@@ -1683,20 +1694,21 @@ def part_runs(exe, src, work, decks, beam):
 def part_signals(exe, src, work, decks, beam):
     """Runs stopped by a signal or by kill -9 after a periodic checkpoint: beam, particles,
     coupled, 2D continuum, continuum-disk coupled."""
-    by_signal(exe, src / "input" / "cantilever.dat", work, "beam_term", signal.SIGTERM, 3.0, 1000)
-    by_signal(exe, src / "input" / "incline.dat", work, "dem_usr1", signal.SIGUSR1, 20.0, 2000)
-    # Started with --end 2.4 s (the deck says 3.0 s): the printed command ends at 2.4 s too.
-    signal_with_end(exe, src / "input" / "cantilever.dat", work, "beam_term_end", 3.0, 2.4, 1000)
+    # each deck ends a few hundred steps after the step awaited (EVERY_STEP)
+    by_signal(exe, src / "input" / "cantilever.dat", work, "beam_term", signal.SIGTERM, 0.3, 1000)
+    by_signal(exe, src / "input" / "incline.dat", work, "dem_usr1", signal.SIGUSR1, 2.5, 2000)
+    # Started with --end 0.4 s (the deck says 0.5 s): the printed command ends at 0.4 s too.
+    signal_with_end(exe, src / "input" / "cantilever.dat", work, "beam_term_end", 0.5, 0.4, 1000)
     by_signal(exe, decks / "coupled_rigid_translation.dat", work, "coupled_term", signal.SIGTERM,
-              0.05, 1000)
-    by_kill_9(exe, src / "input" / "cantilever.dat", work, "beam_kill9", 3.0, 700, 2000)
+              0.015, 1000)
+    by_kill_9(exe, src / "input" / "cantilever.dat", work, "beam_kill9", 0.5, 700, 2000)
     # Every 0.05 s of wall time: several checkpoints before step 3000 (about 0.2 ms per step).
-    by_kill_9(exe, src / "input" / "incline.dat", work, "dem_kill9_wall", 20.0, 0, 3000,
+    by_kill_9(exe, src / "input" / "incline.dat", work, "dem_kill9_wall", 3.5, 0, 3000,
               seconds=0.05)
     by_signal(exe, src / "input" / "continuum_cantilever_dynamic.dat", work, "continuum_term",
-              signal.SIGTERM, 3.0, 1000)
-    by_kill_9(exe, src / "input" / "continuum_cantilever_dynamic.dat", work, "continuum_kill9", 3.0, 700, 2000)
-    by_signal(exe, decks / "coupled2d_pushed.dat", work, "coupled2d_usr1", signal.SIGUSR1, 2.0e-3, 60)
+              signal.SIGTERM, 1.0, 500)
+    by_kill_9(exe, src / "input" / "continuum_cantilever_dynamic.dat", work, "continuum_kill9", 0.8, 200, 500)
+    by_signal(exe, decks / "coupled2d_pushed.dat", work, "coupled2d_usr1", signal.SIGUSR1, 3.0e-3, 60)
 
 
 def part_files(exe, src, work, decks, beam):
