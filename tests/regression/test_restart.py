@@ -450,7 +450,8 @@ def two_decks_one_folder(exe, src, work):
     third = run(exe, *c.group(1).split()[1:])
     check("two decks: the printed command still continues the beam run", third.returncode == 0,
           (third.stdout + third.stderr)[-300:])
-    fourth = run(exe, other, "--output", folder, "--quiet")
+    # (50 of its 500 steps: the warning comes before the first)
+    fourth = run(exe, other, "--output", folder, "--quiet", "--end", 0.05)
     check("two decks: another deck into a finished run's folder: exit 0 with a warning",
           fourth.returncode == 0 and "the checkpoint of another deck's run (two_beam.h5)" in fourth.stdout,
           (fourth.stdout + fourth.stderr).strip()[-300:])
@@ -1478,7 +1479,10 @@ def killed_in_metadata_writes(exe, src, work):
     run, bitwise as the uninterrupted one (doc/output.md, restart)."""
     if not have_strace("killed_in_metadata_writes"):
         return
-    deck = src / "input" / "cantilever.dat"
+    # the beam of input/cantilever.dat to 0.2 s (1 000 steps, of its 2 500: the writes killed
+    # are those of a restart's first flush and of a run's end, whatever its length)
+    (work / "meta_deck").mkdir()
+    deck = edit_deck(src / "input" / "cantilever.dat", work / "meta_deck" / "cantilever.dat", end=0.2)
     env = dict(os.environ, OMP_NUM_THREADS="1")
     ref = work / "ref_meta_kill"
     proc = run(exe, deck, "--output", ref, "--quiet", env=env)
@@ -1496,11 +1500,12 @@ def killed_in_metadata_writes(exe, src, work):
                  (again.stdout + again.stderr).strip()[-300:]):
             compare(name, folder / "cantilever.h5", ref / "cantilever.h5")
 
-    # (a) stopped by SIGTERM in the time loop (at its 3000th pwrite: step 1141 of 2500), then
+    # (a) stopped by SIGTERM in the time loop (at its 1200th pwrite: step 391 of 1000), then
     # its restart killed in its first flush (pwrite 22 is the first of the metadata, 28 the
-    # superblock that ends it)
+    # superblock that ends it; the same writes as with the 2 500 steps of the deck, stopped
+    # at step 991)
     seed = work / "meta_seed"
-    proc = kill_at([deck, "--output", seed, "--quiet"], 3000, "SIGTERM")
+    proc = kill_at([deck, "--output", seed, "--quiet"], 1200, "SIGTERM")
     assert proc.returncode == 128 + 15, proc.stderr
     for when in (23, 25, 27):
         name = f"meta_restart_{when}"
