@@ -93,25 +93,33 @@ def three_steps(text):
 
 
 def non_finite_in(path):
-    """Names of datasets or attributes with a non-finite value in an HDF5 file."""
+    """Names of datasets or attributes with a non-finite value in an HDF5 file (every one of
+    a floating-point type). Through h5py's low-level calls: its Group, Dataset and attribute
+    objects took twice the time, a tenth of the test's CPU."""
     bad = []
 
-    def floats(value):
-        a = np.asarray(value)
-        return a.dtype.kind == "f" and not np.all(np.isfinite(a))
+    def attributes(oid, name):
+        for k in range(h5py.h5a.get_num_attrs(oid)):
+            aid = h5py.h5a.open(oid, index=k)
+            if aid.dtype.kind == "f" and aid.shape is not None:
+                value = np.empty(aid.shape, aid.dtype)
+                aid.read(value)
+                if not np.all(np.isfinite(value)):
+                    bad.append(f"{name}@{aid.name.decode()}")
 
-    def visit(name, obj):
-        for key, value in obj.attrs.items():
-            if floats(value):
-                bad.append(f"{name}@{key}")
-        if isinstance(obj, h5py.Dataset) and obj.dtype.kind == "f" and floats(obj[...]):
-            bad.append(name)
+    def visit(name):
+        oid = h5py.h5o.open(f.id, name)
+        attributes(oid, name.decode())
+        if isinstance(oid, h5py.h5d.DatasetID) and oid.dtype.kind == "f" and oid.shape is not None:
+            value = np.empty(oid.shape, oid.dtype)
+            if value.size:
+                oid.read(h5py.h5s.ALL, h5py.h5s.ALL, value)
+            if not np.all(np.isfinite(value)):
+                bad.append(name.decode())
 
     with h5py.File(path, "r") as f:
-        for key, value in f.attrs.items():
-            if floats(value):
-                bad.append(f"/@{key}")
-        f.visititems(visit)
+        attributes(f.id, "/")
+        h5py.h5o.visit(f.id, visit)
     return bad
 
 
