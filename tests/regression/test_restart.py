@@ -1712,9 +1712,10 @@ def part_signals(exe, src, work, decks, beam):
     # Every 0.05 s of wall time: several checkpoints before step 3000 (about 0.2 ms per step).
     by_kill_9(exe, src / "input" / "incline.dat", work, "dem_kill9_wall", 3.5, 0, 3000,
               seconds=0.05)
+    # (the continuum's steps cost 2 ms each in the Debug build: runs of 450 and 500 steps)
     by_signal(exe, src / "input" / "continuum_cantilever_dynamic.dat", work, "continuum_term",
-              signal.SIGTERM, 1.0, 500)
-    by_kill_9(exe, src / "input" / "continuum_cantilever_dynamic.dat", work, "continuum_kill9", 0.8, 200, 500)
+              signal.SIGTERM, 0.45, 200)
+    by_kill_9(exe, src / "input" / "continuum_cantilever_dynamic.dat", work, "continuum_kill9", 0.5, 100, 250)
     by_signal(exe, decks / "coupled2d_pushed.dat", work, "coupled2d_usr1", signal.SIGUSR1, 3.0e-3, 60)
 
 
