@@ -1343,7 +1343,8 @@ def earlier_results(exe, src, work):
     for kind in ("finished", "interrupted"):
         folder = work / f"earlier_{kind}"
         if kind == "finished":
-            first = run(exe, deck, "--quiet", "--output", folder, "--end", "2e-3").returncode
+            # (60 steps, as the interrupted run below)
+            first = run(exe, deck, "--quiet", "--output", folder, "--end", "6e-4").returncode
             results = folder / "earlier.h5"
         else:
             stopped = stopped_after(exe, deck, folder, 60, "earlier_interrupted")
