@@ -84,12 +84,13 @@ def wait_idle(cluster, timeout):
     while time.monotonic() - t0 < timeout:
         if not cluster.query(["squeue", "-h", "-o", "%i"]).strip():
             return True
-        time.sleep(0.5)
+        time.sleep(0.2)
     return False
 
 
-def on_slurm(src, exe, work):
-    cluster = LocalSlurm(work / "cluster")
+def submit_on_slurm(src, exe, work, cluster):
+    """Start the cluster and submit the sweep and scripts/multicor.slurm; None, or why the
+    Slurm part cannot run here. The jobs run while the local sweep does (main)."""
     reason = cluster.unavailable()
     if reason:
         return reason
@@ -105,22 +106,29 @@ def on_slurm(src, exe, work):
         cluster.start()
     except ClusterError as e:
         return f"the Slurm daemons did not start: {e}"
+    print(f"cluster up in {time.monotonic() - t0:.1f} s ({cluster.dir})")
+    proc = sweep_tool(src, ["submit", folder], env=cluster.env)
+    print(proc.stdout.strip())
+    env = dict(cluster.env, MULTICOR_EXE=str(exe))
+    proc = subprocess.run(["sbatch", "--parsable", "--time=5", f"--output={work / 'single.out'}",
+                           str(src / "scripts" / "multicor.slurm"),
+                           str(src / "input" / "incline.dat"), str(work / "single")],
+                          capture_output=True, text=True, env=env, cwd=src)
+    check("scripts/multicor.slurm submitted", proc.returncode == 0, proc.stderr.strip())
+    # (a task may have ended already: the logs and the table are checked below)
+    print(cluster.query(["squeue", "-h", "-r", "-o", "%i %j %T"]).strip())
+    return None
+
+
+def on_slurm(src, exe, work, cluster, t0):
+    """The end of the jobs submitted by submit_on_slurm, then the other Slurm checks; the
+    Slurm table's rows (t0: the test's start, monotonic)."""
+    folder = work / "slurm sweep"
+    single = work / "single"
+    env = dict(cluster.env, MULTICOR_EXE=str(exe))
     try:
-        print(f"cluster up in {time.monotonic() - t0:.1f} s ({cluster.dir})")
-        t1 = time.monotonic()
-        proc = sweep_tool(src, ["submit", folder], env=cluster.env)
-        print(proc.stdout.strip())
-        single = work / "single"
-        env = dict(cluster.env, MULTICOR_EXE=str(exe))
-        proc = subprocess.run(["sbatch", "--parsable", "--time=5", f"--output={work / 'single.out'}",
-                               str(src / "scripts" / "multicor.slurm"),
-                               str(src / "input" / "incline.dat"), str(single)],
-                              capture_output=True, text=True, env=env, cwd=src)
-        check("scripts/multicor.slurm submitted", proc.returncode == 0, proc.stderr.strip())
-        # (a task may have ended already: the logs and the table are checked below)
-        print(cluster.query(["squeue", "-h", "-r", "-o", "%i %j %T"]).strip())
         done = wait_idle(cluster, 120)
-        print(f"array and collect job done in {time.monotonic() - t1:.1f} s")
+        print(f"array and collect job done {time.monotonic() - t0:.1f} s after the test's start")
         check("all jobs ended within 120 s", done, cluster.query(["squeue"]))
         # The same job submitted again once the run finished (its final checkpoint is in the
         # folder): a fresh run, not a restart with nothing to do (exit 1).
@@ -274,7 +282,8 @@ def locally(src, exe, work):
     print(f"local run -j 2: {time.monotonic() - t0:.1f} s")
     rows = read_table(folder / "results.csv")
     check_table("local", rows)
-    again = sweep_tool(src, ["run", folder, "-j", "2"])
+    # (--no-collect: the table is the first run's; the points it would run are decided before)
+    again = sweep_tool(src, ["run", folder, "-j", "2", "--no-collect"])
     check("a second local run has nothing to do", "4 points finished before, 0 to run"
           in again.stdout, again.stdout.strip().splitlines()[0])
     return rows
@@ -309,8 +318,15 @@ def empty_lock(src, exe, work, cluster):
 def main():
     exe, work, src = arguments(fresh=True)
     t0 = time.monotonic()
-    local_rows = locally(src, exe, work)
-    slurm_rows = on_slurm(src, exe, work)
+    cluster = LocalSlurm(work / "cluster")
+    try:
+        reason = submit_on_slurm(src, exe, work, cluster)
+        # the local sweep runs while Slurm starts its jobs (its scheduler's first pass comes
+        # about 3 s after slurmctld starts) and runs them
+        local_rows = locally(src, exe, work)
+        slurm_rows = reason if reason else on_slurm(src, exe, work, cluster, t0)
+    finally:
+        cluster.stop()
     if isinstance(slurm_rows, list):
         same = [(a["point"], a["v2x"], b["v2x"]) for a, b in zip(local_rows, slurm_rows)
                 if a["v2x"] != b["v2x"]]
