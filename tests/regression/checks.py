@@ -99,6 +99,58 @@ def plots(src, h5, out, names):
           f"exit {proc.returncode}, stderr {proc.stderr.strip()[-300:]!r}, printed {printed}")
 
 
+# One Python process running postproc/plot_results.py's command line (its __main__) on several
+# files in turn: argv[1] the script, argv[2] a JSON list of argument lists; prints a JSON list
+# of [exit code, stdout, stderr] per file (an exception: code 1, its traceback on stderr).
+_PLOTS_DRIVER = """import contextlib, io, json, runpy, sys, traceback
+script, runs, results = sys.argv[1], json.loads(sys.argv[2]), []
+for args in runs:
+    out, err, code = io.StringIO(), io.StringIO(), 0
+    sys.argv = [script] + args
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            runpy.run_path(script, run_name="__main__")
+        except SystemExit as e:
+            code = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
+        except Exception:
+            code = 1
+            traceback.print_exc()
+    results.append([code, out.getvalue(), err.getvalue()])
+print(json.dumps(results))
+"""
+
+
+def plots_together(src, runs):
+    """`plots` on several results files, `runs` a list of (h5, out, names), in ONE Python process
+    (with warnings as errors), which runs plot_results.py's command line on each in turn: the
+    interpreter and matplotlib start once (about 1 s of CPU each time). Each file's check is
+    that of `plots` (exit code 0, nothing on its stderr, the PNG files printed in order), and
+    the process itself must exit 0 with nothing on its stderr (what the libraries write
+    there). Use `plots` for at least one file: the true command line, a process of its own."""
+    import json
+    import sys
+    script = src / "postproc" / "plot_results.py"
+    args = [[str(h5), "--out", str(out)] for h5, out, _ in runs]
+    proc = subprocess.run([sys.executable, "-W", "error", "-c", _PLOTS_DRIVER, str(script), json.dumps(args)],
+                          capture_output=True, text=True)
+    try:
+        results = json.loads(proc.stdout)
+    except ValueError:
+        results = []
+    if len(results) != len(runs):
+        results = [[None, "", ""]] * len(runs)
+    for (h5, out, names), (code, stdout, stderr) in zip(runs, results):
+        out = pathlib.Path(out)
+        stem = pathlib.Path(h5).stem
+        expected = [str(out / f"{stem}_{n}.png") for n in names]
+        printed = stdout.split()
+        check(f"plot_results.py on {pathlib.Path(h5).name} (one process with others)",
+              proc.returncode == 0 and not proc.stderr and code == 0 and not stderr and printed == expected
+              and all(pathlib.Path(p).stat().st_size > 0 for p in printed),
+              f"exit {code}, stderr {stderr.strip()[-300:]!r}, printed {printed}; the process: exit "
+              f"{proc.returncode}, stderr {proc.stderr.strip()[-300:]!r}")
+
+
 def with_solver_lines(deck, dst, lines):
     """Write to `dst` the deck `deck` with `lines` added at the top of its [solver] section
     (which it must have); returns `dst`."""
