@@ -244,7 +244,7 @@ wall = 0.2 0 0.2 1
 law = 1 1 0.5 0 0
 [time]
 step = 1e-3
-end = 0.2
+end = 0.05
 [solver]
 max_sweeps = 2
 tolerance = 1e-12
@@ -252,7 +252,10 @@ tolerance = 1e-12
 
 
 def bond_free(exe, work):
-    """A stack without bonds, every step unconverged: method = block is method = nlgs, bit for bit."""
+    """A stack without bonds, every step unconverged: method = block is method = nlgs, bit for bit.
+    50 steps (the audit's deck ran 200): the guard that judged an empty block gave it up at
+    step 16 (checked with that guard put back: the results differ and step 16 is marked at 30
+    and 50 steps as at 200)."""
     results = {}
     for method in ("block", "nlgs"):
         deck = work / f"bond_free_{method}.dat"
@@ -266,7 +269,7 @@ def bond_free(exe, work):
         results[method] = datasets(out / f"{deck.stem}.h5", "dem"), proc.stdout
     (block, said), (nlgs, _) = results["block"], results["nlgs"]
     check("bond-free stack: no bond, every step unconverged (the guard's path with an empty block)",
-          block["bonds/i"].size == 0 and block["solver/converged"].size == 200 and not block["solver/converged"].any(),
+          block["bonds/i"].size == 0 and block["solver/converged"].size == 50 and not block["solver/converged"].any(),
           f"bonds {block['bonds/i'].size}, converged steps {int(block['solver/converged'].sum())}")
     # bit for bit: the same sweeps from the same warm start in the same order
     differ = sorted(name for name in nlgs if name not in block or not np.array_equal(block[name], nlgs[name]))
