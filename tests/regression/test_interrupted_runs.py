@@ -175,11 +175,14 @@ def kill_9(exe, src, work):
     deck_with_end(deck_src, deck, 1000.0, progress=0.02)
     partial = folder / "long_beam.h5.partial"
     counts, failures = [], []
-    for i, extra in enumerate([0.0, 0.05, 0.13, 0.21, 0.34, 0.55]):
+    for i, extra in enumerate([0.0, 0.011, 0.027, 0.043, 0.069, 0.113]):
         partial.unlink(missing_ok=True)
         proc = start(exe, deck, folder)
         # Past step 100 (20 outputs); then a varying extra delay so that the kill falls at
-        # different moments of the write/flush cycle.
+        # different moments of the write/flush cycle: an output every 5 steps, about 1.2 ms
+        # (0.24 ms a step, Debug and Release alike: the writes dominate), and the delays, 11
+        # to 113 ms (the run computes through them: they were 50 to 550 ms, 1.3 s of its
+        # CPU), differ by several cycles and are no multiples of one.
         if not wait_for_step(proc, 100, []):
             check("kill -9: run reached a few outputs", False, proc.communicate()[1][-300:])
             return
@@ -220,7 +223,8 @@ def kill_9_loop(exe, src, work, deck_name, label, min_step=300):
     deck = deck_with_end(deck_src, work / f"{stem}.dat", 1000.0, progress=0.02)
     partial = folder / f"{stem}.h5.partial"
     counts, failures, short = [], [], []
-    for i, extra in enumerate([0.0, 0.07, 0.19]):
+    # (delays as in kill_9: more than an output's cycle apart, 10 steps here)
+    for i, extra in enumerate([0.0, 0.017, 0.041]):
         partial.unlink(missing_ok=True)
         proc = start(exe, deck, folder)
         # Past step min_step (outputs every 10 steps, and the initial state).
