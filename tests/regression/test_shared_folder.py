@@ -38,6 +38,11 @@ step = 1e-3
 end = 0.01
 """
 
+# The runs stopped or killed mid-way: 10 000 steps, which the test stops at their start, an
+# output every 1 000 (at every step, the default, the 2 000 steps they had took 2.5 s of CPU in
+# the Debug build and their continuations as much; now 0.5 s each)
+LONG_PARTICLES = PARTICLES.replace("end = 0.01", "end = 10.0") + "[output]\ninterval = 1000\n"
+
 BEAM = """[beam]
 section = 1 2.1e11 7800 2.0e-4 1.6666666666666667e-9
 line = 1 0 0 1 0 10 1
@@ -111,7 +116,7 @@ def after_interrupted_run(exe, work):
     partial file, and the particle run is continued to its end from them."""
     folder = work / "interrupted"
     deck = work / "long_disks.dat"
-    deck.write_text(PARTICLES.replace("end = 0.01", "end = 2.0"))
+    deck.write_text(LONG_PARTICLES)
     partial = folder / "long_disks.h5.partial"
     proc = subprocess.Popen([str(exe), str(deck), "--output", str(folder), "--quiet"], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
@@ -136,7 +141,7 @@ def after_interrupted_run(exe, work):
     if run.returncode == 0 and (folder / "long_disks.h5").exists():
         with h5py.File(folder / "long_disks.h5", "r") as f:
             steps = int(f["summary"].attrs["steps"])
-    check("the interrupted particle run is continued to its end (2000 steps)", steps == 2000,
+    check("the interrupted particle run is continued to its end (10 000 steps)", steps == 10000,
           f"exit {run.returncode}, steps {steps}, {run.stderr.strip()[-300:]!r}")
 
 
@@ -172,8 +177,7 @@ def same_file_name(exe, work):
     base = work / "same_name"
     for case, mu in (("c1", "0.5"), ("c2", "0.4")):
         (base / case).mkdir(parents=True)
-        (base / case / "deck.dat").write_text(PARTICLES.replace("end = 0.01", "end = 2.0")
-                                              .replace("1 1 0.5 0 0", f"1 1 {mu} 0 0"))
+        (base / case / "deck.dat").write_text(LONG_PARTICLES.replace("1 1 0.5 0 0", f"1 1 {mu} 0 0"))
     folder = pathlib.Path("results") / "deck"
     code, out = stop_by_sigterm(exe, pathlib.Path("c1") / "deck.dat", folder, base)
     c = re.search(r"^to continue: (multicor .*)$", out, flags=re.M)
@@ -213,7 +217,7 @@ def same_file_name(exe, work):
 
     # kill -9 after a periodic checkpoint: the run can be continued, so refused the same way
     deck = work / "killed.dat"
-    deck.write_text(PARTICLES.replace("end = 0.01", "end = 2.0") + "[output]\ncheckpoint_interval = 20\n")
+    deck.write_text(LONG_PARTICLES + "checkpoint_interval = 20\n")
     folder = work / "killed"
     proc = subprocess.Popen([str(exe), str(deck), "--output", str(folder), "--quiet"], stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL)
