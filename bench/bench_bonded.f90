@@ -20,8 +20,25 @@
 !>      <build>/bench/bench_bonded [deck [nlgs_steps]]   (--help or -h: the usage, nothing run)
 !> A deck that does not exist, or that does not read, stops the program with a message and exit
 !> code 1 before anything is timed; a malformed command line with the usage and exit code 2.
+!> The set-up's announcements (a module procedure: an internal one passed as an argument needs
+!> a trampoline at -O0).
+module bench_bonded_report
+    use, intrinsic :: iso_fortran_env, only: output_unit
+    implicit none
+    private
+    public :: report_line
+contains
+    !> Lines the set-up announces (a long one), printed as they come.
+    subroutine report_line(line)
+        !> The line.
+        character(len=*), intent(in) :: line
+        write (output_unit, '(a)') line
+    end subroutine report_line
+end module bench_bonded_report
+
 program bench_bonded
     use, intrinsic :: iso_fortran_env, only: output_unit, error_unit, compiler_version
+    use bench_bonded_report, only: report_line
     use core_kinds, only: wp, i8
     use core_error, only: error_t
     use io_deck_schema, only: multicor_schema
@@ -217,13 +234,6 @@ contains
         write (error_unit, '(a)') 'bench_bonded: '//message
         stop 1, quiet = .true.
     end subroutine fail
-
-    !> Lines the set-up announces (a long one), printed as they come.
-    subroutine report_line(line)
-        !> The line.
-        character(len=*), intent(in) :: line
-        write (output_unit, '(a)') line
-    end subroutine report_line
 
     !> Name of a method.
     pure function name(method) result(s)
