@@ -21,18 +21,24 @@ configure_and_build build-debug Debug
 
 status=0
 # The Python tests run on one core while the CTest suites run beside them: pytest alone left
-# a core idle for about 100 s of a 12-minute run. Their output is printed when they end.
+# a core idle for about 100 s of a 12-minute run. Their output is printed at the end. The
+# Release phase starts when the Debug suites end, whether pytest has ended or not (it uses no
+# build): waiting for it first would leave a core idle whenever it outlasts them.
 say "Python tests (postproc) and CTest suites, side by side"
 pytest_log=build-debug/pytest.log
 .venv/bin/python -m pytest -q postproc/tests >"$pytest_log" 2>&1 &
 pytest_pid=$!
 ctest --test-dir build-debug --output-on-failure -j "$(nproc)" -LE long || status=1
+say "Long suites, malformed decks and the inlined sweep on the Release build (build/)"
+# in a subshell: a failed build stops this phase (its log is printed), not the wait for pytest
+if (MULTICOR_BUILD_TARGET="multicor long_tests bench" configure_and_build build Release); then
+    ctest --test-dir build --output-on-failure -j "$(nproc)" -L 'baddeck|long|build' || status=1
+else
+    status=1
+fi
 pytest_status=0
 wait "$pytest_pid" || pytest_status=1
 say "Python tests (postproc)"
 cat "$pytest_log"
 [ $pytest_status -eq 0 ] || status=1
-say "Long suites, malformed decks and the inlined sweep on the Release build (build/)"
-MULTICOR_BUILD_TARGET="multicor long_tests bench" configure_and_build build Release
-ctest --test-dir build --output-on-failure -j "$(nproc)" -L 'baddeck|long|build' || status=1
 exit $status
