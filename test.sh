@@ -8,16 +8,16 @@
 # combination of the solver's settings on every particle deck), which run on the Release
 # build in build/ (the one run.sh uses), with the malformed-deck tests (label baddeck) again,
 # so that the messages do not depend on the build type, and the check that the Release sweep
-# inlines its local solver (label build). The Release build also compiles the
-# benchmark programs of bench/ (not part of `all`), so that a change of an interface they call
-# cannot leave them broken. Exit code is non-zero on any failure.
+# inlines its local solver (label build). The Debug build also compiles the benchmark programs
+# of bench/ (not part of `all`), so that a change of an interface they call cannot leave them
+# broken (tests/CMakeLists.txt, bench_bonded_command_line). Exit code is non-zero on any failure.
 set -uo pipefail
 source "$(cd "$(dirname "$0")" && pwd)/scripts/bootstrap.sh"
 cd "$MULTICOR_ROOT"
 
 ensure_system_deps
 ensure_venv
-configure_and_build build-debug Debug
+MULTICOR_BUILD_TARGET="all bench" configure_and_build build-debug Debug
 
 status=0
 # The Python tests run on one core while the CTest suites run beside them: pytest alone left
@@ -31,7 +31,7 @@ pytest_pid=$!
 ctest --test-dir build-debug --output-on-failure -j "$(nproc)" -LE long || status=1
 say "Long suites, malformed decks and the inlined sweep on the Release build (build/)"
 # in a subshell: a failed build stops this phase (its log is printed), not the wait for pytest
-if (MULTICOR_BUILD_TARGET="multicor long_tests bench" configure_and_build build Release); then
+if (MULTICOR_BUILD_TARGET="multicor long_tests" configure_and_build build Release); then
     ctest --test-dir build --output-on-failure -j "$(nproc)" -L 'baddeck|long|build' || status=1
 else
     status=1
